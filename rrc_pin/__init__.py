@@ -1,0 +1,1 @@
+"""rrc-pin: Pinocchio-backed resolved-rate control of robot arms."""

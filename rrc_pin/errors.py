@@ -1,0 +1,63 @@
+"""Exceptions of rrc_pin: one root, :class:`RrcPinError`.
+
+Bad input raises before any state changes, with a message naming the argument. Numerical
+trouble (singularities, infeasible QPs) is never an exception: the resolver falls back and
+reports which method answered.
+"""
+
+from __future__ import annotations
+
+from solvers.errors import InputError
+
+
+class RrcPinError(Exception):
+    """Root of every exception raised by :mod:`rrc_pin`."""
+
+
+class InvalidInput(RrcPinError, InputError):
+    """An argument has the wrong shape, a non-finite entry or an invalid value (a ValueError)."""
+
+
+class UnknownArm(RrcPinError, ValueError):
+    """A name that is neither a catalogue arm, an installed example-robot-data arm, nor a file.
+
+    Attributes:
+        name: The requested name.
+        available: Every name :func:`rrc_pin.load` accepts.
+    """
+
+    def __init__(self, name: str, available: list[str]) -> None:
+        self.name = name
+        self.available = available
+        super().__init__(
+            f"name_or_path: unknown arm {name!r} (not a file either); available: "
+            + ", ".join(available)
+        )
+
+
+class URDFError(RrcPinError, ValueError):
+    """A URDF file is missing, malformed, or describes a model this library refuses.
+
+    Attributes:
+        path: The file (or ``"<string>"``).
+        reason: The parser's or the library's message.
+    """
+
+    def __init__(self, path: str, reason: str) -> None:
+        self.path = path
+        self.reason = reason
+        super().__init__(f"URDF {path}: {reason}")
+
+
+class FrameNotFound(RrcPinError, ValueError):
+    """A frame name that the model does not have.
+
+    Attributes:
+        frame: The requested name.
+        frames: Names the model has.
+    """
+
+    def __init__(self, frame: str, frames: list[str]) -> None:
+        self.frame = frame
+        self.frames = frames
+        super().__init__(f"tool_frame: no frame {frame!r}; frames: {', '.join(frames)}")

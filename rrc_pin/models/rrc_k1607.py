@@ -1,0 +1,63 @@
+"""The 7-DOF redundant Robotics Research Corporation K-1607 (Nguyen & Zhou, NAG 5-1124, 1990).
+
+Craig's modified DH (Nguyen eq. (2)), Table 1 in inches converted here. Tool frame: frame 7's
+origin. q = 0 is the home configuration of Nguyen's figure 2. Joint position and velocity
+limits are not in the report (assumed, K-1607 class).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rrc_pin.dh import DHChain, DHRow
+from rrc_pin.models.arm_spec import INCH, ArmSpec
+
+NAME = "rrc_k1607"
+# Nguyen Table 1: alpha_{i-1} [deg], a_{i-1} [in], d_i [in]
+TABLE_1 = (
+    (0.0, 0.000, 0.0),
+    (-90.0, 0.000, 0.0),
+    (90.0, 5.625, 27.0),
+    (-90.0, 4.250, 0.0),
+    (90.0, -4.250, 27.0),
+    (-90.0, 3.125, 0.0),
+    (90.0, -3.125, 0.0),
+)
+LIMITS_DEG = (170.0, 120.0, 170.0, 135.0, 170.0, 120.0, 170.0)  # assumed
+VELOCITY_LIMIT = (1.0, 1.0, 1.5, 1.5, 2.0, 2.0, 2.0)  # [rad/s], assumed
+EFFORT_LIMIT = (140.0, 140.0, 70.0, 70.0, 20.0, 20.0, 20.0)  # [N m], assumed
+
+
+def build(name: str = NAME) -> ArmSpec:
+    """The K-1607 of Nguyen Table 1, in SI units."""
+    rows = tuple(
+        DHRow(a=a_in * INCH, alpha=np.deg2rad(alpha_deg), d=d_in * INCH, theta=0.0)
+        for alpha_deg, a_in, d_in in TABLE_1
+    )
+    limits = np.deg2rad(LIMITS_DEG)
+
+    def closed_form() -> object:
+        from solvers.closed_form.rrc_k1607 import RrcK1607ClosedForm
+
+        return RrcK1607ClosedForm(
+            a=tuple(row.a for row in rows), d=tuple(row.d for row in rows)
+        )
+
+    return ArmSpec(
+        name=name,
+        chain=DHChain(convention="modified", rows=rows),
+        lower=tuple(-limits),
+        upper=tuple(limits),
+        velocity_limit=VELOCITY_LIMIT,
+        effort_limit=EFFORT_LIMIT,
+        source="Nguyen & Zhou, NASA NAG 5-1124 (1990), Table 1 (inches)",
+        assumed=(
+            "joint limits +-(170, 120, 170, 135, 170, 120, 170) deg",
+            "velocity limits (1, 1, 1.5, 1.5, 2, 2, 2) rad/s and efforts",
+        ),
+        named_poses={"home": (0.0,) * 7},
+        closed_form=closed_form,
+    )
+
+
+SPEC = build()

@@ -1,0 +1,1 @@
+"""Closed-form fast paths of the paper arms, one module per arm."""

@@ -1,0 +1,67 @@
+"""Reference-frame changes of twists and Jacobians (rows ordered [v; w]).
+
+Three frames, named as Pinocchio names them (DESIGN.md, "Conventions"):
+
+- ``world_aligned``: velocity of the tool-frame origin ``p``, in base-frame axes.
+- ``local``: the same velocity in tool-frame axes ``R``.
+- ``world``: spatial velocity at the base origin, base axes: ``v_0 = v_p - w x p``.
+"""
+
+from __future__ import annotations
+
+from typing import Literal
+
+import numpy as np
+import numpy.typing as npt
+
+from solvers.errors import InputError
+
+Reference = Literal["world_aligned", "local", "world"]
+REFERENCES: tuple[str, ...] = ("world_aligned", "local", "world")
+
+
+def check_reference(ref: str, error: type[InputError] = InputError) -> Reference:
+    """Return ``ref`` if it names one of :data:`REFERENCES`, else raise naming ``ref``."""
+    if ref not in REFERENCES:
+        raise error("ref", f"expected one of {', '.join(REFERENCES)}, got {ref!r}")
+    return ref  # type: ignore[return-value]
+
+
+def from_world_aligned(
+    M: npt.NDArray[np.float64],
+    rotation: npt.NDArray[np.float64],
+    position: npt.NDArray[np.float64],
+    ref: Reference,
+) -> npt.NDArray[np.float64]:
+    """Express twists or Jacobian columns given in ``world_aligned`` in frame ``ref``.
+
+    Args:
+        M: (6,) twist or (6, n) Jacobian, rows [v; w], ``world_aligned``.
+        rotation: (3, 3) tool orientation in the base frame.
+        position: (3,) tool-frame origin in the base frame [m].
+        ref: Target frame.
+
+    Returns:
+        Array of the shape of ``M`` in frame ``ref``.
+    """
+    if ref == "world_aligned":
+        return M
+    v, w = M[:3], M[3:]
+    if ref == "local":
+        return np.concatenate([rotation.T @ v, rotation.T @ w])
+    return np.concatenate([v - np.cross(w, position, axis=0), w])
+
+
+def to_world_aligned(
+    M: npt.NDArray[np.float64],
+    rotation: npt.NDArray[np.float64],
+    position: npt.NDArray[np.float64],
+    ref: Reference,
+) -> npt.NDArray[np.float64]:
+    """Inverse of :func:`from_world_aligned`: express ``M`` given in ``ref`` in ``world_aligned``."""
+    if ref == "world_aligned":
+        return M
+    v, w = M[:3], M[3:]
+    if ref == "local":
+        return np.concatenate([rotation @ v, rotation @ w])
+    return np.concatenate([v + np.cross(w, position, axis=0), w])
