@@ -1,0 +1,82 @@
+"""Command line: ``rrc-pin arms | demo | check | urdf --check|--write``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+from rrc_pin import models, urdf_export
+from rrc_pin.loading import INSTALLED, arms, load
+
+REPO_URDF_DIR = Path(__file__).resolve().parents[1] / "urdf"
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``rrc-pin`` console script; returns the exit code."""
+    parser = argparse.ArgumentParser(prog="rrc-pin", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+    sub.add_parser("arms", help="table of the arms rrc_pin.load accepts")
+    demo = sub.add_parser("demo", help="a short tour: kinematics and resolved-rate control")
+    demo.add_argument("--arm", default=None, help="one arm instead of the tour")
+    check = sub.add_parser("check", help="cross-check every catalogue arm: DH, Pinocchio, yourdfpy")
+    check.add_argument("--samples", type=int, default=200)
+    urdf = sub.add_parser("urdf", help="compare or rewrite the committed URDFs")
+    mode = urdf.add_mutually_exclusive_group(required=True)
+    mode.add_argument("--check", action="store_true", help="fail if a committed file differs")
+    mode.add_argument("--write", action="store_true", help="rewrite the committed files")
+    urdf.add_argument("--dir", type=Path, default=REPO_URDF_DIR, help="folder of the URDFs")
+    args = parser.parse_args(argv)
+
+    if args.command == "arms":
+        print(arms_table())
+        return 0
+    if args.command == "urdf":
+        return urdf_command(args.dir, write=args.write)
+    if args.command == "check":
+        from rrc_pin.cross_check import run_cross_check
+
+        return run_cross_check(samples=args.samples)
+    from rrc_pin.demo import run_demo
+
+    return run_demo(args.arm)
+
+
+def arms_table() -> str:
+    """Name, DOF, joint types, tool frame, source and assumed values of every arm."""
+    rows = [("name", "dof", "joints", "tool frame", "source", "assumed")]
+    for name in arms():
+        spec = models.CATALOGUE.get(name)
+        if spec is not None:
+            kinds = "".join(k[0].upper() for k in spec.joint_kinds)
+            rows.append((name, str(spec.nq), kinds, urdf_export.TOOL_FRAME, spec.source, "; ".join(spec.assumed)))
+        else:
+            robot = load(name)
+            kinds = "".join(robot.model.joints[j].shortname().removeprefix("JointModel")[0]
+                            for j in range(1, robot.model.njoints))
+            rows.append((name, str(robot.nq), kinds, robot.tool_frame,
+                         f"example-robot-data: {INSTALLED[name].path}", "-"))
+    widths = [max(len(r[i]) for r in rows) for i in range(5)]
+    return "\n".join(
+        "  ".join(cell.ljust(w) for cell, w in zip(r[:5], widths, strict=True)) + "  " + r[5]
+        for r in rows
+    )
+
+
+def urdf_command(directory: Path, *, write: bool) -> int:
+    """Rewrite (``write``) or check the committed URDFs of the catalogue; return the exit code."""
+    specs = list(models.CATALOGUE.values())
+    if write:
+        for path in urdf_export.write(directory, specs):
+            print(f"wrote {path}")
+        return 0
+    problems = urdf_export.check(directory, specs)
+    for problem in problems:
+        print(problem, file=sys.stderr)
+    print(f"{len(specs) - len(problems)}/{len(specs)} URDFs in {directory} match their DH tables")
+    return 1 if problems else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
