@@ -10,8 +10,6 @@ from pathlib import Path
 from rrc_pin import models, urdf_export
 from rrc_pin.loading import INSTALLED, arms, load
 
-REPO_URDF_DIR = Path(__file__).resolve().parents[1] / "urdf"
-
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rrc-pin`` console script; returns the exit code."""
@@ -26,7 +24,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     mode = urdf.add_mutually_exclusive_group(required=True)
     mode.add_argument("--check", action="store_true", help="fail if a committed file differs")
     mode.add_argument("--write", action="store_true", help="rewrite the committed files")
-    urdf.add_argument("--dir", type=Path, default=REPO_URDF_DIR, help="folder of the URDFs")
+    urdf.add_argument("--dir", type=Path, default=urdf_export.COMMITTED_DIR, help="folder of the URDFs")
     args = parser.parse_args(argv)
 
     if args.command == "arms":

@@ -28,6 +28,8 @@ from rrc_pin.models.arm_spec import ArmSpec
 LINK_RADIUS = 0.03  # [m], visual cylinders
 LINK_MASS = 1.0  # [kg], placeholder inertia for viewers and dynamics demos
 TOOL_FRAME = "tool"
+COMMITTED_DIR = Path(__file__).resolve().parents[1] / "urdf"
+"""The repository's ``urdf/`` folder (exists in a checkout or an editable install)."""
 
 
 def split_row(row: DHRow, convention: str) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
