@@ -24,7 +24,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     mode = urdf.add_mutually_exclusive_group(required=True)
     mode.add_argument("--check", action="store_true", help="fail if a committed file differs")
     mode.add_argument("--write", action="store_true", help="rewrite the committed files")
-    urdf.add_argument("--dir", type=Path, default=urdf_export.COMMITTED_DIR, help="folder of the URDFs")
+    urdf.add_argument(
+        "--dir", type=Path, default=urdf_export.COMMITTED_DIR, help="folder of the URDFs"
+    )
     args = parser.parse_args(argv)
 
     if args.command == "arms":
@@ -48,13 +50,32 @@ def arms_table() -> str:
         spec = models.CATALOGUE.get(name)
         if spec is not None:
             kinds = "".join(k[0].upper() for k in spec.joint_kinds)
-            rows.append((name, str(spec.nq), kinds, urdf_export.TOOL_FRAME, spec.source, "; ".join(spec.assumed)))
+            rows.append(
+                (
+                    name,
+                    str(spec.nq),
+                    kinds,
+                    urdf_export.TOOL_FRAME,
+                    spec.source,
+                    "; ".join(spec.assumed),
+                )
+            )
         else:
             robot = load(name)
-            kinds = "".join(robot.model.joints[j].shortname().removeprefix("JointModel")[0]
-                            for j in range(1, robot.model.njoints))
-            rows.append((name, str(robot.nq), kinds, robot.tool_frame,
-                         f"example-robot-data: {INSTALLED[name].path}", "-"))
+            kinds = "".join(
+                robot.model.joints[j].shortname().removeprefix("JointModel")[0]
+                for j in range(1, robot.model.njoints)
+            )
+            rows.append(
+                (
+                    name,
+                    str(robot.nq),
+                    kinds,
+                    robot.tool_frame,
+                    f"example-robot-data: {INSTALLED[name].path}",
+                    "-",
+                )
+            )
     widths = [max(len(r[i]) for r in rows) for i in range(5)]
     return "\n".join(
         "  ".join(cell.ljust(w) for cell, w in zip(r[:5], widths, strict=True)) + "  " + r[5]

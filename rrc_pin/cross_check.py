@@ -75,14 +75,18 @@ def finite_difference_jacobians(
         }
         for ref, (v, W) in twists.items():
             out[ref][:3, i] = v
-            out[ref][3:, i] = (W[2, 1] - W[1, 2]) / 2, (W[0, 2] - W[2, 0]) / 2, (W[1, 0] - W[0, 1]) / 2
+            out[ref][3:, i] = (
+                (W[2, 1] - W[1, 2]) / 2,
+                (W[0, 2] - W[2, 0]) / 2,
+                (W[1, 0] - W[0, 1]) / 2,
+            )
     return out
 
 
 def cross_check(
     spec: ArmSpec, samples: int, rng: np.random.Generator, urdf_path: Path | None = None
 ) -> CrossCheckReport:
-    """Compare Pinocchio (loaded from ``urdf_path``) with the DH chain, yourdfpy and finite differences.
+    """Compare Pinocchio (from ``urdf_path``) with the DH chain, yourdfpy and finite differences.
 
     Args:
         spec: The arm.
@@ -97,7 +101,9 @@ def cross_check(
             urdf_path = Path(tmp) / f"{spec.name}.urdf"
             urdf_path.write_text(to_urdf(spec))
         robot = load(urdf_path, tool_frame=TOOL_FRAME)
-        other = yourdfpy.URDF.load(str(urdf_path), load_meshes=False, build_collision_scene_graph=False)
+        other = yourdfpy.URDF.load(
+            str(urdf_path), load_meshes=False, build_collision_scene_graph=False
+        )
     report = CrossCheckReport(spec.name, samples)
     for _ in range(samples):
         q = robot.random_q(rng)
@@ -105,7 +111,8 @@ def cross_check(
         other.update_cfg(q)
         report.fk_dh = max(report.fk_dh, float(np.abs(T - spec.chain.fk(q)).max()))
         report.fk_yourdfpy = max(
-            report.fk_yourdfpy, float(np.abs(T - other.get_transform(TOOL_FRAME, "base_link")).max())
+            report.fk_yourdfpy,
+            float(np.abs(T - other.get_transform(TOOL_FRAME, "base_link")).max()),
         )
         fd = finite_difference_jacobians(robot, q)
         for ref in REFERENCES:

@@ -1,4 +1,4 @@
-"""Denavit-Hartenberg conventions of the source papers, and a chain product independent of Pinocchio.
+"""Denavit-Hartenberg conventions of the papers, and a chain product independent of Pinocchio.
 
 Three conventions, each a 4x4 link transform from frame i to frame i-1:
 
@@ -78,7 +78,9 @@ class DHRow:
 
     def __post_init__(self) -> None:
         if self.kind not in JOINT_KINDS:
-            raise InvalidInput("kind", f"expected one of {', '.join(JOINT_KINDS)}, got {self.kind!r}")
+            raise InvalidInput(
+                "kind", f"expected one of {', '.join(JOINT_KINDS)}, got {self.kind!r}"
+            )
         if self.kind != "screw" and self.pitch != 0.0:
             raise InvalidInput("pitch", f"only screw joints have a pitch, this is {self.kind}")
 
@@ -173,14 +175,18 @@ class DHChain:
         """Tool pose in the base frame, shape (4, 4)."""
         return self.frames(q)[-1] @ np.asarray(self.tool)
 
-    def joint_axes(self, q: npt.ArrayLike) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    def joint_axes(
+        self, q: npt.ArrayLike
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
         """Unit axis and a point on the axis of every joint, base frame: two (nq, 3) arrays."""
         F = self.frames(q)
         # standard/nadkarni: joint i moves about z_{i-1}; modified: about z_i.
         on_axis = F[1:] if self.convention == "modified" else F[:-1]
         return on_axis[:, :3, 2].copy(), on_axis[:, :3, 3].copy()
 
-    def jacobian(self, q: npt.ArrayLike, ref: Reference = "world_aligned") -> npt.NDArray[np.float64]:
+    def jacobian(
+        self, q: npt.ArrayLike, ref: Reference = "world_aligned"
+    ) -> npt.NDArray[np.float64]:
         """Geometric Jacobian of the tool frame by cross products (Nguyen eqs. (13)-(17)).
 
         Column i is ``[b_i x (p - o_i) + pitch_i b_i; b_i]`` for revolute and screw joints and
@@ -211,7 +217,9 @@ class DHChain:
         for frame_name, pose in self.extra_frames:
             if frame_name == name:
                 return np.asarray(pose)
-        raise InvalidInput("name", f"no extra frame {name!r}; have {[n for n, _ in self.extra_frames]}")
+        raise InvalidInput(
+            "name", f"no extra frame {name!r}; have {[n for n, _ in self.extra_frames]}"
+        )
 
 
 def _as_tuple(T: npt.ArrayLike) -> tuple[tuple[float, ...], ...]:

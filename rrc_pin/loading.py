@@ -14,7 +14,7 @@ from typing import Any
 import pinocchio as pin
 
 from rrc_pin import models
-from rrc_pin.errors import URDFError, UnknownArm
+from rrc_pin.errors import UnknownArm, URDFError
 from rrc_pin.models.arm_spec import ArmSpec
 from rrc_pin.robot import Robot
 from rrc_pin.urdf_export import TOOL_FRAME, to_urdf
@@ -38,14 +38,18 @@ class InstalledArm:
 _BAXTER = ("s0", "s1", "e0", "e1", "w0", "w1", "w2")
 INSTALLED: dict[str, InstalledArm] = {
     "panda": InstalledArm(
-        "panda_description/urdf/panda.urdf", "panda_hand_tcp", tuple(f"panda_joint{i}" for i in range(1, 8))
+        "panda_description/urdf/panda.urdf",
+        "panda_hand_tcp",
+        tuple(f"panda_joint{i}" for i in range(1, 8)),
     ),
     "ur3": InstalledArm("ur_description/urdf/ur3_robot.urdf", "tool0"),
     "ur5": InstalledArm("ur_description/urdf/ur5_robot.urdf", "tool0"),
     "ur10": InstalledArm("ur_description/urdf/ur10_robot.urdf", "tool0"),
     "kinova": InstalledArm("kinova_description/robots/kinova.urdf", "j2s6s200_end_effector"),
     "xarm7": InstalledArm("xarm_description/urdf/xarm7.urdf", "link_eef"),
-    "z1": InstalledArm("z1_description/urdf/z1.urdf", "gripperStator", tuple(f"joint{i}" for i in range(1, 7))),
+    "z1": InstalledArm(
+        "z1_description/urdf/z1.urdf", "gripperStator", tuple(f"joint{i}" for i in range(1, 7))
+    ),
     "so101": InstalledArm(
         "so_arm_description/urdf/so101.urdf",
         "gripper_frame_link",
@@ -82,11 +86,15 @@ def robots_directory() -> Path | None:
 def arms() -> list[str]:
     """Names :func:`load` accepts: the catalogue, then the installed example-robot-data arms."""
     folder = robots_directory()
-    installed = [n for n, a in INSTALLED.items() if folder is not None and (folder / a.path).is_file()]
+    installed = [
+        n for n, a in INSTALLED.items() if folder is not None and (folder / a.path).is_file()
+    ]
     return list(models.CATALOGUE) + installed
 
 
-def load(name_or_path: str | Path | ArmSpec, tool_frame: str | None = None, **parameters: Any) -> Robot:
+def load(
+    name_or_path: str | Path | ArmSpec, tool_frame: str | None = None, **parameters: Any
+) -> Robot:
     """Load an arm as a :class:`Robot`.
 
     Args:
@@ -109,7 +117,9 @@ def load(name_or_path: str | Path | ArmSpec, tool_frame: str | None = None, **pa
         spec = BUILDERS[key](**parameters) if parameters else models.CATALOGUE[key]
         return _from_spec(spec, tool_frame)
     if parameters:
-        raise URDFError(key, f"geometry parameters {sorted(parameters)} apply to catalogue arms only")
+        raise URDFError(
+            key, f"geometry parameters {sorted(parameters)} apply to catalogue arms only"
+        )
     if key in INSTALLED:
         return _from_installed(key, INSTALLED[key], tool_frame)
     path = Path(key)
@@ -126,7 +136,9 @@ def _from_spec(spec: ArmSpec, tool_frame: str | None) -> Robot:
 def _from_installed(name: str, arm: InstalledArm, tool_frame: str | None) -> Robot:
     folder = robots_directory()
     if folder is None or not (folder / arm.path).is_file():
-        raise URDFError(arm.path, "example-robot-data is not installed (pip install example-robot-data)")
+        raise URDFError(
+            arm.path, "example-robot-data is not installed (pip install example-robot-data)"
+        )
     model = _parse(folder / arm.path)
     if arm.keep:
         locked = [j for j in range(1, model.njoints) if model.names[j] not in arm.keep]

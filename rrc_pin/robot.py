@@ -163,7 +163,9 @@ class Robot:
         pin.forwardKinematics(self.model, self.data, self.to_pinocchio(q))
         return pin.updateFramePlacement(self.model, self.data, fid).homogeneous
 
-    def jacobian(self, q: npt.ArrayLike, ref: Reference = "world_aligned") -> npt.NDArray[np.float64]:
+    def jacobian(
+        self, q: npt.ArrayLike, ref: Reference = "world_aligned"
+    ) -> npt.NDArray[np.float64]:
         """Geometric Jacobian of the tool frame, (6, nq), rows [v; w].
 
         Args:
@@ -176,7 +178,9 @@ class Robot:
         """
         ref = check_reference(ref, InvalidInput)
         q_pin = self.to_pinocchio(q)
-        return pin.computeFrameJacobian(self.model, self.data, q_pin, self._frame_id, PIN_REFERENCE[ref])
+        return pin.computeFrameJacobian(
+            self.model, self.data, q_pin, self._frame_id, PIN_REFERENCE[ref]
+        )
 
 
 def frame_id(model: pin.Model, name: str) -> int:

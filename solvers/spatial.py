@@ -58,7 +58,7 @@ def to_world_aligned(
     position: npt.NDArray[np.float64],
     ref: Reference,
 ) -> npt.NDArray[np.float64]:
-    """Inverse of :func:`from_world_aligned`: express ``M`` given in ``ref`` in ``world_aligned``."""
+    """Inverse of :func:`from_world_aligned`: ``M`` from frame ``ref`` to ``world_aligned``."""
     if ref == "world_aligned":
         return M
     v, w = M[:3], M[3:]

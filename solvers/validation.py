@@ -46,7 +46,9 @@ def as_array(
         raise error(name, f"expected shape {_fmt(shape)}, got {arr.shape}")
     if not np.all(np.isfinite(arr)):
         bad = np.argwhere(~np.isfinite(arr))[0]
-        raise error(name, f"non-finite entry {arr[tuple(bad)]} at index {tuple(int(i) for i in bad)}")
+        raise error(
+            name, f"non-finite entry {arr[tuple(bad)]} at index {tuple(int(i) for i in bad)}"
+        )
     return arr
 
 
@@ -66,4 +68,9 @@ def positive(x: float, name: str, error: type[InputError] = InputError) -> float
 
 
 def _fmt(shape: tuple[int | None, ...]) -> str:
-    return "(" + ", ".join("N" if s is None else str(s) for s in shape) + ("," if len(shape) == 1 else "") + ")"
+    return (
+        "("
+        + ", ".join("N" if s is None else str(s) for s in shape)
+        + ("," if len(shape) == 1 else "")
+        + ")"
+    )

@@ -1,4 +1,4 @@
-"""Every paper arm: Pinocchio (committed URDF) == DH chain == yourdfpy; Jacobians == cross products == FD."""
+"""Paper arms: Pinocchio (committed URDF) == DH == yourdfpy; Jacobians == cross products == FD."""
 
 from __future__ import annotations
 
@@ -15,7 +15,9 @@ SAMPLES = 1000
 
 @pytest.mark.parametrize("name", list(CATALOGUE))
 def test_committed_urdf_agrees_with_dh_yourdfpy_and_finite_differences(name):
-    report = cross_check(CATALOGUE[name], SAMPLES, np.random.default_rng(7), COMMITTED_DIR / f"{name}.urdf")
+    report = cross_check(
+        CATALOGUE[name], SAMPLES, np.random.default_rng(7), COMMITTED_DIR / f"{name}.urdf"
+    )
     assert report.samples == SAMPLES
     assert report.fk_dh < 1e-9 and report.fk_yourdfpy < 1e-9, report
     for ref in ("world_aligned", "local", "world"):

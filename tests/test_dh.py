@@ -1,4 +1,4 @@
-"""DH conventions and the chain product (the project's second reference, independent of Pinocchio)."""
+"""DH conventions and the chain product (the second reference, independent of Pinocchio)."""
 
 from __future__ import annotations
 
@@ -59,7 +59,9 @@ def test_nadkarni_eq_2_5_equals_standard_matrix_eq_2_7(rng, kind):
         np.testing.assert_allclose(x_frame, link_transform(row, q, "standard"), atol=1e-14)
         # x*(i) sits on joint axis i (the z axis of x(i-1)) and its x axis is the normal a_i.
         np.testing.assert_allclose(x_star[:2, 3], 0.0, atol=1e-15)
-        np.testing.assert_allclose(x_frame[:3, 3] - x_star[:3, 3], row.a * x_star[:3, 0], atol=1e-14)
+        np.testing.assert_allclose(
+            x_frame[:3, 3] - x_star[:3, 3], row.a * x_star[:3, 0], atol=1e-14
+        )
 
 
 def test_joint_kinds_move_the_right_parameter():
@@ -72,9 +74,12 @@ def test_joint_kinds_move_the_right_parameter():
 @pytest.mark.parametrize("convention", ["standard", "modified", "nadkarni"])
 def test_cross_product_jacobian_matches_finite_differences(rng, convention):
     kinds = ["revolute", "prismatic", "screw", "revolute", "revolute", "prismatic"]
-    chain = DHChain(convention, tuple(random_row(rng, k) for k in kinds),
-                    base=tuple(map(tuple, rot_x(0.3) @ translation(0.1, 0.2, 0.3))),
-                    tool=tuple(map(tuple, rot_z(0.7) @ translation(0.0, 0.1, 0.05))))
+    chain = DHChain(
+        convention,
+        tuple(random_row(rng, k) for k in kinds),
+        base=tuple(map(tuple, rot_x(0.3) @ translation(0.1, 0.2, 0.3))),
+        tool=tuple(map(tuple, rot_z(0.7) @ translation(0.0, 0.1, 0.05))),
+    )
     h = 1e-6
     for _ in range(20):
         q = rng.uniform(-2, 2, chain.nq)
@@ -91,8 +96,12 @@ def test_cross_product_jacobian_matches_finite_differences(rng, convention):
 
 def test_frames_start_at_base_and_end_before_tool(rng):
     base = rot_z(0.5) @ translation(1, 2, 3)
-    chain = DHChain("standard", (random_row(rng), random_row(rng)),
-                    base=tuple(map(tuple, base)), tool=tuple(map(tuple, translation(z=0.2))))
+    chain = DHChain(
+        "standard",
+        (random_row(rng), random_row(rng)),
+        base=tuple(map(tuple, base)),
+        tool=tuple(map(tuple, translation(z=0.2))),
+    )
     q = rng.uniform(-1, 1, 2)
     F = chain.frames(q)
     np.testing.assert_allclose(F[0], base)

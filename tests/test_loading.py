@@ -10,8 +10,18 @@ from rrc_pin.errors import FrameNotFound, UnknownArm, URDFError
 from rrc_pin.loading import INSTALLED
 from rrc_pin.urdf_export import COMMITTED_DIR
 
-EXPECTED_DOF = {"panda": 7, "ur3": 6, "ur5": 6, "ur10": 6, "kinova": 6, "xarm7": 7, "z1": 6,
-                "so101": 5, "baxter_left": 7, "baxter_right": 7}
+EXPECTED_DOF = {
+    "panda": 7,
+    "ur3": 6,
+    "ur5": 6,
+    "ur10": 6,
+    "kinova": 6,
+    "xarm7": 7,
+    "z1": 6,
+    "so101": 5,
+    "baxter_left": 7,
+    "baxter_right": 7,
+}
 
 
 def test_arms_lists_catalogue_then_installed():

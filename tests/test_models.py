@@ -31,12 +31,16 @@ def test_catalogue_has_the_five_paper_arms_with_sources_and_assumptions():
 def test_barker_limits_and_offsets_are_the_papers():
     spec = CATALOGUE["barker6"]
     np.testing.assert_allclose(np.rad2deg(spec.upper), [160, 165, 135, 135, 105, 270])
-    np.testing.assert_allclose(np.rad2deg([r.theta for r in spec.chain.rows]), [180, 90, 90, 180, 180, 0])
-    # Appendix A, eq. (A1): A_0^1 = [[-C1, 0, -S1, 0], [-S1, 0, C1, 0], [0, 1, 0, NO], [0, 0, 0, 1]].
+    np.testing.assert_allclose(
+        np.rad2deg([r.theta for r in spec.chain.rows]), [180, 90, 90, 180, 180, 0]
+    )
+    # Barker eq. (A1): A_0^1 = [[-C1, 0, -S1, 0], [-S1, 0, C1, 0], [0, 1, 0, NO], [0, 0, 0, 1]].
     q1 = 0.3
     A1 = spec.chain.frames(np.r_[q1, np.zeros(5)])[1]
     c, s = np.cos(q1), np.sin(q1)
-    np.testing.assert_allclose(A1, [[-c, 0, -s, 0], [-s, 0, c, 0], [0, 1, 0, 0.6718], [0, 0, 0, 1]], atol=1e-15)
+    np.testing.assert_allclose(
+        A1, [[-c, 0, -s, 0], [-s, 0, c, 0], [0, 1, 0, 0.6718], [0, 0, 0, 1]], atol=1e-15
+    )
 
 
 def test_barker_variant_keeps_its_parameters_and_flange():
@@ -47,7 +51,9 @@ def test_barker_variant_keeps_its_parameters_and_flange():
     np.testing.assert_allclose(spec.chain.extra_frame("flange"), translation(z=0.0563))
     arm = rrc_pin.load(spec)
     q = arm.random_q(np.random.default_rng(1))
-    np.testing.assert_allclose(arm.frame_pose(q, "flange"), arm.fk(q) @ translation(z=0.0563), atol=1e-12)
+    np.testing.assert_allclose(
+        arm.frame_pose(q, "flange"), arm.fk(q) @ translation(z=0.0563), atol=1e-12
+    )
 
 
 def test_nguyen_table_1_is_converted_from_inches():
@@ -58,27 +64,53 @@ def test_nguyen_table_1_is_converted_from_inches():
 
 
 def test_exam_arm_at_rest_reaches_a1_plus_a2_plus_a3():
-    np.testing.assert_allclose(CATALOGUE["kr5_3r"].chain.fk(np.zeros(3))[:3, 3], [1.2, 0, 0], atol=1e-15)
+    np.testing.assert_allclose(
+        CATALOGUE["kr5_3r"].chain.fk(np.zeros(3))[:3, 3], [1.2, 0, 0], atol=1e-15
+    )
 
 
 # Nadkarni, Appendix II, Illustration 2 (Table A2-2): origins of x*(i), x(i), axes U(i) and the
 # feet rho_n(i) of the normals from the origin to the joint axes, in thesis units, as printed.
 ILLUSTRATION_2 = {
-    "X*": [("0.00", "0.00", "0.00"), ("0.00", "0.00", "0.00"), ("-11.95", "0.00", "2.488"),
-           ("-11.90", "0.241", "2.771"), ("-21.255", "0.241", "4.42"), ("-21.255", "0.241", "4.42"),
-           ("-24.315", "5.273", "4.059")],
-    "X": [("0.00", "0.00", "0.00"), ("0.065", "0.00", "0.369"), ("-11.90", "0.241", "2.771"),
-          ("-11.90", "0.241", "2.771"), ("-21.255", "0.241", "4.42"), ("-24.315", "5.273", "4.059"),
-          ("-24.833", "6.126", "3.998")],
-    "U": [("0.00", "0.00", "1.00"), ("0.00", "-1.00", "0.00"), ("-0.985", "0.00", "0.174"),
-          ("0.112", "-0.766", "0.633"), ("-0.985", "0.00", "0.174"), ("0.171", "0.174", "0.970"),
-          ("0.171", "0.174", "0.970")],
-    "rho": [("0.00", "0.00", "0.00"), ("0.00", "0.00", "0.00"), ("0.065", "0.00", "0.369"),
-            ("-11.927", "0.426", "2.618"), ("0.115", "0.241", "0.652"), ("-21.374", "0.121", "3.747"),
-            ("-24.433", "5.152", "3.386")],
+    "X*": [
+        ("0.00", "0.00", "0.00"),
+        ("0.00", "0.00", "0.00"),
+        ("-11.95", "0.00", "2.488"),
+        ("-11.90", "0.241", "2.771"),
+        ("-21.255", "0.241", "4.42"),
+        ("-21.255", "0.241", "4.42"),
+        ("-24.315", "5.273", "4.059"),
+    ],
+    "X": [
+        ("0.00", "0.00", "0.00"),
+        ("0.065", "0.00", "0.369"),
+        ("-11.90", "0.241", "2.771"),
+        ("-11.90", "0.241", "2.771"),
+        ("-21.255", "0.241", "4.42"),
+        ("-24.315", "5.273", "4.059"),
+        ("-24.833", "6.126", "3.998"),
+    ],
+    "U": [
+        ("0.00", "0.00", "1.00"),
+        ("0.00", "-1.00", "0.00"),
+        ("-0.985", "0.00", "0.174"),
+        ("0.112", "-0.766", "0.633"),
+        ("-0.985", "0.00", "0.174"),
+        ("0.171", "0.174", "0.970"),
+        ("0.171", "0.174", "0.970"),
+    ],
+    "rho": [
+        ("0.00", "0.00", "0.00"),
+        ("0.00", "0.00", "0.00"),
+        ("0.065", "0.00", "0.369"),
+        ("-11.927", "0.426", "2.618"),
+        ("0.115", "0.241", "0.652"),
+        ("-21.374", "0.121", "3.747"),
+        ("-24.433", "5.152", "3.386"),
+    ],
 }
 # rho_n(3) is printed [0.65 0.00 0.369]: a dropped zero (it equals X(2), which is printed 0.065;
-# docs/errata.md). The entry above is the corrected one; the test below proves the printed one wrong.
+# docs/errata.md). Above is the corrected entry; a test below proves the printed one wrong.
 
 
 def nadkarni_illustration_2_frames():
@@ -87,7 +119,7 @@ def nadkarni_illustration_2_frames():
     frames = spec.chain.frames(q0)
     star = [frames[i] @ nadkarni_link(row, q0[i])[0] for i, row in enumerate(spec.chain.rows)]
     star.append(spec.chain.fk(q0))  # the hand frame is x*(7)
-    x_frames = list(frames[1:]) + [star[-1] @ translation(x=1.0 * INCH)]  # a_7 = 1.00
+    x_frames = [*frames[1:], star[-1] @ translation(x=1.0 * INCH)]  # a_7 = 1.00
     return star, x_frames
 
 
@@ -114,14 +146,32 @@ def test_nadkarni_rho_n_3_as_printed_is_an_ocr_error():
     ("joints", "points"),
     [
         # Table A2-7 initial configuration; Illustrations 6 and 7 give the hand by three points.
-        (("0.000", "25.000", "8.000", "0.000", "90.000", "0.000"),
-         [("15.00", "-25.00", "12.00"), ("15.00", "-24.00", "12.00"), ("15.00", "-25.00", "11.00")]),
+        (
+            ("0.000", "25.000", "8.000", "0.000", "90.000", "0.000"),
+            [
+                ("15.00", "-25.00", "12.00"),
+                ("15.00", "-24.00", "12.00"),
+                ("15.00", "-25.00", "11.00"),
+            ],
+        ),
         # Table A2-9 final position (Illustration 5); target from Table A2-8, set two.
-        (("-15.000", "20.000", "0.000", "90.000", "90.000", "0.000"),
-         [("10.00", "-10.00", "20.00"), ("11.00", "-10.00", "20.00"), ("10.00", "-10.00", "19.00")]),
+        (
+            ("-15.000", "20.000", "0.000", "90.000", "90.000", "0.000"),
+            [
+                ("10.00", "-10.00", "20.00"),
+                ("11.00", "-10.00", "20.00"),
+                ("10.00", "-10.00", "19.00"),
+            ],
+        ),
         # Table A2-13 final position (Illustration 7), computed hand as printed.
-        (("-15.000", "20.010", "0.000", "90.000", "90.000", "0.000"),
-         [("10.00", "-10.01", "20.00"), ("11.00", "-10.01", "20.00"), ("10.00", "-10.01", "19.00")]),
+        (
+            ("-15.000", "20.010", "0.000", "90.000", "90.000", "0.000"),
+            [
+                ("10.00", "-10.01", "20.00"),
+                ("11.00", "-10.01", "20.00"),
+                ("10.00", "-10.01", "19.00"),
+            ],
+        ),
     ],
 )
 def test_nadkarni_configuration_2_hand_points(joints, points):
@@ -150,6 +200,16 @@ def test_frame_from_points_recovers_a_pose(rng):
 def test_spec_validation_names_the_field():
     spec = CATALOGUE["kr5_3r"]
     with pytest.raises(InvalidInput, match="^velocity_limit:"):
-        ArmSpec(spec.name, spec.chain, spec.lower, spec.upper, (1.0, 0.0, 1.0), spec.effort_limit, "x")
+        ArmSpec(
+            spec.name, spec.chain, spec.lower, spec.upper, (1.0, 0.0, 1.0), spec.effort_limit, "x"
+        )
     with pytest.raises(InvalidInput, match="^lower:"):
-        ArmSpec(spec.name, spec.chain, (0.0, 0.0), spec.upper, spec.velocity_limit, spec.effort_limit, "x")
+        ArmSpec(
+            spec.name,
+            spec.chain,
+            (0.0, 0.0),
+            spec.upper,
+            spec.velocity_limit,
+            spec.effort_limit,
+            "x",
+        )

@@ -34,7 +34,9 @@ def test_check_reports_a_tampered_file(tmp_path):
 
 def test_rpy_round_trip_including_gimbal_lock(rng):
     angles = [rng.uniform(-np.pi, np.pi, 3) for _ in range(500)]
-    angles += [np.array([r, s * np.pi / 2, y]) for r, y in rng.uniform(-3, 3, (20, 2)) for s in (1, -1)]
+    angles += [
+        np.array([r, s * np.pi / 2, y]) for r, y in rng.uniform(-3, 3, (20, 2)) for s in (1, -1)
+    ]
     for roll, pitch, yaw in angles:
         R = rpy_matrix(roll, pitch, yaw)
         np.testing.assert_allclose(rpy_matrix(*rpy_from_matrix(R)), R, atol=1e-12)
@@ -51,6 +53,8 @@ def test_urdf_has_limits_inertia_visuals_and_tool_frames():
 def test_screw_joints_are_refused():
     spec = CATALOGUE["kr5_3r"]
     rows = (DHRow(0.1, 0.0, 0.0, 0.0, kind="screw", pitch=0.01),)
-    screw = ArmSpec("screwy", DHChain("nadkarni", rows), (-1.0,), (1.0,), (1.0,), (1.0,), spec.source)
+    screw = ArmSpec(
+        "screwy", DHChain("nadkarni", rows), (-1.0,), (1.0,), (1.0,), (1.0,), spec.source
+    )
     with pytest.raises(InvalidInput, match="screw"):
         to_urdf(screw)

@@ -1,4 +1,4 @@
-"""An arm of the catalogue as data: DH chain, limits, named poses and where each value comes from."""
+"""A catalogue arm as data: DH chain, limits, named poses and where each value comes from."""
 
 from __future__ import annotations
 
@@ -57,7 +57,9 @@ class ArmSpec:
             raise InvalidInput("velocity_limit", "every velocity limit must be > 0")
         for pose_name, q in self.named_poses.items():
             if len(q) != n:
-                raise InvalidInput("named_poses", f"{pose_name!r} has {len(q)} values, expected {n}")
+                raise InvalidInput(
+                    "named_poses", f"{pose_name!r} has {len(q)} values, expected {n}"
+                )
 
     @property
     def nq(self) -> int:

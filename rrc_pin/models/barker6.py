@@ -59,7 +59,16 @@ def build(
     Returns:
         The arm's :class:`ArmSpec`.
     """
-    params = {"no": no, "es": es, "sn": sn, "we": we, "a3": a3, "r3": r3, "alpha3": alpha3, "hw": hw}
+    params = {
+        "no": no,
+        "es": es,
+        "sn": sn,
+        "we": we,
+        "a3": a3,
+        "r3": r3,
+        "alpha3": alpha3,
+        "hw": hw,
+    }
     half_pi = np.pi / 2
     a = (0.0, es, a3, 0.0, 0.0, 0.0)
     alpha = (half_pi, 0.0, alpha3, half_pi, half_pi, 0.0)
@@ -79,8 +88,11 @@ def build(
     ]
     symbolic = {k: v for k, v in params.items() if not np.isclose(v, PUMA560[k])}
     if len(symbolic) < len(params):
-        assumed.insert(0, "PUMA 560 values for the symbolic " + ", ".join(
-            k.upper() for k in params if k not in symbolic))
+        assumed.insert(
+            0,
+            "PUMA 560 values for the symbolic "
+            + ", ".join(k.upper() for k in params if k not in symbolic),
+        )
 
     def closed_form() -> object:
         from solvers.closed_form.barker import BarkerClosedForm

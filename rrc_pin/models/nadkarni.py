@@ -63,8 +63,15 @@ def chain_and_initial_pose(
     q0: list[float] = []
     for r, alpha, a, theta, kind in table[:-1]:
         if kind == "prismatic":
-            rows.append(DHRow(a=a * INCH, alpha=np.deg2rad(alpha), d=0.0,
-                              theta=np.deg2rad(theta), kind="prismatic"))
+            rows.append(
+                DHRow(
+                    a=a * INCH,
+                    alpha=np.deg2rad(alpha),
+                    d=0.0,
+                    theta=np.deg2rad(theta),
+                    kind="prismatic",
+                )
+            )
             q0.append(r * INCH)
         else:
             rows.append(DHRow(a=a * INCH, alpha=np.deg2rad(alpha), d=r * INCH, theta=0.0))

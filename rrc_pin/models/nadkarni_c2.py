@@ -22,7 +22,11 @@ TABLE_A2_7: tuple[Row, ...] = (
     (10.00, 90.00, 0.00, 0.00, "revolute"),
     (0.00, 0.00, 1.00, 0.00, None),  # the hand frame
 )
-FIRST_FRAME_POINTS = ((25.0, 0.0, 20.0), (30.0, 0.0, 20.0), (25.0, 0.0, 10.0))  # Table A2-8, set five
+FIRST_FRAME_POINTS = (
+    (25.0, 0.0, 20.0),
+    (30.0, 0.0, 20.0),
+    (25.0, 0.0, 10.0),
+)  # Table A2-8, set five
 
 
 def build(name: str = NAME) -> ArmSpec:

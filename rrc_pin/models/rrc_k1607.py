@@ -39,9 +39,7 @@ def build(name: str = NAME) -> ArmSpec:
     def closed_form() -> object:
         from solvers.closed_form.rrc_k1607 import RrcK1607ClosedForm
 
-        return RrcK1607ClosedForm(
-            a=tuple(row.a for row in rows), d=tuple(row.d for row in rows)
-        )
+        return RrcK1607ClosedForm(a=tuple(row.a for row in rows), d=tuple(row.d for row in rows))
 
     return ArmSpec(
         name=name,

@@ -1,0 +1,86 @@
+"""Layering, exports and lint: the architecture of DESIGN.md cannot drift."""
+
+from __future__ import annotations
+
+import ast
+import importlib
+import pkgutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import rrc_pin
+import solvers
+
+ROOT = Path(__file__).resolve().parents[1]
+UPPER = {"resolver", "control", "controller", "guidance", "cell", "cli", "demo"}
+LOWER = {"dh", "models", "urdf_export", "robot", "loading", "errors", "cross_check"}
+
+
+def modules(package) -> list[str]:
+    return [m.name for m in pkgutil.walk_packages(package.__path__, package.__name__ + ".")]
+
+
+def test_solvers_never_imports_pinocchio_or_rrc_pin():
+    code = (
+        "import importlib, sys\n"
+        f"for name in {modules(solvers)!r}: importlib.import_module(name)\n"
+        "bad = sorted(m for m in sys.modules if m.split('.')[0] in ('pinocchio', 'rrc_pin'))\n"
+        "print(','.join(bad))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == ""
+
+
+def test_lower_layers_never_import_upper_ones():
+    for path in (ROOT / "rrc_pin").rglob("*.py"):
+        rel = path.relative_to(ROOT / "rrc_pin").with_suffix("")
+        if rel.parts[0] not in LOWER:
+            continue
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = []
+            if isinstance(node, ast.ImportFrom) and node.module:
+                names = [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+            elif isinstance(node, ast.Import):
+                names = [a.name for a in node.names]
+            for name in names:
+                parts = name.split(".")
+                assert not (parts[0] == "rrc_pin" and len(parts) > 1 and parts[1] in UPPER), (
+                    rel,
+                    name,
+                )
+
+
+@pytest.mark.parametrize("package", [rrc_pin, solvers])
+def test_every_module_imports(package):
+    for name in modules(package):
+        importlib.import_module(name)
+
+
+def test_star_import_exports_exist():
+    namespace: dict = {}
+    exec("from rrc_pin import *", namespace)
+    assert set(rrc_pin.__all__) <= set(namespace)
+    assert rrc_pin.__all__ == sorted(rrc_pin.__all__)
+
+
+def test_ruff_is_clean():
+    out = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "ruff",
+            "check",
+            "--no-cache",
+            "rrc_pin",
+            "solvers",
+            "tests",
+            "benchmarks",
+        ],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+    )
+    assert out.returncode == 0, out.stdout + out.stderr
