@@ -1,0 +1,51 @@
+"""The rrc-pin command line: arms, urdf --check, check, demo."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rrc_pin.cli import main
+from rrc_pin.urdf_export import COMMITTED_DIR
+
+
+def test_arms_table_lists_sources_and_assumptions(capsys):
+    assert main(["arms"]) == 0
+    out = capsys.readouterr().out
+    assert out.splitlines()[0].split()[:4] == ["name", "dof", "joints", "tool"]
+    assert "barker6       6    RRRRRR" in out and "PUMA 560 values" in out
+    assert "nadkarni_c2   6    PPPRRR" in out
+    assert "panda" in out and "example-robot-data" in out
+
+
+def test_urdf_check_passes_on_the_committed_files(capsys):
+    assert main(["urdf", "--check"]) == 0
+    assert "5/5 URDFs" in capsys.readouterr().out
+
+
+def test_urdf_check_fails_on_a_changed_file_and_write_repairs_it(tmp_path, capsys):
+    folder = tmp_path / "urdf"
+    shutil.copytree(COMMITTED_DIR, folder)
+    (folder / "barker6.urdf").write_text("<robot/>")
+    assert main(["urdf", "--check", "--dir", str(folder)]) == 1
+    assert "barker6.urdf" in capsys.readouterr().err
+    assert main(["urdf", "--write", "--dir", str(folder)]) == 0
+    assert main(["urdf", "--check", "--dir", str(folder)]) == 0
+
+
+def test_check_command_cross_validates(capsys):
+    assert main(["check", "--samples", "20"]) == 0
+    out = capsys.readouterr().out
+    assert out.count(" ok") == 5
+
+
+def test_demo_runs_as_a_console_script():
+    exe = shutil.which("rrc-pin", path=str(Path(sys.executable).parent))
+    if exe is None:
+        pytest.fail("the rrc-pin console script is not installed next to this Python")
+    out = subprocess.run([exe, "demo"], capture_output=True, text=True, timeout=300, check=True)
+    assert "barker6" in out.stdout and "panda" in out.stdout
