@@ -127,6 +127,28 @@ def nadkarni_link(row: DHRow, q: float) -> tuple[Matrix4, Matrix4]:
     return x_star, x_frame
 
 
+def nadkarni_star_transform(previous: DHRow, row: DHRow, q: float) -> Matrix4:
+    """Pose (4, 4) of x*(i) in x*(i-1): Nadkarni eq. (2-8), ``V_{i-1} [U_i X + T_i]``.
+
+    ``T_i = (a_{i-1}, 0, r_i)``: the printed eq. (2-9) reads ``a_i`` (docs/errata.md). The
+    normal length in T must be the previous link's, because x*(i-1) and x(i-1) are a_{i-1}
+    apart along their common x axis (eq. (2-1)), and ``V_{i-1}`` leaves that axis fixed.
+
+    Args:
+        previous: Row i-1 (its ``alpha`` and ``a`` place x(i-1) in x*(i-1)).
+        row: Row i, at joint position ``q``.
+    """
+    theta, r = row.joint_values(q)
+    c, s = np.cos(theta), np.sin(theta)
+    ca, sa = np.cos(previous.alpha), np.sin(previous.alpha)
+    U = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    V = np.array([[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]])
+    T = np.eye(4)
+    T[:3, :3] = V @ U
+    T[:3, 3] = V @ np.array([previous.a, 0.0, r])
+    return T
+
+
 @dataclass(frozen=True)
 class DHChain:
     """A serial arm as a DH table plus fixed base and tool transforms.

@@ -2,10 +2,21 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
-from rrc_pin.dh import DHChain, DHRow, link_transform, nadkarni_link, rot_x, rot_z, translation
+from rrc_pin.dh import (
+    DHChain,
+    DHRow,
+    link_transform,
+    nadkarni_link,
+    nadkarni_star_transform,
+    rot_x,
+    rot_z,
+    translation,
+)
 from rrc_pin.errors import InvalidInput
 
 
@@ -62,6 +73,21 @@ def test_nadkarni_eq_2_5_equals_standard_matrix_eq_2_7(rng, kind):
         np.testing.assert_allclose(
             x_frame[:3, 3] - x_star[:3, 3], row.a * x_star[:3, 0], atol=1e-14
         )
+
+
+@pytest.mark.parametrize("kind", ["revolute", "prismatic", "screw"])
+def test_nadkarni_eq_2_8_with_a_i_minus_1_chains_the_star_frames(rng, kind):
+    """x*(i) in x*(i-1) by eq. (2-8) equals the product through x(i-1); T_i holds a_{i-1}."""
+    for _ in range(50):
+        previous, row = random_row(rng, "revolute"), random_row(rng, kind)
+        q_prev, q = rng.uniform(-2, 2, 2)
+        star_prev, x_prev = nadkarni_link(previous, q_prev)
+        star, _ = nadkarni_link(row, q)
+        expected = np.linalg.inv(star_prev) @ x_prev @ star
+        np.testing.assert_allclose(nadkarni_star_transform(previous, row, q), expected, atol=1e-14)
+        # As printed (T_i = (a_i, 0, r_i)) it is wrong whenever a_i != a_{i-1}.
+        printed = nadkarni_star_transform(replace(previous, a=row.a), row, q)
+        assert np.abs(printed - expected).max() > 1e-6
 
 
 def test_joint_kinds_move_the_right_parameter():
