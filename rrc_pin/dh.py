@@ -136,7 +136,8 @@ def nadkarni_star_transform(previous: DHRow, row: DHRow, q: float) -> Matrix4:
 
     Args:
         previous: Row i-1 (its ``alpha`` and ``a`` place x(i-1) in x*(i-1)).
-        row: Row i, at joint position ``q``.
+        row: Row i.
+        q: Position of joint i [rad or m].
     """
     theta, r = row.joint_values(q)
     c, s = np.cos(theta), np.sin(theta)
