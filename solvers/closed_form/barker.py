@@ -118,6 +118,8 @@ class BarkerClosedForm(ClosedForm):
         self.geometry = BarkerGeometry.from_parameters(**checked)
         self.rcond = rcond
         self._k = constants(self.geometry)
+        scale = sum(abs(v) for k, v in checked.items() if k != "alpha3")
+        self._has_reduced = abs(self.geometry.f2) > 1e-12 * scale  # eq. (39) divides by F2
 
     def __repr__(self) -> str:
         g = self.geometry
@@ -321,7 +323,7 @@ class BarkerClosedForm(ClosedForm):
             return False
         if method != "reduced":
             raise InputError("method", f"expected one of {', '.join(METHODS)}, got {method!r}")
-        if self.geometry.f2 == 0.0:
+        if not self._has_reduced:
             raise InputError(
                 "method", "the reduced path divides by F2 = SN + R3 + cos(alpha3) WE = 0"
             )

@@ -226,7 +226,8 @@ def arm_rates_reduced(
 
     with eq. (25)'s third row, so that at a singular configuration eq. (44) gives the
     least-squares solution of eq. (25) among those satisfying eq. (39), of least
-    (thetadot_2, thetadot_3) norm.
+    (thetadot_2, thetadot_3) norm. M1* cuts singular values ``<= rcond ||M||_F`` (an
+    absolute scale: at the double singularity S2 = 0 with eq. (33) all of M1 vanishes).
 
     Returns:
         ``(rates, regular)``: (N, 3) [rad/s] and the (N,) mask where M1 was inverted.
@@ -236,7 +237,10 @@ def arm_rates_reduced(
     ta = t.c1 * T1 + t.s1 * T2
     tb = t.s1 * T1 - t.c1 * T2
     k = F.f1 / g.f2
-    th2, th3, regular = pinv2_apply(k * F.f3, k * F.f4, -F.f1, -F.f5, k * ta - tb, T3, rcond)
+    fro2 = 2.0 * F.f1**2 + g.f2**2 + F.f3**2 + F.f4**2 + F.f5**2  # ||M||_F^2: absolute scale
+    th2, th3, regular = pinv2_apply(
+        k * F.f3, k * F.f4, -F.f1, -F.f5, k * ta - tb, T3, rcond, fro2
+    )
     out = np.empty((t.s1.shape[0], 3))
     out[:, 0] = (F.f3 * th2 + F.f4 * th3 - ta) / g.f2  # eq. (39)
     out[:, 1] = th2

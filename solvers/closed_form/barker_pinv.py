@@ -15,16 +15,26 @@ Array = npt.NDArray[np.float64]
 
 
 def pinv2_apply(
-    a: Array, b: Array, c: Array, d: Array, g0: Array, g1: Array, rcond: float
+    a: Array,
+    b: Array,
+    c: Array,
+    d: Array,
+    g0: Array,
+    g1: Array,
+    rcond: float,
+    floor: Array | float = 0.0,
 ) -> tuple[Array, Array, Array]:
     """Apply the truncated pseudo-inverse of ``A = [[a, b], [c, d]]`` to ``g = (g0, g1)``.
 
-    Closed form of ``numpy.linalg.pinv(A, rcond) @ g``, vectorised over any broadcast shape.
-    With ``A^T A = [[p, r], [r, s]]``, the squared singular values are
+    Closed form, vectorised over any broadcast shape, of the truncated SVD solution
+    ``sum_{sigma_i > cutoff} v_i u_i^T g / sigma_i`` with ``cutoff = rcond sqrt(max(sigma_1^2,
+    floor))``: ``numpy.linalg.pinv(A, rcond) @ g`` for ``floor = 0``; a ``floor`` sets an
+    absolute scale, so that a matrix that is small as a whole (M1 at the double singularity)
+    is not inverted. With ``A^T A = [[p, r], [r, s]]``, the squared singular values are
     ``(p + s) / 2 +- h``, ``h = sqrt(((p - s) / 2)^2 + r^2)``; ``sigma_2 = |det A| / sigma_1``.
-    Where ``sigma_2 > rcond sigma_1`` (``|det A| > rcond sigma_1^2``) the answer is
-    ``A^-1 g``; elsewhere it is ``v v^T A^T g / sigma_1^2`` with ``v`` the top right singular
-    vector (Barker's M1*, eq. (44), and M2*, eq. (60)).
+    Where ``sigma_2 > cutoff`` the answer is ``A^-1 g``; where only ``sigma_1 > cutoff`` it is
+    ``v v^T A^T g / sigma_1^2`` with ``v`` the top right singular vector; else zero
+    (Barker's M1*, eq. (44), and M2*, eq. (60)).
 
     Args:
         a: Entry (0, 0) of A.
@@ -33,7 +43,8 @@ def pinv2_apply(
         d: Entry (1, 1) of A.
         g0: First entry of the right-hand side.
         g1: Second entry of the right-hand side.
-        rcond: Relative cutoff of the singular values, in (0, 1).
+        rcond: Relative cutoff of the singular values, in [0, 1).
+        floor: Squared singular value below which the cutoff does not scale down.
 
     Returns:
         ``(x0, x1, regular)``: the solution and a boolean array, True where A was inverted.
@@ -45,7 +56,8 @@ def pinv2_apply(
     half = 0.5 * (p - s)
     h = np.hypot(half, r)
     lam = 0.5 * (p + s) + h  # sigma_1^2
-    regular = np.abs(det) > rcond * lam
+    ref = np.maximum(lam, floor)
+    regular = np.abs(det) > rcond * np.sqrt(ref * lam)
     with np.errstate(divide="ignore", invalid="ignore"):
         inv_det = np.where(regular, 1.0, 0.0) / np.where(regular, det, 1.0)
         x0 = (d * g0 - b * g1) * inv_det
@@ -58,14 +70,15 @@ def pinv2_apply(
             h0 = a * g0 + c * g1  # A^T g
             h1 = b * g0 + d * g1
             den = (v0 * v0 + v1 * v1) * lam
-            k = np.where(den > 0.0, (v0 * h0 + v1 * h1) / np.where(den > 0.0, den, 1.0), 0.0)
+            keep = (den > 0.0) & (lam > rcond * rcond * ref)
+            k = np.where(keep, (v0 * h0 + v1 * h1) / np.where(keep, den, 1.0), 0.0)
             x0 = np.where(regular, x0, k * v0)
             x1 = np.where(regular, x1, k * v1)
     return x0, x1, regular
 
 
 def pinv2_apply_scalar(
-    a: float, b: float, c: float, d: float, g0: float, g1: float, rcond: float
+    a: float, b: float, c: float, d: float, g0: float, g1: float, rcond: float, floor: float = 0.0
 ) -> tuple[float, float]:
     """Scalar (Python float) version of :func:`pinv2_apply`, returning ``(x0, x1)``."""
     det = a * d - b * c
@@ -75,14 +88,15 @@ def pinv2_apply_scalar(
     half = 0.5 * (p - s)
     h = (half * half + r * r) ** 0.5
     lam = 0.5 * (p + s) + h
-    if abs(det) > rcond * lam:
+    ref = lam if lam > floor else floor
+    if abs(det) > rcond * (ref * lam) ** 0.5:
         return (d * g0 - b * g1) / det, (a * g1 - c * g0) / det
     if p >= s:
         v0, v1 = half + h, r
     else:
         v0, v1 = r, h - half
     den = (v0 * v0 + v1 * v1) * lam
-    if den <= 0.0:
+    if den <= 0.0 or lam <= rcond * rcond * ref:
         return 0.0, 0.0
     k = (v0 * (a * g0 + c * g1) + v1 * (b * g0 + d * g1)) / den
     return k * v0, k * v1

@@ -52,7 +52,8 @@ def arm_scalar(k: Consts, tr: TrigS, tvel: list[float], reduced: bool, rcond: fl
         ta = c1 * T1 + s1 * T2
         r = f1 / f2
         g1 = r * ta - s1 * T1 + c1 * T2
-        th2, th3 = pinv2_apply_scalar(r * f3, r * f4, -f1, -f5, g1, T3, rcond)
+        fro2 = 2.0 * f1 * f1 + f2 * f2 + f3 * f3 + f4 * f4 + f5 * f5
+        th2, th3 = pinv2_apply_scalar(r * f3, r * f4, -f1, -f5, g1, T3, rcond, fro2)
         return (f3 * th2 + f4 * th3 - ta) / f2, th2, th3  # eqs (44), (39)
     f6 = s1 * f1 + c1 * f2  # eq. (41)
     f7 = c1 * f1 - s1 * f2  # eq. (37)
