@@ -39,6 +39,7 @@ from solvers.closed_form.barker_scalar import (
     arm_scalar,
     constants,
     jacobian_scalar,
+    joint_rates_full_scalar,
     joint_rates_scalar,
     rvel_tilde_scalar,
     trig_scalar,
@@ -274,8 +275,10 @@ class BarkerClosedForm(ClosedForm):
             InputError: Bad ``q``, ``xdot`` or ``method``.
         """
         reduced = self._reduced(method)
-        x = _floats(xdot, "xdot", 6)
-        return np.array(joint_rates_scalar(self._k, _floats(q, "q", 6), x, reduced, self.rcond))
+        qv, x = _floats(q, "q", 6), _floats(xdot, "xdot", 6)
+        if reduced:
+            return np.array(joint_rates_scalar(self._k, qv, x, True, self.rcond))
+        return np.array(joint_rates_full_scalar(self._k, qv, x, self.rcond))
 
     def joint_rates_batch(
         self, Q: npt.ArrayLike, X: npt.ArrayLike, method: Method = "full"
@@ -299,7 +302,7 @@ class BarkerClosedForm(ClosedForm):
     def hand_to_base_batch(self, Q: npt.ArrayLike) -> Array:
         """R0_6 at ``Q`` (N, 6): (N, 3, 3)."""
         Q, _ = self._check_batch(Q)
-        return K.hand_to_base(self.geometry, K.trig(Q))
+        return K.hand_to_base(self.geometry, K.trig(Q, roll=True))
 
     def hand_twist_to_base(self, q: npt.ArrayLike, twist: npt.ArrayLike) -> Array:
         """Operator command ``[TVEL; RVEL]`` (6,) in hand axes -> base axes, eq. (20)."""

@@ -113,6 +113,43 @@ def joint_rates_scalar(
     return arm[0], arm[1], arm[2], th4, th5, th6
 
 
+def joint_rates_full_scalar(
+    k: Consts, q: list[float], x: list[float], rcond: float
+) -> tuple[float, float, float, float, float, float]:
+    """:func:`joint_rates_scalar` for ``reduced=False``, fused into one function.
+
+    The default path of ``BarkerClosedForm.joint_rates``: eqs (34)-(36), (48), (52)-(56),
+    (49)-(51) inline (a third faster than the composed kernels); where either block is
+    singular it hands over to :func:`joint_rates_scalar` and its generalized inverses.
+    """
+    es, swe, a3, f2, sal3, cal3 = k
+    q1, q2, q3, q4, q5, _ = q
+    T1, T2, T3, W1, W2, W3 = x
+    s1, c1, s2, c2 = sin(q1), cos(q1), sin(q2), cos(q2)
+    s23, c23, s4, c4, s5, c5 = sin(q2 + q3), cos(q2 + q3), sin(q4), cos(q4), sin(q5), cos(q5)
+    f5 = s23 * swe + c23 * a3  # eq. (31)
+    f4 = c23 * swe - s23 * a3  # eq. (30)
+    f1 = s2 * es + f5  # eq. (27)
+    f3 = c2 * es + f4  # eq. (29)
+    det = f1 * (swe * sin(q3) + a3 * cos(q3)) * es  # eq. (D9)
+    fro2 = 2.0 * f1 * f1 + f2 * f2 + f3 * f3 + f4 * f4 + f5 * f5
+    if abs(det) <= rcond * fro2 * sqrt(fro2) or abs(s5) <= rcond * (1.0 + abs(c5)):
+        return joint_rates_scalar(k, q, x, False, rcond)
+    u = T1 * (c1 * f1 - s1 * f2) + T2 * (s1 * f1 + c1 * f2)  # T1 F7 + T2 F6, eqs (37), (41)
+    t1 = (T1 * s1 - T2 * c1) * (f1 * f4 - f3 * f5) / det  # eq. (34)
+    t2 = (f5 * u + T3 * f1 * f4) / det  # eq. (35), sign corrected
+    t3 = -f1 * (u + T3 * f3) / det  # eq. (36), sign corrected
+    s = t2 + t3  # eq. (48): RVEL~ = RVEL^ - z0 t1 - z1 (t2 + t3)
+    w1, w2, w3 = W1 + s1 * s, W2 - c1 * s, W3 - t1
+    d1 = c1 * w1 + s1 * w2  # eq. (52)
+    d2 = s1 * w1 - c1 * w2  # eq. (53)
+    d3 = s23 * d1 + c23 * w3  # eq. (54)
+    d4 = c23 * d1 - s23 * w3  # eq. (55)
+    d5 = cal3 * d3 + sal3 * d2  # eq. (56)
+    th6 = (-s4 * d5 + c4 * d4) / s5  # eq. (50)
+    return t1, t2, t3, sal3 * d3 - cal3 * d2 - c5 * th6, -c4 * d5 - s4 * d4, th6  # (51), (49)
+
+
 def jacobian_scalar(k: Consts, q: list[float]) -> np.ndarray:
     """Wrist-centre Jacobian (6, 6), rows [v; w], base axes (Barker eqs (22), (26), (C7)-(C12))."""
     es, swe, a3, f2, sal3, cal3 = k
