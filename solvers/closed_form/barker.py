@@ -19,7 +19,12 @@ Paths (``method``):
   with M2* for the wrist. Exact where J is regular; at an arm singularity it gives the
   least-squares solution of eq. (25) satisfying eq. (39) with least (thetadot_2,
   thetadot_3) norm, which is the minimum-norm one at eq. (33) for commands M can realise,
-  but not at eq. (32) (there M* spreads the rate over thetadot_1 and thetadot_2).
+  but not at eq. (32) nor at the double singularity (there M* spreads the rate over
+  thetadot_1 and thetadot_2).
+
+At an arm singularity both paths answer Barker's decoupled problem (arm block first, then the
+wrist with the arm's rotation removed, eq. (48)); the minimum-norm least-squares solution of
+the whole 6x6 system, ``pinv(J) xdot``, trades the arm residual against the wrist and differs.
 
 Singular set (Appendix D): ``det J = det M det W = ES (S2 ES + F5)(SAL3 WE S3 + A3 C3) S5``
 (up to sign), for any R3 and alpha3: conditions (32), (33) and S5 = 0.
