@@ -1,0 +1,551 @@
+"""Closed-form kinematics and joint rates of the 7-DOF RRC K-1607 (Nguyen & Zhou, NAG 5-1124).
+
+The arm of Nguyen Table 1 in Craig's modified DH (Nguyen eq. (2)), twists fixed at
+``alpha_{i-1} = (0, -90, 90, -90, 90, -90, 90)`` deg. The hand frame is frame 7.
+
+- Forward kinematics: Nguyen eqs. (4)-(11), with the typos of eqs. (5), (8) and (9)
+  corrected (docs/errata.md). The auxiliaries are the axes of the DH frames:
+  ``x3 = (f2, f4, -s2 c3)``, ``z4 = (f1, f3, s2 s3)``, ``x4 = (g1, g3, f5)``,
+  ``z5 = (g2, g4, f6)``, ``x5 = (h2, h4, g6)``, ``z6 = (h1, h3, g5)``, ``x6 = (j1, j2, h5)``.
+  Every ``a_{i-1}`` and ``d_i`` is honoured; for Table 1 (``a0 = a1 = d1 = d2 = d4 = d6 =
+  d7 = 0``) the position reduces to Nguyen's ``p``.
+- Jacobian: the cross-product method, Nguyen eqs. (12)-(17), all seven columns
+  ``J_i = [z_i x (p - o_i); z_i]`` from the same auxiliaries (the report prints only
+  columns 1-3, eqs. (18)-(19)). Rows ``[v; w]``: velocity of frame 7's origin and angular
+  velocity, base axes (``world_aligned``, Pinocchio's LOCAL_WORLD_ALIGNED).
+- Joint rates: the weighted pseudo-inverse with null-space term, Nguyen eqs. (21)-(22),
+  evaluated as ``qdot = J_W^+ (xdot - J z) + z`` (the same vector, one solve) with
+  ``J W J^T`` factored by LDL^T. With ``W = I`` and ``z = 0`` it is the minimum-norm solution
+  of eq. (23).
+
+Near a singularity (a pivot of the LDL^T factorisation of ``J W J^T`` below
+``rcond**2`` times its largest diagonal entry, which can only happen when
+``sigma_min(J W^1/2) < rcond * sigma_max``), the rates come from the SVD-based
+pseudo-inverse of ``J L`` (``W = L L^T``) with singular values below ``rcond * sigma_max``
+dropped: the least-squares solution of smallest ``qdot^T W^-1 qdot``, finite, never NaN.
+Damping is the QP resolver's business, not this module's.
+
+The scalar methods run on Python floats (no numpy call below the final array), the batch
+methods on (N,) numpy arrays; both share the formulas of :func:`_kinematics`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Sequence
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from solvers.closed_form.base import ClosedForm
+from solvers.errors import InputError
+from solvers.validation import as_array, as_vector
+
+NQ = 7
+TASK_DIM = 6
+ALPHA_DEG = (0.0, -90.0, 90.0, -90.0, 90.0, -90.0, 90.0)
+"""Nguyen Table 1 twists alpha_{i-1} [deg]; the closed form is derived for these."""
+DEFAULT_RCOND = 1e-6
+"""Relative singular-value threshold of ``J W^1/2`` below which the SVD fallback answers."""
+
+Entry = Any  # a Python float (scalar path) or an (N,) float array (batch path)
+
+
+def _kinematics(
+    c: Sequence[Entry], s: Sequence[Entry], a: Sequence[float], d: Sequence[float]
+) -> tuple[list[list[Entry]], list[Entry], list[list[Entry]]]:
+    """Hand pose and Jacobian from the joint cosines ``c`` and sines ``s`` (7 each).
+
+    Works element-wise: every entry is a float, or an (N,) array for N configurations.
+
+    Returns:
+        ``(R, p, J)``: ``R`` 3 rows of 3 entries (Nguyen eq. (4): columns n, s, a),
+        ``p`` 3 entries [m], ``J`` 6 rows of 7 entries (rows [v; w], ``world_aligned``).
+    """
+    c1, c2, c3, c4, c5, c6, c7 = c
+    s1, s2, s3, s4, s5, s6, s7 = s
+    c1c2, s1c2, c1s2, s1s2 = c1 * c2, s1 * c2, c1 * s2, s1 * s2
+    s2c3, s2s3 = s2 * c3, s2 * s3
+    # Nguyen eq. (8); f3 and f6 corrected (errata).
+    f1 = -c1c2 * s3 - s1 * c3
+    f2 = c1c2 * c3 - s1 * s3
+    f3 = c1 * c3 - s1c2 * s3
+    f4 = s1c2 * c3 + c1 * s3
+    f5 = -s2c3 * c4 - c2 * s4
+    f6 = c2 * c4 - s2c3 * s4
+    # Nguyen eq. (9); g1 corrected (errata).
+    g1 = c4 * f2 - c1s2 * s4
+    g2 = c1s2 * c4 + s4 * f2
+    g3 = c4 * f4 - s1s2 * s4
+    g4 = s1s2 * c4 + s4 * f4
+    g5 = s2s3 * c5 - s5 * f5
+    g6 = s2s3 * s5 + c5 * f5
+    # Nguyen eq. (10).
+    h1 = c5 * f1 - s5 * g1
+    h2 = s5 * f1 + c5 * g1
+    h3 = c5 * f3 - s5 * g3
+    h4 = s5 * f3 + c5 * g3
+    h5 = c6 * g6 - s6 * f6
+    # Nguyen eq. (11).
+    j1 = c6 * h2 - s6 * g2
+    j2 = c6 * h4 - s6 * g4
+    # Nguyen eqs. (5)-(7): the columns n = x7, s = y7 and a = z7 of the hand orientation.
+    z7 = (s6 * h2 + c6 * g2, s6 * h4 + c6 * g4, s6 * g6 + c6 * f6)
+    R = [
+        [s7 * h1 + c7 * j1, c7 * h1 - s7 * j1, z7[0]],
+        [s7 * h3 + c7 * j2, c7 * h3 - s7 * j2, z7[1]],
+        [s7 * g5 + c7 * h5, c7 * g5 - s7 * h5, z7[2]],
+    ]
+    # Joint axes b_i = z_i (Nguyen eq. (14)) and the x axes of frames 0-6.
+    z = (None, (-s1, c1, 0.0), (c1s2, s1s2, c2), (f1, f3, s2s3), (g2, g4, f6), (h1, h3, g5), z7)
+    x = (None, (c1, s1, 0.0), (c1c2, s1c2, -s2), (f2, f4, -s2c3), (g1, g3, f5), (h2, h4, g6),
+         (j1, j2, h5))
+    # Nguyen eqs. (12)-(13), (16): J_i = [b_i x r_i; b_i] with r_i = p - o_i, from the hand
+    # back: r_7 = 0, r_{i-1} = r_i + a_{i-1} x_{i-1} + d_i z_i (Nguyen eq. (2), column 4).
+    cols: list[Any] = [None] * NQ
+    rx: Entry = 0.0
+    ry: Entry = 0.0
+    rz: Entry = 0.0
+    for k in range(NQ - 1, 0, -1):
+        bx, by, bz = z[k]
+        if k > 1:
+            cols[k] = (by * rz - bz * ry, bz * rx - bx * rz, bx * ry - by * rx, bx, by, bz)
+        else:  # b_2 = (-s1, c1, 0): Nguyen eq. (18), second column
+            cols[k] = (by * rz, -bx * rz, bx * ry - by * rx, bx, by, 0.0)
+        if d[k]:
+            rx, ry, rz = rx + d[k] * bx, ry + d[k] * by, rz + d[k] * bz
+        if a[k]:
+            xx, xy, xz = x[k]
+            rx, ry, rz = rx + a[k] * xx, ry + a[k] * xy, rz + a[k] * xz
+    # b_1 = (0, 0, 1): Nguyen eq. (18), first column (sign of its second entry corrected).
+    cols[0] = (-ry, rx, 0.0, 0.0, 0.0, 1.0)
+    # p = r_1 + o_1 with o_1 = a_0 x_0 + d_1 z_1, x_0 = (1, 0, 0), z_1 = (0, 0, 1).
+    p = [rx + a[0], ry, rz + d[0]]
+    return R, p, [list(row) for row in zip(*cols, strict=True)]
+
+
+class RrcK1607ClosedForm(ClosedForm):
+    """Nguyen's closed forms for the RRC K-1607 (7 revolute joints, 6-D task).
+
+    Args:
+        a: The seven ``a_{i-1}`` of Nguyen Table 1 [m] (``a_0`` first).
+        d: The seven ``d_i`` of Nguyen Table 1 [m] (``d_1`` first).
+        rcond: Relative singular-value threshold of ``J W^1/2`` for the SVD fallback
+            (module docstring).
+
+    Raises:
+        InputError: ``a`` or ``d`` not seven finite numbers, or ``rcond`` not in (0, 1).
+    """
+
+    nq = NQ
+    task_dim = TASK_DIM
+
+    def __init__(
+        self, *, a: npt.ArrayLike, d: npt.ArrayLike, rcond: float = DEFAULT_RCOND
+    ) -> None:
+        self.a = tuple(as_vector(a, "a", NQ).tolist())
+        self.d = tuple(as_vector(d, "d", NQ).tolist())
+        rcond = float(rcond)
+        if not 0.0 < rcond < 1.0:
+            raise InputError("rcond", f"expected a number in (0, 1), got {rcond}")
+        self.rcond = rcond
+
+    def __repr__(self) -> str:
+        return f"RrcK1607ClosedForm(a={self.a}, d={self.d})"
+
+    # ------------------------------------------------------------------ scalar
+
+    def _scalar(self, qs: list[float]) -> tuple[list[list[float]], list[float], list[list[float]]]:
+        return _kinematics([math.cos(v) for v in qs], [math.sin(v) for v in qs], self.a, self.d)
+
+    def fk(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Pose of frame 7 in frame 0, Nguyen eqs. (4)-(11).
+
+        Args:
+            q: Joint angles theta_1..theta_7 (7,) [rad].
+
+        Returns:
+            (4, 4) homogeneous transform, translation [m].
+
+        Raises:
+            InputError: ``q`` is not a finite (7,) vector.
+        """
+        R, p, _ = self._scalar(_floats(q, "q", NQ))
+        return np.array([R[0] + [p[0]], R[1] + [p[1]], R[2] + [p[2]], [0.0, 0.0, 0.0, 1.0]])
+
+    def jacobian(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Jacobian of frame 7, Nguyen eqs. (12)-(17), all seven columns.
+
+        Args:
+            q: Joint angles (7,) [rad].
+
+        Returns:
+            (6, 7) array, rows [v; w], ``world_aligned`` ([m/rad] then [1]).
+
+        Raises:
+            InputError: ``q`` is not a finite (7,) vector.
+        """
+        return np.array(self._scalar(_floats(q, "q", NQ))[2])
+
+    def joint_rates(
+        self,
+        q: npt.ArrayLike,
+        xdot: npt.ArrayLike,
+        W: npt.ArrayLike | None = None,
+        z: npt.ArrayLike | None = None,
+    ) -> npt.NDArray[np.float64]:
+        r"""Joint rates by the weighted pseudo-inverse, Nguyen eqs. (21)-(22).
+
+        .. math::
+            \dot q = J_W^\dagger \dot x + (I_7 - J_W^\dagger J) z,
+            \quad J_W^\dagger = W J^T (J W J^T)^{-1}
+
+        Among all ``qdot`` with ``J qdot = xdot`` it minimises
+        ``(qdot - z)^T W^-1 (qdot - z)``; ``W = I``, ``z = 0`` give the minimum-norm rates of
+        eq. (23). Near a singularity: the SVD fallback of the module docstring, never NaN.
+
+        Args:
+            q: Joint angles (7,) [rad].
+            xdot: Hand twist (6,), [m/s] then [rad/s], ``world_aligned``.
+            W: Weighting matrix (7, 7), symmetric positive definite; None for identity.
+            z: Joint-rate vector (7,) [rad/s] whose null-space part is added; None for zero.
+
+        Returns:
+            Joint rates (7,) [rad/s].
+
+        Raises:
+            InputError: Wrong shape or non-finite entries in any argument (named), or ``W``
+                not symmetric positive definite.
+        """
+        qs = _floats(q, "q", NQ)
+        b = _floats(xdot, "xdot", TASK_DIM)
+        Wm = None if W is None else _check_weight(W)
+        zv = None if z is None else as_vector(z, "z", NQ)
+        J = np.array(self._scalar(qs)[2])
+        if zv is not None:
+            b = (np.array(b) - J.dot(zv)).tolist()
+        JW = J if Wm is None else J.dot(Wm)
+        A = JW.dot(J.T).tolist()
+        tau = self.rcond**2 * (A[0][0] + A[1][1] + A[2][2] + A[3][3] + A[4][4] + A[5][5])
+        try:
+            y = _solve_spd6(A, b, _positive)
+        except _Singular:
+            y = None
+        if y is not None and sum(v * v for v in b) >= tau * tau * sum(v * v for v in y):
+            qdot = np.array(y).dot(JW)
+        else:
+            qdot = _svd_rates(J[None], np.array([b]), Wm, self.rcond)[0]
+        if zv is not None:
+            qdot += zv
+        return qdot
+
+    # ------------------------------------------------------------------- batch
+
+    def fk_batch(self, Q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Poses of frame 7 at N configurations, Nguyen eqs. (4)-(11).
+
+        Args:
+            Q: Joint angles (N, 7) [rad].
+
+        Returns:
+            (N, 4, 4) homogeneous transforms.
+
+        Raises:
+            InputError: ``Q`` is not a finite (N, 7) array.
+        """
+        Q = as_array(Q, "Q", (None, NQ))
+        out = np.zeros((Q.shape[0], 4, 4))
+        out[:, 3, 3] = 1.0
+        for rows, c, s in _chunks(Q):
+            R, p, _ = _kinematics(c, s, self.a, self.d)
+            _fill(out[rows, :3], [R[r] + [p[r]] for r in range(3)])
+        return out
+
+    def jacobian_batch(self, Q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Jacobians of frame 7 at N configurations, Nguyen eqs. (12)-(17).
+
+        Args:
+            Q: Joint angles (N, 7) [rad].
+
+        Returns:
+            (N, 6, 7) array, rows [v; w], ``world_aligned``.
+
+        Raises:
+            InputError: ``Q`` is not a finite (N, 7) array.
+        """
+        Q = as_array(Q, "Q", (None, NQ))
+        out = np.empty((Q.shape[0], TASK_DIM, NQ))
+        for rows, c, s in _chunks(Q):
+            _fill(out[rows], _kinematics(c, s, self.a, self.d)[2])
+        return out
+
+    def joint_rates_batch(
+        self,
+        Q: npt.ArrayLike,
+        X: npt.ArrayLike,
+        W: npt.ArrayLike | None = None,
+        Z: npt.ArrayLike | None = None,
+    ) -> npt.NDArray[np.float64]:
+        """Joint rates at N configurations, Nguyen eqs. (21)-(22); see :meth:`joint_rates`.
+
+        ``J W J^T`` is factored by LDL^T element-wise over the configurations (the same
+        arithmetic for every row, no Python loop over them).
+
+        Args:
+            Q: Joint angles (N, 7) [rad].
+            X: Hand twists (N, 6), ``world_aligned``.
+            W: One weighting matrix (7, 7) for all N, symmetric positive definite; None for
+                identity.
+            Z: Joint-rate vectors (N, 7) [rad/s] whose null-space parts are added; None for
+                zero.
+
+        Returns:
+            Joint rates (N, 7) [rad/s].
+
+        Raises:
+            InputError: Wrong shape or non-finite entries in any argument (named), or ``W``
+                not symmetric positive definite.
+        """
+        Q, X = self._check_batch(Q, X)
+        Wm = None if W is None else _check_weight(W)
+        if Z is not None:
+            Z = as_array(Z, "Z", (Q.shape[0], NQ))
+        out = np.empty((Q.shape[0], NQ))
+        for rows, c, s in _chunks(Q):
+            out[rows] = self._rates_chunk(c, s, X[rows], Wm, None if Z is None else Z[rows])
+        return out
+
+    def _rates_chunk(
+        self,
+        c: list[npt.NDArray[np.float64]],
+        s: list[npt.NDArray[np.float64]],
+        X: npt.NDArray[np.float64],
+        Wm: npt.NDArray[np.float64] | None,
+        Z: npt.NDArray[np.float64] | None,
+    ) -> npt.NDArray[np.float64]:
+        """:meth:`joint_rates_batch` on one chunk: cosines and sines, 7 (M,) arrays each."""
+        n = X.shape[0]
+        J = _kinematics(c, s, self.a, self.d)[2]
+        b = list(X.T)
+        if Z is not None:
+            ZT = list(Z.T)
+            b = [bi - _dot(row, ZT) for bi, row in zip(b, J, strict=True)]
+        if Wm is None:
+            JW = J
+        else:
+            Wcols = Wm.T.tolist()
+            JW = [[_dot(row, col) for col in Wcols] for row in J]
+        A = [[_dot(JW[i], J[j]) if j >= i else None for j in range(TASK_DIM)]
+             for i in range(TASK_DIM)]
+        tau = self.rcond**2 * sum(A[i][i] for i in range(TASK_DIM))
+        guard = _PositiveMask(n)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            y = _solve_spd6(A, b, guard)
+            ok = guard.ok & (_dot(b, b) >= tau * tau * _dot(y, y))
+        qdot = np.empty((n, NQ))
+        for i, column in enumerate(zip(*JW, strict=True)):
+            qdot[:, i] = _dot(column, y)
+        if not np.all(ok):
+            bad = ~ok
+            Jb = np.empty((n, TASK_DIM, NQ))
+            _fill(Jb, J)
+            qdot[bad] = _svd_rates(Jb[bad], np.stack(b, axis=1)[bad], Wm, self.rcond)
+        if Z is not None:
+            qdot += Z
+        return qdot
+
+
+# ---------------------------------------------------------------------- helpers
+
+CHUNK = 4096
+"""Configurations per block in the batch methods.
+
+The formulas keep about a hundred (CHUNK,) intermediates alive at once; blocks of 4096 keep
+them in cache (a few MB) instead of streaming N-sized arrays through memory.
+"""
+
+
+def _floats(x: npt.ArrayLike, name: str, size: int) -> list[float]:
+    """``x`` as a list of ``size`` finite floats, cheaply; errors as :func:`as_vector`."""
+    try:
+        arr = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        arr = None
+    if arr is None or arr.shape != (size,):
+        return as_vector(x, name, size).tolist()
+    values = arr.tolist()
+    if not math.isfinite(sum(values)):  # NaN or inf somewhere (or an overflowing sum)
+        return as_vector(x, name, size).tolist()
+    return values
+
+
+def _chunks(
+    Q: npt.NDArray[np.float64],
+) -> Iterator[tuple[slice, list[npt.NDArray[np.float64]], list[npt.NDArray[np.float64]]]]:
+    """Blocks of :data:`CHUNK` configurations: (rows, cosines, sines), 7 (M,) arrays each.
+
+    The trigonometry runs once over the whole batch, the rest block by block.
+    """
+    C, S = _cos_sin(Q)
+    for lo in range(0, Q.shape[0], CHUNK):
+        rows = slice(lo, lo + CHUNK)
+        yield rows, [c[rows] for c in C], [s[rows] for s in S]
+
+
+def _cos_sin(Q: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Cosines and sines of the columns of ``Q`` (N, 7): two (7, N) arrays.
+
+    By the tangent half-angle, ``t = tan(q/2)``: ``cos q = (1 - t^2) / (1 + t^2)``,
+    ``sin q = 2 t / (1 + t^2)``, one transcendental call instead of two (absolute error a
+    few ulp for every q, including q = pi where t = 1.6e16).
+    """
+    t = np.tan(0.5 * Q.T)
+    u = t * t
+    w = 1.0 / (1.0 + u)
+    return (1.0 - u) * w, (2.0 * w) * t
+
+
+def _dot(u: Sequence[Entry], v: Sequence[Entry]) -> Entry:
+    """Sum of ``u[k] * v[k]``, skipping exact float zeros (the constant Jacobian entries)."""
+    acc: Entry = 0.0
+    for uk, vk in zip(u, v, strict=True):
+        if type(uk) is float and (uk == 0.0 or uk == 1.0):
+            if uk:
+                acc = acc + vk
+        elif type(vk) is float and vk == 0.0:
+            continue
+        else:
+            acc = acc + uk * vk
+    return acc
+
+
+def _check_weight(W: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    """``W`` as a (7, 7) symmetric positive-definite array.
+
+    Raises:
+        InputError: Naming ``W``.
+    """
+    Wm = as_array(W, "W", (NQ, NQ))
+    if not np.allclose(Wm, Wm.T, rtol=1e-12, atol=1e-12 * np.abs(Wm).max()):
+        raise InputError("W", "expected a symmetric matrix")
+    try:
+        np.linalg.cholesky(Wm)
+    except np.linalg.LinAlgError as exc:
+        raise InputError("W", "expected a positive-definite matrix") from exc
+    return Wm
+
+
+class _Singular(Exception):
+    """A 3x3 block of ``J W J^T`` is not positive definite (scalar path)."""
+
+
+def _positive(det: float) -> float:
+    """Scalar guard of :func:`_solve_spd6`: ``det`` if > 0, else raise :class:`_Singular`."""
+    if not det > 0.0:
+        raise _Singular
+    return det
+
+
+class _PositiveMask:
+    """Batch guard of :func:`_solve_spd6`: replaces determinants <= 0 by 1, remembers where."""
+
+    def __init__(self, n: int) -> None:
+        self.ok = np.ones(n, dtype=bool)
+
+    def __call__(self, det: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        good = det > 0.0
+        self.ok &= good
+        return np.where(good, det, 1.0)
+
+
+def _inv3(
+    a00: Entry, a01: Entry, a02: Entry, a11: Entry, a12: Entry, a22: Entry, guard: Any
+) -> tuple[Entry, ...]:
+    """Inverse of a symmetric 3x3 matrix by cofactors: its entries (00, 01, 02, 11, 12, 22).
+
+    ``guard`` receives the determinant and returns it (or a safe stand-in; see
+    :func:`_positive`, :class:`_PositiveMask`).
+    """
+    c00 = a11 * a22 - a12 * a12
+    c01 = a02 * a12 - a01 * a22
+    c02 = a01 * a12 - a02 * a11
+    r = 1.0 / guard(a00 * c00 + a01 * c01 + a02 * c02)
+    return (
+        c00 * r,
+        c01 * r,
+        c02 * r,
+        (a00 * a22 - a02 * a02) * r,
+        (a01 * a02 - a00 * a12) * r,
+        (a00 * a11 - a01 * a01) * r,
+    )
+
+
+def _solve_spd6(A: list[list[Any]], b: Sequence[Entry], guard: Any) -> list[Entry]:
+    """Solve ``A y = b`` for a symmetric positive-definite 6x6 ``A`` (upper triangle read).
+
+    Block elimination with 3x3 blocks ``A = [[P, Q], [Q^T, S]]``: the Schur complement
+    ``S' = S - Q^T P^-1 Q`` is positive definite with ``lambda_min(S') >= lambda_min(A)``,
+    so no pivoting is needed (as in Cholesky). Element-wise: floats or (N,) arrays.
+    """
+    (p00, p01, p02, q00, q01, q02), (_, p11, p12, q10, q11, q12) = A[0], A[1]
+    (_, _, p22, q20, q21, q22), (_, _, _, s00, s01, s02) = A[2], A[3]
+    s11, s12, s22 = A[4][4], A[4][5], A[5][5]
+    i00, i01, i02, i11, i12, i22 = _inv3(p00, p01, p02, p11, p12, p22, guard)
+    # M = P^-1 Q
+    m00 = i00 * q00 + i01 * q10 + i02 * q20
+    m01 = i00 * q01 + i01 * q11 + i02 * q21
+    m02 = i00 * q02 + i01 * q12 + i02 * q22
+    m10 = i01 * q00 + i11 * q10 + i12 * q20
+    m11 = i01 * q01 + i11 * q11 + i12 * q21
+    m12 = i01 * q02 + i11 * q12 + i12 * q22
+    m20 = i02 * q00 + i12 * q10 + i22 * q20
+    m21 = i02 * q01 + i12 * q11 + i22 * q21
+    m22 = i02 * q02 + i12 * q12 + i22 * q22
+    # T = (S - Q^T M)^-1
+    t00, t01, t02, t11, t12, t22 = _inv3(
+        s00 - (q00 * m00 + q10 * m10 + q20 * m20),
+        s01 - (q00 * m01 + q10 * m11 + q20 * m21),
+        s02 - (q00 * m02 + q10 * m12 + q20 * m22),
+        s11 - (q01 * m01 + q11 * m11 + q21 * m21),
+        s12 - (q01 * m02 + q11 * m12 + q21 * m22),
+        s22 - (q02 * m02 + q12 * m12 + q22 * m22),
+        guard,
+    )
+    b0, b1, b2, b3, b4, b5 = b
+    # lower half: y_S = T (b_S - M^T b_P)
+    e0 = b3 - (m00 * b0 + m10 * b1 + m20 * b2)
+    e1 = b4 - (m01 * b0 + m11 * b1 + m21 * b2)
+    e2 = b5 - (m02 * b0 + m12 * b1 + m22 * b2)
+    y3 = t00 * e0 + t01 * e1 + t02 * e2
+    y4 = t01 * e0 + t11 * e1 + t12 * e2
+    y5 = t02 * e0 + t12 * e1 + t22 * e2
+    # upper half: y_P = P^-1 b_P - M y_S
+    y0 = i00 * b0 + i01 * b1 + i02 * b2 - (m00 * y3 + m01 * y4 + m02 * y5)
+    y1 = i01 * b0 + i11 * b1 + i12 * b2 - (m10 * y3 + m11 * y4 + m12 * y5)
+    y2 = i02 * b0 + i12 * b1 + i22 * b2 - (m20 * y3 + m21 * y4 + m22 * y5)
+    return [y0, y1, y2, y3, y4, y5]
+
+
+def _svd_rates(
+    J: npt.NDArray[np.float64],
+    b: npt.NDArray[np.float64],
+    W: npt.NDArray[np.float64] | None,
+    rcond: float,
+) -> npt.NDArray[np.float64]:
+    """Truncated-SVD rates ``L (J L)^+ b`` with ``W = L L^T``: (M, 6, 7), (M, 6) -> (M, 7).
+
+    Singular values below ``rcond`` times the largest are dropped: the least-squares
+    solution of smallest ``qdot^T W^-1 qdot``, finite for any finite input.
+    """
+    if W is None:
+        return (np.linalg.pinv(J, rcond=rcond) @ b[..., None])[..., 0]
+    L = np.linalg.cholesky(W)
+    return (L @ np.linalg.pinv(J @ L, rcond=rcond) @ b[..., None])[..., 0]
+
+
+def _fill(out: npt.NDArray[np.float64], rows: list[list[Entry]]) -> None:
+    """Write ``rows[r][c]`` (an (N,) array or a float) into ``out[:, r, c]``."""
+    for r, row in enumerate(rows):
+        for col, value in enumerate(row):
+            out[:, r, col] = value
