@@ -1,0 +1,290 @@
+"""The resolver against pink's ``solve_ik``: step time and limit compliance, one run.
+
+Run from a checkout: ``/work/venv/bin/python benchmarks/bench_resolver.py`` (``--quick``
+for a short smoke run that writes nothing; ``--steps N`` to change the trajectory length).
+
+For rrc_k1607 and panda, one trajectory of joint configurations is recorded first: from a
+seeded random start, piecewise-constant random twists (new every 50 steps, about 0.4 m/s
+and 0.6 rad/s) are resolved by rrc-pin (native OSQP) and integrated with dt = 10 ms, so that
+position and velocity limits become active along the way. Then, at every recorded
+configuration q_k with its twist, every contender computes joint rates once, the contenders
+interleaved step by step so that they share the machine's state (warm starts carry from
+step to step as in a control loop). A step's time is the whole call:
+
+- rrc-pin: ``Resolver.solve(q, twist)`` (Pinocchio Jacobian, bounds, SVD, QP, record);
+  native warm-started OSQP, each qpsolvers backend, the direction-preserving default, and
+  OSQP without the unconstrained-optimum shortcut (every step through the backend);
+- pink (``pink.solve_ik``): ``configuration.update(q)``, the FrameTask target set to the pose
+  moved by ``twist * dt``, ``solve_ik(..., limits=[ConfigurationLimit(gain=1),
+  VelocityLimit])`` with every qpsolvers backend pink accepts. pink raises when its QP has no
+  solution (counted as a failure, rates taken as zero).
+
+Compliance of every answer: the largest excess of ``|qdot|`` over the velocity limit and of
+``q + qdot dt`` over the position limits. BLAS threads are pinned to one (set before numpy
+is imported) so that the tiny matrix products do not pay for thread hand-offs; both
+libraries run under the same setting. Results go to ``benchmarks/results/resolver.json`` and
+``resolver.png``; :func:`markdown_table` renders them and is printed at the end.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import argparse  # noqa: E402
+import json  # noqa: E402
+import logging  # noqa: E402
+import platform  # noqa: E402
+import time  # noqa: E402
+import warnings  # noqa: E402
+from collections.abc import Callable  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Any  # noqa: E402
+
+import numpy as np  # noqa: E402
+import pinocchio as pin  # noqa: E402
+
+import rrc_pin  # noqa: E402
+from rrc_pin.resolver import Resolver  # noqa: E402
+from solvers.qp_backends import installed_backends  # noqa: E402
+
+ARMS = ("rrc_k1607", "panda")
+RESULTS = Path(__file__).resolve().parent / "results"
+SEED = 20261122
+DT = 0.01
+SEGMENT = 50
+
+
+def machine_info() -> dict[str, Any]:
+    """CPU, Python and library versions of this run."""
+    import osqp
+    import qpsolvers
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    info = {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "pinocchio": pin.__version__,
+        "osqp": osqp.__version__,
+        "qpsolvers": qpsolvers.__version__,
+        "blas_threads": os.environ.get("OPENBLAS_NUM_THREADS"),
+    }
+    try:
+        import pink
+
+        info["pink"] = pink.__version__
+    except ImportError:
+        info["pink"] = None
+    return info
+
+
+def record_trajectory(arm: Any, steps: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Configurations (steps, nq) and twists (steps, 6) of one rrc-pin run (module docstring)."""
+    resolver = Resolver(arm, dt=DT, direction_preserving=False)
+    q = arm.random_q(rng)
+    Q = np.empty((steps, arm.nq))
+    X = np.empty((steps, 6))
+    twist = np.zeros(6)
+    for k in range(steps):
+        if k % SEGMENT == 0:
+            twist = np.concatenate([rng.normal(size=3) * 0.23, rng.normal(size=3) * 0.35])
+        Q[k], X[k] = q, twist
+        q = q + resolver.solve(q, twist).qdot * DT
+    return Q, X
+
+
+def rrc_contenders(arm: Any) -> dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+    """rrc-pin resolvers under test, by label."""
+    out: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]] = {}
+
+    def make(**kwargs: Any) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+        resolver = Resolver(arm, dt=DT, **kwargs)
+        return lambda q, x: resolver.solve(q, x).qdot
+
+    out["rrc-pin osqp (native, warm)"] = make(backend="osqp", direction_preserving=False)
+    out["rrc-pin osqp, no shortcut"] = make(
+        backend="osqp", direction_preserving=False, shortcut=False
+    )
+    out["rrc-pin osqp, direction-preserving"] = make(backend="osqp", direction_preserving=True)
+    for name in installed_backends():
+        if name != "osqp":
+            out[f"rrc-pin {name}"] = make(backend=name, direction_preserving=False)
+    return out
+
+
+def pink_contenders(arm: Any) -> dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]]:
+    """pink.solve_ik with every qpsolvers backend, on the same task and limits."""
+    try:
+        import pink
+        import qpsolvers
+        from pink.limits import ConfigurationLimit, VelocityLimit
+        from pink.tasks import FrameTask
+    except ImportError:
+        return {}
+    logging.getLogger().setLevel(logging.ERROR)  # pink logs every near-limit configuration
+    model = arm.model
+    out: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]] = {}
+    for solver in qpsolvers.available_solvers:
+        configuration = pink.Configuration(model, model.createData(), arm.neutral())
+        task = FrameTask(arm.tool_frame, position_cost=1.0, orientation_cost=1.0)
+        limits = [ConfigurationLimit(model, config_limit_gain=1.0), VelocityLimit(model)]
+
+        def step(
+            q: np.ndarray, x: np.ndarray, configuration: Any = configuration, task: Any = task,
+            limits: Any = limits, solver: str = solver,
+        ) -> np.ndarray:
+            configuration.update(q)
+            T = configuration.get_transform_frame_to_world(arm.tool_frame)
+            target = pin.SE3(pin.exp3(x[3:] * DT) @ T.rotation, T.translation + x[:3] * DT)
+            task.set_target(target)
+            return pink.solve_ik(
+                configuration, [task], DT, solver=solver, limits=limits, safety_break=False
+            )
+
+        out[f"pink {solver}"] = step
+    return out
+
+
+def bench_arm(name: str, steps: int) -> dict[str, Any]:
+    """Time and compliance of every contender along one trajectory of arm ``name``."""
+    arm = rrc_pin.load(name)
+    rng = np.random.default_rng(SEED)
+    Q, X = record_trajectory(arm, steps, rng)
+    contenders = {**rrc_contenders(arm), **pink_contenders(arm)}
+    times: dict[str, list[float]] = {label: [] for label in contenders}
+    v_excess = dict.fromkeys(contenders, 0.0)
+    q_excess = dict.fromkeys(contenders, 0.0)
+    failures = dict.fromkeys(contenders, 0)
+    v_max, lower, upper = arm.velocity_limit, arm.lower, arm.upper
+    clock = time.perf_counter
+    for q, x in zip(Q, X, strict=True):
+        for label, fn in contenders.items():
+            t0 = clock()
+            try:
+                qdot = fn(q, x)
+            except Exception:  # pink raises NoSolutionFound (and others) on failure
+                qdot = np.zeros(arm.nq)
+                failures[label] += 1
+            times[label].append(clock() - t0)
+            step = q + qdot * DT
+            v_excess[label] = max(v_excess[label], float(np.max(np.abs(qdot) - v_max)))
+            q_excess[label] = max(
+                q_excess[label], float(np.max(step - upper)), float(np.max(lower - step))
+            )
+    active = _active_fraction(arm, Q, X)
+    rows = {}
+    for label in contenders:
+        t = np.array(times[label]) * 1e6
+        rows[label] = {
+            "median_us": float(np.median(t)),
+            "p99_us": float(np.percentile(t, 99)),
+            "mean_us": float(np.mean(t)),
+            "max_velocity_excess": v_excess[label],
+            "max_position_excess": q_excess[label],
+            "failures": failures[label],
+        }
+    ours = rows["rrc-pin osqp (native, warm)"]["median_us"]
+    pinks = {k: v for k, v in rows.items() if k.startswith("pink")}
+    summary: dict[str, Any] = {"steps": steps, "active_limit_fraction": active}
+    if pinks:
+        fastest = min(pinks, key=lambda k: pinks[k]["median_us"])
+        summary.update(
+            pink_fastest=fastest,
+            speedup_median=pinks[fastest]["median_us"] / ours,
+            speedup_p99=pinks[fastest]["p99_us"] / rows["rrc-pin osqp (native, warm)"]["p99_us"],
+        )
+    return {"arm": name, "nq": arm.nq, "summary": summary, "contenders": rows}
+
+
+def _active_fraction(arm: Any, Q: np.ndarray, X: np.ndarray) -> float:
+    """Fraction of the trajectory's steps where some bound is active in rrc-pin's answer."""
+    resolver = Resolver(arm, dt=DT, direction_preserving=False)
+    hits = sum(1 for q, x in zip(Q, X, strict=True) if resolver.solve(q, x).active)
+    return hits / len(Q)
+
+
+def markdown_table(results: dict[str, Any]) -> str:
+    """Markdown table of a results dictionary (as written to resolver.json)."""
+    lines = []
+    for arm in results["arms"]:
+        s = arm["summary"]
+        head = (
+            f"**{arm['arm']}** ({arm['nq']} joints, {s['steps']} steps, a bound active at "
+            f"{100 * s['active_limit_fraction']:.0f}% of them)"
+        )
+        if "pink_fastest" in s:
+            head += (
+                f": rrc-pin (native OSQP) is {s['speedup_median']:.1f}x faster than "
+                f"{s['pink_fastest']} at the median, {s['speedup_p99']:.1f}x at the 99th percentile"
+            )
+        lines += [head, "", "| contender | median [us] | p99 [us] | max |qdot| excess "
+                  "[rad/s] | max position excess [rad] | failures |",
+                  "|---|---:|---:|---:|---:|---:|"]
+        for label, r in sorted(arm["contenders"].items(), key=lambda kv: kv[1]["median_us"]):
+            lines.append(
+                f"| {label} | {r['median_us']:.0f} | {r['p99_us']:.0f} | "
+                f"{r['max_velocity_excess']:.2g} | {r['max_position_excess']:.2g} | "
+                f"{r['failures']} |"
+            )
+        lines.append("")
+    return "\n".join(lines)
+
+
+def plot(results: dict[str, Any], path: Path) -> None:
+    """Bar chart of median and p99 step times per contender and arm."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    arms = results["arms"]
+    fig, axes = plt.subplots(1, len(arms), figsize=(7 * len(arms), 5), squeeze=False)
+    for ax, arm in zip(axes[0], arms, strict=True):
+        items = sorted(arm["contenders"].items(), key=lambda kv: kv[1]["median_us"])
+        labels = [k for k, _ in items]
+        med = [v["median_us"] for _, v in items]
+        p99 = [v["p99_us"] for _, v in items]
+        y = np.arange(len(labels))
+        ax.barh(y - 0.2, med, 0.4, label="median")
+        ax.barh(y + 0.2, p99, 0.4, label="99th percentile")
+        ax.set_yticks(y, labels)
+        ax.set_xscale("log")
+        ax.invert_yaxis()
+        ax.set_xlabel("step time [us] (log)")
+        ax.set_title(f"{arm['arm']}: one resolved-rate step")
+        ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Run the benchmark, write JSON and PNG (unless --quick), print the table."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--quick", action="store_true", help="short run, writes nothing")
+    parser.add_argument("--steps", type=int, default=2000, help="trajectory length")
+    args = parser.parse_args(argv)
+    steps = 100 if args.quick else args.steps
+    warnings.simplefilter("ignore")
+    results = {"machine": machine_info(), "dt": DT, "arms": [bench_arm(a, steps) for a in ARMS]}
+    if not args.quick:
+        RESULTS.mkdir(parents=True, exist_ok=True)
+        (RESULTS / "resolver.json").write_text(json.dumps(results, indent=2) + "\n")
+        plot(results, RESULTS / "resolver.png")
+    print(markdown_table(results))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,198 @@
+r"""Joint-rate bounds of one control step: velocity, position over the step, acceleration.
+
+:func:`joint_velocity_bounds` is the one definition; :class:`JointLimits` holds an arm's
+limits prepared once so that a control loop pays only a handful of vector operations per
+step. Three intervals are intersected by priority (velocity, then position, then
+acceleration); where two are disjoint the one of higher priority wins (the other is clipped
+into it), so that ``lb <= ub`` always holds:
+
+1. velocity: :math:`-v_{max} \le \dot q \le v_{max}`, never violated;
+2. position over one step, inside the range shrunk by the margin m (at most half the range)
+   and widened by :data:`ROUNDING`:
+   :math:`g\,(q_{min} + m - q)/dt \le \dot q \le g\,(q_{max} - m - q)/dt`. A start outside
+   that range makes the interval exclude zero: the joint must move back toward the range at
+   the rate that reaches it in one step (times the gain g), but never faster than
+   :math:`v_{max}`, and may not move further out. The problem stays feasible and recovers
+   (where pink and mink raise, or their QP becomes infeasible);
+3. acceleration, if given: :math:`|\dot q - \dot q_{prev}| \le a_{max} dt`; yields to the two
+   above (stopping at a position limit, or returning under the velocity limit, may need more).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from solvers.errors import InputError
+from solvers.validation import as_vector, positive
+
+Array = npt.NDArray[np.float64]
+
+VELOCITY, POSITION, ACCELERATION = 0, 1, 2
+BOUND_KINDS: tuple[str, ...] = ("velocity", "position", "acceleration")
+"""Names of the constraints a bound can come from, indexed by the codes above."""
+
+ROUNDING = 1e-13
+"""[rad or m] The range a step must stay in is widened by this much on each side.
+
+Integrating ``q + qdot dt`` up to a bound lands within a few ulp of it; without this
+tolerance the next step would see a start "outside" the range by 1e-16 and ask to move back
+(and the direction-preserving problem, which needs zero within the bounds, would be skipped).
+A step may therefore end up to ROUNDING outside the (margin-shrunk) range.
+"""
+
+
+class VelocityBounds(NamedTuple):
+    """Joint-rate bounds of one step and the constraint each bound comes from.
+
+    Attributes:
+        lb: Lower bounds (n,) [rad/s or m/s].
+        ub: Upper bounds (n,), ``lb <= ub`` everywhere.
+        lower_kind: Code (n,) of the constraint setting ``lb``: an index of
+            :data:`BOUND_KINDS`.
+        upper_kind: Same for ``ub``.
+    """
+
+    lb: Array
+    ub: Array
+    lower_kind: npt.NDArray[np.int8]
+    upper_kind: npt.NDArray[np.int8]
+
+    @property
+    def contains_zero(self) -> bool:
+        """True when standing still is allowed (no joint is asked to recover)."""
+        return bool((self.lb <= 0.0).all() and (self.ub >= 0.0).all())
+
+
+class JointLimits:
+    """An arm's joint limits, prepared once for the per-step :meth:`bounds`.
+
+    Args:
+        lower: Lower position limits (n,) [rad or m]; -inf allowed.
+        upper: Upper position limits (n,), >= lower; +inf allowed.
+        v_max: Velocity limits (n,) [rad/s or m/s], finite and > 0.
+        margin: Distance kept from each position limit [rad or m], >= 0 (capped at half
+            the range).
+        a_max: Acceleration limits (n,) or a scalar [rad/s^2 or m/s^2], > 0; None for none.
+
+    Raises:
+        InputError: Wrong shapes, NaN limits, lower > upper, non-positive or non-finite
+            velocity limits, negative margin, non-positive acceleration limits.
+    """
+
+    def __init__(
+        self,
+        lower: npt.ArrayLike,
+        upper: npt.ArrayLike,
+        v_max: npt.ArrayLike,
+        margin: float = 0.0,
+        a_max: npt.ArrayLike | None = None,
+    ) -> None:
+        v = as_vector(v_max, "v_max", np.size(v_max))
+        n = v.size
+        if np.any(v <= 0.0):
+            raise InputError("v_max", f"expected velocity limits > 0, got {v}")
+        lo, hi = _limits(lower, upper, n)
+        if not (np.isfinite(margin) and margin >= 0.0):
+            raise InputError("margin", f"expected a finite number >= 0, got {margin!r}")
+        m = np.minimum(margin, 0.5 * (hi - lo))
+        self.n = n
+        self.lower, self.upper, self.v_max, self.margin = lo, hi, v, float(margin)
+        self._range = np.stack([lo + m - ROUNDING, hi - m + ROUNDING])  # (2, n)
+        self._neg_v = -v
+        self._flip = np.array([[-1.0], [1.0]])  # row 0 tests p_lo > -v as -p_lo < v
+        self.a_max: Array | None = None
+        if a_max is not None:
+            a = as_vector(np.broadcast_to(np.asarray(a_max, dtype=float), (n,)), "a_max", n)
+            if np.any(a <= 0.0):
+                raise InputError("a_max", f"expected acceleration limits > 0, got {a}")
+            self.a_max = a
+            self._a_stack = np.stack([-a, a])
+
+    def bounds(
+        self, q: Array, dt: float, gain: float = 1.0, qdot_prev: Array | None = None
+    ) -> VelocityBounds:
+        """The bounds of one step (see the module docstring); inputs are not checked.
+
+        Args:
+            q: Joint positions (n,), finite.
+            dt: Step [s], > 0.
+            gain: Fraction in (0, 1] of the distance to a position bound allowed in one step
+                (pink's ``config_limit_gain``).
+            qdot_prev: Previous joint rates (n,) for the acceleration limits (zero if None).
+
+        Returns:
+            The :class:`VelocityBounds`.
+        """
+        v = self.v_max
+        p = (self._range - q) * (gain / dt)  # rows: position bounds p_lo, p_hi
+        b = np.minimum(np.maximum(p, self._neg_v), v)  # clipped into the velocity interval
+        kind = (p * self._flip < v).view(np.int8)  # 1 = POSITION, 0 = VELOCITY
+        lb, ub = b[0], b[1]
+        lower_kind, upper_kind = kind[0], kind[1]
+        if self.a_max is not None:
+            prev = np.zeros(self.n) if qdot_prev is None else qdot_prev
+            a = np.minimum(np.maximum(prev + self._a_stack * dt, lb), ub)
+            lower_kind = np.where(a[0] > lb, np.int8(ACCELERATION), lower_kind)
+            upper_kind = np.where(a[1] < ub, np.int8(ACCELERATION), upper_kind)
+            lb, ub = a[0], a[1]
+        return VelocityBounds(lb, ub, lower_kind, upper_kind)
+
+
+def joint_velocity_bounds(
+    q: npt.ArrayLike,
+    lower: npt.ArrayLike,
+    upper: npt.ArrayLike,
+    v_max: npt.ArrayLike,
+    dt: float,
+    margin: float = 0.0,
+    qdot_prev: npt.ArrayLike | None = None,
+    a_max: npt.ArrayLike | None = None,
+    gain: float = 1.0,
+) -> VelocityBounds:
+    """Bounds on the joint rates of one step of length ``dt`` (module docstring).
+
+    Args:
+        q: Joint positions (n,) [rad or m].
+        lower: Lower position limits (n,); -inf allowed.
+        upper: Upper position limits (n,), >= lower; +inf allowed.
+        v_max: Velocity limits (n,) [rad/s or m/s], finite and > 0.
+        dt: Step [s], > 0.
+        margin: Distance kept from each position limit [rad or m], >= 0.
+        qdot_prev: Previous joint rates (n,), required with ``a_max``.
+        a_max: Acceleration limits (n,) or scalar [rad/s^2 or m/s^2], > 0; None for none.
+        gain: Fraction in (0, 1] of the distance to a position bound allowed in one step.
+
+    Returns:
+        The :class:`VelocityBounds`, ``lb <= ub`` everywhere.
+
+    Raises:
+        InputError: Wrong shapes, non-finite q, v_max, dt or qdot_prev, lower > upper,
+            negative margin, gain outside (0, 1], or ``a_max`` without ``qdot_prev``.
+    """
+    limits = JointLimits(lower, upper, v_max, margin, a_max)
+    q = as_vector(q, "q", limits.n)
+    dt = positive(dt, "dt")
+    if not 0.0 < gain <= 1.0:
+        raise InputError("gain", f"expected a number in (0, 1], got {gain!r}")
+    prev = None
+    if a_max is not None:
+        if qdot_prev is None:
+            raise InputError("qdot_prev", "required with a_max")
+        prev = as_vector(qdot_prev, "qdot_prev", limits.n)
+    return limits.bounds(q, dt, gain, prev)
+
+
+def _limits(lower: npt.ArrayLike, upper: npt.ArrayLike, n: int) -> tuple[Array, Array]:
+    lo = np.array(lower, dtype=np.float64)
+    hi = np.array(upper, dtype=np.float64)
+    for name, arr in (("lower", lo), ("upper", hi)):
+        if arr.shape != (n,):
+            raise InputError(name, f"expected shape ({n},), got {arr.shape}")
+        if np.any(np.isnan(arr)):
+            raise InputError(name, "NaN entry")
+    if np.any(lo > hi):
+        raise InputError("lower", f"expected lower <= upper, got {lo} > {hi}")
+    return lo, hi
