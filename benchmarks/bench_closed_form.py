@@ -1,0 +1,249 @@
+"""Closed-form fast paths against Pinocchio + numpy: per-call time and batch throughput.
+
+Run from a checkout: ``/work/venv/bin/python benchmarks/bench_closed_form.py``
+(``--quick`` for a short smoke run that writes nothing).
+
+For every paper arm with a closed form (barker6, rrc_k1607, kr5_3r):
+
+- scalar: median per-call time of ``cf.joint_rates(q, xdot)`` against
+  ``pin.computeFrameJacobian(..., LOCAL_WORLD_ALIGNED)`` followed by ``numpy.linalg.solve``
+  (square arms; the first three rows for kr5_3r) or ``numpy.linalg.lstsq`` (minimum norm, for
+  the redundant rrc_k1607; pinv is slower still and is recorded too), both timed with
+  ``timeit`` at the same configurations, interleaved;
+- batch: ``cf.joint_rates_batch`` on N = 10^5 configurations against a Python loop of the
+  same Pinocchio + numpy calls, timed on a subset and scaled to N.
+
+Every closed-form answer is also checked against the Pinocchio one at the timed
+configurations (largest relative difference recorded). Results go to
+``benchmarks/results/closed_form.json`` and ``closed_form.png``; :func:`markdown_table`
+renders them for the README and is printed at the end.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import sys
+import timeit
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+import rrc_pin
+from rrc_pin.robot import frame_id
+
+ARMS = ("barker6", "rrc_k1607", "kr5_3r")
+RESULTS = Path(__file__).resolve().parent / "results"
+SEED = 20261122
+
+
+def machine_info() -> dict[str, Any]:
+    """CPU, Python and library versions of this run."""
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "pinocchio": pin.__version__,
+    }
+
+
+def per_call_us(fn: Callable[[], object], number: int, repeat: int) -> list[float]:
+    """``repeat`` timings of ``number`` calls of ``fn``, each as microseconds per call."""
+    return [t / number * 1e6 for t in timeit.repeat(fn, number=number, repeat=repeat)]
+
+
+def reference_solver(name: str, task_dim: int, nq: int) -> tuple[str, Callable[..., Any]]:
+    """The numpy solve that the Pinocchio Jacobian is paired with, and its label."""
+    if task_dim == nq:
+        return "numpy.linalg.solve", np.linalg.solve
+    return "numpy.linalg.lstsq", lambda J, x: np.linalg.lstsq(J, x, rcond=None)[0]
+
+
+def bench_arm(
+    name: str, *, n_scalar: int, number: int, n_batch: int, n_loop: int
+) -> dict[str, Any]:
+    """Scalar and batch timings of one arm (see the module docstring)."""
+    arm = rrc_pin.load(name)
+    cf = arm.closed_form
+    model, data = arm.model, arm.data
+    fid = frame_id(model, arm.tool_frame)
+    lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    m, nq = cf.task_dim, cf.nq
+    label, solve = reference_solver(name, m, nq)
+    rng = np.random.default_rng(SEED)
+
+    def pin_rates(q: np.ndarray, x: np.ndarray) -> np.ndarray:
+        return solve(pin.computeFrameJacobian(model, data, q, fid, lwa)[:m], x)
+
+    def pin_pinv(q: np.ndarray, x: np.ndarray) -> np.ndarray:
+        return np.linalg.pinv(pin.computeFrameJacobian(model, data, q, fid, lwa)[:m]) @ x
+
+    # Scalar: the same configurations for both, timings interleaved config by config.
+    Qs = np.array([arm.random_q(rng) for _ in range(n_scalar)])
+    Xs = rng.standard_normal((n_scalar, m))
+    cf_us: list[float] = []
+    pin_us: list[float] = []
+    pinv_us: list[float] = []
+    worst = 0.0
+    for q, x in zip(Qs, Xs, strict=True):
+        ours, ref = cf.joint_rates(q, x), pin_rates(q, x)
+        worst = max(worst, float(np.linalg.norm(ours - ref) / np.linalg.norm(ref)))
+        cf_us += per_call_us(lambda q=q, x=x: cf.joint_rates(q, x), number, 3)
+        pin_us += per_call_us(lambda q=q, x=x: pin_rates(q, x), number, 3)
+        if m < nq:
+            pinv_us += per_call_us(lambda q=q, x=x: pin_pinv(q, x), number, 1)
+    scalar = {
+        "closed_form_us": statistics.median(cf_us),
+        "pinocchio_us": statistics.median(pin_us),
+        "speedup": statistics.median(pin_us) / statistics.median(cf_us),
+        "pinocchio_solver": label,
+        "max_relative_difference": worst,
+        "samples": len(cf_us),
+        "calls_per_sample": number,
+    }
+    if pinv_us:
+        scalar["pinocchio_pinv_us"] = statistics.median(pinv_us)
+
+    # Batch: N configurations at once against a Python loop over a subset, scaled.
+    Q = np.array([arm.random_q(rng) for _ in range(n_batch)])
+    X = rng.standard_normal((n_batch, m))
+    cf.joint_rates_batch(Q[:1000], X[:1000])  # warm-up
+    runs = timeit.repeat(lambda: cf.joint_rates_batch(Q, X), number=1, repeat=5)
+    batch_s = statistics.median(runs)
+    Ql, Xl = Q[:n_loop], X[:n_loop]
+
+    def loop() -> np.ndarray:
+        out = np.empty((n_loop, nq))
+        for i in range(n_loop):
+            out[i] = pin_rates(Ql[i], Xl[i])
+        return out
+
+    loop_s = statistics.median(timeit.repeat(loop, number=1, repeat=5))
+    ours, ref = cf.joint_rates_batch(Ql, Xl), loop()
+    batch_worst = float(np.max(np.linalg.norm(ours - ref, axis=1) / np.linalg.norm(ref, axis=1)))
+    batch = {
+        "n": n_batch,
+        "closed_form_s": batch_s,
+        "closed_form_per_s": n_batch / batch_s,
+        "loop_n": n_loop,
+        "loop_s_scaled": loop_s * n_batch / n_loop,
+        "loop_per_s": n_loop / loop_s,
+        "speedup": (loop_s * n_batch / n_loop) / batch_s,
+        "max_relative_difference": batch_worst,
+    }
+    return {"arm": name, "closed_form": type(cf).__name__, "nq": nq, "task_dim": m,
+            "scalar": scalar, "batch": batch}
+
+
+def markdown_table(results: dict[str, Any]) -> str:
+    """The results as a Markdown table (one row per arm), for the README."""
+    lines = [
+        "| arm | closed form per call | Pinocchio + numpy per call | speed-up | "
+        "batch (N = 10^5) | Python loop over Pinocchio | speed-up |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for r in results["arms"]:
+        s, b = r["scalar"], r["batch"]
+        solver = s["pinocchio_solver"].replace("numpy.linalg.", "")
+        lines.append(
+            f"| {r['arm']} | {s['closed_form_us']:.1f} us | {s['pinocchio_us']:.1f} us "
+            f"({solver}) | {s['speedup']:.1f}x | {b['closed_form_per_s'] / 1e6:.2f} M/s | "
+            f"{b['loop_per_s'] / 1e3:.1f} k/s | {b['speedup']:.0f}x |"
+        )
+    info = results["machine"]
+    lines.append("")
+    lines.append(
+        f"Measured on {info['cpu']} ({info['cores']} cores), Python {info['python']}, "
+        f"numpy {info['numpy']}, Pinocchio {info['pinocchio']}; per-call times are medians "
+        "(timeit), batch throughput in configurations per second."
+    )
+    for note in results.get("notes", []):
+        lines.append(f"{note}")
+    return "\n".join(lines)
+
+
+def plot(results: dict[str, Any], path: Path) -> None:
+    """Bar plot: per-call times (left) and batch throughput (right, log scale)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    arms = [r["arm"] for r in results["arms"]]
+    x = np.arange(len(arms))
+    w = 0.38
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4))
+    left.bar(x - w / 2, [r["scalar"]["closed_form_us"] for r in results["arms"]], w,
+             label="closed form")
+    left.bar(x + w / 2, [r["scalar"]["pinocchio_us"] for r in results["arms"]], w,
+             label="Pinocchio J + numpy")
+    left.set_xticks(x, arms)
+    left.set_ylabel("time per call [us] (median)")
+    left.set_title("joint_rates, one configuration")
+    left.legend()
+    right.bar(x - w / 2, [r["batch"]["closed_form_per_s"] for r in results["arms"]], w,
+              label="joint_rates_batch")
+    right.bar(x + w / 2, [r["batch"]["loop_per_s"] for r in results["arms"]], w,
+              label="Python loop over Pinocchio")
+    right.set_yscale("log")
+    right.set_xticks(x, arms)
+    right.set_ylabel("configurations per second")
+    right.set_title("batch, N = 10^5")
+    right.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="short run, writes nothing")
+    args = parser.parse_args(argv)
+    sizes = (
+        {"n_scalar": 3, "number": 200, "n_batch": 5000, "n_loop": 200}
+        if args.quick
+        else {"n_scalar": 40, "number": 1000, "n_batch": 100_000, "n_loop": 2000}
+    )
+    results: dict[str, Any] = {"machine": machine_info(), "sizes": sizes, "arms": [], "notes": []}
+    for name in ARMS:
+        try:
+            cf = rrc_pin.load(name).closed_form
+        except ImportError as exc:
+            cf, why = None, f"{type(exc).__name__}: {exc}"
+        else:
+            why = "no closed form in the catalogue"
+        if cf is None:
+            note = f"{name}: skipped ({why})"
+            print(note)
+            results["notes"].append(note)
+            continue
+        print(f"{name}: timing ...", flush=True)
+        results["arms"].append(bench_arm(name, **sizes))
+    table = markdown_table(results)
+    if not args.quick:
+        RESULTS.mkdir(exist_ok=True)
+        (RESULTS / "closed_form.json").write_text(json.dumps(results, indent=2) + "\n")
+        plot(results, RESULTS / "closed_form.png")
+        print(f"wrote {RESULTS / 'closed_form.json'} and closed_form.png")
+    print(table)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
