@@ -408,6 +408,10 @@ class ResolutionChain:
         elif problem.kind == "direction" and problem.P.shape[0] <= 2:
             x = _direction_exact(problem, bounds)
             status, iterations, solve_time, backend = "exact", 0, 0.0, ""
+        elif problem.kind == "priority" and problem.P.shape[0] == 1:
+            x = np.array([_interval_point(problem.G[:, 0], problem.lo, problem.hi,
+                                          float(problem.x_free[0]))])
+            status, iterations, solve_time, backend = "exact", 0, 0.0, ""
         else:
             if self.backend is None:  # pragma: no cover - excluded at construction
                 raise _MethodFailed("no backend")
@@ -492,6 +496,18 @@ def _direction_exact(problem: QPProblem, bounds: VelocityBounds) -> Array:
         return np.array([uniform_scale(G[:, 0], bounds)])
     z, u = max_scale_one_null(G[:, 0], G[:, 1], bounds.lb, bounds.ub, float(problem.x_free[0]))
     return np.array([z, u])
+
+
+def _interval_point(g: Array, lo: Array, hi: Array, target: float) -> float:
+    """The x nearest ``target`` with ``lo <= g x <= hi`` (one variable: an interval)."""
+    moving = np.abs(g) > 1e-12
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t1, t2 = lo[moving] / g[moving], hi[moving] / g[moving]
+    x_lo = float(np.minimum(t1, t2).max(initial=-np.inf))
+    x_hi = float(np.maximum(t1, t2).min(initial=np.inf))
+    if x_lo > x_hi:  # rounding at a degenerate point: the interval is a point
+        x_lo = x_hi = 0.5 * (x_lo + x_hi)
+    return min(max(target, x_lo), x_hi)
 
 
 def _hold(bounds: VelocityBounds) -> _Answer:

@@ -8,7 +8,8 @@ the rest):
   Warm start: no (qpsolvers ignores initial values for DAQP).
 - ``proxqp``: proximal augmented Lagrangian (Bambade, El-Kazdadi, Taylor & Carpentier,
   "PROX-QP: Yet another Quadratic Programming Solver for Robotics and beyond", RSS 2022).
-  Warm start: yes (the previous primal solution).
+  Warm start: yes (the previous primal solution). Seen to declare a few feasible
+  one-variable problems primal infeasible (then the resolver falls back).
 - ``quadprog``: Goldfarb-Idnani dual active-set (Goldfarb & Idnani, Mathematical Programming
   27:1-33, 1983). Warm start: no.
 - ``clarabel``: interior point with homogeneous embedding (Goulart & Chen, "Clarabel: an
@@ -37,7 +38,13 @@ WARM_STARTING: frozenset[str] = frozenset({"proxqp", "osqp", "qpalm", "piqp", "h
 """qpsolvers solvers that use the initial values they are given."""
 
 DEFAULT_OPTIONS: dict[str, dict[str, Any]] = {
-    "proxqp": {"eps_abs": 1e-9, "eps_rel": 0.0},
+    "proxqp": {
+        "eps_abs": 1e-9,
+        "eps_rel": 0.0,
+        "check_duality_gap": True,  # without it, answers were off by up to 5e-4
+        "eps_duality_gap_abs": 1e-9,
+        "eps_duality_gap_rel": 0.0,
+    },
     "clarabel": {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1e-10},
     "osqp": {"eps_abs": 1e-7, "eps_rel": 1e-7, "polishing": True},
 }
