@@ -124,8 +124,6 @@ def bench_arm(
     Q = np.array([arm.random_q(rng) for _ in range(n_batch)])
     X = rng.standard_normal((n_batch, m))
     cf.joint_rates_batch(Q[:1000], X[:1000])  # warm-up
-    runs = timeit.repeat(lambda: cf.joint_rates_batch(Q, X), number=1, repeat=5)
-    batch_s = statistics.median(runs)
     Ql, Xl = Q[:n_loop], X[:n_loop]
 
     def loop() -> np.ndarray:
@@ -134,7 +132,12 @@ def bench_arm(
             out[i] = pin_rates(Ql[i], Xl[i])
         return out
 
-    loop_s = statistics.median(timeit.repeat(loop, number=1, repeat=5))
+    # Interleaved, so that both see the same machine load.
+    batch_runs, loop_runs = [], []
+    for _ in range(7):
+        batch_runs += timeit.repeat(lambda: cf.joint_rates_batch(Q, X), number=1, repeat=1)
+        loop_runs += timeit.repeat(loop, number=1, repeat=1)
+    batch_s, loop_s = statistics.median(batch_runs), statistics.median(loop_runs)
     ours, ref = cf.joint_rates_batch(Ql, Xl), loop()
     batch_worst = float(np.max(np.linalg.norm(ours - ref, axis=1) / np.linalg.norm(ref, axis=1)))
     batch = {

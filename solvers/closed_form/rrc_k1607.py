@@ -306,7 +306,7 @@ class RrcK1607ClosedForm(ClosedForm):
         """
         Q = as_array(Q, "Q", (None, NQ))
         out = np.empty((Q.shape[0], TASK_DIM, NQ))
-        for rows, c, s in _chunks(Q):
+        for rows, c, s in _chunks(Q, pose=False):
             J = list(zip(*_kinematics(c, s, self.a, self.d, pose=False)[2], strict=True))
             _fill(out[rows], J)
         return out
@@ -343,7 +343,7 @@ class RrcK1607ClosedForm(ClosedForm):
         if Z is not None:
             Z = as_array(Z, "Z", (Q.shape[0], NQ))
         out = np.empty((Q.shape[0], NQ))
-        for rows, c, s in _chunks(Q):
+        for rows, c, s in _chunks(Q, pose=False):
             out[rows] = self._rates_chunk(c, s, X[rows], Wm, None if Z is None else Z[rows])
         return out
 
@@ -410,43 +410,58 @@ def _floats(x: npt.ArrayLike, name: str, size: int) -> list[float]:
 
 
 def _chunks(
-    Q: npt.NDArray[np.float64],
-) -> Iterator[tuple[slice, list[npt.NDArray[np.float64]], list[npt.NDArray[np.float64]]]]:
+    Q: npt.NDArray[np.float64], pose: bool = True
+) -> Iterator[tuple[slice, list[Any], list[Any]]]:
     """Blocks of :data:`CHUNK` configurations: (rows, cosines, sines), 7 (M,) arrays each.
 
-    The trigonometry runs once over the whole batch, the rest block by block.
+    The trigonometry runs once over the whole batch, the rest block by block. Without
+    ``pose`` theta_7 is not needed (its cosine and sine are None).
     """
-    C, S = _cos_sin(Q)
+    C, S = _cos_sin(Q if pose else Q[:, : NQ - 1])
+    extra = [] if pose else [None]
     for lo in range(0, Q.shape[0], CHUNK):
         rows = slice(lo, lo + CHUNK)
-        yield rows, [c[rows] for c in C], [s[rows] for s in S]
+        yield rows, [c[rows] for c in C] + extra, [s[rows] for s in S] + extra
 
 
 def _cos_sin(Q: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-    """Cosines and sines of the columns of ``Q`` (N, 7): two (7, N) arrays.
+    """Cosines and sines of the columns of ``Q`` (N, k): two (k, N) arrays.
 
     By the tangent half-angle, ``t = tan(q/2)``: ``cos q = (1 - t^2) / (1 + t^2)``,
     ``sin q = 2 t / (1 + t^2)``, one transcendental call instead of two (absolute error a
     few ulp for every q, including q = pi where t = 1.6e16).
     """
-    t = np.tan(0.5 * Q.T)
+    t = np.tan(0.5 * np.ascontiguousarray(Q.T))
     u = t * t
     w = 1.0 / (1.0 + u)
     return (1.0 - u) * w, (2.0 * w) * t
 
 
 def _dot(u: Sequence[Entry], v: Sequence[Entry]) -> Entry:
-    """Sum of ``u[k] * v[k]``, skipping exact float zeros (the constant Jacobian entries)."""
-    acc: Entry = 0.0
+    """Sum of ``u[k] * v[k]``, skipping exact float zeros and ones (constant Jacobian entries).
+
+    Accumulates in place into the first product it owns (never into an argument).
+    """
+    acc: Entry = None
+    owned = False
     for uk, vk in zip(u, v, strict=True):
         if type(uk) is float and (uk == 0.0 or uk == 1.0):
-            if uk:
-                acc = acc + vk
-        elif type(vk) is float and vk == 0.0:
-            continue
+            if not uk:
+                continue
+            term = vk
+        elif type(vk) is float and (vk == 0.0 or vk == 1.0):
+            if not vk:
+                continue
+            term = uk
         else:
-            acc = acc + uk * vk
-    return acc
+            term = uk * vk
+        if acc is None:
+            acc, owned = term, term is not uk and term is not vk
+        elif owned:
+            acc += term
+        else:
+            acc, owned = acc + term, True
+    return 0.0 if acc is None else acc
 
 
 def _check_weight(W: npt.ArrayLike) -> npt.NDArray[np.float64]:
