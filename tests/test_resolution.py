@@ -47,7 +47,7 @@ def setting(rng: np.random.Generator, name: str = "panda") -> tuple:
 # does not polish without an active bound, which leaves up to ~1e-4 along the weakly
 # curved null-space direction (curvature mu = 1e-2); the interior-point and proximal
 # solvers reach about 1e-7; the active-set ones are exact.
-TOL = {"osqp": 2e-4, "proxqp": 1e-6, "clarabel": 1e-6, "daqp": 1e-10, "quadprog": 1e-10}
+TOL = {"osqp": 5e-4, "proxqp": 1e-6, "clarabel": 1e-6, "daqp": 1e-10, "quadprog": 1e-10}
 
 
 @pytest.mark.parametrize("name", sorted(MODULES))
