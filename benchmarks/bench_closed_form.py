@@ -191,24 +191,31 @@ def plot(results: dict[str, Any], path: Path) -> None:
     arms = [r["arm"] for r in results["arms"]]
     x = np.arange(len(arms))
     w = 0.38
-    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4))
-    left.bar(x - w / 2, [r["scalar"]["closed_form_us"] for r in results["arms"]], w,
-             label="closed form")
-    left.bar(x + w / 2, [r["scalar"]["pinocchio_us"] for r in results["arms"]], w,
-             label="Pinocchio J + numpy")
-    left.set_xticks(x, arms)
-    left.set_ylabel("time per call [us] (median)")
-    left.set_title("joint_rates, one configuration")
-    left.legend()
-    right.bar(x - w / 2, [r["batch"]["closed_form_per_s"] for r in results["arms"]], w,
-              label="joint_rates_batch")
-    right.bar(x + w / 2, [r["batch"]["loop_per_s"] for r in results["arms"]], w,
-              label="Python loop over Pinocchio")
-    right.set_yscale("log")
-    right.set_xticks(x, arms)
-    right.set_ylabel("configurations per second")
-    right.set_title("batch, N = 10^5")
-    right.legend()
+    fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4.2))
+    panels = (
+        (left, "scalar", "closed_form_us", "pinocchio_us", "closed form",
+         "Pinocchio J + numpy", "time per call [us] (median)", "joint_rates, one configuration"),
+        (right, "batch", "closed_form_per_s", "loop_per_s", "joint_rates_batch",
+         "Python loop over Pinocchio", "configurations per second", "batch, N = 10^5"),
+    )
+    for ax, part, ours, theirs, l1, l2, ylabel, title in panels:
+        a = [r[part][ours] for r in results["arms"]]
+        b = [r[part][theirs] for r in results["arms"]]
+        ax.bar(x - w / 2, a, w, label=l1)
+        ax.bar(x + w / 2, b, w, label=l2)
+        top = max(max(a), max(b))
+        for i, r in enumerate(results["arms"]):
+            y = max(a[i], b[i]) * (1.6 if part == "batch" else 1.04)
+            ax.text(x[i], y, f"{r[part]['speedup']:.1f}x", ha="center", va="bottom")
+        if part == "batch":
+            ax.set_yscale("log")
+            ax.set_ylim(top=top * 15)
+        else:
+            ax.set_ylim(top=top * 1.35)
+        ax.set_xticks(x, arms)
+        ax.set_ylabel(ylabel)
+        ax.set_title(title)
+        ax.legend(loc="upper left", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
