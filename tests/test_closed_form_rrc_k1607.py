@@ -152,6 +152,14 @@ def test_singular_configurations_never_give_nan():
     batch = CF.joint_rates_batch(Q, X)
     assert np.all(np.isfinite(batch))
     np.testing.assert_allclose(batch[0], CF.joint_rates(Q[0], X[0]), rtol=1e-12, atol=1e-15)
+    # Weighted, with a null-space vector, at the singular home pose: L (J L)^+ (x - J z) + z.
+    W, z = random_spd(rng), rng.standard_normal(7)
+    J = ARM.jacobian(home)
+    L = np.linalg.cholesky(W)
+    ref = L @ np.linalg.pinv(J @ L, rcond=CF.rcond) @ (X[0] - J @ z) + z
+    np.testing.assert_allclose(CF.joint_rates(home, X[0], W=W, z=z), ref, rtol=1e-9, atol=1e-12)
+    batch = CF.joint_rates_batch(Q[:1], X[:1], W=W, Z=z[None])
+    np.testing.assert_allclose(batch[0], ref, rtol=1e-9, atol=1e-12)
 
 
 # ------------------------------------------------------- weighted pseudo-inverse
