@@ -1,8 +1,9 @@
-"""Command line: ``rrc-pin arms | demo | check | urdf --check|--write``."""
+"""Command line: ``rrc-pin arms | demo | check | bench | urdf --check|--write``."""
 
 from __future__ import annotations
 
 import argparse
+import subprocess
 import sys
 from collections.abc import Sequence
 from pathlib import Path
@@ -20,6 +21,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     demo.add_argument("--arm", default=None, help="one arm instead of the tour")
     check = sub.add_parser("check", help="cross-check every catalogue arm: DH, Pinocchio, yourdfpy")
     check.add_argument("--samples", type=int, default=200)
+    bench = sub.add_parser("bench", help="run the benchmarks of a checkout, record and tabulate them")
+    bench.add_argument("--only", choices=["closed_form", "resolver"], help="one benchmark")
     urdf = sub.add_parser("urdf", help="compare or rewrite the committed URDFs")
     mode = urdf.add_mutually_exclusive_group(required=True)
     mode.add_argument("--check", action="store_true", help="fail if a committed file differs")
@@ -34,6 +37,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     if args.command == "urdf":
         return urdf_command(args.dir, write=args.write)
+    if args.command == "bench":
+        return bench_command(args.only)
     if args.command == "check":
         from rrc_pin.cross_check import run_cross_check
 
@@ -95,6 +100,20 @@ def urdf_command(directory: Path, *, write: bool) -> int:
         print(problem, file=sys.stderr)
     print(f"{len(specs) - len(problems)}/{len(specs)} URDFs in {directory} match their DH tables")
     return 1 if problems else 0
+
+
+def bench_command(only: str | None) -> int:
+    """Run ``benchmarks/bench_*.py`` of the checkout, then regenerate the README's table."""
+    folder = urdf_export.COMMITTED_DIR.parent / "benchmarks"
+    if not folder.is_dir():
+        print(f"rrc-pin bench runs from a checkout: no {folder}", file=sys.stderr)
+        return 2
+    names = [only] if only else ["closed_form", "resolver"]
+    for name in names:
+        code = subprocess.call([sys.executable, str(folder / f"bench_{name}.py")])
+        if code:
+            return code
+    return subprocess.call([sys.executable, str(folder / "update_readme.py")])
 
 
 if __name__ == "__main__":
