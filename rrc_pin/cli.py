@@ -21,7 +21,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     demo.add_argument("--arm", default=None, help="one arm instead of the tour")
     check = sub.add_parser("check", help="cross-check every catalogue arm: DH, Pinocchio, yourdfpy")
     check.add_argument("--samples", type=int, default=200)
-    bench = sub.add_parser("bench", help="run the benchmarks of a checkout, record and tabulate them")
+    bench = sub.add_parser("bench", help="run, record and tabulate the benchmarks")
     bench.add_argument("--only", choices=["closed_form", "resolver"], help="one benchmark")
     urdf = sub.add_parser("urdf", help="compare or rewrite the committed URDFs")
     mode = urdf.add_mutually_exclusive_group(required=True)
