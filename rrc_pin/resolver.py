@@ -235,7 +235,7 @@ class Resolver:
 def _vector(x: npt.ArrayLike, name: str, n: int) -> Array:
     """``x`` as a finite float (n,) array; one vector operation when it is valid."""
     if isinstance(x, np.ndarray) and x.dtype == np.float64 and x.shape == (n,):
-        if math.isfinite(x.sum()) or np.isfinite(x).all():
+        if math.isfinite(x @ x) or np.isfinite(x).all():  # x @ x overflows only past 1e154
             return x
     return as_vector(x, name, n, InvalidInput)
 

@@ -20,8 +20,6 @@ into it), so that ``lb <= ub`` always holds:
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import numpy as np
 import numpy.typing as npt
 
@@ -44,26 +42,65 @@ A step may therefore end up to ROUNDING outside the (margin-shrunk) range.
 """
 
 
-class VelocityBounds(NamedTuple):
+class VelocityBounds:
     """Joint-rate bounds of one step and the constraint each bound comes from.
 
     Attributes:
         lb: Lower bounds (n,) [rad/s or m/s].
         ub: Upper bounds (n,), ``lb <= ub`` everywhere.
         lower_kind: Code (n,) of the constraint setting ``lb``: an index of
-            :data:`BOUND_KINDS`.
+            :data:`BOUND_KINDS` (computed on first access when built by
+            :meth:`JointLimits.bounds`).
         upper_kind: Same for ``ub``.
     """
 
-    lb: Array
-    ub: Array
-    lower_kind: npt.NDArray[np.int8]
-    upper_kind: npt.NDArray[np.int8]
+    __slots__ = ("_kinds", "_raw", "lb", "ub")
+
+    def __init__(
+        self,
+        lb: Array,
+        ub: Array,
+        lower_kind: npt.NDArray[np.int8] | None = None,
+        upper_kind: npt.NDArray[np.int8] | None = None,
+        *,
+        raw: tuple[Array, Array] | None = None,
+    ) -> None:
+        self.lb = lb
+        self.ub = ub
+        both = lower_kind is not None and upper_kind is not None
+        self._kinds = (lower_kind, upper_kind) if both else None
+        self._raw = raw  # (position bounds (2, n), velocity limits (n,)) for lazy kinds
+
+    def _kind(self) -> tuple[npt.NDArray[np.int8], npt.NDArray[np.int8]]:
+        if self._kinds is None:
+            if self._raw is None:
+                zeros = np.zeros(self.lb.size, dtype=np.int8)
+                self._kinds = (zeros, zeros)
+            else:
+                p, v = self._raw
+                self._kinds = (
+                    (p[0] > -v).astype(np.int8),  # POSITION (1) where tighter than VELOCITY
+                    (p[1] < v).astype(np.int8),
+                )
+        return self._kinds  # type: ignore[return-value]
+
+    @property
+    def lower_kind(self) -> npt.NDArray[np.int8]:
+        """See the class docstring."""
+        return self._kind()[0]
+
+    @property
+    def upper_kind(self) -> npt.NDArray[np.int8]:
+        """See the class docstring."""
+        return self._kind()[1]
 
     @property
     def contains_zero(self) -> bool:
         """True when standing still is allowed (no joint is asked to recover)."""
         return bool((self.lb <= 0.0).all() and (self.ub >= 0.0).all())
+
+    def __repr__(self) -> str:
+        return f"VelocityBounds(lb={self.lb!r}, ub={self.ub!r})"
 
 
 class JointLimits:
@@ -102,7 +139,6 @@ class JointLimits:
         self.lower, self.upper, self.v_max, self.margin = lo, hi, v, float(margin)
         self._range = np.stack([lo + m - ROUNDING, hi - m + ROUNDING])  # (2, n)
         self._neg_v = -v
-        self._flip = np.array([[-1.0], [1.0]])  # row 0 tests p_lo > -v as -p_lo < v
         self.a_max: Array | None = None
         if a_max is not None:
             a = as_vector(np.broadcast_to(np.asarray(a_max, dtype=float), (n,)), "a_max", n)
@@ -129,16 +165,16 @@ class JointLimits:
         v = self.v_max
         p = (self._range - q) * (gain / dt)  # rows: position bounds p_lo, p_hi
         b = np.minimum(np.maximum(p, self._neg_v), v)  # clipped into the velocity interval
-        kind = (p * self._flip < v).view(np.int8)  # 1 = POSITION, 0 = VELOCITY
+        if self.a_max is None:
+            return VelocityBounds(b[0], b[1], raw=(p, v))
         lb, ub = b[0], b[1]
-        lower_kind, upper_kind = kind[0], kind[1]
-        if self.a_max is not None:
-            prev = np.zeros(self.n) if qdot_prev is None else qdot_prev
-            a = np.minimum(np.maximum(prev + self._a_stack * dt, lb), ub)
-            lower_kind = np.where(a[0] > lb, np.int8(ACCELERATION), lower_kind)
-            upper_kind = np.where(a[1] < ub, np.int8(ACCELERATION), upper_kind)
-            lb, ub = a[0], a[1]
-        return VelocityBounds(lb, ub, lower_kind, upper_kind)
+        lower_kind = (p[0] > -v).astype(np.int8)
+        upper_kind = (p[1] < v).astype(np.int8)
+        prev = np.zeros(self.n) if qdot_prev is None else qdot_prev
+        a = np.minimum(np.maximum(prev + self._a_stack * dt, lb), ub)
+        lower_kind[a[0] > lb] = ACCELERATION
+        upper_kind[a[1] < ub] = ACCELERATION
+        return VelocityBounds(a[0], a[1], lower_kind, upper_kind)
 
 
 def joint_velocity_bounds(

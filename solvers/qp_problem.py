@@ -135,25 +135,63 @@ def tracking_problem(
     """
     if not secondary_weight > 0.0:
         raise InputError("secondary_weight", f"expected a number > 0, got {secondary_weight!r}")
+    free = tracking_free(svd, xw, secondary, secondary_weight)
+    return tracking_problem_from(svd, free, bounds)
+
+
+class TrackingFree(NamedTuple):
+    """The box-free minimiser of :func:`tracking_problem` and the terms that build P and q.
+
+    Attributes:
+        x: Minimiser (n,) without the bounds: inside them, it is the solution.
+        d: Eigenvalues (n,) of P in the singular basis V.
+        g: Components (n,) of -q in the singular basis V.
+    """
+
+    x: Array
+    d: Array
+    g: Array
+
+
+def tracking_free(
+    svd: TaskSVD, xw: Array, secondary: Array | None = None, secondary_weight: float = 1e-2
+) -> TrackingFree:
+    """The box-free minimiser of :func:`tracking_problem`, without building P and q.
+
+    The resolver checks it against the bounds first; only when it leaves them are P and q
+    built (:func:`tracking_problem_from`).
+    """
+    d, g = _tracking_terms(svd, xw, secondary, secondary_weight)
+    return TrackingFree(svd.Vt.T @ (g / d), d, g)
+
+
+def tracking_problem_from(svd: TaskSVD, free: TrackingFree, bounds: VelocityBounds) -> QPProblem:
+    """The ``"tracking"`` :class:`QPProblem` from the terms of :func:`tracking_free`."""
+    V = svd.Vt.T
+    return QPProblem(
+        P=(V * free.d) @ svd.Vt, q=V @ -free.g, G=None, lo=None, hi=None, lb=bounds.lb,
+        ub=bounds.ub, offset=None, x_free=free.x, n=svd.n, kind="tracking",
+    )
+
+
+def _tracking_terms(
+    svd: TaskSVD, xw: Array, secondary: Array | None, mu: float
+) -> tuple[Array, Array]:
+    """Eigenvalues d of P and components g of -q in the singular basis V."""
     n = svd.n
     k = svd.sigma.size
     r = svd.rank
-    Vt = svd.Vt
-    lam, mu = svd.lambda_sq, secondary_weight
-    # Eigenvalues of P in the singular basis; > 0: sigma_i > 0 for i < r, mu > 0 beyond.
+    lam = svd.lambda_sq
+    # d > 0: sigma_i > 0 for i < r, mu > 0 beyond.
     d = np.array(
         [s * s + lam + (mu if i >= r else 0.0) for i, s in enumerate(svd.sigma.tolist())]
         + [lam + mu] * (n - k)
     )
-    g = np.zeros(n)  # -V^T q: components of the linear term in the singular basis
+    g = np.zeros(n)
     np.multiply(svd.sigma, svd.U.T @ xw, out=g[:k])
     if secondary is not None:
-        g[r:] += mu * (Vt[r:] @ secondary)
-    V = Vt.T
-    return QPProblem(
-        P=(V * d) @ Vt, q=V @ -g, G=None, lo=None, hi=None, lb=bounds.lb, ub=bounds.ub,
-        offset=None, x_free=V @ (g / d), n=n, kind="tracking",
-    )
+        g[r:] += mu * (svd.Vt[r:] @ secondary)
+    return d, g
 
 
 def direction_problem(

@@ -35,7 +35,8 @@ from solvers.qp_problem import (
     QPProblem,
     direction_problem,
     priority_problem,
-    tracking_problem,
+    tracking_free,
+    tracking_problem_from,
 )
 from solvers.validation import as_array, as_vector
 
@@ -320,7 +321,7 @@ class ResolutionChain:
             except (SolverError, np.linalg.LinAlgError, ArithmeticError) as exc:
                 attempts.append((method, str(exc)))
                 continue
-            if math.isfinite(answer.qdot.sum()) or np.isfinite(answer.qdot).all():
+            if math.isfinite(answer.qdot @ answer.qdot) or np.isfinite(answer.qdot).all():
                 break
             attempts.append((method, "non-finite rates"))
             answer = None
@@ -380,8 +381,14 @@ class ResolutionChain:
             x, answer = self._solve(problem, "qp_direction", bounds)
             answer.scale = problem.scale(x)
         else:
-            problem = tracking_problem(svd, xw, bounds, soft_z, self.secondary_weight)
-            _, answer = self._solve(problem, "qp", bounds)
+            # the box-free minimiser first; P and q are built only when it leaves the box
+            free = tracking_free(svd, xw, soft_z, self.secondary_weight)
+            x = free.x
+            if self.shortcut and (x >= bounds.lb).all() and (x <= bounds.ub).all():
+                answer = _Answer(x, "qp", None, "unconstrained optimum")
+            else:
+                problem = tracking_problem_from(svd, free, bounds)
+                _, answer = self._solve(problem, "qp", bounds, check_free=False)
         if z is None or self.priority != "strict" or svd.rank == svd.n:
             return answer
         second = priority_problem(svd, answer.qdot, bounds, z)
@@ -397,10 +404,10 @@ class ResolutionChain:
         return answer2
 
     def _solve(
-        self, problem: QPProblem, method: str, bounds: VelocityBounds
+        self, problem: QPProblem, method: str, bounds: VelocityBounds, check_free: bool = True
     ) -> tuple[Array, _Answer]:
         """Solve ``problem`` (shortcut, closed form or backend); rates clipped into ``bounds``."""
-        if self.shortcut and problem.free_in_box():
+        if check_free and self.shortcut and problem.free_in_box():
             x = problem.x_free
             if problem.G is None:
                 return x, _Answer(x, method, None, "unconstrained optimum")

@@ -18,8 +18,9 @@ the rest):
 
 Each solve goes through ``qpsolvers.solve_problem``; build time (our conversion plus
 qpsolvers') and solve time are recorded apart. Two-sided rows become pairs of one-sided
-rows; box entries are passed as a box when all finite, else as rows. Tolerances are
-tightened where the solver's defaults are loose.
+rows; box entries are passed as a box when all finite, else as rows. Variables with a
+zero-width box are eliminated and zero-width rows widened by 1e-9 (quadprog and clarabel
+refuse them). Tolerances are tightened where the solver's defaults are loose.
 """
 
 from __future__ import annotations
@@ -91,8 +92,12 @@ class QpsolversBackend(QPBackend):
         """
         t0 = time.perf_counter()
         key = structure_key(problem)
+        full = problem
+        problem, free = _eliminate_fixed(problem)
         qp = self._qpsolvers.Problem(problem.P, problem.q, *_inequalities(problem))
         initvals = self._x.get(key) if self.warm_starts else None
+        if initvals is not None and free is not None:
+            initvals = initvals[free]
         t1 = time.perf_counter()
         try:
             with warnings.catch_warnings():
@@ -105,6 +110,10 @@ class QpsolversBackend(QPBackend):
         t2 = time.perf_counter()
         x = sol.x
         found = bool(sol.found) and x is not None and bool(np.all(np.isfinite(x)))
+        if found and free is not None:
+            x_full = full.lb.copy()  # fixed variables at their (single) value
+            x_full[free] = x
+            x = x_full
         if found:
             self._x[key] = np.array(x, dtype=np.float64)
         inner_build = float(getattr(sol, "build_time", 0.0) or 0.0)
@@ -123,14 +132,46 @@ class QpsolversBackend(QPBackend):
         )
 
 
+WIDTH = 1e-9
+"""Relative width given to zero-width rows (lo == hi), which quadprog refuses as
+inconsistent; the resolver clips the answer back into the exact bounds."""
+
+
+def _widen(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """``hi`` raised to at least ``lo + WIDTH (1 + |lo|)`` where both are finite."""
+    with np.errstate(invalid="ignore"):
+        wider = np.maximum(hi, lo + WIDTH * (1.0 + np.abs(lo)))
+    return np.where(np.isfinite(lo) & np.isfinite(hi), wider, hi)
+
+
+def _eliminate_fixed(problem: QPProblem) -> tuple[QPProblem, np.ndarray | None]:
+    """The problem without the variables whose box has zero width (lb == ub).
+
+    Interior-point and dual active-set solvers fail on such boxes (quadprog: "constraints
+    are inconsistent"). Returns the reduced problem and the mask of the remaining variables
+    (None when nothing is fixed).
+    """
+    fixed = problem.lb >= problem.ub
+    if not fixed.any() or problem.G is not None:
+        return problem, None
+    free = ~fixed
+    value = problem.lb[fixed]
+    q = problem.q[free] + problem.P[np.ix_(free, fixed)] @ value
+    reduced = problem._replace(
+        P=problem.P[np.ix_(free, free)], q=q, lb=problem.lb[free], ub=problem.ub[free],
+        x_free=problem.x_free[free],
+    )
+    return reduced, free
+
+
 def _inequalities(problem: QPProblem) -> tuple[Any, ...]:
     """``(G, h, A, b, lb, ub)`` of qpsolvers for ``problem`` (no equality constraints)."""
     rows: list[np.ndarray] = []
     rhs: list[np.ndarray] = []
     if problem.G is not None and problem.lo is not None and problem.hi is not None:
         rows += [problem.G, -problem.G]
-        rhs += [problem.hi, -problem.lo]
-    lb, ub = problem.lb, problem.ub
+        rhs += [_widen(problem.lo, problem.hi), -problem.lo]
+    lb, ub = problem.lb, _widen(problem.lb, problem.ub)
     if not (np.all(np.isfinite(lb)) and np.all(np.isfinite(ub))):
         eye = np.eye(lb.size)
         low, high = np.isfinite(lb), np.isfinite(ub)
