@@ -90,7 +90,9 @@ def machine_info() -> dict[str, Any]:
     return info
 
 
-def record_trajectory(arm: Any, steps: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+def record_trajectory(
+    arm: Any, steps: int, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray]:
     """Configurations (steps, nq) and twists (steps, 6) of one rrc-pin run (module docstring)."""
     resolver = Resolver(arm, dt=DT, direction_preserving=False)
     q = arm.random_q(rng)
@@ -169,8 +171,11 @@ def bench_arm(name: str, steps: int) -> dict[str, Any]:
     failures = dict.fromkeys(contenders, 0)
     v_max, lower, upper = arm.velocity_limit, arm.lower, arm.upper
     clock = time.perf_counter
+    order = list(contenders)
     for q, x in zip(Q, X, strict=True):
-        for label, fn in contenders.items():
+        rng.shuffle(order)  # no contender always runs first, after another one's cache misses
+        for label in order:
+            fn = contenders[label]
             t0 = clock()
             try:
                 qdot = fn(q, x)
