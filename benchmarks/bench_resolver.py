@@ -250,6 +250,7 @@ def markdown_table(results: dict[str, Any]) -> str:
 def plot(results: dict[str, Any], path: Path) -> None:
     """Bar chart of median and p99 step times per contender and arm."""
     import matplotlib
+    import matplotlib.ticker
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -266,6 +267,9 @@ def plot(results: dict[str, Any], path: Path) -> None:
         ax.barh(y + 0.2, p99, 0.4, label="99th percentile")
         ax.set_yticks(y, labels)
         ax.set_xscale("log")
+        ax.set_xlim(left=50.0)
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
         ax.invert_yaxis()
         ax.set_xlabel("step time [us] (log)")
         ax.set_title(f"{arm['arm']}: one resolved-rate step")

@@ -116,7 +116,7 @@ class Resolver:
         try:
             self.factor = weight_factor(task_weights, len(self.rows), "task_weights")
         except InputError as exc:
-            raise InvalidInput("task_weights", str(exc)) from exc
+            raise _invalid(exc) from exc
         if fallbacks is None:
             fallbacks = ("scaling", "dls") if direction_preserving else ("dls", "scaling")
         methods = tuple(fallbacks) if backend is None else ("qp", *fallbacks)
@@ -208,7 +208,8 @@ class Resolver:
         result = self.chain.resolve(
             J, twist, bounds, secondary, self.factor, self.joint_names, validate=False
         )
-        self._last_qdot = result.qdot
+        # kept for the next acceleration bound (a copy: the caller may modify its result)
+        self._last_qdot = result.qdot if self.limits.a_max is None else result.qdot.copy()
         self._steps += 1
         return result
 

@@ -3,17 +3,21 @@
 :class:`ResolutionChain` tries its methods in order until one answers:
 
 - ``"qp"``: the QP of :mod:`solvers.qp_problem` (tracking, or direction-preserving while no
-  joint has to recover), solved by a backend of :mod:`solvers.qp_backends`; skipped to its
-  closed-form answer when the box-free minimiser is inside the box (then it *is* the QP
-  solution). Fails when the backend raises, reports no solution, or runs out of its
-  iteration or time budget.
+  joint has to recover; optionally a strict second level for the secondary objective).
+  Without a backend when it is not needed: the box-free minimiser inside the bounds *is*
+  the solution (checked before P and q are even built), a direction problem with at most
+  one null-space direction is solved exactly (:mod:`solvers.plane_lp`), and so is a second
+  level with one null-space direction (an interval). Otherwise a backend of
+  :mod:`solvers.qp_backends` (warm-started); this method fails when the backend raises,
+  reports no solution, or runs out of its iteration or time budget.
 - ``"dls"``: damped least squares (:mod:`solvers.dls`) projected (clipped) into the bounds.
 - ``"scaling"``: the damped least-squares rates scaled uniformly by the largest s in [0, 1]
   that keeps them within the bounds (direction kept), then clipped for recovering joints.
 - ``"hold"``: the feasible rates nearest to zero; always the implicit last resort.
 
 Every answer is clipped into the bounds, so it is exactly feasible whatever the backend's
-tolerance (the clip size is reported), and finite. Numerical trouble never raises.
+tolerance (the clip size is reported), and finite. Numerical trouble never raises: the
+:class:`Resolution` says which method answered and why the earlier ones did not.
 """
 
 from __future__ import annotations
@@ -377,9 +381,19 @@ class ResolutionChain:
     def _qp(self, svd: TaskSVD, xw: Array, bounds: VelocityBounds, z: Array | None) -> _Answer:
         soft_z = z if self.priority == "soft" else None
         if self.direction_preserving and bounds.contains_zero:
-            problem = direction_problem(svd, svd.dls(xw), bounds, soft_z, self.secondary_weight)
-            x, answer = self._solve(problem, "qp_direction", bounds)
-            answer.scale = problem.scale(x)
+            dls = svd.dls(xw)
+            if (
+                self.shortcut
+                and soft_z is None
+                and svd.rank == svd.sigma.size  # full row rank: dls is in the row space
+                and (dls >= bounds.lb).all()
+                and (dls <= bounds.ub).all()
+            ):  # u = 1, z = 0: the box-free optimum, before the problem is built
+                answer = _Answer(dls, "qp_direction", 1.0, "unconstrained optimum")
+            else:
+                problem = direction_problem(svd, dls, bounds, soft_z, self.secondary_weight)
+                x, answer = self._solve(problem, "qp_direction", bounds)
+                answer.scale = problem.scale(x)
         else:
             # the box-free minimiser first; P and q are built only when it leaves the box
             free = tracking_free(svd, xw, soft_z, self.secondary_weight)
