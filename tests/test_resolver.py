@@ -81,6 +81,29 @@ def test_limits_hold_for_every_backend(
     assert share >= (0.9 if backend == "proxqp" else 0.99), methods
 
 
+@pytest.mark.parametrize("backend", sorted(MODULES))
+def test_position_task_on_a_redundant_arm(backend: str, arms: dict[str, rrc_pin.Robot]) -> None:
+    """Four null-space directions: the direction-preserving QP goes through the backend."""
+    pytest.importorskip(MODULES[backend])
+    arm = arms["panda"]
+    rng = np.random.default_rng(zlib.crc32(f"position-{backend}".encode()))
+    resolver = Resolver(arm, backend=backend, task="position")
+    through_backend = 0
+    for _ in range(150):
+        q, twist = random_case(arm, rng)
+        r = resolver.solve(q, twist)
+        check_step(arm, q, r.qdot, 0.01)
+        if r.method != "qp_direction":
+            continue
+        through_backend += r.backend == backend
+        J = arm.jacobian(q)[:3]
+        target = J @ damped_least_squares(J, twist[:3])
+        # parallel to the damped command, within the backend's tolerance
+        want = r.scale * target
+        assert np.allclose(J @ r.qdot, want, atol=1e-6 * (1.0 + np.abs(want).max()))
+    assert through_backend > 30
+
+
 @settings(max_examples=150, deadline=None, derandomize=True)
 @given(
     name=st.sampled_from(ARMS),
