@@ -34,12 +34,14 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
+import contextlib  # noqa: E402
 import json  # noqa: E402
 import logging  # noqa: E402
 import platform  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
 import warnings  # noqa: E402
-from collections.abc import Callable  # noqa: E402
+from collections.abc import Callable, Iterator  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
@@ -165,6 +167,29 @@ def bench_arm(name: str, steps: int) -> dict[str, Any]:
     rng = np.random.default_rng(SEED)
     Q, X = record_trajectory(arm, steps, rng)
     contenders = {**rrc_contenders(arm), **pink_contenders(arm)}
+    with _quiet_stdout():  # OSQP's C code prints "Polishing not needed" when nothing is active
+        rows = _run(arm, Q, X, contenders, rng)
+    ours = rows["rrc-pin osqp (native, warm)"]
+    pinks = {k: v for k, v in rows.items() if k.startswith("pink")}
+    summary: dict[str, Any] = {"steps": steps, "active_limit_fraction": _active_fraction(arm, Q, X)}
+    if pinks:
+        fastest = min(pinks, key=lambda k: pinks[k]["median_us"])
+        summary.update(
+            pink_fastest=fastest,
+            speedup_median=pinks[fastest]["median_us"] / ours["median_us"],
+            speedup_p99=pinks[fastest]["p99_us"] / ours["p99_us"],
+        )
+    return {"arm": name, "nq": arm.nq, "summary": summary, "contenders": rows}
+
+
+def _run(
+    arm: Any,
+    Q: np.ndarray,
+    X: np.ndarray,
+    contenders: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]],
+    rng: np.random.Generator,
+) -> dict[str, dict[str, Any]]:
+    """Every contender at every step (shuffled order): times and limit excesses."""
     times: dict[str, list[float]] = {label: [] for label in contenders}
     v_excess = dict.fromkeys(contenders, 0.0)
     q_excess = dict.fromkeys(contenders, 0.0)
@@ -175,10 +200,9 @@ def bench_arm(name: str, steps: int) -> dict[str, Any]:
     for q, x in zip(Q, X, strict=True):
         rng.shuffle(order)  # no contender always runs first, after another one's cache misses
         for label in order:
-            fn = contenders[label]
             t0 = clock()
             try:
-                qdot = fn(q, x)
+                qdot = contenders[label](q, x)
             except Exception:  # pink raises NoSolutionFound (and others) on failure
                 qdot = np.zeros(arm.nq)
                 failures[label] += 1
@@ -188,11 +212,10 @@ def bench_arm(name: str, steps: int) -> dict[str, Any]:
             q_excess[label] = max(
                 q_excess[label], float(np.max(step - upper)), float(np.max(lower - step))
             )
-    active = _active_fraction(arm, Q, X)
-    rows = {}
+    out = {}
     for label in contenders:
         t = np.array(times[label]) * 1e6
-        rows[label] = {
+        out[label] = {
             "median_us": float(np.median(t)),
             "p99_us": float(np.percentile(t, 99)),
             "mean_us": float(np.mean(t)),
@@ -200,17 +223,22 @@ def bench_arm(name: str, steps: int) -> dict[str, Any]:
             "max_position_excess": q_excess[label],
             "failures": failures[label],
         }
-    ours = rows["rrc-pin osqp (native, warm)"]["median_us"]
-    pinks = {k: v for k, v in rows.items() if k.startswith("pink")}
-    summary: dict[str, Any] = {"steps": steps, "active_limit_fraction": active}
-    if pinks:
-        fastest = min(pinks, key=lambda k: pinks[k]["median_us"])
-        summary.update(
-            pink_fastest=fastest,
-            speedup_median=pinks[fastest]["median_us"] / ours,
-            speedup_p99=pinks[fastest]["p99_us"] / rows["rrc-pin osqp (native, warm)"]["p99_us"],
-        )
-    return {"arm": name, "nq": arm.nq, "summary": summary, "contenders": rows}
+    return out
+
+
+@contextlib.contextmanager
+def _quiet_stdout() -> Iterator[None]:
+    """Send file descriptor 1 (C-level prints) to /dev/null for the duration."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        os.dup2(saved, 1)
+        os.close(devnull)
+        os.close(saved)
 
 
 def _active_fraction(arm: Any, Q: np.ndarray, X: np.ndarray) -> float:

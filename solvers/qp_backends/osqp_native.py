@@ -13,6 +13,10 @@ OSQP's 1e-3: ``eps_abs = eps_rel = 1e-6``, with polishing, which then returns th
 of the identified active set to about 1e-12 (without polishing, an ADMM answer at 1e-6 is
 off by up to 1e-4 along weakly curved directions); at most 4000 iterations or 5 ms per
 solve.
+
+OSQP's C code prints "Polishing not needed - no active set detected at optimal point" to
+standard output (whatever ``verbose``) when no constraint is active at the solution; the
+resolver's shortcut returns the box-free optimum without calling OSQP in exactly that case.
 """
 
 from __future__ import annotations
