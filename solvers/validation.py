@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+from math import isfinite
+
 import numpy as np
 import numpy.typing as npt
 
 from solvers.errors import InputError
+
+_F64 = np.dtype(np.float64)
 
 
 def as_vector(
@@ -52,19 +56,82 @@ def as_array(
     return arr
 
 
+def as_float_list(
+    x: npt.ArrayLike, name: str, size: int, error: type[InputError] = InputError
+) -> list[float]:
+    """Return ``x`` as a list of ``size`` finite Python floats (scalar fast paths).
+
+    The common case, a float64 array of shape ``(size,)``, skips :func:`as_vector`: one
+    ``tolist`` and a finiteness test on the sum (NaN or inf make ``total - total`` NaN; a
+    finite sum that overflows falls through to the full check).
+
+    Args:
+        x: Value to check.
+        name: Argument name used in the error message.
+        size: Expected length.
+        error: Exception class to raise (a subclass of :class:`InputError`).
+
+    Raises:
+        InputError: Wrong shape, non-numeric, NaN or inf (the messages of :func:`as_vector`).
+    """
+    if type(x) is np.ndarray and x.dtype is _F64 and x.shape == (size,):
+        values: list[float] = x.tolist()
+        total = sum(values)
+        if total - total == 0.0:
+            return values
+    return as_vector(x, name, size, error).tolist()
+
+
+def finite_number(
+    value: float,
+    name: str,
+    lower: float | None = None,
+    inclusive: bool = True,
+    upper: float | None = None,
+    error: type[InputError] = InputError,
+) -> float:
+    """Return ``value`` as a finite float, optionally bounded.
+
+    Args:
+        value: Value to check.
+        name: Argument name used in the error message.
+        lower: Lower bound, or None for none.
+        inclusive: Whether ``value == lower`` is accepted.
+        upper: Exclusive upper bound, or None for none.
+        error: Exception class to raise (a subclass of :class:`InputError`).
+
+    Raises:
+        InputError: ``value`` is not a number, not finite, or out of bounds; the message
+            states the expected range (``>= 0``, ``> 0``, ``in (0, 1)``, ``in [0, 0.5)``).
+    """
+    if lower is None and upper is None:
+        want = "a finite number"
+    elif upper is None:
+        want = f"a finite number {'>=' if inclusive else '>'} {lower:g}"
+    elif lower is None:
+        want = f"a finite number < {upper:g}"
+    else:
+        want = f"a finite number in {'[' if inclusive else '('}{lower:g}, {upper:g})"
+    try:
+        out = float(value)
+    except (TypeError, ValueError) as exc:
+        raise error(name, f"expected {want}, got {value!r}") from exc
+    if (
+        not isfinite(out)
+        or (lower is not None and (out < lower or (out == lower and not inclusive)))
+        or (upper is not None and out >= upper)
+    ):
+        raise error(name, f"expected {want}, got {out}")
+    return out
+
+
 def positive(x: float, name: str, error: type[InputError] = InputError) -> float:
     """Return ``x`` as a float if it is finite and > 0.
 
     Raises:
         InputError: ``x`` is not a finite positive number.
     """
-    try:
-        value = float(x)
-    except (TypeError, ValueError) as exc:
-        raise error(name, f"expected a positive number, got {x!r}") from exc
-    if not np.isfinite(value) or value <= 0.0:
-        raise error(name, f"expected a finite number > 0, got {value}")
-    return value
+    return finite_number(x, name, 0.0, inclusive=False, error=error)
 
 
 def _fmt(shape: tuple[int | None, ...]) -> str:

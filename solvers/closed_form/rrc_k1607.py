@@ -46,7 +46,7 @@ import numpy.typing as npt
 
 from solvers.closed_form.base import ClosedForm
 from solvers.errors import InputError
-from solvers.validation import as_array, as_vector
+from solvers.validation import as_array, as_float_list, as_vector, finite_number
 
 NQ = 7
 TASK_DIM = 6
@@ -55,7 +55,6 @@ ALPHA_DEG = (0.0, -90.0, 90.0, -90.0, 90.0, -90.0, 90.0)
 DEFAULT_RCOND = 1e-6
 """Relative singular-value threshold of ``J W^1/2`` below which the SVD fallback answers."""
 
-_F64 = np.dtype(np.float64)
 Entry = Any  # a Python float (scalar path) or an (N,) float array (batch path)
 
 
@@ -171,13 +170,7 @@ class RrcK1607ClosedForm(ClosedForm):
     ) -> None:
         self.a = tuple(as_vector(a, "a", NQ).tolist())
         self.d = tuple(as_vector(d, "d", NQ).tolist())
-        try:
-            value = float(rcond)
-        except (TypeError, ValueError) as exc:
-            raise InputError("rcond", f"expected a number in (0, 1), got {rcond!r}") from exc
-        if not 0.0 < value < 1.0:
-            raise InputError("rcond", f"expected a number in (0, 1), got {value}")
-        self.rcond = value
+        self.rcond = finite_number(rcond, "rcond", 0.0, inclusive=False, upper=1.0)
 
     def __repr__(self) -> str:
         return f"RrcK1607ClosedForm(a={self.a}, d={self.d})"
@@ -201,7 +194,7 @@ class RrcK1607ClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` is not a finite (7,) vector.
         """
-        R, p, _ = self._scalar(_floats(q, "q", NQ), pose=True)
+        R, p, _ = self._scalar(as_float_list(q, "q", NQ), pose=True)
         return np.array([R[0] + [p[0]], R[1] + [p[1]], R[2] + [p[2]], [0.0, 0.0, 0.0, 1.0]])
 
     def jacobian(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
@@ -216,7 +209,7 @@ class RrcK1607ClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` is not a finite (7,) vector.
         """
-        return np.ascontiguousarray(np.array(self._scalar(_floats(q, "q", NQ))[2]).T)
+        return np.ascontiguousarray(np.array(self._scalar(as_float_list(q, "q", NQ))[2]).T)
 
     def joint_rates(
         self,
@@ -248,8 +241,8 @@ class RrcK1607ClosedForm(ClosedForm):
             InputError: Wrong shape or non-finite entries in any argument (named), or ``W``
                 not symmetric positive definite.
         """
-        qs = _floats(q, "q", NQ)
-        b = _floats(xdot, "xdot", TASK_DIM)
+        qs = as_float_list(q, "q", NQ)
+        b = as_float_list(xdot, "xdot", TASK_DIM)
         Wm = None if W is None else _check_weight(W)
         zv = None if z is None else as_vector(z, "z", NQ)
         J = np.array(self._scalar(qs)[2]).T
@@ -397,16 +390,6 @@ the cache (a few MB) instead of streaming N-sized arrays through memory: at N = 
 twice as fast as one block. 8192 doubles (64 kB) also stay below glibc's default mmap
 threshold (128 kB), so that no intermediate costs a fresh mapping and its page faults.
 """
-
-
-def _floats(x: npt.ArrayLike, name: str, size: int) -> list[float]:
-    """``x`` as a list of ``size`` finite floats; the common float64-array case is fast."""
-    if type(x) is np.ndarray and x.dtype is _F64 and x.shape == (size,):
-        values: list[float] = x.tolist()
-        total = sum(values)
-        if total - total == 0.0:  # False for NaN or inf; a finite overflow falls through
-            return values
-    return as_vector(x, name, size).tolist()
 
 
 def _chunks(

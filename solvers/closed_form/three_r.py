@@ -37,12 +37,11 @@ import numpy.typing as npt
 
 from solvers.closed_form.base import ClosedForm
 from solvers.errors import InputError
-from solvers.validation import as_array, as_vector
+from solvers.validation import as_array, as_float_list, as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
 DEFAULT_RCOND = 1e-9
 """Relative threshold below which ``r`` or ``det M`` counts as singular (module docstring)."""
-_F64 = np.dtype(np.float64)
 _NULL = (0.0, math.sqrt(0.5), -math.sqrt(0.5))
 
 
@@ -83,12 +82,10 @@ class ThreeRClosedForm(ClosedForm):
     task_dim = 3
 
     def __init__(self, *, a1: float, a2: float, a3: float, rcond: float = DEFAULT_RCOND) -> None:
-        self.a1 = _number(a1, "a1", 0.0, inclusive=True)
-        self.a2 = _number(a2, "a2", 0.0, inclusive=False)
-        self.a3 = _number(a3, "a3", 0.0, inclusive=False)
-        self.rcond = _number(rcond, "rcond", 0.0, inclusive=False)
-        if self.rcond >= 1.0:
-            raise InputError("rcond", f"expected a number in (0, 1), got {self.rcond}")
+        self.a1 = finite_number(a1, "a1", 0.0)
+        self.a2 = finite_number(a2, "a2", 0.0, inclusive=False)
+        self.a3 = finite_number(a3, "a3", 0.0, inclusive=False)
+        self.rcond = finite_number(rcond, "rcond", 0.0, inclusive=False, upper=1.0)
         self._reach = self.a1 + self.a2 + self.a3
 
     def __repr__(self) -> str:
@@ -108,7 +105,7 @@ class ThreeRClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` is not a finite (3,) vector.
         """
-        c1, s1, r, h, c23, s23, _ = self._terms(_floats(q, "q", 3))
+        c1, s1, r, h, c23, s23, _ = self._terms(as_float_list(q, "q", 3))
         a3 = self.a3
         return np.array(
             [
@@ -124,7 +121,7 @@ class ThreeRClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` is not a finite (3,) vector.
         """
-        q0 = _floats(q, "q", 3)[0]
+        q0 = as_float_list(q, "q", 3)[0]
         c1, s1 = math.cos(q0), math.sin(q0)
         return np.array([[0.0, s1, s1], [0.0, -c1, -c1], [1.0, 0.0, 0.0]])
 
@@ -150,8 +147,8 @@ class ThreeRClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` or ``xdot`` not a finite (3,) vector.
         """
-        qs = _floats(q, "q", 3)
-        vx, vy, vz = _floats(xdot, "xdot", 3)
+        qs = as_float_list(q, "q", 3)
+        vx, vy, vz = as_float_list(xdot, "xdot", 3)
         c1, s1, r, h, c23, s23, s3 = self._terms(qs)
         vt = c1 * vy - s1 * vx  # tangential
         vu = c1 * vx + s1 * vy  # radial
@@ -181,8 +178,8 @@ class ThreeRClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` or ``qdot`` not a finite (3,) vector.
         """
-        q0 = _floats(q, "q", 3)[0]
-        d1, d2, d3 = _floats(qdot, "qdot", 3)
+        q0 = as_float_list(q, "q", 3)[0]
+        d1, d2, d3 = as_float_list(qdot, "qdot", 3)
         c1, s1 = math.cos(q0), math.sin(q0)
         return np.array([s1 * (d2 + d3), -c1 * (d2 + d3), d1])
 
@@ -192,7 +189,7 @@ class ThreeRClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` is not a finite (3,) vector.
         """
-        _floats(q, "q", 3)
+        as_float_list(q, "q", 3)
         return np.array(_NULL)
 
     def rates_for_angular_velocity(self, q: npt.ArrayLike, omega: npt.ArrayLike) -> AngularRates:
@@ -212,8 +209,8 @@ class ThreeRClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` or ``omega`` not a finite (3,) vector.
         """
-        q0 = _floats(q, "q", 3)[0]
-        wx, wy, wz = _floats(omega, "omega", 3)
+        q0 = as_float_list(q, "q", 3)[0]
+        wx, wy, wz = as_float_list(omega, "omega", 3)
         c1, s1 = math.cos(q0), math.sin(q0)
         beta = s1 * wx - c1 * wy
         return AngularRates(
@@ -335,25 +332,3 @@ def minimum_norm_shift(qdot: npt.ArrayLike, direction: npt.ArrayLike) -> float:
         raise InputError("direction", "expected a nonzero vector")
     return -float(v @ d) / dd
 
-
-def _floats(x: npt.ArrayLike, name: str, size: int) -> list[float]:
-    """``x`` as a list of ``size`` finite floats; the common float64-array case is fast."""
-    if type(x) is np.ndarray and x.dtype is _F64 and x.shape == (size,):
-        values: list[float] = x.tolist()
-        total = sum(values)
-        if total - total == 0.0:  # False for NaN or inf; a finite overflow falls through
-            return values
-    return as_vector(x, name, size).tolist()
-
-
-def _number(value: float, name: str, bound: float, *, inclusive: bool) -> float:
-    """``value`` as a finite float above ``bound`` (or equal, if ``inclusive``)."""
-    try:
-        out = float(value)
-    except (TypeError, ValueError) as exc:
-        raise InputError(name, f"expected a finite number, got {value!r}") from exc
-    if not math.isfinite(out):
-        raise InputError(name, f"expected a finite number, got {out}")
-    if out < bound or (out == bound and not inclusive):
-        raise InputError(name, f"expected a number {'>=' if inclusive else '>'} {bound}, got {out}")
-    return out
