@@ -5,7 +5,7 @@ to the numerical chain of :mod:`solvers.resolution`: the joint-rate bounds of th
 (velocity, position over one step with a margin, optional acceleration; a start outside the
 limits asks only to move back), the QP (warm-started backend), and the fallbacks. Bad input
 raises :class:`~rrc_pin.errors.InvalidInput` naming the argument before any state changes;
-numerical trouble never raises (the :class:`~solvers.resolution.Resolution` says which
+numerical trouble never raises (the :class:`~solvers.resolution_record.Resolution` says which
 method answered).
 """
 
@@ -24,7 +24,8 @@ from rrc_pin.robot import PIN_REFERENCE, Robot, frame_id
 from solvers.dls import Damping, weight_factor
 from solvers.errors import InputError
 from solvers.joint_bounds import JointLimits
-from solvers.resolution import Resolution, ResolutionChain
+from solvers.resolution import ResolutionChain
+from solvers.resolution_record import Resolution
 from solvers.spatial import REFERENCES, Reference, check_reference
 from solvers.validation import as_vector, positive
 
@@ -181,7 +182,7 @@ class Resolver:
             dt: Step [s] for this call; default the constructor's.
 
         Returns:
-            The :class:`~solvers.resolution.Resolution` (finite, within the bounds).
+            The :class:`~solvers.resolution_record.Resolution` (finite, within the bounds).
 
         Raises:
             InvalidInput: Wrong shape or non-finite q, twist, qdot_prev or secondary, unknown

@@ -10,7 +10,7 @@ from solvers.dls import Damping, damped_least_squares
 from solvers.errors import InputError, ProblemError
 from solvers.joint_bounds import JointLimits, VelocityBounds
 from solvers.qp_backends import QPBackend, QPSolution
-from solvers.resolution import ActiveLimit, Resolution, ResolutionChain, uniform_scale
+from solvers.resolution import ResolutionChain, uniform_scale
 
 MODULES = {"osqp": "osqp", "daqp": "daqp", "proxqp": "proxsuite", "quadprog": "quadprog",
            "clarabel": "clarabel"}
@@ -135,19 +135,6 @@ def test_soft_secondary_leaves_a_feasible_task_unchanged(rng: np.random.Generato
         assert not b.active
         assert np.allclose(J @ b.qdot, J @ a.qdot, atol=1e-9)
         assert not np.allclose(b.qdot, a.qdot)
-
-
-def test_active_limits_name_joint_side_and_kind() -> None:
-    J = np.eye(3)
-    limits = JointLimits([-1.0] * 3, [1.0, 0.999, 1.0], [0.5, 2.0, 2.0])
-    bounds = limits.bounds(np.array([0.0, 0.99, 0.0]), 0.01)
-    r = ResolutionChain().resolve(J, np.array([-10.0, 10.0, 0.1]), bounds,
-                                  joint_names=["a", "b", "c"])
-    assert r.active == (
-        ActiveLimit(0, "lower", "velocity", -0.5, "a"),
-        ActiveLimit(1, "upper", "position", pytest.approx(0.9 + 1e-11, rel=1e-9), "b"),
-    )
-    assert "Resolution(" in repr(r) and isinstance(r, Resolution)
 
 
 def test_uniform_scale() -> None:
