@@ -32,13 +32,13 @@ Singular set (Appendix D): ``det J = det M det W = ES (S2 ES + F5)(SAL3 WE S3 + 
 
 from __future__ import annotations
 
-from math import isfinite
 from typing import Literal, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
 from solvers.closed_form import barker_kernels as K
+from solvers.closed_form.barker_batch import joint_rates_full
 from solvers.closed_form.barker_kernels import BarkerGeometry, FTerms
 from solvers.closed_form.barker_scalar import (
     arm_scalar,
@@ -52,12 +52,11 @@ from solvers.closed_form.barker_scalar import (
 )
 from solvers.closed_form.base import ClosedForm
 from solvers.errors import InputError
-from solvers.validation import as_array, as_vector
+from solvers.validation import as_array, as_float_list, as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
 Method = Literal["full", "reduced"]
 METHODS: tuple[str, ...] = ("full", "reduced")
-_F64 = np.dtype(np.float64)
 
 
 class BarkerSingularity(NamedTuple):
@@ -117,10 +116,8 @@ class BarkerClosedForm(ClosedForm):
         rcond: float = 1e-10,
     ) -> None:
         values = {"no": no, "es": es, "sn": sn, "we": we, "a3": a3, "r3": r3, "alpha3": alpha3}
-        checked = {name: _finite(value, name) for name, value in values.items()}
-        rcond = _finite(rcond, "rcond")
-        if not 0.0 <= rcond < 0.5:
-            raise InputError("rcond", f"expected 0 <= rcond < 0.5, got {rcond}")
+        checked = {name: finite_number(value, name) for name, value in values.items()}
+        rcond = finite_number(rcond, "rcond", 0.0, upper=0.5)
         self.geometry = BarkerGeometry.from_parameters(**checked)
         self.rcond = rcond
         self._k = constants(self.geometry)
@@ -142,7 +139,7 @@ class BarkerClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` is not a finite (6,) vector.
         """
-        return jacobian_scalar(self._k, _floats(q, "q", 6))
+        return jacobian_scalar(self._k, as_float_list(q, "q", 6))
 
     def jacobian_batch(self, Q: npt.ArrayLike) -> Array:
         """Wrist-centre Jacobians (N, 6, 6) at ``Q`` (N, 6) [rad], rows [v; w], base axes.
@@ -218,8 +215,8 @@ class BarkerClosedForm(ClosedForm):
             InputError: Bad ``q``, ``tvel`` or ``method``.
         """
         reduced = self._reduced(method)
-        tr = trig_scalar(_floats(q, "q", 6))
-        tv = _floats(tvel, "tvel", 3)
+        tr = trig_scalar(as_float_list(q, "q", 6))
+        tv = as_float_list(tvel, "tvel", 3)
         return np.array(arm_scalar(self._k, tr, tv, reduced, self.rcond))
 
     def arm_rates_batch(
@@ -234,9 +231,10 @@ class BarkerClosedForm(ClosedForm):
 
     def rvel_tilde(self, q: npt.ArrayLike, arm_rates: npt.ArrayLike, rvel: npt.ArrayLike) -> Array:
         """RVEL~ = RVEL^ - z0 thetadot_1 - z1 thetadot_2 - z2 thetadot_3 (eq. (48)), (3,)."""
-        tr = trig_scalar(_floats(q, "q", 6))
-        arm = _floats(arm_rates, "arm_rates", 3)
-        return np.array(rvel_tilde_scalar(tr, (arm[0], arm[1], arm[2]), _floats(rvel, "rvel", 3)))
+        tr = trig_scalar(as_float_list(q, "q", 6))
+        arm = as_float_list(arm_rates, "arm_rates", 3)
+        rvel_hat = as_float_list(rvel, "rvel", 3)
+        return np.array(rvel_tilde_scalar(tr, (arm[0], arm[1], arm[2]), rvel_hat))
 
     def wrist_rates(
         self, q: npt.ArrayLike, rvel_tilde: npt.ArrayLike, method: Method = "full"
@@ -250,8 +248,8 @@ class BarkerClosedForm(ClosedForm):
             InputError: Bad ``q``, ``rvel_tilde`` or ``method``.
         """
         reduced = self._reduced(method)
-        tr = trig_scalar(_floats(q, "q", 6))
-        rt = _floats(rvel_tilde, "rvel_tilde", 3)
+        tr = trig_scalar(as_float_list(q, "q", 6))
+        rt = as_float_list(rvel_tilde, "rvel_tilde", 3)
         return np.array(wrist_scalar(self._k, tr, (rt[0], rt[1], rt[2]), reduced, self.rcond))
 
     def wrist_rates_batch(
@@ -280,7 +278,7 @@ class BarkerClosedForm(ClosedForm):
             InputError: Bad ``q``, ``xdot`` or ``method``.
         """
         reduced = self._reduced(method)
-        qv, x = _floats(q, "q", 6), _floats(xdot, "xdot", 6)
+        qv, x = as_float_list(q, "q", 6), as_float_list(xdot, "xdot", 6)
         if reduced:
             return np.array(joint_rates_scalar(self._k, qv, x, True, self.rcond))
         return np.array(joint_rates_full_scalar(self._k, qv, x, self.rcond))
@@ -288,10 +286,28 @@ class BarkerClosedForm(ClosedForm):
     def joint_rates_batch(
         self, Q: npt.ArrayLike, X: npt.ArrayLike, method: Method = "full"
     ) -> Array:
-        """Batch :meth:`joint_rates`: ``Q`` (N, 6), ``X`` (N, 6) -> (N, 6) [rad/s]."""
+        """Batch :meth:`joint_rates`: ``Q`` (N, 6), ``X`` (N, 6) -> (N, 6) [rad/s].
+
+        ``method="full"`` runs blocked and in place
+        (:func:`~solvers.closed_form.barker_batch.joint_rates_full`); the configurations it
+        flags as possibly singular are recomputed by the general kernels, so that the result
+        is the one of :meth:`joint_rates` everywhere.
+
+        Raises:
+            InputError: Bad ``Q``, ``X`` or ``method``.
+        """
         reduced = self._reduced(method)
         Q = as_array(Q, "Q", (None, 6))
         X = as_array(X, "X", (Q.shape[0], 6))
+        if reduced:
+            return self._rates_composed(Q, X, reduced=True)
+        out, suspect = joint_rates_full(self._k, Q, X, self.rcond)
+        if suspect.size:  # possibly singular: generalized inverses where needed
+            out[suspect] = self._rates_composed(Q[suspect], X[suspect], reduced=False)
+        return out
+
+    def _rates_composed(self, Q: Array, X: Array, reduced: bool) -> Array:
+        """Joint rates (N, 6) by the arm kernel, eq. (48), then the wrist kernel."""
         g, t = self.geometry, K.trig(Q)
         kernel = K.arm_rates_reduced if reduced else K.arm_rates_full
         arm = kernel(g, t, X[:, :3], self.rcond)[0]
@@ -337,23 +353,3 @@ class BarkerClosedForm(ClosedForm):
             )
         return True
 
-
-def _finite(value: float, name: str) -> float:
-    """``value`` as a finite float, else InputError naming ``name``."""
-    try:
-        out = float(value)
-    except (TypeError, ValueError) as exc:
-        raise InputError(name, f"expected a finite number, got {value!r}") from exc
-    if not isfinite(out):
-        raise InputError(name, f"expected a finite number, got {out}")
-    return out
-
-
-def _floats(x: npt.ArrayLike, name: str, size: int) -> list[float]:
-    """``x`` as a list of ``size`` finite floats; the common float64-array case is fast."""
-    if type(x) is np.ndarray and x.dtype is _F64 and x.shape == (size,):
-        values: list[float] = x.tolist()
-        total = sum(values)
-        if total - total == 0.0:  # False for NaN or inf; a finite overflow falls through
-            return values
-    return as_vector(x, name, size).tolist()

@@ -31,8 +31,9 @@ QP resolver's business, not this module's. Elsewhere the exact rates are returne
 large.
 
 The scalar methods run on Python floats (numpy only for ``J W J^T`` and the result), the
-batch methods on (M,) numpy arrays, block by block (:data:`CHUNK`); both share the formulas
-of :func:`_kinematics` and :func:`_solve_spd6`.
+batch methods on (M,) numpy arrays, block by block
+(:data:`~solvers.closed_form._batch.CHUNK`); both share the formulas of :func:`_kinematics`
+and :func:`_solve_spd6`.
 """
 
 from __future__ import annotations
@@ -44,6 +45,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from solvers.closed_form._batch import blocks, cos_sin
 from solvers.closed_form.base import ClosedForm
 from solvers.errors import InputError
 from solvers.validation import as_array, as_float_list, as_vector, finite_number
@@ -314,7 +316,8 @@ class RrcK1607ClosedForm(ClosedForm):
         """Joint rates at N configurations, Nguyen eqs. (21)-(22); see :meth:`joint_rates`.
 
         The arithmetic of :meth:`joint_rates` runs element-wise over blocks of
-        :data:`CHUNK` configurations (no Python loop over configurations).
+        :data:`~solvers.closed_form._batch.CHUNK` configurations (no Python loop over
+        configurations).
 
         Args:
             Q: Joint angles (N, 7) [rad].
@@ -382,42 +385,19 @@ class RrcK1607ClosedForm(ClosedForm):
 
 # ---------------------------------------------------------------------- helpers
 
-CHUNK = 8192
-"""Configurations per block in the batch methods.
-
-The formulas keep about a hundred (CHUNK,) intermediates alive at once; blocks keep them in
-the cache (a few MB) instead of streaming N-sized arrays through memory: at N = 10^5 about
-twice as fast as one block. 8192 doubles (64 kB) also stay below glibc's default mmap
-threshold (128 kB), so that no intermediate costs a fresh mapping and its page faults.
-"""
-
-
 def _chunks(
     Q: npt.NDArray[np.float64], pose: bool = True
 ) -> Iterator[tuple[slice, list[Any], list[Any]]]:
-    """Blocks of :data:`CHUNK` configurations: (rows, cosines, sines), 7 (M,) arrays each.
+    """Blocks of configurations: (rows, cosines, sines), 7 (M,) arrays each.
 
-    The trigonometry runs once over the whole batch, the rest block by block. Without
-    ``pose`` theta_7 is not needed (its cosine and sine are None).
+    The trigonometry (:func:`~solvers.closed_form._batch.cos_sin`) runs once over the whole
+    batch, the rest block by block (the formulas keep about a hundred (CHUNK,) intermediates
+    alive at once). Without ``pose`` theta_7 is not needed (its cosine and sine are None).
     """
-    C, S = _cos_sin(Q if pose else Q[:, : NQ - 1])
+    C, S = cos_sin(np.ascontiguousarray((Q if pose else Q[:, : NQ - 1]).T))
     extra = [] if pose else [None]
-    for lo in range(0, Q.shape[0], CHUNK):
-        rows = slice(lo, lo + CHUNK)
+    for rows in blocks(Q.shape[0]):
         yield rows, [c[rows] for c in C] + extra, [s[rows] for s in S] + extra
-
-
-def _cos_sin(Q: npt.NDArray[np.float64]) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-    """Cosines and sines of the columns of ``Q`` (N, k): two (k, N) arrays.
-
-    By the tangent half-angle, ``t = tan(q/2)``: ``cos q = (1 - t^2) / (1 + t^2)``,
-    ``sin q = 2 t / (1 + t^2)``, one transcendental call instead of two (absolute error a
-    few ulp for every q, including q = pi where t = 1.6e16).
-    """
-    t = np.tan(0.5 * np.ascontiguousarray(Q.T))
-    u = t * t
-    w = 1.0 / (1.0 + u)
-    return (1.0 - u) * w, (2.0 * w) * t
 
 
 def _dot(u: Sequence[Entry], v: Sequence[Entry]) -> Entry:

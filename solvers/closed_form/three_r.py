@@ -35,6 +35,7 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from solvers.closed_form._batch import cos_sin
 from solvers.closed_form.base import ClosedForm
 from solvers.errors import InputError
 from solvers.validation import as_array, as_float_list, as_vector, finite_number
@@ -296,13 +297,10 @@ class ThreeRClosedForm(ClosedForm):
     def _terms_batch(self, Q: Array) -> tuple[Array, ...]:
         """:meth:`_terms` over N configurations, (N,) arrays.
 
-        Cosines and sines by the tangent half-angle (one transcendental call instead of two;
-        absolute error a few ulp), ``c23``, ``s23`` by the angle-addition formulas.
+        Cosines and sines by :func:`~solvers.closed_form._batch.cos_sin`, ``c23``, ``s23``
+        by the angle-addition formulas.
         """
-        t = np.tan(0.5 * Q.T)
-        u = t * t
-        w = 1.0 / (1.0 + u)
-        (c1, c2, c3), (s1, s2, s3) = (1.0 - u) * w, (2.0 * w) * t
+        (c1, c2, c3), (s1, s2, s3) = cos_sin(np.ascontiguousarray(Q.T))
         c23 = c2 * c3 - s2 * s3
         s23 = s2 * c3 + c2 * s3
         r = self.a1 + self.a2 * c2 + self.a3 * c23
