@@ -48,4 +48,21 @@ def test_demo_runs_as_a_console_script():
     if exe is None:
         pytest.fail("the rrc-pin console script is not installed next to this Python")
     out = subprocess.run([exe, "demo"], capture_output=True, text=True, timeout=300, check=True)
-    assert "barker6" in out.stdout and "panda" in out.stdout
+    assert "nan" not in out.stdout.lower()
+    rows = [
+        line.split()
+        for line in out.stdout.splitlines()
+        if " rad/s about " in line or " m/s along " in line
+    ]
+    assert len(rows) == 4
+    for row in rows:
+        unit_at = row.index("rad") if "rad" in row[:9] else row.index("m")
+        asked, done, veer, excess = (
+            float(row[unit_at - 1]),
+            float(row[unit_at + 1]),
+            float(row[unit_at + 3]),
+            float(row[unit_at + 5]),
+        )
+        assert excess <= 1e-12 and done <= asked * (1 + 1e-3) and veer < 1.0, row
+    closed_form_rows = [line.split() for line in out.stdout.splitlines() if "ClosedForm" in line]
+    assert len(closed_form_rows) == 3 and all(float(r[-1]) < 1e-9 for r in closed_form_rows)
