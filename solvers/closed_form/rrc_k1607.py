@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator, Sequence
+from itertools import chain
 from typing import Any
 
 import numpy as np
@@ -211,7 +212,7 @@ class RrcK1607ClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` is not a finite (7,) vector.
         """
-        return np.ascontiguousarray(np.array(self._scalar(as_float_list(q, "q", NQ))[2]).T)
+        return np.ascontiguousarray(_transposed(self._scalar(as_float_list(q, "q", NQ))[2]).T)
 
     def joint_rates(
         self,
@@ -247,20 +248,20 @@ class RrcK1607ClosedForm(ClosedForm):
         b = as_float_list(xdot, "xdot", TASK_DIM)
         Wm = None if W is None else _check_weight(W)
         zv = None if z is None else as_vector(z, "z", NQ)
-        J = np.array(self._scalar(qs)[2]).T
+        Jt = _transposed(self._scalar(qs)[2])
         if zv is not None:
-            b = (np.array(b) - J.dot(zv)).tolist()
-        JW = J if Wm is None else J.dot(Wm)
-        A = JW.dot(J.T).tolist()
+            b = (np.array(b) - zv.dot(Jt)).tolist()
+        JWt = Jt if Wm is None else Wm.T.dot(Jt)  # (J W)^T
+        A = JWt.T.dot(Jt).tolist()
         tau = self.rcond**2 * (A[0][0] + A[1][1] + A[2][2] + A[3][3] + A[4][4] + A[5][5])
         try:
             y = _solve_spd6(A, b, _positive)
         except _Singular:
             y = None
-        if y is not None and sum(v * v for v in b) >= tau * tau * sum(v * v for v in y):
-            qdot = np.array(y).dot(JW)
+        if y is not None and _norm2(b) >= tau * tau * _norm2(y):
+            qdot = JWt.dot(y)
         else:
-            qdot = _svd_rates(J[None], np.array([b]), Wm, self.rcond)[0]
+            qdot = _svd_rates(Jt.T[None], np.array([b]), Wm, self.rcond)[0]
         if zv is not None:
             qdot += zv
         return qdot
@@ -425,6 +426,20 @@ def _dot(u: Sequence[Entry], v: Sequence[Entry]) -> Entry:
         else:
             acc, owned = acc + term, True
     return 0.0 if acc is None else acc
+
+
+def _transposed(cols: list[Any]) -> npt.NDArray[np.float64]:
+    """``J^T`` (7, 6) from the seven columns of J as float 6-tuples (scalar path).
+
+    ``numpy.fromiter`` with a known count: faster than ``numpy.array`` on nested sequences.
+    """
+    return np.fromiter(chain.from_iterable(cols), np.float64, NQ * TASK_DIM).reshape(NQ, TASK_DIM)
+
+
+def _norm2(v: list[float]) -> float:
+    """Squared Euclidean norm of six floats (scalar path)."""
+    v0, v1, v2, v3, v4, v5 = v
+    return v0 * v0 + v1 * v1 + v2 * v2 + v3 * v3 + v4 * v4 + v5 * v5
 
 
 def _check_weight(W: npt.ArrayLike) -> npt.NDArray[np.float64]:
