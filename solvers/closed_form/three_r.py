@@ -35,7 +35,7 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form._batch import cos_sin
+from solvers.closed_form._batch import blocks, cos_sin
 from solvers.closed_form.base import ClosedForm
 from solvers.errors import InputError
 from solvers.validation import as_array, as_float_list, as_vector, finite_number
@@ -269,20 +269,28 @@ class ThreeRClosedForm(ClosedForm):
     def joint_rates_batch(self, Q: npt.ArrayLike, X: npt.ArrayLike) -> Array:
         """``J_L^-1 v`` at N configurations: ``Q``, ``X`` (N, 3) -> (N, 3) [rad/s].
 
-        Same arithmetic and singularity handling as :meth:`joint_rates`.
+        Same arithmetic and singularity handling as :meth:`joint_rates`, in blocks of
+        :data:`~solvers.closed_form._batch.CHUNK` configurations (cache-sized intermediates).
 
         Raises:
             InputError: ``Q`` or ``X`` not a finite (N, 3) array.
         """
         Q, X = self._check_batch(Q, X)
+        out = np.empty((Q.shape[0], 3))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            for rows in blocks(Q.shape[0]):
+                out[rows] = self._rates_block(Q[rows], X[rows])
+        return out
+
+    def _rates_block(self, Q: Array, X: Array) -> Array:
+        """:meth:`joint_rates_batch` on one block: ``Q``, ``X`` (M, 3) -> (M, 3)."""
         c1, s1, r, h, c23, s23, s3 = self._terms_batch(Q)
         vx, vy, vz = np.ascontiguousarray(X.T)
         vt = c1 * vy - s1 * vx
         vu = c1 * vx + s1 * vy
         m00, m01, m10, m11 = -h, -self.a3 * s23, r - self.a1, self.a3 * c23
         det = (self.a2 * self.a3) * s3
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out = np.stack([vt / r, (m11 * vu - m01 * vz) / det, (m00 * vz - m10 * vu) / det], 1)
+        out = np.stack([vt / r, (m11 * vu - m01 * vz) / det, (m00 * vz - m10 * vu) / det], 1)
         on_axis = np.abs(r) <= self.rcond * self._reach
         if np.any(on_axis):
             out[on_axis, 0] = 0.0
