@@ -14,6 +14,7 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from solvers.closed_form._batch import cos_sin
 from solvers.closed_form.barker_pinv import pinv2_apply, pinv3_apply
 
 Array = npt.NDArray[np.float64]
@@ -92,12 +93,11 @@ def trig(Q: Array, roll: bool = False) -> Trig:
     """Trigonometric terms of the configurations ``Q`` (N, 6) [rad].
 
     Works on the transposed, contiguous angles (elementwise numpy is several times faster on
-    contiguous rows than on the columns of an (N, 6) array) and skips theta_6, which only
+    contiguous rows than on the columns of an (N, 6) array), by
+    :func:`~solvers.closed_form._batch.cos_sin`, and skips theta_6, which only
     :func:`hand_to_base` needs (``roll=True``).
     """
-    Qt = np.ascontiguousarray(Q.T[: 6 if roll else 5])
-    S = np.sin(Qt)
-    C = np.cos(Qt)
+    C, S = cos_sin(np.ascontiguousarray(Q.T[: 6 if roll else 5]))
     s23 = S[1] * C[2] + C[1] * S[2]
     c23 = C[1] * C[2] - S[1] * S[2]
     six = (S[5], C[5]) if roll else (None, None)
