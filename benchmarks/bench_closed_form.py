@@ -41,6 +41,8 @@ from rrc_pin.robot import frame_id
 ARMS = ("barker6", "rrc_k1607", "kr5_3r")
 RESULTS = Path(__file__).resolve().parent / "results"
 SEED = 20261122
+BATCH_RUNS = 11
+"""Interleaved runs of the batch and of the loop; the medians are recorded."""
 
 
 def machine_info() -> dict[str, Any]:
@@ -134,7 +136,7 @@ def bench_arm(
 
     # Interleaved, so that both see the same machine load.
     batch_runs, loop_runs = [], []
-    for _ in range(7):
+    for _ in range(BATCH_RUNS):
         batch_runs += timeit.repeat(lambda: cf.joint_rates_batch(Q, X), number=1, repeat=1)
         loop_runs += timeit.repeat(loop, number=1, repeat=1)
     batch_s, loop_s = statistics.median(batch_runs), statistics.median(loop_runs)
@@ -155,29 +157,44 @@ def bench_arm(
 
 
 def markdown_table(results: dict[str, Any]) -> str:
-    """The results as a Markdown table (one row per arm), for the README."""
+    """The results as a Markdown table, one row per arm, then a note on how they were taken.
+
+    Columns: the scalar closed form and Pinocchio + numpy per call [us] (medians) and their
+    ratio; the batch closed form and the Python loop over Pinocchio + numpy [configurations
+    per second] at N = 10^5, and their ratio. Every cell is a plain number.
+    """
+    n = results["sizes"]["n_batch"]
     lines = [
-        "| arm | closed form per call | Pinocchio + numpy per call | speed-up | "
-        "batch (N = 10^5) | Python loop over Pinocchio | speed-up |",
+        "| arm | scalar closed form [us] | Pinocchio + numpy [us] | speed-up | "
+        "batch [configs/s] | loop [configs/s] | speed-up |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
+    solvers = []
     for r in results["arms"]:
         s, b = r["scalar"], r["batch"]
-        solver = s["pinocchio_solver"].replace("numpy.linalg.", "")
         lines.append(
-            f"| {r['arm']} | {s['closed_form_us']:.1f} us | {s['pinocchio_us']:.1f} us "
-            f"({solver}) | {s['speedup']:.1f}x | {b['closed_form_per_s'] / 1e6:.2f} M/s | "
-            f"{b['loop_per_s'] / 1e3:.1f} k/s | {b['speedup']:.0f}x |"
+            f"| {r['arm']} | {s['closed_form_us']:.1f} | {s['pinocchio_us']:.1f} | "
+            f"{s['speedup']:.1f}x | {b['closed_form_per_s']:,.0f} | {b['loop_per_s']:,.0f} | "
+            f"{b['speedup']:.0f}x |"
         )
+        solvers.append(f"{s['pinocchio_solver']} ({r['arm']})")
     info = results["machine"]
-    lines.append("")
-    lines.append(
-        f"Measured on {info['cpu']} ({info['cores']} cores), Python {info['python']}, "
-        f"numpy {info['numpy']}, Pinocchio {info['pinocchio']}; per-call times are medians "
-        "(timeit), batch throughput in configurations per second."
-    )
-    for note in results.get("notes", []):
-        lines.append(f"{note}")
+    load = info.get("load_average")
+    lines += [
+        "",
+        "Pinocchio + numpy: `computeFrameJacobian` (LOCAL_WORLD_ALIGNED) then "
+        f"{', '.join(solvers)}. Scalar: median time per call of `joint_rates` (timeit). "
+        f"Batch: `joint_rates_batch` on N = {n:,} configurations against a Python loop of the "
+        f"Pinocchio + numpy calls, interleaved in one run (medians of {BATCH_RUNS}). Measured on "
+        f"{info['cpu']} ({info['cores']} cores), Python {info['python']}, numpy "
+        f"{info['numpy']}, Pinocchio {info['pinocchio']}"
+        + (f", load average {load[0]:.2f} at the start and {load[1]:.2f} at the end." if load
+           else "."),
+    ]
+    notes = results.get("notes", [])
+    if notes:
+        lines.append("")
+        lines += [f"- {note}" for note in notes]
     return "\n".join(lines)
 
 
@@ -230,6 +247,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.quick
         else {"n_scalar": 40, "number": 1000, "n_batch": 100_000, "n_loop": 2000}
     )
+    start_load = os.getloadavg()[0]
     results: dict[str, Any] = {"machine": machine_info(), "sizes": sizes, "arms": [], "notes": []}
     for name in ARMS:
         try:
@@ -245,6 +263,7 @@ def main(argv: list[str] | None = None) -> int:
             continue
         print(f"{name}: timing ...", flush=True)
         results["arms"].append(bench_arm(name, **sizes))
+    results["machine"]["load_average"] = [start_load, os.getloadavg()[0]]  # 1-minute
     table = markdown_table(results)
     if not args.quick:
         RESULTS.mkdir(exist_ok=True)
