@@ -81,7 +81,7 @@ def joint_rates_full(
             b = rows.stop - rows.start
             qt = qbuf[: 5 * b].reshape(5, b)
             np.copyto(qt, Q[rows, :5].T)
-            c, s = cos_sin(qt, (cbuf[: 5 * b].reshape(5, b), sbuf[: 5 * b].reshape(5, b)))
+            c, s = cos_sin(qt, (cbuf[: 5 * b].reshape(5, b), sbuf[: 5 * b].reshape(5, b)), 5 * m)
             xt = xbuf[: 6 * b].reshape(6, b)
             np.copyto(xt, X[rows].T)
             o = obuf[: 6 * b].reshape(6, b)
@@ -149,6 +149,8 @@ def joint_rates_full(
             mul(d3, sal3, out=th4)
             th4 -= mul(d2, cal3, out=tmp)
             th4 -= mul(c5, th6, out=tmp)  # eq. (51)
-            out[rows] = o.T
+            block = out[rows]
+            for j in range(6):  # column by column: faster than one transposing copy
+                block[:, j] = o[j]
     empty = np.empty(0, dtype=np.intp)
     return out, np.concatenate(suspect) if suspect else empty
