@@ -28,7 +28,7 @@ from solvers.closed_form._batch import CHUNK, blocks, cos_sin
 from solvers.closed_form.barker_scalar import Consts
 
 Array = npt.NDArray[np.float64]
-_SCRATCH = 26  # rows of the block workspace
+_SCRATCH = 21  # rows of the block workspace: the named intermediates below
 
 
 def screen_bounds(k: Consts, rcond: float) -> tuple[float, float]:
@@ -89,7 +89,7 @@ def joint_rates_full(
             T1, T2, T3, W1, W2, W3 = xt
             t1, t2, t3, th4, th5, th6 = o
             (s23, c23, f1, f3, f4, f5, det, tmp, tmp2, ta, tb, u, inv, f14, sm, d1, d2, w3, d3,
-             d4, d5, *_) = work[:, :b]  # fmt: skip
+             d4, d5) = work[:, :b]  # fmt: skip
             mul(s2, c3, out=s23)
             s23 += mul(c2, s3, out=tmp)  # S23
             mul(c2, c3, out=c23)
