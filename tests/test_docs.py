@@ -19,3 +19,13 @@ def test_every_erratum_names_existing_tests():
         for path, name in refs:
             source = (ROOT / path).read_text()
             assert re.search(rf"def {name}\b", source), f"{path}::{name} does not exist"
+
+
+def test_readme_example_runs():
+    text = (ROOT / "README.md").read_text()
+    example = text.split("```python", 1)[1].split("```", 1)[0]
+    namespace: dict = {}
+    exec(compile(example, "README.md", "exec"), namespace)
+    r = namespace["r"]
+    assert r.qdot.shape == (6,) and r.method.startswith("qp")
+    assert namespace["Qdot"].shape == (1000, 6)
