@@ -66,8 +66,8 @@ def as_float_list(
     finite sum that overflows falls through to the full check).
 
     Args:
-        x: Value to check.
-        name: Argument name used in the error message.
+        x: Vector to check, e.g. a joint configuration ``q`` or a twist.
+        name: Argument name the error names.
         size: Expected length.
         error: Exception class to raise (a subclass of :class:`InputError`).
 
