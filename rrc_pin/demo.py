@@ -12,6 +12,7 @@ from rrc_pin import models
 from rrc_pin.loading import load
 from rrc_pin.resolver import Resolver
 from rrc_pin.robot import Robot
+from solvers.closed_form.quaternion import quaternion_from_matrix, rotation_vector
 
 Array = npt.NDArray[np.float64]
 DT = 0.01  # [s], control period
@@ -86,7 +87,7 @@ def teleoperate(arm: Robot, q0: Array, segments: list[tuple[str, Array, float]])
             unit = "m  "
         else:  # rotation: compare rotation vectors in the starting hand frame
             asked_vec = twist[3:] * duration
-            done_vec = rotation_vector(T0[:3, :3].T @ T1[:3, :3])
+            done_vec = rotation_vector(quaternion_from_matrix(T0[:3, :3].T @ T1[:3, :3]))
             unit = "rad"
         asked, done = float(np.linalg.norm(asked_vec)), float(np.linalg.norm(done_vec))
         cos = float(asked_vec @ done_vec) / max(asked * done, 1e-300)
@@ -97,14 +98,6 @@ def teleoperate(arm: Robot, q0: Array, segments: list[tuple[str, Array, float]])
             f"{max(excess, 0.0):12.1e} {1e6 * np.median(times):9.0f}  {used}"
         )
     return np.array(path)
-
-
-def rotation_vector(R: Array) -> Array:
-    """Rotation vector (3,) [rad] of a rotation matrix R (3, 3), for angles below pi."""
-    cos = np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0)
-    axis = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
-    norm = np.linalg.norm(axis)
-    return axis * (np.arccos(cos) / norm) if norm > 1e-12 else np.zeros(3)
 
 
 def run_demo(arm: str | None = None) -> int:
