@@ -137,6 +137,7 @@ class Resolver:
             raise _invalid(exc) from exc
         self.joint_names = list(getattr(arm, "joint_names", [])) or None
         self._pin = _pinocchio_jacobian(arm) if self.closed_form is None else None
+        self._row_index = None if self.rows == TASKS["full"] else np.array(self.rows)
         self._last_qdot: Array | None = None
         self._steps = 0
 
@@ -215,6 +216,8 @@ class Resolver:
         return result
 
     def _task_twist(self, twist: npt.ArrayLike) -> Array:
+        if type(twist) is np.ndarray and twist.shape == (self.task_dim,):
+            return _vector(twist, "twist", self.task_dim)
         size = np.shape(twist)
         if size == (6,) and self.task_dim != 6:
             return _vector(twist, "twist", 6)[list(self.rows)]
@@ -231,13 +234,17 @@ class Resolver:
             J = np.asarray(self.closed_form.jacobian(q), dtype=np.float64)
         else:
             J = np.asarray(self.arm.jacobian(q, ref), dtype=np.float64)
-        return J if len(self.rows) == J.shape[0] else J[list(self.rows)]
+        return J if self._row_index is None else J[self._row_index]
+
+
+_FLOAT64 = np.dtype(np.float64)
 
 
 def _vector(x: npt.ArrayLike, name: str, n: int) -> Array:
-    """``x`` as a finite float (n,) array; one vector operation when it is valid."""
-    if isinstance(x, np.ndarray) and x.dtype == np.float64 and x.shape == (n,):
-        if math.isfinite(x @ x) or np.isfinite(x).all():  # x @ x overflows only past 1e154
+    """``x`` as a finite float (n,) array; no numpy call when it is one already."""
+    if type(x) is np.ndarray and x.dtype is _FLOAT64 and x.shape == (n,):
+        # a sum of finite floats overflows only past 1e307: then as_vector decides
+        if math.isfinite(sum(x.tolist())):
             return x
     return as_vector(x, name, n, InvalidInput)
 

@@ -136,6 +136,24 @@ class TaskSVD(NamedTuple):
         N = self.Vt[self.rank :]
         return N.T @ N
 
+    def null_basis(self) -> Array:
+        """Orthonormal rows (n - rank, n) spanning the (numerical) null space, :math:`V_n^T`."""
+        return self.Vt[self.rank :]
+
+    def null_project(self, z: Array) -> Array:
+        r"""Null-space part (n,) of ``z`` (n,): :math:`V_n V_n^T z`."""
+        N = self.Vt[self.rank :]
+        return N.T @ (N @ z)
+
+    def row_project(self, v: Array) -> Array:
+        r"""Row-space part (n,) of ``v`` (n,): :math:`V_r V_r^T v`."""
+        Vr = self.Vt[: self.rank]
+        return Vr.T @ (Vr @ v)
+
+    def svd(self) -> TaskSVD:
+        """Itself (the interface of :data:`solvers.task_factor.Task`)."""
+        return self
+
     def dls(self, xw: Array) -> Array:
         r"""Damped least-squares rates (n,) for the weighted task velocity ``xw`` (m,).
 

@@ -54,7 +54,7 @@ class VelocityBounds:
         upper_kind: Same for ``ub``.
     """
 
-    __slots__ = ("_kinds", "_raw", "lb", "ub")
+    __slots__ = ("_kinds", "_v_max", "lb", "ub")
 
     def __init__(
         self,
@@ -63,25 +63,24 @@ class VelocityBounds:
         lower_kind: npt.NDArray[np.int8] | None = None,
         upper_kind: npt.NDArray[np.int8] | None = None,
         *,
-        raw: tuple[Array, Array] | None = None,
+        velocity_limit: Array | None = None,
     ) -> None:
         self.lb = lb
         self.ub = ub
         both = lower_kind is not None and upper_kind is not None
         self._kinds = (lower_kind, upper_kind) if both else None
-        self._raw = raw  # (position bounds (2, n), velocity limits (n,)) for lazy kinds
+        self._v_max = velocity_limit  # the kinds are computed from it on first access
 
     def _kind(self) -> tuple[npt.NDArray[np.int8], npt.NDArray[np.int8]]:
         if self._kinds is None:
-            if self._raw is None:
+            if self._v_max is None:
                 zeros = np.zeros(self.lb.size, dtype=np.int8)
                 self._kinds = (zeros, zeros)
             else:
-                p, v = self._raw
-                self._kinds = (
-                    (p[0] > -v).astype(np.int8),  # POSITION (1) where tighter than VELOCITY
-                    (p[1] < v).astype(np.int8),
-                )
+                # POSITION (1) where the position bound is tighter than the velocity limit v:
+                # after clipping into [-v, v] that is lb > -v (and ub < v)
+                v = self._v_max
+                self._kinds = ((self.lb > -v).astype(np.int8), (self.ub < v).astype(np.int8))
         return self._kinds  # type: ignore[return-value]
 
     @property
@@ -97,7 +96,7 @@ class VelocityBounds:
     @property
     def contains_zero(self) -> bool:
         """True when standing still is allowed (no joint is asked to recover)."""
-        return bool((self.lb <= 0.0).all() and (self.ub >= 0.0).all())
+        return max(self.lb.tolist(), default=0.0) <= 0.0 <= min(self.ub.tolist(), default=0.0)
 
     def __repr__(self) -> str:
         return f"VelocityBounds(lb={self.lb!r}, ub={self.ub!r})"
@@ -163,13 +162,15 @@ class JointLimits:
             The :class:`VelocityBounds`.
         """
         v = self.v_max
-        p = (self._range - q) * (gain / dt)  # rows: position bounds p_lo, p_hi
-        b = np.minimum(np.maximum(p, self._neg_v), v)  # clipped into the velocity interval
+        b = np.subtract(self._range, q)  # rows: position bounds p_lo, p_hi ...
+        b *= gain / dt
+        np.maximum(b, self._neg_v, out=b)  # ... clipped into the velocity interval
+        np.minimum(b, v, out=b)
         if self.a_max is None:
-            return VelocityBounds(b[0], b[1], raw=(p, v))
+            return VelocityBounds(b[0], b[1], velocity_limit=v)
         lb, ub = b[0], b[1]
-        lower_kind = (p[0] > -v).astype(np.int8)
-        upper_kind = (p[1] < v).astype(np.int8)
+        lower_kind = (lb > -v).astype(np.int8)
+        upper_kind = (ub < v).astype(np.int8)
         prev = np.zeros(self.n) if qdot_prev is None else qdot_prev
         a = np.minimum(np.maximum(prev + self._a_stack * dt, lb), ub)
         lower_kind[a[0] > lb] = ACCELERATION

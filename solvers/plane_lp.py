@@ -4,15 +4,20 @@ The 7-joint arm with a 6-row task has one null-space direction ``a`` (n,). The
 direction-preserving problem (:func:`solvers.qp_problem.direction_problem`) then has two
 variables, :math:`\dot q = z\,a + u\,w`, and its priority order is lexicographic: the
 largest scale u first, then the null-space coordinate z nearest a target. Both steps are
-solved exactly here, with no iteration:
+solved exactly here, with no iteration over a tolerance:
 
 1. :math:`\max u` s.t. :math:`lb \le z\,a + u\,w \le ub`, :math:`0 \le u \le 1`. Joint by
    joint, the feasible z form an interval :math:`[L_i(u), U_i(u)]` whose ends move linearly
-   with u (joints with :math:`a_i = 0` bound u directly); the largest u is the first
-   crossing :math:`L_i(u) = U_j(u)` over all pairs, O(n^2) numbers;
+   with u (joints with :math:`a_i = 0` bound u directly by a cap). The gap
+   :math:`F(u) = \max_i L_i(u) - \min_j U_j(u)` is convex and piecewise linear with
+   :math:`F(0) \le 0` (zero is feasible), so the largest feasible u is the root of F below
+   the caps. Newton's method from the caps, on the pair (i, j) that attains F, moves down
+   monotonically onto that root and stops after finitely many pairs (one to three in
+   practice): each step's line lies below F and crosses zero at or above the root;
 2. at that u, z is the target clipped into :math:`[\max_i L_i, \min_j U_j]`.
 
-Feasible whenever the bounds contain zero (z = u = 0).
+Feasible whenever the bounds contain zero (z = u = 0). n is small (the joints of one arm):
+the arithmetic is done on Python floats, cheaper than numpy calls at this size.
 """
 
 from __future__ import annotations
@@ -21,6 +26,10 @@ import numpy as np
 import numpy.typing as npt
 
 Array = npt.NDArray[np.float64]
+
+MOVING = 1e-12
+"""Joints with ``|a_i|`` at most this are not moved by the null direction (they cap u)."""
+
 
 def max_scale_one_null(
     a: Array, w: Array, lb: Array, ub: Array, z_target: float = 0.0
@@ -37,26 +46,38 @@ def max_scale_one_null(
     Returns:
         ``(z, u)`` with u in [0, 1] maximal and z nearest ``z_target`` at that u.
     """
-    moving = np.abs(a) > 1e-12
-    u_max = 1.0
-    fixed = ~moving  # joints the null direction does not move: u w_i in [lb_i, ub_i]
-    if fixed.any():
-        wf = w[fixed]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            caps = np.where(wf > 0.0, ub[fixed] / wf, np.where(wf < 0.0, lb[fixed] / wf, np.inf))
-        u_max = min(u_max, float(caps.min()))
-    inv = 1.0 / a[moving]
-    p, r = lb[moving] * inv, ub[moving] * inv
-    lo0, hi0 = np.minimum(p, r), np.maximum(p, r)  # z interval of each joint at u = 0
-    slope = -w[moving] * inv  # both ends move by slope * u
-    c1 = slope[:, None] - slope[None, :]  # L_i - U_j grows at this rate ...
-    c0 = lo0[:, None] - hi0[None, :]  # ... from this value (<= 0: z = 0 fits at u = 0)
-    binding = c1 > 1e-15 * (1.0 + np.abs(slope).max(initial=0.0))
-    if binding.any():
-        u_max = min(u_max, float((-c0[binding] / c1[binding]).min()))
-    u = min(max(u_max, 0.0), 1.0)
-    z_lo = float((lo0 + slope * u).max(initial=-np.inf))
-    z_hi = float((hi0 + slope * u).min(initial=np.inf))
+    lo0: list[float] = []  # z interval of each moving joint at u = 0 ...
+    hi0: list[float] = []
+    slope: list[float] = []  # ... and the rate at which both of its ends move with u
+    u = 1.0
+    for ai, wi, li, ui in zip(a.tolist(), w.tolist(), lb.tolist(), ub.tolist()):  # noqa: B905
+        if ai > MOVING or ai < -MOVING:
+            p, r = li / ai, ui / ai
+            if p > r:
+                p, r = r, p
+            lo0.append(p)
+            hi0.append(r)
+            slope.append(-wi / ai)
+        elif wi > 0.0 and ui < u * wi:  # u w_i <= ub_i
+            u = ui / wi
+        elif wi < 0.0 and li > u * wi:
+            u = li / wi
+    u = max(u, 0.0)
+    if not lo0:
+        return z_target, u
+    z_lo = z_hi = 0.0
+    for _ in range(len(lo0) ** 2 + 1):  # at most one step per pair (i, j)
+        low = [l0 + s * u for l0, s in zip(lo0, slope)]  # noqa: B905
+        high = [h0 + s * u for h0, s in zip(hi0, slope)]  # noqa: B905
+        z_lo, z_hi = max(low), min(high)
+        if z_lo <= z_hi:
+            break
+        i, j = low.index(z_lo), high.index(z_hi)
+        rate = slope[i] - slope[j]  # > 0: F(0) <= 0 < F(u)
+        step = (hi0[j] - lo0[i]) / rate if rate > 0.0 else 0.0
+        if not step < u:  # rounding at the root: u is the root
+            break
+        u = max(step, 0.0)
     if z_lo > z_hi:  # rounding at a degenerate vertex: the interval is a point
         z_lo = z_hi = 0.5 * (z_lo + z_hi)
     return min(max(z_target, z_lo), z_hi), u

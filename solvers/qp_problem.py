@@ -39,6 +39,8 @@ import numpy.typing as npt
 from solvers.dls import TaskSVD
 from solvers.errors import InputError
 from solvers.joint_bounds import VelocityBounds
+from solvers.plane_lp import max_scale_one_null
+from solvers.task_factor import Task, TaskInverse
 
 Array = npt.NDArray[np.float64]
 
@@ -101,7 +103,7 @@ class QPProblem(NamedTuple):
 
 
 def tracking_problem(
-    svd: TaskSVD,
+    task: Task,
     xw: Array,
     bounds: VelocityBounds,
     secondary: Array | None = None,
@@ -121,7 +123,8 @@ def tracking_problem(
     velocity unchanged.
 
     Args:
-        svd: SVD of the weighted Jacobian with its damping (:func:`solvers.dls.task_svd`).
+        task: The weighted Jacobian factorised with its damping
+            (:func:`solvers.task_factor.factor_task` or :func:`solvers.dls.task_svd`).
         xw: Weighted task velocity :math:`L^T\dot x` (m,).
         bounds: Joint-rate bounds.
         secondary: Desired joint rates z (n,) [rad/s], or None.
@@ -135,42 +138,70 @@ def tracking_problem(
     """
     if not secondary_weight > 0.0:
         raise InputError("secondary_weight", f"expected a number > 0, got {secondary_weight!r}")
-    free = tracking_free(svd, xw, secondary, secondary_weight)
-    return tracking_problem_from(svd, free, bounds)
+    free = tracking_free(task, xw, secondary, secondary_weight)
+    return tracking_problem_from(task, free, bounds)
 
 
 class TrackingFree(NamedTuple):
-    """The box-free minimiser of :func:`tracking_problem` and the terms that build P and q.
+    """The box-free minimiser of :func:`tracking_problem` and what builds P and q from it.
 
     Attributes:
         x: Minimiser (n,) without the bounds: inside them, it is the solution.
-        d: Eigenvalues (n,) of P in the singular basis V.
-        g: Components (n,) of -q in the singular basis V.
+        xw: Weighted task velocity (m,).
+        secondary: Secondary joint rates (n,), or None.
+        mu: Secondary weight.
+        d: SVD only: eigenvalues (n,) of P in the singular basis V (else None).
+        g: SVD only: components (n,) of -q in the singular basis V (else None).
     """
 
     x: Array
-    d: Array
-    g: Array
+    xw: Array
+    secondary: Array | None
+    mu: float
+    d: Array | None = None
+    g: Array | None = None
 
 
 def tracking_free(
-    svd: TaskSVD, xw: Array, secondary: Array | None = None, secondary_weight: float = 1e-2
+    task: Task, xw: Array, secondary: Array | None = None, secondary_weight: float = 1e-2
 ) -> TrackingFree:
-    """The box-free minimiser of :func:`tracking_problem`, without building P and q.
+    r"""The box-free minimiser of :func:`tracking_problem`, without building P and q.
 
     The resolver checks it against the bounds first; only when it leaves them are P and q
-    built (:func:`tracking_problem_from`).
+    built (:func:`tracking_problem_from`). With the inverse factorisation (no damping, full
+    row rank) it is :math:`\tilde J^T A^{-1}\tilde x + N N^T z`.
     """
-    d, g = _tracking_terms(svd, xw, secondary, secondary_weight)
-    return TrackingFree(svd.Vt.T @ (g / d), d, g)
+    mu = secondary_weight
+    if isinstance(task, TaskInverse):
+        x = task.dls(xw)
+        if secondary is not None:
+            x = x + task.null_project(secondary)
+        return TrackingFree(x, xw, secondary, mu)
+    d, g = _tracking_terms(task, xw, secondary, mu)
+    return TrackingFree(task.Vt.T @ (g / d), xw, secondary, mu, d, g)
 
 
-def tracking_problem_from(svd: TaskSVD, free: TrackingFree, bounds: VelocityBounds) -> QPProblem:
-    """The ``"tracking"`` :class:`QPProblem` from the terms of :func:`tracking_free`."""
-    V = svd.Vt.T
+def tracking_problem_from(task: Task, free: TrackingFree, bounds: VelocityBounds) -> QPProblem:
+    r"""The ``"tracking"`` :class:`QPProblem` from :func:`tracking_free`'s minimiser.
+
+    :math:`P = \tilde J^T\tilde J + \lambda^2 I + \mu N N^T` and
+    :math:`q = -\tilde J^T\tilde x - \mu N N^T z`: in the singular basis
+    (:class:`~solvers.dls.TaskSVD`) or through :math:`A^{-1}`
+    (:class:`~solvers.task_factor.TaskInverse`).
+    """
+    if isinstance(task, TaskInverse):
+        P = task.hessian(free.mu)
+        q = free.xw @ task.J
+        if free.secondary is not None:
+            q += free.mu * task.null_project(free.secondary)
+        np.negative(q, out=q)
+    else:
+        V = task.Vt.T
+        P = (V * free.d) @ task.Vt
+        q = V @ -free.g
     return QPProblem(
-        P=(V * free.d) @ svd.Vt, q=V @ -free.g, G=None, lo=None, hi=None, lb=bounds.lb,
-        ub=bounds.ub, offset=None, x_free=free.x, n=svd.n, kind="tracking",
+        P=P, q=q, G=None, lo=None, hi=None, lb=bounds.lb, ub=bounds.ub, offset=None,
+        x_free=free.x, n=task.n, kind="tracking",
     )
 
 
@@ -195,7 +226,7 @@ def _tracking_terms(
 
 
 def direction_problem(
-    svd: TaskSVD,
+    task: Task,
     qdot_dls: Array,
     bounds: VelocityBounds,
     secondary: Array | None = None,
@@ -222,8 +253,8 @@ def direction_problem(
     contains zero (u = 0, z = 0).
 
     Args:
-        svd: SVD of the weighted Jacobian with its damping.
-        qdot_dls: Damped least-squares rates (n,) (:meth:`TaskSVD.dls`).
+        task: The weighted Jacobian factorised with its damping.
+        qdot_dls: Damped least-squares rates (n,) (``task.dls``).
         bounds: Joint-rate bounds; must contain zero (:attr:`VelocityBounds.contains_zero`).
         secondary: Desired joint rates z (n,), or None.
         secondary_weight: :math:`\mu` in [0, 1).
@@ -239,40 +270,132 @@ def direction_problem(
         raise InputError("bounds", "the direction-preserving problem needs lb <= 0 <= ub")
     if not 0.0 <= secondary_weight < 1.0:
         raise InputError("secondary_weight", f"expected [0, 1), got {secondary_weight!r}")
-    n = svd.n
-    Vr = svd.Vt[: svd.rank]
-    Vn = svd.Vt[svd.rank :]
-    w = Vr.T @ (Vr @ qdot_dls)
-    reach = np.maximum(-bounds.lb, bounds.ub)
-    radius = math.sqrt(float(reach @ reach))
-    w_norm = math.sqrt(float(w @ w))
-    s_hi = min(1.0, radius / w_norm) if w_norm > 0.0 else 1.0
-    w = s_hi * w
-    nz = n - svd.rank
-    R2 = max(radius, 1e-12) ** 2
-    reg = (DIRECTION_REGULARISATION + secondary_weight) / R2
-    P = np.diag([reg] * nz + [1.0])
+    terms = direction_terms(task, qdot_dls, bounds, secondary, secondary_weight)
+    return direction_problem_from(terms, bounds)
+
+
+def direction_problem_from(terms: DirectionTerms, bounds: VelocityBounds) -> QPProblem:
+    """The ``"direction"`` :class:`QPProblem` of :func:`direction_terms` (no input checks)."""
+    n = terms.w.size
+    nz = terms.Vn.shape[0]
+    P = np.diag([terms.reg] * nz + [1.0])
     q = np.zeros(nz + 1)
     q[nz] = -2.0
     x_free = np.zeros(nz + 1)
     x_free[nz] = 1.0
-    if secondary is not None and secondary_weight > 0.0 and nz:
-        t = (secondary_weight / R2) * (Vn @ secondary)
-        q[:nz] = -t
-        x_free[:nz] = t / reg
+    if terms.target is not None:
+        q[:nz] = -terms.reg * terms.target
+        x_free[:nz] = terms.target
     G = np.empty((n, nz + 1))
-    G[:, :nz] = Vn.T
-    G[:, nz] = w
+    G[:, :nz] = terms.Vn.T
+    G[:, nz] = terms.w
     return QPProblem(
         P=P, q=q, G=G, lo=bounds.lb, hi=bounds.ub,
         lb=np.concatenate([np.full(nz, -np.inf), [0.0]]),
         ub=np.concatenate([np.full(nz, np.inf), [1.0]]),
-        offset=None, x_free=x_free, n=n, kind="direction", scale_factor=s_hi,
+        offset=None, x_free=x_free, n=n, kind="direction", scale_factor=terms.s_hi,
     )
 
 
+class DirectionTerms(NamedTuple):
+    r"""The data of the direction-preserving problem (:func:`direction_problem`).
+
+    Attributes:
+        Vn: Orthonormal null-space rows (nz, n).
+        w: Joint rates per unit of u (n,), :math:`s_{hi} V_rV_r^T\dot q_{dls}`.
+        s_hi: Cap of the scale, in (0, 1].
+        reg: Weight of :math:`\frac12\|z\|^2` in the cost, :math:`(\epsilon + \mu)/R^2`.
+        target: Minimiser (nz,) of the z terms of the cost, or None for zero.
+    """
+
+    Vn: Array
+    w: Array
+    s_hi: float
+    reg: float
+    target: Array | None
+
+
+def direction_terms(
+    task: Task,
+    qdot_dls: Array,
+    bounds: VelocityBounds,
+    secondary: Array | None = None,
+    secondary_weight: float = 1e-2,
+) -> DirectionTerms:
+    """The :class:`DirectionTerms` of :func:`direction_problem` (no input checks)."""
+    Vn = task.null_basis()
+    # with the inverse factorisation the least-squares rates lie in the row space already
+    w = qdot_dls if isinstance(task, TaskInverse) else task.row_project(qdot_dls)
+    radius = math.hypot(*map(max, (-b for b in bounds.lb.tolist()), bounds.ub.tolist()))
+    w_norm = math.hypot(*w.tolist())
+    s_hi = min(1.0, radius / w_norm) if w_norm > 0.0 else 1.0
+    if s_hi != 1.0:
+        w = s_hi * w
+    R2 = max(radius, 1e-12) ** 2
+    reg = (DIRECTION_REGULARISATION + secondary_weight) / R2
+    target = None
+    if secondary is not None and secondary_weight > 0.0 and Vn.shape[0]:
+        # minimiser of eps/2R^2 |z|^2 + mu/2R^2 |z - Vn z_2|^2
+        target = (secondary_weight / (DIRECTION_REGULARISATION + secondary_weight)) * (
+            Vn @ secondary
+        )
+    return DirectionTerms(Vn, w, s_hi, reg, target)
+
+
+def direction_step(terms: DirectionTerms, bounds: VelocityBounds) -> tuple[Array, float]:
+    """Exact solution of a direction problem with at most one null-space direction.
+
+    No null space: the rates are u w and the largest feasible u is optimal. One direction:
+    the plane LP of :mod:`solvers.plane_lp` (largest u, then z nearest its target). No
+    backend and no :class:`QPProblem` are involved.
+
+    Args:
+        terms: The problem's :func:`direction_terms` (``Vn`` with at most one row).
+        bounds: Joint-rate bounds containing zero.
+
+    Returns:
+        The joint rates (n,) (within the bounds up to rounding) and the scale s in [0, 1].
+
+    Raises:
+        InputError: More than one null-space direction.
+    """
+    Vn, w = terms.Vn, terms.w
+    if Vn.shape[0] == 0:
+        u = largest_scale(w, bounds.lb, bounds.ub)
+        return u * w, u * terms.s_hi
+    if Vn.shape[0] > 1:
+        raise InputError("terms", f"expected at most one null-space direction, got {Vn.shape[0]}")
+    a = Vn[0]
+    target = 0.0 if terms.target is None else float(terms.target[0])
+    z, u = max_scale_one_null(a, w, bounds.lb, bounds.ub, target)
+    return a * z + w * u, u * terms.s_hi
+
+
+def largest_scale(qdot: Array, lb: Array, ub: Array) -> float:
+    """Largest s in [0, 1] with ``lb <= s * qdot <= ub`` on the joints whose bounds contain zero.
+
+    A recovering joint (bounds excluding zero) cannot be satisfied by scaling: it is
+    ignored here (and clipped by the caller).
+
+    Args:
+        qdot: Joint rates (n,).
+        lb: Lower bounds (n,).
+        ub: Upper bounds (n,).
+
+    Returns:
+        The scale s in [0, 1].
+    """
+    s = 1.0
+    for v, lo, hi in zip(qdot.tolist(), lb.tolist(), ub.tolist(), strict=True):
+        if v > hi >= 0.0:
+            s = min(s, hi / v)
+        elif v < lo <= 0.0:
+            s = min(s, lo / v)
+    return max(0.0, s)
+
+
 def priority_problem(
-    svd: TaskSVD, qdot_primary: Array, bounds: VelocityBounds, secondary: Array
+    task: Task, qdot_primary: Array, bounds: VelocityBounds, secondary: Array
 ) -> QPProblem:
     r"""Strict second priority level: the secondary objective in the primary's null space.
 
@@ -286,7 +409,7 @@ def priority_problem(
     Feasible whenever ``qdot_primary`` is within the bounds (z = its null-space part).
 
     Args:
-        svd: SVD of the weighted Jacobian.
+        task: The weighted Jacobian factorised (its SVD is used: ``task.svd()``).
         qdot_primary: Solution of the primary problem (n,), within the bounds.
         bounds: Joint-rate bounds.
         secondary: Desired joint rates :math:`z_2` (n,).
@@ -294,6 +417,7 @@ def priority_problem(
     Returns:
         The ``"priority"`` :class:`QPProblem`: x = z, nx = n - rank (may be 0: nothing to do).
     """
+    svd = task.svd()
     Vr = svd.Vt[: svd.rank]
     Vn = svd.Vt[svd.rank :]
     nz = Vn.shape[0]

@@ -25,24 +25,28 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
+from operator import le, sub
 from typing import Any, Literal
 
 import numpy as np
 import numpy.typing as npt
 
-from solvers.dls import Damping, TaskSVD, task_svd
+from solvers.dls import Damping
 from solvers.errors import InputError, SolverError
 from solvers.joint_bounds import VelocityBounds
-from solvers.plane_lp import max_scale_one_null
 from solvers.qp_backends import QPBackend, make_backend
 from solvers.qp_problem import (
     QPProblem,
-    direction_problem,
+    direction_problem_from,
+    direction_step,
+    direction_terms,
+    largest_scale,
     priority_problem,
     tracking_free,
     tracking_problem_from,
 )
 from solvers.resolution_record import Resolution
+from solvers.task_factor import Task, factor_task
 from solvers.validation import as_array, as_vector
 
 Array = npt.NDArray[np.float64]
@@ -159,7 +163,8 @@ class ResolutionChain:
             secondary: Desired joint rates (n,) for the secondary objective, or None.
             factor: Task-weight factor L (m, m) (:func:`~solvers.dls.weight_factor`) or None.
             joint_names: Names for :attr:`ActiveLimit.name`.
-            validate: Check shapes and finiteness (off only for inputs checked already).
+            validate: Check shapes and finiteness (off only for float64 arrays checked
+                already).
 
         Returns:
             The :class:`Resolution`; never raises for numerical trouble.
@@ -178,25 +183,23 @@ class ResolutionChain:
                 raise InputError("bounds", "expected lb <= ub")
             if secondary is not None:
                 secondary = as_vector(secondary, "secondary", n)
-        J = np.asarray(J, dtype=np.float64)
-        xdot = np.asarray(xdot, dtype=np.float64)
-        z = None if secondary is None else np.asarray(secondary, dtype=np.float64)
-        xw = xdot if factor is None else factor.T @ xdot
+        z: Array | None = secondary  # type: ignore[assignment]
+        xw: Array = xdot if factor is None else factor.T @ xdot  # type: ignore[assignment]
         attempts: list[tuple[str, str]] = []
-        svd: TaskSVD | None
+        task: Task | None
         try:
-            svd = task_svd(J, factor, self.damping)
+            task = factor_task(J, factor, self.damping)  # type: ignore[arg-type]
         except (np.linalg.LinAlgError, ArithmeticError) as exc:
-            svd = None
+            task = None
             attempts.append(("svd", str(exc)))
         answer: _Answer | None = None
         for method in self.methods:
             try:
-                answer = self._run(method, svd, xw, bounds, z)
+                answer = self._run(method, task, xw, bounds, z)
             except (SolverError, np.linalg.LinAlgError, ArithmeticError) as exc:
                 attempts.append((method, str(exc)))
                 continue
-            if math.isfinite(answer.qdot @ answer.qdot) or np.isfinite(answer.qdot).all():
+            if _finite(answer.qdot):
                 break
             attempts.append((method, "non-finite rates"))
             answer = None
@@ -214,9 +217,9 @@ class ResolutionChain:
             answer.iterations,
             answer.backend,
             tuple(attempts),
-            svd.lambda_sq if svd is not None else math.nan,
-            J=J,
-            xdot=xdot,
+            task.lambda_sq if task is not None else math.nan,
+            J=J,  # type: ignore[arg-type]
+            xdot=xdot,  # type: ignore[arg-type]
             bounds=bounds,
             factor=factor,
             active_tol=self.active_tol,
@@ -226,57 +229,42 @@ class ResolutionChain:
     def _run(
         self,
         method: str,
-        svd: TaskSVD | None,
+        task: Task | None,
         xw: Array,
         bounds: VelocityBounds,
         z: Array | None,
     ) -> _Answer:
+        if method == "qp":
+            if task is None:
+                raise _MethodFailed("no factorisation of the Jacobian")
+            return self._qp(task, xw, bounds, z)
         if method == "hold":
             return _hold(bounds)
-        if svd is None:
-            raise _MethodFailed("no SVD of the Jacobian")
-        if method == "qp":
-            return self._qp(svd, xw, bounds, z)
-        qdot = svd.dls(xw)
+        if task is None:
+            raise _MethodFailed("no factorisation of the Jacobian")
+        qdot = task.dls(xw)
         if z is not None:
-            Vn = svd.Vt[svd.rank :]
-            qdot = qdot + Vn.T @ (Vn @ z)
+            qdot = qdot + task.null_project(z)
         if method == "dls":
-            clipped = np.minimum(np.maximum(qdot, bounds.lb), bounds.ub)
-            return _Answer(clipped, "dls", None, "projected", _size(clipped - qdot))
+            return _clipped(qdot, bounds, "dls", None, "projected")
         s = uniform_scale(qdot, bounds)
-        scaled = s * qdot
-        clipped = np.minimum(np.maximum(scaled, bounds.lb), bounds.ub)
-        return _Answer(clipped, "scaling", s, "scaled", _size(clipped - scaled))
+        return _clipped(s * qdot, bounds, "scaling", s, "scaled")
 
-    def _qp(self, svd: TaskSVD, xw: Array, bounds: VelocityBounds, z: Array | None) -> _Answer:
+    def _qp(self, task: Task, xw: Array, bounds: VelocityBounds, z: Array | None) -> _Answer:
         soft_z = z if self.priority == "soft" else None
         if self.direction_preserving and bounds.contains_zero:
-            dls = svd.dls(xw)
-            if (
-                self.shortcut
-                and soft_z is None
-                and svd.rank == svd.sigma.size  # full row rank: dls is in the row space
-                and (dls >= bounds.lb).all()
-                and (dls <= bounds.ub).all()
-            ):  # u = 1, z = 0: the box-free optimum, before the problem is built
-                answer = _Answer(dls, "qp_direction", 1.0, "unconstrained optimum")
-            else:
-                problem = direction_problem(svd, dls, bounds, soft_z, self.secondary_weight)
-                x, answer = self._solve(problem, "qp_direction", bounds)
-                answer.scale = problem.scale(x)
+            answer = self._direction(task, xw, bounds, soft_z)
         else:
             # the box-free minimiser first; P and q are built only when it leaves the box
-            free = tracking_free(svd, xw, soft_z, self.secondary_weight)
-            x = free.x
-            if self.shortcut and (x >= bounds.lb).all() and (x <= bounds.ub).all():
-                answer = _Answer(x, "qp", None, "unconstrained optimum")
+            free = tracking_free(task, xw, soft_z, self.secondary_weight)
+            if self.shortcut and _within(free.x, bounds):
+                answer = _Answer(free.x, "qp", None, "unconstrained optimum")
             else:
-                problem = tracking_problem_from(svd, free, bounds)
+                problem = tracking_problem_from(task, free, bounds)
                 _, answer = self._solve(problem, "qp", bounds, check_free=False)
-        if z is None or self.priority != "strict" or svd.rank == svd.n:
+        if z is None or self.priority != "strict" or task.rank == task.n:
             return answer
-        second = priority_problem(svd, answer.qdot, bounds, z)
+        second = priority_problem(task, answer.qdot, bounds, z)
         try:
             _, answer2 = self._solve(second, "qp_priority", bounds)
         except _MethodFailed as exc:
@@ -288,6 +276,27 @@ class ResolutionChain:
         answer2.clip = max(answer2.clip, answer.clip)
         return answer2
 
+    def _direction(
+        self, task: Task, xw: Array, bounds: VelocityBounds, z: Array | None
+    ) -> _Answer:
+        """The direction-preserving QP: shortcut, exact plane LP, or the backend."""
+        dls = task.dls(xw)
+        if (
+            self.shortcut
+            and z is None
+            and task.rank == min(task.J.shape)  # full row rank: dls is in the row space
+            and _within(dls, bounds)
+        ):  # u = 1, z = 0: the box-free optimum, before the problem is built
+            return _Answer(dls, "qp_direction", 1.0, "unconstrained optimum")
+        terms = direction_terms(task, dls, bounds, z, self.secondary_weight)
+        if terms.Vn.shape[0] <= 1:  # solved exactly, no backend
+            raw, s = direction_step(terms, bounds)
+            return _clipped(raw, bounds, "qp_direction", s, "exact")
+        problem = direction_problem_from(terms, bounds)
+        x, answer = self._solve(problem, "qp_direction", bounds)
+        answer.scale = problem.scale(x)
+        return answer
+
     def _solve(
         self, problem: QPProblem, method: str, bounds: VelocityBounds, check_free: bool = True
     ) -> tuple[Array, _Answer]:
@@ -297,9 +306,6 @@ class ResolutionChain:
             if problem.G is None:
                 return x, _Answer(x, method, None, "unconstrained optimum")
             status, iterations, solve_time, backend = "unconstrained optimum", 0, 0.0, ""
-        elif problem.kind == "direction" and problem.P.shape[0] <= 2:
-            x = _direction_exact(problem, bounds)
-            status, iterations, solve_time, backend = "exact", 0, 0.0, ""
         elif problem.kind == "priority" and problem.P.shape[0] == 1:
             x = np.array([_interval_point(problem.G[:, 0], problem.lo, problem.hi,
                                           float(problem.x_free[0]))])
@@ -314,11 +320,9 @@ class ResolutionChain:
             status, iterations, solve_time, backend = (
                 sol.status, sol.iterations, sol.solve_time, sol.backend,
             )
-        raw = problem.rates(x)
-        qdot = np.minimum(np.maximum(raw, bounds.lb), bounds.ub)
-        return x, _Answer(
-            qdot, method, None, status, _size(qdot - raw), iterations, solve_time, backend
-        )
+        answer = _clipped(problem.rates(x), bounds, method, None, status)
+        answer.iterations, answer.solve_time, answer.backend = iterations, solve_time, backend
+        return x, answer
 
 
 def uniform_scale(qdot: Array, bounds: VelocityBounds) -> float:
@@ -334,30 +338,27 @@ def uniform_scale(qdot: Array, bounds: VelocityBounds) -> float:
     Returns:
         The scale s in [0, 1].
     """
-    s = 1.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        up = (qdot > bounds.ub) & (bounds.ub >= 0.0)
-        down = (qdot < bounds.lb) & (bounds.lb <= 0.0)
-        if np.any(up):
-            s = min(s, float(np.min(bounds.ub[up] / qdot[up])))
-        if np.any(down):
-            s = min(s, float(np.min(bounds.lb[down] / qdot[down])))
-    return max(0.0, s)
+    return largest_scale(qdot, bounds.lb, bounds.ub)
 
 
-def _direction_exact(problem: QPProblem, bounds: VelocityBounds) -> Array:
-    """Solution (z, u) of a direction problem with at most one null-space direction.
+def _within(x: Array, bounds: VelocityBounds) -> bool:
+    """True when ``lb <= x <= ub`` (False for NaN); Python floats: n is small."""
+    xl = x.tolist()
+    return all(map(le, bounds.lb.tolist(), xl)) and all(map(le, xl, bounds.ub.tolist()))
 
-    No null space: the rates are u w and the largest feasible u is optimal. One direction:
-    the plane LP of :mod:`solvers.plane_lp` (largest u, then z nearest its target).
-    """
-    G = problem.G
-    if G is None:  # pragma: no cover - direction problems always have G
-        raise _MethodFailed("direction problem without G")
-    if G.shape[1] == 1:
-        return np.array([uniform_scale(G[:, 0], bounds)])
-    z, u = max_scale_one_null(G[:, 0], G[:, 1], bounds.lb, bounds.ub, float(problem.x_free[0]))
-    return np.array([z, u])
+
+def _finite(x: Array) -> bool:
+    """True when every entry of ``x`` is finite (one sum; numpy only if it overflows)."""
+    return math.isfinite(sum(x.tolist())) or bool(np.isfinite(x).all())
+
+
+def _clipped(
+    raw: Array, bounds: VelocityBounds, method: str, scale: float | None, status: str
+) -> _Answer:
+    """The answer ``raw`` clipped into the bounds, with the size of the clip."""
+    qdot = np.minimum(np.maximum(raw, bounds.lb), bounds.ub)
+    gaps = map(sub, qdot.tolist(), raw.tolist())
+    return _Answer(qdot, method, scale, status, max(map(abs, gaps), default=0.0))
 
 
 def _interval_point(g: Array, lo: Array, hi: Array, target: float) -> float:
@@ -375,9 +376,3 @@ def _interval_point(g: Array, lo: Array, hi: Array, target: float) -> float:
 def _hold(bounds: VelocityBounds) -> _Answer:
     qdot = np.minimum(np.maximum(0.0, bounds.lb), bounds.ub)
     return _Answer(qdot, "hold", None, "hold: feasible rates nearest zero")
-
-
-def _size(d: Array) -> float:
-    return float(np.abs(d).max()) if d.size else 0.0
-
-

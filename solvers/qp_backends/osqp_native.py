@@ -55,13 +55,17 @@ INFTY = 1e30
 
 @dataclass
 class _Workspace:
+    """One OSQP solver for one problem structure, and the buffers its updates reuse."""
+
+    name: str  # structure_key of the problem
     solver: Any
-    p_rows: npt.NDArray[np.intp]
-    p_cols: npt.NDArray[np.intp]
+    p_flat: npt.NDArray[np.intp]  # flat indices of P's upper triangle, in CSC order
     a_data: Array
     g_index: npt.NDArray[np.intp]
-    lo: Array
+    lo: Array  # (nx + ng,): box rows, then G rows
     up: Array
+    lo_box: Array  # views of the first nx entries
+    up_box: Array
     zero_x: Array
     zero_y: Array
     native: Any = None
@@ -88,7 +92,7 @@ class OSQPBackend(QPBackend):
             raise ProblemError("osqp is not installed (pip install osqp)") from exc
         self._osqp = osqp
         self.settings = {**DEFAULT_SETTINGS, **settings}
-        self._workspaces: dict[str, _Workspace] = {}
+        self._workspaces: dict[tuple[str, int, int], _Workspace] = {}
 
     def reset(self) -> None:
         """Forget every warm start (workspaces are kept: their setup is not redone)."""
@@ -98,10 +102,10 @@ class OSQPBackend(QPBackend):
     def warm_start_state(self) -> dict[str, Array]:
         """Copies of the primal and dual solution of every workspace (the next warm start)."""
         state: dict[str, Array] = {}
-        for key, ws in self._workspaces.items():
+        for ws in self._workspaces.values():
             if not ws.cold:
-                state[f"{key}:x"] = np.array(ws.native.solution.x)
-                state[f"{key}:y"] = np.array(ws.native.solution.y)
+                state[f"{ws.name}:x"] = np.array(ws.native.solution.x)
+                state[f"{ws.name}:y"] = np.array(ws.native.solution.y)
         return state
 
     def solve(self, problem: QPProblem) -> QPSolution:
@@ -115,8 +119,8 @@ class OSQPBackend(QPBackend):
             ProblemError: OSQP raised during setup, update or solve.
         """
         t0 = time.perf_counter()
-        key = structure_key(problem)
         nx = problem.P.shape[0]
+        key = (problem.kind, nx, 0 if problem.G is None else problem.G.shape[0])
         ws = self._workspaces.get(key)
         try:
             if ws is None:
@@ -149,15 +153,16 @@ class OSQPBackend(QPBackend):
 
     @staticmethod
     def _update(ws: _Workspace, problem: QPProblem) -> None:
-        nx = problem.P.shape[0]
-        np.maximum(problem.lb, -INFTY, out=ws.lo[:nx])
-        np.minimum(problem.ub, INFTY, out=ws.up[:nx])
-        Px = problem.P[ws.p_rows, ws.p_cols]
+        """New data, same pattern: vectors, then matrices (OSQP refactors its KKT system)."""
+        np.maximum(problem.lb, -INFTY, out=ws.lo_box)
+        np.minimum(problem.ub, INFTY, out=ws.up_box)
+        Px = problem.P.take(ws.p_flat)
         native = ws.native
         if problem.G is None:
             native.update_data_vec(q=problem.q, l=ws.lo, u=ws.up)
             native.update_data_mat(P_x=Px, P_i=None, A_x=None, A_i=None)
             return
+        nx = ws.lo_box.size
         ws.lo[nx:] = problem.lo
         ws.up[nx:] = problem.hi
         ws.a_data[ws.g_index] = problem.G.T.ravel()
@@ -195,13 +200,15 @@ class OSQPBackend(QPBackend):
             lo[nx:] = problem.lo
             up[nx:] = problem.hi
         ws = _Workspace(
+            name=structure_key(problem),
             solver=self._osqp.OSQP(),
-            p_rows=p_rows,
-            p_cols=p_cols,
+            p_flat=p_rows * nx + p_cols,
             a_data=data,
             g_index=g_index,
             lo=lo,
             up=up,
+            lo_box=lo[:nx],
+            up_box=up[:nx],
             zero_x=np.zeros(nx),
             zero_y=np.zeros(nx + ng),
         )

@@ -1,0 +1,159 @@
+r"""Per-step factorisation of the task Jacobian: an inverse where it settles the damping, else SVD.
+
+Every step of the resolver needs the damping :math:`\lambda^2` of the weighted Jacobian
+:math:`\tilde J = L^T J` (m, n), its damped least-squares rates and, when a bound is
+active, the QP terms. The SVD (:class:`solvers.dls.TaskSVD`) gives all of them at any
+configuration, but it is the most expensive call of a step. Away from singularities one
+small inverse suffices:
+
+.. math::
+
+    A = \tilde J\tilde J^T, \qquad
+    \lambda_{min}(A) \ge 1/\operatorname{tr}(A^{-1})
+    \quad\Rightarrow\quad
+    \operatorname{tr}(A^{-1}) \le 1/\epsilon^2 \ \Rightarrow\ \sigma_{min}(\tilde J) \ge \epsilon
+
+(the trace of :math:`A^{-1}` is the sum of the :math:`1/\sigma_i^2`; the bound is within a
+factor m of :math:`\sigma_{min}`). When it certifies :math:`\sigma_{min} \ge \epsilon`, the
+damping schedule of :class:`solvers.dls.Damping` (``measure="sigma"``, no floor) is zero,
+:math:`\tilde J` has full row rank, and, with :math:`N N^T = I - \tilde J^T A^{-1}\tilde J`
+the projector onto its null space:
+
+.. math::
+
+    \dot q_{dls} = \tilde J^T A^{-1}\tilde x, \qquad
+    P = \tilde J^T\tilde J + \mu N N^T = \tilde J^T (I - \mu A^{-1})\tilde J + \mu I
+
+(:class:`TaskInverse`). Otherwise (inside the damping region, rank deficient, a floor or
+the manipulability measure) :func:`factor_task` returns the SVD. Both answer the same
+questions (:data:`Task`), to rounding.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import numpy.typing as npt
+
+from solvers.dls import Damping, TaskSVD, task_svd
+
+try:  # scipy comes with the QP backends (osqp, qpsolvers)
+    from scipy.linalg.lapack import dposv as _lapack_posv
+except ImportError:  # pragma: no cover
+    _lapack_posv = None
+
+Array = npt.NDArray[np.float64]
+
+
+class TaskInverse:
+    r"""A weighted task Jacobian of full row rank outside the damping region, by :math:`A^{-1}`.
+
+    Built by :func:`factor_task` only when the certificate of the module docstring holds;
+    the damping is then zero and the rank is m.
+
+    Attributes:
+        J: The weighted Jacobian :math:`\tilde J` (m, n).
+        Ainv: :math:`(\tilde J\tilde J^T)^{-1}` (m, m).
+        n: Number of joints.
+        rank: m.
+        lambda_sq: 0.0.
+    """
+
+    __slots__ = ("Ainv", "J", "_svd", "lambda_sq", "n", "rank")
+
+    def __init__(self, J: Array, Ainv: Array) -> None:
+        self.J = J
+        self.Ainv = Ainv
+        self.rank, self.n = J.shape
+        self.lambda_sq = 0.0
+        self._svd: TaskSVD | None = None
+
+    def dls(self, xw: Array) -> Array:
+        r"""Least-squares rates (n,) of least norm, :math:`\tilde J^T A^{-1}\tilde x`."""
+        return (self.Ainv @ xw) @ self.J
+
+    def null_project(self, z: Array) -> Array:
+        r"""Null-space part (n,) of ``z`` (n,): :math:`(I - \tilde J^T A^{-1}\tilde J) z`."""
+        return z - (self.Ainv @ (self.J @ z)) @ self.J
+
+    def row_project(self, v: Array) -> Array:
+        r"""Row-space part (n,) of ``v`` (n,): :math:`\tilde J^T A^{-1}\tilde J v`."""
+        return (self.Ainv @ (self.J @ v)) @ self.J
+
+    def hessian(self, mu: float) -> Array:
+        r"""Tracking cost matrix (n, n): :math:`\tilde J^T (I - \mu A^{-1})\tilde J + \mu I`."""
+        M = self.Ainv * -mu
+        _diagonal(M)[:] += 1.0
+        P = self.J.T @ (M @ self.J)
+        _diagonal(P)[:] += mu
+        return P
+
+    def null_basis(self) -> Array:
+        """Orthonormal rows (n - m, n) spanning the null space (from the SVD, computed once)."""
+        svd = self.svd()
+        return svd.Vt[svd.rank :]
+
+    def svd(self) -> TaskSVD:
+        """The SVD of the same Jacobian (computed on first call; damping zero as here)."""
+        if self._svd is None:
+            self._svd = task_svd(self.J, None, None)
+        return self._svd
+
+
+Task = TaskInverse | TaskSVD
+"""Either factorisation: both have ``J``, ``n``, ``rank``, ``lambda_sq``, ``dls``,
+``null_project``, ``row_project``, ``null_basis`` and ``svd``."""
+
+
+def factor_task(J: Array, factor: Array | None = None, damping: Damping | None = None) -> Task:
+    r"""The cheapest factorisation of :math:`L^T J` that settles the damping (no input checks).
+
+    Args:
+        J: Jacobian (m, n), finite.
+        factor: :math:`L` (m, m) from :func:`solvers.dls.weight_factor`, or None for W = I.
+        damping: Damping schedule; None for no damping.
+
+    Returns:
+        A :class:`TaskInverse` where the trace certificate (module docstring) shows that the
+        damping is zero and the rank full, else the :class:`~solvers.dls.TaskSVD`.
+
+    Raises:
+        numpy.linalg.LinAlgError: The SVD did not converge (only for pathological input).
+    """
+    Jw = J if factor is None else factor.T @ J
+    m, n = Jw.shape
+    if m <= n and damping is not None and damping.floor == 0.0 and damping.measure == "sigma":
+        # A^-1 by LAPACK's Cholesky solve (info > 0: A is not numerically positive definite)
+        _, Ainv, info = _posv(Jw @ Jw.T, _identity(m))
+        # tr(A^-1) eps^2 <= 1 certifies sigma_min >= eps; NaN fails the comparison
+        if info == 0 and sum(Ainv.diagonal().tolist()) * damping.threshold**2 <= 1.0:
+            return TaskInverse(Jw, Ainv)
+    return task_svd(Jw, None, damping)
+
+
+def _diagonal(M: Array) -> Array:
+    """Writable view of the diagonal of a square C- or Fortran-contiguous ``M`` (LAPACK's)."""
+    return M.ravel(order="K")[:: M.shape[0] + 1]
+
+
+@functools.cache
+def _identity(m: int) -> Array:
+    """The identity (m, m), shared and read-only."""
+    eye = np.eye(m)
+    eye.flags.writeable = False
+    return eye
+
+
+def _posv(A: Array, B: Array) -> tuple[Array, Array, int]:
+    """``(factor, X, info)`` of LAPACK dposv for ``A X = B``, A symmetric positive definite.
+
+    Through scipy's binding (a quarter of ``numpy.linalg.inv``'s time on these small
+    matrices), or numpy where scipy is absent (``info = 1`` when it finds A singular).
+    """
+    if _lapack_posv is not None:
+        return _lapack_posv(A, B)  # type: ignore[no-any-return]
+    try:
+        return A, np.linalg.solve(A, B), 0
+    except np.linalg.LinAlgError:
+        return A, B, 1
