@@ -31,12 +31,14 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from solvers.active_set import active_joints, solve_on_active_set
 from solvers.dls import Damping
 from solvers.errors import InputError, SolverError
 from solvers.joint_bounds import VelocityBounds
 from solvers.qp_backends import QPBackend, make_backend
 from solvers.qp_problem import (
     QPProblem,
+    TrackingFree,
     direction_problem_from,
     direction_step,
     direction_terms,
@@ -133,15 +135,24 @@ class ResolutionChain:
         self.secondary_weight = float(secondary_weight)
         self.shortcut = bool(shortcut)
         self.active_tol = float(active_tol)
+        self._active: tuple[tuple[int, ...], tuple[int, ...]] = ((), ())
 
     def reset(self) -> None:
-        """Forget the backend's warm start."""
+        """Forget the backend's warm start and the previous active set."""
         if self.backend is not None:
             self.backend.reset()
+        self._active = ((), ())
 
     def warm_start_state(self) -> dict[str, Array]:
-        """Copies of the backend's warm-start values (empty without a backend)."""
-        return self.backend.warm_start_state() if self.backend is not None else {}
+        """Copies of the values that seed the next step.
+
+        The backend's warm start, and the previous tracking answer's active set (joints at
+        their lower and upper bounds, ``active:lower`` and ``active:upper``).
+        """
+        state = self.backend.warm_start_state() if self.backend is not None else {}
+        state["active:lower"] = np.array(self._active[0], dtype=np.intp)
+        state["active:upper"] = np.array(self._active[1], dtype=np.intp)
+        return state
 
     def resolve(
         self,
@@ -259,9 +270,9 @@ class ResolutionChain:
             free = tracking_free(task, xw, soft_z, self.secondary_weight)
             if self.shortcut and _within(free.x, bounds):
                 answer = _Answer(free.x, "qp", None, "unconstrained optimum")
+                self._active = ((), ())
             else:
-                problem = tracking_problem_from(task, free, bounds)
-                _, answer = self._solve(problem, "qp", bounds, check_free=False)
+                answer = self._tracking(task, free, bounds)
         if z is None or self.priority != "strict" or task.rank == task.n:
             return answer
         second = priority_problem(task, answer.qdot, bounds, z)
@@ -275,6 +286,25 @@ class ResolutionChain:
         answer2.iterations += answer.iterations
         answer2.clip = max(answer2.clip, answer.clip)
         return answer2
+
+    def _tracking(self, task: Task, free: TrackingFree, bounds: VelocityBounds) -> _Answer:
+        """The tracking QP whose box-free minimiser leaves the box: guessed active set, or backend.
+
+        The guess is the previous tracking answer's active set, or (after a step without
+        one) the joints the box-free minimiser violates; it is checked for optimality
+        (:mod:`solvers.active_set`) and the backend is asked only when it fails.
+        """
+        if self.shortcut:
+            guess = self._active if self._active != ((), ()) else _violated(free.x, bounds)
+            solution = solve_on_active_set(task, free, bounds, *guess)
+            if solution is not None:
+                self._active = guess
+                qdot, clip = solution
+                return _Answer(qdot, "qp", None, "exact on the guessed active set", clip)
+        problem = tracking_problem_from(task, free, bounds)
+        _, answer = self._solve(problem, "qp", bounds, check_free=False)
+        self._active = active_joints(answer.qdot, bounds)
+        return answer
 
     def _direction(
         self, task: Task, xw: Array, bounds: VelocityBounds, z: Array | None
@@ -345,6 +375,16 @@ def _within(x: Array, bounds: VelocityBounds) -> bool:
     """True when ``lb <= x <= ub`` (False for NaN); Python floats: n is small."""
     xl = x.tolist()
     return all(map(le, bounds.lb.tolist(), xl)) and all(map(le, xl, bounds.ub.tolist()))
+
+
+def _violated(x: Array, bounds: VelocityBounds) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """Joints of ``x`` below their lower, and above their upper bound."""
+    values = x.tolist()
+    lows = bounds.lb.tolist()
+    highs = bounds.ub.tolist()
+    lower = tuple(i for i, (v, low) in enumerate(zip(values, lows)) if v < low)  # noqa: B905
+    upper = tuple(i for i, (v, high) in enumerate(zip(values, highs)) if v > high)  # noqa: B905
+    return lower, upper
 
 
 def _finite(x: Array) -> bool:

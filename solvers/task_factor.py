@@ -22,7 +22,8 @@ the projector onto its null space:
 .. math::
 
     \dot q_{dls} = \tilde J^T A^{-1}\tilde x, \qquad
-    P = \tilde J^T\tilde J + \mu N N^T = \tilde J^T (I - \mu A^{-1})\tilde J + \mu I
+    P = \tilde J^T\tilde J + \mu N N^T = \tilde J^T (\tilde J - \mu C) + \mu I,
+    \qquad C = A^{-1}\tilde J
 
 (:class:`TaskInverse`). Otherwise (inside the damping region, rank deficient, a floor or
 the manipulability measure) :func:`factor_task` returns the SVD. Both answer the same
@@ -32,6 +33,7 @@ questions (:data:`Task`), to rounding.
 from __future__ import annotations
 
 import functools
+import math
 
 import numpy as np
 import numpy.typing as npt
@@ -55,44 +57,61 @@ class TaskInverse:
     Attributes:
         J: The weighted Jacobian :math:`\tilde J` (m, n).
         Ainv: :math:`(\tilde J\tilde J^T)^{-1}` (m, m).
+        C: :math:`A^{-1}\tilde J` (m, n); :math:`C^T` is the pseudo-inverse of
+            :math:`\tilde J`.
         n: Number of joints.
         rank: m.
         lambda_sq: 0.0.
     """
 
-    __slots__ = ("Ainv", "J", "_svd", "lambda_sq", "n", "rank")
+    __slots__ = ("Ainv", "C", "J", "_svd", "lambda_sq", "n", "rank")
 
     def __init__(self, J: Array, Ainv: Array) -> None:
         self.J = J
         self.Ainv = Ainv
+        self.C = Ainv @ J  # (m, n): C^T is the pseudo-inverse of J
         self.rank, self.n = J.shape
         self.lambda_sq = 0.0
         self._svd: TaskSVD | None = None
 
     def dls(self, xw: Array) -> Array:
-        r"""Least-squares rates (n,) of least norm, :math:`\tilde J^T A^{-1}\tilde x`."""
-        return (self.Ainv @ xw) @ self.J
+        r"""Least-squares rates (n,) of least norm, :math:`C^T\tilde x`."""
+        return xw @ self.C
 
     def null_project(self, z: Array) -> Array:
-        r"""Null-space part (n,) of ``z`` (n,): :math:`(I - \tilde J^T A^{-1}\tilde J) z`."""
-        return z - (self.Ainv @ (self.J @ z)) @ self.J
+        r"""Null-space part (n,) of ``z`` (n,): :math:`(I - C^T\tilde J) z`."""
+        return z - (self.J @ z) @ self.C
 
     def row_project(self, v: Array) -> Array:
-        r"""Row-space part (n,) of ``v`` (n,): :math:`\tilde J^T A^{-1}\tilde J v`."""
-        return (self.Ainv @ (self.J @ v)) @ self.J
+        r"""Row-space part (n,) of ``v`` (n,): :math:`C^T\tilde J v`."""
+        return (self.J @ v) @ self.C
 
     def hessian(self, mu: float) -> Array:
-        r"""Tracking cost matrix (n, n): :math:`\tilde J^T (I - \mu A^{-1})\tilde J + \mu I`."""
-        M = self.Ainv * -mu
-        _diagonal(M)[:] += 1.0
-        P = self.J.T @ (M @ self.J)
+        r"""Tracking cost matrix (n, n): :math:`\tilde J^T (\tilde J - \mu C) + \mu I`."""
+        M = self.C * -mu
+        M += self.J
+        P = self.J.T @ M
         _diagonal(P)[:] += mu
         return P
 
     def null_basis(self) -> Array:
-        """Orthonormal rows (n - m, n) spanning the null space (from the SVD, computed once)."""
-        svd = self.svd()
-        return svd.Vt[svd.rank :]
+        r"""Orthonormal rows (n - m, n) spanning the null space.
+
+        One direction (n = m + 1): the column of the projector :math:`N N^T = I - \tilde J^T C`
+        with the largest diagonal, :math:`a\,a_k`, normalised by :math:`|a_k|` (at least
+        :math:`1/\sqrt n` for the largest entry of a unit vector, so well away from zero).
+        More: from the SVD (computed once).
+        """
+        if self.n - self.rank != 1:
+            svd = self.svd()
+            return svd.Vt[svd.rank :]
+        projector = self.J.T @ self.C  # I minus this is N N^T
+        row_part = projector.diagonal().tolist()
+        k = row_part.index(min(row_part))
+        a = projector[:, k] * -1.0
+        a[k] += 1.0
+        a *= 1.0 / math.sqrt(1.0 - row_part[k])
+        return a[None, :]
 
     def svd(self) -> TaskSVD:
         """The SVD of the same Jacobian (computed on first call; damping zero as here)."""
@@ -143,6 +162,15 @@ def _identity(m: int) -> Array:
     eye = np.eye(m)
     eye.flags.writeable = False
     return eye
+
+
+def solve_spd(A: Array, b: Array) -> tuple[Array, bool]:
+    """``(x, ok)`` with ``A x = b`` for a symmetric positive definite A (k, k), b (k,).
+
+    ``ok`` is False (and x meaningless) when the Cholesky factorisation of A fails.
+    """
+    _, x, info = _posv(A, b)
+    return x, info == 0
 
 
 def _posv(A: Array, B: Array) -> tuple[Array, Array, int]:
