@@ -1,29 +1,28 @@
-r"""Per-step factorisation of the task Jacobian: an inverse where it settles the damping, else SVD.
+r"""Per-step factorisation of the task Jacobian: a Cholesky solve where it settles the damping.
 
 Every step of the resolver needs the damping :math:`\lambda^2` of the weighted Jacobian
 :math:`\tilde J = L^T J` (m, n), its damped least-squares rates and, when a bound is
 active, the QP terms. The SVD (:class:`solvers.dls.TaskSVD`) gives all of them at any
 configuration, but it is the most expensive call of a step. Away from singularities one
-small inverse suffices:
+Cholesky solve suffices:
 
 .. math::
 
-    A = \tilde J\tilde J^T, \qquad
-    \lambda_{min}(A) \ge 1/\operatorname{tr}(A^{-1})
-    \quad\Rightarrow\quad
-    \operatorname{tr}(A^{-1}) \le 1/\epsilon^2 \ \Rightarrow\ \sigma_{min}(\tilde J) \ge \epsilon
+    A = \tilde J\tilde J^T, \qquad C = A^{-1}\tilde J \ (m, n), \qquad
+    \|C\|_F^2 = \operatorname{tr}(C C^T) = \operatorname{tr}(A^{-1})
+    = \sum_i \sigma_i^{-2} \ \ge\ \sigma_{min}^{-2}
 
-(the trace of :math:`A^{-1}` is the sum of the :math:`1/\sigma_i^2`; the bound is within a
-factor m of :math:`\sigma_{min}`). When it certifies :math:`\sigma_{min} \ge \epsilon`, the
-damping schedule of :class:`solvers.dls.Damping` (``measure="sigma"``, no floor) is zero,
-:math:`\tilde J` has full row rank, and, with :math:`N N^T = I - \tilde J^T A^{-1}\tilde J`
-the projector onto its null space:
+(:math:`C^T` is the pseudo-inverse of :math:`\tilde J` and :math:`CC^T = A^{-1}`), so
+:math:`\|C\|_F^2 \le 1/\epsilon^2` certifies :math:`\sigma_{min}(\tilde J) \ge \epsilon`
+(the bound is within a factor :math:`\sqrt m` of :math:`\sigma_{min}`). Then the damping
+schedule of :class:`solvers.dls.Damping` (``measure="sigma"``, no floor) is zero,
+:math:`\tilde J` has full row rank, and, with :math:`N N^T = I - \tilde J^T C` the
+projector onto its null space:
 
 .. math::
 
-    \dot q_{dls} = \tilde J^T A^{-1}\tilde x, \qquad
-    P = \tilde J^T\tilde J + \mu N N^T = \tilde J^T (\tilde J - \mu C) + \mu I,
-    \qquad C = A^{-1}\tilde J
+    \dot q_{dls} = C^T\tilde x, \qquad
+    P = \tilde J^T\tilde J + \mu N N^T = \tilde J^T (\tilde J - \mu C) + \mu I
 
 (:class:`TaskInverse`). Otherwise (inside the damping region, rank deficient, a floor or
 the manipulability measure) :func:`factor_task` returns the SVD. Both answer the same
@@ -32,7 +31,6 @@ questions (:data:`Task`), to rounding.
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
@@ -49,27 +47,25 @@ Array = npt.NDArray[np.float64]
 
 
 class TaskInverse:
-    r"""A weighted task Jacobian of full row rank outside the damping region, by :math:`A^{-1}`.
+    r"""A weighted task Jacobian of full row rank outside the damping region, by :math:`C`.
 
     Built by :func:`factor_task` only when the certificate of the module docstring holds;
     the damping is then zero and the rank is m.
 
     Attributes:
         J: The weighted Jacobian :math:`\tilde J` (m, n).
-        Ainv: :math:`(\tilde J\tilde J^T)^{-1}` (m, m).
-        C: :math:`A^{-1}\tilde J` (m, n); :math:`C^T` is the pseudo-inverse of
-            :math:`\tilde J`.
+        C: :math:`(\tilde J\tilde J^T)^{-1}\tilde J` (m, n); :math:`C^T` is the
+            pseudo-inverse of :math:`\tilde J`.
         n: Number of joints.
         rank: m.
         lambda_sq: 0.0.
     """
 
-    __slots__ = ("Ainv", "C", "J", "_svd", "lambda_sq", "n", "rank")
+    __slots__ = ("C", "J", "_svd", "lambda_sq", "n", "rank")
 
-    def __init__(self, J: Array, Ainv: Array) -> None:
+    def __init__(self, J: Array, C: Array) -> None:
         self.J = J
-        self.Ainv = Ainv
-        self.C = Ainv @ J  # (m, n): C^T is the pseudo-inverse of J
+        self.C = C
         self.rank, self.n = J.shape
         self.lambda_sq = 0.0
         self._svd: TaskSVD | None = None
@@ -134,7 +130,7 @@ def factor_task(J: Array, factor: Array | None = None, damping: Damping | None =
         damping: Damping schedule; None for no damping.
 
     Returns:
-        A :class:`TaskInverse` where the trace certificate (module docstring) shows that the
+        A :class:`TaskInverse` where the certificate (module docstring) shows that the
         damping is zero and the rank full, else the :class:`~solvers.dls.TaskSVD`.
 
     Raises:
@@ -143,11 +139,13 @@ def factor_task(J: Array, factor: Array | None = None, damping: Damping | None =
     Jw = J if factor is None else factor.T @ J
     m, n = Jw.shape
     if m <= n and damping is not None and damping.floor == 0.0 and damping.measure == "sigma":
-        # A^-1 by LAPACK's Cholesky solve (info > 0: A is not numerically positive definite)
-        _, Ainv, info = _posv(Jw @ Jw.T, _identity(m))
-        # tr(A^-1) eps^2 <= 1 certifies sigma_min >= eps; NaN fails the comparison
-        if info == 0 and sum(Ainv.diagonal().tolist()) * damping.threshold**2 <= 1.0:
-            return TaskInverse(Jw, Ainv)
+        # C = A^-1 J by LAPACK's Cholesky solve (info > 0: A not numerically definite)
+        _, C, info = _posv(Jw @ Jw.T, Jw)
+        # |C|_F^2 eps^2 <= 1 certifies sigma_min >= eps. NaN fails the comparisons, and so
+        # does C = 0: A overflowed to inf (J beyond 1e154), where LAPACK returns zeros
+        if info == 0 and 0.0 < float(np.vdot(C, C)) * damping.threshold**2 <= 1.0:
+            # LAPACK answers in Fortran order: C order like J keeps later ufuncs on one layout
+            return TaskInverse(Jw, np.ascontiguousarray(C))
     return task_svd(Jw, None, damping)
 
 
@@ -156,27 +154,10 @@ def _diagonal(M: Array) -> Array:
     return M.ravel(order="K")[:: M.shape[0] + 1]
 
 
-@functools.cache
-def _identity(m: int) -> Array:
-    """The identity (m, m), shared and read-only."""
-    eye = np.eye(m)
-    eye.flags.writeable = False
-    return eye
-
-
-def solve_spd(A: Array, b: Array) -> tuple[Array, bool]:
-    """``(x, ok)`` with ``A x = b`` for a symmetric positive definite A (k, k), b (k,).
-
-    ``ok`` is False (and x meaningless) when the Cholesky factorisation of A fails.
-    """
-    _, x, info = _posv(A, b)
-    return x, info == 0
-
-
 def _posv(A: Array, B: Array) -> tuple[Array, Array, int]:
     """``(factor, X, info)`` of LAPACK dposv for ``A X = B``, A symmetric positive definite.
 
-    Through scipy's binding (a quarter of ``numpy.linalg.inv``'s time on these small
+    Through scipy's binding (a quarter of ``numpy.linalg.solve``'s time on these small
     matrices), or numpy where scipy is absent (``info = 1`` when it finds A singular).
     """
     if _lapack_posv is not None:

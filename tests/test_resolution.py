@@ -171,3 +171,29 @@ def test_resolve_validates_input() -> None:
     with pytest.raises(InputError) as info:
         chain.resolve(np.eye(3), np.zeros(3), b, secondary=np.zeros(2))
     assert info.value.argument == "secondary"
+
+
+def test_guessed_active_set_answers_as_the_backend(rng: np.random.Generator) -> None:
+    """Along a trajectory the previous active set is usually right: solved exactly without
+    the backend, equal to an exact active-set solver's answer; the guess is state."""
+    pytest.importorskip("daqp")
+    arm = rrc_pin.load("panda")
+    limits = JointLimits(arm.lower, arm.upper, arm.velocity_limit)
+    fast = ResolutionChain(backend="osqp")
+    exact = ResolutionChain(backend="daqp", shortcut=False)
+    q = arm.neutral() + 0.2
+    twist = rng.standard_normal(6)
+    statuses: dict[str, int] = {}
+    for k in range(300):
+        if k % 30 == 0:
+            twist = rng.standard_normal(6) * 1.5
+        J, bounds = arm.jacobian(q), limits.bounds(q, 0.01)
+        a, b = fast.resolve(J, twist, bounds), exact.resolve(J, twist, bounds)
+        assert np.allclose(a.qdot, b.qdot, atol=1e-9)
+        statuses[a.status] = statuses.get(a.status, 0) + 1
+        q = q + 0.01 * a.qdot
+    assert statuses.get("exact on the guessed active set", 0) > 100, statuses
+    state = fast.warm_start_state()
+    assert {"active:lower", "active:upper"} <= state.keys()
+    fast.reset()
+    assert fast.warm_start_state()["active:lower"].size == 0
