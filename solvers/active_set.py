@@ -32,6 +32,7 @@ step has already: :math:`V \operatorname{diag}(1/d) V^T E^T` (SVD) or
 from __future__ import annotations
 
 import math
+from operator import le
 
 import numpy as np
 import numpy.typing as npt
@@ -57,14 +58,21 @@ def tracking_inverse(task: Task, free: TrackingFree) -> Array:
     Returns:
         The inverse of the tracking problem's P, (n, n).
     """
+    return np.array(_inverse_rows(task, free))
+
+
+def _inverse_rows(task: Task, free: TrackingFree) -> list[list[float]]:
+    """:func:`tracking_inverse` as rows of Python floats (two numpy calls per route)."""
     if isinstance(task, TaskInverse):
-        C = task.C
+        # C^T (C - J/mu) by numpy, the diagonal + 1/mu on Python floats
         W = task.J * (-1.0 / free.mu)
-        W += C
-        Pinv = C.T @ W
-        Pinv.ravel(order="K")[:: task.n + 1] += 1.0 / free.mu  # a view of the diagonal
-        return Pinv
-    return (task.Vt.T / free.d) @ task.Vt  # type: ignore[union-attr,operator]
+        W += task.C
+        rows = (task.C.T @ W).tolist()
+        inverse_mu = 1.0 / free.mu
+        for i, row in enumerate(rows):
+            row[i] += inverse_mu
+        return rows
+    return ((task.Vt.T / free.d) @ task.Vt).tolist()  # type: ignore[union-attr,operator,no-any-return]
 
 
 def solve_on_active_set(
@@ -95,41 +103,44 @@ def solve_on_active_set(
     if not joints:
         return None
     lb, ub = bounds.lb.tolist(), bounds.ub.tolist()
-    x_free = free.x.tolist()
-    gap = [x_free[i] - lb[i] for i in lower] + [x_free[i] - ub[i] for i in upper]
-    Pinv = tracking_inverse(task, free).tolist()
-    nu = _cholesky_solve([[Pinv[i][j] for j in joints] for i in joints], gap)
+    x = free.x.tolist()
+    gap = [x[i] - lb[i] for i in lower] + [x[i] - ub[i] for i in upper]
+    rows = _inverse_rows(task, free)
+    nu = _cholesky_solve([[rows[i][j] for j in joints] for i in joints], gap)
     if nu is None:
         return None
     k = len(lower)
     if max(nu[:k], default=-1.0) > SLACK or min(nu[k:], default=1.0) < -SLACK:
         return None
-    x = []
+    for j, nu_j in zip(joints, nu):  # noqa: B905  x -= P^-1 e_j nu_j (P^-1 is symmetric)
+        x = [v - p * nu_j for v, p in zip(x, rows[j])]  # noqa: B905
+    if all(map(le, lb, x)) and all(map(le, x, ub)):
+        return np.array(x), 0.0
     clip = 0.0
-    for row, low, x0, high in zip(Pinv, lb, x_free, ub):  # noqa: B905
-        v = x0
-        for j, nu_j in zip(joints, nu):  # noqa: B905
-            v -= row[j] * nu_j
-        if v < low:
-            if v < low - SLACK:
-                return None
-            clip, v = max(clip, low - v), low
-        elif v > high:
-            if v > high + SLACK:
-                return None
-            clip, v = max(clip, v - high), high
-        x.append(v)
+    for i, (low, v, high) in enumerate(zip(lb, x, ub)):  # noqa: B905
+        gap_i = max(low - v, v - high)  # > 0: outside by rounding, or a wrong guess
+        if gap_i > SLACK:
+            return None
+        if gap_i > 0.0:
+            clip, x[i] = max(clip, gap_i), min(max(v, low), high)
     return np.array(x), clip
 
 
 def _cholesky_solve(S: list[list[float]], b: list[float]) -> list[float] | None:
     """Solution of ``S x = b`` for a small symmetric positive definite S, or None if it is not.
 
-    Cholesky :math:`S = LL^T` then two triangular solves, on Python floats (k <= n).
+    Closed form for k <= 2, else Cholesky :math:`S = LL^T` and two triangular solves, on
+    Python floats (k <= n).
     """
     k = len(b)
     if k == 1:
         return [b[0] / S[0][0]] if S[0][0] > 0.0 else None
+    if k == 2:
+        (a, c), (_, d) = S
+        det = a * d - c * c
+        if not (a > 0.0 and det > 0.0):
+            return None
+        return [(d * b[0] - c * b[1]) / det, (a * b[1] - c * b[0]) / det]
     L = [[0.0] * k for _ in range(k)]
     for i in range(k):
         Li = L[i]

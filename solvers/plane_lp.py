@@ -46,11 +46,18 @@ def max_scale_one_null(
     Returns:
         ``(z, u)`` with u in [0, 1] maximal and z nearest ``z_target`` at that u.
     """
+    return plane_lp(a.tolist(), w.tolist(), lb.tolist(), ub.tolist(), z_target)
+
+
+def plane_lp(
+    a: list[float], w: list[float], lb: list[float], ub: list[float], z_target: float = 0.0
+) -> tuple[float, float]:
+    """:func:`max_scale_one_null` on lists of Python floats (the resolver's hot path)."""
     lo0: list[float] = []  # z interval of each moving joint at u = 0 ...
     hi0: list[float] = []
     slope: list[float] = []  # ... and the rate at which both of its ends move with u
     u = 1.0
-    for ai, wi, li, ui in zip(a.tolist(), w.tolist(), lb.tolist(), ub.tolist()):  # noqa: B905
+    for ai, wi, li, ui in zip(a, w, lb, ub):  # noqa: B905
         if ai > MOVING or ai < -MOVING:
             p, r = li / ai, ui / ai
             if p > r:

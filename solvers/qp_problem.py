@@ -31,6 +31,7 @@ never returns ``lb > ub``.
 from __future__ import annotations
 
 import math
+from operator import neg
 from typing import Literal, NamedTuple
 
 import numpy as np
@@ -39,7 +40,7 @@ import numpy.typing as npt
 from solvers.dls import TaskSVD
 from solvers.errors import InputError
 from solvers.joint_bounds import VelocityBounds
-from solvers.plane_lp import max_scale_one_null
+from solvers.plane_lp import plane_lp
 from solvers.task_factor import Task, TaskInverse
 
 Array = npt.NDArray[np.float64]
@@ -326,7 +327,7 @@ def direction_terms(
     Vn = task.null_basis()
     # with the inverse factorisation the least-squares rates lie in the row space already
     w = qdot_dls if isinstance(task, TaskInverse) else task.row_project(qdot_dls)
-    radius = math.hypot(*map(max, (-b for b in bounds.lb.tolist()), bounds.ub.tolist()))
+    radius = math.hypot(*map(max, map(neg, bounds.lb.tolist()), bounds.ub.tolist()))
     w_norm = math.hypot(*w.tolist())
     s_hi = min(1.0, radius / w_norm) if w_norm > 0.0 else 1.0
     if s_hi != 1.0:
@@ -342,33 +343,44 @@ def direction_terms(
     return DirectionTerms(Vn, w, s_hi, reg, target)
 
 
-def direction_step(terms: DirectionTerms, bounds: VelocityBounds) -> tuple[Array, float]:
+def direction_step(
+    terms: DirectionTerms, bounds: VelocityBounds
+) -> tuple[Array, float, float]:
     """Exact solution of a direction problem with at most one null-space direction.
 
     No null space: the rates are u w and the largest feasible u is optimal. One direction:
     the plane LP of :mod:`solvers.plane_lp` (largest u, then z nearest its target). No
-    backend and no :class:`QPProblem` are involved.
+    backend and no :class:`QPProblem` are involved; the arithmetic is on Python floats.
 
     Args:
         terms: The problem's :func:`direction_terms` (``Vn`` with at most one row).
         bounds: Joint-rate bounds containing zero.
 
     Returns:
-        The joint rates (n,) (within the bounds up to rounding) and the scale s in [0, 1].
+        The joint rates (n,) clipped into the bounds, the scale s in [0, 1], and the size
+        of the clip (rounding only).
 
     Raises:
         InputError: More than one null-space direction.
     """
-    Vn, w = terms.Vn, terms.w
+    Vn = terms.Vn
+    lb, ub, w = bounds.lb.tolist(), bounds.ub.tolist(), terms.w.tolist()
     if Vn.shape[0] == 0:
-        u = largest_scale(w, bounds.lb, bounds.ub)
-        return u * w, u * terms.s_hi
-    if Vn.shape[0] > 1:
+        u = largest_scale(terms.w, bounds.lb, bounds.ub)
+        rates = [u * wi for wi in w]
+    elif Vn.shape[0] == 1:
+        a = Vn[0].tolist()
+        target = 0.0 if terms.target is None else float(terms.target[0])
+        z, u = plane_lp(a, w, lb, ub, target)
+        rates = [z * ai + u * wi for ai, wi in zip(a, w)]  # noqa: B905
+    else:
         raise InputError("terms", f"expected at most one null-space direction, got {Vn.shape[0]}")
-    a = Vn[0]
-    target = 0.0 if terms.target is None else float(terms.target[0])
-    z, u = max_scale_one_null(a, w, bounds.lb, bounds.ub, target)
-    return a * z + w * u, u * terms.s_hi
+    clip = 0.0
+    for i, (low, v, high) in enumerate(zip(lb, rates, ub)):  # noqa: B905
+        if not low <= v <= high:
+            clipped = min(max(v, low), high)
+            clip, rates[i] = max(clip, abs(clipped - v)), clipped
+    return np.array(rates), u * terms.s_hi, clip
 
 
 def largest_scale(qdot: Array, lb: Array, ub: Array) -> float:

@@ -320,8 +320,8 @@ class ResolutionChain:
             return _Answer(dls, "qp_direction", 1.0, "unconstrained optimum")
         terms = direction_terms(task, dls, bounds, z, self.secondary_weight)
         if terms.Vn.shape[0] <= 1:  # solved exactly, no backend
-            raw, s = direction_step(terms, bounds)
-            return _clipped(raw, bounds, "qp_direction", s, "exact")
+            qdot, s, clip = direction_step(terms, bounds)
+            return _Answer(qdot, "qp_direction", s, "exact", clip)
         problem = direction_problem_from(terms, bounds)
         x, answer = self._solve(problem, "qp_direction", bounds)
         answer.scale = problem.scale(x)

@@ -139,13 +139,15 @@ def factor_task(J: Array, factor: Array | None = None, damping: Damping | None =
     Jw = J if factor is None else factor.T @ J
     m, n = Jw.shape
     if m <= n and damping is not None and damping.floor == 0.0 and damping.measure == "sigma":
-        # C = A^-1 J by LAPACK's Cholesky solve (info > 0: A not numerically definite)
-        _, C, info = _posv(Jw @ Jw.T, Jw)
+        # C = A^-1 J by LAPACK's Cholesky solve (info > 0: A not numerically definite),
+        # in C order like J (LAPACK answers in Fortran order): later ufuncs see one layout
+        _, C, info = _posv(np.dot(Jw, Jw.T), Jw)
+        C = np.ascontiguousarray(C)
+        flat = C.ravel()
         # |C|_F^2 eps^2 <= 1 certifies sigma_min >= eps. NaN fails the comparisons, and so
         # does C = 0: A overflowed to inf (J beyond 1e154), where LAPACK returns zeros
-        if info == 0 and 0.0 < float(np.vdot(C, C)) * damping.threshold**2 <= 1.0:
-            # LAPACK answers in Fortran order: C order like J keeps later ufuncs on one layout
-            return TaskInverse(Jw, np.ascontiguousarray(C))
+        if info == 0 and 0.0 < float(flat @ flat) * damping.threshold**2 <= 1.0:
+            return TaskInverse(Jw, C)
     return task_svd(Jw, None, damping)
 
 
