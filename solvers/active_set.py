@@ -102,7 +102,7 @@ def solve_on_active_set(
     joints = (*lower, *upper)
     if not joints:
         return None
-    lb, ub = bounds.lb.tolist(), bounds.ub.tolist()
+    lb, ub = bounds.lists()
     x = free.x.tolist()
     gap = [x[i] - lb[i] for i in lower] + [x[i] - ub[i] for i in upper]
     rows = _inverse_rows(task, free)
@@ -179,7 +179,8 @@ def active_joints(
     values = qdot.tolist()
     lower: list[int] = []
     upper: list[int] = []
-    for i, (low, v, high) in enumerate(zip(bounds.lb.tolist(), values, bounds.ub.tolist())):  # noqa: B905
+    lb, ub = bounds.lists()
+    for i, (low, v, high) in enumerate(zip(lb, values, ub)):  # noqa: B905
         if v - low <= tol and v - low <= high - v:
             lower.append(i)
         elif high - v <= tol:

@@ -45,16 +45,25 @@ A step may therefore end up to ROUNDING outside the (margin-shrunk) range.
 class VelocityBounds:
     """Joint-rate bounds of one step and the constraint each bound comes from.
 
-    Attributes:
+    Args:
         lb: Lower bounds (n,) [rad/s or m/s].
         ub: Upper bounds (n,), ``lb <= ub`` everywhere.
+        lower_kind: Codes of the constraints behind ``lb`` (see below), or None.
+        upper_kind: Same for ``ub``.
+        velocity_limit: The velocity limits v the bounds were clipped into: without codes,
+            a bound strictly inside [-v, v] is a position bound, one at -v or v a velocity
+            bound (computed on first access). Neither: every bound is a velocity bound.
+
+    Attributes:
+        lb: Lower bounds (n,) [rad/s or m/s] (built on first access when the bounds were
+            made by :meth:`from_lists`).
+        ub: Upper bounds (n,), ``lb <= ub`` everywhere.
         lower_kind: Code (n,) of the constraint setting ``lb``: an index of
-            :data:`BOUND_KINDS` (computed on first access when built by
-            :meth:`JointLimits.bounds`).
+            :data:`BOUND_KINDS`.
         upper_kind: Same for ``ub``.
     """
 
-    __slots__ = ("_kinds", "_v_max", "lb", "ub")
+    __slots__ = ("_kinds", "_lb", "_lists", "_ub", "_v_max")
 
     def __init__(
         self,
@@ -65,11 +74,48 @@ class VelocityBounds:
         *,
         velocity_limit: Array | None = None,
     ) -> None:
-        self.lb = lb
-        self.ub = ub
+        self._lb: Array | None = lb
+        self._ub: Array | None = ub
+        self._lists: tuple[list[float], list[float]] | None = None
         both = lower_kind is not None and upper_kind is not None
         self._kinds = (lower_kind, upper_kind) if both else None
-        self._v_max = velocity_limit  # the kinds are computed from it on first access
+        self._v_max = velocity_limit
+
+    @classmethod
+    def from_lists(
+        cls, lb: list[float], ub: list[float], velocity_limit: Array | None = None
+    ) -> VelocityBounds:
+        """Bounds given as Python floats; the arrays are built only if asked for.
+
+        The resolver's hot path compares a handful of rates with the bounds: on lists of
+        floats that costs less than a numpy call.
+        """
+        bounds = cls.__new__(cls)
+        bounds._lb = bounds._ub = None
+        bounds._lists = (lb, ub)
+        bounds._kinds = None
+        bounds._v_max = velocity_limit
+        return bounds
+
+    @property
+    def lb(self) -> Array:
+        """See the class docstring."""
+        if self._lb is None:
+            self._lb = np.array(self._lists[0])  # type: ignore[index]
+        return self._lb
+
+    @property
+    def ub(self) -> Array:
+        """See the class docstring."""
+        if self._ub is None:
+            self._ub = np.array(self._lists[1])  # type: ignore[index]
+        return self._ub
+
+    def lists(self) -> tuple[list[float], list[float]]:
+        """``(lb, ub)`` as lists of Python floats (made once)."""
+        if self._lists is None:
+            self._lists = (self.lb.tolist(), self.ub.tolist())
+        return self._lists
 
     def _kind(self) -> tuple[npt.NDArray[np.int8], npt.NDArray[np.int8]]:
         if self._kinds is None:
@@ -96,7 +142,8 @@ class VelocityBounds:
     @property
     def contains_zero(self) -> bool:
         """True when standing still is allowed (no joint is asked to recover)."""
-        return max(self.lb.tolist(), default=0.0) <= 0.0 <= min(self.ub.tolist(), default=0.0)
+        lb, ub = self.lists()
+        return max(lb, default=0.0) <= 0.0 <= min(ub, default=0.0)
 
     def __repr__(self) -> str:
         return f"VelocityBounds(lb={self.lb!r}, ub={self.ub!r})"
@@ -137,6 +184,8 @@ class JointLimits:
         self.n = n
         self.lower, self.upper, self.v_max, self.margin = lo, hi, v, float(margin)
         self._range = np.stack([lo + m - ROUNDING, hi - m + ROUNDING])  # (2, n)
+        self._range_lists = self._range.tolist()
+        self._v_list = v.tolist()
         # (2, n) copies of -v and v: a ufunc without broadcasting is faster on these sizes
         self._clip_lo, self._clip_hi = np.stack([-v, -v]), np.stack([v, v])
         self.a_max: Array | None = None
@@ -162,13 +211,13 @@ class JointLimits:
         Returns:
             The :class:`VelocityBounds`.
         """
+        if self.a_max is None:
+            return self._velocity_position(q, gain / dt)
         v = self.v_max
         b = np.subtract(self._range, q)  # rows: position bounds p_lo, p_hi ...
         b *= gain / dt
         np.maximum(b, self._clip_lo, out=b)  # ... clipped into the velocity interval
         np.minimum(b, self._clip_hi, out=b)
-        if self.a_max is None:
-            return VelocityBounds(b[0], b[1], velocity_limit=v)
         lb, ub = b[0], b[1]
         lower_kind = (lb > -v).astype(np.int8)
         upper_kind = (ub < v).astype(np.int8)
@@ -177,6 +226,18 @@ class JointLimits:
         lower_kind[a[0] > lb] = ACCELERATION
         upper_kind[a[1] < ub] = ACCELERATION
         return VelocityBounds(a[0], a[1], lower_kind, upper_kind)
+
+    def _velocity_position(self, q: Array, k: float) -> VelocityBounds:
+        """Velocity and position bounds on Python floats (n is small: no numpy call)."""
+        lows, highs = self._range_lists
+        lb: list[float] = []
+        ub: list[float] = []
+        for low, high, x, v in zip(lows, highs, q.tolist(), self._v_list):  # noqa: B905
+            p = (low - x) * k
+            lb.append(v if p > v else (-v if p < -v else p))
+            p = (high - x) * k
+            ub.append(v if p > v else (-v if p < -v else p))
+        return VelocityBounds.from_lists(lb, ub, self.v_max)
 
 
 def joint_velocity_bounds(

@@ -327,7 +327,8 @@ def direction_terms(
     Vn = task.null_basis()
     # with the inverse factorisation the least-squares rates lie in the row space already
     w = qdot_dls if isinstance(task, TaskInverse) else task.row_project(qdot_dls)
-    radius = math.hypot(*map(max, map(neg, bounds.lb.tolist()), bounds.ub.tolist()))
+    lb, ub = bounds.lists()
+    radius = math.hypot(*map(max, map(neg, lb), ub))
     w_norm = math.hypot(*w.tolist())
     s_hi = min(1.0, radius / w_norm) if w_norm > 0.0 else 1.0
     if s_hi != 1.0:
@@ -364,9 +365,10 @@ def direction_step(
         InputError: More than one null-space direction.
     """
     Vn = terms.Vn
-    lb, ub, w = bounds.lb.tolist(), bounds.ub.tolist(), terms.w.tolist()
+    lb, ub = bounds.lists()
+    w = terms.w.tolist()
     if Vn.shape[0] == 0:
-        u = largest_scale(terms.w, bounds.lb, bounds.ub)
+        u = largest_scale(w, lb, ub)
         rates = [u * wi for wi in w]
     elif Vn.shape[0] == 1:
         a = Vn[0].tolist()
@@ -383,22 +385,22 @@ def direction_step(
     return np.array(rates), u * terms.s_hi, clip
 
 
-def largest_scale(qdot: Array, lb: Array, ub: Array) -> float:
+def largest_scale(qdot: list[float], lb: list[float], ub: list[float]) -> float:
     """Largest s in [0, 1] with ``lb <= s * qdot <= ub`` on the joints whose bounds contain zero.
 
     A recovering joint (bounds excluding zero) cannot be satisfied by scaling: it is
     ignored here (and clipped by the caller).
 
     Args:
-        qdot: Joint rates (n,).
-        lb: Lower bounds (n,).
-        ub: Upper bounds (n,).
+        qdot: Joint rates (n,), Python floats.
+        lb: Lower bounds (n,), Python floats.
+        ub: Upper bounds (n,), Python floats.
 
     Returns:
         The scale s in [0, 1].
     """
     s = 1.0
-    for v, lo, hi in zip(qdot.tolist(), lb.tolist(), ub.tolist(), strict=True):
+    for v, lo, hi in zip(qdot, lb, ub, strict=True):
         if v > hi >= 0.0:
             s = min(s, hi / v)
         elif v < lo <= 0.0:

@@ -368,20 +368,20 @@ def uniform_scale(qdot: Array, bounds: VelocityBounds) -> float:
     Returns:
         The scale s in [0, 1].
     """
-    return largest_scale(qdot, bounds.lb, bounds.ub)
+    return largest_scale(qdot.tolist(), *bounds.lists())
 
 
 def _within(x: Array, bounds: VelocityBounds) -> bool:
     """True when ``lb <= x <= ub`` (False for NaN); Python floats: n is small."""
     xl = x.tolist()
-    return all(map(le, bounds.lb.tolist(), xl)) and all(map(le, xl, bounds.ub.tolist()))
+    lb, ub = bounds.lists()
+    return all(map(le, lb, xl)) and all(map(le, xl, ub))
 
 
 def _violated(x: Array, bounds: VelocityBounds) -> tuple[tuple[int, ...], tuple[int, ...]]:
     """Joints of ``x`` below their lower, and above their upper bound."""
     values = x.tolist()
-    lows = bounds.lb.tolist()
-    highs = bounds.ub.tolist()
+    lows, highs = bounds.lists()
     lower = tuple(i for i, (v, low) in enumerate(zip(values, lows)) if v < low)  # noqa: B905
     upper = tuple(i for i, (v, high) in enumerate(zip(values, highs)) if v > high)  # noqa: B905
     return lower, upper

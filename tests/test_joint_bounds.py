@@ -132,3 +132,25 @@ def test_bad_input_names_the_argument(kwargs: dict, argument: str) -> None:
     with pytest.raises(InputError) as info:
         joint_velocity_bounds(**args)
     assert info.value.argument == argument
+
+
+def test_bounds_from_python_floats_equal_the_numpy_formula() -> None:
+    """The per-step bounds are computed on Python floats; the same numbers as numpy's."""
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        lower = rng.uniform(-3.0, 0.0, N)
+        upper = lower + rng.uniform(0.0, 4.0, N)
+        lower[0], upper[0] = -np.inf, np.inf  # a continuous joint
+        v = rng.uniform(0.1, 3.0, N)
+        limits = JointLimits(lower, upper, v, margin=0.01)
+        q = rng.uniform(-4.0, 4.0, N)
+        dt, gain = float(rng.uniform(1e-3, 0.1)), float(rng.uniform(0.1, 1.0))
+        b = limits.bounds(q, dt, gain)
+        reference = np.clip((limits._range - q) * (gain / dt), -v, v)
+        assert np.array_equal(b.lb, reference[0]) and np.array_equal(b.ub, reference[1])
+        assert b.lists() == (reference[0].tolist(), reference[1].tolist())
+        position = (reference[0] > -v, reference[1] < v)
+        assert np.array_equal(b.lower_kind == POSITION, position[0])
+        assert np.array_equal(b.upper_kind == POSITION, position[1])
+        assert np.all((b.lower_kind == POSITION) | (b.lower_kind == VELOCITY))
+        assert b.contains_zero == bool(np.all(b.lb <= 0.0) and np.all(b.ub >= 0.0))
