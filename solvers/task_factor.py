@@ -139,11 +139,9 @@ def factor_task(J: Array, factor: Array | None = None, damping: Damping | None =
     Jw = J if factor is None else factor.T @ J
     m, n = Jw.shape
     if m <= n and damping is not None and damping.floor == 0.0 and damping.measure == "sigma":
-        # C = A^-1 J by LAPACK's Cholesky solve (info > 0: A not numerically definite),
-        # in C order like J (LAPACK answers in Fortran order): later ufuncs see one layout
+        # C = A^-1 J by LAPACK's Cholesky solve (info > 0: A not numerically definite)
         _, C, info = _posv(np.dot(Jw, Jw.T), Jw)
-        C = np.ascontiguousarray(C)
-        flat = C.ravel()
+        flat = C.ravel(order="K")  # a view, whatever the layout (LAPACK's is Fortran)
         # |C|_F^2 eps^2 <= 1 certifies sigma_min >= eps. NaN fails the comparisons, and so
         # does C = 0: A overflowed to inf (J beyond 1e154), where LAPACK returns zeros
         if info == 0 and 0.0 < float(flat @ flat) * damping.threshold**2 <= 1.0:
@@ -156,15 +154,15 @@ def _diagonal(M: Array) -> Array:
     return M.ravel(order="K")[:: M.shape[0] + 1]
 
 
-def _posv(A: Array, B: Array) -> tuple[Array, Array, int]:
-    """``(factor, X, info)`` of LAPACK dposv for ``A X = B``, A symmetric positive definite.
-
-    Through scipy's binding (a quarter of ``numpy.linalg.solve``'s time on these small
-    matrices), or numpy where scipy is absent (``info = 1`` when it finds A singular).
-    """
-    if _lapack_posv is not None:
-        return _lapack_posv(A, B)  # type: ignore[no-any-return]
+def _numpy_posv(A: Array, B: Array) -> tuple[Array, Array, int]:
+    """``(A, X, info)`` with ``A X = B`` by numpy, for where scipy is absent."""
     try:
         return A, np.linalg.solve(A, B), 0
     except np.linalg.LinAlgError:
         return A, B, 1
+
+
+_posv = _numpy_posv if _lapack_posv is None else _lapack_posv
+"""``(factor, X, info)`` of LAPACK dposv for ``A X = B``, A symmetric positive definite:
+scipy's binding (a quarter of ``numpy.linalg.solve``'s time on these small matrices), or
+numpy where scipy is absent (``info = 1`` when it finds A singular)."""
