@@ -31,7 +31,6 @@ step has already: :math:`V \operatorname{diag}(1/d) V^T E^T` (SVD) or
 
 from __future__ import annotations
 
-import math
 from operator import le
 
 import numpy as np
@@ -39,7 +38,7 @@ import numpy.typing as npt
 
 from solvers.joint_bounds import VelocityBounds
 from solvers.qp_problem import TrackingFree
-from solvers.task_factor import Task, TaskInverse
+from solvers.task_factor import Task, TaskInverse, posv
 
 Array = npt.NDArray[np.float64]
 
@@ -58,21 +57,22 @@ def tracking_inverse(task: Task, free: TrackingFree) -> Array:
     Returns:
         The inverse of the tracking problem's P, (n, n).
     """
-    return np.array(_inverse_rows(task, free))
+    return np.array(_inverse_rows(task, free, list(range(task.n))))
 
 
-def _inverse_rows(task: Task, free: TrackingFree) -> list[list[float]]:
-    """:func:`tracking_inverse` as rows of Python floats (two numpy calls per route)."""
+def _inverse_rows(task: Task, free: TrackingFree, rows: list[int]) -> list[list[float]]:
+    """Rows ``rows`` of :func:`tracking_inverse` (k, n), as Python floats."""
     if isinstance(task, TaskInverse):
-        # C^T (C - J/mu) by numpy, the diagonal + 1/mu on Python floats
+        # C_E^T (C - J/mu) by numpy, then + 1/mu at (r, rows[r]) on Python floats
         W = task.J * (-1.0 / free.mu)
         W += task.C
-        rows = (task.C.T @ W).tolist()
+        out = (task.C[:, rows].T @ W).tolist()
         inverse_mu = 1.0 / free.mu
-        for i, row in enumerate(rows):
-            row[i] += inverse_mu
-        return rows
-    return ((task.Vt.T / free.d) @ task.Vt).tolist()  # type: ignore[union-attr,operator,no-any-return]
+        for r, i in enumerate(rows):
+            out[r][i] += inverse_mu
+        return out
+    Vt = task.Vt  # type: ignore[union-attr]
+    return ((Vt[:, rows].T / free.d) @ Vt).tolist()  # type: ignore[operator,no-any-return]
 
 
 def solve_on_active_set(
@@ -99,21 +99,26 @@ def solve_on_active_set(
         :data:`SLACK`); None when the guess fails the optimality check (module docstring)
         or is empty.
     """
-    joints = (*lower, *upper)
+    joints = [*lower, *upper]
     if not joints:
         return None
     lb, ub = bounds.lists()
     x = free.x.tolist()
     gap = [x[i] - lb[i] for i in lower] + [x[i] - ub[i] for i in upper]
-    rows = _inverse_rows(task, free)
-    nu = _cholesky_solve([[rows[i][j] for j in joints] for i in joints], gap)
+    rows = _inverse_rows(task, free, joints)  # P^-1 E^T, transposed (P is symmetric)
+    nu = _solve_small([[row[j] for j in joints] for row in rows], gap)
     if nu is None:
         return None
     k = len(lower)
-    if max(nu[:k], default=-1.0) > SLACK or min(nu[k:], default=1.0) < -SLACK:
-        return None
-    for j, nu_j in zip(joints, nu):  # noqa: B905  x -= P^-1 e_j nu_j (P^-1 is symmetric)
-        x = [v - p * nu_j for v, p in zip(x, rows[j])]  # noqa: B905
+    for t, nu_t in enumerate(nu):  # the multipliers' signs
+        if (nu_t > SLACK) if t < k else (nu_t < -SLACK):
+            return None
+    for row, nu_j in zip(rows, nu):  # noqa: B905  x -= P^-1 E^T nu
+        x = [v - p * nu_j for v, p in zip(x, row)]  # noqa: B905
+    for i in lower:  # x_E = b_E up to rounding: exactly, as the constraint says
+        x[i] = lb[i]
+    for i in upper:
+        x[i] = ub[i]
     if all(map(le, lb, x)) and all(map(le, x, ub)):
         return np.array(x), 0.0
     clip = 0.0
@@ -126,11 +131,10 @@ def solve_on_active_set(
     return np.array(x), clip
 
 
-def _cholesky_solve(S: list[list[float]], b: list[float]) -> list[float] | None:
+def _solve_small(S: list[list[float]], b: list[float]) -> list[float] | None:
     """Solution of ``S x = b`` for a small symmetric positive definite S, or None if it is not.
 
-    Closed form for k <= 2, else Cholesky :math:`S = LL^T` and two triangular solves, on
-    Python floats (k <= n).
+    Closed form for k <= 2 (Python floats), LAPACK's Cholesky solve beyond.
     """
     k = len(b)
     if k == 1:
@@ -141,32 +145,8 @@ def _cholesky_solve(S: list[list[float]], b: list[float]) -> list[float] | None:
         if not (a > 0.0 and det > 0.0):
             return None
         return [(d * b[0] - c * b[1]) / det, (a * b[1] - c * b[0]) / det]
-    L = [[0.0] * k for _ in range(k)]
-    for i in range(k):
-        Li = L[i]
-        for j in range(i + 1):
-            Lj = L[j]
-            v = S[i][j]
-            for t in range(j):
-                v -= Li[t] * Lj[t]
-            if j < i:
-                Li[j] = v / Lj[j]
-            elif v > 0.0:
-                Li[i] = math.sqrt(v)
-            else:
-                return None
-    y = [0.0] * k
-    for i in range(k):
-        v = b[i]
-        for t in range(i):
-            v -= L[i][t] * y[t]
-        y[i] = v / L[i][i]
-    for i in reversed(range(k)):
-        v = y[i]
-        for t in range(i + 1, k):
-            v -= L[t][i] * y[t]
-        y[i] = v / L[i][i]
-    return y
+    _, x, info = posv(np.array(S), np.array(b))
+    return x.tolist() if info == 0 else None  # type: ignore[no-any-return]
 
 
 def active_joints(

@@ -140,7 +140,7 @@ def factor_task(J: Array, factor: Array | None = None, damping: Damping | None =
     m, n = Jw.shape
     if m <= n and damping is not None and damping.floor == 0.0 and damping.measure == "sigma":
         # C = A^-1 J by LAPACK's Cholesky solve (info > 0: A not numerically definite)
-        _, C, info = _posv(np.dot(Jw, Jw.T), Jw)
+        _, C, info = posv(np.dot(Jw, Jw.T), Jw)
         flat = C.ravel(order="K")  # a view, whatever the layout (LAPACK's is Fortran)
         # |C|_F^2 eps^2 <= 1 certifies sigma_min >= eps. NaN fails the comparisons, and so
         # does C = 0: A overflowed to inf (J beyond 1e154), where LAPACK returns zeros
@@ -162,7 +162,7 @@ def _numpy_posv(A: Array, B: Array) -> tuple[Array, Array, int]:
         return A, B, 1
 
 
-_posv = _numpy_posv if _lapack_posv is None else _lapack_posv
+posv = _numpy_posv if _lapack_posv is None else _lapack_posv
 """``(factor, X, info)`` of LAPACK dposv for ``A X = B``, A symmetric positive definite:
 scipy's binding (a quarter of ``numpy.linalg.solve``'s time on these small matrices), or
 numpy where scipy is absent (``info = 1`` when it finds A singular)."""

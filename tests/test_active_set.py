@@ -9,7 +9,7 @@ import qpsolvers
 import rrc_pin
 from solvers.active_set import (
     SLACK,
-    _cholesky_solve,
+    _solve_small,
     active_joints,
     solve_on_active_set,
     tracking_inverse,
@@ -98,14 +98,15 @@ def test_active_joints() -> None:
     assert active_joints(qdot, b) == ((0, 3), (2,))  # a pinned joint counts at its lower side
 
 
-def test_cholesky_solve(rng: np.random.Generator) -> None:
+def test_solve_small(rng: np.random.Generator) -> None:
     for k in range(1, 7):
         for _ in range(50):
             A = rng.standard_normal((k, k))
             S = A @ A.T + 0.1 * np.eye(k)
             b = rng.standard_normal(k)
-            x = _cholesky_solve(S.tolist(), b.tolist())
+            x = _solve_small(S.tolist(), b.tolist())
             assert x is not None
             assert np.allclose(S @ x, b, atol=1e-10)
-    assert _cholesky_solve([[1.0, 2.0], [2.0, 1.0]], [1.0, 1.0]) is None  # indefinite
-    assert _cholesky_solve([[0.0]], [1.0]) is None
+    assert _solve_small([[1.0, 2.0], [2.0, 1.0]], [1.0, 1.0]) is None  # indefinite
+    assert _solve_small([[0.0]], [1.0]) is None
+    assert _solve_small(np.diag([1.0, -1.0, 1.0]).tolist(), [1.0, 1.0, 1.0]) is None
