@@ -141,10 +141,9 @@ def factor_task(J: Array, factor: Array | None = None, damping: Damping | None =
     if m <= n and damping is not None and damping.floor == 0.0 and damping.measure == "sigma":
         # C = A^-1 J by LAPACK's Cholesky solve (info > 0: A not numerically definite)
         _, C, info = posv(np.dot(Jw, Jw.T), Jw)
-        flat = C.ravel(order="K")  # a view, whatever the layout (LAPACK's is Fortran)
-        # |C|_F^2 eps^2 <= 1 certifies sigma_min >= eps. NaN fails the comparisons, and so
-        # does C = 0: A overflowed to inf (J beyond 1e154), where LAPACK returns zeros
-        if info == 0 and 0.0 < float(flat @ flat) * damping.threshold**2 <= 1.0:
+        # |C|_F eps <= 1 certifies sigma_min >= eps. NaN fails the comparisons, and so does
+        # C = 0: A overflowed to inf (J beyond 1e154), where LAPACK returns zeros
+        if info == 0 and 0.0 < math.hypot(*C.ravel(order="K").tolist()) * damping.threshold <= 1.0:
             return TaskInverse(Jw, C)
     return task_svd(Jw, None, damping)
 
