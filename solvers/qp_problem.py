@@ -31,7 +31,7 @@ never returns ``lb > ub``.
 from __future__ import annotations
 
 import math
-from operator import neg
+from operator import le, neg
 from typing import Literal, NamedTuple
 
 import numpy as np
@@ -378,8 +378,8 @@ def direction_step(
     else:
         raise InputError("terms", f"expected at most one null-space direction, got {Vn.shape[0]}")
     clip = 0.0
-    for i, (low, v, high) in enumerate(zip(lb, rates, ub)):  # noqa: B905
-        if not low <= v <= high:
+    if not (all(map(le, lb, rates)) and all(map(le, rates, ub))):  # rounding at a bound
+        for i, (low, v, high) in enumerate(zip(lb, rates, ub)):  # noqa: B905
             clipped = min(max(v, low), high)
             clip, rates[i] = max(clip, abs(clipped - v)), clipped
     return np.array(rates), u * terms.s_hi, clip

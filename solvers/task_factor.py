@@ -101,13 +101,13 @@ class TaskInverse:
         if self.n - self.rank != 1:
             svd = self.svd()
             return svd.Vt[svd.rank :]
-        projector = self.J.T @ self.C  # I minus this is N N^T
-        row_part = projector.diagonal().tolist()
-        k = row_part.index(min(row_part))
-        a = projector[:, k] * -1.0
-        a[k] += 1.0
-        a *= 1.0 / math.sqrt(1.0 - row_part[k])
-        return a[None, :]
+        rows = (self.J.T @ self.C).tolist()  # I minus this is N N^T; Python floats from here
+        diagonal = [row[i] for i, row in enumerate(rows)]
+        k = diagonal.index(min(diagonal))
+        scale = -1.0 / math.sqrt(1.0 - diagonal[k])
+        a = [row[k] * scale for row in rows]
+        a[k] -= scale
+        return np.array([a])
 
     def svd(self) -> TaskSVD:
         """The SVD of the same Jacobian (computed on first call; damping zero as here)."""
