@@ -11,7 +11,9 @@ Two kernels for any Jacobian ``J`` (m, n), rows [v; w] or any subset of them:
   computed by an SVD so that they stay finite when :math:`J W J^T` is singular.
 
 Both go through :class:`TaskSVD`, the singular value decomposition of the task-weighted
-Jacobian that the QP builder (:mod:`solvers.qp_problem`) reuses for its null-space terms.
+Jacobian that the QP builder (:mod:`solvers.qp_problem`) reuses for its null-space terms
+(the resolver takes it where :mod:`solvers.task_factor` cannot avoid it: near
+singularities).
 """
 
 from __future__ import annotations

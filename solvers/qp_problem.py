@@ -9,8 +9,10 @@ Every problem is in one standard form that OSQP and qpsolvers both take:
 
 and the joint rates are :math:`\dot q = x` (no G) or :math:`\dot q = G x + \dot q_0`, in
 which case the joint-rate bounds are the rows of G. Three builders, all from the
-:class:`~solvers.dls.TaskSVD` of the weighted Jacobian
-:math:`\tilde J = U\Sigma V^T`, :math:`V = [V_r\ V_n]` (row space, null space):
+factorisation of the weighted Jacobian (:data:`solvers.task_factor.Task`: its SVD
+:math:`\tilde J = U\Sigma V^T`, :math:`V = [V_r\ V_n]` (row space, null space), or, away
+from singularities, :math:`C = (\tilde J\tilde J^T)^{-1}\tilde J`, which gives the same
+terms without the SVD):
 
 - :func:`tracking_problem`: weighted least-squares tracking with adaptive damping and a
   secondary objective acting in the null space only (it cannot change the task velocity
@@ -25,7 +27,10 @@ which case the joint-rate bounds are the rows of G. Three builders, all from the
 Parametrising the null space instead of writing :math:`J\dot q = \dots` as equality rows
 keeps the problems small and well conditioned at any distance from a singularity (no
 rank-deficient equality block). Joint bounds come from :mod:`solvers.joint_bounds`, which
-never returns ``lb > ub``.
+never returns ``lb > ub``. The resolver builds a problem only when it needs a backend:
+:func:`tracking_free` and :func:`direction_terms` give what its shortcuts check first,
+:func:`direction_step` solves a direction problem with at most one null-space direction
+exactly, and :mod:`solvers.active_set` the tracking problem on a guessed active set.
 """
 
 from __future__ import annotations

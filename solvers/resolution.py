@@ -5,11 +5,14 @@
 - ``"qp"``: the QP of :mod:`solvers.qp_problem` (tracking, or direction-preserving while no
   joint has to recover; optionally a strict second level for the secondary objective).
   Without a backend when it is not needed: the box-free minimiser inside the bounds *is*
-  the solution (checked before P and q are even built), a direction problem with at most
-  one null-space direction is solved exactly (:mod:`solvers.plane_lp`), and so is a second
-  level with one null-space direction (an interval). Otherwise a backend of
-  :mod:`solvers.qp_backends` (warm-started); this method fails when the backend raises,
-  reports no solution, or runs out of its iteration or time budget.
+  the solution (checked before P and q are even built); a tracking problem is solved
+  exactly on a guessed active set (the previous step's, then the joints the box-free
+  minimiser violates) when the optimality check passes (:mod:`solvers.active_set`); a
+  direction problem with at most one null-space direction is solved exactly
+  (:mod:`solvers.plane_lp`), and so is a second level with one null-space direction (an
+  interval). Otherwise a backend of :mod:`solvers.qp_backends` (warm-started); this method
+  fails when the backend raises, reports no solution, or runs out of its iteration or time
+  budget.
 - ``"dls"``: damped least squares (:mod:`solvers.dls`) projected (clipped) into the bounds.
 - ``"scaling"``: the damped least-squares rates scaled uniformly by the largest s in [0, 1]
   that keeps them within the bounds (direction kept), then clipped for recovering joints.
@@ -18,6 +21,11 @@
 Every answer is clipped into the bounds, so it is exactly feasible whatever the backend's
 tolerance (the clip size is reported), and finite. Numerical trouble never raises: the
 :class:`Resolution` says which method answered and why the earlier ones did not.
+
+The Jacobian is factorised once per step (:func:`solvers.task_factor.factor_task`): a
+Cholesky solve where it certifies that the damping is zero, the SVD otherwise. The hot path
+(the steps of a control loop) costs about a dozen numpy calls; scalar work on the handful
+of joints is done on Python floats, cheaper than numpy calls at this size.
 """
 
 from __future__ import annotations
