@@ -391,8 +391,8 @@ def _within(x: Array, bounds: VelocityBounds) -> bool:
 def _guesses(
     previous: tuple[tuple[int, ...], tuple[int, ...]], x: Array, bounds: VelocityBounds
 ) -> Iterator[tuple[tuple[int, ...], tuple[int, ...]]]:
-    """Active-set guesses: ``previous`` (unless empty), then the set ``x`` violates."""
-    if previous != ((), ()):
+    """Active-set guesses: ``previous`` (unless empty or too long), then ``x``'s violations."""
+    if previous != ((), ()) and max(previous[0] + previous[1]) < x.size:
         yield previous
     violated = _violated(x, bounds)
     if violated != previous:

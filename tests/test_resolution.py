@@ -197,3 +197,16 @@ def test_guessed_active_set_answers_as_the_backend(rng: np.random.Generator) -> 
     assert {"active:lower", "active:upper"} <= state.keys()
     fast.reset()
     assert fast.warm_start_state()["active:lower"].size == 0
+
+
+def test_active_set_guess_survives_a_change_of_arm(rng: np.random.Generator) -> None:
+    """One chain, Jacobians of different sizes: a guess naming joint 6 is not tried on six."""
+    chain = ResolutionChain()
+    for name in ("panda", "barker6", "panda", "barker6"):
+        arm = rrc_pin.load(name)
+        limits = JointLimits(arm.lower, arm.upper, arm.velocity_limit)
+        for _ in range(20):
+            q = arm.random_q(rng)
+            bounds = limits.bounds(q, 0.01)
+            r = chain.resolve(arm.jacobian(q), rng.standard_normal(6) * 3.0, bounds)
+            assert np.all(r.qdot >= bounds.lb) and np.all(r.qdot <= bounds.ub)
