@@ -138,6 +138,7 @@ class Resolver:
         self.joint_names = list(getattr(arm, "joint_names", [])) or None
         self._pin = _pinocchio_jacobian(arm) if self.closed_form is None else None
         self._row_index = None if self.rows == TASKS["full"] else np.array(self.rows)
+        self._twist_shape = (len(self.rows),)
         self._last_qdot: Array | None = None
         self._steps = 0
 
@@ -216,8 +217,8 @@ class Resolver:
         return result
 
     def _task_twist(self, twist: npt.ArrayLike) -> Array:
-        if type(twist) is np.ndarray and twist.shape == (self.task_dim,):
-            return _vector(twist, "twist", self.task_dim)
+        if type(twist) is np.ndarray and twist.shape == self._twist_shape:
+            return _vector(twist, "twist", self._twist_shape[0])
         size = np.shape(twist)
         if size == (6,) and self.task_dim != 6:
             return _vector(twist, "twist", 6)[list(self.rows)]

@@ -211,8 +211,17 @@ class JointLimits:
         Returns:
             The :class:`VelocityBounds`.
         """
-        if self.a_max is None:
-            return self._velocity_position(q, gain / dt)
+        if self.a_max is None:  # n is small: Python floats, no numpy call
+            k = gain / dt
+            lows, highs = self._range_lists
+            lb: list[float] = []
+            ub: list[float] = []
+            for low, high, x, v_i in zip(lows, highs, q.tolist(), self._v_list):  # noqa: B905
+                p = (low - x) * k
+                lb.append(v_i if p > v_i else (-v_i if p < -v_i else p))
+                p = (high - x) * k
+                ub.append(v_i if p > v_i else (-v_i if p < -v_i else p))
+            return VelocityBounds.from_lists(lb, ub, self.v_max)
         v = self.v_max
         b = np.subtract(self._range, q)  # rows: position bounds p_lo, p_hi ...
         b *= gain / dt
@@ -226,18 +235,6 @@ class JointLimits:
         lower_kind[a[0] > lb] = ACCELERATION
         upper_kind[a[1] < ub] = ACCELERATION
         return VelocityBounds(a[0], a[1], lower_kind, upper_kind)
-
-    def _velocity_position(self, q: Array, k: float) -> VelocityBounds:
-        """Velocity and position bounds on Python floats (n is small: no numpy call)."""
-        lows, highs = self._range_lists
-        lb: list[float] = []
-        ub: list[float] = []
-        for low, high, x, v in zip(lows, highs, q.tolist(), self._v_list):  # noqa: B905
-            p = (low - x) * k
-            lb.append(v if p > v else (-v if p < -v else p))
-            p = (high - x) * k
-            ub.append(v if p > v else (-v if p < -v else p))
-        return VelocityBounds.from_lists(lb, ub, self.v_max)
 
 
 def joint_velocity_bounds(
