@@ -68,8 +68,9 @@ class Resolver:
             finite).
         position_gain: Fraction in (0, 1] of the distance to a position bound allowed per step.
         use_closed_form: Take the Jacobian from ``arm.closed_form`` (``world_aligned`` only).
-        shortcut: Skip the backend when the box-free optimum is feasible (it is then the
-            QP's solution).
+        shortcut: Skip the backend when the QP's solution is known without it: the box-free
+            optimum when it is feasible, the exact solution on a guessed active set when it
+            passes the optimality check (:mod:`solvers.active_set`).
         active_tol: Distance to a bound under which it is reported active [rad/s].
         backend_options: Settings for the backend (e.g. OSQP ``eps_abs``).
 

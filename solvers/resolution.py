@@ -97,7 +97,8 @@ class ResolutionChain:
             ``"strict"`` (a second QP in the null space of the primary solution).
         secondary_weight: Weight :math:`\mu` in (0, 1) of the secondary objective.
         shortcut: Return the box-free minimiser without calling the backend when it lies in
-            the box (it is then the QP's solution).
+            the box (it is then the QP's solution), and try the guessed active sets
+            (:mod:`solvers.active_set`) before the backend.
         active_tol: Distance to a bound under which the bound is reported active [rad/s].
         backend_options: Settings passed to the backend when ``backend`` is a name.
 
