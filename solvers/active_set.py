@@ -67,7 +67,7 @@ def _inverse_rows(task: Task, free: TrackingFree, rows: list[int]) -> list[list[
         # then + 1/mu at (i, i) on Python floats
         W = task.J * (-1.0 / free.mu)
         W += task.C
-        full = (task.C.T @ W).tolist()
+        full = np.dot(task.C.T, W).tolist()
         inverse_mu = 1.0 / free.mu
         out = []
         for i in rows:

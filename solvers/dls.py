@@ -169,7 +169,7 @@ class TaskSVD(NamedTuple):
         gain = np.divide(self.sigma, denom, out=np.zeros(k), where=denom > 0.0)
         if self.lambda_sq == 0.0:
             gain[self.rank :] = 0.0  # undamped: numerically zero sigma_i are null directions
-        return self.Vt[:k].T @ (gain * (self.U.T @ xw))
+        return np.dot(gain * np.dot(xw, self.U), self.Vt[:k])
 
 
 def weight_factor(weights: npt.ArrayLike | None, m: int, name: str = "weights") -> Array | None:

@@ -184,7 +184,7 @@ def tracking_free(
             x = x + task.null_project(secondary)
         return TrackingFree(x, xw, secondary, mu)
     d, g = _tracking_terms(task, xw, secondary, mu)
-    return TrackingFree(task.Vt.T @ (g / d), xw, secondary, mu, d, g)
+    return TrackingFree(np.dot(task.Vt.T, g / d), xw, secondary, mu, d, g)
 
 
 def tracking_problem_from(task: Task, free: TrackingFree, bounds: VelocityBounds) -> QPProblem:
@@ -197,7 +197,7 @@ def tracking_problem_from(task: Task, free: TrackingFree, bounds: VelocityBounds
     """
     if isinstance(task, TaskInverse):
         P = task.hessian(free.mu)
-        q = free.xw @ task.J
+        q = np.dot(free.xw, task.J)
         if free.secondary is not None:
             q += free.mu * task.null_project(free.secondary)
         np.negative(q, out=q)
@@ -225,7 +225,7 @@ def _tracking_terms(
         + [lam + mu] * (n - k)
     )
     g = np.zeros(n)
-    np.multiply(svd.sigma, svd.U.T @ xw, out=g[:k])
+    np.multiply(svd.sigma, np.dot(xw, svd.U), out=g[:k])
     if secondary is not None:
         g[r:] += mu * (svd.Vt[r:] @ secondary)
     return d, g

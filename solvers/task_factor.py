@@ -45,6 +45,9 @@ except ImportError:  # pragma: no cover
 
 Array = npt.NDArray[np.float64]
 
+# The products below use np.dot, not the @ operator: the same BLAS call for these 1-D and 2-D
+# operands, with half the per-call overhead on these small arrays (about 1 us against 2).
+
 
 class TaskInverse:
     r"""A weighted task Jacobian of full row rank outside the damping region, by :math:`C`.
@@ -72,21 +75,21 @@ class TaskInverse:
 
     def dls(self, xw: Array) -> Array:
         r"""Least-squares rates (n,) of least norm, :math:`C^T\tilde x`."""
-        return xw @ self.C
+        return np.dot(xw, self.C)
 
     def null_project(self, z: Array) -> Array:
         r"""Null-space part (n,) of ``z`` (n,): :math:`(I - C^T\tilde J) z`."""
-        return z - (self.J @ z) @ self.C
+        return z - np.dot(np.dot(self.J, z), self.C)
 
     def row_project(self, v: Array) -> Array:
         r"""Row-space part (n,) of ``v`` (n,): :math:`C^T\tilde J v`."""
-        return (self.J @ v) @ self.C
+        return np.dot(np.dot(self.J, v), self.C)
 
     def hessian(self, mu: float) -> Array:
         r"""Tracking cost matrix (n, n): :math:`\tilde J^T (\tilde J - \mu C) + \mu I`."""
         M = self.C * -mu
         M += self.J
-        P = self.J.T @ M
+        P = np.dot(self.J.T, M)
         _diagonal(P)[:] += mu
         return P
 
@@ -101,7 +104,7 @@ class TaskInverse:
         if self.n - self.rank != 1:
             svd = self.svd()
             return svd.Vt[svd.rank :]
-        rows = (self.J.T @ self.C).tolist()  # I minus this is N N^T; Python floats from here
+        rows = np.dot(self.J.T, self.C).tolist()  # I minus this is N N^T; Python floats from here
         diagonal = [row[i] for i, row in enumerate(rows)]
         k = diagonal.index(min(diagonal))
         scale = -1.0 / math.sqrt(1.0 - diagonal[k])
