@@ -23,14 +23,10 @@ from typing import Literal, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
+from scipy.linalg.lapack import dgesvd as _gesvd
 
 from solvers.errors import InputError
 from solvers.validation import as_array, as_vector
-
-try:  # scipy comes with the QP backends (osqp, qpsolvers)
-    from scipy.linalg.lapack import dgesvd as _gesvd
-except ImportError:  # pragma: no cover
-    _gesvd = None
 
 Array = npt.NDArray[np.float64]
 
@@ -206,13 +202,12 @@ def weight_factor(weights: npt.ArrayLike | None, m: int, name: str = "weights") 
 def _svd(A: Array) -> tuple[Array, Array, Array]:
     """Full SVD ``U (m, m), sigma (k,), Vt (n, n)`` by LAPACK's dgesvd.
 
-    Through scipy's binding (half of numpy's per-call overhead on these small matrices), or
-    numpy where scipy is absent.
+    Through scipy's binding: half of numpy's per-call overhead on these small matrices.
 
     Raises:
         numpy.linalg.LinAlgError: The SVD did not converge.
     """
-    if _gesvd is None or A.size == 0:
+    if A.size == 0:
         return np.linalg.svd(A, full_matrices=True)
     U, sigma, Vt, info = _gesvd(A, compute_uv=1, full_matrices=1)
     if info != 0:
@@ -220,9 +215,7 @@ def _svd(A: Array) -> tuple[Array, Array, Array]:
     return U, sigma, Vt
 
 
-def task_svd(
-    J: Array, factor: Array | None = None, damping: Damping | None = None
-) -> TaskSVD:
+def task_svd(J: Array, factor: Array | None = None, damping: Damping | None = None) -> TaskSVD:
     r"""SVD of :math:`L^T J` with the damping of ``damping`` (no input checks: hot path).
 
     Args:

@@ -35,13 +35,9 @@ import math
 
 import numpy as np
 import numpy.typing as npt
+from scipy.linalg.lapack import dposv
 
 from solvers.dls import Damping, TaskSVD, task_svd
-
-try:  # scipy comes with the QP backends (osqp, qpsolvers)
-    from scipy.linalg.lapack import dposv as _lapack_posv
-except ImportError:  # pragma: no cover
-    _lapack_posv = None
 
 Array = npt.NDArray[np.float64]
 
@@ -156,15 +152,6 @@ def _diagonal(M: Array) -> Array:
     return M.ravel(order="K")[:: M.shape[0] + 1]
 
 
-def _numpy_posv(A: Array, B: Array) -> tuple[Array, Array, int]:
-    """``(A, X, info)`` with ``A X = B`` by numpy, for where scipy is absent."""
-    try:
-        return A, np.linalg.solve(A, B), 0
-    except np.linalg.LinAlgError:
-        return A, B, 1
-
-
-posv = _numpy_posv if _lapack_posv is None else _lapack_posv
+posv = dposv
 """``(factor, X, info)`` of LAPACK dposv for ``A X = B``, A symmetric positive definite:
-scipy's binding (a quarter of ``numpy.linalg.solve``'s time on these small matrices), or
-numpy where scipy is absent (``info = 1`` when it finds A singular)."""
+scipy's binding, a quarter of ``numpy.linalg.solve``'s time on these small matrices."""
