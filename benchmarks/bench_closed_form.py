@@ -24,7 +24,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import statistics
 import sys
 import timeit
@@ -34,6 +33,7 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
+from machine import machine_info
 
 import rrc_pin
 from rrc_pin.robot import frame_id
@@ -43,26 +43,6 @@ RESULTS = Path(__file__).resolve().parent / "results"
 SEED = 20261122
 BATCH_RUNS = 11
 """Interleaved runs of the batch and of the loop; the medians are recorded."""
-
-
-def machine_info() -> dict[str, Any]:
-    """CPU, Python and library versions of this run."""
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return {
-        "cpu": cpu,
-        "cores": os.cpu_count(),
-        "platform": platform.platform(),
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "pinocchio": pin.__version__,
-    }
 
 
 def per_call_us(fn: Callable[[], object], number: int, repeat: int) -> list[float]:
@@ -152,8 +132,14 @@ def bench_arm(
         "speedup": (loop_s * n_batch / n_loop) / batch_s,
         "max_relative_difference": batch_worst,
     }
-    return {"arm": name, "closed_form": type(cf).__name__, "nq": nq, "task_dim": m,
-            "scalar": scalar, "batch": batch}
+    return {
+        "arm": name,
+        "closed_form": type(cf).__name__,
+        "nq": nq,
+        "task_dim": m,
+        "scalar": scalar,
+        "batch": batch,
+    }
 
 
 def markdown_table(results: dict[str, Any]) -> str:
@@ -188,8 +174,11 @@ def markdown_table(results: dict[str, Any]) -> str:
         f"Pinocchio + numpy calls, interleaved in one run (medians of {BATCH_RUNS}). Measured on "
         f"{info['cpu']} ({info['cores']} cores), Python {info['python']}, numpy "
         f"{info['numpy']}, Pinocchio {info['pinocchio']}"
-        + (f", load average {load[0]:.2f} at the start and {load[1]:.2f} at the end." if load
-           else "."),
+        + (
+            f", load average {load[0]:.2f} at the start and {load[1]:.2f} at the end."
+            if load
+            else "."
+        ),
     ]
     notes = results.get("notes", [])
     if notes:
@@ -210,10 +199,26 @@ def plot(results: dict[str, Any], path: Path) -> None:
     w = 0.38
     fig, (left, right) = plt.subplots(1, 2, figsize=(10, 4.2))
     panels = (
-        (left, "scalar", "closed_form_us", "pinocchio_us", "closed form",
-         "Pinocchio J + numpy", "time per call [us] (median)", "joint_rates, one configuration"),
-        (right, "batch", "closed_form_per_s", "loop_per_s", "joint_rates_batch",
-         "Python loop over Pinocchio", "configurations per second", "batch, N = 10^5"),
+        (
+            left,
+            "scalar",
+            "closed_form_us",
+            "pinocchio_us",
+            "closed form",
+            "Pinocchio J + numpy",
+            "time per call [us] (median)",
+            "joint_rates, one configuration",
+        ),
+        (
+            right,
+            "batch",
+            "closed_form_per_s",
+            "loop_per_s",
+            "joint_rates_batch",
+            "Python loop over Pinocchio",
+            "configurations per second",
+            "batch, N = 10^5",
+        ),
     )
     for ax, part, ours, theirs, l1, l2, ylabel, title in panels:
         a = [r[part][ours] for r in results["arms"]]

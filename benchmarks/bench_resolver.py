@@ -39,7 +39,6 @@ import argparse  # noqa: E402
 import contextlib  # noqa: E402
 import json  # noqa: E402
 import logging  # noqa: E402
-import platform  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 import warnings  # noqa: E402
@@ -49,6 +48,7 @@ from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
+from machine import machine_info  # noqa: E402
 
 import rrc_pin  # noqa: E402
 from rrc_pin.resolver import Resolver  # noqa: E402
@@ -59,39 +59,6 @@ RESULTS = Path(__file__).resolve().parent / "results"
 SEED = 20261122
 DT = 0.01
 SEGMENT = 50
-
-
-def machine_info() -> dict[str, Any]:
-    """CPU, Python and library versions of this run."""
-    import osqp
-    import qpsolvers
-
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    info = {
-        "cpu": cpu,
-        "cores": os.cpu_count(),
-        "platform": platform.platform(),
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "pinocchio": pin.__version__,
-        "osqp": osqp.__version__,
-        "qpsolvers": qpsolvers.__version__,
-        "blas_threads": os.environ.get("OPENBLAS_NUM_THREADS"),
-    }
-    try:
-        import pink
-
-        info["pink"] = pink.__version__
-    except ImportError:
-        info["pink"] = None
-    return info
 
 
 def record_trajectory(
@@ -148,8 +115,12 @@ def pink_contenders(arm: Any) -> dict[str, Callable[[np.ndarray, np.ndarray], np
         limits = [ConfigurationLimit(model, config_limit_gain=1.0), VelocityLimit(model)]
 
         def step(
-            q: np.ndarray, x: np.ndarray, configuration: Any = configuration, task: Any = task,
-            limits: Any = limits, solver: str = solver,
+            q: np.ndarray,
+            x: np.ndarray,
+            configuration: Any = configuration,
+            task: Any = task,
+            limits: Any = limits,
+            solver: str = solver,
         ) -> np.ndarray:
             configuration.update(q)
             T = configuration.get_transform_frame_to_world(arm.tool_frame)
@@ -286,15 +257,21 @@ def markdown_table(results: dict[str, Any]) -> str:
                 f"{name} {100 * count / total:.1f}%"
                 for name, count in sorted(routes.items(), key=lambda kv: -kv[1])
             )
-        lines += [head, "", "| contender | median [us] | p99 [us] | median vs pink fastest | "
-                  "p99 vs pink fastest | max velocity excess [rad/s] | max position excess [rad] "
-                  "| failures |",
-                  "|---|---:|---:|---:|---:|---:|---:|---:|"]
+        lines += [
+            head,
+            "",
+            "| contender | median [us] | p99 [us] | median vs pink fastest | "
+            "p99 vs pink fastest | max velocity excess [rad/s] | max position excess [rad] "
+            "| failures |",
+            "|---|---:|---:|---:|---:|---:|---:|---:|",
+        ]
         for label, r in sorted(arm["contenders"].items(), key=lambda kv: kv[1]["median_us"]):
             ratios = ("-", "-")
             if pink is not None:
-                ratios = (f"{pink['median_us'] / r['median_us']:.2f}x",
-                          f"{pink['p99_us'] / r['p99_us']:.2f}x")
+                ratios = (
+                    f"{pink['median_us'] / r['median_us']:.2f}x",
+                    f"{pink['p99_us'] / r['p99_us']:.2f}x",
+                )
             lines.append(
                 f"| {label} | {r['median_us']:.0f} | {r['p99_us']:.0f} | {ratios[0]} | "
                 f"{ratios[1]} | {r['max_velocity_excess']:.2g} | "
@@ -344,7 +321,14 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     steps = 100 if args.quick else args.steps
     warnings.simplefilter("ignore")
-    results = {"machine": machine_info(), "dt": DT, "arms": [bench_arm(a, steps) for a in ARMS]}
+    results = {
+        "machine": {
+            **machine_info("osqp", "qpsolvers", "pink"),
+            "blas_threads": os.environ.get("OPENBLAS_NUM_THREADS"),
+        },
+        "dt": DT,
+        "arms": [bench_arm(a, steps) for a in ARMS],
+    }
     if not args.quick:
         RESULTS.mkdir(parents=True, exist_ok=True)
         (RESULTS / "resolver.json").write_text(json.dumps(results, indent=2) + "\n")

@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))  # the scripts import their shared machine.py
 README = HERE.parent / "README.md"
 START, END = "<!-- performance:start -->", "<!-- performance:end -->"
 BENCHMARKS = {
