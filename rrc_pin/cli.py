@@ -89,8 +89,14 @@ def arms_table() -> str:
 
 
 def urdf_command(directory: Path, *, write: bool) -> int:
-    """Rewrite (``write``) or check the committed URDFs of the catalogue; return the exit code."""
+    """Rewrite (``write``) or check the committed URDFs of the catalogue; return the exit code.
+
+    Exit codes: 0 all match (or written), 1 some differ, 2 ``directory`` is not a folder.
+    """
     specs = list(models.CATALOGUE.values())
+    if (directory.exists() and not directory.is_dir()) or not (write or directory.is_dir()):
+        print(f"rrc-pin urdf: --dir {directory} is not a folder", file=sys.stderr)
+        return 2
     if write:
         for path in urdf_export.write(directory, specs):
             print(f"wrote {path}")

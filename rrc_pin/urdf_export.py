@@ -1,4 +1,4 @@
-"""DH table to URDF text, and the committed ``urdf/`` files kept equal to it.
+"""DH table to URDF text, and the committed ``urdf/`` files kept equal to it (as numbers).
 
 Every DH link transform is split as ``T_i(q) = pre_i M_i(q) post_i`` with ``M_i`` the joint's
 motion about or along z (it commutes with ``Rz`` and ``Tz``):
@@ -15,7 +15,6 @@ refused.
 
 from __future__ import annotations
 
-import difflib
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +23,7 @@ import numpy.typing as npt
 from rrc_pin.dh import DHChain, DHRow, rot_x, rot_z, translation
 from rrc_pin.errors import InvalidInput
 from rrc_pin.models.arm_spec import ArmSpec
+from rrc_pin.urdf_compare import compare_urdf
 
 LINK_RADIUS = 0.03  # [m], visual cylinders
 LINK_MASS = 1.0  # [kg], placeholder inertia for viewers and dynamics demos
@@ -163,13 +163,20 @@ def _vec(values: npt.ArrayLike) -> str:
     return " ".join(_num(v) for v in np.asarray(values, dtype=float))
 
 
+DIGITS = 15
+"""Significant digits of every number written: DBL_DIG, the most that survive a round trip
+text -> float -> text, so a committed file read and written again is unchanged, and numbers
+that differ between CPUs in their last bit almost always print the same (rounding error
+<= 5e-16 relative, far below the 1e-9 of the kinematic cross-checks)."""
+
+
 def _num(x: float) -> str:
-    """Shortest round-trip decimal of ``x``, with float noise below 1e-15 shown as 0."""
+    """``x`` at :data:`DIGITS` significant digits, with float noise below 1e-15 shown as 0.
+
+    The one place where the URDF's numbers are formatted.
+    """
     x = float(x)
-    if abs(x) < 1e-15:
-        return "0"
-    text = repr(x)
-    return text[:-2] if text.endswith(".0") else text
+    return "0" if abs(x) < 1e-15 else f"{x:.{DIGITS}g}"
 
 
 def committed_path(directory: Path, name: str) -> Path:
@@ -188,16 +195,28 @@ def write(directory: Path, specs: list[ArmSpec]) -> list[Path]:
     return paths
 
 
-def check(directory: Path, specs: list[ArmSpec]) -> list[str]:
-    """Regenerate every URDF in memory; return a diff per file that differs or is missing."""
+def check(directory: Path, specs: list[ArmSpec], max_lines: int = 20) -> list[str]:
+    """Regenerate every URDF in memory and compare it with the committed file as numbers.
+
+    Args:
+        directory: Folder of the committed files.
+        specs: Arms to check.
+        max_lines: Differences listed per file at most (the rest are counted).
+
+    Returns:
+        One report per file that is missing or differs beyond the tolerance of
+        :mod:`rrc_pin.urdf_compare` (its path, then one line per difference); empty when all
+        match.
+    """
     problems = []
     for spec in specs:
         path = committed_path(directory, spec.name)
-        expected = to_urdf(spec)
-        actual = path.read_text() if path.exists() else ""
-        if actual != expected:
-            diff = difflib.unified_diff(
-                actual.splitlines(), expected.splitlines(), str(path), "generated", lineterm="", n=1
-            )
-            problems.append("\n".join(list(diff)[:40]) or f"{path}: missing")
+        if not path.is_file():
+            problems.append(f"{path}: missing (rrc-pin urdf --write creates it)")
+            continue
+        lines = compare_urdf(path.read_text(), to_urdf(spec))
+        if lines:
+            more = len(lines) - max_lines
+            lines = lines[:max_lines] + ([f"... and {more} more"] if more > 0 else [])
+            problems.append("\n".join([f"{path}: differs from its DH table", *lines]))
     return problems

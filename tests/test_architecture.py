@@ -16,7 +16,7 @@ import solvers
 
 ROOT = Path(__file__).resolve().parents[1]
 UPPER = {"resolver", "control", "controller", "guidance", "cell", "cli", "demo"}
-LOWER = {"dh", "models", "urdf_export", "robot", "loading", "errors", "cross_check"}
+LOWER = {"dh", "models", "urdf_export", "urdf_compare", "robot", "loading", "errors", "cross_check"}
 
 
 def modules(package) -> list[str]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import shutil
 import subprocess
 import sys
@@ -35,6 +36,47 @@ def test_urdf_check_fails_on_a_changed_file_and_write_repairs_it(tmp_path, capsy
     assert "barker6.urdf" in capsys.readouterr().err
     assert main(["urdf", "--write", "--dir", str(folder)]) == 0
     assert main(["urdf", "--check", "--dir", str(folder)]) == 0
+
+
+def scaled_numbers(text: str, factor: float, only: int | None = None) -> str:
+    """``text`` with the numbers in attribute values (after the XML declaration) times ``factor``
+    (all of them, or only the ``only``-th of those above 1e-3)."""
+    head, body = text.split("?>", 1)
+    count = iter(range(10**6))
+
+    def scale(m: re.Match[str]) -> str:
+        x = float(m.group())
+        if only is None or (abs(x) > 1e-3 and next(count) == only):
+            return repr(x * factor)
+        return m.group()
+
+    number = r"(?<=[\s\"])-?\d+(?:\.\d*)?(?:e[-+]?\d+)?(?=[\s\"])"
+    return head + "?>" + re.sub(number, scale, body)
+
+
+def test_urdf_check_compares_numbers_with_a_tolerance(tmp_path, capsys):
+    folder = tmp_path / "urdf"
+    shutil.copytree(COMMITTED_DIR, folder)
+    for path in folder.glob("*.urdf"):
+        path.write_text(scaled_numbers(path.read_text(), 1.0 + 1e-15))  # a few ulps
+    assert main(["urdf", "--check", "--dir", str(folder)]) == 0
+    path = folder / "rrc_k1607.urdf"
+    path.write_text(scaled_numbers(path.read_text(), 1.0 + 1e-9, only=40))
+    capsys.readouterr()
+    assert main(["urdf", "--check", "--dir", str(folder)]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert err[0] == f"{path}: differs from its DH table" and len(err) == 2
+    assert err[1].startswith("/robot/") and "committed" in err[1] and "generated" in err[1]
+
+
+def test_urdf_with_a_bad_folder_is_one_line(tmp_path, capsys):
+    assert main(["urdf", "--check", "--dir", str(tmp_path / "nothing")]) == 2
+    assert main(["urdf", "--write", "--dir", str(COMMITTED_DIR / "barker6.urdf")]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 2 and all("is not a folder" in line for line in err)
+    (tmp_path / "empty").mkdir()
+    assert main(["urdf", "--check", "--dir", str(tmp_path / "empty")]) == 1
+    assert capsys.readouterr().err.count("missing") == 5
 
 
 def test_check_command_cross_validates(capsys):

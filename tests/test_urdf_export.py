@@ -29,7 +29,8 @@ def test_check_reports_a_tampered_file(tmp_path):
     path = tmp_path / "kr5_3r.urdf"
     path.write_text(path.read_text().replace('velocity="6.5"', 'velocity="7.5"'))
     problems = check(tmp_path, specs)
-    assert len(problems) == 1 and 'velocity="7.5"' in problems[0]
+    assert len(problems) == 1
+    assert "joint[joint1]/limit@velocity: committed '7.5', generated '6.5'" in problems[0]
 
 
 def test_rpy_round_trip_including_gimbal_lock(rng):
