@@ -1,7 +1,9 @@
 """rrc-pin: Pinocchio-backed resolved-rate control of robot arms.
 
-Entry points (DESIGN.md, "Public API"): :func:`arms`, :func:`load`, :class:`Robot`,
-:class:`Resolver` and its :class:`Resolution`.
+Entry points: :func:`arms`, :func:`load`, :class:`Robot`; :class:`Resolver` with its options
+(:class:`JointLimits`, :class:`QPOptions`, :class:`Damping`), tasks (:class:`FrameTask`,
+:class:`RelativeFrameTask`, :class:`PostureTask`, :class:`JointTask`, :class:`DampingTask`)
+and its answer, :class:`Resolution`.
 """
 
 from rrc_pin.errors import (
@@ -11,23 +13,34 @@ from rrc_pin.errors import (
     UnknownArm,
     URDFError,
 )
+from rrc_pin.limits import JointLimits
 from rrc_pin.loading import arms, load
-from rrc_pin.resolver import Resolver
+from rrc_pin.resolver import Damping, QPOptions, Resolver, UnknownBackend
 from rrc_pin.robot import Robot
-from solvers.dls import Damping
-from solvers.resolution_record import ActiveLimit, Resolution
+from rrc_pin.tasks import DampingTask, FrameTask, JointTask, PostureTask, RelativeFrameTask, Task
+from solvers.resolution import ActiveLimit, Resolution, TaskReport
 
 __all__ = [
     "ActiveLimit",
     "Damping",
+    "DampingTask",
     "FrameNotFound",
+    "FrameTask",
     "InvalidInput",
+    "JointLimits",
+    "JointTask",
+    "PostureTask",
+    "QPOptions",
+    "RelativeFrameTask",
     "Resolution",
     "Resolver",
     "Robot",
     "RrcPinError",
+    "Task",
+    "TaskReport",
     "URDFError",
     "UnknownArm",
+    "UnknownBackend",
     "arms",
     "load",
 ]

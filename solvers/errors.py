@@ -12,10 +12,12 @@ class InputError(SolverError, ValueError):
 
     Attributes:
         argument: Name of the offending argument, as the caller spelled it.
+        reason: What was expected and what came.
     """
 
     def __init__(self, argument: str, message: str) -> None:
         self.argument = argument
+        self.reason = message
         super().__init__(f"{argument}: {message}")
 
 

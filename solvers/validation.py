@@ -38,22 +38,32 @@ def as_array(
     """Return ``x`` as a finite float array of the given shape (``None`` matches any size).
 
     Raises:
-        InputError: Wrong shape, non-numeric, NaN or inf.
+        InputError: Wrong shape, not real numbers (booleans, complex numbers and strings are
+            refused), NaN or inf.
     """
+    if type(x) is np.ndarray and x.dtype == _F64 and x.shape == shape:  # the common case
+        if not np.isfinite(x).all():
+            _non_finite(x, name, error)
+        return x
     try:
-        arr = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise error(name, f"expected a numeric array of shape {_fmt(shape)}, got {x!r}") from exc
+        raw = np.asarray(x)
+    except (TypeError, ValueError) as exc:  # ragged sequences
+        raise error(name, f"expected a real numeric array of shape {_fmt(shape)}, got {x!r}") from exc
+    if raw.dtype.kind not in "fiu":  # booleans, complex numbers, strings and objects
+        raise error(name, f"expected a real numeric array of shape {_fmt(shape)}, got {x!r}")
+    arr = raw.astype(np.float64, copy=False)
     if arr.ndim != len(shape) or any(
         want is not None and got != want for got, want in zip(arr.shape, shape, strict=True)
     ):
         raise error(name, f"expected shape {_fmt(shape)}, got {arr.shape}")
-    if not np.all(np.isfinite(arr)):
-        bad = np.argwhere(~np.isfinite(arr))[0]
-        raise error(
-            name, f"non-finite entry {arr[tuple(bad)]} at index {tuple(int(i) for i in bad)}"
-        )
+    if not np.isfinite(arr).all():
+        _non_finite(arr, name, error)
     return arr
+
+
+def _non_finite(arr: npt.NDArray[np.float64], name: str, error: type[InputError]) -> None:
+    bad = np.argwhere(~np.isfinite(arr))[0]
+    raise error(name, f"non-finite entry {arr[tuple(bad)]} at index {tuple(int(i) for i in bad)}")
 
 
 def as_float_list(
@@ -101,7 +111,8 @@ def finite_number(
         error: Exception class to raise (a subclass of :class:`InputError`).
 
     Raises:
-        InputError: ``value`` is not a number, not finite, or out of bounds; the message
+        InputError: ``value`` is not a real number (a bool or a string is refused), not
+            finite, or out of bounds; the message
             states the expected range (``>= 0``, ``> 0``, ``in (0, 1)``, ``in [0, 0.5)``).
     """
     if lower is None and upper is None:
@@ -112,10 +123,9 @@ def finite_number(
         want = f"a finite number < {upper:g}"
     else:
         want = f"a finite number in {'[' if inclusive else '('}{lower:g}, {upper:g})"
-    try:
-        out = float(value)
-    except (TypeError, ValueError) as exc:
-        raise error(name, f"expected {want}, got {value!r}") from exc
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
+        raise error(name, f"expected {want}, got {value!r}")
+    out = float(value)
     if (
         not isfinite(out)
         or (lower is not None and (out < lower or (out == lower and not inclusive)))

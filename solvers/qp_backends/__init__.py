@@ -1,62 +1,78 @@
 """QP backends behind one interface, and the dispatcher that picks one by name.
 
-``"osqp"`` is OSQP through its native API (:mod:`.osqp_native`, warm-started workspace);
-every other name is a solver that ``qpsolvers.available_solvers`` lists
-(:mod:`.qpsolvers_backend`).
+``"daqp"`` and ``"osqp"`` are called through their own APIs (:mod:`.daqp_backend`,
+:mod:`.osqp_backend`); every other name is a solver that ``qpsolvers.available_solvers``
+lists (:mod:`.qpsolvers_backend`). :func:`make_backend` checks the options by solving a
+small QP with them, so that a misspelt setting is refused at construction instead of
+making every later solve fail.
 """
 
 from __future__ import annotations
 
+import importlib.util
 from typing import Any
 
-from solvers.errors import BackendNotFound
-from solvers.qp_backends.base import QPBackend, QPSolution, structure_key
-from solvers.qp_backends.osqp_native import OSQPBackend
+import numpy as np
+
+from solvers.errors import BackendNotFound, InputError, ProblemError
+from solvers.qp import QP
+from solvers.qp_backends.base import QPBackend, QPSolution
+from solvers.qp_backends.daqp_backend import DaqpBackend
+from solvers.qp_backends.osqp_backend import OSQPBackend
 from solvers.qp_backends.qpsolvers_backend import QpsolversBackend
+
+NATIVE: dict[str, type[QPBackend]] = {"daqp": DaqpBackend, "osqp": OSQPBackend}
+"""Backends called through their own Python API."""
 
 
 def installed_backends() -> list[str]:
-    """Names :func:`make_backend` accepts: ``"osqp"`` first, then qpsolvers' other solvers."""
-    names: list[str] = []
-    try:
-        import osqp  # noqa: F401
+    """Names :func:`make_backend` accepts: daqp and osqp first, then qpsolvers' others."""
+    import qpsolvers
 
-        names.append("osqp")
-    except ImportError:  # pragma: no cover - osqp is a hard dependency
-        pass
-    try:
-        import qpsolvers
-
-        names += sorted(s for s in qpsolvers.available_solvers if s != "osqp")
-    except ImportError:  # pragma: no cover - qpsolvers is a hard dependency
-        pass
-    return names
+    native = [name for name in NATIVE if importlib.util.find_spec(name) is not None]
+    others = sorted(s for s in qpsolvers.available_solvers if s not in NATIVE)
+    return native + others
 
 
 def make_backend(name: str, **options: Any) -> QPBackend:
-    """A fresh backend (with its own warm-start state) by name.
+    """A fresh backend (with its own warm starts) by name, its options checked.
 
     Args:
         name: One of :func:`installed_backends`.
-        **options: Backend settings (OSQP settings, or the qpsolvers solver's options).
+        **options: Backend settings (e.g. DAQP's ``iter_limit``, OSQP's ``eps_abs``).
 
     Raises:
         BackendNotFound: ``name`` is not installed; the error lists the installed ones.
+        InputError: The backend refuses ``options`` (argument ``backend_options``).
     """
     installed = installed_backends()
     if not isinstance(name, str) or name not in installed:
         raise BackendNotFound(str(name), installed)
-    if name == "osqp":
-        return OSQPBackend(**options)
-    return QpsolversBackend(name, **options)
+    backend = NATIVE[name](**options) if name in NATIVE else QpsolversBackend(name, **options)
+    try:  # a two-variable QP with a bound and a row: every setting is read at the first solve
+        probe = backend.solve(_PROBE)
+    except ProblemError as exc:
+        reason = str(exc).splitlines()[0][:300]
+        raise InputError("backend_options", f"{name} refused {options}: {reason}") from exc
+    if probe.x is None or not np.allclose(probe.x, [0.5, 0.5], atol=1e-3):
+        raise InputError("backend_options", f"{name} with {options} fails a 2-variable QP")
+    backend.reset()
+    return backend
 
+
+_PROBE = QP(
+    P=np.eye(2), q=np.array([-1.0, -1.0]), C=np.array([[1.0, 1.0]]), l=np.array([-np.inf]),
+    u=np.array([1.0]), lb=np.zeros(2), ub=np.ones(2), key="probe",
+)  # fmt: skip
+"""min |z|^2/2 - z1 - z2 s.t. z1 + z2 <= 1, 0 <= z <= 1: z = (0.5, 0.5)."""
 
 __all__ = [
+    "NATIVE",
+    "DaqpBackend",
     "OSQPBackend",
     "QPBackend",
     "QPSolution",
     "QpsolversBackend",
     "installed_backends",
     "make_backend",
-    "structure_key",
 ]

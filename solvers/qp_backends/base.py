@@ -1,71 +1,67 @@
-"""What every QP backend provides: one ``solve(problem) -> QPSolution`` method."""
+"""What every QP backend provides: ``solve(qp) -> QPSolution``, with its own warm starts."""
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-from solvers.qp_problem import QPProblem
+from solvers.qp import QP
 
 Array = npt.NDArray[np.float64]
 
 
 class QPSolution(NamedTuple):
-    """What a backend returned for one :class:`~solvers.qp_problem.QPProblem`.
+    """What a backend returned for one :class:`~solvers.qp.QP`.
 
     Attributes:
-        x: Primal solution (nx,), or None when none was found. Within the backend's
-            tolerance only: the caller enforces the box exactly.
-        found: True when the backend reports a solution (possibly inaccurate).
-        status: The backend's own status string.
+        x: Primal solution (nz,), or None when none was found. Within the backend's
+            tolerance only: the caller checks it and enforces the bounds exactly.
+        status: The backend's own status ("solved" when found).
         iterations: Iterations used (0 where the backend does not say).
-        build_time: Time spent turning the problem into the backend's data [s].
         solve_time: Time spent in the backend's solver [s].
         backend: Backend name.
     """
 
     x: Array | None
-    found: bool
     status: str
     iterations: int
-    build_time: float
     solve_time: float
     backend: str
 
 
 class QPBackend(ABC):
-    """A QP solver behind one method; may keep warm-start state between calls.
+    """A QP solver behind one method; keeps warm-start values per problem structure.
+
+    Args:
+        **options: The solver's settings (checked by :func:`solvers.qp_backends.make_backend`).
 
     Attributes:
         name: Backend name, as :func:`solvers.qp_backends.make_backend` takes it.
-        warm_starts: True when the previous solution seeds the next solve.
+        options: The settings passed to the solver at every solve.
     """
 
     name: str
-    warm_starts: bool = False
+
+    def __init__(self, **options: Any) -> None:
+        self.options = dict(options)
+        self._last: dict[str, Array] = {}
 
     @abstractmethod
-    def solve(self, problem: QPProblem) -> QPSolution:
-        """Solve ``problem``.
+    def solve(self, qp: QP) -> QPSolution:
+        """Solve ``qp``, warm-started from the last solution of the same ``qp.key``.
 
         Raises:
-            ProblemError: The backend raised (bad data, crash); not for an unsolved QP, which
-                returns ``found=False``.
+            ProblemError: The solver raised (bad data, unknown setting); an unsolved QP is
+                not an error: it returns ``x = None``.
         """
 
-    @abstractmethod
     def reset(self) -> None:
-        """Forget every warm-start value (the next solve starts cold)."""
+        """Forget every warm-start value (the next solves start cold)."""
+        self._last.clear()
 
-    @abstractmethod
     def warm_start_state(self) -> dict[str, Array]:
-        """Copies of the values that seed the next solve, keyed by problem structure."""
-
-
-def structure_key(problem: QPProblem) -> str:
-    """Key of a problem's structure (kind and sizes): one warm-start slot per key."""
-    ng = 0 if problem.G is None else problem.G.shape[0]
-    return f"{problem.kind}:{problem.P.shape[0]}x{ng}"
+        """Copies of the values that seed the next solves, by problem key."""
+        return {key: x.copy() for key, x in self._last.items()}

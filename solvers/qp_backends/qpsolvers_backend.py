@@ -1,26 +1,20 @@
-"""Every other QP solver that qpsolvers finds installed, selectable by name.
+"""Every other QP solver that qpsolvers finds installed, by name, through ``qpsolvers.Problem``.
 
-Algorithms and references of the ones rrc-pin is tested with (qpsolvers' own docs list
+Algorithms and references of the ones rrc-pin is tested with (qpsolvers' documentation lists
 the rest):
 
-- ``daqp``: dual active-set (Arnström, Bemporad & Axehill, "A dual active-set solver for
-  embedded quadratic programming using recursive LDL^T updates", IEEE TAC 67(8), 2022).
-  Warm start: no (qpsolvers ignores initial values for DAQP).
-- ``proxqp``: proximal augmented Lagrangian (Bambade, El-Kazdadi, Taylor & Carpentier,
-  "PROX-QP: Yet another Quadratic Programming Solver for Robotics and beyond", RSS 2022).
-  Warm start: yes (the previous primal solution). Seen to declare a few feasible
-  one-variable problems primal infeasible (then the resolver falls back).
-- ``quadprog``: Goldfarb-Idnani dual active-set (Goldfarb & Idnani, Mathematical Programming
-  27:1-33, 1983). Warm start: no.
+- ``quadprog``: Goldfarb-Idnani dual active set (Goldfarb & Idnani, "A numerically stable
+  dual method for solving strictly convex quadratic programs", Math. Prog. 27, 1983).
+- ``proxqp``: proximal augmented Lagrangian (Bambade et al., "PROX-QP: Yet another quadratic
+  programming solver for robotics and beyond", RSS 2022).
 - ``clarabel``: interior point with homogeneous embedding (Goulart & Chen, "Clarabel: an
-  interior-point solver for conic programs with quadratic objectives", arXiv:2405.12762,
-  2024). Warm start: no.
+  interior-point solver for conic programs with quadratic objectives", 2024).
+- ``osqp``, ``daqp``: rrc-pin calls these through their own APIs (:mod:`.osqp_backend`,
+  :mod:`.daqp_backend`); through qpsolvers they are ``qpsolvers:osqp`` and ``qpsolvers:daqp``.
 
-Each solve goes through ``qpsolvers.solve_problem``; build time (our conversion plus
-qpsolvers') and solve time are recorded apart. Two-sided rows become pairs of one-sided
-rows; box entries are passed as a box when all finite, else as rows. Variables with a
-zero-width box are eliminated and zero-width rows widened by 1e-9 (quadprog and clarabel
-refuse them). Tolerances are tightened where the solver's defaults are loose.
+Warm starts: the previous solution of the same problem key is passed as ``initvals`` (used
+by the solvers that take one). Zero-width bounds and rows (``lb == ub``) are widened by
+:data:`WIDTH` (quadprog and clarabel refuse them); the caller clips the answer back.
 """
 
 from __future__ import annotations
@@ -32,11 +26,11 @@ from typing import Any
 import numpy as np
 
 from solvers.errors import ProblemError
-from solvers.qp_backends.base import Array, QPBackend, QPSolution, structure_key
-from solvers.qp_problem import QPProblem
+from solvers.qp import QP
+from solvers.qp_backends.base import Array, QPBackend, QPSolution
 
-WARM_STARTING: frozenset[str] = frozenset({"proxqp", "osqp", "qpalm", "piqp", "highs"})
-"""qpsolvers solvers that use the initial values they are given."""
+WIDTH = 1e-9
+"""Relative width given to zero-width bounds and rows."""
 
 DEFAULT_OPTIONS: dict[str, dict[str, Any]] = {
     "proxqp": {
@@ -47,7 +41,7 @@ DEFAULT_OPTIONS: dict[str, dict[str, Any]] = {
         "eps_duality_gap_rel": 0.0,
     },
     "clarabel": {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1e-10},
-    "osqp": {"eps_abs": 1e-7, "eps_rel": 1e-7, "polishing": True},
+    "osqp": {"eps_abs": 1e-7, "eps_rel": 1e-7, "polishing": True, "max_iter": 20000},
 }
 """Per-solver options used unless overridden."""
 
@@ -58,126 +52,52 @@ class QpsolversBackend(QPBackend):
     Args:
         solver: A name in ``qpsolvers.available_solvers``.
         **options: Solver options overriding :data:`DEFAULT_OPTIONS`.
-
-    Raises:
-        ProblemError: qpsolvers is not importable or does not have ``solver``.
     """
 
     def __init__(self, solver: str, **options: Any) -> None:
-        try:
-            import qpsolvers
-        except ImportError as exc:  # pragma: no cover - qpsolvers is a hard dependency
-            raise ProblemError("qpsolvers is not installed (pip install qpsolvers)") from exc
-        if solver not in qpsolvers.available_solvers:
-            raise ProblemError(f"qpsolvers has no installed solver {solver!r}")
-        self._qpsolvers = qpsolvers
+        super().__init__(**{**DEFAULT_OPTIONS.get(solver, {}), **options})
         self.name = solver
-        self.warm_starts = solver in WARM_STARTING
-        self.options = {**DEFAULT_OPTIONS.get(solver, {}), **options}
-        self._x: dict[str, Array] = {}
 
-    def reset(self) -> None:
-        """Forget the previous solutions."""
-        self._x.clear()
-
-    def warm_start_state(self) -> dict[str, Array]:
-        """Copies of the previous solutions, by problem structure."""
-        return {key: x.copy() for key, x in self._x.items()}
-
-    def solve(self, problem: QPProblem) -> QPSolution:
-        """Solve with ``qpsolvers.solve_problem``.
+    def solve(self, qp: QP) -> QPSolution:
+        """Solve ``qp`` with ``qpsolvers.solve_problem``.
 
         Raises:
-            ProblemError: The solver raised.
+            ProblemError: The solver raised (an unknown option included).
         """
+        import qpsolvers
+
+        widened = qp._replace(ub=_widen(qp.lb, qp.ub))
+        if qp.l is not None and qp.u is not None:
+            widened = widened._replace(u=_widen(qp.l, qp.u))
         t0 = time.perf_counter()
-        key = structure_key(problem)
-        full = problem
-        problem, free = _eliminate_fixed(problem)
-        qp = self._qpsolvers.Problem(problem.P, problem.q, *_inequalities(problem))
-        initvals = self._x.get(key) if self.warm_starts else None
-        if initvals is not None and free is not None:
-            initvals = initvals[free]
-        t1 = time.perf_counter()
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                sol = self._qpsolvers.solve_problem(
-                    qp, solver=self.name, initvals=initvals, **self.options
-                )
+                sol = qpsolvers.solve_problem(
+                    widened.problem(), solver=self.name, initvals=self._last.get(qp.key),
+                    **self.options,
+                )  # fmt: skip
         except Exception as exc:
             raise ProblemError(f"{self.name}: {exc}") from exc
-        t2 = time.perf_counter()
-        x = sol.x
-        found = bool(sol.found) and x is not None and bool(np.all(np.isfinite(x)))
-        if found and free is not None:
-            x_full = full.lb.copy()  # fixed variables at their (single) value
-            x_full[free] = x
-            x = x_full
-        if found:
-            self._x[key] = np.array(x, dtype=np.float64)
-        inner_build = float(getattr(sol, "build_time", 0.0) or 0.0)
-        inner_solve = getattr(sol, "solve_time", None)
-        solve_time = float(inner_solve) if inner_solve else (t2 - t1)
+        solve_time = time.perf_counter() - t0
+        x = sol.x if sol.found else None
+        if x is not None and not np.isfinite(x).all():
+            x = None
+        if x is not None:
+            self._last[qp.key] = np.array(x, dtype=np.float64)
         extras = sol.extras if isinstance(sol.extras, dict) else {}
         iterations = extras.get("iterations", extras.get("iter", 0))
         return QPSolution(
-            x=np.array(x, dtype=np.float64) if found else None,
-            found=found,
-            status="solved" if found else "not found",
-            iterations=int(np.max(iterations)) if np.size(iterations) else 0,
-            build_time=(t1 - t0) + inner_build,
-            solve_time=solve_time,
-            backend=self.name,
+            None if x is None else np.array(x, dtype=np.float64),
+            "solved" if x is not None else "not found",
+            int(np.max(iterations)) if np.size(iterations) else 0,
+            solve_time,
+            self.name,
         )
 
 
-WIDTH = 1e-9
-"""Relative width given to zero-width rows (lo == hi), which quadprog refuses as
-inconsistent; the resolver clips the answer back into the exact bounds."""
-
-
-def _widen(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+def _widen(lo: Array, hi: Array) -> Array:
     """``hi`` raised to at least ``lo + WIDTH (1 + |lo|)`` where both are finite."""
     with np.errstate(invalid="ignore"):
         wider = np.maximum(hi, lo + WIDTH * (1.0 + np.abs(lo)))
     return np.where(np.isfinite(lo) & np.isfinite(hi), wider, hi)
-
-
-def _eliminate_fixed(problem: QPProblem) -> tuple[QPProblem, np.ndarray | None]:
-    """The problem without the variables whose box has zero width (lb == ub).
-
-    Interior-point and dual active-set solvers fail on such boxes (quadprog: "constraints
-    are inconsistent"). Returns the reduced problem and the mask of the remaining variables
-    (None when nothing is fixed).
-    """
-    fixed = problem.lb >= problem.ub
-    if not fixed.any() or problem.G is not None:
-        return problem, None
-    free = ~fixed
-    value = problem.lb[fixed]
-    q = problem.q[free] + problem.P[np.ix_(free, fixed)] @ value
-    reduced = problem._replace(
-        P=problem.P[np.ix_(free, free)], q=q, lb=problem.lb[free], ub=problem.ub[free],
-        x_free=problem.x_free[free],
-    )
-    return reduced, free
-
-
-def _inequalities(problem: QPProblem) -> tuple[Any, ...]:
-    """``(G, h, A, b, lb, ub)`` of qpsolvers for ``problem`` (no equality constraints)."""
-    rows: list[np.ndarray] = []
-    rhs: list[np.ndarray] = []
-    if problem.G is not None and problem.lo is not None and problem.hi is not None:
-        rows += [problem.G, -problem.G]
-        rhs += [_widen(problem.lo, problem.hi), -problem.lo]
-    lb, ub = problem.lb, _widen(problem.lb, problem.ub)
-    if not (np.all(np.isfinite(lb)) and np.all(np.isfinite(ub))):
-        eye = np.eye(lb.size)
-        low, high = np.isfinite(lb), np.isfinite(ub)
-        rows += [-eye[low], eye[high]]
-        rhs += [-lb[low], ub[high]]
-        lb = ub = None
-    if not rows:
-        return None, None, None, None, lb, ub
-    return np.vstack(rows), np.concatenate(rhs), None, None, lb, ub

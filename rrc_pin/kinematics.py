@@ -1,0 +1,84 @@
+"""The kinematics of one control tick: frame Jacobians and poses, computed once for all tasks.
+
+:class:`Kinematics` runs ``pinocchio.computeJointJacobians`` (which includes the forward
+kinematics) and ``updateFramePlacements`` once at a configuration, in a ``pinocchio.Data``
+that belongs to its caller (a resolver's own: never a Data shared between threads); the tasks
+then read frame Jacobians (``getFrameJacobian``, no recomputation) and poses from it.
+:class:`Layout` is what the tasks may name on a robot, prepared once.
+"""
+
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
+
+from rrc_pin.robot import PIN_REFERENCE
+from solvers.spatial import Reference
+
+Array = npt.NDArray[np.float64]
+
+
+class Layout(NamedTuple):
+    """The names a task may use on one robot, and its continuous joints.
+
+    Attributes:
+        nv: Number of joints (one rate each).
+        frames: Frame name to Pinocchio frame index.
+        joints: Joint name to index in q.
+        continuous: Mask (nv,) of the continuous (unbounded revolute) joints.
+    """
+
+    nv: int
+    frames: dict[str, int]
+    joints: dict[str, int]
+    continuous: npt.NDArray[np.bool_]
+
+    @classmethod
+    def of(cls, model: pin.Model, joint_names: list[str]) -> Layout:
+        """The layout of ``model`` (frames by name: the body frame where names repeat)."""
+        body = pin.FrameType.BODY
+        frames: dict[str, int] = {}
+        for i, f in enumerate(model.frames):
+            if f.name not in frames or (f.type == body and model.frames[frames[f.name]].type != body):
+                frames[f.name] = i
+        continuous = np.array([model.joints[j].nq == 2 for j in range(1, model.njoints)])
+        return cls(model.nv, frames, {n: i for i, n in enumerate(joint_names)}, continuous)
+
+
+class Kinematics:
+    """Frame Jacobians (6, nv) and poses of one configuration.
+
+    Args:
+        model: The ``pinocchio.Model``.
+        data: A ``pinocchio.Data`` of ``model`` owned by the caller (overwritten).
+        layout: The robot's :class:`Layout`.
+        q: Joint positions at the API (nv,) [rad or m], one coordinate per joint.
+        q_pin: The same configuration as Pinocchio's vector (model.nq,).
+
+    Attributes:
+        q: Joint positions (nv,).
+        q_pin: Pinocchio configuration (model.nq,).
+        continuous: Mask (nv,) of the continuous joints.
+    """
+
+    def __init__(self, model: pin.Model, data: Any, layout: Layout, q: Array, q_pin: Array) -> None:
+        self.q, self.q_pin, self.continuous = q, q_pin, layout.continuous
+        self._model, self._data, self._layout = model, data, layout
+        pin.computeJointJacobians(model, data, q_pin)
+        pin.updateFramePlacements(model, data)
+
+    def jacobian(self, frame: str, ref: Reference = "world_aligned") -> Array:
+        """Geometric Jacobian (6, nv) of ``frame``, rows [v; w], in frame ``ref``."""
+        fid = self._layout.frames[frame]
+        return pin.getFrameJacobian(self._model, self._data, fid, PIN_REFERENCE[ref])
+
+    def joint_index(self, joint: str) -> int:
+        """Index in q of the joint named ``joint``."""
+        return self._layout.joints[joint]
+
+    def pose(self, frame: str) -> Array:
+        """Pose (4, 4) of ``frame`` in the base frame [m] (a copy)."""
+        return np.array(self._data.oMf[self._layout.frames[frame]].homogeneous)

@@ -1,0 +1,132 @@
+"""FrameTask: a commanded twist of one frame of the robot."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.errors import InvalidInput
+from rrc_pin.kinematics import Kinematics
+from rrc_pin.tasks.task import Task, check_weight
+from solvers.resolution import TaskRows
+from solvers.spatial import REFERENCES, Reference
+from solvers.validation import as_vector
+
+Array = npt.NDArray[np.float64]
+
+ROWS: dict[str, tuple[int, ...]] = {
+    "full": (0, 1, 2, 3, 4, 5),
+    "position": (0, 1, 2),
+    "orientation": (3, 4, 5),
+}
+"""Named row selections of the [v; w] twist."""
+
+
+class FrameTask(Task):
+    """The twist ``[v; w]`` of frame ``frame``, in the reference frame ``ref``.
+
+    Args:
+        frame: Name of a frame of the robot (e.g. its tool frame).
+        twist: Commanded twist (6,) [m/s, rad/s], or only the selected rows; default zero
+            (hold the frame still).
+        ref: ``world_aligned`` (default: velocity of the frame's origin in base axes),
+            ``local`` (the same in the frame's axes; Barker's hand-frame commands) or
+            ``world`` (spatial velocity at the base origin, full rows only: its linear part
+            is not the frame's velocity).
+        rows: ``"full"``, ``"position"`` (rows 0:3), ``"orientation"`` (3:6), a boolean
+            mask (6,) or row indices.
+        weight: Cost > 0 of the squared residual, scalar or one per selected row.
+        name: Name in the report (default the frame's).
+
+    Raises:
+        InvalidInput: A bad twist, ref, rows or weight, or ``world`` with partial rows.
+    """
+
+    def __init__(
+        self,
+        frame: str,
+        twist: npt.ArrayLike | None = None,
+        *,
+        ref: Reference = "world_aligned",
+        rows: str | Sequence[int] | Sequence[bool] = "full",
+        weight: float | npt.ArrayLike = 1.0,
+        name: str | None = None,
+    ) -> None:
+        if not isinstance(frame, str):
+            raise InvalidInput("frame", f"expected a frame name, got {frame!r}")
+        self.frame = frame
+        self.ref = check_reference(ref)
+        self.selected = task_rows(rows)
+        if self.ref == "world" and len(self.selected) != 6:
+            raise InvalidInput(
+                "ref",
+                "'world' is the spatial velocity at the base origin: its linear part is not "
+                "the frame's velocity, so partial rows cannot use it; use 'world_aligned'",
+            )
+        self.weight = check_weight(weight, len(self.selected))
+        self.row_weights = self._row_weights(len(self.selected))
+        self.name = frame if name is None else name
+        self.twist = np.zeros(len(self.selected)) if twist is None else self.check_twist(twist)
+
+    def check_twist(self, twist: npt.ArrayLike) -> Array:
+        """``twist`` as the selected rows: (6,) or (rows,) finite.
+
+        Raises:
+            InvalidInput: Wrong shape or a non-finite entry.
+        """
+        m = len(self.selected)
+        size = np.shape(twist)
+        if size == (6,) and m != 6:
+            return as_vector(twist, "twist", 6, InvalidInput)[list(self.selected)]
+        if size != (m,):
+            want = "(6,)" if m == 6 else f"(6,) or ({m},)"
+            raise InvalidInput("twist", f"expected shape {want}, got {size}")
+        return as_vector(twist, "twist", m, InvalidInput)
+
+    def frames(self) -> tuple[str, ...]:
+        """The commanded frame."""
+        return (self.frame,)
+
+    def rows(self, kin: Kinematics) -> TaskRows:
+        """The frame's Jacobian rows and the commanded twist."""
+        J = kin.jacobian(self.frame, self.ref)
+        if len(self.selected) != 6:
+            J = J[list(self.selected)]
+        return TaskRows(J, self.twist.copy(), self.row_weights, self.name)
+
+
+def check_reference(ref: str) -> Reference:
+    """``ref`` if it names one of :data:`solvers.spatial.REFERENCES`.
+
+    Raises:
+        InvalidInput: Anything else, naming ``ref`` and the choices.
+    """
+    if ref not in REFERENCES:
+        raise InvalidInput("ref", f"expected one of {', '.join(REFERENCES)}, got {ref!r}")
+    return ref  # type: ignore[return-value]
+
+
+def task_rows(rows: str | Sequence[int] | Sequence[bool]) -> tuple[int, ...]:
+    """Row indices of a row selection (:class:`FrameTask`).
+
+    Raises:
+        InvalidInput: An unknown name, a mask not of shape (6,), repeated or out-of-range rows.
+    """
+    if isinstance(rows, str):
+        if rows not in ROWS:
+            raise InvalidInput("rows", f"expected one of {', '.join(ROWS)} or indices, got {rows!r}")
+        return ROWS[rows]
+    arr = np.asarray(rows)
+    if arr.dtype == bool:
+        if arr.shape != (6,):
+            raise InvalidInput("rows", f"a boolean mask must have shape (6,), got {arr.shape}")
+        selected = tuple(int(i) for i in np.flatnonzero(arr))
+    elif arr.ndim == 1 and np.issubdtype(arr.dtype, np.integer):
+        selected = tuple(int(i) for i in arr)
+    else:
+        raise InvalidInput("rows", f"expected row indices, got {rows!r}")
+    if not selected or len(set(selected)) != len(selected) or not all(0 <= r < 6 for r in selected):
+        raise InvalidInput("rows", f"expected distinct rows in 0..5, got {rows!r}")
+    return selected

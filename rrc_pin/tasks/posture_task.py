@@ -1,0 +1,65 @@
+"""PostureTask: joint rates toward a reference configuration."""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.errors import InvalidInput
+from rrc_pin.kinematics import Kinematics, Layout
+from rrc_pin.tasks.task import Task, check_weight
+from solvers.resolution import TaskRows
+from solvers.validation import as_vector, finite_number
+
+Array = npt.NDArray[np.float64]
+
+
+class PostureTask(Task):
+    r"""Every joint toward ``q_ref``: :math:`\dot q \approx k\,(q_{ref} - q)`.
+
+    Continuous joints take the short way round (the difference wrapped into [-pi, pi]).
+
+    Args:
+        q_ref: Reference configuration (nq,) [rad or m].
+        gain: k > 0 [1/s]: the fraction of the remaining distance asked per second.
+        weight: Cost > 0, scalar or one per joint.
+        name: Name in the report.
+
+    Raises:
+        InvalidInput: A bad q_ref, gain or weight.
+    """
+
+    def __init__(
+        self,
+        q_ref: npt.ArrayLike,
+        gain: float = 1.0,
+        *,
+        weight: float | npt.ArrayLike = 1.0,
+        name: str = "posture",
+    ) -> None:
+        self.q_ref = as_vector(q_ref, "q_ref", np.size(q_ref), InvalidInput)
+        self.gain = finite_number(gain, "gain", 0.0, inclusive=False, error=InvalidInput)
+        self.weight = check_weight(weight, self.q_ref.size)
+        self.name = name
+
+    def frames(self) -> tuple[str, ...]:
+        """None."""
+        return ()
+
+    def check(self, layout: Layout) -> None:
+        """Refuse a q_ref (or weights) of another size than the robot's joints.
+
+        Raises:
+            InvalidInput: ``q_ref`` has the wrong size.
+        """
+        if self.q_ref.size != layout.nv:
+            raise InvalidInput("q_ref", f"expected shape ({layout.nv},), got ({self.q_ref.size},)")
+
+    def rows(self, kin: Kinematics) -> TaskRows:
+        """Identity rows and ``gain (q_ref - q)``."""
+        error = self.q_ref - kin.q
+        if kin.continuous.any():
+            wrapped = np.remainder(error + np.pi, 2.0 * np.pi) - np.pi
+            error = np.where(kin.continuous, wrapped, error)
+        n = error.size
+        return TaskRows(np.eye(n), self.gain * error, self._row_weights(n), self.name)

@@ -1,0 +1,74 @@
+"""RelativeFrameTask: the twist of one frame relative to another, on one model."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.kinematics import Kinematics
+from rrc_pin.tasks.frame_task import FrameTask
+from rrc_pin.tasks.task import Task
+from solvers.resolution import TaskRows
+
+Array = npt.NDArray[np.float64]
+
+
+class RelativeFrameTask(Task):
+    r"""The motion of frame ``frame_b`` as seen from frame ``frame_a``, in ``frame_a``'s axes.
+
+    With :math:`T_a, T_b` the two poses in the base frame and :math:`p_{ab} = R_a^T(p_b - p_a)`,
+    the task's twist is :math:`[\dot p_{ab};\ R_a^T(\omega_b - \omega_a)]`, so its rows are
+
+    .. math::
+
+        J_{ab} = \begin{bmatrix} R_a^T (J_b^v - J_a^v + [p_b - p_a]_\times J_a^\omega) \\
+                 R_a^T (J_b^\omega - J_a^\omega) \end{bmatrix}
+
+    (Jacobians ``world_aligned``). A zero twist keeps :math:`T_a^{-1}T_b` constant: two
+    hands holding one object keep their grip while the pair moves.
+
+    Args:
+        frame_a: The reference frame (e.g. the left hand).
+        frame_b: The moving frame (e.g. the right hand).
+        twist: Relative twist (6,) [m/s, rad/s] or the selected rows; default zero.
+        rows: Row selection as in :class:`FrameTask`.
+        weight: Cost > 0, scalar or per selected row.
+        name: Name in the report (default ``"frame_b/frame_a"``).
+
+    Raises:
+        InvalidInput: Bad twist, rows or weight.
+    """
+
+    def __init__(
+        self,
+        frame_a: str,
+        frame_b: str,
+        twist: npt.ArrayLike | None = None,
+        *,
+        rows: str | Sequence[int] | Sequence[bool] = "full",
+        weight: float | npt.ArrayLike = 1.0,
+        name: str | None = None,
+    ) -> None:
+        self._spec = FrameTask(frame_b, twist, rows=rows, weight=weight, name=name)
+        self.frame_a, self.frame_b = frame_a, frame_b
+        self.twist, self.weight, self.selected = self._spec.twist, self._spec.weight, self._spec.selected
+        self.name = f"{frame_b}/{frame_a}" if name is None else name
+
+    def frames(self) -> tuple[str, ...]:
+        """Both frames."""
+        return (self.frame_a, self.frame_b)
+
+    def rows(self, kin: Kinematics) -> TaskRows:
+        """The relative Jacobian rows (class docstring) and the commanded relative twist."""
+        Ja = kin.jacobian(self.frame_a)
+        Jb = kin.jacobian(self.frame_b)
+        Ta, Tb = kin.pose(self.frame_a), kin.pose(self.frame_b)
+        Rt = Ta[:3, :3].T
+        d = Tb[:3, 3] - Ta[:3, 3]
+        cross = np.array([[0.0, -d[2], d[1]], [d[2], 0.0, -d[0]], [-d[1], d[0], 0.0]])
+        J = np.vstack([Rt @ (Jb[:3] - Ja[:3] + cross @ Ja[3:]), Rt @ (Jb[3:] - Ja[3:])])
+        if len(self.selected) != 6:
+            J = J[list(self.selected)]
+        return TaskRows(J, self.twist.copy(), self._spec.row_weights, self.name)

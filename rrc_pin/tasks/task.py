@@ -1,0 +1,68 @@
+"""What every task is: rows ``A qdot ~= b`` of one control tick (pink's Task pattern)."""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.errors import FrameNotFound, InvalidInput
+from rrc_pin.kinematics import Kinematics, Layout
+from solvers.resolution import TaskRows
+from solvers.validation import as_vector, finite_number
+
+Array = npt.NDArray[np.float64]
+
+
+class Task(ABC):
+    """A task of a resolution: its Jacobian rows and desired rates at one tick.
+
+    Attributes:
+        name: Name in the resolution's report.
+        weight: Cost of the task's squared residual (weighted priorities) and its rows' weight
+            within a strict level; > 0, scalar or one per row.
+    """
+
+    name: str
+    weight: float | Array
+
+    @abstractmethod
+    def frames(self) -> tuple[str, ...]:
+        """Frames the task reads (checked against the robot before anything is computed)."""
+
+    @abstractmethod
+    def rows(self, kin: Kinematics) -> TaskRows:
+        """The rows ``A qdot ~= b`` (A: (m, nv)) at the configuration of ``kin``."""
+
+    def check(self, layout: Layout) -> None:
+        """Refuse a task that names what the robot does not have (before any computation).
+
+        Raises:
+            FrameNotFound: A frame the robot does not have (the error lists its frames).
+            InvalidInput: Anything else that does not fit the robot.
+        """
+        for frame in self.frames():
+            if frame not in layout.frames:
+                raise FrameNotFound(frame, sorted(layout.frames))
+
+    def _row_weights(self, m: int) -> Array | None:
+        """The weight as (m,) row weights, or None when it is 1 everywhere."""
+        w = np.broadcast_to(np.asarray(self.weight, dtype=np.float64), (m,))
+        return None if (w == 1.0).all() else np.array(w)
+
+
+def check_weight(weight: float | npt.ArrayLike, size: int | None = None) -> float | Array:
+    """A task weight: a finite number > 0, or (size,) of them.
+
+    Raises:
+        InvalidInput: Not positive, not finite, or the wrong shape.
+    """
+    if np.ndim(weight) == 0:
+        return finite_number(weight, "weight", 0.0, inclusive=False, error=InvalidInput)  # type: ignore[arg-type]
+    if size is None:
+        raise InvalidInput("weight", f"expected a number > 0, got {weight!r}")
+    w = as_vector(weight, "weight", size, InvalidInput)
+    if (w <= 0.0).any():
+        raise InvalidInput("weight", f"expected weights > 0, got {w}")
+    return w

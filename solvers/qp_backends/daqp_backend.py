@@ -1,0 +1,75 @@
+"""DAQP through its own Python API (``daqp.solve``).
+
+Algorithm: dual active-set method with recursive LDL^T updates, for small and medium dense
+QPs (Arnström, Bemporad & Axehill, "A dual active-set solver for embedded quadratic
+programming using recursive LDL^T updates", IEEE TAC 67(8), 2022). It returns the exact
+solution of the identified active set (no ADMM tolerance), takes two-sided rows and simple
+bounds natively, and is warm-started here with the previous primal solution of the same
+problem structure (``primal_start``, which seeds the active set).
+
+Called directly rather than through ``qpsolvers.solve_problem``: 6.6 us against 16 us per
+7-variable box QP, measured on panda's resolver problems (the default backend's cost on every
+step with an active limit).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from solvers.errors import ProblemError
+from solvers.qp import QP
+from solvers.qp_backends.base import QPBackend, QPSolution
+
+DEFAULT_SETTINGS = {"primal_tol": 1e-9}
+"""DAQP settings used unless overridden. DAQP's default primal tolerance (1e-6) lets an
+inactive bound be exceeded by up to that much, and clipping the answer back then bends the
+commanded direction (by 2.6e-6 on random panda problems); at 1e-9 the violated bound joins
+the active set and the answers are exact to 4e-16, with no more iterations."""
+
+
+class DaqpBackend(QPBackend):
+    """DAQP, warm-started from the last primal solution per problem key.
+
+    Args:
+        **options: DAQP settings (``primal_tol``, ``dual_tol``, ``iter_limit``...).
+    """
+
+    name = "daqp"
+
+    def __init__(self, **options: object) -> None:
+        super().__init__(**{**DEFAULT_SETTINGS, **options})
+
+    def solve(self, qp: QP) -> QPSolution:
+        """Solve ``qp`` (:class:`~solvers.qp_backends.base.QPBackend`).
+
+        Raises:
+            ProblemError: DAQP raised (for instance on an unknown setting).
+        """
+        import daqp
+
+        nz = qp.q.size
+        if qp.C is None or qp.l is None or qp.u is None:
+            A, upper, lower = np.zeros((0, nz)), qp.ub, qp.lb
+        else:  # the box first, then the rows (DAQP takes infinite bounds as they are)
+            A = qp.C
+            upper = np.concatenate([qp.ub, qp.u])
+            lower = np.concatenate([qp.lb, qp.l])
+        sense = np.zeros(upper.size, dtype=np.intc)  # C ints: all inequalities
+        t0 = time.perf_counter()
+        try:
+            x, _, exitflag, info = daqp.solve(
+                qp.P, qp.q, A, upper, lower, sense,
+                primal_start=self._last.get(qp.key), **self.options,
+            )  # fmt: skip
+        except Exception as exc:
+            raise ProblemError(f"daqp: {exc}") from exc
+        solve_time = time.perf_counter() - t0
+        found = exitflag > 0 and bool(np.isfinite(x).all())
+        if found:
+            self._last[qp.key] = x
+        else:
+            self._last.pop(qp.key, None)
+        status = "solved" if found else f"exitflag {exitflag}"
+        return QPSolution(x if found else None, status, int(info["iterations"]), solve_time, self.name)

@@ -1,0 +1,487 @@
+r"""The resolver's numerical pipeline: task rows by priority level and the step's bounds in,
+one :class:`~solvers.resolution.Resolution` out.
+
+Each task gives rows ``A qdot ~= b`` with row weights (:class:`TaskRows`); the limits give the
+joint-rate bounds of the step (:class:`~solvers.joint_bounds.StepBounds`) and, optionally,
+inequality rows ``G qdot <= h`` (:class:`Inequalities`, for collision and workspace limits).
+The levels are solved one after another, each exactly within the optimal set of those above
+it (Kanoun, Lamiraux & Wieber 2011; Escande, Mansard & Wieber 2014): a level's rows, stacked
+and row-weighted, are factorised once (:class:`~solvers.jacobian_svd.JacobianSVD`), and the
+next level moves only in their null space, so it cannot change their achieved rates.
+
+The top level (level 0):
+
+1. its least-squares rates of least norm, exact, are the answer when they are inside the
+   bounds (the box-free optimum: no QP is built);
+2. otherwise, near a singularity, the damping of :class:`~solvers.jacobian_svd.Damping`;
+   the damped rates are the answer when inside the bounds;
+3. otherwise the QP (:mod:`solvers.qp`), solved by the backend:
+
+   - direction-preserving (default, and standing still allowed): with w the (damped) rates,
+     :math:`\dot q = u\,c\,w + V_n y`, maximise :math:`u \in [0, 1]` subject to the bounds
+     (and rows); the task velocity is :math:`u c` times the command's, whatever y, so the
+     hand slows down along the command instead of veering (Drake's formulation; the null
+     space parametrised, so no rank-deficient equality rows). The cap c <= 1 keeps u of order
+     one for absurd commands. Without a null space, the largest feasible u is computed
+     directly;
+   - least squares (tracking mode, weighted priorities, or a joint recovering into its
+     range): :math:`\min \|A\dot q - b\|^2 + \sum_i\lambda_i^2 (v_i^T\dot q)^2 +
+     \epsilon\|\dot q\|^2` within the bounds.
+
+4. If the backend fails (an exception, no solution, or an answer outside the bounds beyond
+   its tolerance), the fallbacks answer in order: ``lp`` (the exact box-and-direction LP by
+   scipy's HiGHS: the largest u, any y), ``dls`` (the rates clipped), ``scaling`` (the
+   rates scaled uniformly into the bounds), and always last ``hold`` (the feasible rates
+   nearest zero). Nothing raises for numerical trouble.
+
+The lower levels (strict priorities): :math:`\dot q = x + N^T z` with x the answer so far
+and N the rows spanning the null space of every level above; the level's least squares in z
+within the bounds (box-free optimum first, then the backend). A level that fails keeps the
+answer of the levels above (recorded in ``attempts``).
+
+Every answer is finally clipped into the bounds (the clip size is reported), so it is
+exactly feasible whatever the backend's tolerance.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from solvers.errors import InputError, ProblemError
+from solvers.jacobian_svd import Damping, JacobianSVD, uniform_scale
+from solvers.joint_bounds import StepBounds
+from solvers.qp import QP, Decoding
+from solvers.qp_backends import QPBackend
+from solvers.resolution import EXACT_TOL, METHODS, Method, Resolution, Status, TaskRows, norm
+
+Array = npt.NDArray[np.float64]
+
+FEASIBILITY_TOL = 1e-6
+"""A backend's answer may leave the bounds by this much times (1 + the norm of the velocity
+limits) before it counts as a failure (it is clipped back in either way)."""
+
+LEAST_NORM = 1e-9
+"""Weight of the least-norm term of the least-squares QPs, relative to the largest squared
+singular value (it makes P definite where the rows leave joints free)."""
+
+DIRECTION_REGULARIZATION = 1e-4
+r"""Weight :math:`\epsilon` of :math:`\tfrac12 u^2 + \tfrac12\|y\|^2/R^2` in the direction QP
+(R the radius of the bounds). Measured along panda's benchmark trajectory (1,500 QPs): the
+scale is within 1.3e-10 of the exact LP maximum; below 1e-6 DAQP declares up to 12% of these
+(feasible) problems infeasible."""
+
+
+class Inequalities(NamedTuple):
+    """Rows ``G qdot <= h`` that every answer must satisfy (collision, workspace walls).
+
+    Attributes:
+        G: Rows (p, n).
+        h: Bounds (p,); ``h >= 0`` where standing still is allowed.
+        names: One name per row, for the report.
+    """
+
+    G: Array
+    h: Array
+    names: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class ResolveOptions:
+    """How the pipeline solves (module docstring).
+
+    Attributes:
+        direction_preserving: Top level as the direction-preserving QP (else least squares).
+        damping: Damping near singularities, or None for none.
+        fallbacks: Methods tried in order after the QP (names of
+            :data:`~solvers.resolution.METHODS` except ``qp``); ``hold`` always ends.
+
+    Raises:
+        InputError: An unknown or repeated fallback, ``qp`` among them.
+    """
+
+    direction_preserving: bool = True
+    damping: Damping | None = field(default_factory=Damping)
+    fallbacks: tuple[Method, ...] = ("lp", "scaling")
+
+    def __post_init__(self) -> None:
+        fallbacks = (self.fallbacks,) if isinstance(self.fallbacks, str) else self.fallbacks
+        try:
+            fallbacks = tuple(fallbacks)
+        except TypeError:
+            raise InputError("fallbacks", f"expected method names, got {self.fallbacks!r}") from None
+        for name in fallbacks:
+            if name not in METHODS or name == "qp":
+                choices = ", ".join(m for m in METHODS if m != "qp")
+                raise InputError("fallbacks", f"unknown method {name!r}; expected {choices}")
+        if len(set(fallbacks)) != len(fallbacks):
+            raise InputError("fallbacks", f"repeated method in {fallbacks}")
+        if self.damping is not None and not isinstance(self.damping, Damping):
+            raise InputError("damping", f"expected a solvers Damping or None, got {self.damping!r}")
+        if not isinstance(self.direction_preserving, bool):
+            raise InputError(
+                "direction_preserving", f"expected True or False, got {self.direction_preserving!r}"
+            )
+        chain = fallbacks if fallbacks[-1:] == ("hold",) else (*fallbacks, "hold")
+        object.__setattr__(self, "fallbacks", chain)
+
+
+@dataclass
+class _Solved:
+    """What one level's solve produced (mutable while the pipeline runs).
+
+    ``qdot`` is within the bounds (clipped, ``clip`` the size of the clip).
+    """
+
+    qdot: Array
+    clip: float = 0.0
+    backend: str = ""
+    iterations: int = 0
+    solve_time: float = 0.0
+
+
+class _Failed(Exception):
+    """A method did not produce a usable answer (internal control flow)."""
+
+
+@dataclass
+class _TopLevel:
+    """The top level's factorisation and the rates the fallbacks reuse."""
+
+    A: Array  # stacked, row-weighted rows
+    b: Array
+    svd: JacobianSVD
+    w: Array  # the (damped) least-squares rates
+    lam: Array | None  # squared damping per singular direction, None when undamped
+    inside: Array | None  # w when it satisfies the bounds and rows, else None
+
+    @property
+    def lambda_sq(self) -> float:
+        """The largest squared damping (0 when undamped)."""
+        return 0.0 if self.lam is None else float(self.lam.max())
+
+
+def resolve(
+    levels: Sequence[Sequence[TaskRows]],
+    bounds: StepBounds,
+    velocity: Array,
+    backend: QPBackend,
+    options: ResolveOptions,
+    *,
+    weighted: bool = False,
+    rows: Inequalities | None = None,
+    joint_names: tuple[str, ...] | None = None,
+) -> Resolution:
+    """Joint rates serving ``levels`` in priority order within ``bounds`` (module docstring).
+
+    Inputs are not checked here (the caller validates them): every array finite, shapes
+    consistent, at least one level of at least one task.
+
+    Args:
+        levels: Task rows per priority level, highest first (one level when ``weighted``).
+        bounds: Joint-rate bounds of the step.
+        velocity: Joint velocity limits (n,) > 0, for the damping.
+        backend: The QP backend (warm-started across calls).
+        options: How to solve.
+        weighted: One level whose tasks trade off by their weights (least squares, no
+            direction preservation).
+        rows: Inequality rows every answer must satisfy, or None.
+        joint_names: Names for the report.
+
+    Returns:
+        The :class:`~solvers.resolution.Resolution`; never raises for numerical trouble.
+    """
+    t0 = time.perf_counter()
+    attempts: list[tuple[str, str]] = []
+    solved: _Solved | None = None
+    top: _TopLevel | None = None
+    method: Method = "qp"
+    direction = options.direction_preserving and not weighted and bounds.contains_zero
+    if rows is not None and (rows.h < 0.0).any():
+        direction = False  # standing still would violate a row: least squares
+    try:
+        top = _top_level(levels[0], bounds, velocity, options, rows)
+        solved = _solve_top(top, bounds, backend, options, direction, rows)
+    except (_Failed, ProblemError, np.linalg.LinAlgError, ArithmeticError, ValueError) as exc:
+        attempts.append(("qp", str(exc)))
+    if solved is None:
+        for name in options.fallbacks:
+            try:
+                solved = _fallback(name, top, bounds, rows)
+                method = name
+                break
+            except _Failed as exc:
+                attempts.append((name, str(exc)))
+    assert solved is not None  # "hold" always answers
+    if method == "qp" and len(levels) > 1:
+        null = top.svd.null_basis() if top is not None else None
+        for k, level in enumerate(levels[1:], start=1):
+            if null is None or null.shape[0] == 0:
+                break
+            try:
+                null = _lower_level(level, solved, null, bounds, backend, options, rows, k)
+            except (_Failed, ProblemError, np.linalg.LinAlgError, ArithmeticError) as exc:
+                attempts.append((f"level {k}", f"{exc}; the levels above kept"))
+                break
+    solved.qdot.flags.writeable = False
+    return _report(
+        levels, bounds, method, top, solved, attempts, time.perf_counter() - t0, joint_names
+    )
+
+
+def _stack(tasks: Sequence[TaskRows]) -> tuple[Array, Array]:
+    """Rows and rates of ``tasks`` stacked, each row times the square root of its weight."""
+    As, bs = [], []
+    for t in tasks:
+        if t.weight is None:
+            As.append(t.A)
+            bs.append(t.b)
+        else:
+            root = np.sqrt(t.weight)
+            As.append(t.A * root[:, None])
+            bs.append(t.b * root)
+    if len(As) == 1:
+        return As[0], bs[0]
+    return np.vstack(As), np.concatenate(bs)
+
+
+def _clipped(x: Array, bounds: StepBounds) -> tuple[Array, float]:
+    """``x`` clipped into the bounds, and the Euclidean size of the clip (NaN for NaN)."""
+    y = np.minimum(np.maximum(x, bounds.lb), bounds.ub)
+    change = y - x
+    return y, math.sqrt(change @ change)
+
+
+def _rows_hold(x: Array, rows: Inequalities | None, tol: float = 0.0) -> bool:
+    return rows is None or bool((rows.G @ x <= rows.h + tol).all())
+
+
+def _top_level(
+    tasks: Sequence[TaskRows],
+    bounds: StepBounds,
+    velocity: Array,
+    options: ResolveOptions,
+    rows: Inequalities | None,
+) -> _TopLevel:
+    """Factorise the top level and find its (damped) least-squares rates."""
+    A, b = _stack(tasks)
+    svd = JacobianSVD(A)
+    w = svd.rates(b)
+    lam = None
+    y, clip = _clipped(w, bounds)
+    if not (clip == 0.0 and _rows_hold(w, rows)) and options.damping is not None:
+        lam = options.damping.lambda_sq(svd, velocity, w, bounds.lb, bounds.ub)
+        if lam is not None:
+            w = svd.rates(b, lam)
+            y, clip = _clipped(w, bounds)
+    inside = w if clip == 0.0 and _rows_hold(w, rows) else None
+    return _TopLevel(A, b, svd, w, lam, inside)
+
+
+def _solve_top(
+    top: _TopLevel,
+    bounds: StepBounds,
+    backend: QPBackend,
+    options: ResolveOptions,
+    direction: bool,
+    rows: Inequalities | None,
+) -> _Solved:
+    if top.inside is not None:  # the box-free optimum: no QP
+        return _Solved(top.inside.copy())
+    if direction:
+        qp, decoding = _direction_qp(top, bounds, rows, options)
+        w = decoding.M[:, -1]  # type: ignore[index]
+        u_floor = uniform_scale(w, bounds.lb, bounds.ub)  # u with y = 0: always feasible
+        if qp.q.size == 1 and rows is None:  # no null space: the largest feasible u
+            return _Solved(*_clipped(w * u_floor, bounds))
+        solved = _backend_solve(qp, decoding, bounds, backend, rows)
+        if rows is None and float(solved.qdot @ w) < u_floor * float(w @ w) * (1.0 - 1e-9):
+            solved.qdot, solved.clip = _clipped(w * u_floor, bounds)  # an inaccurate backend
+        return solved
+    qp, decoding = _least_squares_qp(top, bounds, rows, options)
+    return _backend_solve(qp, decoding, bounds, backend, rows)
+
+
+def _direction_qp(
+    top: _TopLevel, bounds: StepBounds, rows: Inequalities | None, options: ResolveOptions
+) -> tuple[QP, Decoding]:
+    """The direction-preserving QP (module docstring): z = (y, u), qdot = [V_n^T, c w] z."""
+    null = top.svd.null_basis()
+    d, n = null.shape
+    half = np.maximum(-bounds.lb, bounds.ub)
+    radius = norm(half)  # no feasible rates are longer, and w is orthogonal to the null space
+    length = norm(top.w)
+    M = np.empty((n, d + 1))
+    M[:, :d] = null.T
+    M[:, d] = top.w * (radius / length) if length > radius else top.w  # u of order one
+    eps = DIRECTION_REGULARIZATION
+    P = np.diag([eps / (radius * radius or 1.0)] * d + [eps])
+    q = np.array([0.0] * d + [-1.0])
+    lb = np.array([-np.inf] * d + [0.0])
+    ub = np.array([np.inf] * d + [1.0])
+    C, lo, hi = _rows_of(M, bounds, rows, None)
+    return QP(P, q, C, lo, hi, lb, ub, f"direction:{n}:{d}"), Decoding(None, M)
+
+
+def _least_squares_qp(
+    top: _TopLevel, bounds: StepBounds, rows: Inequalities | None, options: ResolveOptions
+) -> tuple[QP, Decoding]:
+    """The tracking QP over qdot: min |A qdot - b|^2 + damping + eps |qdot|^2, box = bounds."""
+    A, svd = top.A, top.svd
+    n = A.shape[1]
+    P = A.T @ A
+    if top.lam is not None:  # the damping of each direction, in the singular basis
+        Vr = svd.Vt[: svd.rank]
+        P += (Vr.T * top.lam[: svd.rank]) @ Vr
+    top_sigma = float(svd.sigma[0]) if svd.sigma.size else 1.0
+    P.flat[:: n + 1] += LEAST_NORM * max(top_sigma * top_sigma, 1.0)
+    q = -(top.b @ A)
+    if rows is None:
+        qp = QP(P, q, None, None, None, bounds.lb, bounds.ub, f"least_squares:{n}")
+    else:
+        qp = QP(P, q, rows.G, np.full(rows.h.size, -np.inf), rows.h, bounds.lb, bounds.ub,
+                f"least_squares:{n}:{rows.h.size}")  # fmt: skip
+    return qp, Decoding(None, None)
+
+
+def _rows_of(
+    M: Array, bounds: StepBounds, rows: Inequalities | None, x0: Array | None
+) -> tuple[Array, Array, Array]:
+    """Constraint rows ``l <= C z <= u`` of rates ``x0 + M z``: the bounds, then ``G``."""
+    lo = bounds.lb if x0 is None else bounds.lb - x0
+    hi = bounds.ub if x0 is None else bounds.ub - x0
+    if rows is None:
+        return M, lo, hi
+    h = rows.h if x0 is None else rows.h - rows.G @ x0
+    return (
+        np.vstack([M, rows.G @ M]),
+        np.concatenate([lo, np.full(h.size, -np.inf)]),
+        np.concatenate([hi, h]),
+    )
+
+
+def _backend_solve(
+    qp: QP, decoding: Decoding, bounds: StepBounds, backend: QPBackend, rows: Inequalities | None
+) -> _Solved:
+    """The backend's answer, clipped into the bounds; a failure beyond its tolerance."""
+    sol = backend.solve(qp)
+    if sol.x is None:
+        raise _Failed(f"{sol.backend}: {sol.status}")
+    qdot, clip = _clipped(decoding.rates(sol.x), bounds)
+    tol = FEASIBILITY_TOL * (1.0 + norm(bounds.velocity))
+    if not (clip <= tol and _rows_hold(qdot, rows, tol)):
+        raise _Failed(f"{sol.backend}: answer outside the bounds by {clip:.3g}")
+    return _Solved(qdot, clip, sol.backend, sol.iterations, sol.solve_time)
+
+
+def _lower_level(
+    tasks: Sequence[TaskRows],
+    solved: _Solved,
+    null: Array,
+    bounds: StepBounds,
+    backend: QPBackend,
+    options: ResolveOptions,
+    rows: Inequalities | None,
+    k: int,
+) -> Array:
+    """Serve one lower level in the null space ``null`` (d, n) of the levels above.
+
+    Updates ``solved`` in place; returns the null space left for the next level.
+    """
+    A, b = _stack(tasks)
+    x = solved.qdot
+    B = A @ null.T
+    c = b - A @ x
+    svd = JacobianSVD(B)
+    candidate, clip = _clipped(x + svd.rates(c) @ null, bounds)
+    if not (clip == 0.0 and _rows_hold(candidate, rows)):
+        d, n = null.shape
+        P = B.T @ B
+        top_sigma = float(svd.sigma[0]) if svd.sigma.size else 1.0
+        P.flat[:: d + 1] += LEAST_NORM * max(top_sigma * top_sigma, 1.0)
+        C, lo, hi = _rows_of(null.T, bounds, rows, x)
+        free = np.full(d, np.inf)
+        qp = QP(P, -(c @ B), C, lo, hi, -free, free, f"level{k}:{n}:{d}")
+        answer = _backend_solve(qp, Decoding(x, null.T), bounds, backend, rows)
+        candidate, clip = answer.qdot, max(answer.clip, solved.clip)
+        solved.backend = answer.backend or solved.backend
+        solved.iterations += answer.iterations
+        solved.solve_time += answer.solve_time
+    solved.qdot, solved.clip = candidate, clip
+    return svd.null_basis() @ null
+
+
+def _fallback(
+    name: Method, top: _TopLevel | None, bounds: StepBounds, rows: Inequalities | None
+) -> _Solved:
+    """One fallback method's answer (module docstring); raises _Failed when it cannot."""
+    if name == "hold":
+        return _Solved(np.minimum(np.maximum(0.0, bounds.lb), bounds.ub))
+    if top is None:
+        raise _Failed("no factorisation of the top level")
+    if name == "dls":
+        return _Solved(*_clipped(top.w, bounds))
+    if not bounds.contains_zero:
+        raise _Failed("a joint must recover: zero rates are outside the bounds")
+    if name == "scaling":
+        return _Solved(*_clipped(uniform_scale(top.w, bounds.lb, bounds.ub) * top.w, bounds))
+    return _Solved(*_clipped(_direction_lp(top, bounds, rows), bounds))
+
+
+def _direction_lp(top: _TopLevel, bounds: StepBounds, rows: Inequalities | None) -> Array:
+    """The largest u of the direction problem, by scipy's HiGHS (exact, any y)."""
+    from scipy.optimize import linprog
+
+    null = top.svd.null_basis()
+    d, n = null.shape
+    M = np.column_stack([null.T, top.w])
+    C, lo, hi = _rows_of(M, bounds, rows, None)
+    finite_lo = np.isfinite(lo)
+    cost = np.zeros(d + 1)
+    cost[d] = -1.0
+    result = linprog(
+        cost,
+        A_ub=np.vstack([C, -C[finite_lo]]),
+        b_ub=np.concatenate([hi, -lo[finite_lo]]),
+        bounds=[(None, None)] * d + [(0.0, 1.0)],
+        method="highs",
+    )
+    if result.status != 0 or result.x is None:
+        raise _Failed(f"linprog: {result.message}")
+    return np.asarray(M @ result.x, dtype=np.float64)
+
+
+def _report(
+    levels: Sequence[Sequence[TaskRows]],
+    bounds: StepBounds,
+    method: Method,
+    top: _TopLevel | None,
+    solved: _Solved,
+    attempts: list[tuple[str, str]],
+    elapsed: float,
+    names: tuple[str, ...] | None,
+) -> Resolution:
+    """The Resolution: the status decided here where the pipeline knows it, else on access."""
+    status: Status | None = None
+    if method != "qp":
+        status = "fallback"
+    elif not bounds.contains_zero:
+        status = "recovering"
+    elif top is not None and top.lam is not None:
+        status = "damped"
+    elif top is not None and top.svd.rank < top.A.shape[0]:
+        U = top.svd.U[:, : top.svd.rank]
+        outside = top.b - (top.b @ U) @ U.T  # the command's part outside the Jacobian's range
+        if norm(outside) > EXACT_TOL * (1.0 + norm(top.b)):
+            status = "singular"
+    return Resolution(
+        solved.qdot, method, solved.backend, solved.iterations, tuple(attempts), solved.clip,
+        top.lambda_sq if top is not None else 0.0, elapsed - solved.solve_time,
+        solved.solve_time, bounds, tuple(tuple(level) for level in levels), names, status,
+    )  # fmt: skip
