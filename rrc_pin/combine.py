@@ -45,8 +45,8 @@ def combine(arms: Mapping[str, tuple[Robot, npt.ArrayLike]], name: str | None = 
 
     Raises:
         InvalidInput: ``arms`` is empty or not a mapping, a key is not a non-empty name
-            without ``/``, a value is not ``(Robot, T_base)``, or ``T_base`` is not a (4, 4)
-            rigid transform (within :data:`PLACEMENT_TOL`).
+            without ``/``, a value is not ``(Robot, T_base)``, ``T_base`` is not a (4, 4)
+            rigid transform (within :data:`PLACEMENT_TOL`), or ``name`` is not a string.
 
     Example:
         >>> cell = combine({"left": (panda, T_left), "right": (ur5, T_right)})
@@ -55,6 +55,8 @@ def combine(arms: Mapping[str, tuple[Robot, npt.ArrayLike]], name: str | None = 
     """
     if not isinstance(arms, Mapping) or not arms:
         raise InvalidInput("arms", f"expected a non-empty mapping key -> (Robot, T), got {arms!r}")
+    if name is not None and not isinstance(name, str):
+        raise InvalidInput("name", f"expected a string, got {name!r}")
     model = pin.Model()
     tools: list[str] = []
     parts: list[str] = []

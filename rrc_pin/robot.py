@@ -27,6 +27,7 @@ import pinocchio as pin
 
 from rrc_pin.errors import FrameNotFound, InvalidInput, ToolFrameRequired, URDFError
 from rrc_pin.models.arm_spec import ArmSpec
+from solvers.errors import InputError
 from solvers.spatial import Reference, check_reference
 from solvers.validation import as_vector
 
@@ -164,13 +165,22 @@ class Robot:
         the closed form answers for (its ``frame`` attribute: ``"tool"``, e.g. Barker's wrist
         centre), so that ``load("barker6", tool_frame="flange").closed_form`` is None rather
         than the wrist-centre rates under the flange's name.
+
+        Raises:
+            InvalidInput: The geometry has no closed form (e.g. ``kr5_3r`` with ``a2=0``),
+                naming the parameter.
         """
         factory = self.spec.closed_form if self.spec is not None else None
         if factory is None or self.tool_frame is None:
             return None
         with self._lock:
             if self._closed_form is None:
-                self._closed_form = factory()
+                try:
+                    self._closed_form = factory()
+                except InputError as exc:  # e.g. kr5_3r with a2 = 0: no closed form exists
+                    raise InvalidInput(
+                        exc.argument, f"{self.name} has no closed form for this geometry ({exc})"
+                    ) from exc
             cf = self._closed_form
         return cf if getattr(cf, "frame", CLOSED_FORM_FRAME) == self.tool_frame else None
 

@@ -130,3 +130,8 @@ def test_bad_arms_are_refused_naming_the_entry(arms, message):
         }
     with pytest.raises(InvalidInput, match=message):
         combine(arms)
+
+
+def test_a_bad_name_is_refused():
+    with pytest.raises(InvalidInput, match="^name: expected a string"):
+        combine({"a": (rrc_pin.load("kr5_3r"), np.eye(4))}, name=3)

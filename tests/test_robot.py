@@ -236,6 +236,13 @@ def test_bad_ref_and_frame():
         arm.frame_pose(np.zeros(6), "nowhere")
 
 
+def test_a_geometry_without_closed_form_is_an_rrc_pin_error():
+    arm = rrc_pin.load("kr5_3r", a2=0.0)  # Pinocchio takes it; the 3R closed form divides by a2
+    assert arm.fk(np.zeros(3))[0, 3] == pytest.approx(0.7)
+    with pytest.raises(InvalidInput, match="^a2: kr5_3r has no closed form for this geometry"):
+        _ = arm.closed_form
+
+
 def test_closed_form_is_none_for_non_paper_arms():
     assert rrc_pin.load("ur5").closed_form is None
     assert rrc_pin.load("nadkarni_c1").closed_form is None
