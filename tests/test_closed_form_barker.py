@@ -1,4 +1,4 @@
-"""Barker's closed form (solvers/closed_form/barker.py) against Pinocchio, and its errata.
+"""Barker's closed form (solvers/closed_form/barker*.py) against Pinocchio, and its errata.
 
 Reference everywhere: ``rrc_pin.load(...)`` (Pinocchio's LOCAL_WORLD_ALIGNED Jacobian of the
 wrist centre), for the PUMA defaults and the variant alpha3 = 88 deg, A3 = 0.02 m, R3 = 0.01 m.
@@ -229,9 +229,11 @@ def test_wrist_generalized_inverse_splits_equally_at_theta5_zero(arm: Arm) -> No
     Q = arm.sample(rng, 100)
     Q[:, 4] = 0.0
     for method in METHODS:
-        for exact in (False, True):  # damping keeps the split: it acts on (1, 1) and (1, -1)
+        # damping keeps the split (it acts on (1, 1) and (1, -1)), to the rounding of its
+        # normal equations (condition number 2 / band^2)
+        for exact, tol in ((True, 1e-15), (False, 1e-11)):
             W = arm.cf.wrist_rates_batch(Q, rng.normal(size=(100, 3)), method, exact)
-            assert np.all(np.abs(W[:, 0] - W[:, 2]) <= 1e-15 * np.abs(W).max())
+            assert np.all(np.abs(W[:, 0] - W[:, 2]) <= tol * np.abs(W).max())
 
 
 # -- determinant and the singular set ------------------------------------------------------
@@ -472,7 +474,9 @@ def test_batch_equals_scalar(arm: Arm) -> None:
     for method, exact in ((m, e) for m in METHODS for e in (False, True)):
         B = cf.joint_rates_batch(Q, X, method, exact)
         S = np.array([cf.joint_rates(q, x, method, exact) for q, x in zip(Q, X, strict=True)])
-        assert rel(S, B).max() < 1e-12
+        # in the bands the damped normal equations (condition up to (sigma_max / eps)^2 ~ 1e4)
+        # see the last-bit differences of the two trigonometries
+        assert rel(S, B).max() < (1e-12 if exact else 1e-11)
         B = cf.arm_rates_batch(Q, X[:, :3], method, exact)
         S = np.array([cf.arm_rates(q, x[:3], method, exact) for q, x in zip(Q, X, strict=True)])
         assert rel(S, B).max() < 1e-12
