@@ -11,18 +11,21 @@ from __future__ import annotations
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 import numpy.typing as npt
 
 from rrc_pin import models
+from rrc_pin.errors import InvalidInput
 from rrc_pin.loading import load
 from rrc_pin.models.arm_spec import ArmSpec
 from rrc_pin.robot import Robot
 from rrc_pin.urdf_export import COMMITTED_DIR, TOOL_FRAME, to_urdf
-from solvers.spatial import REFERENCES
+from solvers.spatial import REFERENCES, Reference
 
 FD_STEP = 1e-6  # [rad] or [m]
+REFS = cast(tuple[Reference, ...], REFERENCES)  # the three frame names, typed
 
 
 @dataclass
@@ -42,8 +45,8 @@ class CrossCheckReport:
     samples: int
     fk_dh: float = 0.0
     fk_yourdfpy: float = 0.0
-    jacobian_dh: dict[str, float] = field(default_factory=lambda: dict.fromkeys(REFERENCES, 0.0))
-    jacobian_fd: dict[str, float] = field(default_factory=lambda: dict.fromkeys(REFERENCES, 0.0))
+    jacobian_dh: dict[Reference, float] = field(default_factory=lambda: dict.fromkeys(REFS, 0.0))
+    jacobian_fd: dict[Reference, float] = field(default_factory=lambda: dict.fromkeys(REFS, 0.0))
 
     def worst(self) -> tuple[float, float]:
         """(largest exact-reference error, largest finite-difference error)."""
@@ -52,23 +55,29 @@ class CrossCheckReport:
 
 
 def finite_difference_jacobians(
-    robot: Robot, q: npt.NDArray[np.float64], step: float = FD_STEP
-) -> dict[str, npt.NDArray[np.float64]]:
-    """Central finite difference of the tool pose, as (6, nq) Jacobians in the three frames.
+    robot: Robot, q: npt.NDArray[np.float64], step: float = FD_STEP, frame: str | None = None
+) -> dict[Reference, npt.NDArray[np.float64]]:
+    """Central finite difference of a frame's pose, as (6, nq) Jacobians in the three frames.
 
     With ``dT`` the derivative of the pose ``T = [R p; 0 1]``: ``world_aligned`` takes
     ``v = dp`` and ``[w]x = dR R^T``; ``world`` reads ``(v, w)`` from ``dT T^-1``; ``local`` from
     ``T^-1 dT``.
+
+    Args:
+        robot: The robot.
+        q: Joint positions (nq,) [rad or m].
+        step: Difference step [rad or m].
+        frame: Frame to differentiate; default: the tool frame.
     """
-    T = robot.fk(q)
+    T = robot.fk(q, frame)
     T_inv = np.linalg.inv(T)
-    out = {ref: np.empty((6, robot.nq)) for ref in REFERENCES}
+    out = {ref: np.empty((6, robot.nq)) for ref in REFS}
     for i in range(robot.nq):
         dq = np.zeros(robot.nq)
         dq[i] = step
-        dT = (robot.fk(q + dq) - robot.fk(q - dq)) / (2.0 * step)
+        dT = (robot.fk(q + dq, frame) - robot.fk(q - dq, frame)) / (2.0 * step)
         world = dT @ T_inv
-        twists = {
+        twists: dict[Reference, tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]] = {
             "world_aligned": (dT[:3, 3], world[:3, :3]),
             "world": (world[:3, 3], world[:3, :3]),
             "local": ((T_inv @ dT)[:3, 3], (T_inv @ dT)[:3, :3]),
@@ -93,8 +102,13 @@ def cross_check(
         samples: Number of random configurations within the limits.
         rng: Seeded generator.
         urdf_path: URDF file to load; default: the generated text written to a temporary file.
+
+    Raises:
+        InvalidInput: ``samples`` is not an integer >= 1 (checking nothing proves nothing).
     """
     import yourdfpy  # heavy import, only needed here
+
+    check_samples(samples)
 
     with tempfile.TemporaryDirectory() as tmp:
         if urdf_path is None:
@@ -115,7 +129,7 @@ def cross_check(
             float(np.abs(T - other.get_transform(TOOL_FRAME, "base_link")).max()),
         )
         fd = finite_difference_jacobians(robot, q)
-        for ref in REFERENCES:
+        for ref in REFS:
             J = robot.jacobian(q, ref)
             report.jacobian_dh[ref] = max(
                 report.jacobian_dh[ref], float(np.abs(J - spec.chain.jacobian(q, ref)).max())
@@ -127,8 +141,24 @@ def cross_check(
     return report
 
 
+def check_samples(samples: int) -> int:
+    """Return ``samples`` if it is an integer >= 1.
+
+    Raises:
+        InvalidInput: It is not (``0`` would check nothing and pass).
+    """
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
+        raise InvalidInput("samples", f"expected an integer >= 1, got {samples!r}")
+    return int(samples)
+
+
 def run_cross_check(samples: int = 200, seed: int = 0, urdf_dir: Path | None = None) -> int:
-    """Cross-check every catalogue arm against its committed URDF; print a table; exit code."""
+    """Cross-check every catalogue arm against its committed URDF; print a table; exit code.
+
+    Raises:
+        InvalidInput: ``samples`` is not an integer >= 1.
+    """
+    check_samples(samples)
     folder = urdf_dir or COMMITTED_DIR
     rng = np.random.default_rng(seed)
     failed = 0

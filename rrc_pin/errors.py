@@ -55,9 +55,28 @@ class FrameNotFound(RrcPinError, ValueError):
     Attributes:
         frame: The requested name.
         frames: Names the model has.
+        argument: The argument that named it (``tool_frame``, ``frame``...).
     """
 
-    def __init__(self, frame: str, frames: list[str]) -> None:
+    def __init__(self, frame: str, frames: list[str], argument: str = "tool_frame") -> None:
         self.frame = frame
         self.frames = frames
-        super().__init__(f"tool_frame: no frame {frame!r}; frames: {', '.join(frames)}")
+        self.argument = argument
+        super().__init__(f"{argument}: no frame {frame!r}; frames: {', '.join(frames)}")
+
+
+class ToolFrameRequired(InvalidInput):
+    """Several frames could be meant and the call named none.
+
+    Raised by :func:`rrc_pin.load` for a URDF whose tree ends in several links (baxter, talos)
+    loaded without ``tool_frame``, and by ``Robot.fk`` / ``Robot.jacobian`` without ``frame`` on
+    a robot with several tool frames.
+
+    Attributes:
+        argument: The argument to pass (``tool_frame`` or ``frame``).
+        candidates: The names it may take.
+    """
+
+    def __init__(self, argument: str, context: str, candidates: list[str]) -> None:
+        self.candidates = candidates
+        super().__init__(argument, f"{context}; name one of: {', '.join(candidates)}")

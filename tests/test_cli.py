@@ -10,17 +10,74 @@ from pathlib import Path
 
 import pytest
 
-from rrc_pin.cli import main
+import rrc_pin
+from rrc_pin.cli import EXIT_BROKEN_PIPE, main
 from rrc_pin.urdf_export import COMMITTED_DIR
 
 
-def test_arms_table_lists_sources_and_assumptions(capsys):
+def test_arms_table_lists_tool_frames_sources_and_assumptions(capsys):
     assert main(["arms"]) == 0
-    out = capsys.readouterr().out
-    assert out.splitlines()[0].split()[:4] == ["name", "dof", "joints", "tool"]
-    assert "barker6       6    RRRRRR" in out and "PUMA 560 values" in out
-    assert "nadkarni_c2   6    PPPRRR" in out
-    assert "panda" in out and "example-robot-data" in out
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].split()[:5] == ["name", "dof", "joints", "tool", "frames"]
+    rows = {line.split()[0]: line for line in lines[1:]}
+    assert list(rows) == rrc_pin.arms()
+    assert rows["barker6"].split()[1:4] == ["6", "RRRRRR", "tool"]
+    assert "PUMA 560 values" in rows["barker6"]
+    assert rows["nadkarni_c2"].split()[1:3] == ["6", "PPPRRR"]
+    assert "panda_hand_tcp" in rows["panda"] and "example-robot-data" in rows["panda"]
+    assert rows["baxter"].split()[1:5] == ["15", "R" * 15, "left_gripper,", "right_gripper"]
+    assert "l_gripper_tool_frame, r_gripper_tool_frame" in rows["pr2"]
+    assert "locked: head, laser tilt, grippers" in rows["pr2"]
+
+
+def run_console_script(*args: str, close_stdout: bool = False) -> subprocess.CompletedProcess:
+    exe = shutil.which("rrc-pin", path=str(Path(sys.executable).parent))
+    if exe is None:
+        pytest.fail("the rrc-pin console script is not installed next to this Python")
+    if not close_stdout:
+        return subprocess.run([exe, *args], capture_output=True, text=True, timeout=300)
+    proc = subprocess.Popen([exe, *args], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()  # the reader goes away before the first line: `rrc-pin ... | head -0`
+    err = proc.stderr.read().decode()
+    proc.wait(timeout=300)
+    return subprocess.CompletedProcess(proc.args, proc.returncode, "", err)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["demo", "--arm", "ur55"], "rrc-pin demo: name_or_path: unknown arm 'ur55'"),
+        (["check", "--samples", "0"], "rrc-pin check: samples: expected an integer >= 1, got 0"),
+        (["check", "--samples", "-3"], "rrc-pin check: samples: expected an integer >= 1"),
+    ],
+)
+def test_errors_are_one_line_and_exit_code_2(args, message, capsys):
+    """Issue 7 item 7, issue 18 item 12: a traceback, or a check of nothing that passed."""
+    assert main(args) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(message), err
+
+
+def test_errors_are_one_line_from_the_console_script_too():
+    out = run_console_script("demo", "--arm", "ur55")
+    assert out.returncode == 2 and "Traceback" not in out.stderr
+    assert out.stderr.splitlines() == [out.stderr.strip()]
+    assert out.stderr.startswith("rrc-pin demo: name_or_path: unknown arm 'ur55'")
+
+
+def test_a_closed_stdout_ends_quietly():
+    """Issue 18 item 12: `rrc-pin check | head -1` ended in BrokenPipeError."""
+    out = run_console_script("check", "--samples", "2", close_stdout=True)
+    assert out.stderr == "" and out.returncode == EXIT_BROKEN_PIPE
+
+
+def test_demo_help_says_what_arm_does(capsys):
+    with pytest.raises(SystemExit) as info:
+        main(["demo", "--help"])
+    assert info.value.code == 0
+    help_text = " ".join(capsys.readouterr().out.split())
+    assert "--arm NAME print only the kinematics row of this arm" in help_text
+    assert "instead of the tour" in help_text
 
 
 def test_urdf_check_passes_on_the_committed_files(capsys):
@@ -86,10 +143,8 @@ def test_check_command_cross_validates(capsys):
 
 
 def test_demo_runs_as_a_console_script():
-    exe = shutil.which("rrc-pin", path=str(Path(sys.executable).parent))
-    if exe is None:
-        pytest.fail("the rrc-pin console script is not installed next to this Python")
-    out = subprocess.run([exe, "demo"], capture_output=True, text=True, timeout=300, check=True)
+    out = run_console_script("demo")
+    assert out.returncode == 0, out.stderr
     assert "nan" not in out.stdout.lower()
     rows = [
         line.split()

@@ -2,8 +2,10 @@
 
 Reference everywhere: ``rrc_pin.load(...)`` (Pinocchio's LOCAL_WORLD_ALIGNED Jacobian of the
 wrist centre), for the PUMA defaults and the variant alpha3 = 88 deg, A3 = 0.02 m, R3 = 0.01 m.
-At singular configurations the reference is the decoupled truncated pseudo-inverse:
-``pinv(J[:3, :3], rcond) TVEL`` then ``pinv(J[3:, 3:], rcond) (RVEL - J[3:, :3] arm)``.
+In the singular bands the reference of the default path is damped least squares on
+Pinocchio's blocks (:func:`damped_reference`); of ``exact=True`` at singular configurations
+the decoupled truncated pseudo-inverse: ``pinv(J[:3, :3], rcond) TVEL`` then
+``pinv(J[3:, 3:], rcond) (RVEL - J[3:, :3] arm)``.
 """
 
 from __future__ import annotations
@@ -42,7 +44,7 @@ class Arm:
     def sample(self, rng: np.random.Generator, n: int) -> np.ndarray:
         return rng.uniform(self.lower, self.upper, size=(n, 6))
 
-    def regular(self, Q: np.ndarray, margin: float = 1e-2) -> np.ndarray:
+    def regular(self, Q: np.ndarray, margin: float = 3e-2) -> np.ndarray:
         s = self.cf.singularity_batch(Q)
         return (
             (np.abs(s.eq32) > margin * self.length)
@@ -58,7 +60,8 @@ def arm(request: pytest.FixtureRequest) -> Arm:
 
 @pytest.fixture(scope="module")
 def regular_set(arm: Arm) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """>= 10000 configurations off all three conditions, their Pinocchio Jacobians, twists."""
+    """>= 10000 configurations off the three conditions and outside the bands, with their
+    Pinocchio Jacobians and twists."""
     rng = np.random.default_rng(1983)
     Q = arm.sample(rng, 12_000)
     Q = Q[arm.regular(Q)]
@@ -80,6 +83,32 @@ def decoupled_reference(J: np.ndarray, x: np.ndarray, rcond: float) -> np.ndarra
     rt = x[:, 3:] - np.einsum("nij,nj->ni", J[:, 3:, :3], arm)
     wrist = np.einsum("nij,nj->ni", np.linalg.pinv(J[:, 3:, 3:], rcond=rcond), rt)
     return np.concatenate([arm, wrist], axis=1)
+
+
+def damped_reference(arm: Arm, Q: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """The default path from Pinocchio's blocks: exact outside the bands, damped inside.
+
+    Arm: ``(M^T M + lambda^2 I)^-1 M^T TVEL`` with ``lambda^2 = eps^2 - s^2``, ``s = |det M| /
+    ||adj M||_F``, ``eps = band L``; wrist: the damping on thetadot_4 and thetadot_6 only,
+    ``(W^T W + lambda^2 diag(1, 0, 1))^-1 W^T RVEL~`` with ``s = sigma_min(W)``, ``eps = band``.
+    """
+    J, p = arm.jac(Q), arm.spec.parameters
+    reach = abs(p["es"]) + np.hypot(np.sin(p["alpha3"]) * p["we"], p["a3"])
+    M, W = J[:, :3, :3], J[:, 3:, 3:]
+    adj = np.stack([np.cross(M[:, 1], M[:, 2]), np.cross(M[:, 2], M[:, 0]),
+                    np.cross(M[:, 0], M[:, 1])], axis=1)  # fmt: skip
+    s2 = np.linalg.det(M) ** 2 / np.maximum((adj**2).sum(axis=(1, 2)), 1e-300)
+    lam2 = np.maximum((arm.cf.band * reach) ** 2 - s2, 0.0)
+    Mt = M.transpose(0, 2, 1)
+    damped = np.linalg.solve(Mt @ M + lam2[:, None, None] * np.eye(3), Mt @ x[:, :3, None])
+    exact = np.linalg.solve(np.where(lam2[:, None, None] > 0, np.eye(3), M), x[:, :3, None])
+    rates = np.where(lam2[:, None] > 0, damped[..., 0], exact[..., 0])
+    rt = x[:, 3:] - np.einsum("nij,nj->ni", J[:, 3:, :3], rates)
+    lam2 = np.maximum(arm.cf.band**2 - np.linalg.svd(W, compute_uv=False)[:, -1] ** 2, 0.0)
+    Wt = W.transpose(0, 2, 1)
+    A = Wt @ W + lam2[:, None, None] * np.diag([1.0, 0.0, 1.0])
+    wrist = np.linalg.solve(A, np.einsum("nij,nj->ni", Wt, rt)[..., None])[..., 0]
+    return np.concatenate([rates, wrist], axis=1)
 
 
 def truncated_pinv(A: np.ndarray, cutoff: float) -> np.ndarray:
@@ -168,21 +197,29 @@ def test_every_path_at_start_pose_and_joint_zeros(arm: Arm, method: str) -> None
     Q = special_poses(arm, np.random.default_rng(7))
     Jp = arm.jac(Q)
     X = np.random.default_rng(8).normal(size=(len(Q), 6))
-    ref = decoupled_reference(Jp, X, arm.cf.rcond)
     s = arm.cf.singularity_batch(Q)
-    # the arm block is regular at all these poses (det M = ES A3^2 at q = 0); the wrist is
-    # exactly singular wherever theta_5 = 0, and there M2* must give the minimum-norm rates
-    assert not np.any(s.arm_singular)
+    # the wrist is exactly singular wherever theta_5 = 0: M2* gives the minimum-norm rates with
+    # ``exact``, the default path the damped ones; the arm is regular but in its band at
+    # q = 0 (det M = ES A3^2) and wherever theta_2 = theta_3 = 0
     assert np.sum(s.wrist_singular) == np.sum(Q[:, 4] == 0.0) >= 25
-    out = arm.cf.joint_rates_batch(Q, X, method=method)
-    assert np.all(np.isfinite(out))
-    assert rel(out, ref).max() < TOL
-    scalar = np.array([arm.cf.joint_rates(q, x, method=method) for q, x in zip(Q, X, strict=True)])
-    assert rel(scalar, ref).max() < TOL
-    arm_ref = np.linalg.solve(Jp[:, :3, :3], X[:, :3, None])[..., 0]
-    assert rel(arm.cf.arm_rates_batch(Q, X[:, :3], method=method), arm_ref).max() < TOL
-    wrist_ref = np.einsum("nij,nj->ni", np.linalg.pinv(Jp[:, 3:, 3:], rcond=arm.cf.rcond), X[:, 3:])
-    assert rel(arm.cf.wrist_rates_batch(Q, X[:, 3:], method=method), wrist_ref).max() < TOL
+    assert s.arm_singular[0] and abs(s.det_m[0]) > 1e-4
+    cf = arm.cf
+    # the reduced path damps M1, not M: compared outside the arm's band
+    keep = ~s.arm_singular if method == "reduced" else np.ones(len(Q), dtype=bool)
+    for exact, ref in ((True, decoupled_reference(Jp, X, cf.rcond)),
+                       (False, damped_reference(arm, Q, X))):  # fmt: skip
+        rows = np.ones(len(Q), dtype=bool) if exact else keep
+        out = cf.joint_rates_batch(Q, X, method=method, exact=exact)
+        assert np.all(np.isfinite(out))
+        assert rel(out[rows], ref[rows]).max() < TOL
+        pairs = zip(Q, X, strict=True)
+        scalar = np.array([cf.joint_rates(q, x, method=method, exact=exact) for q, x in pairs])
+        assert rel(scalar[rows], ref[rows]).max() < TOL
+        arm_rates = cf.arm_rates_batch(Q, X[:, :3], method, exact)
+        assert rel(arm_rates[rows], ref[rows, :3]).max() < TOL
+    wrist_ref = np.einsum("nij,nj->ni", np.linalg.pinv(Jp[:, 3:, 3:], rcond=cf.rcond), X[:, 3:])
+    wrist = cf.wrist_rates_batch(Q, X[:, 3:], method=method, exact=True)
+    assert rel(wrist, wrist_ref).max() < TOL
 
 
 def test_wrist_generalized_inverse_splits_equally_at_theta5_zero(arm: Arm) -> None:
@@ -192,8 +229,11 @@ def test_wrist_generalized_inverse_splits_equally_at_theta5_zero(arm: Arm) -> No
     Q = arm.sample(rng, 100)
     Q[:, 4] = 0.0
     for method in METHODS:
-        W = arm.cf.wrist_rates_batch(Q, rng.normal(size=(100, 3)), method=method)
-        assert np.all(np.abs(W[:, 0] - W[:, 2]) <= 1e-15 * np.abs(W).max())
+        # damping keeps the split (it acts on (1, 1) and (1, -1)), to the rounding of its
+        # normal equations (condition number 2 / band^2)
+        for exact, tol in ((True, 1e-15), (False, 1e-11)):
+            W = arm.cf.wrist_rates_batch(Q, rng.normal(size=(100, 3)), method, exact)
+            assert np.all(np.abs(W[:, 0] - W[:, 2]) <= tol * np.abs(W).max())
 
 
 # -- determinant and the singular set ------------------------------------------------------
@@ -270,27 +310,32 @@ def test_singularity_record(arm: Arm) -> None:
 
 
 @pytest.mark.parametrize("which", ["eq32", "eq33", "s5", "double"])
-def test_full_path_is_minimum_norm_at_singularities(arm: Arm, which: str) -> None:
+def test_full_path_at_singularities_damped_or_minimum_norm(arm: Arm, which: str) -> None:
+    """Default: damped least squares (the null direction gets nothing, the others are damped
+    by sigma^2 / (sigma^2 + eps^2)); ``exact``: the minimum-norm M*, M2* (eqs (38), (60))."""
     rng = np.random.default_rng(13)
     Q = on_condition(arm, which, rng, 100)
     X = rng.normal(size=(100, 6))
-    ref = decoupled_reference(arm.jac(Q), X, arm.cf.rcond)
-    out = arm.cf.joint_rates_batch(Q, X)
-    assert np.all(np.isfinite(out))
-    assert rel(out, ref).max() < TOL
-    scalar = np.array([arm.cf.joint_rates(q, x) for q, x in zip(Q[:30], X[:30], strict=True)])
-    assert rel(scalar, ref[:30]).max() < TOL
+    cf = arm.cf
+    minimum_norm = decoupled_reference(arm.jac(Q), X, cf.rcond)
+    for exact, ref in ((True, minimum_norm), (False, damped_reference(arm, Q, X))):
+        out = cf.joint_rates_batch(Q, X, exact=exact)
+        assert np.all(np.isfinite(out))
+        assert rel(out, ref).max() < TOL
+        pairs = zip(Q[:30], X[:30], strict=True)
+        scalar = np.array([cf.joint_rates(q, x, exact=exact) for q, x in pairs])
+        assert rel(scalar, ref[:30]).max() < TOL
 
 
 @pytest.mark.parametrize("which", ["eq32", "eq33", "double"])
 def test_reduced_path_at_arm_singularities(arm: Arm, which: str) -> None:
-    """Eq. (39) + eq. (44): least squares of eq. (25) among rates satisfying eq. (39), least
-    (thetadot_2, thetadot_3) norm; the minimum-norm answer at eq. (33) for realisable commands,
-    not at eq. (32) (M* also moves thetadot_1 there)."""
+    """Eq. (39) + eq. (44) with the exact M1*: least squares of eq. (25) among rates
+    satisfying eq. (39), least (thetadot_2, thetadot_3) norm; the minimum-norm answer at
+    eq. (33) for realisable commands, not at eq. (32) (M* also moves thetadot_1 there)."""
     rng = np.random.default_rng(17)
     Q = on_condition(arm, which, rng, 100)
     T = rng.normal(size=(100, 3))
-    out = arm.cf.arm_rates_batch(Q, T, method="reduced")
+    out = arm.cf.arm_rates_batch(Q, T, method="reduced", exact=True)
     assert np.all(np.isfinite(out))
     F = arm.cf.f_terms_batch(Q)
     f2 = arm.cf.geometry.f2
@@ -301,18 +346,96 @@ def test_reduced_path_at_arm_singularities(arm: Arm, which: str) -> None:
     ta = np.cos(Q[:, 0]) * T[:, 0] + np.sin(Q[:, 0]) * T[:, 1]
     A = M[:, :, 1:] + M[:, :, :1] * np.stack([F.f3, F.f4], axis=-1)[:, None, :] / f2
     b = T + M[:, :, 0] * (ta / f2)[:, None]
-    cutoff = arm.cf.rcond * np.linalg.norm(M, axis=(1, 2))  # M1* truncates at rcond ||M||_F
+    cutoff = arm.cf.rcond * np.linalg.norm(M, axis=(1, 2))  # M1*: an absolute cut (rcond L)
     th23 = np.array([truncated_pinv(a, c) @ v for a, c, v in zip(A, cutoff, b, strict=True)])
     assert rel(out[:, 1:], th23).max() < TOL
     # realisable commands: compare with M* (eq. (38))
     T_in = np.einsum("nij,nj->ni", M, rng.normal(size=(100, 3)))
-    red = arm.cf.arm_rates_batch(Q, T_in, method="reduced")
-    full = arm.cf.arm_rates_batch(Q, T_in)
+    red = arm.cf.arm_rates_batch(Q, T_in, method="reduced", exact=True)
+    full = arm.cf.arm_rates_batch(Q, T_in, exact=True)
     assert rel(np.einsum("nij,nj->ni", M, red), T_in).max() < 1e-8
     if which == "eq33":
         assert rel(red, full).max() < TOL
     else:
         assert np.all(np.linalg.norm(red, axis=1) > np.linalg.norm(full, axis=1) * (1 + 1e-6))
+
+
+# -- continuity across the singular neighbourhoods (issue 18) ------------------------------
+
+GRID = np.concatenate([-np.logspace(-1, -12, 56), [0.0], np.logspace(-12, -1, 56)])
+"""Offsets [rad] from a singular configuration: a fine logarithmic grid through zero."""
+SWEEP_BASE = np.array([0.3, -0.5, 0.8, 0.4, 0.6, 0.2])
+SWEEP_TWIST = np.array([0.1, -0.2, 0.15, 0.1, 0.2, 0.3])
+
+
+def sweep(arm: Arm, which: str) -> np.ndarray:
+    """(len(GRID), 6) configurations crossing one singularity at offset 0: theta_5 = 0,
+    eq. (33) in theta_3, eq. (32) in theta_2, or the double singularity (S2 = 0, eq. (33))."""
+    g = arm.cf.geometry
+    Q = np.tile(SWEEP_BASE, (len(GRID), 1))
+    t3 = np.arctan2(-g.a3, g.swe)  # SAL3 WE S3 + A3 C3 = 0
+    if which == "s5":
+        Q[:, 4] = GRID
+    elif which == "eq33":
+        Q[:, 2] = t3 + GRID
+    elif which == "double":
+        Q[:, 1], Q[:, 2] = GRID, t3 + GRID
+    else:  # eq. (32): S2 (ES + SAL3 WE C3 - A3 S3) + C2 (SAL3 WE S3 + A3 C3) = 0
+        s3, c3 = np.sin(SWEEP_BASE[2]), np.cos(SWEEP_BASE[2])
+        Q[:, 1] = np.arctan2(-(g.swe * s3 + g.a3 * c3), g.es + g.swe * c3 - g.a3 * s3) + GRID
+    return Q
+
+
+@pytest.mark.parametrize("which", ["s5", "eq32", "eq33", "double"])
+def test_default_rates_are_continuous_through_every_singularity(arm: Arm, which: str) -> None:
+    """Issue 18: across 1e-12 rad the rates jumped from 0.33 to 2.5e11 rad/s (theta_5). The
+    default path must be continuous (bounded jumps), finite, bounded by 1 / band times the
+    command, and still Pinocchio's exact solve far outside the bands."""
+    Q = sweep(arm, which)
+    X = np.tile(SWEEP_TWIST, (len(Q), 1))
+    band = 1e-2  # the documented default
+    p = arm.spec.parameters
+    eps = band * (abs(p["es"]) + np.hypot(np.sin(p["alpha3"]) * p["we"], p["a3"]))
+    for out in (arm.cf.joint_rates_batch(Q, X),
+                np.array([arm.cf.joint_rates(q, x) for q, x in zip(Q, X, strict=True)])):
+        assert np.all(np.isfinite(out))
+        # bounded: no block amplifies its command by more than 1 / eps
+        assert np.all(np.linalg.norm(out[:, :3], axis=1) <= np.linalg.norm(X[0, :3]) / eps)
+        rt = X[:, 3:] - np.einsum("nij,nj->ni", arm.jac(Q)[:, 3:, :3], out[:, :3])
+        assert np.all(np.linalg.norm(out[:, 3::2], axis=1)
+                      <= np.linalg.norm(rt, axis=1) / band * (1 + 1e-9))  # fmt: skip
+        # continuous: jumps bounded by a Lipschitz constant of the damped solve (|x| / eps^2)
+        slope = np.linalg.norm(np.diff(out, axis=0), axis=1) / np.diff(GRID)
+        assert slope.max() < 10.0 * np.linalg.norm(SWEEP_TWIST) / eps**2
+    far = np.abs(GRID) >= 0.1
+    s = arm.cf.singularity_batch(Q[far])
+    assert not np.any(s.arm_singular | s.wrist_singular)
+    ref = np.linalg.solve(arm.jac(Q[far]), X[far][..., None])[..., 0]
+    assert rel(arm.cf.joint_rates_batch(Q[far], X[far]), ref).max() < TOL
+    # on request, the exact inverse: as large as 1 / sigma_min near the singularity
+    near = np.abs(GRID) == 1e-6
+    J = np.array([arm.spec.chain.jacobian(q, "world_aligned") for q in Q[near]])
+    exact = arm.cf.joint_rates_batch(Q[near], X[near], exact=True)
+    assert rel(exact, np.linalg.solve(J, X[near][..., None])[..., 0]).max() < 1e-6
+    assert np.linalg.norm(exact, axis=1).min() > 1e3
+
+
+def test_rates_are_bounded_by_the_band(arm: Arm) -> None:
+    """|thetadot_123| <= |TVEL| / (band L), |(thetadot_4, thetadot_6)| <= |RVEL~| / band."""
+    rng = np.random.default_rng(61)
+    Q = np.concatenate([arm.sample(rng, 2000)]
+                       + [on_condition(arm, c, rng, 200) for c in ("eq32", "eq33", "s5", "double")])
+    Q += rng.choice([0.0, 1e-9, 1e-6, 1e-3], size=Q.shape)  # and their neighbourhoods
+    X = rng.normal(size=(len(Q), 6))
+    cf = arm.cf
+    out = cf.joint_rates_batch(Q, X)
+    eps = cf.band * cf.geometry.reach
+    assert np.all(np.linalg.norm(out[:, :3], axis=1) <= np.linalg.norm(X[:, :3], axis=1) / eps)
+    rt = cf.rvel_tilde_batch(Q, out[:, :3], X[:, 3:])
+    assert np.all(np.linalg.norm(out[:, 3::2], axis=1)
+                  <= np.linalg.norm(rt, axis=1) / cf.band * (1 + 1e-12))  # fmt: skip
+    # the damped normal equations have a condition number up to (sigma_max / eps)^2 ~ 1e4
+    assert rel(out, damped_reference(arm, Q, X)).max() < 1e-8  # reached: 3e-9
 
 
 # -- appendix B: hand to base, frame 2 -----------------------------------------------------
@@ -348,23 +471,48 @@ def test_batch_equals_scalar(arm: Arm) -> None:
     Q = np.concatenate([arm.sample(rng, 900), *singular])
     X = rng.normal(size=(1000, 6))
     cf = arm.cf
-    for method in METHODS:
-        B = cf.joint_rates_batch(Q, X, method)
-        S = np.array([cf.joint_rates(q, x, method) for q, x in zip(Q, X, strict=True)])
+    for method, exact in ((m, e) for m in METHODS for e in (False, True)):
+        B = cf.joint_rates_batch(Q, X, method, exact)
+        S = np.array([cf.joint_rates(q, x, method, exact) for q, x in zip(Q, X, strict=True)])
+        # in the bands the damped normal equations (condition up to (sigma_max / eps)^2 ~ 1e4)
+        # see the last-bit differences of the two trigonometries
+        assert rel(S, B).max() < (1e-12 if exact else 1e-11)
+        B = cf.arm_rates_batch(Q, X[:, :3], method, exact)
+        S = np.array([cf.arm_rates(q, x[:3], method, exact) for q, x in zip(Q, X, strict=True)])
         assert rel(S, B).max() < 1e-12
-        B = cf.arm_rates_batch(Q, X[:, :3], method)
-        S = np.array([cf.arm_rates(q, x[:3], method) for q, x in zip(Q, X, strict=True)])
-        assert rel(S, B).max() < 1e-12
-        B = cf.wrist_rates_batch(Q, X[:, 3:], method)
-        S = np.array([cf.wrist_rates(q, x[3:], method) for q, x in zip(Q, X, strict=True)])
+        B = cf.wrist_rates_batch(Q, X[:, 3:], method, exact)
+        S = np.array([cf.wrist_rates(q, x[3:], method, exact) for q, x in zip(Q, X, strict=True)])
         assert rel(S, B).max() < 1e-12
     assert np.abs(np.array([cf.jacobian(q) for q in Q]) - cf.jacobian_batch(Q)).max() < 1e-14
     sb, d = cf.singularity_batch(Q), cf.det_m_batch(Q)
     for i in range(0, 1000, 37):
         s = cf.singularity(Q[i])
-        assert s == tuple(v[i].item() for v in sb)
-        assert cf.det_m(Q[i]) == d[i]
-        assert np.array_equal(cf.m_matrix(Q[i]), cf.m_matrix_batch(Q[i : i + 1])[0])
+        np.testing.assert_allclose(s[:4], [v[i] for v in sb[:4]], rtol=1e-14, atol=1e-16)
+        assert s[4:] == (sb.arm_singular[i], sb.wrist_singular[i])
+        assert cf.det_m(Q[i]) == pytest.approx(d[i], rel=1e-14, abs=1e-18)
+        np.testing.assert_allclose(cf.m_matrix(Q[i]), cf.m_matrix_batch(Q)[i], rtol=1e-14,
+                                   atol=1e-16)  # fmt: skip
+    rt = rng.normal(size=(1000, 3))
+    rows = zip(Q, X, rt, strict=True)
+    S = np.array([np.concatenate([cf.rvel_tilde(q, a, r), cf.hand_twist_to_base(q, x)])
+                  for q, x, (a, r) in zip(Q, X, zip(rt, X[:, 3:], strict=True), strict=True)])
+    del rows
+    B = np.concatenate([cf.rvel_tilde_batch(Q, rt, X[:, 3:]), cf.hand_twist_to_base_batch(Q, X)], 1)
+    np.testing.assert_allclose(S, B, rtol=1e-14, atol=1e-15)
+
+
+def test_batch_is_independent_of_the_blocks(arm: Arm) -> None:
+    """A batch longer than a block equals its parts computed apart (a few ulps)."""
+    from solvers.closed_form._batch import CHUNK
+
+    rng = np.random.default_rng(31)
+    Q = np.concatenate([arm.sample(rng, CHUNK + 50), on_condition(arm, "s5", rng, 20)])
+    X = rng.normal(size=(len(Q), 6))
+    whole = arm.cf.joint_rates_batch(Q, X)
+    parts = np.concatenate([arm.cf.joint_rates_batch(Q[i : i + 999], X[i : i + 999])
+                            for i in range(0, len(Q), 999)])  # fmt: skip
+    np.testing.assert_allclose(whole, parts, rtol=1e-14, atol=1e-15)
+    assert arm.cf.joint_rates_batch(Q[:0], X[:0]).shape == (0, 6)
 
 
 # -- bad input ------------------------------------------------------------------------------

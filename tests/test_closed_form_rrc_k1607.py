@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 import rrc_pin
+from solvers.closed_form import null_space_projector, weighted_pseudo_inverse, weighted_rates
 from solvers.closed_form.rrc_k1607 import RrcK1607ClosedForm
 from solvers.errors import InputError
 
@@ -239,10 +240,15 @@ def test_weighted_batch_equals_scalar(regular):
     Q, _, X = regular
     rng = np.random.default_rng(13)
     Q, X = Q[:1000], X[:1000]
-    W, Z = random_spd(rng), rng.standard_normal((1000, 7))
-    batch = CF.joint_rates_batch(Q, X, W=W, Z=Z)
-    scalar = np.array([CF.joint_rates(q, x, W=W, z=z) for q, x, z in zip(Q, X, Z, strict=True)])
-    assert relative(batch, scalar).max() < 1e-10
+    Z = rng.standard_normal((1000, 7))
+    for W in (random_spd(rng), rng.uniform(0.1, 10.0, 7)):  # a matrix, a diagonal
+        batch = CF.joint_rates_batch(Q, X, W=W, Z=Z)
+        pairs = zip(Q, X, Z, strict=True)
+        scalar = np.array([CF.joint_rates(q, x, W=W, z=z) for q, x, z in pairs])
+        assert relative(batch, scalar).max() < 1e-10
+        triples = zip(Q[:50], X[:50], Z[:50], strict=True)
+        svd = [weighted_rates(ARM.jacobian(q), x, W, z) for q, x, z in triples]
+        assert relative(batch[:50], np.array(svd)).max() < 1e-9
 
 
 # ------------------------------------------------------------------ batch == scalar
@@ -258,6 +264,91 @@ def test_batch_equals_scalar_for_1000_configurations(regular):
     scalar = np.array([CF.joint_rates(q, x) for q, x in zip(Q, X, strict=True)])
     assert relative(CF.joint_rates_batch(Q, X), scalar).max() < 1e-12
     assert CF.joint_rates_batch(Q[:0], X[:0]).shape == (0, 7)
+
+
+# ------------------------------------- Nguyen eqs. (21)-(23) for any Jacobian (weighted.py)
+
+
+def spd(rng: np.random.Generator, n: int) -> np.ndarray:
+    A = rng.standard_normal((n, n))
+    return A @ A.T + n * np.eye(n)
+
+
+def test_weighted_pseudo_inverse_is_eq_22() -> None:
+    rng = np.random.default_rng(20261122)
+    for _ in range(200):
+        n = rng.integers(6, 10)
+        J = rng.standard_normal((6, n))
+        W = spd(rng, n)
+        ref = W @ J.T @ np.linalg.inv(J @ W @ J.T)  # Nguyen eq. (22) as printed
+        assert np.allclose(weighted_pseudo_inverse(J, W), ref, rtol=1e-8, atol=1e-10)
+        w = rng.uniform(0.1, 10.0, n)
+        ref = np.diag(w) @ J.T @ np.linalg.inv(J @ np.diag(w) @ J.T)
+        assert np.allclose(weighted_pseudo_inverse(J, w), ref, rtol=1e-8, atol=1e-10)
+
+
+def test_identity_weight_is_moore_penrose_eq_23() -> None:
+    J = np.random.default_rng(20261122).standard_normal((6, 7))
+    assert np.allclose(weighted_pseudo_inverse(J), J.T @ np.linalg.inv(J @ J.T), atol=1e-12)
+    assert np.allclose(weighted_pseudo_inverse(J), np.linalg.pinv(J), atol=1e-12)
+
+
+def test_eq_21_minimises_the_weighted_norm() -> None:
+    """Among all q with J q = x, J_W^+ x has the least q^T W^-1 q (Nguyen eq. (20)-(22))."""
+    rng = np.random.default_rng(20261122)
+    for _ in range(100):
+        J = rng.standard_normal((6, 7))
+        W = spd(rng, 7)
+        x = rng.standard_normal(6)
+        q0 = weighted_rates(J, x, W)
+        assert np.allclose(J @ q0, x, atol=1e-10)
+        Winv = np.linalg.inv(W)
+        for _ in range(5):
+            z = rng.standard_normal(7)
+            q = weighted_rates(J, x, W, z)
+            assert np.allclose(J @ q, x, atol=1e-9)  # the z term lies in the null space
+            assert q @ Winv @ q >= q0 @ Winv @ q0 - 1e-10
+
+
+def test_rrc_k1607_pseudo_inverse_reproduces_joint_rates() -> None:
+    """Section 5 of Nguyen: x = J qdot, then J^+ x; the difference lies in the null space."""
+    rng = np.random.default_rng(20261122)
+    for _ in range(50):
+        q = ARM.random_q(rng)
+        J = ARM.jacobian(q)
+        qdot = rng.uniform(-1.0, 1.0, 7)
+        back = weighted_rates(J, J @ qdot)
+        assert np.allclose(J @ back, J @ qdot, atol=1e-10)
+        assert np.allclose(null_space_projector(J) @ (qdot - back), qdot - back, atol=1e-9)
+
+
+def test_singular_jwj_stays_finite() -> None:
+    """J W J^T singular (rrc_k1607 at home): eq. (22) cannot be evaluated, the SVD form can."""
+    J = ARM.jacobian(np.zeros(7))
+    W = np.diag([1.0, 2.0, 1.0, 2.0, 1.0, 2.0, 1.0])
+    assert np.linalg.matrix_rank(J @ W @ J.T) == 5
+    pinv = weighted_pseudo_inverse(J, W)
+    assert np.all(np.isfinite(pinv))
+    assert np.allclose(J @ pinv @ J, J, atol=1e-10)  # generalized inverse property
+    N = null_space_projector(J, W)
+    assert np.allclose(J @ N, 0.0, atol=1e-10)
+    assert np.allclose(N @ N, N, atol=1e-10)
+
+
+def test_nguyen_functions_reject_bad_input() -> None:
+    J = np.ones((6, 7))
+    cases = [
+        (lambda: weighted_pseudo_inverse(J, np.ones(6)), "W"),
+        (lambda: weighted_pseudo_inverse(J, -np.eye(7)), "W"),
+        (lambda: weighted_rates(J, np.ones(6), z=np.ones(6)), "z"),
+        (lambda: weighted_rates(J, np.ones(5)), "xdot"),
+        (lambda: weighted_pseudo_inverse(J, rcond=1.5), "rcond"),
+        (lambda: null_space_projector(np.full((6, 7), np.nan)), "J"),
+    ]
+    for call, argument in cases:
+        with pytest.raises(InputError) as info:
+            call()
+        assert info.value.argument == argument
 
 
 # ---------------------------------------------------------------------- bad input
@@ -281,6 +372,7 @@ def test_batch_equals_scalar_for_1000_configurations(regular):
         (lambda: CF.joint_rates_batch(np.full((3, 7), np.nan), np.zeros((3, 6))), "Q"),
         (lambda: CF.joint_rates_batch(np.zeros((3, 7)), np.zeros((3, 6)), Z=np.zeros(7)), "Z"),
         (lambda: CF.joint_rates_batch(np.zeros((3, 7)), np.zeros((3, 6)), W=np.ones((7, 7))), "W"),
+        (lambda: CF.joint_rates(np.zeros(7), np.zeros(6), W=[1, 1, 1, 0, 1, 1, 1]), "W"),
         (lambda: RrcK1607ClosedForm(a=np.zeros(6), d=np.zeros(7)), "a"),
         (lambda: RrcK1607ClosedForm(a=np.zeros(7), d=[0, 0, 0, 0, 0, 0, np.nan]), "d"),
         (lambda: RrcK1607ClosedForm(a=np.zeros(7), d=np.zeros(7), rcond=0.0), "rcond"),

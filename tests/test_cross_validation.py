@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 import rrc_pin
-from rrc_pin.cross_check import cross_check, finite_difference_jacobians
+from rrc_pin.cross_check import cross_check, finite_difference_jacobians, run_cross_check
+from rrc_pin.errors import InvalidInput
 from rrc_pin.models import CATALOGUE, barker6
 from rrc_pin.urdf_export import COMMITTED_DIR
 
@@ -52,3 +53,24 @@ def test_installed_arm_jacobians_match_finite_differences(name, rng):
         fd = finite_difference_jacobians(arm, q)
         for ref, J_fd in fd.items():
             np.testing.assert_allclose(arm.jacobian(q, ref), J_fd, atol=1e-6)
+
+
+def test_a_check_of_nothing_is_refused():
+    """Issue 18 item 12: ``samples=0`` checked nothing and passed."""
+    for samples in (0, -1, 2.5, True):
+        with pytest.raises(InvalidInput, match="^samples: expected an integer >= 1"):
+            cross_check(CATALOGUE["kr5_3r"], samples, np.random.default_rng(0))
+        with pytest.raises(InvalidInput, match="^samples: expected an integer >= 1"):
+            run_cross_check(samples)
+
+
+def test_finite_differences_of_any_frame(rng):
+    arm = rrc_pin.load("barker6")
+    q = arm.random_q(rng)
+    fd = finite_difference_jacobians(arm, q, frame="flange")
+    for ref, J_fd in fd.items():
+        np.testing.assert_allclose(arm.jacobian(q, ref, frame="flange"), J_fd, atol=1e-6)
+    assert (
+        np.abs(fd["world_aligned"] - finite_difference_jacobians(arm, q)["world_aligned"]).max()
+        > 1e-3
+    )

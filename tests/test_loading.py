@@ -6,9 +6,18 @@ import numpy as np
 import pytest
 
 import rrc_pin
-from rrc_pin.errors import FrameNotFound, UnknownArm, URDFError
-from rrc_pin.loading import INSTALLED
-from rrc_pin.urdf_export import COMMITTED_DIR
+from rrc_pin.cross_check import finite_difference_jacobians
+from rrc_pin.errors import (
+    FrameNotFound,
+    InvalidInput,
+    RrcPinError,
+    ToolFrameRequired,
+    UnknownArm,
+    URDFError,
+)
+from rrc_pin.loading import INSTALLED, parameters_of, robots_directory
+from rrc_pin.models import CATALOGUE, barker6
+from rrc_pin.urdf_export import COMMITTED_DIR, to_urdf
 
 EXPECTED_DOF = {
     "panda": 7,
@@ -21,7 +30,16 @@ EXPECTED_DOF = {
     "so101": 5,
     "baxter_left": 7,
     "baxter_right": 7,
+    "baxter": 15,
+    "pr2": 15,
+    "tiago_pro": 15,
+    "tiago_dual": 15,
+    "talos_upper": 16,
+    "g1_upper": 17,
+    "centauro_upper": 13,
+    "romeo_upper": 15,
 }
+MULTI_ARM = [name for name in EXPECTED_DOF if len(INSTALLED[name].tool_frames) > 1]
 
 
 def test_arms_lists_catalogue_then_installed():
@@ -34,23 +52,97 @@ def test_arms_lists_catalogue_then_installed():
 def test_installed_arms_load_from_the_package(name):
     arm = rrc_pin.load(name)
     assert arm.nq == EXPECTED_DOF[name]
-    assert arm.tool_frame == INSTALLED[name].tool_frame
+    assert arm.tool_frames == INSTALLED[name].tool_frames
     assert "example-robot-data" in arm.source
     assert np.all(np.isfinite(arm.velocity_limit)) and np.all(arm.velocity_limit > 0)
-    assert np.isfinite(arm.jacobian(arm.neutral())).all()
+    for frame in arm.tool_frames:
+        assert np.isfinite(arm.jacobian(arm.neutral(), frame=frame)).all()
 
 
 def test_baxter_arms_lock_everything_else():
     left, right = rrc_pin.load("baxter_left"), rrc_pin.load("baxter_right")
     assert all(n.startswith("left_") for n in left.joint_names)
     assert all(n.startswith("right_") for n in right.joint_names)
+    both = rrc_pin.load("baxter")
+    assert both.joint_names == ["head_pan", *left.joint_names, *right.joint_names]
+    assert both.tool_frame is None and both.tool_frames == ("left_gripper", "right_gripper")
 
 
-def test_any_urdf_path_loads_with_last_link_as_tool():
-    arm = rrc_pin.load(COMMITTED_DIR / "kr5_3r.urdf")
-    assert arm.name == "kr5_3r" and arm.tool_frame == "tool" and arm.nq == 3
+def test_pr2_arms_share_the_torso_lift(rng):
+    pr2 = rrc_pin.load("pr2")
+    assert pr2.joint_names[0] == "torso_lift_joint" and pr2.lower[0] == 0.0
+    assert not any("gripper" in n or "head" in n for n in pr2.joint_names)
+    assert np.sum(np.isinf(pr2.upper)) == 4  # forearm and wrist rolls are continuous
+    q = pr2.random_q(rng)
+    left = pr2.jacobian(q, frame="l_gripper_tool_frame")
+    right = pr2.jacobian(q, frame="r_gripper_tool_frame")
+    np.testing.assert_allclose(left[:3, 0], [0, 0, 1], atol=1e-12)  # the lift moves both hands
+    np.testing.assert_allclose(right[:3, 0], [0, 0, 1], atol=1e-12)
+    is_left = np.array([n.startswith("l_") for n in pr2.joint_names])
+    assert np.all(left[:, ~is_left][:, 1:] == 0.0) and np.all(right[:, is_left] == 0.0)
+    assert np.abs(left[:, is_left]).min(axis=0).max() >= 0.0 and np.linalg.matrix_rank(left) == 6
+
+
+@pytest.mark.parametrize("name", MULTI_ARM)
+def test_robots_with_several_arms_have_exact_jacobians_at_every_hand(name, rng):
+    robot = rrc_pin.load(name)
+    assert len(robot.tool_frames) == 2 and robot.tool_frame is None
+    for _ in range(5):
+        q = robot.random_q(rng)
+        for frame in robot.tool_frames:
+            fd = finite_difference_jacobians(robot, q, frame=frame)
+            for ref, J_fd in fd.items():
+                np.testing.assert_allclose(robot.jacobian(q, ref, frame), J_fd, atol=1e-6)
+
+
+def test_a_chain_urdf_keeps_its_one_end_link_as_tool(tmp_path):
+    path = tmp_path / "my_arm.urdf"
+    path.write_text(to_urdf(CATALOGUE["kr5_3r"]).replace('name="kr5_3r"', 'name="my_arm"'))
+    arm = rrc_pin.load(path)
+    assert arm.name == "my_arm" and arm.tool_frame == "tool" and arm.nq == 3
+    assert arm.spec is None and arm.closed_form is None
+
+
+def test_a_committed_catalogue_urdf_loads_as_the_catalogue_arm(rng):
+    """Issue 18 item 13: by path as by name: tool frame "tool", the spec, the closed form."""
+    for name in CATALOGUE:
+        by_path, by_name = rrc_pin.load(COMMITTED_DIR / f"{name}.urdf"), rrc_pin.load(name)
+        assert by_path.name == name and by_path.spec is CATALOGUE[name]
+        assert by_path.tool_frames == by_name.tool_frames == ("tool",)
+        assert (by_path.closed_form is None) == (by_name.closed_form is None)
+        q = by_name.random_q(rng)
+        np.testing.assert_allclose(by_path.fk(q), by_name.fk(q), atol=1e-12)
     arm = rrc_pin.load(str(COMMITTED_DIR / "barker6.urdf"), tool_frame="flange")
-    assert arm.tool_frame == "flange"
+    assert arm.tool_frame == "flange" and arm.closed_form is None
+
+
+def test_a_changed_catalogue_urdf_is_a_generic_arm(tmp_path):
+    text = (COMMITTED_DIR / "barker6.urdf").read_text()
+    path = tmp_path / "barker6.urdf"
+    path.write_text(text.replace('xyz="0 0 0.6718"', 'xyz="0 0 0.6719"', 1))
+    assert path.read_text() != text
+    arm = rrc_pin.load(path)
+    assert arm.spec is None and arm.closed_form is None
+    assert arm.tool_frame == "flange"  # the chain's one end link: flange hangs from tool
+
+
+def test_a_tree_urdf_needs_its_tool_frames(tmp_path):
+    """Issue 18 item 13 / 19: baxter.urdf is a tree; its last link is no tool."""
+    path = robots_directory() / INSTALLED["baxter"].path
+    with pytest.raises(
+        ToolFrameRequired,
+        match="^tool_frame: .*baxter.urdf is a tree with "
+        r"\d+ end links; name one of: .*left_gripper",
+    ) as info:
+        rrc_pin.load(path)
+    assert {"left_gripper", "right_gripper"} <= set(info.value.candidates)
+    assert "sonar_ring" not in info.value.candidates
+    robot = rrc_pin.load(path, tool_frame=("left_gripper", "right_gripper"))
+    assert robot.nq == 19 and robot.tool_frames == ("left_gripper", "right_gripper")
+    ur5 = robots_directory() / INSTALLED["ur5"].path
+    with pytest.raises(ToolFrameRequired) as info:
+        rrc_pin.load(ur5)
+    assert sorted(info.value.candidates) == ["ee_link", "tool0"]
 
 
 def test_catalogue_parameters_build_a_variant():
@@ -73,7 +165,13 @@ def test_missing_urdf_names_the_path(tmp_path):
 def test_malformed_urdf_gives_path_and_parser_message(tmp_path):
     path = tmp_path / "broken.urdf"
     path.write_text('<robot name="x"><link name="a"/><joint name="j" type="revolute">')
+    with pytest.raises(URDFError, match=f"{path}: not XML: .+"):
+        rrc_pin.load(path)
+    path.write_text('<robot name="x"><link name="a"/><joint name="j" type="revolute"/></robot>')
     with pytest.raises(URDFError, match=f"{path}: Pinocchio could not parse it: .+"):
+        rrc_pin.load(path)
+    path.write_text("<launch/>")
+    with pytest.raises(URDFError, match=f"{path}: not a URDF: the root element is <launch>"):
         rrc_pin.load(path)
 
 
@@ -83,5 +181,57 @@ def test_unknown_tool_frame():
 
 
 def test_parameters_for_non_catalogue_arms_are_refused():
-    with pytest.raises(URDFError, match="catalogue arms only"):
-        rrc_pin.load("ur5", alpha3=1.0)
+    """Issue 7 item 4: an argument mistake, not a URDF error."""
+    for name in ("ur5", "panda"):
+        with pytest.raises(
+            InvalidInput,
+            match="^alpha3: geometry parameters apply to "
+            "catalogue names only .*not to 'panda'|'ur5'",
+        ):
+            rrc_pin.load(name, alpha3=1.0)
+
+
+def test_parameters_with_an_arm_spec_are_refused():
+    """Issue 18 item 9: they were ignored silently."""
+    with pytest.raises(
+        InvalidInput,
+        match="^a3: geometry parameters apply to catalogue names only .*not to an ArmSpec",
+    ):
+        rrc_pin.load(barker6.build(), a3=0.1)
+
+
+@pytest.mark.parametrize("value", [np.nan, np.inf, "x", "0.1", None, [0.1], True])
+def test_a_bad_parameter_value_is_named_without_parser_noise(value, capfd):
+    """Issue 18 item 9: no urdfdom output, no bare ValueError or UFuncTypeError."""
+    with pytest.raises(InvalidInput, match="^a3: expected a finite number"):
+        rrc_pin.load("barker6", a3=value)
+    assert capfd.readouterr().err == ""
+
+
+def test_an_unknown_parameter_lists_those_the_builder_takes():
+    """Issue 7 item 4: it was a bare TypeError."""
+    with pytest.raises(
+        InvalidInput,
+        match="^alpha4: not a parameter of barker6; it takes: no, es, sn, we, a3, r3, alpha3, hw$",
+    ):
+        rrc_pin.load("barker6", alpha4=1)
+    with pytest.raises(InvalidInput, match="^a: not a parameter of rrc_k1607; it takes: none$"):
+        rrc_pin.load("rrc_k1607", a=1)
+    assert parameters_of("kr5_3r") == ["a1", "a2", "a3"]
+    arm = rrc_pin.load("kr5_3r", a2=0.6)
+    np.testing.assert_allclose(arm.fk(np.zeros(3))[:3, 3], [1.3, 0, 0], atol=1e-12)
+
+
+def test_every_loading_error_is_an_rrc_pin_error(tmp_path):
+    calls = [
+        lambda: rrc_pin.load("puma"),
+        lambda: rrc_pin.load(3.5),
+        lambda: rrc_pin.load(tmp_path / "missing.urdf"),
+        lambda: rrc_pin.load(tmp_path),
+        lambda: rrc_pin.load("barker6", tool_frame=3),
+        lambda: rrc_pin.load("barker6", a3=1j),
+        lambda: rrc_pin.load("panda", tool_frame=()),
+    ]
+    for call in calls:
+        with pytest.raises(RrcPinError):
+            call()

@@ -8,7 +8,7 @@ import pytest
 import rrc_pin
 from rrc_pin.dh import nadkarni_link, translation
 from rrc_pin.errors import InvalidInput
-from rrc_pin.models import CATALOGUE, INCH, barker6
+from rrc_pin.models import CATALOGUE, INCH, barker6, kr5_3r
 from rrc_pin.models.arm_spec import ArmSpec
 from rrc_pin.models.nadkarni import frame_from_points
 
@@ -213,3 +213,12 @@ def test_spec_validation_names_the_field():
             spec.effort_limit,
             "x",
         )
+
+
+@pytest.mark.parametrize("value", [np.nan, -np.inf, "0.02", None, True, 1j])
+def test_builders_refuse_a_parameter_that_is_not_a_finite_number(value):
+    with pytest.raises(InvalidInput, match="^a3: expected a finite number"):
+        barker6.build(a3=value)
+    with pytest.raises(InvalidInput, match="^a3: expected a finite number"):
+        kr5_3r.build(a3=value)
+    assert kr5_3r.build(a3=np.float32(0.25)).parameters["a3"] == pytest.approx(0.25)

@@ -4,12 +4,16 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from rrc_pin.dh import DHChain
 from rrc_pin.errors import InvalidInput
+from solvers.validation import finite_number
+
+if TYPE_CHECKING:
+    from solvers.closed_form.base import ClosedForm
 
 INCH = 0.0254
 """Metres per inch: the one place where the papers' inches become SI."""
@@ -42,7 +46,7 @@ class ArmSpec:
     source: str
     assumed: tuple[str, ...] = ()
     named_poses: dict[str, tuple[float, ...]] = field(default_factory=dict)
-    closed_form: Callable[[], Any] | None = None
+    closed_form: Callable[[], ClosedForm] | None = None
     parameters: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -70,3 +74,20 @@ class ArmSpec:
     def joint_kinds(self) -> tuple[str, ...]:
         """Kind of every joint: ``revolute``, ``prismatic`` or ``screw``."""
         return tuple(row.kind for row in self.chain.rows)
+
+
+def check_parameters(values: dict[str, float]) -> dict[str, float]:
+    """Return a builder's geometry ``values`` as floats, each finite and real.
+
+    Builders call it first, so that a bad value is refused before any table is built.
+
+    Raises:
+        InvalidInput: A value is not a finite real number, naming its parameter.
+    """
+    out = {}
+    for key, value in values.items():
+        real = isinstance(value, (int, float, np.integer, np.floating))
+        if not real or isinstance(value, (bool, np.bool_)):
+            raise InvalidInput(key, f"expected a finite number, got {value!r}")
+        out[key] = finite_number(value, key, error=InvalidInput)
+    return out

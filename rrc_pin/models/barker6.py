@@ -9,10 +9,15 @@ the wrist centre (frames 4, 5 and 6 coincide: r5 = r6 = 0 in the resolved-rate e
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from rrc_pin.dh import DHChain, DHRow, pose, translation
-from rrc_pin.models.arm_spec import ArmSpec
+from rrc_pin.models.arm_spec import ArmSpec, check_parameters
+
+if TYPE_CHECKING:
+    from solvers.closed_form.base import ClosedForm
 
 NAME = "barker6"
 JOINT_LIMITS_DEG = (160.0, 165.0, 135.0, 135.0, 105.0, 270.0)  # Barker's table, +-
@@ -58,17 +63,14 @@ def build(
 
     Returns:
         The arm's :class:`ArmSpec`.
+
+    Raises:
+        InvalidInput: A parameter is not a finite real number (named in the message).
     """
-    params = {
-        "no": no,
-        "es": es,
-        "sn": sn,
-        "we": we,
-        "a3": a3,
-        "r3": r3,
-        "alpha3": alpha3,
-        "hw": hw,
-    }
+    params = check_parameters(
+        {"no": no, "es": es, "sn": sn, "we": we, "a3": a3, "r3": r3, "alpha3": alpha3, "hw": hw}
+    )
+    no, es, sn, we, a3, r3, alpha3, hw = params.values()
     half_pi = np.pi / 2
     a = (0.0, es, a3, 0.0, 0.0, 0.0)
     alpha = (half_pi, 0.0, alpha3, half_pi, half_pi, 0.0)
@@ -94,7 +96,7 @@ def build(
             + ", ".join(k.upper() for k in params if k not in symbolic),
         )
 
-    def closed_form() -> object:
+    def closed_form() -> ClosedForm:
         from solvers.closed_form.barker import BarkerClosedForm
 
         return BarkerClosedForm(no=no, es=es, sn=sn, we=we, a3=a3, r3=r3, alpha3=alpha3)

@@ -6,16 +6,26 @@ not in the exam (assumed, KR5 class).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from rrc_pin.dh import DHChain, DHRow
-from rrc_pin.models.arm_spec import ArmSpec
+from rrc_pin.models.arm_spec import ArmSpec, check_parameters
+
+if TYPE_CHECKING:
+    from solvers.closed_form.base import ClosedForm
 
 NAME = "kr5_3r"
 
 
 def build(a1: float = 0.2, a2: float = 0.5, a3: float = 0.5, name: str = NAME) -> ArmSpec:
-    """The exam's 3R arm with link lengths ``a1``, ``a2``, ``a3`` [m]."""
+    """The exam's 3R arm with link lengths ``a1``, ``a2``, ``a3`` [m].
+
+    Raises:
+        InvalidInput: A length is not a finite real number (named in the message).
+    """
+    a1, a2, a3 = check_parameters({"a1": a1, "a2": a2, "a3": a3}).values()
     rows = (
         DHRow(a=a1, alpha=np.pi / 2, d=0.0, theta=0.0),
         DHRow(a=a2, alpha=0.0, d=0.0, theta=0.0),
@@ -23,7 +33,7 @@ def build(a1: float = 0.2, a2: float = 0.5, a3: float = 0.5, name: str = NAME) -
     )
     limits = np.deg2rad((170.0, 135.0, 150.0))
 
-    def closed_form() -> object:
+    def closed_form() -> ClosedForm:
         from solvers.closed_form.three_r import ThreeRClosedForm
 
         return ThreeRClosedForm(a1=a1, a2=a2, a3=a3)

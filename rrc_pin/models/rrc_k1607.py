@@ -7,10 +7,15 @@ limits are not in the report (assumed, K-1607 class).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from rrc_pin.dh import DHChain, DHRow
 from rrc_pin.models.arm_spec import INCH, ArmSpec
+
+if TYPE_CHECKING:
+    from solvers.closed_form.base import ClosedForm
 
 NAME = "rrc_k1607"
 # Nguyen Table 1: alpha_{i-1} [deg], a_{i-1} [in], d_i [in]
@@ -36,7 +41,7 @@ def build(name: str = NAME) -> ArmSpec:
     )
     limits = np.deg2rad(LIMITS_DEG)
 
-    def closed_form() -> object:
+    def closed_form() -> ClosedForm:
         from solvers.closed_form.rrc_k1607 import RrcK1607ClosedForm
 
         return RrcK1607ClosedForm(a=tuple(row.a for row in rows), d=tuple(row.d for row in rows))

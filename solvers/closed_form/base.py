@@ -1,20 +1,27 @@
-"""The protocol every closed-form fast path follows (DESIGN.md, "Public API")."""
+"""The protocol every closed-form fast path follows (DESIGN.md, "Public API"), and its helpers."""
 
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from solvers.validation import as_array, as_vector
 
+Array = npt.NDArray[np.float64]
+Entry = Any
+"""A quantity of a kernel: a Python float (one configuration) or an (N,) float array."""
+
 
 class ClosedForm(ABC):
     """Closed-form Jacobian and joint rates of one paper arm.
 
-    Frames: the Jacobian rows are ``[v; w]`` of the tool-frame origin in base-frame axes
-    (``world_aligned``), the first :attr:`task_dim` rows of ``Robot.jacobian(q)``.
+    Frames: the Jacobian rows are ``[v; w]`` of the origin of :attr:`frame` in base-frame
+    axes (``world_aligned``), the first :attr:`task_dim` rows of ``Robot.jacobian(q)`` when
+    the robot's tool frame is :attr:`frame`.
 
     Subclasses implement the two batch methods; the scalar methods default to a batch of one
     and may be overridden by faster scalar code.
@@ -22,13 +29,16 @@ class ClosedForm(ABC):
     Attributes:
         nq: Number of joints.
         task_dim: Rows of the task: 6 (twist) or 3 (linear velocity only).
+        frame: Name of the frame of the generated URDF whose twist the closed form answers
+            for (``"tool"`` for every paper arm).
     """
 
     nq: int
     task_dim: int
+    frame: str = "tool"
 
     @abstractmethod
-    def jacobian_batch(self, Q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    def jacobian_batch(self, Q: npt.ArrayLike) -> Array:
         """Jacobians at N configurations.
 
         Args:
@@ -42,7 +52,7 @@ class ClosedForm(ABC):
         """
 
     @abstractmethod
-    def joint_rates_batch(self, Q: npt.ArrayLike, X: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    def joint_rates_batch(self, Q: npt.ArrayLike, X: npt.ArrayLike) -> Array:
         """Joint rates realising the task velocities at N configurations.
 
         Args:
@@ -57,23 +67,35 @@ class ClosedForm(ABC):
             InputError: Wrong shapes or non-finite entries.
         """
 
-    def jacobian(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    def jacobian(self, q: npt.ArrayLike) -> Array:
         """Jacobian at one configuration ``q`` (nq,): shape (task_dim, nq)."""
-        q = as_vector(q, "q", self.nq)
-        return self.jacobian_batch(q[None, :])[0]
+        return first(self.jacobian_batch(row(q, "q", self.nq)))
 
-    def joint_rates(self, q: npt.ArrayLike, xdot: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    def joint_rates(self, q: npt.ArrayLike, xdot: npt.ArrayLike) -> Array:
         """Joint rates (nq,) realising the task velocity ``xdot`` (task_dim,) at ``q`` (nq,)."""
-        q = as_vector(q, "q", self.nq)
-        xdot = as_vector(xdot, "xdot", self.task_dim)
-        return self.joint_rates_batch(q[None, :], xdot[None, :])[0]
+        return first(self.joint_rates_batch(row(q, "q", self.nq), row(xdot, "xdot", self.task_dim)))
 
-    def _check_batch(
-        self, Q: npt.ArrayLike, X: npt.ArrayLike | None = None
-    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64] | None]:
-        """Validate ``Q`` (N, nq) and, if given, ``X`` (N, task_dim) with the same N."""
+    def _check_batch(self, Q: npt.ArrayLike, X: npt.ArrayLike) -> tuple[Array, Array]:
+        """Validate ``Q`` (N, nq) and ``X`` (N, task_dim) with the same N."""
         Q = as_array(Q, "Q", (None, self.nq))
-        if X is None:
-            return Q, None
-        X = as_array(X, "X", (Q.shape[0], self.task_dim))
-        return Q, X
+        return Q, as_array(X, "X", (Q.shape[0], self.task_dim))
+
+
+def row(x: npt.ArrayLike, name: str, size: int) -> Array:
+    """``x`` checked as a finite (size,) vector named ``name``, as a batch of one (1, size)."""
+    return as_vector(x, name, size)[None]
+
+
+def first(batch: Array) -> Array:
+    """The first item of a batch (a batch of one answering a scalar call)."""
+    item: Array = batch[0]
+    return item
+
+
+def stack_entries(rows: Sequence[Sequence[Entry]], n: int) -> Array:
+    """The matrices (n, R, C) whose entry (r, c) is ``rows[r][c]`` (a float or an (n,) array)."""
+    out = np.empty((n, len(rows), len(rows[0])))
+    for r, entries in enumerate(rows):
+        for c, value in enumerate(entries):
+            out[:, r, c] = value
+    return out

@@ -36,6 +36,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from solvers.closed_form.base import first
 from solvers.errors import InputError
 from solvers.validation import as_array
 
@@ -89,7 +90,7 @@ def quaternion_from_matrix(R: npt.ArrayLike) -> Array:
     )
     q = np.take_along_axis(scaled, pivot[:, None, None], axis=1)[:, 0] / (2.0 * big[:, None])
     q *= np.where(q[:, :1] < 0.0, -1.0, 1.0)
-    return q[0] if single else q
+    return first(q) if single else q
 
 
 def matrix_from_quaternion(q: npt.ArrayLike) -> Array:
@@ -117,7 +118,7 @@ def matrix_from_quaternion(q: npt.ArrayLike) -> Array:
     R += 2.0 * s[:, :, None] * s[:, None, :]
     R += 2.0 * eta[:, None, None] * _skew(s)
     R /= norm2[:, None, None]
-    return R[0] if single else R
+    return first(R) if single else R
 
 
 def quaternion_difference(q1: npt.ArrayLike, q2: npt.ArrayLike) -> Array:
@@ -146,7 +147,7 @@ def quaternion_difference(q1: npt.ArrayLike, q2: npt.ArrayLike) -> Array:
     d_eta = eta1 * eta2 + np.einsum("ni,ni->n", s1, s2)  # eq. (33)
     d_s = eta1[:, None] * s2 - eta2[:, None] * s1 + np.cross(s1, s2)  # eq. (34)
     out = np.concatenate([d_eta[:, None], d_s], axis=1)
-    return out[0] if single else out
+    return first(out) if single else out
 
 
 def differential_rotation(dq: npt.ArrayLike) -> Array:
@@ -168,7 +169,7 @@ def differential_rotation(dq: npt.ArrayLike) -> Array:
     qs, single = _stack(dq, "dq", (4,))
     sign = np.where(qs[:, :1] < 0.0, -1.0, 1.0)
     out = 2.0 * sign * qs[:, 1:]
-    return out[0] if single else out
+    return first(out) if single else out
 
 
 def rotation_vector(dq: npt.ArrayLike) -> Array:
@@ -193,7 +194,7 @@ def rotation_vector(dq: npt.ArrayLike) -> Array:
     # theta / sin(theta/2), continued by its limit 2 at theta = 0.
     scale = np.where(sin_half > 0.0, theta / np.where(sin_half > 0.0, sin_half, 1.0), 2.0)
     out = scale[:, None] * qs[:, 1:]
-    return out[0] if single else out
+    return first(out) if single else out
 
 
 def small_rotation(delta: npt.ArrayLike) -> Array:
@@ -218,7 +219,7 @@ def small_rotation(delta: npt.ArrayLike) -> Array:
     """
     d, single = _stack(delta, "delta", (3,))
     out = np.eye(3) + _skew(d)
-    return out[0] if single else out
+    return first(out) if single else out
 
 
 def _skew(s: Array) -> Array:

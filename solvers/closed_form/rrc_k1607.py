@@ -14,51 +14,46 @@ The arm of Nguyen Table 1 in Craig's modified DH (Nguyen eq. (2)), twists fixed 
   columns 1-3, eqs. (18)-(19)). Rows ``[v; w]``: velocity of frame 7's origin and angular
   velocity, base axes (``world_aligned``, Pinocchio's LOCAL_WORLD_ALIGNED).
 - Joint rates: the weighted pseudo-inverse with null-space term, Nguyen eqs. (21)-(22),
-  evaluated as ``qdot = J_W^+ (xdot - J z) + z`` (the same vector, one solve): ``J W J^T y =
-  xdot - J z`` by block elimination with 3x3 blocks (:func:`_solve_spd6`), then
-  ``qdot = W J^T y + z``. With ``W = I`` and ``z = 0`` it is the minimum-norm solution of
-  eq. (23). Forming ``J W J^T`` squares the condition number: the rates are accurate to
-  about ``eps kappa(J W^1/2)^2`` (1e-13 at kappa = 40, 1e-8 at kappa = 1e4).
+  evaluated as ``qdot = J_W^+ (xdot - J z) + z`` (the same vector, one solve). With
+  ``W = L L^T`` and ``B = J L``: ``B B^T y = xdot - J z`` by block elimination with 3x3
+  blocks (:func:`_solve_spd6`), then ``qdot = L B^T y + z`` (eq. (22) as printed). With
+  ``W = I`` and ``z = 0`` it is the minimum-norm solution of eq. (23). Forming ``B B^T``
+  squares the condition number: the rates are accurate to about ``eps kappa(B)^2`` (1e-13 at
+  kappa = 40, 1e-8 at kappa = 1e4).
 
-Singularities: with ``tau = rcond^2 trace(J W J^T)``, the rates come from the fallback
-where the solve proves ``lambda_min(J W J^T) < tau`` (``sigma_min(J W^1/2)`` below about
-``rcond sigma_max``): a 3x3 block determinant <= 0, or ``|b| < tau |y|`` for the solution
-``y`` of ``J W J^T y = b`` (``|b| >= lambda_min |y|`` always). The fallback is the SVD
-pseudo-inverse of ``J L`` (``W = L L^T``) with singular values below ``rcond`` times the
-largest dropped: ``qdot = L (J L)^+ (xdot - J z) + z``, the least-squares rates of least
-``(qdot - z)^T W^-1 (qdot - z)``, finite for any finite input, never NaN. Damping is the
-QP resolver's business, not this module's. Elsewhere the exact rates are returned, however
+Singularities: with ``tau = rcond^2 trace(B B^T)``, the rates come from the SVD form of
+:mod:`solvers.closed_form.weighted` (``L B^+ (xdot - J z) + z``, singular values below
+``rcond sigma_max`` dropped: the least-squares rates of least ``(qdot - z)^T W^-1
+(qdot - z)``, finite for any finite input, never NaN) where the solve proves
+``lambda_min(B B^T) < tau``: a 3x3 block determinant <= 0, or ``|b| < tau |y|`` for the
+solution ``y`` of ``B B^T y = b`` (``|b| >= lambda_min |y|`` always). Damping is the QP
+resolver's business, not this module's. Elsewhere the exact rates are returned, however
 large.
 
-The scalar methods run on Python floats (numpy only for ``J W J^T`` and the result), the
-batch methods on (M,) numpy arrays, block by block
-(:data:`~solvers.closed_form._batch.CHUNK`); both share the formulas of :func:`_kinematics`
-and :func:`_solve_spd6`.
+Every formula is written once, for Python floats (one configuration) and (N,) arrays (a
+batch, in blocks of :data:`~solvers.closed_form._batch.CHUNK` configurations) alike.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Sequence
-from itertools import chain
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from solvers.closed_form._batch import blocks, cos_sin
-from solvers.closed_form.base import ClosedForm
-from solvers.errors import InputError
-from solvers.validation import as_array, as_float_list, as_vector, finite_number
+from solvers.closed_form.base import Array, ClosedForm, Entry, stack_entries
+from solvers.closed_form.weighted import svd_rates, weight_factor
+from solvers.validation import as_array, as_vector, finite_number
 
 NQ = 7
 TASK_DIM = 6
 ALPHA_DEG = (0.0, -90.0, 90.0, -90.0, 90.0, -90.0, 90.0)
 """Nguyen Table 1 twists alpha_{i-1} [deg]; the closed form is derived for these."""
 DEFAULT_RCOND = 1e-6
-"""Relative singular-value threshold of ``J W^1/2`` below which the SVD fallback answers."""
-
-Entry = Any  # a Python float (scalar path) or an (N,) float array (batch path)
+"""Relative singular-value threshold of ``J W^1/2`` below which the SVD form answers."""
 
 
 def _kinematics(
@@ -67,14 +62,14 @@ def _kinematics(
     a: Sequence[float],
     d: Sequence[float],
     pose: bool = True,
-) -> tuple[list[list[Entry]] | None, list[Entry], list[list[Entry]]]:
+) -> tuple[list[list[Entry]], list[Entry], list[Any]]:
     """Hand pose and Jacobian from the joint cosines ``c`` and sines ``s`` (7 each).
 
     Works element-wise: every entry is a float, or an (N,) array for N configurations.
 
     Returns:
         ``(R, p, J_cols)``: ``R`` 3 rows of 3 entries (Nguyen eq. (4): columns n, s, a),
-        None unless ``pose`` (the Jacobian does not need it, nor theta_7), ``p`` 3 entries
+        empty unless ``pose`` (the Jacobian does not need it, nor theta_7), ``p`` 3 entries
         [m], ``J_cols`` the 7 columns of J, 6 entries each (rows [v; w], ``world_aligned``).
     """
     c1, c2, c3, c4, c5, c6, c7 = c
@@ -106,7 +101,7 @@ def _kinematics(
     j2 = c6 * h4 - s6 * g4
     # Nguyen eqs. (5)-(7): the columns n = x7, s = y7 and a = z7 of the hand orientation.
     z7 = (s6 * h2 + c6 * g2, s6 * h4 + c6 * g4, s6 * g6 + c6 * f6)
-    R = None
+    R: list[list[Entry]] = []
     if pose:
         R = [
             [s7 * h1 + c7 * j1, c7 * h1 - s7 * j1, z7[0]],
@@ -114,9 +109,10 @@ def _kinematics(
             [s7 * g5 + c7 * h5, c7 * g5 - s7 * h5, z7[2]],
         ]
     # Joint axes b_i = z_i (Nguyen eq. (14)) and the x axes of frames 0-6.
-    z = (None, (-s1, c1, 0.0), (c1s2, s1s2, c2), (f1, f3, s2s3), (g2, g4, f6), (h1, h3, g5), z7)
-    x = (None, (c1, s1, 0.0), (c1c2, s1c2, -s2), (f2, f4, -s2c3), (g1, g3, f5), (h2, h4, g6),
-         (j1, j2, h5))
+    z: tuple[Any, ...] = (None, (-s1, c1, 0.0), (c1s2, s1s2, c2), (f1, f3, s2s3), (g2, g4, f6),
+                          (h1, h3, g5), z7)  # fmt: skip
+    x: tuple[Any, ...] = (None, (c1, s1, 0.0), (c1c2, s1c2, -s2), (f2, f4, -s2c3), (g1, g3, f5),
+                          (h2, h4, g6), (j1, j2, h5))  # fmt: skip
     # Nguyen eqs. (12)-(13), (16): J_i = [b_i x r_i; b_i] with r_i = p - o_i, from the hand
     # back: r_7 = 0 (so J_7 = [0; z_7]), r_{i-1} = r_i + a_{i-1} x_{i-1} + d_i z_i (Nguyen
     # eq. (2), column 4).
@@ -155,10 +151,13 @@ def _step(
 class RrcK1607ClosedForm(ClosedForm):
     """Nguyen's closed forms for the RRC K-1607 (7 revolute joints, 6-D task).
 
+    Frames: :attr:`frame` is the generated URDF's ``"tool"`` frame, Nguyen's frame 7; twists
+    are its origin's velocity and its angular velocity in base axes (``world_aligned``).
+
     Args:
         a: The seven ``a_{i-1}`` of Nguyen Table 1 [m] (``a_0`` first).
         d: The seven ``d_i`` of Nguyen Table 1 [m] (``d_1`` first).
-        rcond: Relative singular-value threshold of ``J W^1/2`` for the SVD fallback
+        rcond: Relative singular-value threshold of ``J W^1/2`` for the SVD form
             (module docstring).
 
     Raises:
@@ -167,6 +166,7 @@ class RrcK1607ClosedForm(ClosedForm):
 
     nq = NQ
     task_dim = TASK_DIM
+    frame = "tool"
 
     def __init__(
         self, *, a: npt.ArrayLike, d: npt.ArrayLike, rcond: float = DEFAULT_RCOND
@@ -178,14 +178,13 @@ class RrcK1607ClosedForm(ClosedForm):
     def __repr__(self) -> str:
         return f"RrcK1607ClosedForm(a={self.a}, d={self.d})"
 
-    # ------------------------------------------------------------------ scalar
+    def _columns(self, q: Array, pose: bool = False) -> tuple[Any, Any, list[Any]]:
+        """:func:`_kinematics` of one configuration (7,), on Python floats."""
+        qs = q.tolist()
+        return _kinematics([math.cos(v) for v in qs], [math.sin(v) for v in qs], self.a, self.d,
+                           pose)  # fmt: skip
 
-    def _scalar(self, qs: list[float], pose: bool = False) -> tuple[Any, Any, list[list[float]]]:
-        c = [math.cos(v) for v in qs]
-        s = [math.sin(v) for v in qs]
-        return _kinematics(c, s, self.a, self.d, pose)
-
-    def fk(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    def fk(self, q: npt.ArrayLike) -> Array:
         """Pose of frame 7 in frame 0, Nguyen eqs. (4)-(11).
 
         Args:
@@ -197,10 +196,22 @@ class RrcK1607ClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` is not a finite (7,) vector.
         """
-        R, p, _ = self._scalar(as_float_list(q, "q", NQ), pose=True)
+        R, p, _ = self._columns(as_vector(q, "q", NQ), pose=True)
         return np.array([R[0] + [p[0]], R[1] + [p[1]], R[2] + [p[2]], [0.0, 0.0, 0.0, 1.0]])
 
-    def jacobian(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+    def fk_batch(self, Q: npt.ArrayLike) -> Array:
+        """Poses of frame 7 at N configurations ``Q`` (N, 7) [rad]: (N, 4, 4).
+
+        Raises:
+            InputError: ``Q`` is not a finite (N, 7) array.
+        """
+        Q = as_array(Q, "Q", (None, NQ))
+        C, S = cos_sin(np.ascontiguousarray(Q.T))
+        R, p, _ = _kinematics(list(C), list(S), self.a, self.d)
+        return stack_entries([R[0] + [p[0]], R[1] + [p[1]], R[2] + [p[2]],
+                              [0.0, 0.0, 0.0, 1.0]], Q.shape[0])  # fmt: skip
+
+    def jacobian(self, q: npt.ArrayLike) -> Array:
         """Jacobian of frame 7, Nguyen eqs. (12)-(17), all seven columns.
 
         Args:
@@ -212,7 +223,18 @@ class RrcK1607ClosedForm(ClosedForm):
         Raises:
             InputError: ``q`` is not a finite (7,) vector.
         """
-        return np.ascontiguousarray(_transposed(self._scalar(as_float_list(q, "q", NQ))[2]).T)
+        return np.ascontiguousarray(np.array(self._columns(as_vector(q, "q", NQ))[2]).T)
+
+    def jacobian_batch(self, Q: npt.ArrayLike) -> Array:
+        """Jacobians of frame 7 at ``Q`` (N, 7) [rad]: (N, 6, 7), rows [v; w], ``world_aligned``.
+
+        Raises:
+            InputError: ``Q`` is not a finite (N, 7) array.
+        """
+        Q = as_array(Q, "Q", (None, NQ))
+        C, S = cos_sin(np.ascontiguousarray(Q.T[: NQ - 1]))  # theta_7 does not move J
+        cols = _kinematics([*C, None], [*S, None], self.a, self.d, pose=False)[2]
+        return stack_entries(list(zip(*cols, strict=True)), Q.shape[0])
 
     def joint_rates(
         self,
@@ -220,7 +242,7 @@ class RrcK1607ClosedForm(ClosedForm):
         xdot: npt.ArrayLike,
         W: npt.ArrayLike | None = None,
         z: npt.ArrayLike | None = None,
-    ) -> npt.NDArray[np.float64]:
+    ) -> Array:
         r"""Joint rates by the weighted pseudo-inverse, Nguyen eqs. (21)-(22).
 
         .. math::
@@ -229,12 +251,13 @@ class RrcK1607ClosedForm(ClosedForm):
 
         Among all ``qdot`` with ``J qdot = xdot`` it minimises
         ``(qdot - z)^T W^-1 (qdot - z)``; ``W = I``, ``z = 0`` give the minimum-norm rates of
-        eq. (23). Near a singularity: the SVD fallback of the module docstring, never NaN.
+        eq. (23). Near a singularity: the SVD form of the module docstring, never NaN.
 
         Args:
             q: Joint angles (7,) [rad].
             xdot: Hand twist (6,), [m/s] then [rad/s], ``world_aligned``.
-            W: Weighting matrix (7, 7), symmetric positive definite; None for identity.
+            W: Weighting matrix: (7, 7) symmetric positive definite or (7,) positive
+                (diagonal); None for identity.
             z: Joint-rate vector (7,) [rad/s] whose null-space part is added; None for zero.
 
         Returns:
@@ -244,87 +267,37 @@ class RrcK1607ClosedForm(ClosedForm):
             InputError: Wrong shape or non-finite entries in any argument (named), or ``W``
                 not symmetric positive definite.
         """
-        qs = as_float_list(q, "q", NQ)
-        b = as_float_list(xdot, "xdot", TASK_DIM)
-        Wm = None if W is None else _check_weight(W)
+        qv, b = as_vector(q, "q", NQ), as_vector(xdot, "xdot", TASK_DIM)
+        L = weight_factor(W, NQ)
         zv = None if z is None else as_vector(z, "z", NQ)
-        Jt = _transposed(self._scalar(qs)[2])
+        # One configuration: J on Python floats, its products by numpy, the solve of
+        # _solve_spd6 on floats: 16 us against 250 us for the batch path on one row (measured).
+        Jt = np.array(self._columns(qv)[2])  # J^T (7, 6)
         if zv is not None:
-            b = (np.array(b) - zv.dot(Jt)).tolist()
-        JWt = Jt if Wm is None else Wm.T.dot(Jt)  # (J W)^T
-        A = JWt.T.dot(Jt).tolist()
-        tau = self.rcond**2 * (A[0][0] + A[1][1] + A[2][2] + A[3][3] + A[4][4] + A[5][5])
-        try:
-            y = _solve_spd6(A, b, _positive)
-        except _Singular:
-            y = None
-        if y is not None and _norm2(b) >= tau * tau * _norm2(y):
-            qdot = JWt.dot(y)
+            b = b - zv @ Jt
+        Bt = Jt if L is None else L.T @ Jt  # (J L)^T
+        A = Bt.T.dot(Bt).tolist()
+        tau = self.rcond**2 * sum(A[i][i] for i in range(TASK_DIM))
+        bl = b.tolist()
+        y = _solve_spd6(A, bl)
+        if _dot(bl, bl) >= tau * tau * _dot(y, y):  # False for NaN: not positive definite
+            qdot = Bt.dot(y)
+            qdot = qdot if L is None else L @ qdot
         else:
-            qdot = _svd_rates(Jt.T[None], np.array([b]), Wm, self.rcond)[0]
-        if zv is not None:
-            qdot += zv
-        return qdot
-
-    # ------------------------------------------------------------------- batch
-
-    def fk_batch(self, Q: npt.ArrayLike) -> npt.NDArray[np.float64]:
-        """Poses of frame 7 at N configurations, Nguyen eqs. (4)-(11).
-
-        Args:
-            Q: Joint angles (N, 7) [rad].
-
-        Returns:
-            (N, 4, 4) homogeneous transforms.
-
-        Raises:
-            InputError: ``Q`` is not a finite (N, 7) array.
-        """
-        Q = as_array(Q, "Q", (None, NQ))
-        out = np.zeros((Q.shape[0], 4, 4))
-        out[:, 3, 3] = 1.0
-        for rows, c, s in _chunks(Q):
-            R, p, _ = _kinematics(c, s, self.a, self.d)
-            _fill(out[rows, :3], [R[r] + [p[r]] for r in range(3)])
-        return out
-
-    def jacobian_batch(self, Q: npt.ArrayLike) -> npt.NDArray[np.float64]:
-        """Jacobians of frame 7 at N configurations, Nguyen eqs. (12)-(17).
-
-        Args:
-            Q: Joint angles (N, 7) [rad].
-
-        Returns:
-            (N, 6, 7) array, rows [v; w], ``world_aligned``.
-
-        Raises:
-            InputError: ``Q`` is not a finite (N, 7) array.
-        """
-        Q = as_array(Q, "Q", (None, NQ))
-        out = np.empty((Q.shape[0], TASK_DIM, NQ))
-        for rows, c, s in _chunks(Q, pose=False):
-            J = list(zip(*_kinematics(c, s, self.a, self.d, pose=False)[2], strict=True))
-            _fill(out[rows], J)
+            qdot = svd_rates(Jt.T, b, L, self.rcond)
+        out: Array = qdot if zv is None else qdot + zv
         return out
 
     def joint_rates_batch(
-        self,
-        Q: npt.ArrayLike,
-        X: npt.ArrayLike,
-        W: npt.ArrayLike | None = None,
+        self, Q: npt.ArrayLike, X: npt.ArrayLike, W: npt.ArrayLike | None = None,
         Z: npt.ArrayLike | None = None,
-    ) -> npt.NDArray[np.float64]:
+    ) -> Array:  # fmt: skip
         """Joint rates at N configurations, Nguyen eqs. (21)-(22); see :meth:`joint_rates`.
-
-        The arithmetic of :meth:`joint_rates` runs element-wise over blocks of
-        :data:`~solvers.closed_form._batch.CHUNK` configurations (no Python loop over
-        configurations).
 
         Args:
             Q: Joint angles (N, 7) [rad].
             X: Hand twists (N, 6), ``world_aligned``.
-            W: One weighting matrix (7, 7) for all N, symmetric positive definite; None for
-                identity.
+            W: One weighting matrix for all N, as in :meth:`joint_rates`.
             Z: Joint-rate vectors (N, 7) [rad/s] whose null-space parts are added; None for
                 zero.
 
@@ -336,184 +309,92 @@ class RrcK1607ClosedForm(ClosedForm):
                 not symmetric positive definite.
         """
         Q, X = self._check_batch(Q, X)
-        Wm = None if W is None else _check_weight(W)
+        L = weight_factor(W, NQ)
         if Z is not None:
             Z = as_array(Z, "Z", (Q.shape[0], NQ))
         out = np.empty((Q.shape[0], NQ))
-        for rows, c, s in _chunks(Q, pose=False):
-            out[rows] = self._rates_chunk(c, s, X[rows], Wm, None if Z is None else Z[rows])
+        C, S = cos_sin(np.ascontiguousarray(Q.T[: NQ - 1]))
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            for rows in blocks(Q.shape[0]):
+                c, s = [v[rows] for v in C], [v[rows] for v in S]
+                J = list(zip(*_kinematics([*c, None], [*s, None], self.a, self.d, False)[2],
+                             strict=True))  # fmt: skip
+                z = None if Z is None else Z[rows]
+                out[rows] = self._rates_block(J, X[rows], L, z)
+        if Z is not None:
+            out += Z
         return out
 
-    def _rates_chunk(
-        self,
-        c: list[npt.NDArray[np.float64]],
-        s: list[npt.NDArray[np.float64]],
-        X: npt.NDArray[np.float64],
-        Wm: npt.NDArray[np.float64] | None,
-        Z: npt.NDArray[np.float64] | None,
-    ) -> npt.NDArray[np.float64]:
-        """:meth:`joint_rates_batch` on one chunk: cosines and sines, 7 (M,) arrays each."""
+    def _rates_block(
+        self, J: Sequence[Sequence[Entry]], X: Array, L: Array | None, Z: Array | None
+    ) -> Array:
+        """Rates (M, 7) of one block: ``J`` 6 rows of 7 entries ((M,) arrays or floats)."""
         n = X.shape[0]
-        J = list(zip(*_kinematics(c, s, self.a, self.d, pose=False)[2], strict=True))  # rows
         b = list(np.ascontiguousarray(X.T))
         if Z is not None:
             ZT = list(np.ascontiguousarray(Z.T))
-            b = [bi - _dot(row, ZT) for bi, row in zip(b, J, strict=True)]
-        if Wm is None:
-            JW = J
-        else:
-            Wcols = Wm.T.tolist()
-            JW = [[_dot(row, col) for col in Wcols] for row in J]
-        A = [[_dot(JW[i], J[j]) if j >= i else None for j in range(TASK_DIM)]
-             for i in range(TASK_DIM)]
+            b = [bi - _dot(r, ZT) for bi, r in zip(b, J, strict=True)]
+        B = J if L is None else [[_dot(r, col) for col in L.T.tolist()] for r in J]
+        A: list[list[Any]] = [[_dot(B[i], B[j]) if j >= i else None for j in range(TASK_DIM)]
+             for i in range(TASK_DIM)]  # fmt: skip
         tau = self.rcond**2 * sum(A[i][i] for i in range(TASK_DIM))
-        guard = _PositiveMask(n)
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            y = _solve_spd6(A, b, guard)
-            ok = guard.ok & (_dot(b, b) >= tau * tau * _dot(y, y))
-        qdot = np.empty((n, NQ))
-        for i, column in enumerate(zip(*JW, strict=True)):
-            qdot[:, i] = _dot(column, y)
+        y = _solve_spd6(A, b)
+        ok = _dot(b, b) >= tau * tau * _dot(y, y)  # False for NaN: not positive definite
+        v = [_dot(col, y) for col in zip(*B, strict=True)]  # B^T y
+        qdot = np.stack(v if L is None else [_dot(r, v) for r in L.tolist()], axis=1)
         if not np.all(ok):
-            bad = ~ok
-            Jb = np.empty((n, TASK_DIM, NQ))
-            _fill(Jb, J)
-            qdot[bad] = _svd_rates(Jb[bad], np.stack(b, axis=1)[bad], Wm, self.rcond)
-        if Z is not None:
-            qdot += Z
+            bad = np.flatnonzero(~ok)
+            Jb = stack_entries(J, n)[bad]
+            qdot[bad] = svd_rates(Jb, np.stack(b, axis=1)[bad], L, self.rcond)
         return qdot
 
 
 # ---------------------------------------------------------------------- helpers
 
-def _chunks(
-    Q: npt.NDArray[np.float64], pose: bool = True
-) -> Iterator[tuple[slice, list[Any], list[Any]]]:
-    """Blocks of configurations: (rows, cosines, sines), 7 (M,) arrays each.
-
-    The trigonometry (:func:`~solvers.closed_form._batch.cos_sin`) runs once over the whole
-    batch, the rest block by block (the formulas keep about a hundred (CHUNK,) intermediates
-    alive at once). Without ``pose`` theta_7 is not needed (its cosine and sine are None).
-    """
-    C, S = cos_sin(np.ascontiguousarray((Q if pose else Q[:, : NQ - 1]).T))
-    extra = [] if pose else [None]
-    for rows in blocks(Q.shape[0]):
-        yield rows, [c[rows] for c in C] + extra, [s[rows] for s in S] + extra
-
 
 def _dot(u: Sequence[Entry], v: Sequence[Entry]) -> Entry:
-    """Sum of ``u[k] * v[k]``, skipping exact float zeros and ones (constant Jacobian entries).
-
-    Accumulates in place into the first product it owns (never into an argument).
-    """
-    acc: Entry = None
-    owned = False
-    for uk, vk in zip(u, v, strict=True):
-        if type(uk) is float and (uk == 0.0 or uk == 1.0):
-            if not uk:
-                continue
-            term = vk
-        elif type(vk) is float and (vk == 0.0 or vk == 1.0):
-            if not vk:
-                continue
-            term = uk
-        else:
-            term = uk * vk
-        if acc is None:
-            acc, owned = term, term is not uk and term is not vk
-        elif owned:
-            acc += term
-        else:
-            acc, owned = acc + term, True
-    return 0.0 if acc is None else acc
+    """Sum of ``u[k] * v[k]``, skipping exact float zeros (constant Jacobian entries)."""
+    acc: Entry = 0.0
+    for a, b in zip(u, v, strict=True):
+        if not ((type(a) is float and a == 0.0) or (type(b) is float and b == 0.0)):
+            acc = acc + a * b
+    return acc
 
 
-def _transposed(cols: list[Any]) -> npt.NDArray[np.float64]:
-    """``J^T`` (7, 6) from the seven columns of J as float 6-tuples (scalar path).
-
-    ``numpy.fromiter`` with a known count: faster than ``numpy.array`` on nested sequences.
-    """
-    return np.fromiter(chain.from_iterable(cols), np.float64, NQ * TASK_DIM).reshape(NQ, TASK_DIM)
-
-
-def _norm2(v: list[float]) -> float:
-    """Squared Euclidean norm of six floats (scalar path)."""
-    v0, v1, v2, v3, v4, v5 = v
-    return v0 * v0 + v1 * v1 + v2 * v2 + v3 * v3 + v4 * v4 + v5 * v5
-
-
-def _check_weight(W: npt.ArrayLike) -> npt.NDArray[np.float64]:
-    """``W`` as a (7, 7) symmetric positive-definite array.
-
-    Raises:
-        InputError: Naming ``W``.
-    """
-    Wm = as_array(W, "W", (NQ, NQ))
-    if not np.allclose(Wm, Wm.T, rtol=1e-12, atol=1e-12 * np.abs(Wm).max()):
-        raise InputError("W", "expected a symmetric matrix")
-    try:
-        np.linalg.cholesky(Wm)
-    except np.linalg.LinAlgError as exc:
-        raise InputError("W", "expected a positive-definite matrix") from exc
-    return Wm
-
-
-class _Singular(Exception):
-    """A 3x3 block of ``J W J^T`` is not positive definite (scalar path)."""
-
-
-def _positive(det: float) -> float:
-    """Scalar guard of :func:`_solve_spd6`: ``det`` if > 0, else raise :class:`_Singular`."""
-    if not det > 0.0:
-        raise _Singular
-    return det
-
-
-class _PositiveMask:
-    """Batch guard of :func:`_solve_spd6`: replaces determinants <= 0 by 1, remembers where."""
-
-    def __init__(self, n: int) -> None:
-        self.ok = np.ones(n, dtype=bool)
-
-    def __call__(self, det: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-        good = det > 0.0
-        self.ok &= good
-        return np.where(good, det, 1.0)
+def _positive(det: Entry) -> Entry:
+    """``det`` where > 0, else NaN: a solve that is not positive definite fails visibly."""
+    if isinstance(det, np.ndarray):
+        return np.where(det > 0.0, det, np.nan)
+    return det if det > 0.0 else math.nan
 
 
 def _inv3(
-    a00: Entry, a01: Entry, a02: Entry, a11: Entry, a12: Entry, a22: Entry, guard: Any
+    a00: Entry, a01: Entry, a02: Entry, a11: Entry, a12: Entry, a22: Entry
 ) -> tuple[Entry, ...]:
-    """Inverse of a symmetric 3x3 matrix by cofactors: its entries (00, 01, 02, 11, 12, 22).
+    """Inverse of a symmetric positive-definite 3x3 matrix by cofactors.
 
-    ``guard`` receives the determinant and returns it (or a safe stand-in; see
-    :func:`_positive`, :class:`_PositiveMask`).
+    Returns its entries (00, 01, 02, 11, 12, 22); NaN if the determinant is not positive.
     """
     c00 = a11 * a22 - a12 * a12
     c01 = a02 * a12 - a01 * a22
     c02 = a01 * a12 - a02 * a11
-    r = 1.0 / guard(a00 * c00 + a01 * c01 + a02 * c02)
-    return (
-        c00 * r,
-        c01 * r,
-        c02 * r,
-        (a00 * a22 - a02 * a02) * r,
-        (a01 * a02 - a00 * a12) * r,
-        (a00 * a11 - a01 * a01) * r,
-    )
+    r = 1.0 / _positive(a00 * c00 + a01 * c01 + a02 * c02)
+    return (c00 * r, c01 * r, c02 * r, (a00 * a22 - a02 * a02) * r,
+            (a01 * a02 - a00 * a12) * r, (a00 * a11 - a01 * a01) * r)  # fmt: skip
 
 
-def _solve_spd6(A: list[list[Any]], b: Sequence[Entry], guard: Any) -> list[Entry]:
+def _solve_spd6(A: list[list[Any]], b: Sequence[Entry]) -> list[Entry]:
     """Solve ``A y = b`` for a symmetric positive-definite 6x6 ``A`` (upper triangle read).
 
     Block elimination with 3x3 blocks ``A = [[P, Q], [Q^T, S]]``: the Schur complement
     ``S' = S - Q^T P^-1 Q`` is positive definite with ``lambda_min(S') >= lambda_min(A)``,
-    so no pivoting is needed (as in Cholesky). Element-wise: floats or (N,) arrays.
+    so no pivoting is needed (as in Cholesky). Element-wise: floats or (N,) arrays; NaN
+    where a block is not positive definite.
     """
     (p00, p01, p02, q00, q01, q02), (_, p11, p12, q10, q11, q12) = A[0], A[1]
     (_, _, p22, q20, q21, q22), (_, _, _, s00, s01, s02) = A[2], A[3]
     s11, s12, s22 = A[4][4], A[4][5], A[5][5]
-    i00, i01, i02, i11, i12, i22 = _inv3(p00, p01, p02, p11, p12, p22, guard)
+    i00, i01, i02, i11, i12, i22 = _inv3(p00, p01, p02, p11, p12, p22)
     # M = P^-1 Q
     m00 = i00 * q00 + i01 * q10 + i02 * q20
     m01 = i00 * q01 + i01 * q11 + i02 * q21
@@ -532,7 +413,6 @@ def _solve_spd6(A: list[list[Any]], b: Sequence[Entry], guard: Any) -> list[Entr
         s11 - (q01 * m01 + q11 * m11 + q21 * m21),
         s12 - (q01 * m02 + q11 * m12 + q21 * m22),
         s22 - (q02 * m02 + q12 * m12 + q22 * m22),
-        guard,
     )
     b0, b1, b2, b3, b4, b5 = b
     # lower half: y_S = T (b_S - M^T b_P)
@@ -547,27 +427,3 @@ def _solve_spd6(A: list[list[Any]], b: Sequence[Entry], guard: Any) -> list[Entr
     y1 = i01 * b0 + i11 * b1 + i12 * b2 - (m10 * y3 + m11 * y4 + m12 * y5)
     y2 = i02 * b0 + i12 * b1 + i22 * b2 - (m20 * y3 + m21 * y4 + m22 * y5)
     return [y0, y1, y2, y3, y4, y5]
-
-
-def _svd_rates(
-    J: npt.NDArray[np.float64],
-    b: npt.NDArray[np.float64],
-    W: npt.NDArray[np.float64] | None,
-    rcond: float,
-) -> npt.NDArray[np.float64]:
-    """Truncated-SVD rates ``L (J L)^+ b`` with ``W = L L^T``: (M, 6, 7), (M, 6) -> (M, 7).
-
-    Singular values below ``rcond`` times the largest are dropped: the least-squares
-    solution of smallest ``qdot^T W^-1 qdot``, finite for any finite input.
-    """
-    if W is None:
-        return (np.linalg.pinv(J, rcond=rcond) @ b[..., None])[..., 0]
-    L = np.linalg.cholesky(W)
-    return (L @ np.linalg.pinv(J @ L, rcond=rcond) @ b[..., None])[..., 0]
-
-
-def _fill(out: npt.NDArray[np.float64], rows: list[list[Entry]]) -> None:
-    """Write ``rows[r][c]`` (an (N,) array or a float) into ``out[:, r, c]``."""
-    for r, row in enumerate(rows):
-        for col, value in enumerate(row):
-            out[:, r, col] = value

@@ -1,0 +1,104 @@
+"""``rrc_pin.combine``: several robots, each at its base placement, as one :class:`Robot`.
+
+The multi-arm cells resolve this one model: the arms' models are joined under one base with
+``pinocchio.appendModel``, so one ``computeJointJacobians`` serves every arm, and the
+resolver's tasks and limits apply to it unchanged (a frame task per tool frame, one QP).
+
+- Names: every joint and frame of the arm under key ``k`` is renamed ``k/<name>``
+  (``left/panda_joint1``, ``right/tool0``), so names never clash.
+- Order: q is the concatenation of the arms' q, in the order of the mapping; ``lower``,
+  ``upper`` and ``velocity_limit`` are concatenated the same way.
+- Frames: ``T_base`` (4, 4) is the pose of the arm's base frame in the cell's base frame
+  [m]; poses and Jacobians are expressed in the cell's base frame.
+- Tool frames: the prefixed tool frames of every arm, in order.
+- Sparsity: arms share no joint, so the Jacobian of one arm's frame has zero columns for
+  every other arm's joints (block-sparse).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
+
+from rrc_pin.errors import InvalidInput
+from rrc_pin.robot import Robot
+from solvers.validation import as_array
+
+PLACEMENT_TOL = 1e-9
+"""Largest departure of ``T_base`` from a rigid transform (R^T R - I, last row) accepted."""
+
+
+def combine(arms: Mapping[str, tuple[Robot, npt.ArrayLike]], name: str | None = None) -> Robot:
+    """One robot made of ``arms``, each at its base placement.
+
+    Args:
+        arms: Key -> ``(robot, T_base)``: the robot (any :class:`Robot`, with one tool frame
+            or several) and the (4, 4) pose of its base in the cell's base frame [m]. Keys
+            prefix the names (``"left"`` gives ``left/...``).
+        name: Name of the result; default: the keys joined by ``+``.
+
+    Returns:
+        A :class:`Robot` with ``tool_frames`` the prefixed tool frames of every arm.
+
+    Raises:
+        InvalidInput: ``arms`` is empty or not a mapping, a key is not a non-empty name
+            without ``/``, a value is not ``(Robot, T_base)``, ``T_base`` is not a (4, 4)
+            rigid transform (within :data:`PLACEMENT_TOL`), or ``name`` is not a string.
+
+    Example:
+        >>> cell = combine({"left": (panda, T_left), "right": (ur5, T_right)})
+        >>> cell.tool_frames
+        ('left/panda_hand_tcp', 'right/tool0')
+    """
+    if not isinstance(arms, Mapping) or not arms:
+        raise InvalidInput("arms", f"expected a non-empty mapping key -> (Robot, T), got {arms!r}")
+    if name is not None and not isinstance(name, str):
+        raise InvalidInput("name", f"expected a string, got {name!r}")
+    model = pin.Model()
+    tools: list[str] = []
+    parts: list[str] = []
+    for key, value in arms.items():
+        robot, placement = _entry(key, value)
+        model = pin.appendModel(model, _prefixed(robot.model, f"{key}/"), 0, placement)
+        tools += [f"{key}/{frame}" for frame in robot.tool_frames]
+        parts.append(f"{key}: {robot.name}")
+    return Robot(
+        model,
+        tools,
+        name=name if name is not None else "+".join(arms),
+        source=f"combine({', '.join(parts)})",
+    )
+
+
+def _entry(key: object, value: object) -> tuple[Robot, pin.SE3]:
+    """Check one ``key: (robot, T_base)`` entry; return the robot and its placement."""
+    if not isinstance(key, str) or not key or "/" in key:
+        raise InvalidInput("arms", f"keys must be non-empty names without '/', got {key!r}")
+    label = f"arms[{key!r}]"
+    if not (isinstance(value, tuple) and len(value) == 2 and isinstance(value[0], Robot)):
+        raise InvalidInput(label, f"expected (Robot, T_base (4, 4)), got {value!r}")
+    T = as_array(value[1], label, (4, 4), InvalidInput)
+    R = T[:3, :3]
+    rigid = (
+        np.abs(R.T @ R - np.eye(3)).max() <= PLACEMENT_TOL
+        and np.linalg.det(R) > 0.0
+        and np.abs(T[3] - (0.0, 0.0, 0.0, 1.0)).max() <= PLACEMENT_TOL
+    )
+    if not rigid:
+        raise InvalidInput(label, f"T_base is not a rigid transform: {T.tolist()}")
+    return value[0], pin.SE3(R, T[:3, 3])
+
+
+def _prefixed(model: pin.Model, prefix: str) -> pin.Model:
+    """A copy of ``model`` with every joint and frame name but the universe's prefixed."""
+    out = pin.Model(model)
+    for j in range(1, out.njoints):
+        out.names[j] = prefix + out.names[j]
+    for i in range(1, len(out.frames)):
+        frame = out.frames[i]  # a copy: rename it, then store it back
+        frame.name = prefix + frame.name
+        out.frames[i] = frame
+    return out
