@@ -26,7 +26,7 @@ import numpy as np
 import numpy.typing as npt
 
 from solvers.errors import InputError
-from solvers.validation import as_vector, finite_number, positive
+from solvers.validation import as_vector, finite_number, positive, real_array
 
 Array = npt.NDArray[np.float64]
 
@@ -50,6 +50,7 @@ class StepBounds(NamedTuple):
         ub: Upper bounds (n,), ``lb <= ub`` everywhere.
         contains_zero: True when standing still is allowed (no joint must move).
         velocity: The velocity limits (n,) the bounds were clipped into.
+        position: The position bounds ``(lower, upper)`` (n,) before that clip.
         acceleration: The acceleration bounds ``(lower, upper)`` (n,) before they were clipped
             into the velocity and position bounds, or None without acceleration limits.
     """
@@ -58,16 +59,23 @@ class StepBounds(NamedTuple):
     ub: Array
     contains_zero: bool
     velocity: Array
+    position: tuple[Array, Array]
     acceleration: tuple[Array, Array] | None = None
 
     def kind(self, joint: int, side: Literal["lower", "upper"]) -> BoundKind:
         """The constraint behind the ``side`` bound of ``joint``."""
-        bound = float(self.lb[joint] if side == "lower" else self.ub[joint])
+        i = 0 if side == "lower" else 1
+        bound = float((self.lb, self.ub)[i][joint])
+        v = float(self.velocity[joint])
         if self.acceleration is not None:
-            a = float(self.acceleration[0 if side == "lower" else 1][joint])
-            if bound == a and abs(a) < float(self.velocity[joint]):
+            a = float(self.acceleration[i][joint])
+            if bound == a and abs(a) < v:
                 return "acceleration"
-        return "velocity" if abs(bound) == float(self.velocity[joint]) else "position"
+        position = float(self.position[i][joint])
+        tighter = position > -v if i == 0 else position < v
+        # neither its own position bound nor the velocity limit: clipped across to the
+        # other side's position bound (an acceleration band beyond a position limit)
+        return "position" if tighter or abs(bound) != v else "velocity"
 
 
 class JointBounds:
@@ -83,7 +91,8 @@ class JointBounds:
         gain: Fraction in (0, 1] of the distance to a position bound allowed in one step.
 
     Raises:
-        InputError: Wrong shapes, NaN limits, lower > upper, velocity limits not finite and
+        InputError: Wrong shapes, entries that are not real numbers (booleans, complex
+            numbers, strings), NaN limits, lower > upper, velocity limits not finite and
             > 0, a negative margin, acceleration limits not > 0, a gain outside (0, 1].
     """
 
@@ -108,12 +117,15 @@ class JointBounds:
         half = 0.5 * (hi - lo)
         self.n = n
         self.lower, self.upper, self.velocity, self.margin = lo, hi, v, m
-        self.low = lo + np.minimum(m, half)  # the range a step must stay in
-        self.high = hi - np.minimum(m, half)
+        cut = np.minimum(m, half)
+        self.low = lo + cut  # the range a step must stay in
+        # capped at half the range: one point (rounding would leave low and high an ulp
+        # apart, either way round, and an empty range cannot hold a step)
+        self.high = np.where(m < half, np.maximum(hi - cut, self.low), self.low)
         self.acceleration: Array | None = None
         if acceleration is not None:
-            a = np.broadcast_to(np.asarray(acceleration, dtype=np.float64), (n,))
-            a = as_vector(a, "acceleration", n)
+            a = real_array(acceleration, "acceleration")
+            a = as_vector(np.full(n, a) if a.ndim == 0 else a, "acceleration", n)
             if np.any(a <= 0.0):
                 raise InputError("acceleration", f"expected acceleration limits > 0, got {a}")
             self.acceleration = a
@@ -142,16 +154,16 @@ class JointBounds:
             lb[on_limit] = np.minimum(lb[on_limit], 0.0)
             ub[on_limit] = np.maximum(ub[on_limit], 0.0)
             outside = float(np.maximum(lb, -ub).max()) > 0.0
+        position = (lb.copy(), ub.copy())
         np.minimum(np.maximum(b, self._minus_velocity, out=b), self.velocity, out=b)
         if self.acceleration is None:
-            return StepBounds(lb, ub, not outside, self.velocity)
+            return StepBounds(lb, ub, not outside, self.velocity, position)
         prev = np.zeros(self.n) if qdot_prev is None else qdot_prev
         reach = self.acceleration * dt
         wanted = (prev - reach, prev + reach)
         lb, ub = np.minimum(np.maximum(wanted, lb), ub)
-        return StepBounds(
-            lb, ub, float(np.maximum(lb, -ub).max()) <= 0.0, self.velocity, wanted
-        )
+        zero_ok = float(np.maximum(lb, -ub).max()) <= 0.0
+        return StepBounds(lb, ub, zero_ok, self.velocity, position, wanted)
 
 
 def joint_velocity_bounds(
@@ -183,8 +195,8 @@ def joint_velocity_bounds(
 
 
 def _limits(lower: npt.ArrayLike, upper: npt.ArrayLike, n: int) -> tuple[Array, Array]:
-    lo = np.array(lower, dtype=np.float64)
-    hi = np.array(upper, dtype=np.float64)
+    lo = real_array(lower, "lower").copy()  # copies: later changes to the caller's arrays
+    hi = real_array(upper, "upper").copy()  # do not count
     for name, arr in (("lower", lo), ("upper", hi)):
         if arr.shape != (n,):
             raise InputError(name, f"expected shape ({n},), got {arr.shape}")
