@@ -45,13 +45,7 @@ def as_array(
         if not np.isfinite(x).all():
             _non_finite(x, name, error)
         return x
-    try:
-        raw = np.asarray(x)
-    except (TypeError, ValueError) as exc:  # ragged sequences
-        raise error(name, f"expected a real numeric array of shape {_fmt(shape)}, got {x!r}") from exc
-    if raw.dtype.kind not in "fiu":  # booleans, complex numbers, strings and objects
-        raise error(name, f"expected a real numeric array of shape {_fmt(shape)}, got {x!r}")
-    arr = raw.astype(np.float64, copy=False)
+    arr = real_array(x, name, error, f"expected a real numeric array of shape {_fmt(shape)}")
     if arr.ndim != len(shape) or any(
         want is not None and got != want for got, want in zip(arr.shape, shape, strict=True)
     ):
@@ -61,35 +55,29 @@ def as_array(
     return arr
 
 
+def real_array(
+    x: npt.ArrayLike,
+    name: str,
+    error: type[InputError] = InputError,
+    want: str = "expected real numbers",
+) -> npt.NDArray[np.float64]:
+    """``x`` as a float array of any shape (infinities and NaN kept), real numbers only.
+
+    Raises:
+        InputError: Booleans, complex numbers, strings, objects or ragged sequences.
+    """
+    try:
+        raw = np.asarray(x)
+    except (TypeError, ValueError) as exc:  # ragged sequences
+        raise error(name, f"{want}, got {x!r}") from exc
+    if raw.dtype.kind not in "fiu":  # booleans, complex numbers, strings and objects
+        raise error(name, f"{want}, got {x!r}")
+    return raw.astype(np.float64, copy=False)
+
+
 def _non_finite(arr: npt.NDArray[np.float64], name: str, error: type[InputError]) -> None:
     bad = np.argwhere(~np.isfinite(arr))[0]
     raise error(name, f"non-finite entry {arr[tuple(bad)]} at index {tuple(int(i) for i in bad)}")
-
-
-def as_float_list(
-    x: npt.ArrayLike, name: str, size: int, error: type[InputError] = InputError
-) -> list[float]:
-    """Return ``x`` as a list of ``size`` finite Python floats (scalar fast paths).
-
-    The common case, a float64 array of shape ``(size,)``, skips :func:`as_vector`: one
-    ``tolist`` and a finiteness test on the sum (NaN or inf make ``total - total`` NaN; a
-    finite sum that overflows falls through to the full check).
-
-    Args:
-        x: Vector to check, e.g. a joint configuration ``q`` or a twist.
-        name: Argument name the error names.
-        size: Expected length.
-        error: Exception class to raise (a subclass of :class:`InputError`).
-
-    Raises:
-        InputError: Wrong shape, non-numeric, NaN or inf (the messages of :func:`as_vector`).
-    """
-    if type(x) is np.ndarray and x.dtype is _F64 and x.shape == (size,):
-        values: list[float] = x.tolist()
-        total = sum(values)
-        if total - total == 0.0:
-            return values
-    return as_vector(x, name, size, error).tolist()
 
 
 def finite_number(
@@ -123,9 +111,13 @@ def finite_number(
         want = f"a finite number < {upper:g}"
     else:
         want = f"a finite number in {'[' if inclusive else '('}{lower:g}, {upper:g})"
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
+    real = (int, float, np.integer, np.floating)  # not complex numbers (np.number)
+    if isinstance(value, (bool, np.bool_, np.timedelta64)) or not isinstance(value, real):
         raise error(name, f"expected {want}, got {value!r}")
-    out = float(value)
+    try:
+        out = float(value)
+    except OverflowError:  # an int beyond the float range
+        raise error(name, f"expected {want}, got an int of {len(str(value))} digits") from None
     if (
         not isfinite(out)
         or (lower is not None and (out < lower or (out == lower and not inclusive)))
