@@ -35,12 +35,14 @@ singularity.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 from scipy.linalg.lapack import dgesvd
 
+from solvers.direction import uniform_scale
 from solvers.validation import finite_number
 
 Array = npt.NDArray[np.float64]
@@ -77,8 +79,9 @@ class JacobianSVD:
             if info != 0:
                 raise np.linalg.LinAlgError(f"dgesvd did not converge (info={info})")
             self.U, self.sigma, self.Vt = U[:, :k], sigma, Vt
-        top = float(self.sigma[0]) if k else 0.0
-        self.rank = int(np.count_nonzero(self.sigma > RANK_TOL * top)) if top > 0.0 else 0
+        values = self.sigma.tolist()
+        cut = RANK_TOL * values[0] if values else 0.0
+        self.rank = sum(s > cut for s in values) if cut > 0.0 else 0
 
     def rates(self, b: Array, lambda_sq: Array | None = None) -> Array:
         r"""Least-squares rates of least norm (n,) for the task velocity ``b`` (m,).
@@ -99,12 +102,12 @@ class JacobianSVD:
 
 @dataclass(frozen=True)
 class Damping:
-    """Damping near singularities, where a command's exact rates exceed the limits.
+    r"""Damping near singularities, where a command's exact rates exceed the limits.
 
     See the module docstring for the schedule.
 
     Attributes:
-        ratio: :math:`\\kappa` > 1: a singular direction is weak when, at full joint rate, it
+        ratio: :math:`\kappa` > 1: a singular direction is weak when, at full joint rate, it
             delivers less than 1/ratio of the task speed of the strongest direction.
 
     Raises:
@@ -134,6 +137,13 @@ class Damping:
         r = svd.rank
         if r == 0:
             return None
+        # min(v) <= r_i <= sqrt(n) max(v): no direction is weak while sigma_max / sigma_min
+        # is below ratio min(v) / (sqrt(n) max(v)), known without V (most steps)
+        v = velocity.tolist()
+        if float(svd.sigma[0]) * math.sqrt(len(v)) * max(v) <= (
+            float(svd.sigma[r - 1]) * min(v) * self.ratio
+        ):
+            return None
         reach = 1.0 / (np.abs(svd.Vt[:r]) / velocity).max(axis=1)  # r_i
         speed = svd.sigma[:r] * reach  # c_i
         onset = float(speed.max()) / self.ratio  # c_on
@@ -145,20 +155,3 @@ class Damping:
         lam = np.zeros(svd.sigma.size)
         lam[:r] = weak * (onset / reach) ** 2 * (1.0 - s_exact)
         return lam if lam.any() else None
-
-
-def uniform_scale(x: Array, lb: Array, ub: Array) -> float:
-    """Largest s in [0, 1] with ``lb <= s x <= ub``, for bounds with ``lb <= 0 <= ub``.
-
-    Args:
-        x: Rates (n,).
-        lb: Lower bounds (n,) <= 0 (not checked).
-        ub: Upper bounds (n,) >= 0 (not checked).
-    """
-    s = 1.0
-    for xi, low, high in zip(x.tolist(), lb.tolist(), ub.tolist(), strict=True):
-        if xi > 0.0:
-            s = min(s, high / xi)
-        elif xi < 0.0:
-            s = min(s, low / xi)
-    return s
