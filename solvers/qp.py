@@ -45,16 +45,27 @@ class QP(NamedTuple):
     key: str
 
     def problem(self) -> qpsolvers.Problem:
-        """The same QP as a ``qpsolvers.Problem`` (rows ``G z <= h``, finite sides only)."""
-        G: Array | None = None
-        h: Array | None = None
+        """The same QP as a ``qpsolvers.Problem``: rows ``G z <= h`` for every finite side.
+
+        The box is passed as ``lb, ub`` when it is finite, else its finite sides become rows
+        (some solvers mishandle infinite box bounds: proxqp reports no solution).
+        """
+        rows, rhs = [], []
         if self.C is not None and self.l is not None and self.u is not None:
             low, high = np.isfinite(self.l), np.isfinite(self.u)
-            G = np.vstack([self.C[high], -self.C[low]])
-            h = np.concatenate([self.u[high], -self.l[low]])
-        lb = self.lb if np.isfinite(self.lb).any() else None
-        ub = self.ub if np.isfinite(self.ub).any() else None
-        return qpsolvers.Problem(self.P, self.q, G, h, lb=lb, ub=ub)
+            rows += [self.C[high], -self.C[low]]
+            rhs += [self.u[high], -self.l[low]]
+        lb: Array | None = self.lb
+        ub: Array | None = self.ub
+        if not (np.isfinite(self.lb).all() and np.isfinite(self.ub).all()):
+            eye = np.eye(self.q.size)
+            low, high = np.isfinite(self.lb), np.isfinite(self.ub)
+            rows += [eye[high], -eye[low]]
+            rhs += [self.ub[high], -self.lb[low]]
+            lb = ub = None
+        h = np.concatenate(rhs) if rhs else None
+        G = np.vstack(rows) if h is not None and h.size else None  # no finite side: no rows
+        return qpsolvers.Problem(self.P, self.q, G, h if G is not None else None, lb=lb, ub=ub)
 
     def feasible(self, z: Array, tol: float = 0.0) -> bool:
         """True when ``z`` satisfies every bound and row within ``tol`` (False for NaN)."""

@@ -58,6 +58,14 @@ class QPBackend(ABC):
                 not an error: it returns ``x = None``.
         """
 
+    def _start(self, qp: QP) -> Array | None:
+        """The last solution of ``qp.key`` if it has ``qp``'s size, else None.
+
+        A key reused for another size must not pass a warm start of the wrong length.
+        """
+        x = self._last.get(qp.key)
+        return x if x is not None and x.shape == qp.q.shape else None
+
     def reset(self) -> None:
         """Forget every warm-start value (the next solves start cold)."""
         self._last.clear()

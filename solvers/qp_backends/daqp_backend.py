@@ -61,7 +61,7 @@ class DaqpBackend(QPBackend):
         try:
             x, _, exitflag, info = daqp.solve(
                 qp.P, qp.q, A, upper, lower, sense,
-                primal_start=self._last.get(qp.key), **self.options,
+                primal_start=self._start(qp), **self.options,
             )  # fmt: skip
         except Exception as exc:
             raise ProblemError(f"daqp: {exc}") from exc
@@ -72,4 +72,5 @@ class DaqpBackend(QPBackend):
         else:
             self._last.pop(qp.key, None)
         status = "solved" if found else f"exitflag {exitflag}"
-        return QPSolution(x if found else None, status, int(info["iterations"]), solve_time, self.name)
+        iterations = int(info["iterations"])
+        return QPSolution(x if found else None, status, iterations, solve_time, self.name)

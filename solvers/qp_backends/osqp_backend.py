@@ -52,6 +52,7 @@ class _Workspace:
     p_rows: npt.NDArray[np.intp]  # entries of P's upper triangle, in CSC order
     p_cols: npt.NDArray[np.intp]
     nz: int
+    nc: int  # constraint rows, the box included
     cold: bool = False
 
 
@@ -87,9 +88,12 @@ class OSQPBackend(QPBackend):
         lower = qp.lb if qp.l is None else np.concatenate([qp.lb, qp.l])
         upper = qp.ub if qp.u is None else np.concatenate([qp.ub, qp.u])
         ws = self._workspaces.get(qp.key)
+        # a new key, or a key reused for another size (OSQP's update would keep the old
+        # problem and only print an error): set up; a new workspace starts from zero
+        fresh = ws is None or (ws.nz, ws.nc) != (nz, rows.shape[0])
         t0 = time.perf_counter()
         try:
-            if ws is None:
+            if ws is None or fresh:
                 ws = self._setup(osqp, qp, rows, lower, upper)
                 self._workspaces[qp.key] = ws
             else:
@@ -100,7 +104,7 @@ class OSQPBackend(QPBackend):
                 ws.solver.warm_start(x=np.zeros(nz), y=np.zeros(rows.shape[0]))
             result = ws.solver.solve(raise_error=False)
             iterations = int(result.info.iter)
-            if result.info.status not in ACCEPTED and not ws.cold:
+            if result.info.status not in ACCEPTED and not (ws.cold or fresh):
                 # a warm start from a very different problem can stall ADMM: once from zero
                 ws.solver.warm_start(x=np.zeros(nz), y=np.zeros(rows.shape[0]))
                 result = ws.solver.solve(raise_error=False)
@@ -116,6 +120,8 @@ class OSQPBackend(QPBackend):
         ws.cold = x is None
         if x is not None:
             self._last[qp.key] = x
+        else:  # the next solve starts from zero: no warm-start value left for this key
+            self._last.pop(qp.key, None)
         return QPSolution(x, "solved" if x is not None else status, iterations, solve_time,
                           self.name)  # fmt: skip
 
@@ -133,4 +139,4 @@ class OSQPBackend(QPBackend):
         )
         solver = osqp.OSQP()
         solver.setup(P, qp.q, A, lower, upper, **self.options)
-        return _Workspace(solver, p_rows, p_cols, nz)
+        return _Workspace(solver, p_rows, p_cols, nz, nc)

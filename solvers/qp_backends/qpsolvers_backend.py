@@ -74,7 +74,7 @@ class QpsolversBackend(QPBackend):
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 sol = qpsolvers.solve_problem(
-                    widened.problem(), solver=self.name, initvals=self._last.get(qp.key),
+                    widened.problem(), solver=self.name, initvals=self._start(qp),
                     **self.options,
                 )  # fmt: skip
         except Exception as exc:
