@@ -25,13 +25,15 @@ from solvers.joint_bounds import BoundKind, StepBounds
 
 Array = npt.NDArray[np.float64]
 
-Method = Literal["qp", "lp", "dls", "scaling", "hold"]
+Method = Literal["qp", "scipy", "dls", "scaling", "hold"]
 """How the rates were obtained: ``qp`` the QP (solved by the backend, or its box-free optimum
-when that is inside the limits), then the fallbacks: ``lp`` the exact box-and-direction LP
-(scipy's HiGHS), ``dls`` the damped least-squares rates clipped into the bounds, ``scaling``
-those rates scaled uniformly into the bounds, ``hold`` the feasible rates nearest zero."""
+when that is inside the limits), then the fallbacks: ``scipy`` the same top-level problem
+solved exactly by scipy.optimize (the box-and-direction LP by HiGHS, or the bounded least
+squares by BVLS), ``dls`` the (damped) least-squares rates clipped into the bounds,
+``scaling`` those rates scaled uniformly into the bounds, ``hold`` the feasible rates nearest
+zero."""
 
-METHODS: tuple[Method, ...] = ("qp", "lp", "dls", "scaling", "hold")
+METHODS: tuple[Method, ...] = ("qp", "scipy", "dls", "scaling", "hold")
 
 Status = Literal["exact", "scaled", "damped", "singular", "least_squares", "recovering", "fallback"]
 """What the answer is, for the top priority level:
@@ -186,7 +188,7 @@ class Resolution:
 
     @cached_property
     def residual(self) -> float:
-        """Top level's task error :math:`\\|J\\dot q - \\dot x\\|_2` (mixed units)."""
+        r"""Top level's task error :math:`\|J\dot q - \dot x\|_2` (mixed units)."""
         return self._top[1]
 
     @cached_property
@@ -252,8 +254,8 @@ def scale_along(achieved: Array, commanded: Array, weight: Array | None = None) 
     r"""Fraction in [0, 1] of ``commanded`` achieved along its direction (module docstring).
 
     :math:`\langle y, b\rangle_W/\|b\|_W^2`, 1 for a zero command; where a product would
-    overflow (entries beyond about 1e154) both vectors are first divided by their largest
-    entry.
+    overflow (entries beyond about 1e154) or underflow, b is divided by its largest entry
+    and y by its own, and the ratio of those two entries multiplies the result.
 
     Args:
         achieved: Achieved rates y (m,).
@@ -261,17 +263,27 @@ def scale_along(achieved: Array, commanded: Array, weight: Array | None = None) 
         weight: Row weights W (m,) > 0, or None for 1.
     """
     wb = commanded if weight is None else weight * commanded
-    den = float(commanded @ wb)
-    num = float(achieved @ wb)
-    if not (math.isfinite(den) and math.isfinite(num)):
-        top = max(float(np.abs(commanded).max()), float(np.abs(achieved).max()))
-        return scale_along(achieved / top, commanded / top, weight)
-    if den == 0.0:
-        if not commanded.any():
-            return 1.0
-        top = float(np.abs(commanded).max())  # underflow: scale up
-        return scale_along(achieved / top, commanded / top, weight)
-    return min(1.0, max(0.0, num / den))
+    with np.errstate(over="ignore", invalid="ignore"):  # beyond 1e154: rescaled below
+        den = float(commanded @ wb)
+        num = float(achieved @ wb)
+    if math.isfinite(den) and math.isfinite(num) and den >= _TINY:
+        return min(1.0, max(0.0, num / den))
+    if not commanded.any():
+        return 1.0
+    top = float(np.abs(commanded).max())  # entries of b and y rescaled to at most 1
+    peak = float(np.abs(achieved).max())
+    if peak == 0.0:
+        return 0.0
+    b = commanded / top
+    wb = b if weight is None else weight * b
+    ratio = float((achieved / peak) @ wb) / float(b @ wb)
+    if ratio <= 0.0:
+        return 0.0
+    with np.errstate(over="ignore"):  # peak / top beyond 1e308: far more than the command
+        return min(1.0, ratio * float(np.float64(peak) / top))
+
+
+_TINY = float(np.finfo(np.float64).tiny)
 
 
 def norm(x: Array) -> float:

@@ -1,5 +1,4 @@
-r"""The resolver's numerical pipeline: task rows by priority level and the step's bounds in,
-one :class:`~solvers.resolution.Resolution` out.
+r"""The resolver's numerical pipeline: task rows and the step's bounds in, a Resolution out.
 
 Each task gives rows ``A qdot ~= b`` with row weights (:class:`TaskRows`); the limits give the
 joint-rate bounds of the step (:class:`~solvers.joint_bounds.StepBounds`) and, optionally,
@@ -13,26 +12,28 @@ The top level (level 0):
 
 1. its least-squares rates of least norm, exact, are the answer when they are inside the
    bounds (the box-free optimum: no QP is built);
-2. otherwise, near a singularity, the damping of :class:`~solvers.jacobian_svd.Damping`;
-   the damped rates are the answer when inside the bounds;
-3. otherwise the QP (:mod:`solvers.qp`), solved by the backend:
+2. otherwise the QP (:mod:`solvers.qp`, :mod:`solvers.direction`), solved by the backend:
 
-   - direction-preserving (default, and standing still allowed): with w the (damped) rates,
+   - direction-preserving (default, and standing still allowed): with w the exact rates,
      :math:`\dot q = u\,c\,w + V_n y`, maximise :math:`u \in [0, 1]` subject to the bounds
      (and rows); the task velocity is :math:`u c` times the command's, whatever y, so the
      hand slows down along the command instead of veering (Drake's formulation; the null
      space parametrised, so no rank-deficient equality rows). The cap c <= 1 keeps u of order
      one for absurd commands. Without a null space, the largest feasible u is computed
-     directly;
+     directly. Near a singularity (:class:`~solvers.jacobian_svd.Damping`: a weak singular
+     direction, and exact rates beyond the bounds) the same problem is also solved along the
+     damped rates, and whichever goes further along the command answers (``damped``);
    - least squares (tracking mode, weighted priorities, or a joint recovering into its
-     range): :math:`\min \|A\dot q - b\|^2 + \sum_i\lambda_i^2 (v_i^T\dot q)^2 +
-     \epsilon\|\dot q\|^2` within the bounds.
+     range): :math:`\min \|A\dot q - b\|^2 + \epsilon\|\dot q\|^2` within the bounds,
+     exactly the least squares of the tasks' costs (a damping task adds Levenberg-Marquardt
+     damping).
 
-4. If the backend fails (an exception, no solution, or an answer outside the bounds beyond
-   its tolerance), the fallbacks answer in order: ``lp`` (the exact box-and-direction LP by
-   scipy's HiGHS: the largest u, any y), ``dls`` (the rates clipped), ``scaling`` (the
-   rates scaled uniformly into the bounds), and always last ``hold`` (the feasible rates
-   nearest zero). Nothing raises for numerical trouble.
+3. If the backend fails (an exception, no solution, or an answer outside the bounds beyond
+   its tolerance), the fallbacks answer in order: ``scipy`` (the same problem, exactly, by
+   scipy.optimize: the direction LP by HiGHS, the largest u with any y; or the bounded least
+   squares by BVLS), ``dls`` (the rates clipped), ``scaling`` (the rates scaled uniformly
+   into the bounds), and always last ``hold`` (the feasible rates nearest zero). Nothing
+   raises for numerical trouble.
 
 The lower levels (strict priorities): :math:`\dot q = x + N^T z` with x the answer so far
 and N the rows spanning the null space of every level above; the level's least squares in z
@@ -45,7 +46,6 @@ exactly feasible whatever the backend's tolerance.
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -54,12 +54,22 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from solvers.direction import direction_lp, direction_qp, uniform_scale
 from solvers.errors import InputError, ProblemError
-from solvers.jacobian_svd import Damping, JacobianSVD, uniform_scale
+from solvers.jacobian_svd import Damping, JacobianSVD
 from solvers.joint_bounds import StepBounds
 from solvers.qp import QP, Decoding
 from solvers.qp_backends import QPBackend
-from solvers.resolution import EXACT_TOL, METHODS, Method, Resolution, Status, TaskRows, norm
+from solvers.resolution import (
+    EXACT_TOL,
+    METHODS,
+    Method,
+    Resolution,
+    Status,
+    TaskRows,
+    norm,
+    scale_along,
+)
 
 Array = npt.NDArray[np.float64]
 
@@ -67,16 +77,15 @@ FEASIBILITY_TOL = 1e-6
 """A backend's answer may leave the bounds by this much times (1 + the norm of the velocity
 limits) before it counts as a failure (it is clipped back in either way)."""
 
-LEAST_NORM = 1e-9
+ROUNDING = 1e-12
+"""[rad/s] Slack given to the rows of a lower level's QP, whose start z = 0 sits on its
+bounds wherever a joint is at a bound."""
+
+LEAST_NORM = 1e-6
 """Weight of the least-norm term of the least-squares QPs, relative to the largest squared
-singular value (it makes P definite where the rows leave joints free)."""
-
-DIRECTION_REGULARIZATION = 1e-4
-r"""Weight :math:`\epsilon` of :math:`\tfrac12 u^2 + \tfrac12\|y\|^2/R^2` in the direction QP
-(R the radius of the bounds). Measured along panda's benchmark trajectory (1,500 QPs): the
-scale is within 1.3e-10 of the exact LP maximum; below 1e-6 DAQP declares up to 12% of these
-(feasible) problems infeasible."""
-
+singular value: it makes P definite where the rows leave joints free, and keeps DAQP's
+factorisation well conditioned (at 1e-9 it declared some feasible lower levels infeasible).
+The box-free optimum, used whenever it is inside the bounds, has no such term."""
 
 class Inequalities(NamedTuple):
     """Rows ``G qdot <= h`` that every answer must satisfy (collision, workspace walls).
@@ -108,14 +117,15 @@ class ResolveOptions:
 
     direction_preserving: bool = True
     damping: Damping | None = field(default_factory=Damping)
-    fallbacks: tuple[Method, ...] = ("lp", "scaling")
+    fallbacks: Sequence[Method] = ("scipy", "scaling")
 
     def __post_init__(self) -> None:
-        fallbacks = (self.fallbacks,) if isinstance(self.fallbacks, str) else self.fallbacks
+        given: Sequence[str] = self.fallbacks
         try:
-            fallbacks = tuple(fallbacks)
+            fallbacks = (given,) if isinstance(given, str) else tuple(given)
         except TypeError:
-            raise InputError("fallbacks", f"expected method names, got {self.fallbacks!r}") from None
+            got = self.fallbacks
+            raise InputError("fallbacks", f"expected method names, got {got!r}") from None
         for name in fallbacks:
             if name not in METHODS or name == "qp":
                 choices = ", ".join(m for m in METHODS if m != "qp")
@@ -152,19 +162,30 @@ class _Failed(Exception):
 
 @dataclass
 class _TopLevel:
-    """The top level's factorisation and the rates the fallbacks reuse."""
+    """The top level's factorisation, its exact rates, and the damping near singularities."""
 
     A: Array  # stacked, row-weighted rows
     b: Array
     svd: JacobianSVD
-    w: Array  # the (damped) least-squares rates
-    lam: Array | None  # squared damping per singular direction, None when undamped
-    inside: Array | None  # w when it satisfies the bounds and rows, else None
+    exact: Array  # the least-squares rates of least norm
+    fits: bool  # the exact rates satisfy the bounds and rows: the answer
+    lam: Array | None  # squared damping per singular direction where it may help, else None
+    damped: bool = False  # the damped direction answered (it went further along the command)
+
+    @property
+    def w(self) -> Array:
+        """The direction that answered: the damped rates or the exact ones."""
+        return self.svd.rates(self.b, self.lam) if self.damped else self.exact
+
+    @property
+    def smooth(self) -> Array:
+        """The damped rates where damping may help, else the exact ones (for fallbacks)."""
+        return self.exact if self.lam is None else self.svd.rates(self.b, self.lam)
 
     @property
     def lambda_sq(self) -> float:
-        """The largest squared damping (0 when undamped)."""
-        return 0.0 if self.lam is None else float(self.lam.max())
+        """The largest squared damping applied (0 when undamped)."""
+        return float(self.lam.max()) if self.damped and self.lam is not None else 0.0
 
 
 def resolve(
@@ -206,14 +227,14 @@ def resolve(
     if rows is not None and (rows.h < 0.0).any():
         direction = False  # standing still would violate a row: least squares
     try:
-        top = _top_level(levels[0], bounds, velocity, options, rows)
+        top = _top_level(levels[0], bounds, velocity, options, rows, direction)
         solved = _solve_top(top, bounds, backend, options, direction, rows)
     except (_Failed, ProblemError, np.linalg.LinAlgError, ArithmeticError, ValueError) as exc:
         attempts.append(("qp", str(exc)))
     if solved is None:
         for name in options.fallbacks:
             try:
-                solved = _fallback(name, top, bounds, rows)
+                solved = _fallback(name, top, bounds, rows, direction)
                 method = name
                 break
             except _Failed as exc:
@@ -231,8 +252,9 @@ def resolve(
                 break
     solved.qdot.flags.writeable = False
     return _report(
-        levels, bounds, method, top, solved, attempts, time.perf_counter() - t0, joint_names
-    )
+        levels, bounds, method, top, solved, attempts, time.perf_counter() - t0, joint_names,
+        weighted,
+    )  # fmt: skip
 
 
 def _stack(tasks: Sequence[TaskRows]) -> tuple[Array, Array]:
@@ -254,8 +276,7 @@ def _stack(tasks: Sequence[TaskRows]) -> tuple[Array, Array]:
 def _clipped(x: Array, bounds: StepBounds) -> tuple[Array, float]:
     """``x`` clipped into the bounds, and the Euclidean size of the clip (NaN for NaN)."""
     y = np.minimum(np.maximum(x, bounds.lb), bounds.ub)
-    change = y - x
-    return y, math.sqrt(change @ change)
+    return y, norm(y - x)
 
 
 def _rows_hold(x: Array, rows: Inequalities | None, tol: float = 0.0) -> bool:
@@ -268,20 +289,17 @@ def _top_level(
     velocity: Array,
     options: ResolveOptions,
     rows: Inequalities | None,
+    damp: bool,
 ) -> _TopLevel:
-    """Factorise the top level and find its (damped) least-squares rates."""
+    """Factorise the top level, its exact rates, and (if ``damp``) the damping it may need."""
     A, b = _stack(tasks)
     svd = JacobianSVD(A)
-    w = svd.rates(b)
+    exact = svd.rates(b)
+    fits = _clipped(exact, bounds)[1] == 0.0 and _rows_hold(exact, rows)
     lam = None
-    y, clip = _clipped(w, bounds)
-    if not (clip == 0.0 and _rows_hold(w, rows)) and options.damping is not None:
-        lam = options.damping.lambda_sq(svd, velocity, w, bounds.lb, bounds.ub)
-        if lam is not None:
-            w = svd.rates(b, lam)
-            y, clip = _clipped(w, bounds)
-    inside = w if clip == 0.0 and _rows_hold(w, rows) else None
-    return _TopLevel(A, b, svd, w, lam, inside)
+    if damp and not fits and options.damping is not None:
+        lam = options.damping.lambda_sq(svd, velocity, exact, bounds.lb, bounds.ub)
+    return _TopLevel(A, b, svd, exact, fits, lam)
 
 
 def _solve_top(
@@ -292,53 +310,63 @@ def _solve_top(
     direction: bool,
     rows: Inequalities | None,
 ) -> _Solved:
-    if top.inside is not None:  # the box-free optimum: no QP
-        return _Solved(top.inside.copy())
-    if direction:
-        qp, decoding = _direction_qp(top, bounds, rows, options)
-        w = decoding.M[:, -1]  # type: ignore[index]
-        u_floor = uniform_scale(w, bounds.lb, bounds.ub)  # u with y = 0: always feasible
-        if qp.q.size == 1 and rows is None:  # no null space: the largest feasible u
-            return _Solved(*_clipped(w * u_floor, bounds))
-        solved = _backend_solve(qp, decoding, bounds, backend, rows)
-        if rows is None and float(solved.qdot @ w) < u_floor * float(w @ w) * (1.0 - 1e-9):
-            solved.qdot, solved.clip = _clipped(w * u_floor, bounds)  # an inaccurate backend
-        return solved
-    qp, decoding = _least_squares_qp(top, bounds, rows, options)
-    return _backend_solve(qp, decoding, bounds, backend, rows)
+    """The top level's answer: the exact rates, or the QP (module docstring).
+
+    Near a singularity (``top.lam``) the direction-preserving problem is solved along the
+    exact and along the damped direction, and the one that goes further along the command
+    answers: damping only ever helps.
+    """
+    if top.fits:  # the box-free optimum: no QP
+        return _Solved(top.exact)
+    if not direction:
+        qp, decoding = _least_squares_qp(top, bounds, rows)
+        return _backend_solve(qp, decoding, bounds, backend, rows)
+    solved = _along(top.exact, top, bounds, backend, rows)
+    if top.lam is not None:
+        damped = top.svd.rates(top.b, top.lam)
+        inside = _clipped(damped, bounds)[1] == 0.0 and _rows_hold(damped, rows)
+        other = _Solved(damped) if inside else _along(damped, top, bounds, backend, rows)
+        if _progress(other, top) > _progress(solved, top):
+            top.damped = True
+            other.iterations += solved.iterations
+            other.solve_time += solved.solve_time
+            return other
+    return solved
 
 
-def _direction_qp(
-    top: _TopLevel, bounds: StepBounds, rows: Inequalities | None, options: ResolveOptions
-) -> tuple[QP, Decoding]:
-    """The direction-preserving QP (module docstring): z = (y, u), qdot = [V_n^T, c w] z."""
+def _progress(solved: _Solved, top: _TopLevel) -> float:
+    """How far along the top level's command an answer goes (its scale)."""
+    return scale_along(top.A @ solved.qdot, top.b)
+
+
+def _along(
+    w: Array, top: _TopLevel, bounds: StepBounds, backend: QPBackend, rows: Inequalities | None
+) -> _Solved:
+    """The direction-preserving problem along the rates ``w`` (solvers.direction)."""
     null = top.svd.null_basis()
+    if rows is None and null.shape[0] == 0:  # no null space: the largest uniform scale
+        return _Solved(*_clipped(uniform_scale(w, bounds.lb, bounds.ub) * w, bounds))
     d, n = null.shape
-    half = np.maximum(-bounds.lb, bounds.ub)
-    radius = norm(half)  # no feasible rates are longer, and w is orthogonal to the null space
-    length = norm(top.w)
-    M = np.empty((n, d + 1))
-    M[:, :d] = null.T
-    M[:, d] = top.w * (radius / length) if length > radius else top.w  # u of order one
-    eps = DIRECTION_REGULARIZATION
-    P = np.diag([eps / (radius * radius or 1.0)] * d + [eps])
-    q = np.array([0.0] * d + [-1.0])
-    lb = np.array([-np.inf] * d + [0.0])
-    ub = np.array([np.inf] * d + [1.0])
-    C, lo, hi = _rows_of(M, bounds, rows, None)
-    return QP(P, q, C, lo, hi, lb, ub, f"direction:{n}:{d}"), Decoding(None, M)
+    qp, decoding = direction_qp(w, null, bounds.lb, bounds.ub, f"direction:{n}:{d}")
+    if rows is not None:
+        C, lo, hi = _rows_of(decoding.M, bounds, rows, None)  # type: ignore[arg-type]
+        qp = qp._replace(C=C, l=lo, u=hi)
+    solved = _backend_solve(qp, decoding, bounds, backend, rows)
+    if rows is None:  # u with y = 0 is feasible: an accurate backend does at least as well
+        wc = decoding.M[:, -1]  # type: ignore[index]
+        u_floor = uniform_scale(wc, bounds.lb, bounds.ub)
+        if float(solved.qdot @ wc) < u_floor * float(wc @ wc) * (1.0 - 1e-9):
+            solved.qdot, solved.clip = _clipped(wc * u_floor, bounds)
+    return solved
 
 
 def _least_squares_qp(
-    top: _TopLevel, bounds: StepBounds, rows: Inequalities | None, options: ResolveOptions
+    top: _TopLevel, bounds: StepBounds, rows: Inequalities | None
 ) -> tuple[QP, Decoding]:
     """The tracking QP over qdot: min |A qdot - b|^2 + damping + eps |qdot|^2, box = bounds."""
     A, svd = top.A, top.svd
     n = A.shape[1]
     P = A.T @ A
-    if top.lam is not None:  # the damping of each direction, in the singular basis
-        Vr = svd.Vt[: svd.rank]
-        P += (Vr.T * top.lam[: svd.rank]) @ Vr
     top_sigma = float(svd.sigma[0]) if svd.sigma.size else 1.0
     P.flat[:: n + 1] += LEAST_NORM * max(top_sigma * top_sigma, 1.0)
     q = -(top.b @ A)
@@ -406,6 +434,9 @@ def _lower_level(
         top_sigma = float(svd.sigma[0]) if svd.sigma.size else 1.0
         P.flat[:: d + 1] += LEAST_NORM * max(top_sigma * top_sigma, 1.0)
         C, lo, hi = _rows_of(null.T, bounds, rows, x)
+        # z = 0 (the answer so far) is feasible: keep it so for the backend's tolerance where
+        # joints sit exactly on their bounds (the final clip restores them exactly)
+        lo, hi = np.minimum(lo, 0.0) - ROUNDING, np.maximum(hi, 0.0) + ROUNDING
         free = np.full(d, np.inf)
         qp = QP(P, -(c @ B), C, lo, hi, -free, free, f"level{k}:{n}:{d}")
         answer = _backend_solve(qp, Decoding(x, null.T), bounds, backend, rows)
@@ -418,7 +449,11 @@ def _lower_level(
 
 
 def _fallback(
-    name: Method, top: _TopLevel | None, bounds: StepBounds, rows: Inequalities | None
+    name: Method,
+    top: _TopLevel | None,
+    bounds: StepBounds,
+    rows: Inequalities | None,
+    direction: bool,
 ) -> _Solved:
     """One fallback method's answer (module docstring); raises _Failed when it cannot."""
     if name == "hold":
@@ -426,35 +461,38 @@ def _fallback(
     if top is None:
         raise _Failed("no factorisation of the top level")
     if name == "dls":
-        return _Solved(*_clipped(top.w, bounds))
+        return _Solved(*_clipped(top.smooth, bounds))
+    if name == "scipy":
+        return _Solved(*_clipped(_scipy(top, bounds, rows, direction), bounds))
     if not bounds.contains_zero:
         raise _Failed("a joint must recover: zero rates are outside the bounds")
-    if name == "scaling":
-        return _Solved(*_clipped(uniform_scale(top.w, bounds.lb, bounds.ub) * top.w, bounds))
-    return _Solved(*_clipped(_direction_lp(top, bounds, rows), bounds))
+    w = top.smooth
+    return _Solved(*_clipped(uniform_scale(w, bounds.lb, bounds.ub) * w, bounds))
 
 
-def _direction_lp(top: _TopLevel, bounds: StepBounds, rows: Inequalities | None) -> Array:
-    """The largest u of the direction problem, by scipy's HiGHS (exact, any y)."""
-    from scipy.optimize import linprog
+def _scipy(top: _TopLevel, bounds: StepBounds, rows: Inequalities | None, direction: bool) -> Array:
+    """The top level's problem solved exactly by scipy.optimize (slower than a backend)."""
+    if direction:
+        M = np.column_stack([top.svd.null_basis().T, top.exact])
+        C, lo, hi = _rows_of(M, bounds, rows, None)
+        try:
+            return direction_lp(M, C, lo, hi)
+        except ValueError as exc:
+            raise _Failed(str(exc)) from exc
+    if rows is not None:
+        raise _Failed("scipy's bounded least squares takes no inequality rows")
+    from scipy.optimize import lsq_linear
 
-    null = top.svd.null_basis()
-    d, n = null.shape
-    M = np.column_stack([null.T, top.w])
-    C, lo, hi = _rows_of(M, bounds, rows, None)
-    finite_lo = np.isfinite(lo)
-    cost = np.zeros(d + 1)
-    cost[d] = -1.0
-    result = linprog(
-        cost,
-        A_ub=np.vstack([C, -C[finite_lo]]),
-        b_ub=np.concatenate([hi, -lo[finite_lo]]),
-        bounds=[(None, None)] * d + [(0.0, 1.0)],
-        method="highs",
-    )
-    if result.status != 0 or result.x is None:
-        raise _Failed(f"linprog: {result.message}")
-    return np.asarray(M @ result.x, dtype=np.float64)
+    x: Array = bounds.lb.copy()  # joints with lb == ub are fixed there; BVLS takes the others
+    free = bounds.lb < bounds.ub
+    if free.any():
+        A = top.A[:, free]
+        result = lsq_linear(A, top.b - top.A[:, ~free] @ x[~free],
+                            bounds=(bounds.lb[free], bounds.ub[free]), method="bvls")  # fmt: skip
+        if not result.success:
+            raise _Failed(f"lsq_linear: {result.message}")
+        x[free] = result.x
+    return x
 
 
 def _report(
@@ -466,6 +504,7 @@ def _report(
     attempts: list[tuple[str, str]],
     elapsed: float,
     names: tuple[str, ...] | None,
+    weighted: bool,
 ) -> Resolution:
     """The Resolution: the status decided here where the pipeline knows it, else on access."""
     status: Status | None = None
@@ -473,9 +512,9 @@ def _report(
         status = "fallback"
     elif not bounds.contains_zero:
         status = "recovering"
-    elif top is not None and top.lam is not None:
+    elif top is not None and top.damped:
         status = "damped"
-    elif top is not None and top.svd.rank < top.A.shape[0]:
+    elif top is not None and not weighted and top.svd.rank < top.A.shape[0]:
         U = top.svd.U[:, : top.svd.rank]
         outside = top.b - (top.b @ U) @ U.T  # the command's part outside the Jacobian's range
         if norm(outside) > EXACT_TOL * (1.0 + norm(top.b)):
@@ -483,5 +522,13 @@ def _report(
     return Resolution(
         solved.qdot, method, solved.backend, solved.iterations, tuple(attempts), solved.clip,
         top.lambda_sq if top is not None else 0.0, elapsed - solved.solve_time,
-        solved.solve_time, bounds, tuple(tuple(level) for level in levels), names, status,
+        solved.solve_time, bounds, _copies(levels), names, status,
     )  # fmt: skip
+
+
+def _copies(levels: Sequence[Sequence[TaskRows]]) -> tuple[tuple[TaskRows, ...], ...]:
+    """The levels with copies of their rows and rates: the resolution is a snapshot."""
+    return tuple(
+        tuple(TaskRows(t.A.copy(), t.b.copy(), t.weight, t.name) for t in level)
+        for level in levels
+    )
