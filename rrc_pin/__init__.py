@@ -6,10 +6,12 @@ Entry points: :func:`arms`, :func:`load`, :class:`Robot`; :class:`Resolver` with
 and its answer, :class:`Resolution`.
 """
 
+from rrc_pin.combine import combine
 from rrc_pin.errors import (
     FrameNotFound,
     InvalidInput,
     RrcPinError,
+    ToolFrameRequired,
     UnknownArm,
     URDFError,
 )
@@ -38,9 +40,11 @@ __all__ = [
     "RrcPinError",
     "Task",
     "TaskReport",
+    "ToolFrameRequired",
     "URDFError",
     "UnknownArm",
     "UnknownBackend",
     "arms",
+    "combine",
     "load",
 ]

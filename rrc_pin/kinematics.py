@@ -42,7 +42,8 @@ class Layout(NamedTuple):
         body = pin.FrameType.BODY
         frames: dict[str, int] = {}
         for i, f in enumerate(model.frames):
-            if f.name not in frames or (f.type == body and model.frames[frames[f.name]].type != body):
+            first = frames.get(f.name)
+            if first is None or (f.type == body and model.frames[first].type != body):
                 frames[f.name] = i
         continuous = np.array([model.joints[j].nq == 2 for j in range(1, model.njoints)])
         return cls(model.nv, frames, {n: i for i, n in enumerate(joint_names)}, continuous)
@@ -73,7 +74,8 @@ class Kinematics:
     def jacobian(self, frame: str, ref: Reference = "world_aligned") -> Array:
         """Geometric Jacobian (6, nv) of ``frame``, rows [v; w], in frame ``ref``."""
         fid = self._layout.frames[frame]
-        return pin.getFrameJacobian(self._model, self._data, fid, PIN_REFERENCE[ref])
+        J: Array = pin.getFrameJacobian(self._model, self._data, fid, PIN_REFERENCE[ref])
+        return J
 
     def joint_index(self, joint: str) -> int:
         """Index in q of the joint named ``joint``."""

@@ -80,13 +80,14 @@ class QPOptions:
             arm, see docs/benchmarks.md), ``"osqp"``, or a qpsolvers solver (``proxqp``,
             ``quadprog``, ``clarabel``...).
         options: The backend's own settings, checked at construction.
-        fallbacks: Methods tried after the QP fails, in order: ``"lp"`` (exact direction
-            LP), ``"dls"``, ``"scaling"``; ``"hold"`` always ends the chain.
+        fallbacks: Methods tried after the QP fails, in order: ``"scipy"`` (the same problem
+            solved exactly by scipy.optimize), ``"dls"``, ``"scaling"``; ``"hold"`` always ends
+            the chain.
     """
 
     backend: str = "daqp"
     options: Mapping[str, Any] = field(default_factory=dict)
-    fallbacks: Sequence[Method] = ("lp", "scaling")
+    fallbacks: Sequence[Method] = ("scipy", "scaling")
 
 
 class Resolver:
@@ -98,6 +99,7 @@ class Resolver:
         task: The task of ``solve(q, twist)``: a :class:`~rrc_pin.tasks.FrameTask` whose
             frame, rows, ref and weights are used (its twist is the call's); default the
             robot's tool frame, full twist (position only below six joints), world_aligned.
+            A robot with several tool frames has no default: solve it with tasks.
         limits: Joint limits (default :class:`~rrc_pin.limits.JointLimits()`).
         qp: Backend and fallbacks (default :class:`QPOptions()`: daqp, then the exact LP).
         damping: Damping near singularities (default :class:`Damping()`), or None.
@@ -137,7 +139,7 @@ class Resolver:
         if damping is not None:
             _typed(damping, jacobian_svd.Damping, "damping")
         try:
-            self.options = ResolveOptions(direction_preserving, damping, _names(self.qp.fallbacks))
+            self.options = ResolveOptions(direction_preserving, damping, self.qp.fallbacks)
             self.backend = make_backend(self.qp.backend, **dict(self.qp.options))
         except BackendNotFound as exc:
             raise UnknownBackend(exc.backend, exc.available) from exc
@@ -147,8 +149,12 @@ class Resolver:
         self._data = robot.model.createData()  # this resolver's own: thread-safe across resolvers
         self._layout = Layout.of(robot.model, list(robot.joint_names))
         self.task = self._default_task() if task is None else _typed(task, FrameTask, "task")
-        self.task.check(self._layout)
-        self._frame = self._layout.frames[self.task.frame]
+        self._frame = -1
+        if self.task is not None:
+            self.task.check(self._layout)
+            self._frame = self._layout.frames[self.task.frame]
+        elif use_closed_form:
+            raise InvalidInput("use_closed_form", "the closed form needs a task (one frame)")
         self._closed_form = self._closed_form_for(self.task) if use_closed_form else None
         self._names = tuple(robot.joint_names)
         self._identity = robot.model.nq == robot.model.nv
@@ -215,7 +221,7 @@ class Resolver:
             kin = Kinematics(self.robot.model, self._data, self._layout, q, q_pin)
             rows = [[t.rows(kin) for t in level] for level in levels]
         else:
-            rows, weighted = [[self._twist_rows(q, command, ref)]], False
+            rows, weighted = [[self._twist_rows(q, command, ref)]], False  # type: ignore[arg-type]
         bounds = self._bounds.step(q, step, prev)
         result = resolve(
             rows, bounds, self._bounds.velocity, self.backend, self.options, weighted=weighted,
@@ -224,10 +230,28 @@ class Resolver:
         self._last_qdot = result.qdot
         return result
 
+    def rows_of(self, task: Task, q: npt.ArrayLike) -> TaskRows:
+        """The rows ``A qdot ~= b`` that ``task`` gives at ``q`` (what ``solve`` stacks).
+
+        Raises:
+            InvalidInput: A bad q, or a task that does not fit the robot.
+            FrameNotFound: The task names a frame the robot does not have.
+        """
+        q = self.robot.check_q(q)
+        _typed(task, Task, "task").check(self._layout)
+        q_pin = q if self._identity else self.robot.to_pinocchio(q)
+        return task.rows(Kinematics(self.robot.model, self._data, self._layout, q, q_pin))
+
     def _twist_rows(self, q: Array, twist: npt.ArrayLike, ref: Reference | None) -> TaskRows:
         """The resolver's task at ``q`` with ``twist``: one Pinocchio (or closed-form) call."""
         task = self.task
-        b = np.array(task.check_twist(twist))  # a copy: the resolution is a snapshot
+        if task is None:
+            raise InvalidInput(
+                "command", f"{self.robot.name} has several tool frames "
+                f"({', '.join(self.robot.tool_frames)}): pass tasks, e.g. [FrameTask(frame, "
+                "twist)], or Resolver(robot, task=FrameTask(frame))",
+            )  # fmt: skip
+        b = task.check_twist(twist)
         ref = task.ref if ref is None else check_reference(ref)
         if ref == "world" and len(task.selected) != 6:
             raise InvalidInput("ref", "'world' is the spatial velocity at the base origin: "
@@ -251,7 +275,7 @@ class Resolver:
         """The tasks as priority levels, every task checked against the robot."""
         if priority not in ("weighted", "strict"):
             raise InvalidInput("priority", f"expected 'weighted' or 'strict', got {priority!r}")
-        items = [command] if isinstance(command, Task) else list(command)  # type: ignore[arg-type]
+        items = [command] if isinstance(command, Task) else list(command)
         if not items:
             raise InvalidInput("command", "expected a twist, a task or a non-empty list of tasks")
         if priority == "weighted":
@@ -274,19 +298,20 @@ class Resolver:
                 t.check(self._layout)  # type: ignore[union-attr]
         return levels, priority == "weighted"  # type: ignore[return-value]
 
-    def _default_task(self) -> FrameTask:
+    def _default_task(self) -> FrameTask | None:
+        """The robot's tool frame, full twist (position below six joints).
+
+        None when the robot has several tool frames (then ``solve`` takes tasks).
+        """
         frame = self.robot.tool_frame
         if frame is None:
-            raise InvalidInput(
-                "task", f"{self.robot.name} has several tool frames "
-                f"({', '.join(getattr(self.robot, 'tool_frames', ()))}): pass "
-                "task=FrameTask(frame) or solve with tasks",
-            )  # fmt: skip
+            return None
         return FrameTask(frame, rows="full" if self.robot.nq >= 6 else "position")
 
-    def _closed_form_for(self, task: FrameTask) -> Any:
+    def _closed_form_for(self, task: FrameTask | None) -> Any:
         cf = self.robot.closed_form
-        if cf is None or task.frame != getattr(cf, "frame", "tool") or task.frame != self.robot.tool_frame:
+        assert task is not None
+        if cf is None or task.frame != cf.frame or task.frame != self.robot.tool_frame:
             raise InvalidInput(
                 "use_closed_form",
                 f"{self.robot.name} has no closed form for frame {task.frame!r} (the papers' "
@@ -312,21 +337,8 @@ def _typed(value: Any, kind: type, name: str) -> Any:
     return value
 
 
-def _names(fallbacks: Sequence[str] | str) -> tuple[str, ...]:
-    """A fallback chain as a tuple of names (one name alone is a chain of one)."""
-    if isinstance(fallbacks, str):
-        return (fallbacks,)
-    try:
-        return tuple(fallbacks)
-    except TypeError:
-        raise InvalidInput("qp.fallbacks", f"expected method names, got {fallbacks!r}") from None
-
-
 def _is_tasks(command: Any) -> bool:
-    """True when ``command`` is a non-empty list of tasks or of levels of tasks."""
+    """True when ``command`` is a list of tasks or of levels (lists) of tasks, not a twist."""
     if isinstance(command, np.ndarray) or not isinstance(command, (list, tuple)):
         return False
-    return bool(command) and all(
-        isinstance(t, Task) or (isinstance(t, (list, tuple)) and t and isinstance(t[0], Task))
-        for t in command
-    )
+    return any(isinstance(t, (Task, list, tuple)) for t in command)

@@ -57,7 +57,9 @@ class JointLimits:
                 "velocity=\"0\" or none); pass JointLimits(velocity=[...]) in rad/s or m/s",
             )
         if np.size(velocity) != robot.nq:
-            raise InvalidInput("velocity", f"expected shape ({robot.nq},), got {np.shape(velocity)}")
+            raise InvalidInput(
+                "velocity", f"expected shape ({robot.nq},), got {np.shape(velocity)}"
+            )
         try:
             return JointBounds(
                 robot.lower, robot.upper, velocity, self.margin, self.acceleration,

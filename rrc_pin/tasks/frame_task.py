@@ -94,7 +94,7 @@ class FrameTask(Task):
         J = kin.jacobian(self.frame, self.ref)
         if len(self.selected) != 6:
             J = J[list(self.selected)]
-        return TaskRows(J, self.twist.copy(), self.row_weights, self.name)
+        return TaskRows(J, self.twist, self.row_weights, self.name)
 
 
 def check_reference(ref: str) -> Reference:
@@ -116,7 +116,9 @@ def task_rows(rows: str | Sequence[int] | Sequence[bool]) -> tuple[int, ...]:
     """
     if isinstance(rows, str):
         if rows not in ROWS:
-            raise InvalidInput("rows", f"expected one of {', '.join(ROWS)} or indices, got {rows!r}")
+            raise InvalidInput(
+                "rows", f"expected one of {', '.join(ROWS)} or indices, got {rows!r}"
+            )
         return ROWS[rows]
     arr = np.asarray(rows)
     if arr.dtype == bool:
@@ -127,6 +129,7 @@ def task_rows(rows: str | Sequence[int] | Sequence[bool]) -> tuple[int, ...]:
         selected = tuple(int(i) for i in arr)
     else:
         raise InvalidInput("rows", f"expected row indices, got {rows!r}")
-    if not selected or len(set(selected)) != len(selected) or not all(0 <= r < 6 for r in selected):
+    repeated = len(set(selected)) != len(selected)
+    if not selected or repeated or not all(0 <= r < 6 for r in selected):
         raise InvalidInput("rows", f"expected distinct rows in 0..5, got {rows!r}")
     return selected

@@ -45,7 +45,8 @@ class JointTask(Task):
             InvalidInput: Unknown joint (the error lists the robot's joints).
         """
         if self.joint not in layout.joints:
-            raise InvalidInput("joint", f"no joint {self.joint!r}; joints: {', '.join(layout.joints)}")
+            joints = ", ".join(layout.joints)
+            raise InvalidInput("joint", f"no joint {self.joint!r}; joints: {joints}")
 
     def rows(self, kin: Kinematics) -> TaskRows:
         """One row selecting the joint."""

@@ -6,11 +6,14 @@ from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
+import pinocchio as pin
 
+from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.tasks.frame_task import FrameTask
 from rrc_pin.tasks.task import Task
 from solvers.resolution import TaskRows
+from solvers.validation import as_array, finite_number
 
 Array = npt.NDArray[np.float64]
 
@@ -26,8 +29,11 @@ class RelativeFrameTask(Task):
         J_{ab} = \begin{bmatrix} R_a^T (J_b^v - J_a^v + [p_b - p_a]_\times J_a^\omega) \\
                  R_a^T (J_b^\omega - J_a^\omega) \end{bmatrix}
 
-    (Jacobians ``world_aligned``). A zero twist keeps :math:`T_a^{-1}T_b` constant: two
-    hands holding one object keep their grip while the pair moves.
+    (Jacobians ``world_aligned``). A zero twist keeps :math:`T_a^{-1}T_b` constant to first
+    order: two hands holding one object keep their grip while the pair moves, up to the
+    integration's error. With a ``target`` pose :math:`T^*` of b in a, the commanded
+    relative twist gets the feedback :math:`k\,[p^* - p_{ab};\ \log(R^* R_{ab}^T)]` (in a's
+    axes), which removes that drift.
 
     Args:
         frame_a: The reference frame (e.g. the left hand).
@@ -35,10 +41,12 @@ class RelativeFrameTask(Task):
         twist: Relative twist (6,) [m/s, rad/s] or the selected rows; default zero.
         rows: Row selection as in :class:`FrameTask`.
         weight: Cost > 0, scalar or per selected row.
+        target: Pose (4, 4) of frame b in frame a to hold (e.g. the grasp), or None.
+        gain: k > 0 [1/s], the fraction of the pose error corrected per second.
         name: Name in the report (default ``"frame_b/frame_a"``).
 
     Raises:
-        InvalidInput: Bad twist, rows or weight.
+        InvalidInput: Bad twist, rows, weight, target or gain.
     """
 
     def __init__(
@@ -49,11 +57,16 @@ class RelativeFrameTask(Task):
         *,
         rows: str | Sequence[int] | Sequence[bool] = "full",
         weight: float | npt.ArrayLike = 1.0,
+        target: npt.ArrayLike | None = None,
+        gain: float = 10.0,
         name: str | None = None,
     ) -> None:
         self._spec = FrameTask(frame_b, twist, rows=rows, weight=weight, name=name)
         self.frame_a, self.frame_b = frame_a, frame_b
-        self.twist, self.weight, self.selected = self._spec.twist, self._spec.weight, self._spec.selected
+        self.twist, self.weight = self._spec.twist, self._spec.weight
+        self.selected = self._spec.selected
+        self.target = None if target is None else as_array(target, "target", (4, 4), InvalidInput)
+        self.gain = finite_number(gain, "gain", 0.0, inclusive=False, error=InvalidInput)
         self.name = f"{frame_b}/{frame_a}" if name is None else name
 
     def frames(self) -> tuple[str, ...]:
@@ -69,6 +82,13 @@ class RelativeFrameTask(Task):
         d = Tb[:3, 3] - Ta[:3, 3]
         cross = np.array([[0.0, -d[2], d[1]], [d[2], 0.0, -d[0]], [-d[1], d[0], 0.0]])
         J = np.vstack([Rt @ (Jb[:3] - Ja[:3] + cross @ Ja[3:]), Rt @ (Jb[3:] - Ja[3:])])
+        b = self.twist.copy()
+        if self.target is not None:
+            R_ab = Rt @ Tb[:3, :3]
+            error = np.concatenate([
+                self.target[:3, 3] - Rt @ d, pin.log3(self.target[:3, :3] @ R_ab.T)
+            ])  # fmt: skip
+            b = b + self.gain * error[list(self.selected)]
         if len(self.selected) != 6:
             J = J[list(self.selected)]
-        return TaskRows(J, self.twist.copy(), self._spec.row_weights, self.name)
+        return TaskRows(J, b, self._spec.row_weights, self.name)

@@ -44,7 +44,7 @@ class Task(ABC):
         """
         for frame in self.frames():
             if frame not in layout.frames:
-                raise FrameNotFound(frame, sorted(layout.frames))
+                raise FrameNotFound(frame, sorted(layout.frames), "frame")
 
     def _row_weights(self, m: int) -> Array | None:
         """The weight as (m,) row weights, or None when it is 1 everywhere."""
