@@ -196,7 +196,8 @@ class DHChain:
 
     def fk(self, q: npt.ArrayLike) -> Matrix4:
         """Tool pose in the base frame, shape (4, 4)."""
-        return self.frames(q)[-1] @ np.asarray(self.tool)
+        T: Matrix4 = self.frames(q)[-1] @ np.asarray(self.tool)
+        return T
 
     def joint_axes(
         self, q: npt.ArrayLike

@@ -78,10 +78,11 @@ def _compare(
         names_b = [_label(k, 0, 1) for k in kids_b]
         out.append(f"{path}: committed children {names_a}, generated {names_b}")
         return
-    for i, (x, y) in enumerate(zip(kids_a, kids_b, strict=True)):
-        same_tag = sum(k.tag == x.tag for k in kids_a)
-        index = sum(k.tag == x.tag for k in kids_a[:i])
-        _compare(x, y, f"{path}/{_label(x, index, same_tag)}", rel, floor, out)
+    for i, (child_a, child_b) in enumerate(zip(kids_a, kids_b, strict=True)):
+        same_tag = sum(k.tag == child_a.tag for k in kids_a)
+        index = sum(k.tag == child_a.tag for k in kids_a[:i])
+        label = _label(child_a, index, same_tag)
+        _compare(child_a, child_b, f"{path}/{label}", rel, floor, out)
 
 
 def _same_value(x: str, y: str, rel: float, floor: float) -> bool:

@@ -66,6 +66,17 @@ def test_star_import_exports_exist():
     assert rrc_pin.__all__ == sorted(rrc_pin.__all__)
 
 
+def test_mypy_is_clean():
+    """Strict typing of both packages (pyproject.toml's [tool.mypy])."""
+    out = subprocess.run(
+        [sys.executable, "-m", "mypy", "--no-incremental"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+    )
+    assert out.returncode == 0, out.stdout + out.stderr
+
+
 def test_ruff_is_clean():
     out = subprocess.run(
         [sys.executable, "-m", "ruff", "check", "--no-cache", "."],
