@@ -27,5 +27,12 @@ def test_readme_example_runs():
     namespace: dict = {}
     exec(compile(example, "README.md", "exec"), namespace)
     r = namespace["r"]
-    assert r.qdot.shape == (6,) and r.method.startswith("qp")
+    assert r.qdot.shape == (15,) and r.method == "qp"
+    assert [t.level for t in r.tasks] == [0, 0, 1]
     assert namespace["Qdot"].shape == (1000, 6)
+
+
+def test_documents_stand_alone():
+    """A clone has no ../shared: the README and docs never point there."""
+    for path in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        assert "../shared" not in path.read_text(), path
