@@ -124,7 +124,7 @@ def test_away_from_singularities_the_command_is_met_exactly(arms: dict) -> None:
     r = Resolver(arm).solve(q, twist)
     np.testing.assert_allclose(J @ r.qdot, twist, atol=1e-15)
     np.testing.assert_allclose(r.qdot, np.linalg.pinv(J) @ twist, atol=1e-14)
-    assert r.status == "exact" and r.scale == 1.0 and r.lambda_sq == 0.0
+    assert r.status == "exact" and r.scale == pytest.approx(1.0, abs=1e-12) and r.lambda_sq == 0.0
 
 
 @pytest.mark.parametrize("name", ["panda", "ur5", "barker6"])
