@@ -157,7 +157,6 @@ class Resolver:
             raise InvalidInput("use_closed_form", "the closed form needs a task (one frame)")
         self._closed_form = self._closed_form_for(self.task) if use_closed_form else None
         self._names = tuple(robot.joint_names)
-        self._identity = robot.model.nq == robot.model.nv
         self._last_qdot: Array | None = None
 
     def reset(self) -> None:
@@ -207,7 +206,7 @@ class Resolver:
             FrameNotFound: A task names a frame the robot does not have (the error lists
                 them).
         """
-        q = self.robot.check_q(q)
+        q, q_pin = self.robot.configuration(q)
         step = self.dt if dt is None else _dt(dt)
         prev = None
         if self.limits.acceleration is not None:
@@ -217,11 +216,11 @@ class Resolver:
             if ref is not None:
                 raise InvalidInput("ref", "tasks carry their own ref; pass ref to FrameTask")
             levels, weighted = self._levels(command, priority)  # type: ignore[arg-type]
-            q_pin = q if self._identity else self.robot.to_pinocchio(q)
             kin = Kinematics(self.robot.model, self._data, self._layout, q, q_pin)
             rows = [[t.rows(kin) for t in level] for level in levels]
         else:
-            rows, weighted = [[self._twist_rows(q, command, ref)]], False  # type: ignore[arg-type]
+            rows = [[self._twist_rows(q, q_pin, command, ref)]]  # type: ignore[arg-type]
+            weighted = False
         bounds = self._bounds.step(q, step, prev)
         result = resolve(
             rows, bounds, self._bounds.velocity, self.backend, self.options, weighted=weighted,
@@ -237,12 +236,13 @@ class Resolver:
             InvalidInput: A bad q, or a task that does not fit the robot.
             FrameNotFound: The task names a frame the robot does not have.
         """
-        q = self.robot.check_q(q)
+        q, q_pin = self.robot.configuration(q)
         _typed(task, Task, "task").check(self._layout)
-        q_pin = q if self._identity else self.robot.to_pinocchio(q)
         return task.rows(Kinematics(self.robot.model, self._data, self._layout, q, q_pin))
 
-    def _twist_rows(self, q: Array, twist: npt.ArrayLike, ref: Reference | None) -> TaskRows:
+    def _twist_rows(
+        self, q: Array, q_pin: Array, twist: npt.ArrayLike, ref: Reference | None
+    ) -> TaskRows:
         """The resolver's task at ``q`` with ``twist``: one Pinocchio (or closed-form) call."""
         task = self.task
         if task is None:
@@ -261,7 +261,6 @@ class Resolver:
                 raise InvalidInput("ref", f"the closed form gives world_aligned rows, got {ref!r}")
             J = np.asarray(self._closed_form.jacobian(q), dtype=np.float64)
         else:
-            q_pin = q if self._identity else self.robot.to_pinocchio(q)
             J = pin.computeFrameJacobian(
                 self.robot.model, self._data, q_pin, self._frame, PIN_REFERENCE[ref]
             )

@@ -212,16 +212,26 @@ class Robot:
         Raises:
             InvalidInput: ``q`` is not a finite (nq,) vector.
         """
+        return self.configuration(q)[1]
+
+    def configuration(
+        self, q: npt.ArrayLike
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """``q`` checked (nq,) and as Pinocchio's configuration vector (model.nq,).
+
+        Raises:
+            InvalidInput: ``q`` is not a finite (nq,) vector.
+        """
         q = self.check_q(q)
         if self._identity_map:
-            return q
+            return q, q
         out = np.empty(self.model.nq)
         api, pin_idx = self._scalar
         out[pin_idx] = q[api]
         api, pin_idx = self._angle
         out[pin_idx] = np.cos(q[api])
         out[pin_idx + 1] = np.sin(q[api])
-        return out
+        return q, out
 
     def neutral(self) -> npt.NDArray[np.float64]:
         """The zero configuration clipped into the joint limits, (nq,) [rad or m]."""

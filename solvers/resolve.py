@@ -142,7 +142,7 @@ class ResolveOptions:
         object.__setattr__(self, "fallbacks", chain)
 
 
-@dataclass
+@dataclass(slots=True)
 class _Solved:
     """What one level's solve produced (mutable while the pipeline runs).
 
@@ -160,7 +160,7 @@ class _Failed(Exception):
     """A method did not produce a usable answer (internal control flow)."""
 
 
-@dataclass
+@dataclass(slots=True)
 class _TopLevel:
     """The top level's factorisation, its exact rates, and the damping near singularities."""
 

@@ -16,6 +16,7 @@ import numpy.typing as npt
 
 from solvers.errors import InputError
 
+Array = npt.NDArray[np.float64]
 Reference = Literal["world_aligned", "local", "world"]
 REFERENCES: tuple[str, ...] = ("world_aligned", "local", "world")
 
@@ -27,12 +28,7 @@ def check_reference(ref: str, error: type[InputError] = InputError) -> Reference
     return ref  # type: ignore[return-value]
 
 
-def from_world_aligned(
-    M: npt.NDArray[np.float64],
-    rotation: npt.NDArray[np.float64],
-    position: npt.NDArray[np.float64],
-    ref: Reference,
-) -> npt.NDArray[np.float64]:
+def from_world_aligned(M: Array, rotation: Array, position: Array, ref: Reference) -> Array:
     """Express twists or Jacobian columns given in ``world_aligned`` in frame ``ref``.
 
     Args:
@@ -52,16 +48,9 @@ def from_world_aligned(
     return np.concatenate([v - np.cross(w, position, axis=0), w])
 
 
-def to_world_aligned(
-    M: npt.NDArray[np.float64],
-    rotation: npt.NDArray[np.float64],
-    position: npt.NDArray[np.float64],
-    ref: Reference,
-) -> npt.NDArray[np.float64]:
-    """Inverse of :func:`from_world_aligned`: ``M`` from frame ``ref`` to ``world_aligned``."""
-    if ref == "world_aligned":
-        return M
-    v, w = M[:3], M[3:]
-    if ref == "local":
-        return np.concatenate([rotation @ v, rotation @ w])
-    return np.concatenate([v + np.cross(w, position, axis=0), w])
+def to_world_aligned(M: Array, rotation: Array, position: Array, ref: Reference) -> Array:
+    """Inverse of :func:`from_world_aligned`: ``M`` from frame ``ref`` to ``world_aligned``.
+
+    The same change with the rotation transposed and the position negated.
+    """
+    return from_world_aligned(M, rotation.T, -position, ref)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import warnings
 
@@ -208,9 +207,9 @@ def test_the_resolution_is_immutable() -> None:
     scale = r.scale
     for field in ("qdot", "method", "backend", "iterations", "attempts", "clip", "lambda_sq",
                   "bounds", "levels", "known_status", "scale", "status", "active"):  # fmt: skip
-        with pytest.raises(dataclasses.FrozenInstanceError):
+        with pytest.raises(AttributeError):
             setattr(r, field, None)
-    with pytest.raises(dataclasses.FrozenInstanceError):
+    with pytest.raises(AttributeError):
         del r.method
     with pytest.raises(ValueError, match="read-only"):
         r.qdot[0] = 1.0
@@ -241,7 +240,7 @@ def test_a_resolution_built_directly() -> None:
     assert r.scale == 0.5 and r.residual == 1.0 and r.status == "fallback"
     assert r.active == (ActiveLimit(0, "upper", "velocity", 1.0, None),)
     assert r.tasks[0].bound_by == r.active
-    unknown = dataclasses.replace(r, known_status=None)
+    unknown = r._replace(known_status=None)
     assert unknown.status == "scaled"
-    missed = dataclasses.replace(unknown, qdot=np.array([0.5, 0.5]))
+    missed = unknown._replace(qdot=np.array([0.5, 0.5]))
     assert missed.status == "least_squares" and missed.scale == 0.25
