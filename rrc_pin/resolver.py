@@ -76,8 +76,8 @@ class QPOptions:
 
     Attributes:
         backend: A name of :func:`solvers.qp_backends.installed_backends`: ``"daqp"``
-            (default: exact active-set answers, fastest median and tail on every catalogue
-            arm, see docs/benchmarks.md), ``"osqp"``, or a qpsolvers solver (``proxqp``,
+            (default: exact active-set answers, the fastest median and tail of rrc-pin's
+            backends in docs/benchmarks.md), ``"osqp"``, or a qpsolvers solver (``proxqp``,
             ``quadprog``, ``clarabel``...).
         options: The backend's own settings, checked at construction.
         fallbacks: Methods tried after the QP fails, in order: ``"scipy"`` (the same problem

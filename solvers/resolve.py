@@ -56,7 +56,7 @@ import numpy.typing as npt
 
 from solvers.direction import direction_lp, direction_qp, uniform_scale
 from solvers.errors import InputError, ProblemError
-from solvers.jacobian_svd import Damping, JacobianSVD
+from solvers.jacobian_svd import Damping, JacobianSVD, normal_rates
 from solvers.joint_bounds import StepBounds
 from solvers.qp import QP, Decoding
 from solvers.qp_backends import QPBackend
@@ -86,6 +86,7 @@ LEAST_NORM = 1e-6
 singular value: it makes P definite where the rows leave joints free, and keeps DAQP's
 factorisation well conditioned (at 1e-9 it declared some feasible lower levels infeasible).
 The box-free optimum, used whenever it is inside the bounds, has no such term."""
+
 
 class Inequalities(NamedTuple):
     """Rows ``G qdot <= h`` that every answer must satisfy (collision, workspace walls).
@@ -162,15 +163,22 @@ class _Failed(Exception):
 
 @dataclass(slots=True)
 class _TopLevel:
-    """The top level's factorisation, its exact rates, and the damping near singularities."""
+    """The top level's rows, its exact rates, and the damping near singularities."""
 
     A: Array  # stacked, row-weighted rows
     b: Array
-    svd: JacobianSVD
     exact: Array  # the least-squares rates of least norm
     fits: bool  # the exact rates satisfy the bounds and rows: the answer
-    lam: Array | None  # squared damping per singular direction where it may help, else None
+    factor: JacobianSVD | None  # the SVD, once a step needs it (see svd)
+    lam: Array | None = None  # squared damping per singular direction where it may help
     damped: bool = False  # the damped direction answered (it went further along the command)
+
+    @property
+    def svd(self) -> JacobianSVD:
+        """The SVD of the rows (computed on first use: most steps do not need it)."""
+        if self.factor is None:
+            self.factor = JacobianSVD(self.A)
+        return self.factor
 
     @property
     def w(self) -> Array:
@@ -246,7 +254,8 @@ def resolve(
             if null is None or null.shape[0] == 0:
                 break
             try:
-                null = _lower_level(level, solved, null, bounds, backend, options, rows, k)
+                last = k == len(levels) - 1
+                null = _lower_level(level, solved, null, bounds, backend, rows, k, last)
             except (_Failed, ProblemError, np.linalg.LinAlgError, ArithmeticError) as exc:
                 attempts.append((f"level {k}", f"{exc}; the levels above kept"))
                 break
@@ -291,15 +300,18 @@ def _top_level(
     rows: Inequalities | None,
     damp: bool,
 ) -> _TopLevel:
-    """Factorise the top level, its exact rates, and (if ``damp``) the damping it may need."""
+    """The top level's exact rates, and (if ``damp``) the damping it may need."""
     A, b = _stack(tasks)
-    svd = JacobianSVD(A)
-    exact = svd.rates(b)
+    factor = None
+    exact = normal_rates(A, b)
+    if exact is None:  # not well posed for the normal equations: the SVD
+        factor = JacobianSVD(A)
+        exact = factor.rates(b)
     fits = _clipped(exact, bounds)[1] == 0.0 and _rows_hold(exact, rows)
-    lam = None
+    top = _TopLevel(A, b, exact, fits, factor)
     if damp and not fits and options.damping is not None:
-        lam = options.damping.lambda_sq(svd, velocity, exact, bounds.lb, bounds.ub)
-    return _TopLevel(A, b, svd, exact, fits, lam)
+        top.lam = options.damping.lambda_sq(top.svd, velocity, exact, bounds.lb, bounds.ub)
+    return top
 
 
 def _solve_top(
@@ -328,6 +340,7 @@ def _solve_top(
         other = _Solved(damped) if inside else _along(damped, top, bounds, backend, rows)
         if _progress(other, top) > _progress(solved, top):
             top.damped = True
+            other.backend = other.backend or solved.backend  # the exact direction's ran too
             other.iterations += solved.iterations
             other.solve_time += solved.solve_time
             return other
@@ -364,11 +377,9 @@ def _least_squares_qp(
     top: _TopLevel, bounds: StepBounds, rows: Inequalities | None
 ) -> tuple[QP, Decoding]:
     """The tracking QP over qdot: min |A qdot - b|^2 + damping + eps |qdot|^2, box = bounds."""
-    A, svd = top.A, top.svd
+    A = top.A
     n = A.shape[1]
-    P = A.T @ A
-    top_sigma = float(svd.sigma[0]) if svd.sigma.size else 1.0
-    P.flat[:: n + 1] += LEAST_NORM * max(top_sigma * top_sigma, 1.0)
+    P = _with_least_norm(A.T @ A, top.svd)
     q = -(top.b @ A)
     if rows is None:
         qp = QP(P, q, None, None, None, bounds.lb, bounds.ub, f"least_squares:{n}")
@@ -376,6 +387,16 @@ def _least_squares_qp(
         qp = QP(P, q, rows.G, np.full(rows.h.size, -np.inf), rows.h, bounds.lb, bounds.ub,
                 f"least_squares:{n}:{rows.h.size}")  # fmt: skip
     return qp, Decoding(None, None)
+
+
+def _with_least_norm(P: Array, svd: JacobianSVD) -> Array:
+    """``P`` (d, d), the normal matrix of the rows ``svd`` factorises, plus the least norm term.
+
+    The term is :data:`LEAST_NORM` times the largest squared singular value (at least 1).
+    """
+    top_sigma = float(svd.sigma[0]) if svd.sigma.size else 1.0
+    P.flat[:: P.shape[0] + 1] += LEAST_NORM * max(top_sigma * top_sigma, 1.0)
+    return P
 
 
 def _rows_of(
@@ -414,25 +435,29 @@ def _lower_level(
     null: Array,
     bounds: StepBounds,
     backend: QPBackend,
-    options: ResolveOptions,
     rows: Inequalities | None,
     k: int,
-) -> Array:
+    last: bool,
+) -> Array | None:
     """Serve one lower level in the null space ``null`` (d, n) of the levels above.
 
-    Updates ``solved`` in place; returns the null space left for the next level.
+    Updates ``solved`` in place; returns the null space left for the next level (None after
+    the ``last`` one, whose SVD is then not needed when the normal equations answer).
     """
     A, b = _stack(tasks)
     x = solved.qdot
     B = A @ null.T
     c = b - A @ x
-    svd = JacobianSVD(B)
-    candidate, clip = _clipped(x + svd.rates(c) @ null, bounds)
+    svd = None
+    z = normal_rates(B, c) if last else None
+    if z is None:
+        svd = JacobianSVD(B)
+        z = svd.rates(c)
+    candidate, clip = _clipped(x + z @ null, bounds)
     if not (clip == 0.0 and _rows_hold(candidate, rows)):
         d, n = null.shape
-        P = B.T @ B
-        top_sigma = float(svd.sigma[0]) if svd.sigma.size else 1.0
-        P.flat[:: d + 1] += LEAST_NORM * max(top_sigma * top_sigma, 1.0)
+        svd = svd or JacobianSVD(B)
+        P = _with_least_norm(B.T @ B, svd)
         C, lo, hi = _rows_of(null.T, bounds, rows, x)
         # z = 0 (the answer so far) is feasible: keep it so for the backend's tolerance where
         # joints sit exactly on their bounds (the final clip restores them exactly)
@@ -445,7 +470,7 @@ def _lower_level(
         solved.iterations += answer.iterations
         solved.solve_time += answer.solve_time
     solved.qdot, solved.clip = candidate, clip
-    return svd.null_basis() @ null
+    return None if last else (svd or JacobianSVD(B)).null_basis() @ null
 
 
 def _fallback(
@@ -514,7 +539,7 @@ def _report(
         status = "recovering"
     elif top is not None and top.damped:
         status = "damped"
-    elif top is not None and not weighted and top.svd.rank < top.A.shape[0]:
+    elif top is not None and top.factor is not None and top.factor.rank < top.A.shape[0]:
         U = top.svd.U[:, : top.svd.rank]
         outside = top.b - (top.b @ U) @ U.T  # the command's part outside the Jacobian's range
         if norm(outside) > EXACT_TOL * (1.0 + norm(top.b)):

@@ -70,6 +70,14 @@ class FrameTask(Task):
         self.name = frame if name is None else name
         self.twist = np.zeros(len(self.selected)) if twist is None else self.check_twist(twist)
 
+    def set_twist(self, twist: npt.ArrayLike) -> None:
+        """Command a new twist (checked as at construction): keep a task across ticks.
+
+        Raises:
+            InvalidInput: Wrong shape or a non-finite entry; the task is then unchanged.
+        """
+        self.twist = self.check_twist(twist)
+
     def check_twist(self, twist: npt.ArrayLike) -> Array:
         """``twist`` as the selected rows: (6,) or (rows,) finite.
 

@@ -69,6 +69,14 @@ class RelativeFrameTask(Task):
         self.gain = finite_number(gain, "gain", 0.0, inclusive=False, error=InvalidInput)
         self.name = f"{frame_b}/{frame_a}" if name is None else name
 
+    def set_twist(self, twist: npt.ArrayLike) -> None:
+        """Command a new relative twist (checked): keep a task across ticks.
+
+        Raises:
+            InvalidInput: Wrong shape or a non-finite entry; the task is then unchanged.
+        """
+        self.twist = self._spec.check_twist(twist)
+
     def frames(self) -> tuple[str, ...]:
         """Both frames."""
         return (self.frame_a, self.frame_b)
