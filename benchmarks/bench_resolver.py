@@ -1,31 +1,38 @@
-"""The resolver against pink's ``solve_ik``: step time and limit compliance, one run.
+"""The resolver against pink's ``solve_ik``: step time as users run it, and limit compliance.
 
-Run from a checkout: ``/work/venv/bin/python benchmarks/bench_resolver.py`` (``--quick``
-for a short smoke run that writes nothing; ``--steps N`` to change the trajectory length).
+Run from a checkout: ``python benchmarks/bench_resolver.py --out DIR`` (``--record`` writes
+``benchmarks/results/`` instead, ``--quick`` a short smoke run, ``--steps N`` the trajectory
+length; with neither ``--out`` nor ``--record`` nothing is written). ``rrc-pin bench`` runs it.
 
-For rrc_k1607 and panda, one trajectory of joint configurations is recorded first: from a
-seeded random start, piecewise-constant random twists (new every 50 steps, about 0.4 m/s
-and 0.6 rad/s) are resolved by rrc-pin (native OSQP) and integrated with dt = 10 ms, so that
-position and velocity limits become active along the way. Then, at every recorded
-configuration q_k with its twist, every contender computes joint rates once, the contenders
-interleaved step by step so that they share the machine's state (warm starts carry from
-step to step as in a control loop). A step's time is the whole call:
+One arm at a time (rrc_k1607, panda), one trajectory of joint configurations is recorded
+first: from a seeded random start, piecewise-constant random twists (new every 50 steps,
+about 0.4 m/s and 0.6 rad/s) are resolved by rrc-pin in tracking mode
+(``Resolver(arm, dt, direction_preserving=False)``, DAQP) and integrated with dt = 10 ms, so
+that position and velocity limits become active along the way. Then every contender
+computes joint rates at every recorded configuration q_k with its twist. A step's time is
+the whole call, as its users make it:
 
-- rrc-pin: ``Resolver.solve(q, twist)`` (Pinocchio Jacobian, bounds, factorisation, QP,
-  record); native warm-started OSQP, each qpsolvers backend, the direction-preserving
-  default, and OSQP without the shortcuts (box-free optimum, guessed active set: every
-  step through the backend). With the shortcuts the backend answers only the steps whose
-  active set changed (about 1%), so the backends differ mostly in the tail;
-- pink (``pink.solve_ik``): ``configuration.update(q)``, the FrameTask target set to the pose
-  moved by ``twist * dt``, ``solve_ik(..., limits=[ConfigurationLimit(gain=1),
-  VelocityLimit])`` with every qpsolvers backend pink accepts. pink raises when its QP has no
-  solution (counted as a failure, rates taken as zero).
+- rrc-pin: ``Resolver.solve(q, twist)`` (Pinocchio Jacobian, bounds, one SVD, the QP when
+  the box-free optimum leaves the bounds, the Resolution): the default (DAQP,
+  direction-preserving), tracking (DAQP, ``direction_preserving=False``), OSQP and every
+  other installed backend (direction-preserving);
+- pink (``pink.solve_ik``): ``configuration.update(q)``, the FrameTask target set to the
+  pose moved by ``twist * dt``, ``solve_ik(..., limits=[ConfigurationLimit(gain=1),
+  VelocityLimit])`` with every qpsolvers backend pink accepts. pink raises when its QP has
+  no solution (a failure, rates taken as zero).
 
-Compliance of every answer: the largest excess of ``|qdot|`` over the velocity limit and of
-``q + qdot dt`` over the position limits. BLAS threads are pinned to one (set before numpy
-is imported) so that the tiny matrix products do not pay for thread hand-offs; both
-libraries run under the same setting. Results go to ``benchmarks/results/resolver.json`` and
-``resolver.png``; :func:`markdown_table` renders them and is printed at the end.
+Each contender is timed in the three modes of :mod:`timing` (tight loop, 1 kHz loop with
+``time.sleep`` to the next tick, interleaved with its peers in an order shuffled at each
+step), each mode from fresh contenders. Per contender and mode: median, p10, p90, p99 and
+mean [us], the ratio to pink's fastest backend of that mode (its median over the
+contender's, its p99 over the contender's: above 1, faster than pink), the largest
+velocity and position excess, failures; per rrc-pin contender how its steps were answered
+(status, method, backend share, active bounds). Then where the default's step time goes:
+:mod:`stage_profile` (``time.perf_counter`` wrappers around each stage). BLAS threads are
+pinned to one (set before numpy is imported) for both libraries, so that the tiny matrix
+products do not pay for thread hand-offs; OSQP's C-level prints are sent to /dev/null.
+Results: ``resolver.json`` and ``resolver.png``; :func:`docs_section` and
+:func:`readme_table` render them (``update_readme.py``).
 """
 
 from __future__ import annotations
@@ -36,22 +43,31 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import argparse  # noqa: E402
-import contextlib  # noqa: E402
 import json  # noqa: E402
 import logging  # noqa: E402
 import sys  # noqa: E402
-import time  # noqa: E402
 import warnings  # noqa: E402
-from collections.abc import Callable, Iterator  # noqa: E402
+from collections import Counter  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
-from machine import machine_info  # noqa: E402
+from machine import load_average, machine_info, source_state  # noqa: E402
+from stage_profile import profile_steps, profile_table  # noqa: E402
+from timing import (  # noqa: E402
+    MODE_TITLES,
+    MODES,
+    PERIOD,
+    Contender,
+    add_ratios,
+    progress,
+    quiet_stdout,
+    run_mode,
+    summarise,
+)
 
 import rrc_pin  # noqa: E402
-from rrc_pin.resolver import Resolver  # noqa: E402
 from solvers.qp_backends import installed_backends  # noqa: E402
 
 ARMS = ("rrc_k1607", "panda")
@@ -59,13 +75,18 @@ RESULTS = Path(__file__).resolve().parent / "results"
 SEED = 20261122
 DT = 0.01
 SEGMENT = 50
+STEPS, QUICK_STEPS = 2000, 100
+DEFAULT = "rrc-pin default (daqp, direction)"
+TRACKING = "rrc-pin tracking (daqp)"
+BACKEND_MODULES = ("daqp", "osqp", "proxsuite", "quadprog", "clarabel")
+"""Modules of the QP backends, for the versions recorded."""
+
+Array = np.ndarray
 
 
-def record_trajectory(
-    arm: Any, steps: int, rng: np.random.Generator
-) -> tuple[np.ndarray, np.ndarray]:
+def record_trajectory(arm: Any, steps: int, rng: np.random.Generator) -> tuple[Array, Array]:
     """Configurations (steps, nq) and twists (steps, 6) of one rrc-pin run (module docstring)."""
-    resolver = Resolver(arm, dt=DT, direction_preserving=False)
+    resolver = rrc_pin.Resolver(arm, dt=DT, direction_preserving=False)
     q = arm.random_q(rng)
     Q = np.empty((steps, arm.nq))
     X = np.empty((steps, 6))
@@ -78,263 +99,396 @@ def record_trajectory(
     return Q, X
 
 
-def rrc_contenders(arm: Any) -> dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]]:
-    """rrc-pin resolvers under test, by label."""
-    out: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]] = {}
-
-    def make(**kwargs: Any) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
-        resolver = Resolver(arm, dt=DT, **kwargs)
-        return lambda q, x: resolver.solve(q, x).qdot
-
-    out["rrc-pin osqp (native, warm)"] = make(backend="osqp", direction_preserving=False)
-    out["rrc-pin osqp, no shortcut"] = make(
-        backend="osqp", direction_preserving=False, shortcut=False
-    )
-    out["rrc-pin osqp, direction-preserving"] = make(backend="osqp", direction_preserving=True)
+def rrc_options() -> dict[str, dict[str, Any]]:
+    """The rrc-pin contenders: label to Resolver keyword arguments."""
+    out: dict[str, dict[str, Any]] = {
+        DEFAULT: {},
+        TRACKING: {"direction_preserving": False},
+    }
     for name in installed_backends():
-        if name != "osqp":
-            out[f"rrc-pin {name}"] = make(backend=name, direction_preserving=False)
+        if name != "daqp":
+            out[f"rrc-pin {name} (direction)"] = {"qp": rrc_pin.QPOptions(backend=name)}
     return out
 
 
-def pink_contenders(arm: Any) -> dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]]:
-    """pink.solve_ik with every qpsolvers backend, on the same task and limits."""
+def rrc_contenders(arm: Any) -> list[Contender]:
+    """Fresh rrc-pin resolvers, each calling ``solve(q, twist)``, keeping the Resolutions."""
+    out = []
+    for label, kwargs in rrc_options().items():
+        resolver = rrc_pin.Resolver(arm, dt=DT, **kwargs)
+        out.append(Contender(label, resolver.solve, rates=lambda r: r.qdot, keep=True))
+    return out
+
+
+def pink_backends() -> list[str]:
+    """The qpsolvers backends pink is run with (every one installed), or [] without pink."""
     try:
-        import pink
+        import pink  # noqa: F401
         import qpsolvers
-        from pink.limits import ConfigurationLimit, VelocityLimit
-        from pink.tasks import FrameTask
     except ImportError:
-        return {}
+        return []
+    return list(qpsolvers.available_solvers)
+
+
+def pink_contenders(arm: Any) -> list[Contender]:
+    """pink.solve_ik with every qpsolvers backend, on the same task and limits."""
+    if not pink_backends():
+        return []
+    import pink
+    from pink.limits import ConfigurationLimit, VelocityLimit
+    from pink.tasks import FrameTask
+
     logging.getLogger().setLevel(logging.ERROR)  # pink logs every near-limit configuration
-    model = arm.model
-    out: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]] = {}
-    for solver in qpsolvers.available_solvers:
+    model, frame = arm.model, arm.tool_frame
+    out = []
+    for solver in pink_backends():
         configuration = pink.Configuration(model, model.createData(), arm.neutral())
-        task = FrameTask(arm.tool_frame, position_cost=1.0, orientation_cost=1.0)
+        task = FrameTask(frame, position_cost=1.0, orientation_cost=1.0)
         limits = [ConfigurationLimit(model, config_limit_gain=1.0), VelocityLimit(model)]
 
         def step(
-            q: np.ndarray,
-            x: np.ndarray,
+            q: Array,
+            x: Array,
             configuration: Any = configuration,
             task: Any = task,
             limits: Any = limits,
             solver: str = solver,
-        ) -> np.ndarray:
+        ) -> Array:
             configuration.update(q)
-            T = configuration.get_transform_frame_to_world(arm.tool_frame)
-            target = pin.SE3(pin.exp3(x[3:] * DT) @ T.rotation, T.translation + x[:3] * DT)
-            task.set_target(target)
+            T = configuration.get_transform_frame_to_world(frame)
+            task.set_target(pin.SE3(pin.exp3(x[3:] * DT) @ T.rotation, T.translation + x[:3] * DT))
             return pink.solve_ik(
                 configuration, [task], DT, solver=solver, limits=limits, safety_break=False
             )
 
-        out[f"pink {solver}"] = step
+        out.append(Contender(f"pink {solver}", step))
     return out
+
+
+def rrc_statistics(resolutions: list[Any]) -> dict[str, Any]:
+    """How a contender's steps were answered: status, method and backend counts, active bounds,
+    the resolver's own build time (median over every step [us]) and backend solve time
+    (median over the steps that called the backend [us]), the largest clip [rad/s]."""
+    n = len(resolutions)
+    backends = Counter(r.backend for r in resolutions if r.backend)
+    solves = [r.solve_time for r in resolutions if r.backend]
+    return {
+        "steps": n,
+        "status": dict(Counter(r.status for r in resolutions).most_common()),
+        "method": dict(Counter(r.method for r in resolutions).most_common()),
+        "backend_share": sum(backends.values()) / n if n else 0.0,
+        "backends": dict(backends.most_common()),
+        "active_fraction": sum(bool(r.active) for r in resolutions) / n if n else 0.0,
+        "with_attempts": sum(bool(r.attempts) for r in resolutions),
+        "build_time_median_us": float(np.median([r.build_time for r in resolutions]) * 1e6),
+        "backend_solve_median_us": float(np.median(solves) * 1e6) if solves else 0.0,
+        "max_clip": float(max((r.clip for r in resolutions), default=0.0)),
+    }
 
 
 def bench_arm(name: str, steps: int) -> dict[str, Any]:
-    """Time and compliance of every contender along one trajectory of arm ``name``."""
+    """Every contender in every mode along one trajectory of arm ``name``, then the profile."""
     arm = rrc_pin.load(name)
-    rng = np.random.default_rng(SEED)
-    Q, X = record_trajectory(arm, steps, rng)
-    contenders = {**rrc_contenders(arm), **pink_contenders(arm)}
-    with _quiet_stdout():  # OSQP's C code prints "Polishing not needed" when nothing is active
-        rows = _run(arm, Q, X, contenders, rng)
-    ours = rows["rrc-pin osqp (native, warm)"]
-    pinks = {k: v for k, v in rows.items() if k.startswith("pink")}
-    active, routes = _routes(arm, Q, X)
-    summary: dict[str, Any] = {"steps": steps, "active_limit_fraction": active, "routes": routes}
-    if pinks:
-        fastest = min(pinks, key=lambda k: pinks[k]["median_us"])
-        summary.update(
-            pink_fastest=fastest,
-            speedup_median=pinks[fastest]["median_us"] / ours["median_us"],
-            speedup_p99=pinks[fastest]["p99_us"] / ours["p99_us"],
-        )
-    return {"arm": name, "nq": arm.nq, "summary": summary, "contenders": rows}
+    progress(f"{name}: recording {steps} steps (rrc-pin tracking)")
+    Q, X = record_trajectory(arm, steps, np.random.default_rng(SEED))
+    limits = (arm.lower, arm.upper, arm.velocity_limit)
+    shuffle = np.random.default_rng(SEED + 1)
+    modes: dict[str, Any] = {}
+    rrc: dict[str, Any] = {}
+    for mode in MODES:
+        contenders = rrc_contenders(arm) + pink_contenders(arm)
+        progress(f"{name}: {MODE_TITLES[mode]}, {len(contenders)} contenders")
+        with quiet_stdout():  # OSQP's C code prints "Polishing not needed"
+            runs = run_mode(mode, contenders, Q, X, shuffle, PERIOD)
+        rows = summarise(runs, Q, limits, DT)
+        pinks = [k for k in rows if k.startswith("pink ")]
+        fastest = min(pinks, key=lambda k: rows[k]["median_us"]) if pinks else None
+        if fastest is not None:
+            add_ratios(rows, fastest)
+        modes[mode] = {"pink_fastest": fastest, "contenders": rows}
+        rrc[mode] = {c.label: rrc_statistics(runs[c.label].kept) for c in contenders if c.keep}
+    progress(f"{name}: profile of the default")
+    profile = profile_default(arm, Q, X)
+    recorded = rrc["tight"].get(TRACKING, {})
+    return {
+        "arm": name,
+        "nq": arm.nq,
+        "tool_frame": arm.tool_frame,
+        "trajectory": {
+            "steps": steps,
+            "recorded_by": "rrc_pin.Resolver(arm, dt, direction_preserving=False) (DAQP)",
+            "active_fraction": recorded.get("active_fraction"),
+        },
+        "modes": modes,
+        "rrc_pin": rrc,
+        "profile": profile,
+    }
 
 
-def _run(
-    arm: Any,
-    Q: np.ndarray,
-    X: np.ndarray,
-    contenders: dict[str, Callable[[np.ndarray, np.ndarray], np.ndarray]],
-    rng: np.random.Generator,
-) -> dict[str, dict[str, Any]]:
-    """Every contender at every step (shuffled order): times and limit excesses."""
-    times: dict[str, list[float]] = {label: [] for label in contenders}
-    v_excess = dict.fromkeys(contenders, 0.0)
-    q_excess = dict.fromkeys(contenders, 0.0)
-    failures = dict.fromkeys(contenders, 0)
-    v_max, lower, upper = arm.velocity_limit, arm.lower, arm.upper
-    clock = time.perf_counter
-    order = list(contenders)
-    for q, x in zip(Q, X, strict=True):
-        rng.shuffle(order)  # no contender always runs first, after another one's cache misses
-        for label in order:
-            t0 = clock()
-            try:
-                qdot = contenders[label](q, x)
-            except Exception:  # pink raises NoSolutionFound (and others) on failure
-                qdot = np.zeros(arm.nq)
-                failures[label] += 1
-            times[label].append(clock() - t0)
-            step = q + qdot * DT
-            v_excess[label] = max(v_excess[label], float(np.max(np.abs(qdot) - v_max)))
-            q_excess[label] = max(
-                q_excess[label], float(np.max(step - upper)), float(np.max(lower - step))
-            )
-    out = {}
-    for label in contenders:
-        t = np.array(times[label]) * 1e6
-        out[label] = {
-            "median_us": float(np.median(t)),
-            "p99_us": float(np.percentile(t, 99)),
-            "mean_us": float(np.mean(t)),
-            "max_velocity_excess": v_excess[label],
-            "max_position_excess": q_excess[label],
-            "failures": failures[label],
-        }
-    return out
+def profile_default(arm: Any, Q: Array, X: Array) -> dict[str, Any]:
+    """The default's stage profile (:mod:`stage_profile`), with the plain tight-loop median
+    of the same trajectory and the instrumentation's overhead [us]."""
+    reference = rrc_pin.Resolver(arm, dt=DT)
+    rates = np.array([reference.solve(q, x).qdot for q, x in zip(Q, X, strict=True)])
+    plain = rrc_pin.Resolver(arm, dt=DT)
+    run = run_mode("tight", [Contender(DEFAULT, plain.solve, lambda r: r.qdot)], Q, X)
+    resolver = rrc_pin.Resolver(arm, dt=DT)
+    profile = profile_steps(lambda q, x: resolver.solve(q, x), resolver, Q, X, rates)
+    profile["plain_median_us"] = float(np.median(run[DEFAULT].seconds) * 1e6)
+    profile["overhead_us"] = (
+        profile["stages"]["all"]["total"]["median_us"] - profile["plain_median_us"]
+    )
+    return profile
 
 
-@contextlib.contextmanager
-def _quiet_stdout() -> Iterator[None]:
-    """Send file descriptor 1 (C-level prints) to /dev/null for the duration."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    devnull = os.open(os.devnull, os.O_WRONLY)
-    try:
-        os.dup2(devnull, 1)
-        yield
-    finally:
-        os.dup2(saved, 1)
-        os.close(devnull)
-        os.close(saved)
+def main(argv: list[str] | None = None) -> int:
+    """Run the benchmark; write JSON and PNG to --out or (--record) benchmarks/results."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help=f"{QUICK_STEPS} steps per arm")
+    parser.add_argument("--steps", type=int, default=None, help=f"trajectory length ({STEPS})")
+    where = parser.add_mutually_exclusive_group()
+    where.add_argument("--out", type=Path, help="folder for resolver.json and resolver.png")
+    where.add_argument("--record", action="store_true", help="write benchmarks/results/")
+    parser.add_argument("--arms", nargs="+", default=list(ARMS), help="arms (rrc_k1607 panda)")
+    args = parser.parse_args(argv)
+    steps = args.steps or (QUICK_STEPS if args.quick else STEPS)
+    if steps < 2:
+        parser.error("--steps: at least 2")
+    if args.record and (
+        args.quick or steps != STEPS or args.arms != list(ARMS) or not pink_backends()
+    ):
+        parser.error(f"--record keeps full runs only ({STEPS} steps, every arm, pink installed)")
+    warnings.simplefilter("ignore")
+    start = load_average()
+    results: dict[str, Any] = {
+        "benchmark": "resolver",
+        "machine": machine_info("qpsolvers", "pink", *BACKEND_MODULES),
+        "source": source_state(),
+        "settings": {
+            "dt": DT,
+            "steps": steps,
+            "segment": SEGMENT,
+            "seed": SEED,
+            "period_s": PERIOD,
+            "khz_wait": "time.sleep to the next tick",
+            "quick": bool(args.quick),
+            "pink_backends": pink_backends(),
+        },
+        "notes": [] if pink_backends() else ["pink is not installed: its rows are absent"],
+        "arms": [bench_arm(a, steps) for a in args.arms],
+    }
+    results["load_average"] = {"start": start, "end": load_average()}
+    out = RESULTS if args.record else args.out
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "resolver.json").write_text(json.dumps(results, indent=2) + "\n")
+        if plot(results, out / "resolver.png"):
+            progress(f"wrote {out / 'resolver.json'} and resolver.png")
+        else:
+            progress(f"wrote {out / 'resolver.json'} (matplotlib not installed: no plot)")
+    print(readme_table(results))
+    return 0
 
 
-def _routes(arm: Any, Q: np.ndarray, X: np.ndarray) -> tuple[float, dict[str, int]]:
-    """Fraction of the steps with a bound active in rrc-pin's answer, and how the main
-    contender's steps were answered (status counts: box-free optimum, guessed active set,
-    backend)."""
-    resolver = Resolver(arm, dt=DT, direction_preserving=False)
-    hits = 0
-    routes: dict[str, int] = {}
-    for q, x in zip(Q, X, strict=True):
-        r = resolver.solve(q, x)
-        hits += bool(r.active)
-        route = "backend" if r.backend else r.status
-        routes[route] = routes.get(route, 0) + 1
-    return hits / len(Q), routes
+# ---- rendering (update_readme.py) -------------------------------------------------------------
 
 
-def markdown_table(results: dict[str, Any]) -> str:
-    """Markdown table of a results dictionary (as written to resolver.json).
+def _us(x: float) -> str:
+    return f"{x:,.0f}" if x >= 10 else f"{x:.1f}"
 
-    Per arm: median and 99th percentile of every contender's step time, and both as a
-    ratio against pink's fastest backend (its median over the contender's median, and the
-    same for the 99th percentile: above 1, faster than pink); then the limit compliance.
-    """
-    lines = []
+
+def _ratio(row: dict[str, Any], key: str) -> str:
+    value = row.get(key)
+    return "-" if value is None else f"{value:.2f}x"
+
+
+def readme_table(results: dict[str, Any]) -> str:
+    """The README's table: for each arm, rrc-pin default and tracking against pink's fastest
+    backend, median and p99 in each mode, and the ratios (pink's time over rrc-pin's)."""
+    head = "| arm | contender |"
+    rule = "| --- | --- |"
+    for mode in MODES:
+        head += f" {MODE_TITLES[mode]}: median / p99 [us] | vs pink |"
+        rule += " ---: | ---: |"
+    lines = [head, rule]
     for arm in results["arms"]:
-        s = arm["summary"]
-        head = (
-            f"**{arm['arm']}** ({arm['nq']} joints, {s['steps']} steps, a bound active at "
-            f"{100 * s['active_limit_fraction']:.0f}% of them)"
-        )
-        pink = arm["contenders"].get(s.get("pink_fastest", ""))
-        if pink is not None:
-            head += (
-                f": rrc-pin (native OSQP) is {s['speedup_median']:.1f}x faster than "
-                f"{s['pink_fastest']} at the median, {s['speedup_p99']:.1f}x at the 99th percentile"
-            )
-        routes = s.get("routes")
-        if routes:
-            total = sum(routes.values())
-            head += "; its steps answered by: " + ", ".join(
-                f"{name} {100 * count / total:.1f}%"
-                for name, count in sorted(routes.items(), key=lambda kv: -kv[1])
-            )
-        lines += [
-            head,
-            "",
-            "| contender | median [us] | p99 [us] | median vs pink fastest | "
-            "p99 vs pink fastest | max velocity excess [rad/s] | max position excess [rad] "
-            "| failures |",
-            "|---|---:|---:|---:|---:|---:|---:|---:|",
-        ]
-        for label, r in sorted(arm["contenders"].items(), key=lambda kv: kv[1]["median_us"]):
-            ratios = ("-", "-")
-            if pink is not None:
-                ratios = (
-                    f"{pink['median_us'] / r['median_us']:.2f}x",
-                    f"{pink['p99_us'] / r['p99_us']:.2f}x",
+        modes = arm["modes"]
+        labels = [DEFAULT, TRACKING]
+        for label in [*labels, "pink fastest"]:
+            cells = f"| {arm['arm']} | {label} |"
+            if label == "pink fastest":
+                names = [modes[m]["pink_fastest"] or "-" for m in MODES]
+                cells = f"| {arm['arm']} | pink fastest ({', '.join(_short(n) for n in names)}) |"
+            for mode in MODES:
+                rows = modes[mode]["contenders"]
+                key = modes[mode]["pink_fastest"] if label == "pink fastest" else label
+                row = rows.get(key) if key else None
+                if row is None:
+                    cells += " - | - |"
+                    continue
+                ratio = (
+                    "1"
+                    if label == "pink fastest"
+                    else (
+                        f"{row.get('vs_baseline_median', float('nan')):.1f}x / "
+                        f"{row.get('vs_baseline_p99', float('nan')):.1f}x"
+                    )
                 )
-            lines.append(
-                f"| {label} | {r['median_us']:.0f} | {r['p99_us']:.0f} | {ratios[0]} | "
-                f"{ratios[1]} | {r['max_velocity_excess']:.2g} | "
-                f"{r['max_position_excess']:.2g} | {r['failures']} |"
-            )
-        lines.append("")
+                cells += f" {_us(row['median_us'])} / {_us(row['p99_us'])} | {ratio} |"
+            lines.append(cells)
+    lines += ["", _setup_line(results)]
     return "\n".join(lines)
 
 
-def plot(results: dict[str, Any], path: Path) -> None:
-    """Bar chart of median and p99 step times per contender and arm."""
-    import matplotlib
-    import matplotlib.ticker
+def _short(label: str) -> str:
+    return label.removeprefix("pink ")
 
+
+def _setup_line(results: dict[str, Any]) -> str:
+    s, m = results["settings"], results["machine"]
+    load = results.get("load_average", {})
+    arms = ", ".join(
+        f"{a['arm']} ({a['nq']} joints, a bound active at "
+        f"{100 * (a['trajectory']['active_fraction'] or 0):.0f}% of the steps)"
+        for a in results["arms"]
+    )
+    text = (
+        f"{s['steps']} steps of a seeded random teleoperation ({arms}), dt = {1000 * s['dt']:g} "
+        "ms. rrc-pin default: `Resolver(arm)` (DAQP, direction-preserving); tracking: "
+        "`direction_preserving=False`; pink: `solve_ik` with the same frame task and limits, "
+        "its fastest qpsolvers backend in each mode. Ratios: pink's time over rrc-pin's (above "
+        "1: rrc-pin faster), median / p99. Measured on "
+        f"{m['cpu']} ({m['cores']} cores), Python {m['python']}, Pinocchio {m['pinocchio']}, "
+        f"pink {m.get('pink')}"
+    )
+    if load:
+        text += (
+            f", load average {load['start'][0]:.2f} at the start, {load['end'][0]:.2f} at the end"
+        )
+    return text + "."
+
+
+def docs_section(results: dict[str, Any]) -> str:
+    """Every table of the resolver benchmark, for docs/benchmarks.md."""
+    s = results["settings"]
+    lines = [
+        f"Trajectories: {s['steps']} steps, dt = {1000 * s['dt']:g} ms, twists new every "
+        f"{s['segment']} steps (seed {s['seed']}), recorded by rrc-pin in tracking mode. The "
+        "1 kHz loop waits with `time.sleep` until the next 1 ms tick. Ratios: pink's fastest "
+        "backend of the same mode (by median) over the contender: its median over the "
+        "contender's median, its p99 over the contender's p99 (above 1: faster than pink).",
+        "",
+    ]
+    for note in results.get("notes", []):
+        lines += [f"- {note}", ""]
+    for arm in results["arms"]:
+        t = arm["trajectory"]
+        lines += [
+            f"### {arm['arm']} ({arm['nq']} joints, tool frame `{arm['tool_frame']}`)",
+            "",
+            f"A bound is active in rrc-pin tracking's answer at "
+            f"{100 * (t['active_fraction'] or 0):.1f}% of the {t['steps']} steps.",
+            "",
+        ]
+        for mode in MODES:
+            m = arm["modes"][mode]
+            lines += [
+                f"**{MODE_TITLES[mode]}** (pink's fastest: {m['pink_fastest'] or '-'})",
+                "",
+                "| contender | median [us] | p10 | p90 | p99 | mean | median vs pink | "
+                "p99 vs pink | max velocity excess [rad/s] | max position excess [rad] | "
+                "failures |",
+                "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+            ]
+            for label, r in sorted(m["contenders"].items(), key=lambda kv: kv[1]["median_us"]):
+                lines.append(
+                    f"| {label} | {_us(r['median_us'])} | {_us(r['p10_us'])} | "
+                    f"{_us(r['p90_us'])} | {_us(r['p99_us'])} | {_us(r['mean_us'])} | "
+                    f"{_ratio(r, 'vs_baseline_median')} | {_ratio(r, 'vs_baseline_p99')} | "
+                    f"{r['max_velocity_excess']:.2g} | {r['max_position_excess']:.2g} | "
+                    f"{r['failures']} |"
+                )
+            overruns = {k: r["overruns"] for k, r in m["contenders"].items() if r["overruns"]}
+            if overruns:
+                lines += [
+                    "",
+                    "Ticks overrun (call longer than 1 ms): "
+                    + ", ".join(f"{k} {v}" for k, v in overruns.items()),
+                ]
+            errors = {k: r["first_error"] for k, r in m["contenders"].items() if "first_error" in r}
+            if errors:
+                lines += [
+                    "",
+                    "First failure: " + "; ".join(f"{k}: `{v[:120]}`" for k, v in errors.items()),
+                ]
+            lines.append("")
+        lines += _routes_table(arm) + profile_table(arm["profile"], "the default")
+    return "\n".join(lines)
+
+
+def _routes_table(arm: dict[str, Any]) -> list[str]:
+    stats = arm["rrc_pin"]["tight"]
+    statuses = sorted({s for r in stats.values() for s in r["status"]})
+    lines = [
+        "How rrc-pin's steps were answered (tight loop; the same in every mode): status counts, "
+        "share answered by the backend (the rest: the box-free optimum, or a closed-form scale), "
+        "steps with a failed attempt (then a fallback answered), the resolver's own times: "
+        "its build time (everything but the backend, median over all steps) and the backend's "
+        "solve time (median over the steps that called it).",
+        "",
+        "| contender | " + " | ".join(statuses) + " | backend share | bound active | "
+        "failed attempts | build [us] | backend solve [us] |",
+        "| --- |" + " ---: |" * (len(statuses) + 5),
+    ]
+    for label, r in stats.items():
+        counts = " | ".join(str(r["status"].get(s, 0)) for s in statuses)
+        lines.append(
+            f"| {label} | {counts} | {100 * r['backend_share']:.1f}% | "
+            f"{100 * r['active_fraction']:.1f}% | {r['with_attempts']} | "
+            f"{r['build_time_median_us']:.1f} | {r.get('backend_solve_median_us', 0.0):.1f} |"
+        )
+    return [*lines, ""]
+
+
+def plot(results: dict[str, Any], path: Path) -> bool:
+    """Median step time per contender, mode and arm (bars), p99 as a tick; False without
+    matplotlib (nothing written)."""
+    try:
+        import matplotlib
+    except ImportError:
+        return False
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    import matplotlib.ticker
 
     arms = results["arms"]
-    fig, axes = plt.subplots(1, len(arms), figsize=(7 * len(arms), 5), squeeze=False)
+    fig, axes = plt.subplots(1, len(arms), figsize=(7.5 * len(arms), 6), squeeze=False)
+    width = 0.27
     for ax, arm in zip(axes[0], arms, strict=True):
-        items = sorted(arm["contenders"].items(), key=lambda kv: kv[1]["median_us"])
-        labels = [k for k, _ in items]
-        med = [v["median_us"] for _, v in items]
-        p99 = [v["p99_us"] for _, v in items]
+        tight = arm["modes"]["tight"]["contenders"]
+        labels = sorted(tight, key=lambda k: tight[k]["median_us"])
         y = np.arange(len(labels))
-        ax.barh(y - 0.2, med, 0.4, label="median")
-        ax.barh(y + 0.2, p99, 0.4, label="99th percentile")
+        for i, mode in enumerate(MODES):
+            rows = arm["modes"][mode]["contenders"]
+            med = [rows[k]["median_us"] for k in labels]
+            p99 = [rows[k]["p99_us"] for k in labels]
+            offset = (i - 1) * width
+            ax.barh(y + offset, med, width, label=f"{MODE_TITLES[mode]} (median)")
+            ax.plot(p99, y + offset, "k|", markersize=7)
+        ax.plot([], [], "k|", label="p99")
         ax.set_yticks(y, labels)
         ax.set_xscale("log")
-        ax.set_xlim(left=50.0)
         ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
         ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
         ax.invert_yaxis()
         ax.set_xlabel("step time [us] (log)")
         ax.set_title(f"{arm['arm']}: one resolved-rate step")
-        ax.legend()
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
-
-
-def main(argv: list[str] | None = None) -> None:
-    """Run the benchmark, write JSON and PNG (unless --quick), print the table."""
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--quick", action="store_true", help="short run, writes nothing")
-    parser.add_argument("--steps", type=int, default=2000, help="trajectory length")
-    args = parser.parse_args(argv)
-    steps = 100 if args.quick else args.steps
-    warnings.simplefilter("ignore")
-    results = {
-        "machine": {
-            **machine_info("osqp", "qpsolvers", "pink"),
-            "blas_threads": os.environ.get("OPENBLAS_NUM_THREADS"),
-        },
-        "dt": DT,
-        "arms": [bench_arm(a, steps) for a in ARMS],
-    }
-    if not args.quick:
-        RESULTS.mkdir(parents=True, exist_ok=True)
-        (RESULTS / "resolver.json").write_text(json.dumps(results, indent=2) + "\n")
-        plot(results, RESULTS / "resolver.png")
-    print(markdown_table(results))
+    return True
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -1,56 +1,236 @@
-"""Regenerate the README's performance section from the recorded benchmark results.
+"""Generate docs/benchmarks.md and the README's performance section from the recorded results.
 
-Run from a checkout after the benchmarks: ``python benchmarks/update_readme.py``. Each
-benchmark script records ``benchmarks/results/<name>.json`` and renders it with its own
-``markdown_table``; this script puts those tables between the README's markers.
+Run from a checkout after the benchmarks: ``python benchmarks/update_readme.py``. Every
+number comes from ``benchmarks/results/<name>.json``, rendered by the benchmark script's own
+``docs_section`` (every table, for docs/benchmarks.md) and ``readme_table`` (the short
+tables between the README's markers ``<!-- performance:start -->`` and
+``<!-- performance:end -->``); nothing is typed. ``--results DIR --docs FILE --no-readme``
+renders another run (what ``rrc-pin bench --out DIR`` does) without touching the checkout.
 """
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import json
+import os
 import sys
 from pathlib import Path
+from types import ModuleType
+from typing import Any
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))  # the scripts import their shared machine.py
-README = HERE.parent / "README.md"
+sys.path.insert(0, str(HERE))  # the scripts import their shared modules (machine, timing...)
+ROOT = HERE.parent
+README = ROOT / "README.md"
+DOCS = ROOT / "docs" / "benchmarks.md"
+RESULTS = HERE / "results"
 START, END = "<!-- performance:start -->", "<!-- performance:end -->"
 BENCHMARKS = {
     "closed_form": ("bench_closed_form.py", "Closed forms against Pinocchio + numpy"),
-    "resolver": ("bench_resolver.py", "Resolver step time against qpsolvers backends and pink"),
+    "resolver": ("bench_resolver.py", "Resolver step time against pink, as users run it"),
+    "tasks": ("bench_tasks.py", "Two grippers and a posture on baxter: rrc-pin, pink, PlaCo"),
 }
+"""Benchmark name: (script, title), in the order of the documents."""
+
+MODES_TEXT = """\
+A step's time is the whole call a user makes (a library, a backend, a set of options: a
+*contender*), timed with `time.perf_counter` along a recorded trajectory, in up to three
+modes (`benchmarks/timing.py`), each from fresh contenders (warm starts carry from step to
+step within a mode, as in a control loop; one untimed call at the first step before timing):
+
+- **tight loop**: one contender at a time, every step back to back: caches, branch
+  predictors and the CPU clock stay hot for that contender (what a micro-benchmark measures);
+- **1 kHz loop** (resolver benchmark): one contender at a time, one call per tick of a 1 kHz
+  loop; after each call the loop sleeps (`time.sleep`) until the next 1 ms tick, as a
+  periodic control loop does. A sleep rather than a busy-wait, because a control loop gives
+  its core up between ticks: the process may be descheduled, the core may run something else
+  or idle and lower its clock, and the call finds its caches as a real tick does (a busy-wait
+  would keep them hot and measure the tight loop again). A call longer than the period
+  starts the next tick at once (counted as an overrun);
+- **interleaved**: at every step every contender is called once, in an order shuffled at
+  each step, so each call finds the caches its peers left (one process running several
+  libraries, or a controller doing other work between ticks).
+
+Statistics per contender and mode: median, 10th, 90th and 99th percentiles and mean [us];
+ratios to a peer measured in the same run and mode (the peer's time over the contender's:
+above 1, the contender is faster); the largest excess over the velocity limits and over the
+position limits after one Euler step; failures (the library raised; its rates taken as
+zero). BLAS threads are pinned to one for every library (the matrices are tiny). The
+machine is shared: the load average (1 minute) at the start and end of each benchmark is
+recorded. It counts the benchmark's own process too: a benchmark that runs right after
+another one starts at about 1 on its own, and ends near 1 plus what other processes add;
+those inflate the tails more than the medians."""
 
 
-def render() -> str:
-    """Markdown of every recorded benchmark, in a fixed order."""
+def load_module(name: str) -> ModuleType:
+    """The benchmark script ``name`` imported as a module (for its renderers)."""
+    script = BENCHMARKS[name][0]
+    spec = importlib.util.spec_from_file_location(f"_bench_{name}", HERE / script)
+    if spec is None or spec.loader is None:
+        raise ImportError(f"cannot import {HERE / script}")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def recorded(results: Path) -> dict[str, dict[str, Any]]:
+    """The results found in ``results`` (name -> the JSON's content)."""
+    out = {}
+    for name in BENCHMARKS:
+        path = results / f"{name}.json"
+        if path.exists():
+            out[name] = json.loads(path.read_text())
+    return out
+
+
+def render_readme(results: Path) -> str:
+    """The README's performance section (between the markers)."""
+    found = recorded(results)
     parts = []
     for name, (script, title) in BENCHMARKS.items():
-        results_path = HERE / "results" / f"{name}.json"
-        if not results_path.exists():
-            parts.append(f"### {title}\n\nNot recorded yet: run `python benchmarks/{script}`.\n")
+        if name not in found:
+            parts.append(f"### {title}\n\nNot recorded yet: run `rrc-pin bench --record`.\n")
             continue
-        spec = importlib.util.spec_from_file_location(name, HERE / script)
-        module = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(module)
-        results = json.loads(results_path.read_text())
-        parts.append(
-            f"### {title}\n\n{module.markdown_table(results).strip()}\n\n"
-            f"Recorded by `benchmarks/{script}`; plot: `benchmarks/results/{name}.png`.\n"
-        )
+        table = load_module(name).readme_table(found[name]).strip()
+        parts.append(f"### {title}\n\n{table}\n\nRecorded by `benchmarks/{script}`.\n")
+    parts.append(
+        "Every table, the modes, the profile of a step and the machine: `docs/benchmarks.md`.\n"
+    )
     return "\n".join(parts)
 
 
-def main() -> int:
-    """Rewrite the README between the markers; exit code 1 if the markers are missing."""
-    text = README.read_text()
+def render_docs(results: Path, docs: Path) -> str:
+    """docs/benchmarks.md: how the benchmarks measure, the machine, every table."""
+    found = recorded(results)
+    plots = Path(os.path.relpath(results, docs.parent))
+    lines = [
+        "# Benchmarks",
+        "",
+        "Generated by `python benchmarks/update_readme.py` from "
+        f"`{_shown(results)}/*.json`; do not edit by hand. Rerun on your machine with "
+        "`rrc-pin bench` (writes a new folder, never the recorded results) or "
+        "`rrc-pin bench --record` (rewrites `benchmarks/results/`, this file and the "
+        "README's table); `--only closed_form|resolver|tasks`, `--quick` for a smoke run.",
+        "",
+        "## How a step is timed",
+        "",
+        MODES_TEXT,
+        "",
+    ]
+    if found:
+        lines += ["## Machine, versions, load", "", *_machine_table(found), ""]
+    for name, (script, title) in BENCHMARKS.items():
+        lines += [f"## {title}", ""]
+        if name not in found:
+            lines += [f"Not recorded: run `python benchmarks/{script}`.", ""]
+            continue
+        module = load_module(name)
+        doc = (module.__doc__ or "").strip().split("\n\n")
+        lines += [
+            f"Recorded by `benchmarks/{script}`: {doc[0].rstrip('.')}.",
+            "",
+            module.docs_section(found[name]).strip(),
+            "",
+        ]
+        if (results / f"{name}.png").exists():
+            lines += [f"![{title}]({(plots / f'{name}.png').as_posix()})", ""]
+    return "\n".join(lines).rstrip() + "\n"
+
+
+def _shown(path: Path) -> str:
+    try:
+        return path.resolve().relative_to(ROOT).as_posix()
+    except ValueError:
+        return str(path)
+
+
+def _machine_table(found: dict[str, dict[str, Any]]) -> list[str]:
+    keys = [
+        ("cpu", "CPU"),
+        ("cores", "cores"),
+        ("python", "Python"),
+        ("numpy", "numpy"),
+        ("pinocchio", "Pinocchio"),
+        ("pink", "pink"),
+        ("qpsolvers", "qpsolvers"),
+        ("daqp", "daqp"),
+        ("osqp", "osqp"),
+        ("proxsuite", "proxsuite"),
+        ("quadprog", "quadprog"),
+        ("clarabel", "clarabel"),
+        ("blas_threads", "BLAS threads"),
+    ]
+    names = list(found)
+    lines = ["| | " + " | ".join(names) + " |", "| --- |" + " --- |" * len(names)]
+    for key, title in keys:
+        values = [found[n]["machine"].get(key, "-") for n in names]
+        if all(v in (None, "-") for v in values):
+            continue
+        lines.append(
+            f"| {title} | " + " | ".join("-" if v is None else str(v) for v in values) + " |"
+        )
+    loads = []
+    for n in names:
+        load = found[n].get("load_average") or found[n]["machine"].get("load_average")
+        if isinstance(load, dict):
+            loads.append(f"{load['start'][0]:.2f} -> {load['end'][0]:.2f}")
+        elif load:
+            loads.append(f"{load[0]:.2f} -> {load[1]:.2f}")
+        else:
+            loads.append("-")
+    lines.append("| load average (1 min), start -> end | " + " | ".join(loads) + " |")
+    code = []
+    for n in names:
+        s = found[n].get("source", {})
+        text = f"{s.get('commit') or '-'}"
+        if s.get("uncommitted_changes"):
+            text += " + uncommitted: " + ", ".join(s.get("changed_files") or ["some files"])
+        code.append(f"{text} (sources {s.get('source_sha256', '-')})" if s else "-")
+    lines.append("| code measured (rrc_pin/, solvers/) | " + " | ".join(code) + " |")
+    placo = found.get("tasks", {}).get("placo", {}).get("info")
+    if placo:
+        lines.append(
+            "| PlaCo (own interpreter) | "
+            + " | ".join(
+                f"placo {placo['placo']}, Pinocchio {placo['pinocchio']}, numpy {placo['numpy']}"
+                if n == "tasks"
+                else "-"
+                for n in names
+            )
+            + " |"
+        )
+    return lines
+
+
+def update_readme(readme: Path, section: str) -> bool:
+    """Rewrite ``readme`` between the markers; False if the markers are missing."""
+    text = readme.read_text()
     if START not in text or END not in text:
-        print(f"{README}: markers {START} ... {END} not found", file=sys.stderr)
-        return 1
+        return False
     head, rest = text.split(START, 1)
     _, tail = rest.split(END, 1)
-    README.write_text(f"{head}{START}\n{render()}{END}{tail}")
-    print(f"updated {README}")
+    readme.write_text(f"{head}{START}\n{section}{END}{tail}")
+    return True
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Write the docs (and the README's section); exit code 1 if the markers are missing."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--results", type=Path, default=RESULTS, help="folder of the JSON files")
+    parser.add_argument("--docs", type=Path, default=DOCS, help="the Markdown file to write")
+    parser.add_argument("--readme", type=Path, default=README, help="the README to update")
+    parser.add_argument("--no-readme", action="store_true", help="leave the README alone")
+    args = parser.parse_args(argv)
+    args.docs.parent.mkdir(parents=True, exist_ok=True)
+    args.docs.write_text(render_docs(args.results, args.docs))
+    print(f"wrote {args.docs}")
+    if args.no_readme:
+        return 0
+    if not update_readme(args.readme, render_readme(args.results)):
+        print(f"{args.readme}: markers {START} ... {END} not found", file=sys.stderr)
+        return 1
+    print(f"updated {args.readme}")
     return 0
 
 

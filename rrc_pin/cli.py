@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import os
 import subprocess
 import sys
+import time
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -56,8 +58,33 @@ def parser() -> argparse.ArgumentParser:
     )
     check = sub.add_parser("check", help="cross-check every catalogue arm: DH, Pinocchio, yourdfpy")
     check.add_argument("--samples", type=int, default=200, help="configurations per arm (>= 1)")
-    bench = sub.add_parser("bench", help="run, record and tabulate the benchmarks")
-    bench.add_argument("--only", choices=["closed_form", "resolver"], help="one benchmark")
+    bench = sub.add_parser(
+        "bench",
+        help="run the benchmarks of a checkout (needs the bench extra): results to a new "
+        "folder, or with --record to benchmarks/results, docs/benchmarks.md and the README",
+    )
+    bench.add_argument("--only", choices=BENCHMARKS, help="one benchmark")
+    bench.add_argument("--quick", action="store_true", help="short runs (a smoke test)")
+    bench_to = bench.add_mutually_exclusive_group()
+    bench_to.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="folder for the results (default: a new ./rrc-pin-bench-<timestamp>)",
+    )
+    bench_to.add_argument(
+        "--record",
+        action="store_true",
+        help="rewrite benchmarks/results/, docs/benchmarks.md and the README's table",
+    )
+    bench.add_argument(
+        "--placo-python",
+        default=None,
+        metavar="PATH",
+        help="interpreter with placo for the tasks benchmark (default: .venv-placo/bin/python "
+        "of the checkout, if any; placo pins its own Pinocchio)",
+    )
     urdf = sub.add_parser("urdf", help="compare or rewrite the committed URDFs")
     mode = urdf.add_mutually_exclusive_group(required=True)
     mode.add_argument("--check", action="store_true", help="fail if a committed file differs")
@@ -80,7 +107,13 @@ def run(args: argparse.Namespace) -> int:
     if args.command == "urdf":
         return urdf_command(args.dir, write=args.write)
     if args.command == "bench":
-        return bench_command(args.only)
+        return bench_command(
+            args.only,
+            quick=args.quick,
+            out=args.out,
+            record=args.record,
+            placo_python=args.placo_python,
+        )
     if args.command == "check":
         from rrc_pin.cross_check import run_cross_check
 
@@ -144,18 +177,119 @@ def urdf_command(directory: Path, *, write: bool) -> int:
     return 1 if problems else 0
 
 
-def bench_command(only: str | None) -> int:
-    """Run ``benchmarks/bench_*.py`` of the checkout, then regenerate the README's table."""
-    folder = urdf_export.COMMITTED_DIR.parent / "benchmarks"
+CHECKOUT = urdf_export.COMMITTED_DIR.parent
+"""The checkout whose ``benchmarks/`` ``rrc-pin bench`` runs."""
+
+BENCHMARKS = ("closed_form", "resolver", "tasks")
+BENCH_MODULES = {
+    "closed_form": ("matplotlib",),
+    "resolver": ("pink", "matplotlib"),
+    "tasks": ("pink", "matplotlib"),
+}
+"""What each benchmark needs from the bench extra (placo is optional: its rows are skipped)."""
+
+
+def bench_command(
+    only: str | None,
+    *,
+    quick: bool = False,
+    out: Path | None = None,
+    record: bool = False,
+    placo_python: str | None = None,
+) -> int:
+    """Run the checkout's ``benchmarks/bench_*.py``, then render their tables.
+
+    The bench extra is checked first (one line on stderr naming what to install, exit code
+    2, nothing written). Results go to ``out`` (default: a new ``./rrc-pin-bench-<timestamp>``
+    folder) with a ``benchmarks.md`` of every table; only ``record`` rewrites the checkout's
+    ``benchmarks/results/``, ``docs/benchmarks.md`` and the README's performance section.
+
+    Args:
+        only: One benchmark of :data:`BENCHMARKS`, or None for all.
+        quick: Short runs (a smoke test); refused with ``record``.
+        out: Folder for the results (created if missing).
+        record: Write the checkout's recorded results and documents instead.
+        placo_python: PlaCo's interpreter for the tasks benchmark, or None to look for it.
+
+    Returns:
+        0, or the exit code of the first script that failed; 2 for a missing extra.
+    """
+    folder = CHECKOUT / "benchmarks"
     if not folder.is_dir():
         print(f"rrc-pin bench runs from a checkout: no {folder}", file=sys.stderr)
         return 2
-    names = [only] if only else ["closed_form", "resolver"]
+    names = [only] if only else list(BENCHMARKS)
+    missing = sorted({m for name in names for m in BENCH_MODULES[name] if not _installed(m)})
+    if missing:
+        print(
+            f'rrc-pin bench: {", ".join(missing)} not installed: pip install -e ".[bench]"',
+            file=sys.stderr,
+        )
+        return 2
+    if record and quick:
+        print("rrc-pin bench: --record keeps full runs only; drop --quick", file=sys.stderr)
+        return 2
+    if "tasks" in names and not _placo_found(placo_python):
+        print(
+            "rrc-pin bench: PlaCo not found, its rows are skipped (placo pins its own Pinocchio: "
+            "python -m venv .venv-placo && .venv-placo/bin/pip install placo)"
+        )
+    results = folder / "results" if record else (out or _new_folder(Path.cwd()))
+    results.mkdir(parents=True, exist_ok=True)
     for name in names:
-        code = subprocess.call([sys.executable, str(folder / f"bench_{name}.py")])
+        args = ["--quick"] if quick else []
+        args += ["--record"] if record else ["--out", str(results)]
+        if name == "tasks" and placo_python:
+            args += ["--placo-python", placo_python]
+        print(f"rrc-pin bench: {name}", flush=True)
+        code = _run_script(folder / f"bench_{name}.py", args)
         if code:
             return code
-    return subprocess.call([sys.executable, str(folder / "update_readme.py")])
+    render = (
+        []
+        if record
+        else ["--results", str(results), "--docs", str(results / "benchmarks.md"), "--no-readme"]
+    )
+    code = _run_script(folder / "update_readme.py", render)
+    if code == 0:
+        print(f"rrc-pin bench: results in {results}")
+    return code
+
+
+def _installed(module: str) -> bool:
+    """Whether ``module`` can be imported (a None entry in sys.modules counts as missing)."""
+    try:
+        return importlib.util.find_spec(module) is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def _placo_found(placo_python: str | None) -> bool:
+    """Whether the tasks benchmark will find PlaCo (as ``benchmarks/bench_tasks.py`` looks)."""
+    return bool(
+        placo_python
+        or os.environ.get("RRC_PIN_PLACO_PYTHON")
+        or _installed("placo")
+        or (CHECKOUT / ".venv-placo" / "bin" / "python").exists()
+    )
+
+
+def _new_folder(parent: Path) -> Path:
+    """A folder ``rrc-pin-bench-<timestamp>`` in ``parent`` that did not exist (created)."""
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    for k in range(1000):
+        path = parent / (f"rrc-pin-bench-{stamp}" + (f"-{k}" if k else ""))
+        try:
+            path.mkdir(parents=True)
+        except FileExistsError:
+            continue
+        return path
+    raise FileExistsError(f"{parent}: no free rrc-pin-bench-{stamp}-N folder")
+
+
+def _run_script(script: Path, args: list[str]) -> int:
+    """Run a benchmark script with this interpreter; its exit code."""
+    return subprocess.call([sys.executable, str(script), *args])
 
 
 if __name__ == "__main__":

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import re
 import shutil
 import subprocess
@@ -163,3 +164,103 @@ def test_demo_runs_as_a_console_script():
         assert excess <= 1e-12 and done <= asked * (1 + 1e-3) and veer < 1.0, row
     closed_form_rows = [line.split() for line in out.stdout.splitlines() if "ClosedForm" in line]
     assert len(closed_form_rows) == 3 and all(float(r[-1]) < 1e-9 for r in closed_form_rows)
+
+
+# ---- rrc-pin bench (issue 18 item 11) ---------------------------------------------------------
+
+ROOT = Path(__file__).resolve().parents[1]
+CHECKED_IN = [ROOT / "README.md", *sorted((ROOT / "benchmarks" / "results").glob("*"))]
+if (ROOT / "docs" / "benchmarks.md").exists():
+    CHECKED_IN.append(ROOT / "docs" / "benchmarks.md")
+
+
+def snapshot(paths: list[Path]) -> dict[Path, bytes]:
+    return {p: p.read_bytes() for p in paths}
+
+
+def test_bench_without_its_extras_says_what_to_install(tmp_path, monkeypatch, capsys):
+    """The README's install lacks pink: one line, exit code 2, nothing written (it rewrote the
+    committed resolver.json without pink's rows, then died on matplotlib)."""
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setitem(sys.modules, "pink", None)  # find_spec answers None: not installed
+    before = snapshot(CHECKED_IN)
+    assert main(["bench", "--only", "resolver"]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and "pink" in err[0] and 'pip install -e ".[bench]"' in err[0], err
+    assert list(tmp_path.iterdir()) == [] and snapshot(CHECKED_IN) == before
+
+
+def test_bench_writes_a_new_folder_by_default_and_never_the_checkout(tmp_path, monkeypatch):
+    """A quick closed-form run (no pink needed) lands in ./rrc-pin-bench-<timestamp>, with its
+    JSON and a benchmarks.md; --out DIR takes another folder; the checkout stays as it was."""
+    import rrc_pin.cli as cli
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(cli, "_installed", lambda module: True)  # matplotlib may be absent
+    before = snapshot(CHECKED_IN)
+    assert main(["bench", "--only", "closed_form", "--quick"]) == 0
+    (folder,) = tmp_path.iterdir()
+    assert re.fullmatch(r"rrc-pin-bench-\d{8}-\d{6}", folder.name), folder.name
+    results = json.loads((folder / "closed_form.json").read_text())
+    assert results["quick"] is True and [a["arm"] for a in results["arms"]]
+    assert "## Closed forms" in (folder / "benchmarks.md").read_text()
+    mine = tmp_path / "mine" / "run"
+    assert main(["bench", "--only", "closed_form", "--quick", "--out", str(mine)]) == 0
+    assert (mine / "closed_form.json").exists() and (mine / "benchmarks.md").exists()
+    assert snapshot(CHECKED_IN) == before
+
+
+def test_bench_record_rewrites_results_docs_and_readme_and_refuses_quick(
+    tmp_path, monkeypatch, capsys
+):
+    """--record is the only way to the checkout's results, docs/benchmarks.md and README (here a
+    copy of the checkout); a smoke run cannot be recorded."""
+    import rrc_pin.cli as cli
+
+    checkout = tmp_path / "checkout"
+    shutil.copytree(
+        ROOT / "benchmarks", checkout / "benchmarks", ignore=shutil.ignore_patterns("__pycache__")
+    )
+    for path in (checkout / "benchmarks" / "results").iterdir():
+        if path.name != "closed_form.json":  # the one this run "records"
+            path.unlink()
+    (checkout / "docs").mkdir()
+    shutil.copy(ROOT / "README.md", checkout / "README.md")
+    readme = checkout / "README.md"
+    start, end = "<!-- performance:start -->", "<!-- performance:end -->"
+    head, rest = readme.read_text().split(start, 1)
+    readme.write_text(f"{head}{start}\nstale\n{end}{rest.split(end, 1)[1]}")
+    monkeypatch.setattr(cli, "CHECKOUT", checkout)
+    monkeypatch.setattr(cli, "_installed", lambda module: True)
+    calls = []
+    real = cli._run_script
+
+    def run_script(script: Path, args: list[str]) -> int:
+        calls.append((script.name, args))
+        if script.name == "update_readme.py":
+            return real(script, args)
+        return 0  # the benchmark itself: its JSON is the copied results/closed_form.json
+
+    monkeypatch.setattr(cli, "_run_script", run_script)
+    before = snapshot(CHECKED_IN)
+    assert main(["bench", "--only", "closed_form", "--record", "--quick"]) == 2
+    assert "--record keeps full runs only" in capsys.readouterr().err and calls == []
+    assert main(["bench", "--only", "closed_form", "--record"]) == 0
+    assert calls == [("bench_closed_form.py", ["--record"]), ("update_readme.py", [])]
+    assert "stale" not in readme.read_text() and "### Closed forms" in readme.read_text()
+    assert "## Closed forms" in (checkout / "docs" / "benchmarks.md").read_text()
+    assert snapshot(CHECKED_IN) == before
+
+
+def test_readme_performance_section_is_generated_from_the_results():
+    """The README's tables are what benchmarks/update_readme.py renders from the JSON files."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    try:
+        import update_readme
+    finally:
+        sys.path.remove(str(ROOT / "benchmarks"))
+    text = (ROOT / "README.md").read_text()
+    section = text.split(update_readme.START, 1)[1].split(update_readme.END, 1)[0]
+    assert section == "\n" + update_readme.render_readme(update_readme.RESULTS)
+    docs = ROOT / "docs" / "benchmarks.md"
+    assert docs.read_text() == update_readme.render_docs(update_readme.RESULTS, docs)

@@ -1,0 +1,292 @@
+"""How the benchmarks time a contender as its users run it: loop modes, statistics, compliance.
+
+A contender is one way of computing the joint rates of a step (a library, a backend, a set
+of options), called exactly as its users call it, the whole call timed with
+``time.perf_counter``. Along one recorded trajectory (configurations ``Q`` and commands
+``X``), it is timed in one of three modes (issue 18 item 14: a control loop is not a tight
+loop):
+
+- ``tight``: one contender at a time, every step back to back (what a micro-benchmark
+  measures: caches, branch predictors and the CPU clock stay hot for that contender);
+- ``khz``: one contender at a time, one call per tick of a 1 kHz loop: after each call the
+  loop sleeps (``time.sleep``) until the next 1 ms tick, as a periodic control loop does. A
+  sleep rather than a busy-wait, because a control loop gives the core up between ticks:
+  the process may be descheduled, the core may run something else or idle and lower its
+  clock, and the call finds its caches as a real tick does (a busy-wait would keep the
+  core hot and measure the tight loop again). A call longer than the period starts the next
+  one at once (counted in ``overruns``), never a burst of catch-up calls;
+- ``interleaved``: at every step every contender is called once, in an order shuffled at
+  each step, so that each call finds the caches left by its peers (what one process running
+  several libraries, or a controller doing other work between ticks, sees).
+
+In the ``tight`` and ``khz`` modes the contenders take turns of :data:`BLOCK` consecutive
+steps (the order shuffled at every round), each going through the trajectory in order, so
+that every contender samples the whole run's machine state: on a shared machine the load
+of other processes drifts within seconds, and one contender timed at once over the whole
+trajectory would meet a different machine than the next (measured: the medians of identical
+code paths differed by up to 1.9x that way). The first call of a turn finds the caches of
+the previous contender; that is 1 call in 250 (0.4%), below the 99th percentile.
+
+Each mode starts from fresh contenders (warm starts carry from step to step within a mode,
+as in a control loop) and calls each once, untimed, at the first step before timing.
+
+A contender that raises is counted as a failure at that step and its rates taken as zero.
+Compliance is measured on every answer: the largest excess of ``|qdot|`` over the velocity
+limit and of ``q + qdot dt`` over the position limits (0 when there is none).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import time
+from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+Array = npt.NDArray[np.float64]
+
+MODES = ("tight", "khz", "interleaved")
+MODE_TITLES = {
+    "tight": "tight loop",
+    "khz": "1 kHz loop",
+    "interleaved": "interleaved with the peers",
+}
+PERIOD = 1e-3
+"""[s] Period of the ``khz`` mode."""
+BLOCK = 250
+"""Steps a contender runs in one turn of the ``tight`` and ``khz`` modes."""
+
+
+@dataclass
+class Contender:
+    """One way of computing a step's joint rates, as its users call it.
+
+    Attributes:
+        label: Name in the tables.
+        call: One step ``call(q, x)`` (q (n,) [rad], x the command) returning what the library
+            returns; the whole call is timed. For a ``remote`` contender, it returns
+            ``(rates or None, seconds)`` timed in the other process (None: it failed).
+        rates: The joint rates (n,) [rad/s] of what ``call`` returned (not timed).
+        keep: Keep what ``call`` returned (rrc-pin's Resolutions, for their statistics).
+        remote: ``call`` runs in another process (see ``call``).
+        loop: For a remote contender, its tight loop run in its own process:
+            ``loop(Q, X) -> (rates (steps, n), seconds (steps,), failed (steps,))``.
+    """
+
+    label: str
+    call: Callable[[Array, Array], Any]
+    rates: Callable[[Any], Array] = np.asarray
+    keep: bool = False
+    remote: bool = False
+    loop: Callable[[Array, Array], tuple[Array, Array, Array]] | None = None
+
+
+@dataclass
+class Run:
+    """What one contender did in one mode.
+
+    Attributes:
+        seconds: Time of each step's call (steps,) [s].
+        rates: Joint rates of each step (steps, n) [rad/s] (zero where it failed).
+        failed: Steps where the call raised (steps,).
+        kept: What the calls returned, if the contender keeps it.
+        overruns: ``khz`` mode: calls longer than the period.
+        first_error: The first failure's exception (type and message), or "".
+    """
+
+    seconds: Array
+    rates: Array
+    failed: npt.NDArray[np.bool_]
+    kept: list[Any] = field(default_factory=list)
+    overruns: int = 0
+    first_error: str = ""
+
+
+def run_mode(
+    mode: str,
+    contenders: Sequence[Contender],
+    Q: Array,
+    X: Array,
+    rng: np.random.Generator | None = None,
+    period: float = PERIOD,
+) -> dict[str, Run]:
+    """Time ``contenders`` along the trajectory ``(Q, X)`` in ``mode`` (module docstring).
+
+    Args:
+        mode: ``tight``, ``khz`` or ``interleaved``.
+        contenders: Fresh contenders (their warm starts begin here).
+        Q: Configurations (steps, n) [rad].
+        X: Commands (steps, m).
+        rng: Shuffles the order of the contenders (at every step of the ``interleaved``
+            mode, where it is required; at every round of turns of the others).
+        period: [s] Period of the ``khz`` mode.
+
+    Returns:
+        A :class:`Run` per contender label.
+    """
+    steps, n = Q.shape
+    runs = {
+        c.label: Run(np.empty(steps), np.zeros((steps, n)), np.zeros(steps, dtype=bool))
+        for c in contenders
+    }
+    for c in contenders:  # one untimed call: imports, workspaces, first-call set-up
+        _step(c, Q[0], X[0])
+    if mode == "interleaved":
+        if rng is None:
+            raise ValueError("the interleaved mode needs an rng")
+        order = list(contenders)
+        for k in range(steps):
+            rng.shuffle(order)  # no contender always runs first, after another one's misses
+            for c in order:
+                _record(runs[c.label], c, k, *_step(c, Q[k], X[k]))
+        return runs
+    if mode not in ("tight", "khz"):
+        raise ValueError(f"unknown mode {mode!r}; expected one of {', '.join(MODES)}")
+    turns = rng if rng is not None else np.random.default_rng(0)
+    for a in range(0, steps, BLOCK):
+        b = min(a + BLOCK, steps)
+        order = list(contenders)
+        turns.shuffle(order)
+        for c in order:
+            run = runs[c.label]
+            if mode == "tight" and c.loop is not None:  # a remote contender loops in its process
+                run.rates[a:b], run.seconds[a:b], failed = c.loop(Q[a:b], X[a:b])
+                run.failed[a:b] = failed.astype(bool)
+                continue
+            deadline = time.perf_counter()
+            for k in range(a, b):
+                _record(run, c, k, *_step(c, Q[k], X[k]))
+                if mode == "khz":
+                    deadline += period
+                    wait = deadline - time.perf_counter()
+                    if wait > 0.0:
+                        time.sleep(wait)
+                    else:  # the call took the whole tick: start the next one now, no catch-up
+                        run.overruns += 1
+                        deadline = time.perf_counter()
+    return runs
+
+
+def _step(c: Contender, q: Array, x: Array) -> tuple[Any, float, str]:
+    """One call of ``c``: (what it returned, seconds, the error or "" when it answered)."""
+    if c.remote:
+        rates, seconds = c.call(q, x)
+        return rates, seconds, "failed in its process" if rates is None else ""
+    clock = time.perf_counter
+    t0 = clock()
+    try:
+        out = c.call(q, x)
+    except Exception as exc:  # a peer raising (pink's NoSolutionFound...) is a failed step
+        return None, clock() - t0, f"{type(exc).__name__}: {exc}"[:300]
+    return out, clock() - t0, ""
+
+
+def _record(run: Run, c: Contender, k: int, out: Any, seconds: float, error: str) -> None:
+    run.seconds[k] = seconds
+    if error:
+        run.failed[k] = True
+        run.first_error = run.first_error or error
+        return
+    run.rates[k] = out if c.remote else c.rates(out)
+    if c.keep:
+        run.kept.append(out)
+
+
+def statistics(seconds: Array) -> dict[str, float]:
+    """Median, 10th, 90th and 99th percentiles, mean and maximum of step times [us]."""
+    us = np.asarray(seconds) * 1e6
+    p10, p50, p90, p99 = np.percentile(us, [10, 50, 90, 99])
+    return {
+        "median_us": float(p50),
+        "p10_us": float(p10),
+        "p90_us": float(p90),
+        "p99_us": float(p99),
+        "mean_us": float(us.mean()),
+        "max_us": float(us.max()),
+    }
+
+
+def compliance(
+    Q: Array, rates: Array, lower: Array, upper: Array, velocity: Array, dt: float
+) -> dict[str, float]:
+    """Largest excess over the velocity limits [rad/s] and over the position limits after one
+    Euler step ``q + qdot dt`` [rad], over all steps (0 when every answer is inside)."""
+    after = Q + rates * dt
+    return {
+        "max_velocity_excess": float(max(0.0, (np.abs(rates) - velocity).max())),
+        "max_position_excess": float(max(0.0, (after - upper).max(), (lower - after).max())),
+    }
+
+
+def summarise(
+    runs: dict[str, Run], Q: Array, limits: tuple[Array, Array, Array], dt: float
+) -> dict[str, dict[str, Any]]:
+    """Statistics, compliance and failures of every contender of one mode."""
+    lower, upper, velocity = limits
+    out: dict[str, dict[str, Any]] = {}
+    for label, run in runs.items():
+        row: dict[str, Any] = statistics(run.seconds)
+        row.update(compliance(Q, run.rates, lower, upper, velocity, dt))
+        row["failures"] = int(run.failed.sum())
+        row["overruns"] = run.overruns
+        if run.first_error:
+            row["first_error"] = run.first_error
+        out[label] = row
+    return out
+
+
+def add_ratios(rows: dict[str, dict[str, Any]], baseline: str) -> None:
+    """Add each row's ratio to the baseline row, in place: ``vs_baseline_median`` is the
+    baseline's median over the row's (above 1: faster than the baseline), the same for p99."""
+    base = rows[baseline]
+    for row in rows.values():
+        row["vs_baseline_median"] = base["median_us"] / row["median_us"]
+        row["vs_baseline_p99"] = base["p99_us"] / row["p99_us"]
+
+
+@contextlib.contextmanager
+def quiet_stdout() -> Iterator[None]:
+    """Send file descriptor 1 to /dev/null for the duration (OSQP's C code prints "Polishing
+    not needed" when nothing is active); Python's ``sys.stdout`` is flushed first. Progress
+    goes to stderr, which stays open."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 1)
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(devnull)
+        os.close(saved)
+
+
+def progress(message: str) -> None:
+    """One line of progress on stderr (stdout may be silenced by :func:`quiet_stdout`)."""
+    print(message, file=sys.stderr, flush=True)
+
+
+@contextlib.contextmanager
+def one_core(pids: list[int]) -> Iterator[int | None]:
+    """Pin this process and ``pids`` to the core this process runs on; restore on exit."""
+    if not hasattr(os, "sched_setaffinity"):
+        yield None
+        return
+    saved = os.sched_getaffinity(0)
+    try:
+        cpu = int(Path("/proc/self/stat").read_text().rsplit(")", 1)[1].split()[36])
+    except (OSError, IndexError, ValueError):
+        cpu = min(saved)
+    try:
+        for pid in [0, *pids]:
+            os.sched_setaffinity(pid, {cpu})
+        yield cpu
+    finally:
+        os.sched_setaffinity(0, saved)
