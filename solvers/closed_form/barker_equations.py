@@ -28,7 +28,7 @@ from typing import NamedTuple
 import numpy as np
 
 from solvers.closed_form._batch import cos_sin
-from solvers.closed_form.base import Array, Entry, stack_entries
+from solvers.closed_form.base import Array, Entry, dot, stack_entries
 
 
 class BarkerGeometry(NamedTuple):
@@ -41,6 +41,7 @@ class BarkerGeometry(NamedTuple):
         swe: SAL3 WE [m].
         f2: F2 = SN~ + CAL3 WE, SN~ = SN + R3 [m] (Barker eq. (28), with the tilde restored).
         reach: L = |ES| + hypot(SAL3 WE, A3) [m], the scale of the arm's band.
+        r2: (SAL3 WE)^2 + A3^2 = F4^2 + F5^2 [m^2].
     """
 
     no: float
@@ -55,6 +56,7 @@ class BarkerGeometry(NamedTuple):
     swe: float
     f2: float
     reach: float
+    r2: float
 
     @classmethod
     def from_parameters(
@@ -65,7 +67,7 @@ class BarkerGeometry(NamedTuple):
         swe = sal3 * we
         f2 = sn + r3 + cal3 * we
         reach = abs(es) + math.hypot(swe, a3)
-        return cls(no, es, sn, we, a3, r3, alpha3, sal3, cal3, swe, f2, reach)
+        return cls(no, es, sn, we, a3, r3, alpha3, sal3, cal3, swe, f2, reach, swe * swe + a3 * a3)
 
 
 class Trig(NamedTuple):
@@ -110,9 +112,15 @@ def trig(q: Sequence[float]) -> Trig:
                 s(q4), c(q4), s(q5), c(q5), s(q6), c(q6))  # fmt: skip
 
 
-def trig_batch(Q: Array, six: bool = False) -> Trig:
-    """Trigonometric terms of ``Q`` (N, 6) [rad], (N,) each; theta_6 only with ``six``."""
-    C, S = cos_sin(np.ascontiguousarray(Q.T[: 6 if six else 5]))
+def trig_batch(Q: Array, six: bool = False, out: tuple[Array, Array] | None = None) -> Trig:
+    """Trigonometric terms of ``Q`` (N, 6) [rad], (N,) each; theta_6 only with ``six``.
+
+    ``out``: optional flat buffers of at least ``5 N`` floats (``6 N`` with ``six``) for the
+    cosines and sines, reused across the blocks of a batch.
+    """
+    k, n = 6 if six else 5, Q.shape[0]
+    bufs = None if out is None else (out[0][: k * n].reshape(k, n), out[1][: k * n].reshape(k, n))
+    C, S = cos_sin(np.ascontiguousarray(Q.T[:k]), bufs)
     s23 = S[1] * C[2] + C[1] * S[2]
     c23 = C[1] * C[2] - S[1] * S[2]
     sc6 = (S[5], C[5]) if six else (None, None)
@@ -144,17 +152,29 @@ def m_rows(t: Trig, F: FTerms) -> list[list[Entry]]:
             [0.0, -F.f1, -F.f5]]  # fmt: skip
 
 
+def m_rotated(
+    t: Trig, F: FTerms, tvel: Sequence[Entry]
+) -> tuple[list[list[Entry]], list[Entry]]:
+    """Eq. (25) with its rows turned by theta_1, and TVEL^ with them.
+
+    ``(C1 row1 + S1 row2, S1 row1 - C1 row2, row3)`` of M (eqs (37), (41)): the same
+    least-squares problem as M (an orthogonal change of rows), sparser.
+    """
+    T1, T2, T3 = tvel
+    rows = [[-F.f2, F.f3, F.f4], [-F.f1, 0.0, 0.0], [0.0, -F.f1, -F.f5]]
+    return rows, [t.c1 * T1 + t.s1 * T2, t.s1 * T1 - t.c1 * T2, T3]
+
+
 def det_adj2(g: BarkerGeometry, t: Trig, F: FTerms) -> tuple[Entry, Entry]:
     """Det M = ES F1 (SAL3 WE S3 + A3 C3) (eq. (D9)) [m^3] and ||adj M||_F^2 [m^4].
 
-    Rows ``C1 row1 + S1 row2``, ``S1 row1 - C1 row2`` and row 3 of M are ``(-F2, F3, F4)``,
-    ``(-F1, 0, 0)``, ``(0, -F1, -F5)`` (eqs (37), (41)); their cross products give
-    ``||adj M||^2 = (ES e33)^2 + (F2 F5)^2 + F1^2 (F1^2 + F2^2 + F3^2 + F4^2 + F5^2)``.
+    The cross products of the rows of :func:`m_rotated` give ``||adj M||^2 = (ES e33)^2 +
+    (F2 F5)^2 + F1^2 (F1^2 + F2^2 + F3^2 + F4^2 + F5^2)``, with ``F4^2 + F5^2 =
+    (SAL3 WE)^2 + A3^2`` (eqs (30), (31)).
     """
     e = g.es * eq33(g, t)
     f1s = F.f1 * F.f1
-    adj2 = e * e + (g.f2 * F.f5) ** 2 + f1s * (f1s + g.f2 * g.f2 + F.f3 * F.f3 + F.f4 * F.f4
-                                              + F.f5 * F.f5)  # fmt: skip
+    adj2 = e * e + (g.f2 * F.f5) ** 2 + f1s * (f1s + F.f3 * F.f3 + g.f2 * g.f2 + g.r2)
     return F.f1 * e, adj2
 
 
@@ -313,9 +333,10 @@ def damped_solve(
         The solution, one entry per unknown.
     """
     n, lam2 = len(A), eps * eps - s2
-    N = [[sum(A[r][i] * A[r][j] for r in range(n)) + (lam2 if i == j else 0.0)
-          for j in range(n)] for i in range(n)]  # fmt: skip
-    h = [sum(A[r][i] * b[r] for r in range(n)) for i in range(n)]
+    cols = list(zip(*A, strict=True))
+    N = [[dot(cols[i], cols[j]) + (lam2 if i == j else 0.0) for j in range(n)]
+         for i in range(n)]  # fmt: skip
+    h = [dot(cols[i], b) for i in range(n)]
     L: list[list[Entry]] = [[0.0] * n for _ in range(n)]  # N = L L^T
     for i in range(n):
         for j in range(i + 1):

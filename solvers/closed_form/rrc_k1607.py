@@ -44,7 +44,7 @@ import numpy as np
 import numpy.typing as npt
 
 from solvers.closed_form._batch import blocks, cos_sin
-from solvers.closed_form.base import Array, ClosedForm, Entry, stack_entries
+from solvers.closed_form.base import Array, ClosedForm, Entry, dot, stack_entries
 from solvers.closed_form.weighted import svd_rates, weight_factor
 from solvers.validation import as_array, as_vector, finite_number
 
@@ -280,7 +280,7 @@ class RrcK1607ClosedForm(ClosedForm):
         tau = self.rcond**2 * sum(A[i][i] for i in range(TASK_DIM))
         bl = b.tolist()
         y = _solve_spd6(A, bl)
-        if _dot(bl, bl) >= tau * tau * _dot(y, y):  # False for NaN: not positive definite
+        if dot(bl, bl) >= tau * tau * dot(y, y):  # False for NaN: not positive definite
             qdot = Bt.dot(y)
             qdot = qdot if L is None else L @ qdot
         else:
@@ -333,15 +333,15 @@ class RrcK1607ClosedForm(ClosedForm):
         b = list(np.ascontiguousarray(X.T))
         if Z is not None:
             ZT = list(np.ascontiguousarray(Z.T))
-            b = [bi - _dot(r, ZT) for bi, r in zip(b, J, strict=True)]
-        B = J if L is None else [[_dot(r, col) for col in L.T.tolist()] for r in J]
-        A: list[list[Any]] = [[_dot(B[i], B[j]) if j >= i else None for j in range(TASK_DIM)]
+            b = [bi - dot(r, ZT) for bi, r in zip(b, J, strict=True)]
+        B = J if L is None else [[dot(r, col) for col in L.T.tolist()] for r in J]
+        A: list[list[Any]] = [[dot(B[i], B[j]) if j >= i else None for j in range(TASK_DIM)]
              for i in range(TASK_DIM)]  # fmt: skip
         tau = self.rcond**2 * sum(A[i][i] for i in range(TASK_DIM))
         y = _solve_spd6(A, b)
-        ok = _dot(b, b) >= tau * tau * _dot(y, y)  # False for NaN: not positive definite
-        v = [_dot(col, y) for col in zip(*B, strict=True)]  # B^T y
-        qdot = np.stack(v if L is None else [_dot(r, v) for r in L.tolist()], axis=1)
+        ok = dot(b, b) >= tau * tau * dot(y, y)  # False for NaN: not positive definite
+        v = [dot(col, y) for col in zip(*B, strict=True)]  # B^T y
+        qdot = np.stack(v if L is None else [dot(r, v) for r in L.tolist()], axis=1)
         if not np.all(ok):
             bad = np.flatnonzero(~ok)
             Jb = stack_entries(J, n)[bad]
@@ -350,15 +350,6 @@ class RrcK1607ClosedForm(ClosedForm):
 
 
 # ---------------------------------------------------------------------- helpers
-
-
-def _dot(u: Sequence[Entry], v: Sequence[Entry]) -> Entry:
-    """Sum of ``u[k] * v[k]``, skipping exact float zeros (constant Jacobian entries)."""
-    acc: Entry = 0.0
-    for a, b in zip(u, v, strict=True):
-        if not ((type(a) is float and a == 0.0) or (type(b) is float and b == 0.0)):
-            acc = acc + a * b
-    return acc
 
 
 def _positive(det: Entry) -> Entry:
