@@ -103,28 +103,32 @@ def finite_number(
             finite, or out of bounds; the message
             states the expected range (``>= 0``, ``> 0``, ``in (0, 1)``, ``in [0, 0.5)``).
     """
-    if lower is None and upper is None:
-        want = "a finite number"
-    elif upper is None:
-        want = f"a finite number {'>=' if inclusive else '>'} {lower:g}"
-    elif lower is None:
-        want = f"a finite number < {upper:g}"
-    else:
-        want = f"a finite number in {'[' if inclusive else '('}{lower:g}, {upper:g})"
     real = (int, float, np.integer, np.floating)  # not complex numbers (np.number)
     if isinstance(value, (bool, np.bool_, np.timedelta64)) or not isinstance(value, real):
-        raise error(name, f"expected {want}, got {value!r}")
+        raise error(name, f"expected {_wanted(lower, inclusive, upper)}, got {value!r}")
     try:
         out = float(value)
     except OverflowError:  # an int beyond the float range
-        raise error(name, f"expected {want}, got an int of {len(str(value))} digits") from None
+        got = f"an int of {len(str(value))} digits"
+        raise error(name, f"expected {_wanted(lower, inclusive, upper)}, got {got}") from None
     if (
         not isfinite(out)
         or (lower is not None and (out < lower or (out == lower and not inclusive)))
         or (upper is not None and out >= upper)
     ):
-        raise error(name, f"expected {want}, got {out}")
+        raise error(name, f"expected {_wanted(lower, inclusive, upper)}, got {out}")
     return out
+
+
+def _wanted(lower: float | None, inclusive: bool, upper: float | None) -> str:
+    """The range :func:`finite_number` expects, in words."""
+    if lower is None and upper is None:
+        return "a finite number"
+    if upper is None:
+        return f"a finite number {'>=' if inclusive else '>'} {lower:g}"
+    if lower is None:
+        return f"a finite number < {upper:g}"
+    return f"a finite number in {'[' if inclusive else '('}{lower:g}, {upper:g})"
 
 
 def positive(x: float, name: str, error: type[InputError] = InputError) -> float:

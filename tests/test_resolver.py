@@ -14,7 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import rrc_pin
-from rrc_pin import FrameTask, JointLimits, QPOptions, Resolver
+from rrc_pin import FrameTask, JointLimits, PostureTask, QPOptions, Resolver
 from rrc_pin.errors import InvalidInput, RrcPinError
 from solvers.qp_backends import installed_backends
 
@@ -533,3 +533,30 @@ def test_a_urdf_without_velocity_limits_says_what_to_pass(tmp_path) -> None:
     assert info.value.argument == "velocity" and "JointLimits(velocity=" in str(info.value)
     r = Resolver(arm, limits=JointLimits(velocity=[1.0, 1.0, 1.0]))
     assert np.all(np.abs(r.solve([0.1, 0.5, -0.7], [1.0, 0, 0]).qdot) <= 1.0)
+
+
+def test_a_command_outside_the_range_is_singular_whichever_factorisation_answered(
+    arms: dict,
+) -> None:
+    """A full twist on a 5-joint arm (six rows, rank five) has a part no rates can meet:
+    'singular', whether the normal equations answered (small commands that fit) or the SVD
+    did (large ones that need the QP); weighted tasks trade off by design: never 'singular'."""
+    arm = rrc_pin.load("so101")
+    resolver = Resolver(arm)
+    rng = np.random.default_rng(11)
+    for size, allowed in ((1e-3, {"singular"}), (1e2, {"singular", "damped"})):
+        statuses = []
+        for _ in range(20):
+            task = FrameTask(arm.tool_frame, rng.normal(size=6) * size)
+            statuses.append(resolver.solve(arm.random_q(rng), [task], priority="strict").status)
+        assert set(statuses) <= allowed and statuses.count("singular") >= 10, (size, statuses)
+    baxter = arms["baxter"] if "baxter" in arms else rrc_pin.load("baxter")
+    left, right = baxter.tool_frames
+    two = Resolver(baxter)
+    posture = PostureTask(baxter.neutral(), gain=1.0, weight=0.01)
+    statuses = set()
+    for _ in range(40):
+        x = rng.normal(size=12) * rng.choice([1e-3, 1.0])
+        tasks = [FrameTask(left, x[:6]), FrameTask(right, x[6:]), posture]
+        statuses.add(two.solve(baxter.random_q(rng), tasks).status)
+    assert statuses <= {"least_squares", "exact"}, statuses

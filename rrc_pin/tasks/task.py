@@ -48,8 +48,9 @@ class Task(ABC):
 
     def _row_weights(self, m: int) -> Array | None:
         """The weight as (m,) row weights, or None when it is 1 everywhere."""
-        w = np.broadcast_to(np.asarray(self.weight, dtype=np.float64), (m,))
-        return None if (w == 1.0).all() else np.array(w)
+        if isinstance(self.weight, float):  # check_weight gives a float or an (m,) array
+            return None if self.weight == 1.0 else np.full(m, self.weight)
+        return None if (self.weight == 1.0).all() else self.weight
 
 
 def check_weight(weight: float | npt.ArrayLike, size: int | None = None) -> float | Array:
