@@ -71,7 +71,7 @@ def finite_difference_jacobians(
     """
     T = robot.fk(q, frame)
     T_inv = np.linalg.inv(T)
-    out = {ref: np.empty((6, robot.nq)) for ref in REFS}
+    out: dict[Reference, npt.NDArray[np.float64]] = {ref: np.empty((6, robot.nq)) for ref in REFS}
     for i in range(robot.nq):
         dq = np.zeros(robot.nq)
         dq[i] = step

@@ -55,7 +55,7 @@ def closed_form_check(rng: np.random.Generator) -> None:
                 rates = cf.joint_rates(q, x, exact=True)
             else:
                 rates = cf.joint_rates(q, x)
-            worst = max(worst, np.linalg.norm(rates - reference) / np.linalg.norm(reference))
+            worst = max(worst, float(np.linalg.norm(rates - reference) / np.linalg.norm(reference)))
         print(f"{name:12s} {type(cf).__name__:>22s} {worst:28.1e}")
 
 

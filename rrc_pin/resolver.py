@@ -22,7 +22,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -44,6 +44,9 @@ from solvers.spatial import Reference
 from solvers.validation import as_vector, positive
 
 Array = npt.NDArray[np.float64]
+
+TaskCommand = Task | Sequence[Task | Sequence[Task]]
+"""Tasks for :meth:`Resolver.solve`: one, a list (weighted), or a list of levels (strict)."""
 
 Priority = Literal["weighted", "strict"]
 
@@ -173,7 +176,7 @@ class Resolver:
     def solve(
         self,
         q: npt.ArrayLike,
-        command: npt.ArrayLike | Task | Sequence[Task | Sequence[Task]],
+        command: npt.ArrayLike | TaskCommand,
         ref: Reference | None = None,
         *,
         priority: Priority = "weighted",
@@ -215,11 +218,11 @@ class Resolver:
         if isinstance(command, Task) or _is_tasks(command):
             if ref is not None:
                 raise InvalidInput("ref", "tasks carry their own ref; pass ref to FrameTask")
-            levels, weighted = self._levels(command, priority)  # type: ignore[arg-type]
+            levels, weighted = self._levels(cast(TaskCommand, command), priority)
             kin = Kinematics(self.robot.model, self._data, self._layout, q, q_pin)
             rows = [[t.rows(kin) for t in level] for level in levels]
         else:
-            rows = [[self._twist_rows(q, q_pin, command, ref)]]  # type: ignore[arg-type]
+            rows = [[self._twist_rows(q, q_pin, cast(npt.ArrayLike, command), ref)]]
             weighted = False
         bounds = self._bounds.step(q, step, prev)
         result = resolve(
@@ -269,7 +272,7 @@ class Resolver:
         return TaskRows(J, b, task.row_weights, task.name)
 
     def _levels(
-        self, command: Task | Sequence[Task | Sequence[Task]], priority: str
+        self, command: TaskCommand, priority: str
     ) -> tuple[list[list[Task]], bool]:
         """The tasks as priority levels, every task checked against the robot."""
         if priority not in ("weighted", "strict"):

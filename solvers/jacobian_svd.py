@@ -185,8 +185,8 @@ class Damping:
             return None
         reach = 1.0 / (np.abs(svd.Vt[:r]) / velocity).max(axis=1)  # r_i
         speed = svd.sigma[:r] * reach  # c_i
-        onset = float(speed.max()) / self.ratio  # c_on
-        if float(speed.min()) >= onset:
+        onset = float(np.max(speed)) / self.ratio  # c_on
+        if float(np.min(speed)) >= onset:
             return None  # no weak direction: far from singularities
         contains_zero = (lb <= 0.0).all() and (ub >= 0.0).all()
         s_exact = uniform_scale(exact, lb, ub) if contains_zero else 0.0

@@ -194,7 +194,7 @@ class _TopLevel:
     @property
     def lambda_sq(self) -> float:
         """The largest squared damping applied (0 when undamped)."""
-        return float(self.lam.max()) if self.damped and self.lam is not None else 0.0
+        return float(np.max(self.lam)) if self.damped and self.lam is not None else 0.0
 
 
 def resolve(

@@ -111,14 +111,17 @@ def cos_sin(
     c_all, s_all = out[0].reshape(-1), out[1].reshape(-1)
     n = flat.shape[0]
     m = max(min(n, block), 1)
-    y, r, r2, t = np.empty(m), np.empty(m), np.empty(m), np.empty(m)
-    k = np.empty(m, dtype=np.int64)
+    y: Array = np.empty(m)
+    r: Array = np.empty(m)
+    r2: Array = np.empty(m)
+    t: Array = np.empty(m)
+    k: npt.NDArray[np.int64] = np.empty(m, dtype=np.int64)
     for rows in blocks(n, m):
         x, c, s = flat[rows], c_all[rows], s_all[rows]
         size = x.shape[0]
         if size < m:
             y, r, r2, t, k = y[:size], r[:size], r2[:size], t[:size], k[:size]
-        if x.max() > LIMIT or x.min() < -LIMIT:
+        if np.max(x) > LIMIT or np.min(x) < -LIMIT:
             np.cos(x, out=c)
             np.sin(x, out=s)
             continue

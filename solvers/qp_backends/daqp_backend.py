@@ -20,7 +20,7 @@ import numpy as np
 
 from solvers.errors import ProblemError
 from solvers.qp import QP
-from solvers.qp_backends.base import QPBackend, QPSolution
+from solvers.qp_backends.base import Array, QPBackend, QPSolution
 
 DEFAULT_SETTINGS = {"primal_tol": 1e-9}
 """DAQP settings used unless overridden. DAQP's default primal tolerance (1e-6) lets an
@@ -50,6 +50,7 @@ class DaqpBackend(QPBackend):
         import daqp
 
         nz = qp.q.size
+        A: Array
         if qp.C is None or qp.l is None or qp.u is None:
             A, upper, lower = np.zeros((0, nz)), qp.ub, qp.lb
         else:  # the box first, then the rows (DAQP takes infinite bounds as they are)
