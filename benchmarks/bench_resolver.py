@@ -65,6 +65,7 @@ from timing import (  # noqa: E402
     quiet_stdout,
     run_mode,
     summarise,
+    timing_chart,
 )
 
 import rrc_pin  # noqa: E402
@@ -453,41 +454,13 @@ def _routes_table(arm: dict[str, Any]) -> list[str]:
 def plot(results: dict[str, Any], path: Path) -> bool:
     """Median step time per contender, mode and arm (bars), p99 as a tick; False without
     matplotlib (nothing written)."""
-    try:
-        import matplotlib
-    except ImportError:
-        return False
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import matplotlib.ticker
-
     arms = results["arms"]
-    fig, axes = plt.subplots(1, len(arms), figsize=(7.5 * len(arms), 6), squeeze=False)
-    width = 0.27
-    for ax, arm in zip(axes[0], arms, strict=True):
-        tight = arm["modes"]["tight"]["contenders"]
-        labels = sorted(tight, key=lambda k: tight[k]["median_us"])
-        y = np.arange(len(labels))
-        for i, mode in enumerate(MODES):
-            rows = arm["modes"][mode]["contenders"]
-            med = [rows[k]["median_us"] for k in labels]
-            p99 = [rows[k]["p99_us"] for k in labels]
-            offset = (i - 1) * width
-            ax.barh(y + offset, med, width, label=f"{MODE_TITLES[mode]} (median)")
-            ax.plot(p99, y + offset, "k|", markersize=7)
-        ax.plot([], [], "k|", label="p99")
-        ax.set_yticks(y, labels)
-        ax.set_xscale("log")
-        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
-        ax.invert_yaxis()
-        ax.set_xlabel("step time [us] (log)")
-        ax.set_title(f"{arm['arm']}: one resolved-rate step")
-        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return True
+    panels = [
+        ({mode: arm["modes"][mode]["contenders"] for mode in MODES},
+         f"{arm['arm']}: one resolved-rate step")
+        for arm in arms
+    ]  # fmt: skip
+    return timing_chart(panels, path, (7.5 * len(arms), 6))
 
 
 if __name__ == "__main__":

@@ -10,9 +10,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 from stage_profile import profile_table
-from timing import MODE_TITLES
+from timing import MODE_TITLES, timing_chart
 
 MODES = ("tight", "interleaved")
 """The modes the tasks benchmark times (:mod:`timing`)."""
@@ -257,39 +256,6 @@ def _g(value: float | None) -> str:
 
 def plot(results: dict[str, Any], path: Path) -> bool:
     """Median step time per contender and mode (bars), p99 as a tick; False without matplotlib."""
-    try:
-        import matplotlib
-    except ImportError:
-        return False
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import matplotlib.ticker
-
-    tight = results["modes"]["tight"]["contenders"]
-    labels = sorted(tight, key=lambda k: tight[k]["median_us"])
-    y = np.arange(len(labels))
-    fig, ax = plt.subplots(figsize=(8, 0.5 * len(labels) + 1.5))
-    width = 0.38
-    for i, mode in enumerate(MODES):
-        rows = results["modes"][mode]["contenders"]
-        offset = (i - 0.5) * width
-        ax.barh(
-            y + offset,
-            [rows[k]["median_us"] for k in labels],
-            width,
-            label=f"{MODE_TITLES[mode]} (median)",
-        )
-        ax.plot([rows[k]["p99_us"] for k in labels], y + offset, "k|", markersize=8)
-    ax.plot([], [], "k|", label="p99")
-    ax.set_yticks(y, labels)
-    ax.set_xscale("log")
-    ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-    ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
-    ax.invert_yaxis()
-    ax.set_xlabel("step time [us] (log)")
-    ax.set_title(f"{results['robot']}: two frame tasks and a posture, one step")
-    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=2)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return True
+    rows = {mode: results["modes"][mode]["contenders"] for mode in MODES}
+    title = f"{results['robot']}: two frame tasks and a posture, one step"
+    return timing_chart([(rows, title)], path, (8, 0.5 * len(rows[MODES[0]]) + 1.5))

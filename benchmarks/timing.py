@@ -290,3 +290,49 @@ def one_core(pids: list[int]) -> Iterator[int | None]:
         yield cpu
     finally:
         os.sched_setaffinity(0, saved)
+
+
+def timing_chart(
+    panels: list[tuple[dict[str, dict[str, dict[str, float]]], str]],
+    path: Path,
+    size: tuple[float, float],
+) -> bool:
+    """Bar charts of step times to ``path``; False without matplotlib (nothing written).
+
+    One panel per (rows by mode, title): a bar per contender and mode (its median; contenders
+    sorted by the first mode's), the p99 as a tick, on a log axis.
+    """
+    try:
+        import matplotlib
+    except ImportError:
+        return False
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import matplotlib.ticker
+
+    fig, axes = plt.subplots(1, len(panels), figsize=size, squeeze=False)
+    for ax, (by_mode, title) in zip(axes[0], panels, strict=True):
+        modes = list(by_mode)
+        first = by_mode[modes[0]]
+        labels = sorted(first, key=lambda k: first[k]["median_us"])
+        y = np.arange(len(labels))
+        width = 0.8 / len(modes)
+        for i, mode in enumerate(modes):
+            rows = by_mode[mode]
+            offset = (i - (len(modes) - 1) / 2) * width
+            median = [rows[k]["median_us"] for k in labels]
+            ax.barh(y + offset, median, width, label=f"{MODE_TITLES[mode]} (median)")
+            ax.plot([rows[k]["p99_us"] for k in labels], y + offset, "k|", markersize=7)
+        ax.plot([], [], "k|", label="p99")
+        ax.set_yticks(y, labels)
+        ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.xaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.invert_yaxis()
+        ax.set_xlabel("step time [us] (log)")
+        ax.set_title(title)
+        ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return True
