@@ -61,11 +61,13 @@ from timing import (  # noqa: E402
     PERIOD,
     Contender,
     add_ratios,
+    mode_table,
     progress,
     quiet_stdout,
     run_mode,
     summarise,
     timing_chart,
+    us,
 )
 
 import rrc_pin  # noqa: E402
@@ -294,15 +296,6 @@ def main(argv: list[str] | None = None) -> int:
 # ---- rendering (update_readme.py) -------------------------------------------------------------
 
 
-def _us(x: float) -> str:
-    return f"{x:,.0f}" if x >= 10 else f"{x:.1f}"
-
-
-def _ratio(row: dict[str, Any], key: str) -> str:
-    value = row.get(key)
-    return "-" if value is None else f"{value:.2f}x"
-
-
 def readme_table(results: dict[str, Any]) -> str:
     """The README's table: for each arm, rrc-pin default and tracking against pink's fastest
     backend, median and p99 in each mode, and the ratios (pink's time over rrc-pin's)."""
@@ -335,7 +328,7 @@ def readme_table(results: dict[str, Any]) -> str:
                         f"{row.get('vs_baseline_p99', float('nan')):.1f}x"
                     )
                 )
-                cells += f" {_us(row['median_us'])} / {_us(row['p99_us'])} | {ratio} |"
+                cells += f" {us(row['median_us'])} / {us(row['p99_us'])} | {ratio} |"
             lines.append(cells)
     lines += ["", _setup_line(results)]
     return "\n".join(lines)
@@ -392,37 +385,7 @@ def docs_section(results: dict[str, Any]) -> str:
             "",
         ]
         for mode in MODES:
-            m = arm["modes"][mode]
-            lines += [
-                f"**{MODE_TITLES[mode]}** (pink's fastest: {m['pink_fastest'] or '-'})",
-                "",
-                "| contender | median [us] | p10 | p90 | p99 | mean | median vs pink | "
-                "p99 vs pink | max velocity excess [rad/s] | max position excess [rad] | "
-                "failures |",
-                "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
-            ]
-            for label, r in sorted(m["contenders"].items(), key=lambda kv: kv[1]["median_us"]):
-                lines.append(
-                    f"| {label} | {_us(r['median_us'])} | {_us(r['p10_us'])} | "
-                    f"{_us(r['p90_us'])} | {_us(r['p99_us'])} | {_us(r['mean_us'])} | "
-                    f"{_ratio(r, 'vs_baseline_median')} | {_ratio(r, 'vs_baseline_p99')} | "
-                    f"{r['max_velocity_excess']:.2g} | {r['max_position_excess']:.2g} | "
-                    f"{r['failures']} |"
-                )
-            overruns = {k: r["overruns"] for k, r in m["contenders"].items() if r["overruns"]}
-            if overruns:
-                lines += [
-                    "",
-                    "Ticks overrun (call longer than 1 ms): "
-                    + ", ".join(f"{k} {v}" for k, v in overruns.items()),
-                ]
-            errors = {k: r["first_error"] for k, r in m["contenders"].items() if "first_error" in r}
-            if errors:
-                lines += [
-                    "",
-                    "First failure: " + "; ".join(f"{k}: `{v[:120]}`" for k, v in errors.items()),
-                ]
-            lines.append("")
+            lines += mode_table(arm["modes"][mode], mode, {"pink": "baseline"})
         lines += _routes_table(arm) + profile_table(arm["profile"], "the default")
     return "\n".join(lines)
 

@@ -65,7 +65,7 @@ from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
-from bench_resolver import rrc_statistics  # noqa: E402
+from bench_resolver import BACKEND_MODULES, rrc_statistics  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
 from placo_peer import PlacoPeer, Worker, placo_checks, placo_python, placo_urdf  # noqa: E402
 from render_tasks import MODES, PLACO, STRICT, WEIGHTED, plot, readme_table  # noqa: E402
@@ -454,9 +454,7 @@ def main(argv: list[str] | None = None) -> int:
         notes.append(placo_why)
     results: dict[str, Any] = {
         "benchmark": "tasks",
-        "machine": machine_info(
-            "qpsolvers", "pink", "daqp", "osqp", "proxsuite", "quadprog", "clarabel"
-        ),
+        "machine": machine_info("qpsolvers", "pink", *BACKEND_MODULES),
         "source": source_state(),
         "settings": {
             "dt": DT,

@@ -11,16 +11,12 @@ from pathlib import Path
 from typing import Any
 
 from stage_profile import profile_table
-from timing import MODE_TITLES, timing_chart
+from timing import MODE_TITLES, mode_table, timing_chart, us
 
 MODES = ("tight", "interleaved")
 """The modes the tasks benchmark times (:mod:`timing`)."""
 WEIGHTED, STRICT, PLACO = "rrc-pin weighted", "rrc-pin strict", "PlaCo"
 """Labels of the contenders the tables name."""
-
-
-def _us(x: float) -> str:
-    return f"{x:,.0f}" if x >= 10 else f"{x:.1f}"
 
 
 def _x(value: float | None) -> str:
@@ -62,7 +58,7 @@ def readme_table(results: dict[str, Any]) -> str:
                 if ours and "vs_placo_median" in row
                 else "-"
             )
-            cells += f" {_us(row['median_us'])} / {_us(row['p99_us'])} | {vs_pink} | {vs_placo} |"
+            cells += f" {us(row['median_us'])} / {us(row['p99_us'])} | {vs_pink} | {vs_placo} |"
         lines.append(cells)
     lines += ["", _setup_line(results)]
     return "\n".join(lines)
@@ -147,30 +143,7 @@ def docs_section(results: dict[str, Any]) -> str:
             "",
         ]
     for mode in MODES:
-        m = results["modes"][mode]
-        lines += [
-            f"**{MODE_TITLES[mode]}** (pink's fastest: {m['pink_fastest'] or '-'})",
-            "",
-            "| contender | median [us] | p10 | p90 | p99 | mean | median vs pink | p99 vs pink "
-            "| median vs PlaCo | p99 vs PlaCo | max velocity excess [rad/s] | "
-            "max position excess [rad] | failures |",
-            "| --- |" + " ---: |" * 12,
-        ]
-        for label, r in sorted(m["contenders"].items(), key=lambda kv: kv[1]["median_us"]):
-            lines.append(
-                f"| {label} | {_us(r['median_us'])} | {_us(r['p10_us'])} | {_us(r['p90_us'])} | "
-                f"{_us(r['p99_us'])} | {_us(r['mean_us'])} | {_x2(r, 'vs_baseline_median')} | "
-                f"{_x2(r, 'vs_baseline_p99')} | {_x2(r, 'vs_placo_median')} | "
-                f"{_x2(r, 'vs_placo_p99')} | {r['max_velocity_excess']:.2g} | "
-                f"{r['max_position_excess']:.2g} | {r['failures']} |"
-            )
-        errors = {k: r["first_error"] for k, r in m["contenders"].items() if "first_error" in r}
-        if errors:
-            lines += [
-                "",
-                "First failure: " + "; ".join(f"{k}: `{v[:120]}`" for k, v in errors.items()),
-            ]
-        lines.append("")
+        lines += mode_table(results["modes"][mode], mode, {"pink": "baseline", "PlaCo": "placo"})
     stats = results["rrc_pin"]["tight"]
     statuses = sorted({x for r in stats.values() for x in r["status"]})
     lines += [
@@ -191,11 +164,6 @@ def docs_section(results: dict[str, Any]) -> str:
     for label, p in results.get("profiles", {}).items():
         lines += profile_table(p, label)
     return "\n".join(lines)
-
-
-def _x2(row: dict[str, Any], key: str) -> str:
-    value = row.get(key)
-    return "-" if value is None else f"{value:.2f}x"
 
 
 def _equivalence_lines(eq: dict[str, Any]) -> list[str]:

@@ -336,3 +336,52 @@ def timing_chart(
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return True
+
+
+def us(x: float) -> str:
+    """A time [us] for a table: thousands separated, one decimal below 10."""
+    return f"{x:,.0f}" if x >= 10 else f"{x:.1f}"
+
+
+def ratio(row: dict[str, Any], key: str) -> str:
+    """A ratio of a contender's row for a table ("-" where there is none)."""
+    value = row.get(key)
+    return "-" if value is None else f"{value:.2f}x"
+
+
+def mode_table(m: dict[str, Any], mode: str, baselines: dict[str, str]) -> list[str]:
+    """Markdown lines of one timing mode: a row per contender by median (times, the ratios
+    to each of ``baselines`` (column name: key prefix in the rows), limit excess, failures),
+    then the overrun ticks and the first failures."""
+    vs = "".join(f" median vs {b} | p99 vs {b} |" for b in baselines)
+    lines = [
+        f"**{MODE_TITLES[mode]}** (pink's fastest: {m['pink_fastest'] or '-'})",
+        "",
+        f"| contender | median [us] | p10 | p90 | p99 | mean |{vs} max velocity excess [rad/s] "
+        "| max position excess [rad] | failures |",
+        "| --- |" + " ---: |" * (8 + 2 * len(baselines)),
+    ]
+    for label, r in sorted(m["contenders"].items(), key=lambda kv: kv[1]["median_us"]):
+        ratios = "".join(
+            f" {ratio(r, f'vs_{k}_median')} | {ratio(r, f'vs_{k}_p99')} |"
+            for k in baselines.values()
+        )
+        lines.append(
+            f"| {label} | {us(r['median_us'])} | {us(r['p10_us'])} | {us(r['p90_us'])} | "
+            f"{us(r['p99_us'])} | {us(r['mean_us'])} |{ratios} "
+            f"{r['max_velocity_excess']:.2g} | {r['max_position_excess']:.2g} | {r['failures']} |"
+        )
+    overruns = {k: r["overruns"] for k, r in m["contenders"].items() if r.get("overruns")}
+    if overruns:
+        lines += [
+            "",
+            "Ticks overrun (call longer than 1 ms): "
+            + ", ".join(f"{k} {v}" for k, v in overruns.items()),
+        ]
+    errors = {k: r["first_error"] for k, r in m["contenders"].items() if "first_error" in r}
+    if errors:
+        lines += [
+            "",
+            "First failure: " + "; ".join(f"{k}: `{v[:120]}`" for k, v in errors.items()),
+        ]
+    return [*lines, ""]
