@@ -13,11 +13,12 @@ from rrc_pin.errors import (
     RrcPinError,
     ToolFrameRequired,
     UnknownArm,
+    UnknownBackend,
     URDFError,
 )
 from rrc_pin.limits import JointLimits
 from rrc_pin.loading import arms, load
-from rrc_pin.resolver import Damping, QPOptions, Resolver, UnknownBackend
+from rrc_pin.resolver import Damping, QPOptions, Resolver
 from rrc_pin.robot import Robot
 from rrc_pin.tasks import DampingTask, FrameTask, JointTask, PostureTask, RelativeFrameTask, Task
 from solvers.resolution import ActiveLimit, Resolution, TaskReport

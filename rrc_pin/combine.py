@@ -19,16 +19,12 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
-from solvers.validation import as_array
-
-PLACEMENT_TOL = 1e-9
-"""Largest departure of ``T_base`` from a rigid transform (R^T R - I, last row) accepted."""
+from solvers.validation import rigid_transform
 
 
 def combine(arms: Mapping[str, tuple[Robot, npt.ArrayLike]], name: str | None = None) -> Robot:
@@ -46,7 +42,8 @@ def combine(arms: Mapping[str, tuple[Robot, npt.ArrayLike]], name: str | None = 
     Raises:
         InvalidInput: ``arms`` is empty or not a mapping, a key is not a non-empty name
             without ``/``, a value is not ``(Robot, T_base)``, ``T_base`` is not a (4, 4)
-            rigid transform (within :data:`PLACEMENT_TOL`), or ``name`` is not a string.
+            rigid transform (within :data:`solvers.validation.RIGID_TOL`), or ``name`` is not a
+            string.
 
     Example:
         >>> cell = combine({"left": (panda, T_left), "right": (ur5, T_right)})
@@ -80,16 +77,8 @@ def _entry(key: object, value: object) -> tuple[Robot, pin.SE3]:
     label = f"arms[{key!r}]"
     if not (isinstance(value, tuple) and len(value) == 2 and isinstance(value[0], Robot)):
         raise InvalidInput(label, f"expected (Robot, T_base (4, 4)), got {value!r}")
-    T = as_array(value[1], label, (4, 4), InvalidInput)
-    R = T[:3, :3]
-    rigid = (
-        np.abs(R.T @ R - np.eye(3)).max() <= PLACEMENT_TOL
-        and np.linalg.det(R) > 0.0
-        and np.abs(T[3] - (0.0, 0.0, 0.0, 1.0)).max() <= PLACEMENT_TOL
-    )
-    if not rigid:
-        raise InvalidInput(label, f"T_base is not a rigid transform: {T.tolist()}")
-    return value[0], pin.SE3(R, T[:3, 3])
+    T = rigid_transform(value[1], label, InvalidInput)
+    return value[0], pin.SE3(T[:3, :3], T[:3, 3])
 
 
 def _prefixed(model: pin.Model, prefix: str) -> pin.Model:

@@ -7,7 +7,7 @@ reports which method answered.
 
 from __future__ import annotations
 
-from solvers.errors import InputError
+from solvers.errors import BackendNotFound, InputError
 
 
 class RrcPinError(Exception):
@@ -80,3 +80,7 @@ class ToolFrameRequired(InvalidInput):
     def __init__(self, argument: str, context: str, candidates: list[str]) -> None:
         self.candidates = candidates
         super().__init__(argument, f"{context}; name one of: {', '.join(candidates)}")
+
+
+class UnknownBackend(RrcPinError, BackendNotFound):
+    """A QP backend that is not installed (the error lists the installed ones)."""

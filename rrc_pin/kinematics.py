@@ -9,13 +9,13 @@ then read frame Jacobians (``getFrameJacobian``, no recomputation) and poses fro
 
 from __future__ import annotations
 
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from rrc_pin.robot import PIN_REFERENCE
+from rrc_pin.robot import PIN_REFERENCE, frame_index
 from solvers.spatial import Reference
 
 Array = npt.NDArray[np.float64]
@@ -38,15 +38,10 @@ class Layout(NamedTuple):
 
     @classmethod
     def of(cls, model: pin.Model, joint_names: list[str]) -> Layout:
-        """The layout of ``model`` (frames by name: the body frame where names repeat)."""
-        body = pin.FrameType.BODY
-        frames: dict[str, int] = {}
-        for i, f in enumerate(model.frames):
-            first = frames.get(f.name)
-            if first is None or (f.type == body and model.frames[first].type != body):
-                frames[f.name] = i
+        """The layout of ``model`` whose joints (in q's order) are ``joint_names``."""
         continuous = np.array([model.joints[j].nq == 2 for j in range(1, model.njoints)])
-        return cls(model.nv, frames, {n: i for i, n in enumerate(joint_names)}, continuous)
+        joints = {n: i for i, n in enumerate(joint_names)}
+        return cls(model.nv, frame_index(model), joints, continuous)
 
 
 class Kinematics:
@@ -65,7 +60,9 @@ class Kinematics:
         continuous: Mask (nv,) of the continuous joints.
     """
 
-    def __init__(self, model: pin.Model, data: Any, layout: Layout, q: Array, q_pin: Array) -> None:
+    def __init__(
+        self, model: pin.Model, data: pin.Data, layout: Layout, q: Array, q_pin: Array
+    ) -> None:
         self.q, self.q_pin, self.continuous = q, q_pin, layout.continuous
         self._model, self._data, self._layout = model, data, layout
         pin.computeJointJacobians(model, data, q_pin)

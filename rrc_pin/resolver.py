@@ -28,20 +28,19 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from rrc_pin.errors import InvalidInput, RrcPinError
+from rrc_pin.errors import InvalidInput, UnknownBackend
 from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.limits import JointLimits
 from rrc_pin.loading import load
 from rrc_pin.robot import PIN_REFERENCE, Robot
 from rrc_pin.tasks import FrameTask, Task
-from rrc_pin.tasks.frame_task import check_reference
 from solvers import jacobian_svd
 from solvers.errors import BackendNotFound, InputError
 from solvers.qp_backends import make_backend
 from solvers.resolution import Method, Resolution, TaskRows
-from solvers.resolve import ResolveOptions, resolve
+from solvers.resolve import DEFAULT_FALLBACKS, ResolveOptions, resolve
 from solvers.spatial import Reference
-from solvers.validation import as_vector, positive
+from solvers.validation import positive
 
 Array = npt.NDArray[np.float64]
 
@@ -49,10 +48,6 @@ TaskCommand = Task | Sequence[Task | Sequence[Task]]
 """Tasks for :meth:`Resolver.solve`: one, a list (weighted), or a list of levels (strict)."""
 
 Priority = Literal["weighted", "strict"]
-
-
-class UnknownBackend(RrcPinError, BackendNotFound):
-    """A QP backend that is not installed (the error lists the installed ones)."""
 
 
 class Damping(jacobian_svd.Damping):
@@ -90,7 +85,7 @@ class QPOptions:
 
     backend: str = "daqp"
     options: Mapping[str, Any] = field(default_factory=dict)
-    fallbacks: Sequence[Method] = ("scipy", "scaling")
+    fallbacks: Sequence[Method] = DEFAULT_FALLBACKS
 
 
 class Resolver:
@@ -139,8 +134,6 @@ class Resolver:
         self.limits = JointLimits() if limits is None else _typed(limits, JointLimits, "limits")
         self._bounds = self.limits.bounds(robot)
         self.qp = QPOptions() if qp is None else _typed(qp, QPOptions, "qp")
-        if damping is not None:
-            _typed(damping, jacobian_svd.Damping, "damping")
         try:
             self.options = ResolveOptions(direction_preserving, damping, self.qp.fallbacks)
             self.backend = make_backend(self.qp.backend, **dict(self.qp.options))
@@ -211,10 +204,11 @@ class Resolver:
         """
         q, q_pin = self.robot.configuration(q)
         step = self.dt if dt is None else _dt(dt)
-        prev = None
-        if self.limits.acceleration is not None:
-            prev = self._last_qdot if qdot_prev is None else self._vector(qdot_prev, "qdot_prev")
-            prev = np.zeros(self.robot.nq) if prev is None else prev
+        prev = None if qdot_prev is None else self.robot.check_q(qdot_prev, "qdot_prev")
+        if self.limits.acceleration is None:
+            prev = None
+        elif prev is None:
+            prev = np.zeros(self.robot.nq) if self._last_qdot is None else self._last_qdot
         if isinstance(command, Task) or _is_tasks(command):
             if ref is not None:
                 raise InvalidInput("ref", "tasks carry their own ref; pass ref to FrameTask")
@@ -226,8 +220,7 @@ class Resolver:
             weighted = False
         bounds = self._bounds.step(q, step, prev)
         result = resolve(
-            rows, bounds, self._bounds.velocity, self.backend, self.options, weighted=weighted,
-            joint_names=self._names,
+            rows, bounds, self.backend, self.options, weighted=weighted, joint_names=self._names,
         )  # fmt: skip
         self._last_qdot = result.qdot
         return result
@@ -255,10 +248,7 @@ class Resolver:
                 "twist)], or Resolver(robot, task=FrameTask(frame))",
             )  # fmt: skip
         b = task.check_twist(twist)
-        ref = task.ref if ref is None else check_reference(ref)
-        if ref == "world" and len(task.selected) != 6:
-            raise InvalidInput("ref", "'world' is the spatial velocity at the base origin: "
-                               "partial rows cannot use it; use 'world_aligned'")  # fmt: skip
+        ref = task.ref if ref is None else task.check_ref(ref)
         if self._closed_form is not None:
             if ref != "world_aligned":
                 raise InvalidInput("ref", f"the closed form gives world_aligned rows, got {ref!r}")
@@ -267,9 +257,7 @@ class Resolver:
             J = pin.computeFrameJacobian(
                 self.robot.model, self._data, q_pin, self._frame, PIN_REFERENCE[ref]
             )
-        if len(task.selected) != J.shape[0]:
-            J = J[list(task.selected)]
-        return TaskRows(J, b, task.row_weights, task.name)
+        return task.rows_from(J, b)
 
     def _levels(
         self, command: TaskCommand, priority: str
@@ -277,9 +265,7 @@ class Resolver:
         """The tasks as priority levels, every task checked against the robot."""
         if priority not in ("weighted", "strict"):
             raise InvalidInput("priority", f"expected 'weighted' or 'strict', got {priority!r}")
-        items = [command] if isinstance(command, Task) else list(command)
-        if not items:
-            raise InvalidInput("command", "expected a twist, a task or a non-empty list of tasks")
+        items = [command] if isinstance(command, Task) else list(command)  # never empty
         if priority == "weighted":
             if not all(isinstance(t, Task) for t in items):
                 raise InvalidInput(
@@ -324,9 +310,6 @@ class Resolver:
                 "task", f"the closed form has {cf.task_dim} rows; rows {task.selected} asked"
             )
         return cf
-
-    def _vector(self, x: npt.ArrayLike, name: str) -> Array:
-        return as_vector(x, name, self.robot.nq, InvalidInput)
 
 
 def _dt(dt: float) -> float:

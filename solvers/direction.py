@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from solvers.errors import ProblemError
 from solvers.qp import QP, Decoding
 from solvers.resolution import norm
 
@@ -102,7 +103,7 @@ def direction_lp(M: Array, C: Array, lo: Array, hi: Array) -> Array:
         The joint rates ``M z`` (n,).
 
     Raises:
-        ValueError: HiGHS found no solution (it always exists when the bounds contain zero).
+        ProblemError: HiGHS found no solution (one exists when the bounds contain zero).
     """
     from scipy.optimize import linprog
 
@@ -118,5 +119,5 @@ def direction_lp(M: Array, C: Array, lo: Array, hi: Array) -> Array:
         method="highs",
     )
     if result.status != 0 or result.x is None:
-        raise ValueError(f"linprog: {result.message}")
+        raise ProblemError(f"linprog: {result.message}")
     return np.asarray(M @ result.x, dtype=np.float64)

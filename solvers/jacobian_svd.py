@@ -46,6 +46,7 @@ import numpy.typing as npt
 from scipy.linalg.lapack import dgesvd, dposv
 
 from solvers.direction import uniform_scale
+from solvers.joint_bounds import excludes_zero
 from solvers.resolution import norm
 from solvers.validation import finite_number
 
@@ -60,14 +61,22 @@ NORMAL_RCOND = 1e-3
 least this times its largest: the normal matrix's condition is then about 1e6 (the ratio
 squared, an estimate from below), leaving some ten digits; otherwise the SVD answers."""
 
+NORMAL_RESIDUAL = 1e-10
+"""Relative residual under which the normal equations' rates of a wide J are accepted (below
+:data:`solvers.resolution.EXACT_TOL`, so that accepted rates meet the command)."""
+
 
 def normal_rates(J: Array, b: Array) -> Array | None:
     r"""The least-squares rates of least norm :math:`J^+ b` (n,) by the normal equations.
 
     Wide or square J (m <= n): :math:`\dot q = J^T y`, :math:`J J^T y = b`, accepted when
-    :math:`J\dot q = b` to 1e-10 relative (a solution in the row space is the least-norm
-    one). Tall J (m > n): :math:`J^T J \dot q = J^T b`, the one least-squares solution. By
-    LAPACK's Cholesky solve (dposv).
+    :math:`J\dot q = b` to :data:`NORMAL_RESIDUAL` relative (a solution in the row space is
+    the least-norm one). Tall J (m > n): :math:`J^T J \dot q = J^T b`, the one least-squares
+    solution. By LAPACK's Cholesky solve (dposv).
+
+    Args:
+        J: Rows (m, n), row-weighted.
+        b: Their rates (m,).
 
     Returns:
         The rates, or None where the normal matrix is not numerically definite or badly
@@ -85,7 +94,7 @@ def normal_rates(J: Array, b: Array) -> Array | None:
     if not wide:
         return np.asarray(y, dtype=np.float64)
     x: Array = y @ J
-    if norm(J @ x - b) > 1e-10 * (1.0 + norm(b)):
+    if norm(J @ x - b) > NORMAL_RESIDUAL * (1.0 + norm(b)):
         return None
     return x
 
@@ -188,8 +197,7 @@ class Damping:
         onset = float(np.max(speed)) / self.ratio  # c_on
         if float(np.min(speed)) >= onset:
             return None  # no weak direction: far from singularities
-        contains_zero = (lb <= 0.0).all() and (ub >= 0.0).all()
-        s_exact = uniform_scale(exact, lb, ub) if contains_zero else 0.0
+        s_exact = 0.0 if excludes_zero(lb, ub) else uniform_scale(exact, lb, ub)
         weak = np.maximum(1.0 - (speed / onset) ** 2, 0.0)
         lam = np.zeros(svd.sigma.size)
         lam[:r] = weak * (onset / reach) ** 2 * (1.0 - s_exact)

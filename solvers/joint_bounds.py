@@ -49,6 +49,9 @@ class StepBounds(NamedTuple):
         lb: Lower bounds (n,) [rad/s or m/s].
         ub: Upper bounds (n,), ``lb <= ub`` everywhere.
         contains_zero: True when standing still is allowed (no joint must move).
+        recovering: True when a joint is outside its range and must move back (its position
+            bounds exclude zero); zero can also be excluded by the acceleration limits alone
+            (the arm cannot stop in one step), which is not recovering.
         velocity: The velocity limits (n,) the bounds were clipped into.
         position: The position bounds ``(lower, upper)`` (n,) before that clip.
         acceleration: The acceleration bounds ``(lower, upper)`` (n,) before they were clipped
@@ -58,6 +61,7 @@ class StepBounds(NamedTuple):
     lb: Array
     ub: Array
     contains_zero: bool
+    recovering: bool
     velocity: Array
     position: tuple[Array, Array]
     acceleration: tuple[Array, Array] | None = None
@@ -148,22 +152,27 @@ class JointBounds:
         # every qdot <= ub, fused multiply-add or not; the same for lb. Rows: lower, upper.
         b = (self._range - q) * (self.gain / dt * SHRINK)
         lb, ub = b
-        outside = float(np.maximum(lb, -ub).max()) > 0.0  # lb > 0 or ub < 0 somewhere
+        outside = excludes_zero(lb, ub)
         if outside:  # a joint outside its range: on its limit, or recovering
             on_limit = (q <= self.high + ON_LIMIT) & (q >= self.low - ON_LIMIT)
             lb[on_limit] = np.minimum(lb[on_limit], 0.0)
             ub[on_limit] = np.maximum(ub[on_limit], 0.0)
-            outside = float(np.maximum(lb, -ub).max()) > 0.0
+            outside = excludes_zero(lb, ub)
         position = (lb.copy(), ub.copy())
         np.minimum(np.maximum(b, self._minus_velocity, out=b), self.velocity, out=b)
         if self.acceleration is None:
-            return StepBounds(lb, ub, not outside, self.velocity, position)
+            return StepBounds(lb, ub, not outside, outside, self.velocity, position)
         prev = np.zeros(self.n) if qdot_prev is None else qdot_prev
         reach = self.acceleration * dt
         wanted = (prev - reach, prev + reach)
         lb, ub = np.minimum(np.maximum(wanted, lb), ub)
-        zero_ok = float(np.maximum(lb, -ub).max()) <= 0.0
-        return StepBounds(lb, ub, zero_ok, self.velocity, position, wanted)
+        zero_ok = not excludes_zero(lb, ub)
+        return StepBounds(lb, ub, zero_ok, outside, self.velocity, position, wanted)
+
+
+def excludes_zero(lb: Array, ub: Array) -> bool:
+    """True when zero rates are outside ``lb <= qdot <= ub`` (lb > 0 or ub < 0 somewhere)."""
+    return float(np.maximum(lb, -ub).max()) > 0.0
 
 
 def joint_velocity_bounds(

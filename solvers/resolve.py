@@ -95,12 +95,15 @@ class Inequalities(NamedTuple):
     Attributes:
         G: Rows (p, n).
         h: Bounds (p,); ``h >= 0`` where standing still is allowed.
-        names: One name per row, for the report.
     """
 
     G: Array
     h: Array
-    names: tuple[str, ...]
+
+
+DEFAULT_FALLBACKS: tuple[Method, ...] = ("scipy", "scaling")
+"""The fallbacks tried after the QP by default: the same problem solved exactly by scipy,
+then the uniform scale of the (damped) rates; ``hold`` ends every chain."""
 
 
 @dataclass(frozen=True)
@@ -114,12 +117,13 @@ class ResolveOptions:
             :data:`~solvers.resolution.METHODS` except ``qp``); ``hold`` always ends.
 
     Raises:
-        InputError: An unknown or repeated fallback, ``qp`` among them.
+        InputError: An unknown or repeated fallback, ``qp`` among them, or ``hold`` before
+            another one (nothing after it would run).
     """
 
     direction_preserving: bool = True
     damping: Damping | None = field(default_factory=Damping)
-    fallbacks: Sequence[Method] = ("scipy", "scaling")
+    fallbacks: Sequence[Method] = DEFAULT_FALLBACKS
 
     def __post_init__(self) -> None:
         given: Sequence[str] = self.fallbacks
@@ -134,6 +138,8 @@ class ResolveOptions:
                 raise InputError("fallbacks", f"unknown method {name!r}; expected {choices}")
         if len(set(fallbacks)) != len(fallbacks):
             raise InputError("fallbacks", f"repeated method in {fallbacks}")
+        if "hold" in fallbacks[:-1]:
+            raise InputError("fallbacks", f"'hold' always answers, so it comes last: {fallbacks}")
         if self.damping is not None and not isinstance(self.damping, Damping):
             raise InputError("damping", f"expected a solvers Damping or None, got {self.damping!r}")
         if not isinstance(self.direction_preserving, bool):
@@ -157,9 +163,19 @@ class _Solved:
     iterations: int = 0
     solve_time: float = 0.0
 
+    def absorb(self, other: _Solved) -> None:
+        """Count ``other``'s backend work (iterations, time) as this answer's too."""
+        self.backend = self.backend or other.backend
+        self.iterations += other.iterations
+        self.solve_time += other.solve_time
+
 
 class _Failed(Exception):
     """A method did not produce a usable answer (internal control flow)."""
+
+
+_NUMERICAL = (_Failed, ProblemError, np.linalg.LinAlgError, ArithmeticError)
+"""What a method may fail with (numerical trouble): the pipeline records it and goes on."""
 
 
 @dataclass(slots=True)
@@ -182,11 +198,6 @@ class _TopLevel:
         return self.factor
 
     @property
-    def w(self) -> Array:
-        """The direction that answered: the damped rates or the exact ones."""
-        return self.svd.rates(self.b, self.lam) if self.damped else self.exact
-
-    @property
     def smooth(self) -> Array:
         """The damped rates where damping may help, else the exact ones (for fallbacks)."""
         return self.exact if self.lam is None else self.svd.rates(self.b, self.lam)
@@ -200,7 +211,6 @@ class _TopLevel:
 def resolve(
     levels: Sequence[Sequence[TaskRows]],
     bounds: StepBounds,
-    velocity: Array,
     backend: QPBackend,
     options: ResolveOptions,
     *,
@@ -216,7 +226,6 @@ def resolve(
     Args:
         levels: Task rows per priority level, highest first (one level when ``weighted``).
         bounds: Joint-rate bounds of the step.
-        velocity: Joint velocity limits (n,) > 0, for the damping.
         backend: The QP backend (warm-started across calls).
         options: How to solve.
         weighted: One level whose tasks trade off by their weights (least squares, no
@@ -236,9 +245,9 @@ def resolve(
     if rows is not None and (rows.h < 0.0).any():
         direction = False  # standing still would violate a row: least squares
     try:
-        top = _top_level(levels[0], bounds, velocity, options, rows, direction)
+        top = _top_level(levels[0], bounds, options, rows, direction)
         solved = _solve_top(top, bounds, backend, options, direction, rows)
-    except (_Failed, ProblemError, np.linalg.LinAlgError, ArithmeticError, ValueError) as exc:
+    except _NUMERICAL as exc:
         attempts.append(("qp", str(exc)))
     if solved is None:
         for name in options.fallbacks:
@@ -246,7 +255,7 @@ def resolve(
                 solved = _fallback(name, top, bounds, rows, direction)
                 method = name
                 break
-            except _Failed as exc:
+            except _NUMERICAL as exc:
                 attempts.append((name, str(exc)))
     assert solved is not None  # "hold" always answers
     if method == "qp" and len(levels) > 1:
@@ -257,7 +266,7 @@ def resolve(
             try:
                 last = k == len(levels) - 1
                 null = _lower_level(level, solved, null, bounds, backend, rows, k, last)
-            except (_Failed, ProblemError, np.linalg.LinAlgError, ArithmeticError) as exc:
+            except _NUMERICAL as exc:
                 attempts.append((f"level {k}", f"{exc}; the levels above kept"))
                 break
     solved.qdot.flags.writeable = False
@@ -293,10 +302,19 @@ def _rows_hold(x: Array, rows: Inequalities | None, tol: float = 0.0) -> bool:
     return rows is None or bool((rows.G @ x <= rows.h + tol).all())
 
 
+def _inside(x: Array, bounds: StepBounds, rows: Inequalities | None) -> bool:
+    """Whether the rates ``x`` satisfy the bounds and the rows exactly."""
+    return _clipped(x, bounds)[1] == 0.0 and _rows_hold(x, rows)
+
+
+def _scaled(w: Array, bounds: StepBounds) -> _Solved:
+    """The rates ``w`` scaled uniformly to the largest fraction in [0, 1] within the bounds."""
+    return _Solved(*_clipped(uniform_scale(w, bounds.lb, bounds.ub) * w, bounds))
+
+
 def _top_level(
     tasks: Sequence[TaskRows],
     bounds: StepBounds,
-    velocity: Array,
     options: ResolveOptions,
     rows: Inequalities | None,
     damp: bool,
@@ -308,10 +326,10 @@ def _top_level(
     if exact is None:  # not well posed for the normal equations: the SVD
         factor = JacobianSVD(A)
         exact = factor.rates(b)
-    fits = _clipped(exact, bounds)[1] == 0.0 and _rows_hold(exact, rows)
+    fits = _inside(exact, bounds, rows)
     top = _TopLevel(A, b, exact, fits, factor)
     if damp and not fits and options.damping is not None:
-        top.lam = options.damping.lambda_sq(top.svd, velocity, exact, bounds.lb, bounds.ub)
+        top.lam = options.damping.lambda_sq(top.svd, bounds.velocity, exact, bounds.lb, bounds.ub)
     return top
 
 
@@ -337,13 +355,11 @@ def _solve_top(
     solved = _along(top.exact, top, bounds, backend, rows)
     if top.lam is not None:
         damped = top.svd.rates(top.b, top.lam)
-        inside = _clipped(damped, bounds)[1] == 0.0 and _rows_hold(damped, rows)
+        inside = _inside(damped, bounds, rows)
         other = _Solved(damped) if inside else _along(damped, top, bounds, backend, rows)
         if _progress(other, top) > _progress(solved, top):
             top.damped = True
-            other.backend = other.backend or solved.backend  # the exact direction's ran too
-            other.iterations += solved.iterations
-            other.solve_time += solved.solve_time
+            other.absorb(solved)  # the exact direction's QP ran too
             return other
     return solved
 
@@ -359,7 +375,7 @@ def _along(
     """The direction-preserving problem along the rates ``w`` (solvers.direction)."""
     null = top.svd.null_basis()
     if rows is None and null.shape[0] == 0:  # no null space: the largest uniform scale
-        return _Solved(*_clipped(uniform_scale(w, bounds.lb, bounds.ub) * w, bounds))
+        return _scaled(w, bounds)
     d, n = null.shape
     qp, decoding = direction_qp(w, null, bounds.lb, bounds.ub, f"direction:{n}:{d}")
     if rows is not None:
@@ -369,7 +385,7 @@ def _along(
     if rows is None:  # u with y = 0 is feasible: an accurate backend does at least as well
         wc = decoding.M[:, -1]  # type: ignore[index]
         u_floor = uniform_scale(wc, bounds.lb, bounds.ub)
-        if float(solved.qdot @ wc) < u_floor * float(wc @ wc) * (1.0 - 1e-9):
+        if float(solved.qdot @ wc) < u_floor * float(wc @ wc) * (1.0 - EXACT_TOL):
             solved.qdot, solved.clip = _clipped(wc * u_floor, bounds)
     return solved
 
@@ -461,8 +477,8 @@ def _lower_level(
     if z is None:
         svd = JacobianSVD(B)
         z = svd.rates(c)
-    candidate, clip = _clipped(x + z @ null, bounds)
-    if not (clip == 0.0 and _rows_hold(candidate, rows)):
+    candidate, clip = x + z @ null, 0.0
+    if not _inside(candidate, bounds, rows):
         d, n = null.shape
         P = _with_least_norm(B.T @ B, svd)
         C, lo, hi = _rows_of(null.T, bounds, rows, x)
@@ -473,11 +489,13 @@ def _lower_level(
         qp = QP(P, -(c @ B), C, lo, hi, -free, free, f"level{k}:{n}:{d}")
         answer = _backend_solve(qp, Decoding(x, null.T), bounds, backend, rows)
         candidate, clip = answer.qdot, max(answer.clip, solved.clip)
-        solved.backend = answer.backend or solved.backend
-        solved.iterations += answer.iterations
-        solved.solve_time += answer.solve_time
+        solved.backend = answer.backend or solved.backend  # the last backend that answered
+        solved.absorb(answer)
     solved.qdot, solved.clip = candidate, clip
-    return None if last else (svd or JacobianSVD(B)).null_basis() @ null
+    if last:
+        return None
+    assert svd is not None  # only the last level may skip the SVD
+    return svd.null_basis() @ null
 
 
 def _fallback(
@@ -488,29 +506,30 @@ def _fallback(
     direction: bool,
 ) -> _Solved:
     """One fallback method's answer (module docstring); raises _Failed when it cannot."""
-    if name == "hold":
+    if name == "hold":  # the last resort: it answers even where zero breaks a row
         return _Solved(np.minimum(np.maximum(0.0, bounds.lb), bounds.ub))
     if top is None:
         raise _Failed("no factorisation of the top level")
-    if name == "dls":
-        return _Solved(*_clipped(top.smooth, bounds))
     if name == "scipy":
         return _Solved(*_clipped(_scipy(top, bounds, rows, direction), bounds))
-    if not bounds.contains_zero:
-        raise _Failed("a joint must recover: zero rates are outside the bounds")
-    w = top.smooth
-    return _Solved(*_clipped(uniform_scale(w, bounds.lb, bounds.ub) * w, bounds))
+    if name == "dls":
+        solved = _Solved(*_clipped(top.smooth, bounds))
+    elif not bounds.contains_zero:
+        raise _Failed("zero rates are outside the bounds: the uniform scale has no start")
+    else:
+        solved = _scaled(top.smooth, bounds)
+    if not _rows_hold(solved.qdot, rows):
+        raise _Failed(f"{name}: the answer breaks an inequality row")
+    return solved
 
 
 def _scipy(top: _TopLevel, bounds: StepBounds, rows: Inequalities | None, direction: bool) -> Array:
     """The top level's problem solved exactly by scipy.optimize (slower than a backend)."""
-    if direction:
-        M = np.column_stack([top.svd.null_basis().T, top.exact])
-        C, lo, hi = _rows_of(M, bounds, rows, None)
-        try:
-            return direction_lp(M, C, lo, hi)
-        except ValueError as exc:
-            raise _Failed(str(exc)) from exc
+    if direction:  # the backend's direction problem, by HiGHS
+        _, decoding = direction_qp(top.exact, top.svd.null_basis(), bounds.lb, bounds.ub, "")
+        assert decoding.M is not None
+        C, lo, hi = _rows_of(decoding.M, bounds, rows, None)
+        return direction_lp(decoding.M, C, lo, hi)
     if rows is not None:
         raise _Failed("scipy's bounded least squares takes no inequality rows")
     from scipy.optimize import lsq_linear
@@ -542,7 +561,7 @@ def _report(
     status: Status | None = None
     if method != "qp":
         status = "fallback"
-    elif not bounds.contains_zero:
+    elif bounds.recovering:
         status = "recovering"
     elif top is not None and top.damped:
         status = "damped"

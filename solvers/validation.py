@@ -147,3 +147,27 @@ def _fmt(shape: tuple[int | None, ...]) -> str:
         + ("," if len(shape) == 1 else "")
         + ")"
     )
+
+
+RIGID_TOL = 1e-9
+"""Largest departure of a pose from a rigid transform (R^T R - I, last row) accepted."""
+
+
+def rigid_transform(
+    x: npt.ArrayLike, name: str, error: type[InputError] = InputError
+) -> npt.NDArray[np.float64]:
+    """``x`` as a (4, 4) rigid transform (a rotation and a translation, within :data:`RIGID_TOL`).
+
+    Raises:
+        InputError: Wrong shape, a non-finite entry, or not a rigid transform.
+    """
+    T = as_array(x, name, (4, 4), error)
+    R = T[:3, :3]
+    rigid = (
+        np.abs(R.T @ R - np.eye(3)).max() <= RIGID_TOL
+        and np.linalg.det(R) > 0.0
+        and np.abs(T[3] - (0.0, 0.0, 0.0, 1.0)).max() <= RIGID_TOL
+    )
+    if not rigid:
+        raise error(name, f"not a rigid transform: {T.tolist()}")
+    return T

@@ -116,8 +116,8 @@ def test_the_inputs_are_not_changed(rng):
         ({"a": "ur5"}, r"^arms\['a'\]: expected \(Robot, T_base \(4, 4\)\)"),
         ({"a": ("UR5", np.eye(4))}, r"^arms\['a'\]: expected \(Robot, T_base"),
         ({"a": ("ROBOT", np.eye(3))}, r"^arms\['a'\]: expected .*shape \(4, 4\)"),
-        ({"a": ("ROBOT", 2 * np.eye(4))}, r"^arms\['a'\]: T_base is not a rigid transform"),
-        ({"a": ("ROBOT", np.diag([1.0, 1, -1, 1]))}, r"^arms\['a'\]: T_base is not a rigid"),
+        ({"a": ("ROBOT", 2 * np.eye(4))}, r"^arms\['a'\]: not a rigid transform"),
+        ({"a": ("ROBOT", np.diag([1.0, 1, -1, 1]))}, r"^arms\['a'\]: not a rigid"),
         ({"a": ("ROBOT", np.full((4, 4), np.nan))}, r"^arms\['a'\]: non-finite entry"),
     ],
 )

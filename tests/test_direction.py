@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from solvers.direction import REGULARIZATION, direction_lp, direction_qp, uniform_scale
+from solvers.errors import ProblemError
 from solvers.jacobian_svd import JacobianSVD
 from solvers.qp_backends import installed_backends, make_backend
 
@@ -272,5 +273,5 @@ def test_direction_lp_with_extra_one_sided_rows() -> None:
     assert qdot[0] == pytest.approx(1.0, abs=1e-9)  # u = 1 with y = -0.7
     assert qdot[2] + qdot[0] <= 0.3 + 1e-9
     hi[3] = -2.5  # y + u <= -2.5 with y >= -1 and u >= 0: infeasible
-    with pytest.raises(ValueError, match="linprog"):
+    with pytest.raises(ProblemError, match="linprog"):
         direction_lp(M, C, lo, hi)

@@ -371,3 +371,17 @@ def test_bad_step_input_is_refused_naming_the_argument(changes: dict, argument: 
     with pytest.raises(InputError) as info:
         joint_velocity_bounds(**kwargs)
     assert info.value.argument == argument
+
+
+def test_recovering_is_a_position_outside_the_range_not_an_arm_that_cannot_stop() -> None:
+    """Zero excluded by the acceleration limits alone (moving too fast to stop in one step)
+    is not recovering; a joint outside its range is, with or without acceleration limits."""
+    limits = JointBounds([-1.0] * 2, [1.0] * 2, [1.0] * 2, acceleration=[1.0, 1.0])
+    fast = limits.step(np.zeros(2), 0.01, np.array([0.5, 0.0]))
+    assert not fast.contains_zero and not fast.recovering
+    assert fast.lb[0] == pytest.approx(0.49) and fast.ub[0] == pytest.approx(0.51)
+    outside = limits.step(np.array([1.5, 0.0]), 0.01, np.zeros(2))
+    assert outside.recovering and not outside.contains_zero
+    plain = JointBounds([-1.0] * 2, [1.0] * 2, [1.0] * 2)
+    assert plain.step(np.array([1.5, 0.0]), 0.01).recovering
+    assert not plain.step(np.array([1.0, 0.0]), 0.01).recovering  # on the limit

@@ -166,12 +166,12 @@ def small_problem(command: np.ndarray, q: np.ndarray | None = None) -> tuple:
     limits = JointBounds([-2.5] * 3, [2.5] * 3, [1.0, 1.0, 1.5])
     bounds = limits.step(q, 0.01)
     levels = [[TaskRows(J, command, None, "hand")]]
-    return levels, bounds, limits.velocity
+    return levels, bounds
 
 
 def solved(command: np.ndarray, q: np.ndarray | None = None) -> Resolution:
-    levels, bounds, velocity = small_problem(command, q)
-    return resolve(levels, bounds, velocity, make_backend("daqp"), ResolveOptions(),
+    levels, bounds = small_problem(command, q)
+    return resolve(levels, bounds, make_backend("daqp"), ResolveOptions(),
                    joint_names=("j1", "j2", "j3"))  # fmt: skip
 
 
@@ -221,8 +221,8 @@ def test_the_resolution_is_immutable() -> None:
 def test_the_resolution_is_a_snapshot_of_the_command() -> None:
     """Changing the caller's arrays afterwards changes nothing in it (module docstring)."""
     b = np.array([3.0, 1.0])
-    levels, bounds, velocity = small_problem(b)
-    r = resolve(levels, bounds, velocity, make_backend("daqp"), ResolveOptions())
+    levels, bounds = small_problem(b)
+    r = resolve(levels, bounds, make_backend("daqp"), ResolveOptions())
     want = solved(np.array([3.0, 1.0]))
     b[:] = [0.0, -0.5]  # before anything was read
     levels[0][0].A[:] = 0.0

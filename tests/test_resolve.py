@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import qpsolvers
 
+from solvers.direction import uniform_scale
 from solvers.errors import InputError, ProblemError
 from solvers.joint_bounds import JointBounds, StepBounds
 from solvers.qp_backends import QPBackend, QPSolution, make_backend
@@ -57,7 +58,7 @@ def test_strict_levels_are_lexicographically_optimal(rng: np.random.Generator) -
         sizes = tuple(int(m) for m in rng.integers(1, 4, size=3))
         levels = levels_at(rng, sizes, float(rng.choice([0.1, 1.0, 5.0])))
         b = bounds_at(rng)
-        r = resolve(levels, b, b.velocity, backend, options)
+        r = resolve(levels, b, backend, options)
         assert r.method == "qp" and not r.attempts, r.attempts
         for k in range(3):
             A = np.vstack([t.A for t in levels[k]])
@@ -74,8 +75,8 @@ def test_a_lower_level_never_changes_a_higher_one(rng: np.random.Generator) -> N
             levels = levels_at(rng, (3, 3, 2), float(rng.choice([0.1, 1.0, 5.0])))
             b = bounds_at(rng)
             for k in range(1, 3):
-                upper = resolve(levels[:k], b, b.velocity, backend, options).qdot
-                full = resolve(levels[: k + 1], b, b.velocity, backend, options).qdot
+                upper = resolve(levels[:k], b, backend, options).qdot
+                full = resolve(levels[: k + 1], b, backend, options).qdot
                 for level in levels[:k]:
                     A = level[0].A
                     np.testing.assert_allclose(A @ full, A @ upper, atol=1e-9)
@@ -88,7 +89,7 @@ def test_the_top_level_keeps_one_common_scale(rng: np.random.Generator) -> None:
         levels = levels_at(rng, (3, 3), 20.0)
         top = [levels[0][0], levels[1][0]]
         b = bounds_at(rng)
-        r = resolve([top], b, b.velocity, backend, ResolveOptions(damping=None))
+        r = resolve([top], b, backend, ResolveOptions(damping=None))
         s = r.scale
         if r.status != "scaled":
             continue
@@ -106,7 +107,7 @@ def test_weighted_is_one_least_squares(rng: np.random.Generator) -> None:
             TaskRows(rng.normal(size=(3, N)), rng.normal(size=3), np.full(3, 0.1), "b"),
         ]
         b = bounds_at(rng)
-        r = resolve([tasks], b, b.velocity, backend, ResolveOptions(), weighted=True)
+        r = resolve([tasks], b, backend, ResolveOptions(), weighted=True)
         A = np.vstack([tasks[0].A, np.sqrt(0.1) * tasks[1].A])
         y = np.concatenate([tasks[0].b, np.sqrt(0.1) * tasks[1].b])
         ref = qpsolvers.solve_qp(A.T @ A + 1e-10 * np.eye(N), -A.T @ y, lb=b.lb, ub=b.ub,
@@ -123,8 +124,8 @@ def test_inequality_rows_are_kept(rng: np.random.Generator) -> None:
         for _ in range(100):
             levels = levels_at(rng, (4,), 3.0)
             b = bounds_at(rng)
-            rows = Inequalities(rng.normal(size=(2, N)), rng.uniform(0.0, 0.5, 2), ("w1", "w2"))
-            r = resolve(levels, b, b.velocity, backend, ResolveOptions(direction), rows=rows)
+            rows = Inequalities(rng.normal(size=(2, N)), rng.uniform(0.0, 0.5, 2))
+            r = resolve(levels, b, backend, ResolveOptions(direction), rows=rows)
             assert np.all(rows.G @ r.qdot <= rows.h + 1e-9)
             assert np.all(r.qdot >= b.lb) and np.all(r.qdot <= b.ub)
 
@@ -148,24 +149,24 @@ def test_fallback_chain_order_attempts_and_never_raise(rng: np.random.Generator)
     levels = levels_at(rng, (6,), 50.0)
     b = bounds_at(rng)
     for mode in ("raise", "not found"):
-        r = resolve(levels, b, b.velocity, Broken(mode), ResolveOptions())
+        r = resolve(levels, b, Broken(mode), ResolveOptions())
         assert r.method == "scipy" and r.status == "fallback"
         assert r.attempts[0][0] == "qp"
         assert np.all(r.qdot >= b.lb) and np.all(r.qdot <= b.ub)
-        exact = resolve(levels, b, b.velocity, make_backend("daqp"), ResolveOptions())
+        exact = resolve(levels, b, make_backend("daqp"), ResolveOptions())
         assert r.scale == pytest.approx(exact.scale, rel=1e-4)  # the exact LP
     for fallbacks, method in ((("scaling",), "scaling"), (("dls",), "dls"), ((), "hold")):
-        r = resolve(levels, b, b.velocity, Broken("raise"), ResolveOptions(fallbacks=fallbacks))
+        r = resolve(levels, b, Broken("raise"), ResolveOptions(fallbacks=fallbacks))
         assert r.method == method and 0.0 <= r.scale <= 1.0
     recovering = JointBounds(np.full(N, -1.0), np.full(N, 1.0), np.ones(N)).step(
         np.full(N, 1.5), 0.01
     )
     assert not recovering.contains_zero
-    r = resolve(levels, recovering, recovering.velocity, Broken("raise"),
+    r = resolve(levels, recovering, Broken("raise"),
                 ResolveOptions(fallbacks=("scaling",)))  # fmt: skip
     assert r.method == "hold" and [a[0] for a in r.attempts] == ["qp", "scaling"]
     np.testing.assert_array_equal(r.qdot, np.clip(0.0, recovering.lb, recovering.ub))
-    r = resolve(levels, recovering, recovering.velocity, Broken("raise"), ResolveOptions())
+    r = resolve(levels, recovering, Broken("raise"), ResolveOptions())
     assert r.method == "scipy"  # bounded least squares (BVLS)
 
 
@@ -173,7 +174,7 @@ def test_fallback_chain_order_attempts_and_never_raise(rng: np.random.Generator)
 def test_numerical_trouble_never_raises(rng: np.random.Generator) -> None:
     b = bounds_at(rng)
     for A in (rng.normal(size=(6, N)) * 1e300, np.zeros((6, N)), rng.normal(size=(6, N)) * 1e-300):
-        r = resolve([[TaskRows(A, np.ones(6) * 1e6, None, "t")]], b, b.velocity,
+        r = resolve([[TaskRows(A, np.ones(6) * 1e6, None, "t")]], b,
                     make_backend("daqp"), ResolveOptions())  # fmt: skip
         assert np.all(np.isfinite(r.qdot))
         assert np.all(r.qdot >= b.lb) and np.all(r.qdot <= b.ub)
@@ -189,3 +190,24 @@ def test_options_are_checked() -> None:
         ResolveOptions(damping=0.1)  # type: ignore[arg-type]
     assert info.value.argument == "damping"
     assert ResolveOptions(fallbacks="dls").fallbacks == ("dls", "hold")  # type: ignore[arg-type]
+
+
+def test_fallbacks_keep_the_inequality_rows_or_give_way(rng: np.random.Generator) -> None:
+    """dls and scaling answers that break a row count as failed: the next method answers."""
+    levels = levels_at(rng, (3,), 50.0)
+    b = bounds_at(rng)
+    exact = np.linalg.pinv(levels[0][0].A) @ levels[0][0].b
+    dls = np.clip(exact, b.lb, b.ub)
+    scaled = uniform_scale(exact, b.lb, b.ub) * exact
+    g = rng.normal(size=(2, N))
+    rows = Inequalities(g, np.array([g[0] @ dls, g[1] @ scaled]) - 0.1)  # both just broken
+    for fallbacks in (("dls",), ("scaling",)):
+        r = resolve(levels, b, Broken("raise"), ResolveOptions(fallbacks=fallbacks), rows=rows)
+        assert [a[0] for a in r.attempts] == ["qp", fallbacks[0]], r.attempts
+        assert "breaks an inequality row" in r.attempts[1][1] and r.method == "hold"
+
+
+def test_hold_can_only_end_the_chain() -> None:
+    with pytest.raises(InputError, match="fallbacks: 'hold' always answers"):
+        ResolveOptions(fallbacks=("hold", "scipy"))
+    assert ResolveOptions(fallbacks=("dls", "hold")).fallbacks == ("dls", "hold")

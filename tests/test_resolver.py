@@ -560,3 +560,26 @@ def test_a_command_outside_the_range_is_singular_whichever_factorisation_answere
         tasks = [FrameTask(left, x[:6]), FrameTask(right, x[6:]), posture]
         statuses.add(two.solve(baxter.random_q(rng), tasks).status)
     assert statuses <= {"least_squares", "exact"}, statuses
+
+
+def test_qdot_prev_is_checked_without_acceleration_limits_too(arms: dict) -> None:
+    arm = arms["panda"]
+    resolver = Resolver(arm)
+    q, twist = arm.neutral(), np.array([0.01, 0, 0, 0, 0, 0])
+    with pytest.raises(InvalidInput) as info:
+        resolver.solve(q, twist, qdot_prev="junk")
+    assert info.value.argument == "qdot_prev"
+    assert resolver.solve(q, twist, qdot_prev=np.ones(arm.nq)).status == "exact"
+
+
+def test_an_arm_that_cannot_stop_in_one_step_is_not_recovering(arms: dict) -> None:
+    """Acceleration limits alone can exclude zero: least squares answers, not 'recovering'
+    (kept for a joint outside its range)."""
+    arm = arms["rrc_k1607"]
+    resolver = Resolver(arm, limits=JointLimits(acceleration=1.0))
+    q = 0.5 * (arm.lower + arm.upper)
+    r = resolver.solve(q, np.zeros(6), qdot_prev=0.5 * arm.velocity_limit)
+    assert not r.bounds.contains_zero and not r.bounds.recovering
+    assert r.status != "recovering" and r.method == "qp"
+    outside = arm.upper + 0.1
+    assert Resolver(arm).solve(outside, np.zeros(6)).status == "recovering"

@@ -204,6 +204,9 @@ def test_bad_tasks_are_refused_before_any_state_change(baxter: rrc_pin.Robot) ->
         (lambda: resolver.solve(q, [JointTask("elbow")]), InvalidInput, "joint"),
         (lambda: resolver.solve(q, [PostureTask(np.zeros(3))]), InvalidInput, "q_ref"),
         (lambda: resolver.solve(q, [PostureTask(q, gain=0.0)]), InvalidInput, "gain"),
+        (lambda: resolver.solve(q, [RelativeFrameTask(left, left, target=2 * np.eye(4))]),
+         InvalidInput, "target"),  # not a rigid transform
+        (lambda: resolver.solve(q, [RelativeFrameTask(3, left)]), InvalidInput, "frame_a"),  # type: ignore[arg-type]
         (lambda: resolver.solve(q, [FrameTask(left)], ref="local"), InvalidInput, "ref"),
         (lambda: resolver.solve(q, [[FrameTask(left)], [FrameTask(left)]]), InvalidInput,
          "command"),  # levels need priority="strict"

@@ -11,7 +11,7 @@ from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.tasks.task import Task, check_weight
 from solvers.resolution import TaskRows
-from solvers.spatial import REFERENCES, Reference
+from solvers.spatial import Reference, check_reference
 from solvers.validation import as_vector
 
 Array = npt.NDArray[np.float64]
@@ -57,16 +57,9 @@ class FrameTask(Task):
         if not isinstance(frame, str):
             raise InvalidInput("frame", f"expected a frame name, got {frame!r}")
         self.frame = frame
-        self.ref = check_reference(ref)
         self.selected = task_rows(rows)
-        if self.ref == "world" and len(self.selected) != 6:
-            raise InvalidInput(
-                "ref",
-                "'world' is the spatial velocity at the base origin: its linear part is not "
-                "the frame's velocity, so partial rows cannot use it; use 'world_aligned'",
-            )
+        self.ref = self.check_ref(ref)
         self.weight = check_weight(weight, len(self.selected))
-        self.row_weights = self._row_weights(len(self.selected))
         self.name = frame if name is None else name
         self.twist = np.zeros(len(self.selected)) if twist is None else self.check_twist(twist)
 
@@ -93,27 +86,34 @@ class FrameTask(Task):
             raise InvalidInput("twist", f"expected shape {want}, got {size}")
         return as_vector(twist, "twist", m, InvalidInput)
 
+    def check_ref(self, ref: str) -> Reference:
+        """``ref`` if it names a reference frame that this task's rows can use.
+
+        Raises:
+            InvalidInput: An unknown name, or ``world`` with partial rows.
+        """
+        checked = check_reference(ref, InvalidInput)
+        if checked == "world" and len(self.selected) != 6:
+            raise InvalidInput(
+                "ref",
+                "'world' is the spatial velocity at the base origin: its linear part is not "
+                "the frame's velocity, so partial rows cannot use it; use 'world_aligned'",
+            )
+        return checked
+
     def frames(self) -> tuple[str, ...]:
         """The commanded frame."""
         return (self.frame,)
 
     def rows(self, kin: Kinematics) -> TaskRows:
         """The frame's Jacobian rows and the commanded twist."""
-        J = kin.jacobian(self.frame, self.ref)
+        return self.rows_from(kin.jacobian(self.frame, self.ref), self.twist)
+
+    def rows_from(self, J: Array, b: Array) -> TaskRows:
+        """The task's rows from a full (6, nv) Jacobian ``J`` and the selected rates ``b``."""
         if len(self.selected) != 6:
             J = J[list(self.selected)]
-        return TaskRows(J, self.twist, self.row_weights, self.name)
-
-
-def check_reference(ref: str) -> Reference:
-    """``ref`` if it names one of :data:`solvers.spatial.REFERENCES`.
-
-    Raises:
-        InvalidInput: Anything else, naming ``ref`` and the choices.
-    """
-    if ref not in REFERENCES:
-        raise InvalidInput("ref", f"expected one of {', '.join(REFERENCES)}, got {ref!r}")
-    return ref  # type: ignore[return-value]
+        return TaskRows(J, b, self._row_weights(len(self.selected)), self.name)
 
 
 def task_rows(rows: str | Sequence[int] | Sequence[bool]) -> tuple[int, ...]:

@@ -9,7 +9,7 @@ from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.tasks.task import Task, check_weight
 from solvers.resolution import TaskRows
-from solvers.validation import as_vector, finite_number
+from solvers.validation import as_vector, positive
 
 Array = npt.NDArray[np.float64]
 
@@ -38,7 +38,7 @@ class PostureTask(Task):
         name: str = "posture",
     ) -> None:
         self.q_ref = as_vector(q_ref, "q_ref", np.size(q_ref), InvalidInput)
-        self.gain = finite_number(gain, "gain", 0.0, inclusive=False, error=InvalidInput)
+        self.gain = positive(gain, "gain", InvalidInput)
         self.weight = check_weight(weight, self.q_ref.size)
         self.name = name
 

@@ -13,7 +13,7 @@ from rrc_pin.kinematics import Kinematics
 from rrc_pin.tasks.frame_task import FrameTask
 from rrc_pin.tasks.task import Task
 from solvers.resolution import TaskRows
-from solvers.validation import as_array, finite_number
+from solvers.validation import positive, rigid_transform
 
 Array = npt.NDArray[np.float64]
 
@@ -61,13 +61,32 @@ class RelativeFrameTask(Task):
         gain: float = 10.0,
         name: str | None = None,
     ) -> None:
-        self._spec = FrameTask(frame_b, twist, rows=rows, weight=weight, name=name)
+        if not isinstance(frame_a, str):
+            raise InvalidInput("frame_a", f"expected a frame name, got {frame_a!r}")
+        # b's twist, rows and weights, checked and selected as a FrameTask's
+        self._spec = FrameTask(
+            frame_b, twist, rows=rows, weight=weight,
+            name=f"{frame_b}/{frame_a}" if name is None else name,
+        )  # fmt: skip
         self.frame_a, self.frame_b = frame_a, frame_b
-        self.twist, self.weight = self._spec.twist, self._spec.weight
-        self.selected = self._spec.selected
-        self.target = None if target is None else as_array(target, "target", (4, 4), InvalidInput)
-        self.gain = finite_number(gain, "gain", 0.0, inclusive=False, error=InvalidInput)
-        self.name = f"{frame_b}/{frame_a}" if name is None else name
+        self.target = None if target is None else rigid_transform(target, "target", InvalidInput)
+        self.gain = positive(gain, "gain", InvalidInput)
+        self.name = self._spec.name
+
+    @property
+    def twist(self) -> Array:
+        """The commanded relative twist (its selected rows)."""
+        return self._spec.twist
+
+    @property
+    def weight(self) -> float | Array:  # type: ignore[override]
+        """Cost of the squared residual, scalar or per selected row."""
+        return self._spec.weight
+
+    @property
+    def selected(self) -> tuple[int, ...]:
+        """The selected rows of the relative twist."""
+        return self._spec.selected
 
     def set_twist(self, twist: npt.ArrayLike) -> None:
         """Command a new relative twist (checked): keep a task across ticks.
@@ -75,7 +94,7 @@ class RelativeFrameTask(Task):
         Raises:
             InvalidInput: Wrong shape or a non-finite entry; the task is then unchanged.
         """
-        self.twist = self._spec.check_twist(twist)
+        self._spec.set_twist(twist)
 
     def frames(self) -> tuple[str, ...]:
         """Both frames."""
@@ -88,8 +107,7 @@ class RelativeFrameTask(Task):
         Ta, Tb = kin.pose(self.frame_a), kin.pose(self.frame_b)
         Rt = Ta[:3, :3].T
         d = Tb[:3, 3] - Ta[:3, 3]
-        cross = np.array([[0.0, -d[2], d[1]], [d[2], 0.0, -d[0]], [-d[1], d[0], 0.0]])
-        J = np.vstack([Rt @ (Jb[:3] - Ja[:3] + cross @ Ja[3:]), Rt @ (Jb[3:] - Ja[3:])])
+        J = np.vstack([Rt @ (Jb[:3] - Ja[:3] + pin.skew(d) @ Ja[3:]), Rt @ (Jb[3:] - Ja[3:])])
         b = self.twist.copy()
         if self.target is not None:
             R_ab = Rt @ Tb[:3, :3]
@@ -97,6 +115,4 @@ class RelativeFrameTask(Task):
                 self.target[:3, 3] - Rt @ d, pin.log3(self.target[:3, :3] @ R_ab.T)
             ])  # fmt: skip
             b = b + self.gain * error[list(self.selected)]
-        if len(self.selected) != 6:
-            J = J[list(self.selected)]
-        return TaskRows(J, b, self._spec.row_weights, self.name)
+        return self._spec.rows_from(J, b)

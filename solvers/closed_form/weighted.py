@@ -20,10 +20,8 @@ import numpy.typing as npt
 
 from solvers.closed_form.base import Array
 from solvers.errors import InputError
+from solvers.jacobian_svd import RANK_TOL  # the default rcond
 from solvers.validation import as_array, as_vector, finite_number
-
-RANK_TOL = 1e-9
-"""Default ``rcond``: singular values below ``RANK_TOL * sigma_max`` count as zero."""
 
 
 def weight_factor(W: npt.ArrayLike | None, n: int, name: str = "W") -> Array | None:

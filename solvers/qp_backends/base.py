@@ -66,6 +66,13 @@ class QPBackend(ABC):
         x = self._last.get(qp.key)
         return x if x is not None and x.shape == qp.q.shape else None
 
+    def _remember(self, qp: QP, x: Array | None) -> None:
+        """Keep ``x`` as the warm start of ``qp.key``; a failed solve (None) drops it."""
+        if x is None:
+            self._last.pop(qp.key, None)
+        else:
+            self._last[qp.key] = x
+
     def reset(self) -> None:
         """Forget every warm-start value (the next solves start cold)."""
         self._last.clear()

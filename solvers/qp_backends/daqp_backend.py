@@ -68,10 +68,7 @@ class DaqpBackend(QPBackend):
             raise ProblemError(f"daqp: {exc}") from exc
         solve_time = time.perf_counter() - t0
         found = exitflag > 0 and bool(np.isfinite(x).all())
-        if found:
-            self._last[qp.key] = x
-        else:
-            self._last.pop(qp.key, None)
+        self._remember(qp, x if found else None)
         status = "solved" if found else f"exitflag {exitflag}"
         iterations = int(info["iterations"])
         return QPSolution(x if found else None, status, iterations, solve_time, self.name)

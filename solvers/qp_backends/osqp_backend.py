@@ -118,10 +118,7 @@ class OSQPBackend(QPBackend):
         if x is not None and not np.isfinite(x).all():
             x, status = None, "non-finite solution"
         ws.cold = x is None
-        if x is not None:
-            self._last[qp.key] = x
-        else:  # the next solve starts from zero: no warm-start value left for this key
-            self._last.pop(qp.key, None)
+        self._remember(qp, x)  # after a failure the next solve starts from zero
         return QPSolution(x, "solved" if x is not None else status, iterations, solve_time,
                           self.name)  # fmt: skip
 

@@ -10,7 +10,7 @@ the rest):
 - ``clarabel``: interior point with homogeneous embedding (Goulart & Chen, "Clarabel: an
   interior-point solver for conic programs with quadratic objectives", 2024).
 - ``osqp``, ``daqp``: rrc-pin calls these through their own APIs (:mod:`.osqp_backend`,
-  :mod:`.daqp_backend`); through qpsolvers they are ``qpsolvers:osqp`` and ``qpsolvers:daqp``.
+  :mod:`.daqp_backend`), never through this module.
 
 Warm starts: the previous solution of the same problem key is passed as ``initvals`` (used
 by the solvers that take one). Zero-width bounds and rows (``lb == ub``) are widened by
@@ -41,7 +41,6 @@ DEFAULT_OPTIONS: dict[str, dict[str, Any]] = {
         "eps_duality_gap_rel": 0.0,
     },
     "clarabel": {"tol_gap_abs": 1e-10, "tol_gap_rel": 1e-10, "tol_feas": 1e-10},
-    "osqp": {"eps_abs": 1e-7, "eps_rel": 1e-7, "polishing": True, "max_iter": 20000},
 }
 """Per-solver options used unless overridden."""
 
@@ -80,15 +79,15 @@ class QpsolversBackend(QPBackend):
         except Exception as exc:
             raise ProblemError(f"{self.name}: {exc}") from exc
         solve_time = time.perf_counter() - t0
-        x = sol.x if sol.found else None
+        x = np.array(sol.x, dtype=np.float64) if sol.found and sol.x is not None else None
         if x is not None and not np.isfinite(x).all():
             x = None
-        if x is not None:
-            self._last[qp.key] = np.array(x, dtype=np.float64)
+        if x is not None:  # a failure keeps the last solution of the key as the next start:
+            self._remember(qp, x)  # proxqp: 58 of 300 degenerate direction QPs refused, 100 if cold
         extras = sol.extras if isinstance(sol.extras, dict) else {}
         iterations = extras.get("iterations", extras.get("iter", 0))
         return QPSolution(
-            None if x is None else np.array(x, dtype=np.float64),
+            None if x is None else x.copy(),  # the warm start is not the caller's
             "solved" if x is not None else "not found",
             int(np.max(iterations)) if np.size(iterations) else 0,
             solve_time,
