@@ -22,8 +22,8 @@ EXIT_BROKEN_PIPE = 141
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``rrc-pin`` console script; returns the exit code.
 
-    Exit codes: 0 success, 1 a check failed, 2 bad arguments or an :class:`RrcPinError`
-    (printed as one line on stderr, no traceback), 141 stdout closed by its reader
+    Exit codes: 0 success, 1 a check failed, 2 bad arguments, an :class:`RrcPinError` or a
+    file-system error (printed as one line on stderr, no traceback), 141 stdout closed by its reader
     (``rrc-pin check | head -1``).
     """
     args = parser().parse_args(argv)
@@ -37,6 +37,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except BrokenPipeError:
         _discard_stdout()
         return EXIT_BROKEN_PIPE
+    except OSError as exc:  # a folder that cannot be written, a path that is a file...
+        print(f"rrc-pin {args.command}: {exc}", file=sys.stderr)
+        return 2
     return code
 
 
@@ -163,7 +166,7 @@ def urdf_command(directory: Path, *, write: bool) -> int:
     Exit codes: 0 all match (or written), 1 some differ, 2 ``directory`` is not a folder.
     """
     specs = list(models.CATALOGUE.values())
-    if (directory.exists() and not directory.is_dir()) or not (write or directory.is_dir()):
+    if not directory.is_dir() and (directory.exists() or not write):
         print(f"rrc-pin urdf: --dir {directory} is not a folder", file=sys.stderr)
         return 2
     if write:
@@ -229,11 +232,6 @@ def bench_command(
     if record and quick:
         print("rrc-pin bench: --record keeps full runs only; drop --quick", file=sys.stderr)
         return 2
-    if "tasks" in names and not _placo_found(placo_python):
-        print(
-            "rrc-pin bench: PlaCo not found, its rows are skipped (placo pins its own Pinocchio: "
-            "python -m venv .venv-placo && .venv-placo/bin/pip install placo)"
-        )
     results = folder / "results" if record else (out or _new_folder(Path.cwd()))
     results.mkdir(parents=True, exist_ok=True)
     for name in names:
@@ -262,16 +260,6 @@ def _installed(module: str) -> bool:
         return importlib.util.find_spec(module) is not None
     except (ImportError, ValueError):
         return False
-
-
-def _placo_found(placo_python: str | None) -> bool:
-    """Whether the tasks benchmark will find PlaCo (as ``benchmarks/bench_tasks.py`` looks)."""
-    return bool(
-        placo_python
-        or os.environ.get("RRC_PIN_PLACO_PYTHON")
-        or _installed("placo")
-        or (CHECKOUT / ".venv-placo" / "bin" / "python").exists()
-    )
 
 
 def _new_folder(parent: Path) -> Path:

@@ -21,15 +21,17 @@ DT = 0.01  # [s], control period
 
 
 def kinematics_tour(names: list[str]) -> None:
-    """Print, per arm, the tool pose and Jacobian conditioning at a named pose."""
-    print(f"{'arm':12s} {'dof':>3s} {'pose':12s} {'tool position [m]':>28s} {'cond(J)':>9s}")
+    """Print, per arm and tool frame, its position and Jacobian conditioning at a named pose."""
+    print(f"{'arm':12s} {'dof':>3s} {'pose':12s} {'tool frame':16s} {'position [m]':>28s} "
+          f"{'cond(J)':>9s}")  # fmt: skip
     for name in names:
         arm = load(name)
         spec = models.CATALOGUE.get(name)
         pose_name, q = next(iter(spec.named_poses.items())) if spec else ("neutral", arm.neutral())
-        position = np.array2string(arm.fk(q)[:3, 3], precision=4, suppress_small=True)
-        cond = np.linalg.cond(arm.jacobian(q))
-        print(f"{name:12s} {arm.nq:3d} {pose_name:12s} {position:>28s} {cond:9.2e}")
+        for frame in arm.tool_frames:
+            position = np.array2string(arm.fk(q, frame)[:3, 3], precision=4, suppress_small=True)
+            cond = np.linalg.cond(arm.jacobian(q, frame=frame))
+            print(f"{name:12s} {arm.nq:3d} {pose_name:12s} {frame:16s} {position:>28s} {cond:9.2e}")
 
 
 def closed_form_check(rng: np.random.Generator) -> None:

@@ -9,7 +9,6 @@ the joints that do not move an arm, the torso or (baxter) the head are locked at
 from __future__ import annotations
 
 import importlib.metadata
-import inspect
 import os
 import xml.etree.ElementTree as ET
 from collections.abc import Callable, Sequence
@@ -221,11 +220,13 @@ def parameters_of(name: str) -> list[str]:
     """Geometry parameters that :func:`load` passes to the builder of catalogue arm ``name``.
 
     Raises:
-        UnknownArm: ``name`` is not a catalogue arm.
+        InvalidInput: ``name`` is not a catalogue arm.
     """
-    if name not in BUILDERS:
-        raise UnknownArm(name, list(BUILDERS))
-    return [p for p in inspect.signature(BUILDERS[name]).parameters if p != "name"]
+    if name not in models.CATALOGUE:
+        raise InvalidInput(
+            "name", f"{name!r} is not a catalogue arm; catalogue: {', '.join(models.CATALOGUE)}"
+        )
+    return list(models.CATALOGUE[name].parameters)
 
 
 def load(
@@ -260,14 +261,14 @@ def load(
     """
     if isinstance(name_or_path, ArmSpec):
         _refuse_parameters(parameters, "an ArmSpec: build the variant with its module's build()")
-        return _from_spec(name_or_path, tool_frame, "catalogue")
+        return _from_spec(name_or_path, tool_frame)
     if not isinstance(name_or_path, (str, os.PathLike)):
         raise InvalidInput(
             "name_or_path", f"expected a name, a path or an ArmSpec, got {name_or_path!r}"
         )
     key = os.fspath(name_or_path)
     if key in BUILDERS:
-        return _from_spec(_build(key, parameters), tool_frame, "catalogue")
+        return _from_spec(_build(key, parameters), tool_frame)
     _refuse_parameters(parameters, f"{key!r}, which is not a catalogue arm")
     if key in INSTALLED:
         return _from_installed(key, INSTALLED[key], tool_frame)
@@ -299,13 +300,12 @@ def _build(name: str, parameters: dict[str, float]) -> ArmSpec:
     return BUILDERS[name](**parameters)
 
 
-def _from_spec(spec: ArmSpec, tool_frame: ToolFrames, source: str) -> Robot:
+def _from_spec(spec: ArmSpec, tool_frame: ToolFrames) -> Robot:
     try:
         model = pin.buildModelFromXML(to_urdf(spec))
     except (RuntimeError, ValueError) as exc:
         raise URDFError(f"<{spec.name}>", f"Pinocchio could not build it: {exc}") from exc
-    tools = TOOL_FRAME if tool_frame is None else tool_frame
-    return Robot(model, tools, name=spec.name, source=source, spec=spec)
+    return Robot(model, _catalogue_tool(tool_frame), name=spec.name, source="catalogue", spec=spec)
 
 
 def _from_installed(name: str, arm: InstalledArm, tool_frame: ToolFrames) -> Robot:
@@ -338,9 +338,14 @@ def _from_file(path: Path, tool_frame: ToolFrames) -> Robot:
     model = _parse(path)
     spec = models.CATALOGUE.get(root.get("name", ""))
     if spec is not None and not compare_urdf(text, to_urdf(spec)):
-        tools = TOOL_FRAME if tool_frame is None else tool_frame
+        tools = _catalogue_tool(tool_frame)
         return Robot(model, tools, name=spec.name, source=str(path), spec=spec)
     return Robot(model, tool_frame, name=path.stem, source=str(path))
+
+
+def _catalogue_tool(tool_frame: ToolFrames) -> ToolFrames:
+    """A catalogue arm's tool frame: the generated URDF's ``tool`` unless one is given."""
+    return TOOL_FRAME if tool_frame is None else tool_frame
 
 
 def _parse(path: Path) -> pin.Model:

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
@@ -27,12 +26,10 @@ import pinocchio as pin
 
 from rrc_pin.errors import FrameNotFound, InvalidInput, ToolFrameRequired, URDFError
 from rrc_pin.models.arm_spec import ArmSpec
+from solvers.closed_form.base import ClosedForm
 from solvers.errors import InputError
 from solvers.spatial import Reference, check_reference
 from solvers.validation import as_vector
-
-if TYPE_CHECKING:
-    from solvers.closed_form.base import ClosedForm
 
 PIN_REFERENCE = {
     "world_aligned": pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
@@ -40,8 +37,6 @@ PIN_REFERENCE = {
     "world": pin.ReferenceFrame.WORLD,
 }
 
-CLOSED_FORM_FRAME = "tool"
-"""Frame a closed form answers for when it does not say (its ``frame`` class attribute)."""
 
 Seed = np.random.Generator | int | None
 """What :meth:`Robot.random_q` takes: a numpy Generator, an int seed (>= 0) or None."""
@@ -171,7 +166,7 @@ class Robot:
                 naming the parameter.
         """
         factory = self.spec.closed_form if self.spec is not None else None
-        if factory is None or self.tool_frame is None:
+        if factory is None or self.tool_frame != ClosedForm.frame:
             return None
         with self._lock:
             if self._closed_form is None:
@@ -181,8 +176,7 @@ class Robot:
                     raise InvalidInput(
                         exc.argument, f"{self.name} has no closed form for this geometry ({exc})"
                     ) from exc
-            cf = self._closed_form
-        return cf if getattr(cf, "frame", CLOSED_FORM_FRAME) == self.tool_frame else None
+            return self._closed_form
 
     @property
     def data(self) -> pin.Data:

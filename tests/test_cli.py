@@ -81,6 +81,12 @@ def test_demo_help_says_what_arm_does(capsys):
     assert "instead of the tour" in help_text
 
 
+def test_demo_arm_prints_a_row_per_tool_frame_of_a_two_armed_robot(capsys):
+    assert main(["demo", "--arm", "baxter"]) == 0
+    out = capsys.readouterr().out
+    assert "left_gripper" in out and "right_gripper" in out
+
+
 def test_urdf_check_passes_on_the_committed_files(capsys):
     assert main(["urdf", "--check"]) == 0
     assert "5/5 URDFs" in capsys.readouterr().out
@@ -264,3 +270,19 @@ def test_readme_performance_section_is_generated_from_the_results():
     assert section == "\n" + update_readme.render_readme(update_readme.RESULTS)
     docs = ROOT / "docs" / "benchmarks.md"
     assert docs.read_text() == update_readme.render_docs(update_readme.RESULTS, docs)
+
+
+def test_file_system_errors_are_one_line_and_exit_2(tmp_path, capsys, monkeypatch):
+    """A results folder that is a file, a URDF folder under a file: one line, no traceback."""
+    import rrc_pin.cli as cli
+
+    monkeypatch.setattr(cli, "_installed", lambda module: True)
+    a_file = tmp_path / "a_file"
+    a_file.write_text("")
+    for argv in (
+        ["bench", "--only", "closed_form", "--quick", "--out", str(a_file)],
+        ["urdf", "--write", "--dir", str(a_file / "urdf")],
+    ):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"rrc-pin {argv[0]}: ") and err.count("\n") == 1, err

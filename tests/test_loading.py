@@ -218,6 +218,8 @@ def test_an_unknown_parameter_lists_those_the_builder_takes():
     with pytest.raises(InvalidInput, match="^a: not a parameter of rrc_k1607; it takes: none$"):
         rrc_pin.load("rrc_k1607", a=1)
     assert parameters_of("kr5_3r") == ["a1", "a2", "a3"]
+    with pytest.raises(InvalidInput, match="^name: 'panda' is not a catalogue arm"):
+        parameters_of("panda")
     arm = rrc_pin.load("kr5_3r", a2=0.6)
     np.testing.assert_allclose(arm.fk(np.zeros(3))[:3, 3], [1.3, 0, 0], atol=1e-12)
 

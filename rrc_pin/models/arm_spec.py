@@ -84,10 +84,4 @@ def check_parameters(values: dict[str, float]) -> dict[str, float]:
     Raises:
         InvalidInput: A value is not a finite real number, naming its parameter.
     """
-    out = {}
-    for key, value in values.items():
-        real = isinstance(value, (int, float, np.integer, np.floating))
-        if not real or isinstance(value, (bool, np.bool_)):
-            raise InvalidInput(key, f"expected a finite number, got {value!r}")
-        out[key] = finite_number(value, key, error=InvalidInput)
-    return out
+    return {key: finite_number(value, key, error=InvalidInput) for key, value in values.items()}

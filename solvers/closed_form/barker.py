@@ -146,7 +146,6 @@ class BarkerClosedForm(ClosedForm):
 
     nq = 6
     task_dim = 6
-    frame = "tool"
 
     def __init__(
         self, *, no: float, es: float, sn: float, we: float, a3: float, r3: float,

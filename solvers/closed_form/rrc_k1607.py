@@ -166,7 +166,6 @@ class RrcK1607ClosedForm(ClosedForm):
 
     nq = NQ
     task_dim = TASK_DIM
-    frame = "tool"
 
     def __init__(
         self, *, a: npt.ArrayLike, d: npt.ArrayLike, rcond: float = DEFAULT_RCOND

@@ -93,7 +93,6 @@ class ThreeRClosedForm(ClosedForm):
 
     nq = 3
     task_dim = 3
-    frame = "tool"
 
     def __init__(self, *, a1: float, a2: float, a3: float, rcond: float = DEFAULT_RCOND) -> None:
         self.a1 = finite_number(a1, "a1", 0.0)
