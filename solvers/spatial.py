@@ -1,6 +1,6 @@
 """Reference-frame changes of twists and Jacobians (rows ordered [v; w]).
 
-Three frames, named as Pinocchio names them (DESIGN.md, "Conventions"):
+Three frames, named as Pinocchio names them (README, "Conventions"):
 
 - ``world_aligned``: velocity of the tool-frame origin ``p``, in base-frame axes.
 - ``local``: the same velocity in tool-frame axes ``R``.

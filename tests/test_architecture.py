@@ -1,4 +1,4 @@
-"""Layering, exports and lint: the architecture of DESIGN.md cannot drift."""
+"""Layering, exports and lint: the architecture of docs/api.md cannot drift."""
 
 from __future__ import annotations
 

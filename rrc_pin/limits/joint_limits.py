@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
@@ -11,6 +11,9 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput
 from solvers.errors import InputError
 from solvers.joint_bounds import JointBounds
+
+if TYPE_CHECKING:
+    from rrc_pin.robot import Robot
 
 Array = npt.NDArray[np.float64]
 
@@ -36,12 +39,11 @@ class JointLimits:
     velocity: npt.ArrayLike | None = None
     position_gain: float = 1.0
 
-    def bounds(self, robot: Any) -> JointBounds:
+    def bounds(self, robot: Robot) -> JointBounds:
         """The robot's limits prepared for the per-step bounds.
 
         Args:
-            robot: A :class:`rrc_pin.Robot` (``lower``, ``upper``, ``velocity_limit``,
-                ``joint_names``).
+            robot: The robot (its ``lower``, ``upper``, ``velocity_limit``, ``joint_names``).
 
         Raises:
             InvalidInput: An invalid field (named), or a joint without a finite velocity

@@ -1,4 +1,4 @@
-"""The protocol every closed-form fast path follows (DESIGN.md, "Public API"), and its helpers."""
+"""The protocol every closed-form fast path follows (docs/api.md, closed forms), and its helpers."""
 
 from __future__ import annotations
 
