@@ -169,7 +169,7 @@ def test_arm_and_wrist_rates_solve_their_blocks(arm: Arm, regular_set, method: s
     arm_ref = np.linalg.solve(Jp[:, :3, :3], X[:, :3, None])[..., 0]
     assert rel(arm.cf.arm_rates_batch(Q, X[:, :3], method=method), arm_ref).max() < TOL
     wrist_ref = np.linalg.solve(Jp[:, 3:, 3:], X[:, 3:, None])[..., 0]
-    assert rel(arm.cf.wrist_rates_batch(Q, X[:, 3:], method=method), wrist_ref).max() < TOL
+    assert rel(arm.cf.wrist_rates_batch(Q, X[:, 3:]), wrist_ref).max() < TOL  # no method
     rows = zip(Q[:50], arm_ref[:50], X[:50], strict=True)
     rt = np.array([arm.cf.rvel_tilde(q, a, x[3:]) for q, a, x in rows])
     assert rel(rt, X[:50, 3:] - np.einsum("nij,nj->ni", Jp[:50, 3:, :3], arm_ref[:50])).max() < TOL
@@ -218,7 +218,7 @@ def test_every_path_at_start_pose_and_joint_zeros(arm: Arm, method: str) -> None
         arm_rates = cf.arm_rates_batch(Q, X[:, :3], method, exact)
         assert rel(arm_rates[rows], ref[rows, :3]).max() < TOL
     wrist_ref = np.einsum("nij,nj->ni", np.linalg.pinv(Jp[:, 3:, 3:], rcond=cf.rcond), X[:, 3:])
-    wrist = cf.wrist_rates_batch(Q, X[:, 3:], method=method, exact=True)
+    wrist = cf.wrist_rates_batch(Q, X[:, 3:], exact=True)
     assert rel(wrist, wrist_ref).max() < TOL
 
 
@@ -228,12 +228,11 @@ def test_wrist_generalized_inverse_splits_equally_at_theta5_zero(arm: Arm) -> No
     rng = np.random.default_rng(11)
     Q = arm.sample(rng, 100)
     Q[:, 4] = 0.0
-    for method in METHODS:
-        # damping keeps the split (it acts on (1, 1) and (1, -1)), to the rounding of its
-        # normal equations (condition number 2 / band^2)
-        for exact, tol in ((True, 1e-15), (False, 1e-11)):
-            W = arm.cf.wrist_rates_batch(Q, rng.normal(size=(100, 3)), method, exact)
-            assert np.all(np.abs(W[:, 0] - W[:, 2]) <= tol * np.abs(W).max())
+    # damping keeps the split (it acts on (1, 1) and (1, -1)), to the rounding of its normal
+    # equations (condition number 2 / band^2)
+    for exact, tol in ((True, 1e-15), (False, 1e-11)):
+        W = arm.cf.wrist_rates_batch(Q, rng.normal(size=(100, 3)), exact)
+        assert np.all(np.abs(W[:, 0] - W[:, 2]) <= tol * np.abs(W).max())
 
 
 # -- determinant and the singular set ------------------------------------------------------
@@ -480,8 +479,9 @@ def test_batch_equals_scalar(arm: Arm) -> None:
         B = cf.arm_rates_batch(Q, X[:, :3], method, exact)
         S = np.array([cf.arm_rates(q, x[:3], method, exact) for q, x in zip(Q, X, strict=True)])
         assert rel(S, B).max() < 1e-12
-        B = cf.wrist_rates_batch(Q, X[:, 3:], method, exact)
-        S = np.array([cf.wrist_rates(q, x[3:], method, exact) for q, x in zip(Q, X, strict=True)])
+    for exact in (False, True):  # the wrist has no method
+        B = cf.wrist_rates_batch(Q, X[:, 3:], exact)
+        S = np.array([cf.wrist_rates(q, x[3:], exact) for q, x in zip(Q, X, strict=True)])
         assert rel(S, B).max() < 1e-12
     assert np.abs(np.array([cf.jacobian(q) for q in Q]) - cf.jacobian_batch(Q)).max() < 1e-14
     sb, d = cf.singularity_batch(Q), cf.det_m_batch(Q)
@@ -577,8 +577,13 @@ def test_constructor_is_keyword_only_and_checks_rcond() -> None:
     params = dict(no=0.6718, es=0.4318, sn=0.15, we=0.4318, a3=0.0203, r3=0.0, alpha3=np.pi / 2)
     with pytest.raises(InputError, match="rcond"):
         BarkerClosedForm(**params, rcond=0.7)
+    no_f2 = BarkerClosedForm(**{**params, "sn": 0.0})
     with pytest.raises(InputError, match="F2"):  # SN + R3 + CAL3 WE = 0: no reduced path
-        BarkerClosedForm(**{**params, "sn": 0.0}).joint_rates(np.ones(6), np.ones(6), "reduced")
+        no_f2.joint_rates(np.ones(6), np.ones(6), "reduced")
+    # the wrist never divides by F2: its rates are the last three of the full path's
+    full = no_f2.joint_rates(np.ones(6), np.ones(6))
+    rt = no_f2.rvel_tilde(np.ones(6), full[:3], np.ones(3))
+    np.testing.assert_allclose(no_f2.wrist_rates(np.ones(6), rt), full[3:], rtol=1e-14)
 
 
 # -- errata (docs/errata.d/barker.md) and the report's statements ---------------------------

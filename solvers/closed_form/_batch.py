@@ -76,9 +76,7 @@ def blocks(n: int, size: int = CHUNK) -> Iterator[slice]:
         yield slice(lo, min(lo + step, n))
 
 
-def cos_sin(
-    q: Array, out: tuple[Array, Array] | None = None, block: int = CHUNK
-) -> tuple[Array, Array]:
+def cos_sin(q: Array, out: tuple[Array, Array] | None = None) -> tuple[Array, Array]:
     r"""Cosines and sines of the angles ``q`` [rad], elementwise, any shape.
 
     With ``k = round(q 512 / pi)`` and ``r = q - k pi / 512`` (Cody-Waite reduction in two
@@ -92,14 +90,12 @@ def cos_sin(
     ``sin r = r - r^3/6 + r^5/120``, ``cos r - 1 = -r^2/2 + r^4/24``, truncated below
     2e-18. Absolute error: within about 1.1e-16 of ``numpy.sin`` / ``numpy.cos`` (an ulp of
     the table entry plus the final rounding); near a multiple of ``pi`` the sine is exact to
-    that absolute error, not to its own ulp. Work goes in blocks of ``block`` elements, so
+    that absolute error, not to its own ulp. Work goes in blocks of :data:`CHUNK` elements, so
     that the scratch arrays stay in the cache.
 
     Args:
         q: Angles, float64, finite (any shape; validated by the caller).
         out: Optional ``(cos, sin)``: C-contiguous float64 arrays of ``q``'s shape.
-        block: Elements per block (a caller that already works in cache-sized blocks passes
-            its own size, so that each of the two dozen operations runs once).
 
     Returns:
         ``(cos q, sin q)``, each of ``q``'s shape (``out`` when given).
@@ -110,7 +106,7 @@ def cos_sin(
     flat = np.ascontiguousarray(q).reshape(-1)
     c_all, s_all = out[0].reshape(-1), out[1].reshape(-1)
     n = flat.shape[0]
-    m = max(min(n, block), 1)
+    m = max(min(n, CHUNK), 1)
     y: Array = np.empty(m)
     r: Array = np.empty(m)
     r2: Array = np.empty(m)

@@ -36,7 +36,7 @@ values (2.8 % of random configurations within the limits), the wrist where
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Literal, NamedTuple
 
 import numpy as np
@@ -49,6 +49,8 @@ from solvers.closed_form.barker_equations import (
     Trig,
     arm_from_m1,
     arm_full,
+    arm_in_band,
+    arm_s2,
     damped_solve,
     det_adj2,
     eq33,
@@ -56,6 +58,7 @@ from solvers.closed_form.barker_equations import (
     hand_to_base_rows,
     jacobian_rows,
     m1_system,
+    m2_rows,
     m_rotated,
     m_rows,
     rvel_tilde,
@@ -64,6 +67,7 @@ from solvers.closed_form.barker_equations import (
     truncated_solve,
     tvel_frame2,
     wrist_regular,
+    wrist_s2,
     wrist_terms,
 )
 from solvers.closed_form.base import Array, ClosedForm, Entry, first, row, stack_entries
@@ -101,20 +105,45 @@ def _at(value: Entry, idx: npt.NDArray[np.intp]) -> Entry:
     return np.take(value, idx) if isinstance(value, np.ndarray) else value
 
 
-def _repair(
-    out: Sequence[Array], A: list[list[Entry]], b: Sequence[Entry], s2: Array, eps: float,
-    bad: npt.NDArray[np.bool_], exact: bool,
-) -> None:  # fmt: skip
-    """Overwrite ``out[i][bad]`` by the band solve of the blocks at the rows ``bad``."""
-    idx = np.flatnonzero(bad)
-    if idx.size:
-        A_bad, b_bad = [[_at(v, idx) for v in r] for r in A], [_at(v, idx) for v in b]
-        if exact:
-            x = truncated_solve(A_bad, b_bad, eps, idx.size)
-        else:
-            x = damped_solve(A_bad, b_bad, s2[idx], eps)
-        for o, xi in zip(out, x, strict=True):
+_Band = Callable[[], tuple[list[list[Entry]], Sequence[Entry], Entry]]
+"""A block's system in its band, built on demand: ``(A, b, s^2)`` of ``A x = b``."""
+
+
+def _solved(
+    closed: Callable[[], Sequence[Entry]], band: _Band, bad: Entry, eps: float, exact: bool,
+    repair: bool = True,
+) -> Sequence[Entry]:  # fmt: skip
+    """A block's rates: the closed form ``closed()`` outside its band, :func:`_band_solve` in.
+
+    One configuration (Python floats, ``bad`` a bool): one answer or the other (the closed
+    form divides by zero on the singular set). A batch ((N,) arrays, ``bad`` (N,)): the closed
+    form at every row (inf or NaN in the band), then with ``repair`` the rows in the band
+    solved again.
+    """
+    if not isinstance(bad, np.ndarray):
+        return _band_solve(band, eps, exact) if bad else closed()
+    out = closed()
+    idx = np.flatnonzero(bad) if repair else None
+    if idx is not None and idx.size:
+        for o, xi in zip(out, _band_solve(band, eps, exact, idx), strict=True):
             o[idx] = xi
+    return out
+
+
+def _band_solve(
+    band: _Band, eps: float, exact: bool, idx: npt.NDArray[np.intp] | None = None
+) -> list[Entry]:
+    """``band()`` solved by :func:`damped_solve`, or by :func:`truncated_solve` with ``exact``.
+
+    At the rows ``idx`` of a batch, or (``idx`` None) for one configuration, as floats.
+    """
+    A, b, s2 = band()
+    if idx is not None:
+        A, b, s2 = [[_at(v, idx) for v in r] for r in A], [_at(v, idx) for v in b], s2[idx]
+    if not exact:
+        return damped_solve(A, b, s2, eps)
+    x = truncated_solve(A, b, eps, 1 if idx is None else idx.size)
+    return x if idx is not None else [v.item() for v in x]
 
 
 # -- the closed form -----------------------------------------------------------------------
@@ -232,20 +261,20 @@ class BarkerClosedForm(ClosedForm):
         eps_arm, eps_wrist = self._eps(exact=False)
         return BarkerSingularity(
             eq32=F.f1, eq33=eq33(g, t), s5=t.s5, det_m=det,
-            arm_singular=det * det <= eps_arm**2 * adj2,
-            wrist_singular=t.s5 * t.s5 <= eps_wrist**2 * (1.0 + np.abs(t.c5)),
+            arm_singular=arm_in_band(det, adj2, eps_arm),
+            wrist_singular=wrist_s2(t) <= eps_wrist * eps_wrist,
         )  # fmt: skip
 
     # -- joint rates ------------------------------------------------------------------------
 
     def _arm(
-        self, t: Trig, tvel: Sequence[Array], reduced: bool, exact: bool, repair: bool = True
-    ) -> tuple[list[Array], npt.NDArray[np.bool_]]:
-        """thetadot_1..3 (N,) each by the closed form, and the rows in the arm's band.
+        self, t: Trig, tvel: Sequence[Entry], reduced: bool, exact: bool, repair: bool = True
+    ) -> tuple[Sequence[Entry], Entry]:
+        """thetadot_1..3 by the closed form, and whether in the arm's band (floats or (N,) each).
 
-        With ``repair`` the rows in the band are solved again (eq. (38) or eq. (44), by
-        :func:`damped_solve` or :func:`truncated_solve`); without, their rates are
-        meaningless (inf or NaN).
+        In the band (:func:`_solved`): eq. (38) or eq. (44), by :func:`damped_solve` or
+        :func:`truncated_solve`; for a batch without ``repair`` those rows are meaningless
+        (inf or NaN).
         """
         g = self.geometry
         F = f_terms(g, t)
@@ -253,46 +282,45 @@ class BarkerClosedForm(ClosedForm):
         if reduced:  # eqs (39), (44)
             A, b, ta = m1_system(t, F, tvel)
             det = A[0][0] * A[1][1] - A[0][1] * A[1][0]
-            fro2 = sum(v * v for r in A for v in r)
-            th23 = [(A[1][1] * b[0] - A[0][1] * b[1]) / det,
-                    (A[0][0] * b[1] - A[1][0] * b[0]) / det]  # fmt: skip
-            bad = det * det <= eps * eps * fro2
-            if repair:
-                _repair(th23, A, b, det * det / np.where(fro2 > 0.0, fro2, 1.0), eps, bad, exact)
-            return list(arm_from_m1(F, th23[0], th23[1], ta)), bad
+            fro2 = sum(v * v for r in A for v in r)  # ||adj M1||_F^2 of the 2x2 M1
+            bad = arm_in_band(det, fro2, eps)
+            th23 = _solved(lambda: ((A[1][1] * b[0] - A[0][1] * b[1]) / det,
+                                    (A[0][0] * b[1] - A[1][0] * b[0]) / det),
+                           lambda: (A, b, arm_s2(det, fro2)), bad, eps, exact, repair)  # fmt: skip
+            return arm_from_m1(F, th23[0], th23[1], ta), bad
         det, adj2 = det_adj2(g, t, F)
-        out = list(arm_full(t, F, det, tvel))
-        bad = det * det <= eps * eps * adj2
-        if repair:
-            s2 = det * det / np.where(adj2 > 0.0, adj2, 1.0)
-            _repair(out, *m_rotated(t, F, tvel), s2, eps, bad, exact)  # eq. (38)
+        bad = arm_in_band(det, adj2, eps)
+        out = _solved(lambda: arm_full(t, F, det, tvel),
+                      lambda: (*m_rotated(t, F, tvel), arm_s2(det, adj2)),  # eq. (38)
+                      bad, eps, exact, repair)  # fmt: skip
         return out, bad
 
     def _wrist(
-        self, t: Trig, rt: Sequence[Array], exact: bool, repair: bool = True
-    ) -> tuple[list[Array], npt.NDArray[np.bool_]]:
-        """thetadot_4..6 (N,) each from RVEL~ by eqs (49)-(51), and the rows in the band.
+        self, t: Trig, rt: Sequence[Entry], exact: bool, repair: bool = True
+    ) -> tuple[Sequence[Entry], Entry]:
+        """thetadot_4..6 from RVEL~ by eqs (49)-(51), and whether in the wrist's band.
 
-        With ``repair`` those rows are solved again on M2 (eq. (60)).
+        In the band (:func:`_solved`): M2 (eq. (60)).
         """
         th5, ga, gb = wrist_terms(self.geometry, t, rt)
-        th46 = list(wrist_regular(t, ga, gb))
         eps = self._eps(exact)[1]
-        s2 = t.s5 * t.s5 / (1.0 + np.abs(t.c5))  # 1 - |C5|, without cancellation
+        s2 = wrist_s2(t)
         bad = s2 <= eps * eps
-        if repair:
-            _repair(th46, [[0.0, t.s5], [1.0, t.c5]], (ga, gb), s2, eps, bad, exact)
+        th46 = _solved(lambda: wrist_regular(t, ga, gb), lambda: (m2_rows(t), (ga, gb), s2), bad,
+                       eps, exact, repair)  # fmt: skip
         return [th46[0], th5, th46[1]], bad
 
     def _rates(
-        self, Q: Array, X: Array, reduced: bool, exact: bool, repair: bool,
-        buffers: tuple[Array, Array] | None = None,
-    ) -> tuple[list[Array], npt.NDArray[np.bool_]]:  # fmt: skip
-        """Joint rates (N,) each at ``Q``, ``X`` (N, 6): arm, eq. (48), wrist; band rows."""
-        t, x = trig_batch(Q, out=buffers), list(np.ascontiguousarray(X.T))
+        self, t: Trig, x: Sequence[Entry], reduced: bool, exact: bool, repair: bool
+    ) -> tuple[list[Entry], Entry]:
+        """Joint rates at ``t`` for ``x`` (6 entries): arm, eq. (48), wrist; whether in a band.
+
+        Floats (one configuration) or (N,) arrays (a batch) alike: :meth:`_arm`,
+        :meth:`_wrist`.
+        """
         arm, arm_bad = self._arm(t, x[:3], reduced, exact, repair)
         wrist, wrist_bad = self._wrist(t, rvel_tilde(t, arm, x[3:]), exact, repair)
-        return arm + wrist, arm_bad | wrist_bad
+        return [*arm, *wrist], arm_bad | wrist_bad
 
     def arm_rates(
         self, q: npt.ArrayLike, tvel: npt.ArrayLike, method: Method = "full", exact: bool = False
@@ -333,27 +361,23 @@ class BarkerClosedForm(ClosedForm):
         return np.stack(rvel_tilde(trig_batch(Q), list(A.T), list(R.T)), axis=1)
 
     def wrist_rates(
-        self, q: npt.ArrayLike, rvel_tilde: npt.ArrayLike, method: Method = "full",
-        exact: bool = False,
-    ) -> Array:  # fmt: skip
+        self, q: npt.ArrayLike, rvel_tilde: npt.ArrayLike, exact: bool = False
+    ) -> Array:
         """thetadot_4..6 (3,) [rad/s] from RVEL~ (eq. (48)) (3,) [rad/s], base axes.
 
-        Eqs (49)-(51) for both methods; in the wrist's band damped, or M2* (eq. (60)) with
-        ``exact`` (``pinv(W, rcond) @ rvel_tilde``).
+        Eqs (49)-(51), the wrist of both methods of :meth:`joint_rates`; in the wrist's band
+        damped, or M2* (eq. (60)) with ``exact`` (``pinv(W, rcond) @ rvel_tilde``).
 
         Raises:
-            InputError: Bad ``q``, ``rvel_tilde`` or ``method``.
+            InputError: Bad ``q`` or ``rvel_tilde``.
         """
-        return first(self.wrist_rates_batch(
-            row(q, "q", 6), row(rvel_tilde, "rvel_tilde", 3), method, exact
-        ))
+        return first(self.wrist_rates_batch(row(q, "q", 6), row(rvel_tilde, "rvel_tilde", 3),
+                                            exact))  # fmt: skip
 
     def wrist_rates_batch(
-        self, Q: npt.ArrayLike, RVEL_TILDE: npt.ArrayLike, method: Method = "full",
-        exact: bool = False,
-    ) -> Array:  # fmt: skip
+        self, Q: npt.ArrayLike, RVEL_TILDE: npt.ArrayLike, exact: bool = False
+    ) -> Array:
         """Batch :meth:`wrist_rates`: ``Q`` (N, 6), ``RVEL_TILDE`` (N, 3) -> (N, 3) [rad/s]."""
-        self._reduced(method)
         Q = as_array(Q, "Q", (None, 6))
         R = as_array(RVEL_TILDE, "RVEL_TILDE", (Q.shape[0], 3))
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -382,27 +406,9 @@ class BarkerClosedForm(ClosedForm):
         """
         reduced = self._reduced(method)
         qv, xv = as_vector(q, "q", 6), as_vector(xdot, "xdot", 6)
-        if reduced or exact:  # the batch path on one row
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                return np.concatenate(self._rates(qv[None], xv[None], reduced, exact, True)[0])
         # One configuration on Python floats: 9 us (16 us in a band) against 64 us for the
         # batch path on one row (measured; 5 of the 9 us are the two argument checks).
-        g, t, x = self.geometry, trig(qv.tolist()), xv.tolist()
-        F = f_terms(g, t)
-        det, adj2 = det_adj2(g, t, F)
-        eps_arm, eps_wrist = self._eps(exact=False)
-        if det * det > eps_arm * eps_arm * adj2:
-            arm = arm_full(t, F, det, x[:3])
-        else:
-            arm = tuple(damped_solve(*m_rotated(t, F, x[:3]), det * det / adj2 if adj2 else 0.0,
-                                     eps_arm))  # fmt: skip
-        th5, ga, gb = wrist_terms(g, t, rvel_tilde(t, arm, x[3:]))
-        s2 = t.s5 * t.s5 / (1.0 + abs(t.c5))
-        if s2 > eps_wrist * eps_wrist:
-            th4, th6 = wrist_regular(t, ga, gb)
-        else:
-            th4, th6 = damped_solve([[0.0, t.s5], [1.0, t.c5]], (ga, gb), s2, eps_wrist)
-        return np.array([*arm, th4, th5, th6])
+        return np.array(self._rates(trig(qv.tolist()), xv.tolist(), reduced, exact, True)[0])
 
     def joint_rates_batch(
         self, Q: npt.ArrayLike, X: npt.ArrayLike, method: Method = "full", exact: bool = False
@@ -419,16 +425,20 @@ class BarkerClosedForm(ClosedForm):
         # Cosines and sines in buffers reused by every block: 20 % of the batch time saved
         # (measured), the page faults of fresh 320 kB arrays.
         buffers = (np.empty(5 * CHUNK), np.empty(5 * CHUNK))
+
+        def rates(Qr: Array, Xr: Array, repair: bool) -> tuple[list[Entry], Entry]:
+            t, x = trig_batch(Qr, out=buffers), list(np.ascontiguousarray(Xr.T))
+            return self._rates(t, x, reduced, exact, repair)
+
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
             for rows in blocks(Q.shape[0]):
-                rates, bad[rows] = self._rates(Q[rows], X[rows], reduced, exact, False, buffers)
-                for j, v in enumerate(rates):
+                values, bad[rows] = rates(Q[rows], X[rows], False)
+                for j, v in enumerate(values):
                     out[rows, j] = v
             idx = np.flatnonzero(bad)  # in a band: solved again, in blocks of their own
             for part in blocks(idx.size):
                 i = idx[part]  # np.take: a third of the time of Q[i] (measured)
-                Qi, Xi = np.take(Q, i, 0), np.take(X, i, 0)
-                out[i] = np.stack(self._rates(Qi, Xi, reduced, exact, True, buffers)[0], axis=1)
+                out[i] = np.stack(rates(np.take(Q, i, 0), np.take(X, i, 0), True)[0], axis=1)
         return out
 
     # -- hand frame (Appendix B) ------------------------------------------------------------

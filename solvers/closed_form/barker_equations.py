@@ -130,6 +130,17 @@ def trig_batch(Q: Array, six: bool = False, out: tuple[Array, Array] | None = No
 # -- the equations (floats or arrays) ------------------------------------------------------
 
 
+def turn1(t: Trig, x: Entry, y: Entry) -> tuple[Entry, Entry]:
+    """``(C1 x + S1 y, S1 x - C1 y)``: the turn by theta_1 of Barker's D1, D2 (eqs (52), (53)).
+
+    The components of a base-axis vector ``(x, y, .)`` along the horizontal unit vectors
+    ``(C1, S1, 0)`` and ``(S1, -C1, 0)`` (orthogonal, its own inverse). The same turn takes
+    the rows of eq. (25) (:func:`m_rotated`, :func:`m1_system`) and TVEL^
+    (:func:`tvel_frame2`).
+    """
+    return t.c1 * x + t.s1 * y, t.s1 * x - t.c1 * y
+
+
 def f_terms(g: BarkerGeometry, t: Trig) -> FTerms:
     """F1..F7 of Barker eqs (27)-(31), (41) and (37); F2 with SN~ = SN + R3 (a float)."""
     f5 = t.s23 * g.swe + t.c23 * g.a3  # eq. (31)
@@ -157,12 +168,11 @@ def m_rotated(
 ) -> tuple[list[list[Entry]], list[Entry]]:
     """Eq. (25) with its rows turned by theta_1, and TVEL^ with them.
 
-    ``(C1 row1 + S1 row2, S1 row1 - C1 row2, row3)`` of M (eqs (37), (41)): the same
+    The :func:`turn1` of the first two rows of M, the third kept (eqs (37), (41)): the same
     least-squares problem as M (an orthogonal change of rows), sparser.
     """
-    T1, T2, T3 = tvel
     rows = [[-F.f2, F.f3, F.f4], [-F.f1, 0.0, 0.0], [0.0, -F.f1, -F.f5]]
-    return rows, [t.c1 * T1 + t.s1 * T2, t.s1 * T1 - t.c1 * T2, T3]
+    return rows, [*turn1(t, tvel[0], tvel[1]), tvel[2]]
 
 
 def det_adj2(g: BarkerGeometry, t: Trig, F: FTerms) -> tuple[Entry, Entry]:
@@ -197,13 +207,12 @@ def m1_system(
     As printed, M1's first row is ``(C1 F2 - F6)(F3, F4) = -S1 F1 (F3, F4)``, which vanishes
     at theta_1 = 0 where M is regular. The row used here is ``(S1 row1 - C1 row2)`` of
     eq. (25) with eq. (39) substituted, divided by F2: ``[F1 F3 / F2, F1 F4 / F2] (thetadot_2,
-    thetadot_3) = F1 ta / F2 - tb``, ``ta = C1 TVEL(1) + S1 TVEL(2)``,
-    ``tb = S1 TVEL(1) - C1 TVEL(2)``; the second row is eq. (25)'s third.
+    thetadot_3) = F1 ta / F2 - tb`` with ``(ta, tb)`` the :func:`turn1` of (TVEL(1),
+    TVEL(2)); the second row is eq. (25)'s third.
     """
-    T1, T2, T3 = tvel
-    ta = t.c1 * T1 + t.s1 * T2
+    ta, tb = turn1(t, tvel[0], tvel[1])
     k = F.f1 / F.f2
-    return [[k * F.f3, k * F.f4], [-F.f1, -F.f5]], [k * ta - (t.s1 * T1 - t.c1 * T2), T3], ta
+    return [[k * F.f3, k * F.f4], [-F.f1, -F.f5]], [k * ta - tb, tvel[2]], ta
 
 
 def arm_from_m1(F: FTerms, th2: Entry, th3: Entry, ta: Entry) -> tuple[Entry, ...]:
@@ -220,14 +229,13 @@ def rvel_tilde(t: Trig, arm: Sequence[Entry], rvel: Sequence[Entry]) -> tuple[En
 def wrist_terms(g: BarkerGeometry, t: Trig, rt: Sequence[Entry]) -> tuple[Entry, Entry, Entry]:
     """thetadot_5 (eq. (49)) and the right-hand side (ga, gb) of M2 (eqs (58), (59)).
 
-    ``M2 (thetadot_4, thetadot_6) = (ga, gb)`` with ``M2 = [[0, S5], [1, C5]]``, from D1..D5
-    of eqs (52)-(56).
+    ``M2 (thetadot_4, thetadot_6) = (ga, gb)`` with M2 of :func:`m2_rows`, from D1..D5 of
+    eqs (52)-(56).
 
     In the orthonormal directions (C4 x3 + S4 y3, z4, z3) the wrist block reads (S5 thetadot_6,
     thetadot_5, thetadot_4 + C5 thetadot_6): thetadot_5 separates, M2 carries the rest.
     """
-    d1 = t.c1 * rt[0] + t.s1 * rt[1]  # eq. (52)
-    d2 = t.s1 * rt[0] - t.c1 * rt[1]  # eq. (53)
+    d1, d2 = turn1(t, rt[0], rt[1])  # eqs (52), (53)
     d3 = t.s23 * d1 + t.c23 * rt[2]  # eq. (54)
     d4 = t.c23 * d1 - t.s23 * rt[2]  # eq. (55)
     d5 = g.cal3 * d3 + g.sal3 * d2  # eq. (56)
@@ -236,9 +244,37 @@ def wrist_terms(g: BarkerGeometry, t: Trig, rt: Sequence[Entry]) -> tuple[Entry,
 
 
 def wrist_regular(t: Trig, ga: Entry, gb: Entry) -> tuple[Entry, Entry]:
-    """(thetadot_4, thetadot_6) by Barker eqs (51), (50)."""
+    """(thetadot_4, thetadot_6) by Barker eqs (51), (50): ``M2^-1 (ga, gb)``."""
     th6 = ga / t.s5  # eq. (50)
     return gb - t.c5 * th6, th6  # eq. (51)
+
+
+def m2_rows(t: Trig) -> list[list[Entry]]:
+    """Barker's M2 = [[0, S5], [1, C5]], eq. (58), by rows: M2 (thetadot_4, thetadot_6)."""
+    return [[0.0, t.s5], [1.0, t.c5]]
+
+
+def wrist_s2(t: Trig) -> Entry:
+    """The wrist's band measure ``s^2 = sigma_min(M2)^2 = 1 - |C5| = S5^2 / (1 + |C5|)``.
+
+    Exact for M2 of eq. (58) (``M2^T M2`` has eigenvalues ``1 +- |C5|``); the last form has
+    no cancellation near theta_5 = 0.
+    """
+    return t.s5 * t.s5 / (1.0 + abs(t.c5))
+
+
+def arm_s2(det: Entry, adj2: Entry) -> Entry:
+    """The arm's band measure ``s^2 = det^2 / ||adj||_F^2 <= sigma_min^2`` of M or of M1.
+
+    ``det``, ``adj2`` from :func:`det_adj2` for M; for the 2x2 M1 ``||adj M1||_F =
+    ||M1||_F``. Zero where the adjugate is (the block has rank <= 1, so ``det = 0``).
+    """
+    return det * det / (adj2 + (adj2 == 0.0))  # adj2 >= 0: 1 in place of 0
+
+
+def arm_in_band(det: Entry, adj2: Entry, eps: float) -> Entry:
+    """Whether the arm is in its band, ``arm_s2(det, adj2) <= eps^2``, without the division."""
+    return det * det <= eps * eps * adj2
 
 
 def frame3_axes(g: BarkerGeometry, t: Trig) -> tuple[tuple[Entry, ...], ...]:
@@ -303,11 +339,12 @@ def hand_to_base_rows(g: BarkerGeometry, t: Trig) -> list[list[Entry]]:
 def tvel_frame2(t: Trig, tvel: Sequence[Entry]) -> tuple[Entry, ...]:
     """Components of TVEL^ along X2, Y2, Z2, Barker eqs (B27)-(B29) corrected.
 
-    ``R2_1 R1_0`` (eqs (B25), (B26)) gives (TVEL)_X2 = S2 (C1 TVEL(1) + S1 TVEL(2)) + C2 TVEL(3),
-    (TVEL)_Y2 = C2 (C1 TVEL(1) + S1 TVEL(2)) - S2 TVEL(3), (TVEL)_Z2 = C1 TVEL(2) - S1 TVEL(1).
+    ``R2_1 R1_0`` (eqs (B25), (B26)) gives, with ``(ta, tb)`` the :func:`turn1` of
+    (TVEL(1), TVEL(2)): (TVEL)_X2 = S2 ta + C2 TVEL(3), (TVEL)_Y2 = C2 ta - S2 TVEL(3),
+    (TVEL)_Z2 = -tb.
     """
-    ta = t.c1 * tvel[0] + t.s1 * tvel[1]
-    return t.s2 * ta + t.c2 * tvel[2], t.c2 * ta - t.s2 * tvel[2], t.c1 * tvel[1] - t.s1 * tvel[0]
+    ta, tb = turn1(t, tvel[0], tvel[1])
+    return t.s2 * ta + t.c2 * tvel[2], t.c2 * ta - t.s2 * tvel[2], -tb
 
 
 # -- generalized inverses in the band (arrays) ---------------------------------------------

@@ -23,8 +23,9 @@ class ClosedForm(ABC):
     axes (``world_aligned``), the first :attr:`task_dim` rows of ``Robot.jacobian(q)`` when
     the robot's tool frame is :attr:`frame`.
 
-    Subclasses implement the two batch methods; the scalar methods default to a batch of one
-    and may be overridden by faster scalar code.
+    Subclasses implement all four methods, the scalar ones on Python floats (one
+    configuration; faster than a batch of one) and the batch ones on (N,) arrays, both from
+    the same kernels.
 
     Attributes:
         nq: Number of joints.
@@ -67,13 +68,21 @@ class ClosedForm(ABC):
             InputError: Wrong shapes or non-finite entries.
         """
 
+    @abstractmethod
     def jacobian(self, q: npt.ArrayLike) -> Array:
-        """Jacobian at one configuration ``q`` (nq,): shape (task_dim, nq)."""
-        return first(self.jacobian_batch(row(q, "q", self.nq)))
+        """Jacobian at one configuration ``q`` (nq,): shape (task_dim, nq).
 
+        Raises:
+            InputError: ``q`` is not a finite (nq,) vector.
+        """
+
+    @abstractmethod
     def joint_rates(self, q: npt.ArrayLike, xdot: npt.ArrayLike) -> Array:
-        """Joint rates (nq,) realising the task velocity ``xdot`` (task_dim,) at ``q`` (nq,)."""
-        return first(self.joint_rates_batch(row(q, "q", self.nq), row(xdot, "xdot", self.task_dim)))
+        """Joint rates (nq,) realising the task velocity ``xdot`` (task_dim,) at ``q`` (nq,).
+
+        Raises:
+            InputError: Wrong shapes or non-finite entries.
+        """
 
     def _check_batch(self, Q: npt.ArrayLike, X: npt.ArrayLike) -> tuple[Array, Array]:
         """Validate ``Q`` (N, nq) and ``X`` (N, task_dim) with the same N."""

@@ -269,23 +269,8 @@ class RrcK1607ClosedForm(ClosedForm):
         qv, b = as_vector(q, "q", NQ), as_vector(xdot, "xdot", TASK_DIM)
         L = weight_factor(W, NQ)
         zv = None if z is None else as_vector(z, "z", NQ)
-        # One configuration: J on Python floats, its products by numpy, the solve of
-        # _solve_spd6 on floats: 16 us against 250 us for the batch path on one row (measured).
-        Jt = np.array(self._columns(qv)[2])  # J^T (7, 6)
-        if zv is not None:
-            b = b - zv @ Jt
-        Bt = Jt if L is None else L.T @ Jt  # (J L)^T
-        A = Bt.T.dot(Bt).tolist()
-        tau = self.rcond**2 * sum(A[i][i] for i in range(TASK_DIM))
-        bl = b.tolist()
-        y = _solve_spd6(A, bl)
-        if dot(bl, bl) >= tau * tau * dot(y, y):  # False for NaN: not positive definite
-            qdot = Bt.dot(y)
-            qdot = qdot if L is None else L @ qdot
-        else:
-            qdot = svd_rates(Jt.T, b, L, self.rcond)
-        out: Array = qdot if zv is None else qdot + zv
-        return out
+        J = np.array(self._columns(qv)[2]).T  # one configuration: a numpy (6, 7) matrix
+        return _weighted_rates(J, b, zv, L, self.rcond)
 
     def joint_rates_batch(
         self, Q: npt.ArrayLike, X: npt.ArrayLike, W: npt.ArrayLike | None = None,
@@ -318,37 +303,56 @@ class RrcK1607ClosedForm(ClosedForm):
                 c, s = [v[rows] for v in C], [v[rows] for v in S]
                 J = list(zip(*_kinematics([*c, None], [*s, None], self.a, self.d, False)[2],
                              strict=True))  # fmt: skip
-                z = None if Z is None else Z[rows]
-                out[rows] = self._rates_block(J, X[rows], L, z)
-        if Z is not None:
-            out += Z
+                z = None if Z is None else np.ascontiguousarray(Z[rows].T)
+                out[rows] = _weighted_rates(J, np.ascontiguousarray(X[rows].T), z, L, self.rcond)
         return out
-
-    def _rates_block(
-        self, J: Sequence[Sequence[Entry]], X: Array, L: Array | None, Z: Array | None
-    ) -> Array:
-        """Rates (M, 7) of one block: ``J`` 6 rows of 7 entries ((M,) arrays or floats)."""
-        n = X.shape[0]
-        b = list(np.ascontiguousarray(X.T))
-        if Z is not None:
-            ZT = list(np.ascontiguousarray(Z.T))
-            b = [bi - dot(r, ZT) for bi, r in zip(b, J, strict=True)]
-        B = J if L is None else [[dot(r, col) for col in L.T.tolist()] for r in J]
-        A: list[list[Any]] = [[dot(B[i], B[j]) if j >= i else None for j in range(TASK_DIM)]
-             for i in range(TASK_DIM)]  # fmt: skip
-        tau = self.rcond**2 * sum(A[i][i] for i in range(TASK_DIM))
-        y = _solve_spd6(A, b)
-        ok = dot(b, b) >= tau * tau * dot(y, y)  # False for NaN: not positive definite
-        v = [dot(col, y) for col in zip(*B, strict=True)]  # B^T y
-        qdot = np.stack(v if L is None else [dot(r, v) for r in L.tolist()], axis=1)
-        if not np.all(ok):
-            bad = np.flatnonzero(~ok)
-            Jb = stack_entries(J, n)[bad]
-            qdot[bad] = svd_rates(Jb, np.stack(b, axis=1)[bad], L, self.rcond)
-        return qdot
 
 
 # ---------------------------------------------------------------------- helpers
+
+
+def _weighted_rates(J: Any, b: Array, z: Array | None, L: Array | None, rcond: float) -> Array:
+    r"""Nguyen eq. (22) as ``qdot = L B^T y + z`` with ``B = J L``, ``B B^T y = xdot - J z``.
+
+    ``y`` by :func:`_solve_spd6`; where the solve proves ``lambda_min(B B^T) < tau`` (``|b| <
+    tau |y|`` with ``tau = rcond^2 trace(B B^T)``, or NaN), the SVD form
+    :func:`~solvers.closed_form.weighted.svd_rates` instead (module docstring).
+
+    Each step is written once for both kinds of argument; only the matrix products are
+    spelled two ways:
+
+    - one configuration: ``J`` a numpy (6, 7) matrix, ``b`` = xdot (6,), ``z`` (7,) or None;
+      the products by numpy, the solve on Python floats (16 us a call, against 38 us with
+      the products by :func:`~solvers.closed_form.base.dot` on floats and 250 us for a block
+      of one, measured). Returns (7,).
+    - a block of M configurations: ``J`` its 6 rows of 7 entries ((M,) arrays or constant
+      floats), ``b`` (6, M), ``z`` (7, M) or None; the products by
+      :func:`~solvers.closed_form.base.dot`, which skips the constant entries. Returns (M, 7).
+    """
+    one = isinstance(J, np.ndarray)
+    if z is not None:
+        b = b - (J.dot(z) if one else np.array([dot(r, list(z)) for r in J]))
+    B = J
+    if L is not None:
+        B = J.dot(L) if one else [[dot(r, c) for c in L.T.tolist()] for r in J]
+    if one:  # A = B B^T
+        A = B.dot(B.T).tolist()
+    else:  # its upper triangle, all that _solve_spd6 reads
+        A = [[dot(B[i], B[j]) if j >= i else None for j in range(TASK_DIM)]
+             for i in range(TASK_DIM)]  # fmt: skip
+    tau = rcond**2 * sum(A[i][i] for i in range(TASK_DIM))
+    e = b.tolist() if one else list(b)  # the entries of b: floats, or (M,) rows
+    y = _solve_spd6(A, e)
+    ok = dot(e, e) >= tau * tau * dot(y, y)  # False for NaN: not positive definite
+    v: Any = B.T.dot(y) if one else [dot(col, y) for col in zip(*B, strict=True)]  # B^T y
+    if L is not None:
+        v = L.dot(v) if one else [dot(r, v) for r in L.tolist()]
+    qdot: Array = v if one else np.stack(v, axis=1)  # a new array: rows below are views
+    if not (ok if one else np.all(ok)):  # one configuration: a bool (np.all costs 2 us)
+        bad = np.flatnonzero(~np.atleast_1d(ok))
+        Js = J[None] if one else stack_entries(J, len(qdot))
+        qdot.reshape(-1, NQ)[bad] = svd_rates(Js[bad], b.T.reshape(-1, TASK_DIM)[bad], L, rcond)
+    return qdot if z is None else qdot + z.T
 
 
 def _positive(det: Entry) -> Entry:
