@@ -1,5 +1,11 @@
-"""Nadkarni's guidance: the screw of a finite displacement (chapter III)."""
+"""Nadkarni's guidance (M.S. thesis, 1977).
 
+The screw of a finite displacement (chapter III), guidance Types I-IV on any arm (chapter
+IV), the velocity analysis and the second-order correction (chapter V).
+"""
+
+from rrc_pin.guidance.general import general, general_axes
+from rrc_pin.guidance.operator import Command, operator
 from rrc_pin.guidance.screw import (
     Screw,
     displacement,
@@ -9,13 +15,28 @@ from rrc_pin.guidance.screw import (
     screw_of_displacement,
     screw_twist,
 )
+from rrc_pin.guidance.screw_motion import screw_motion
+from rrc_pin.guidance.stepping import GuidancePath, Step, ThesisSolver, run_steps
+from rrc_pin.guidance.straight_line import straight_line
+from rrc_pin.guidance.velocity import joint_rates
 
 __all__ = [
+    "Command",
+    "GuidancePath",
     "Screw",
+    "Step",
+    "ThesisSolver",
     "displacement",
     "frames_from_points",
+    "general",
+    "general_axes",
+    "joint_rates",
+    "operator",
+    "run_steps",
     "screw_from_points",
     "screw_from_poses",
+    "screw_motion",
     "screw_of_displacement",
     "screw_twist",
+    "straight_line",
 ]

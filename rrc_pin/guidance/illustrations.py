@@ -1,0 +1,268 @@
+"""Nadkarni's Appendix II, Illustrations 1, 2 and 4-7: the thesis's data and our runs of them.
+
+Lengths are in the thesis's units (taken as inches) and angles in degrees here only, where the
+tables are transcribed; the runs are in SI on the catalogue arms ``nadkarni_c1`` and
+``nadkarni_c2``. Each illustration gives rows of (label, printed numbers as strings, computed
+numbers), so that a report and the tests read the same data.
+
+Readings that reproduce the printed digits (docs/api.md, "Guidance"):
+
+- Illustration 7 (Type I, Table A2-13): k = 35; the screw and the origin-to-origin line are
+  located again at every step from the hand reached to the goal, a ``1 / (k - i)`` share each.
+- Illustration 6 (Type IV, Table A2-11): k = 9 and 4; each command's twist is constant, its
+  axis through the hand point where the command starts.
+- Illustration 4 (Type II, Table A2-6): the escape is (-0.05, 0.05, 0.25, 0.25, -0.25, -0.25)
+  rad (read from the table); every printed step is one constant twist; the printed final
+  theta1 is 0.05 rad above the configuration whose hand the thesis prints.
+- Illustration 5 (Type III, Table A2-9): the r3 column is k = 27 equal divisions; theta4 is not
+  reproduced (docs/errata.md).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.dh import DHChain
+from rrc_pin.errors import InvalidInput
+from rrc_pin.guidance.general import general
+from rrc_pin.guidance.operator import Command, operator
+from rrc_pin.guidance.screw import frames_from_points, screw_from_points
+from rrc_pin.guidance.stepping import Array, Correction, GuidancePath
+from rrc_pin.guidance.straight_line import straight_line
+from rrc_pin.models import CATALOGUE, INCH
+
+ILLUSTRATION_1_POSITIONS = (
+    ((25.00, 0.00, 20.00), (30.00, 0.00, 20.00), (25.00, 0.00, 10.00)),
+    ((-20.30, -7.83, -6.66), (-20.65, -8.29, -5.85), (-21.06, -7.18, -6.62)),
+    ((-24.50, 5.30, 4.00), (-24.67, 5.47, 4.97), (-25.00, 6.00, 4.00)),
+)
+ILLUSTRATION_1_PRINTED = (  # u, rho_n, d, theta [deg], h
+    (("0.5699", "-0.4433", "0.6918"), ("-1.758", "-0.762", "0.960"), "-40.79", "176.36", "-13.25"),
+    (("0.8381", "-0.3386", "0.4276"), ("5.942", "6.862", "-6.212"), "-3.407", "-40.54", "4.815"),
+)
+ILLUSTRATION_4_GOAL = ((-20.30, -7.83, -6.66), (-20.65, -8.29, -5.85), (-21.06, -7.18, -6.62))
+TABLE_A2_6 = (  # theta1..6 [deg]; the first row after the escape, then every printed step
+    ("67.135", "82.865", "54.324", "14.324", "45.676", "15.676"),
+    ("68.106", "83.55", "61.919", "17.688", "36.391", "12.618"),
+    ("69.611", "84.265", "63.399", "20.212", "33.161", "10.420"),
+    ("71.373", "85.001", "63.108", "22.239", "31.714", "8.608"),
+    ("73.303", "85.772", "61.990", "23.914", "31.133", "7.039"),
+    ("75.358", "86.589", "60.404", "25.317", "31.073", "5.666"),
+    ("77.512", "87.459", "58.524", "26.499", "31.371", "4.450"),
+    ("79.746", "88.388", "56.445", "27.495", "31.941", "3.37"),
+)
+TABLE_A2_6_FINAL = ("102.843", "100.014", "30.213", "29.926", "49.794", "-0.034")
+ILLUSTRATION_4_HAND = (
+    ("-20.30", "-7.83", "-6.65"),
+    ("-20.65", "-8.29", "-5.83"),
+    ("-21.06", "-7.18", "-6.61"),
+)
+CONFIG_2_GOAL = ((10.00, -10.00, 20.00), (11.00, -10.00, 20.00), (10.00, -10.00, 19.00))
+TABLE_A2_9 = (  # r1, r2, r3, theta4, theta5, theta6
+    ("-0.225", "26.496", "7.704", "10.000", "90.000", "0.000"),
+    ("-0.948", "27.775", "7.407", "21.801", "90.000", "0.000"),
+    ("-1.960", "28.790", "7.111", "32.005", "90.000", "0.000"),
+    ("-3.108", "29.464", "6.815", "41.009", "90.000", "0.000"),
+    ("-4.229", "29.864", "6.519", "48.652", "90.000", "0.000"),
+    ("-5.317", "29.953", "6.222", "55.008", "90.000", "0.000"),
+    ("-6.254", "29.919", "5.926", "60.255", "90.000", "0.000"),
+    ("-7.138", "29.674", "5.630", "64.592", "90.000", "0.000"),
+    ("-7.918", "29.343", "5.333", "68.199", "90.000", "0.000"),
+)
+TABLE_A2_9_FINAL = ("-15.000", "20.000", "0.000", "90.000", "90.000", "0.000")
+TABLE_A2_11 = (  # stage 1: steps 1-3 and its end (step 9); stage 2: steps 1-4
+    (1, ("0.00", "25.58", "7.56", "3.33", "90.00", "0.00")),
+    (2, ("-0.03", "26.16", "7.11", "6.67", "90.00", "0.00")),
+    (3, ("-0.10", "26.74", "6.67", "10.00", "90.00", "0.00")),
+    (9, ("-1.20", "30.07", "4.00", "30.00", "90.00", "0.00")),
+    (10, ("-1.53", "30.64", "3.75", "33.75", "90.00", "0.00")),
+    (11, ("-1.90", "31.18", "3.50", "37.50", "90.00", "0.00")),
+    (12, ("-2.29", "31.70", "3.25", "41.25", "90.00", "0.00")),
+    (13, ("-2.73", "32.20", "3.00", "45.00", "90.00", "0.00")),
+)
+ILLUSTRATION_6_RHO = (("15.14", "-25.07", "16.00"), ("15.19", "-25.12", "17.00"))
+TABLE_A2_13 = (
+    ("-0.143", "25.020", "7.771", "2.571", "90.000", "0.000"),
+    ("-0.306", "25.040", "7.543", "5.143", "90.000", "0.000"),
+    ("-0.490", "25.058", "7.314", "7.714", "90.000", "0.000"),
+    ("-0.694", "25.075", "7.086", "10.286", "90.000", "0.000"),
+    ("-0.918", "25.087", "6.857", "12.857", "90.000", "0.000"),
+    ("-1.162", "25.096", "6.629", "15.429", "90.000", "0.000"),
+    ("-1.427", "25.100", "6.400", "18.000", "90.000", "0.000"),
+    ("-1.710", "25.098", "6.171", "20.571", "90.000", "0.000"),
+    ("-2.013", "25.089", "5.943", "23.143", "90.000", "0.000"),
+    ("-2.336", "25.073", "5.714", "25.714", "90.000", "0.000"),
+)
+TABLE_A2_13_FINAL = ("-15.000", "20.010", "0.000", "90.000", "90.000", "0.000")
+ILLUSTRATION_7_HAND = (
+    ("10.00", "-10.01", "20.00"),
+    ("11.00", "-10.01", "20.00"),
+    ("10.00", "-10.01", "19.00"),
+)
+
+
+@dataclass(frozen=True)
+class Row:
+    """One printed line beside the computed numbers (thesis units, degrees)."""
+
+    label: str
+    printed: tuple[str, ...]
+    computed: tuple[float, ...]
+
+
+def chain(name: str) -> DHChain:
+    """The catalogue DH chain of ``nadkarni_c1`` or ``nadkarni_c2`` (SI)."""
+    return CATALOGUE[name].chain
+
+
+def start(name: str) -> Array:
+    """The tables' initial configuration of configuration #1 or #2 (SI)."""
+    spec = CATALOGUE[name]
+    return np.asarray(next(iter(spec.named_poses.values())), dtype=np.float64)
+
+
+def thesis_units(q: npt.ArrayLike, prismatic: int) -> tuple[float, ...]:
+    """Joint values in the tables' units: the first ``prismatic`` in inches, the rest degrees."""
+    v = np.asarray(q, dtype=float)
+    return tuple(float(x) for x in np.r_[v[:prismatic] / INCH, np.degrees(v[prismatic:])])
+
+
+def hand_points(T: Array) -> tuple[tuple[float, ...], ...]:
+    """The thesis's three hand points (origin, +z, +x at a_7 = 1) in inches."""
+    p = T[:3, 3] / INCH
+    return tuple(tuple(float(x) for x in v) for v in (p, p + T[:3, 2], p + T[:3, 0]))
+
+
+def illustration_1() -> list[Row]:
+    """Screw axes between the three positions of Table A2-1 (nominal printed inputs)."""
+    rows = []
+    P = np.asarray(ILLUSTRATION_1_POSITIONS)
+    for n, printed in enumerate(ILLUSTRATION_1_PRINTED):
+        s = screw_from_points(P[n], P[n + 1])
+        u, rho, d, theta, h = printed
+        tag = f"{n + 1}->{n + 2}"
+        rows += [
+            Row(f"u {tag}", u, tuple(float(x) for x in s.u)),
+            Row(f"rho_n {tag}", rho, tuple(float(x) for x in s.rho)),
+            Row(
+                f"d, theta, h {tag}",
+                (d, theta, h),
+                (float(s.d), float(np.degrees(s.theta)), float(s.h)),
+            ),
+        ]
+    return rows
+
+
+def illustration_2() -> list[Row]:
+    """Mechanism data of configuration #1 (Table A2-2): the hand frame x*(7) and X(7)."""
+    T = chain("nadkarni_c1").fk(start("nadkarni_c1"))
+    a, _, c = hand_points(T)
+    return [
+        Row("X*(7)", ("-24.315", "5.273", "4.059"), a),
+        Row("U(7)", ("0.171", "0.174", "0.970"), tuple(float(x) for x in T[:3, 2])),
+        Row("X(7)", ("-24.833", "6.126", "3.998"), c),
+    ]
+
+
+ESCAPE_4 = np.array([-0.05, 0.05, 0.25, 0.25, -0.25, -0.25])
+"""The singularity escape of Illustration 4 [rad], as Table A2-6's first row shows it."""
+
+
+def illustration_4() -> list[Row]:
+    """Type II on configuration #1 (Table A2-6): the escape, the constant step, the final hand.
+
+    The rows compare the twist of each printed step with the first one's (constant within the
+    printed digits) and the hand of the printed final joints with theta1 lowered by 0.05 rad.
+    """
+    q0 = start("nadkarni_c1")
+    arm = chain("nadkarni_c1")
+    kicked = np.radians([float(v) for v in TABLE_A2_6[0]]) - q0
+    rows = [Row("escape [rad]", tuple(f"{x:.2f}" for x in ESCAPE_4), tuple(map(float, kicked)))]
+    twists = printed_step_twists(arm, TABLE_A2_6)
+    for i, B in enumerate(twists[1:], start=2):
+        rows.append(
+            Row(f"step {i} twist / step 1", ("1",) * 6, tuple(float(x) for x in B / twists[0]))
+        )
+    final = np.radians([float(v) for v in TABLE_A2_6_FINAL])
+    final[0] += ESCAPE_4[0]
+    for label, printed, computed in zip(
+        "abc", ILLUSTRATION_4_HAND, hand_points(arm.fk(final)), strict=True
+    ):
+        rows.append(Row(f"{label}2 (theta1 - 0.05 rad)", printed, computed))
+    return rows
+
+
+def printed_step_twists(arm: DHChain, table: tuple[tuple[str, ...], ...]) -> Array:
+    """WORLD twists ``J(q_i) (q_{i+1} - q_i)`` (n - 1, 6) of the printed steps of a table."""
+    Q = np.radians([[float(v) for v in row] for row in table])
+    return np.array(
+        [arm.jacobian(Q[i], ref="world") @ (Q[i + 1] - Q[i]) for i in range(len(Q) - 1)]
+    )
+
+
+def illustration_5(correction: Correction = "none") -> tuple[list[Row], GuidancePath]:
+    """Type III on configuration #2 (Table A2-9), k = 27 divisions."""
+    arm = chain("nadkarni_c2")
+    goal = frames_from_points(np.asarray(CONFIG_2_GOAL) * INCH)
+    path = straight_line(arm, start("nadkarni_c2"), goal, 27, spacing=INCH, correction=correction)
+    rows = [
+        Row(f"step {i + 1}", p, thesis_units(path.q[i + 1], 3)) for i, p in enumerate(TABLE_A2_9)
+    ]
+    rows.append(Row("final", TABLE_A2_9_FINAL, thesis_units(path.q[-1], 3)))
+    return rows, path
+
+
+def illustration_6(correction: Correction = "none") -> tuple[list[Row], list[GuidancePath]]:
+    """Type IV on configuration #2 (Table A2-11): z in the global frame, then x in the hand's."""
+    arm = chain("nadkarni_c2")
+    q0 = start("nadkarni_c2")
+    commands = [
+        Command((0.0, 0.0, 1.0), 4.0 * INCH, np.radians(-30.0), "global"),
+        Command((1.0, 0.0, 0.0), -1.0 * INCH, np.radians(15.0), "hand"),
+    ]
+    paths = operator(arm, q0, commands, [9, 4], correction=correction)
+    q = np.concatenate([paths[0].q, paths[1].q[1:]])
+    rows = [Row(f"step {i}", p, thesis_units(q[i], 3)) for i, p in TABLE_A2_11]
+    for n, (path, printed) in enumerate(zip(paths, ILLUSTRATION_6_RHO, strict=True)):
+        rows.append(Row(f"rho_0 end of stage {n + 1}", printed, hand_points(path.hand[-1])[0]))
+    return rows, paths
+
+
+def illustration_7(correction: Correction = "none") -> tuple[list[Row], GuidancePath]:
+    """Type I (Example 4) on configuration #2 (Table A2-13), k = 35."""
+    arm = chain("nadkarni_c2")
+    goal = frames_from_points(np.asarray(CONFIG_2_GOAL) * INCH)
+    path = general(arm, start("nadkarni_c2"), goal, 35, correction=correction)
+    rows = [
+        Row(f"step {i + 1}", p, thesis_units(path.q[i + 1], 3)) for i, p in enumerate(TABLE_A2_13)
+    ]
+    rows.append(Row("final", TABLE_A2_13_FINAL, thesis_units(path.q[-1], 3)))
+    for label, printed, computed in zip(
+        "abc", ILLUSTRATION_7_HAND, hand_points(path.hand[-1]), strict=True
+    ):
+        rows.append(Row(f"{label}2", printed, computed))
+    return rows, path
+
+
+def report(number: int) -> list[Row]:
+    """The rows of Illustration ``number`` (1, 2, 4, 5, 6 or 7).
+
+    Raises:
+        InvalidInput: Another number (Illustration 3 is 1 and 2 in one run).
+    """
+    if number == 1:
+        return illustration_1()
+    if number == 2:
+        return illustration_2()
+    if number == 4:
+        return illustration_4()
+    if number == 5:
+        return illustration_5()[0]
+    if number == 6:
+        return illustration_6()[0]
+    if number == 7:
+        return illustration_7()[0]
+    raise InvalidInput("illustration", f"expected 1, 2, 4, 5, 6 or 7, got {number!r}")

@@ -1,0 +1,335 @@
+"""The stepping core shared by Nadkarni's guidance types I-IV (chapter IV).
+
+Every type gives, at each step, the small displacement of the hand as a twist ``B`` (6,) in
+Pinocchio's WORLD frame, rows [v; w]: the velocity of the base origin times the step,
+Nadkarni's vector B of eq. (4-11a) with its two halves swapped. The core turns it into joint
+increments ``D`` with ``J_world(q) D = B`` (eq. (4-11b)) by one of two solvers:
+
+- ``"thesis"``: the thesis's own linear solve (least squares of minimum norm where the arm is
+  not square), with his singularity escape (chapter IV, "Singularities" 1): where ``J`` is
+  singular (condition number above ``singular_cond``), small increments are given to the
+  joints until it is not, and the step is taken from the new configuration;
+- a :class:`rrc_pin.Resolver`: ``B / dt`` as a WORLD twist, so the joint limits hold (the
+  resolver slows a step down rather than leave them; its report says so).
+
+The second-order correction the thesis suggests (chapter V, suggestion 2) refines the
+first-order increments by a few iterations, aiming at the exact pose of the step,
+``T_target = exp(B) T(q)``: ``correction="eq5_5"`` solves his eqs (4-9) and (5-5) by
+fixed-point iterations (each joint's own second-order term, no cross terms between joints:
+second order only where one revolute joint turns, docs/errata.md); ``correction="newton"``
+iterates on the exact pose (every term, quadratic convergence).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Literal, NamedTuple, Protocol
+
+import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
+
+from rrc_pin.errors import InvalidInput
+from rrc_pin.resolver import Resolver
+from solvers.validation import finite_number
+
+Array = npt.NDArray[np.float64]
+Correction = Literal["none", "eq5_5", "newton"]
+SINGULAR_COND = 1e4
+"""Condition number of the WORLD Jacobian above which the thesis solver escapes."""
+ESCAPE_STEP = 0.05
+"""Size [rad or m] of the joint increments of the singularity escape."""
+
+
+@dataclass(frozen=True)
+class ThesisSolver:
+    """The thesis's linear solve of eq. (4-11b) with his singularity escape.
+
+    Attributes:
+        singular_cond: Condition number of ``J_world`` above which the arm counts as
+            singular (> 1).
+        escape: (nq,) joint increments [rad or m] given until ``J`` is regular (at most 20
+            times); None: :data:`ESCAPE_STEP` with alternating signs (joint 1 down, 2 up...).
+    """
+
+    singular_cond: float = SINGULAR_COND
+    escape: tuple[float, ...] | None = None
+
+    def __post_init__(self) -> None:
+        finite_number(self.singular_cond, "singular_cond", lower=1.0, inclusive=False,
+                      error=InvalidInput)  # fmt: skip
+        if self.escape is not None:
+            kick = np.asarray(self.escape, dtype=float)
+            if kick.ndim != 1 or not np.isfinite(kick).all() or not kick.any():
+                raise InvalidInput("escape", f"expected finite nonzero increments, got {kick}")
+
+    def kick(self, nq: int) -> Array:
+        """The escape's joint increments (nq,).
+
+        Raises:
+            InvalidInput: ``escape`` has not ``nq`` entries.
+        """
+        if self.escape is None:
+            return ESCAPE_STEP * np.where(np.arange(nq) % 2 == 0, -1.0, 1.0)
+        if len(self.escape) != nq:
+            raise InvalidInput("escape", f"expected {nq} increments, got {len(self.escape)}")
+        return np.asarray(self.escape, dtype=np.float64)
+
+
+Solver = Literal["thesis"] | ThesisSolver | Resolver
+
+
+class Kinematics(Protocol):
+    """What the stepping needs of an arm: :class:`rrc_pin.Robot` and :class:`rrc_pin.dh.DHChain`."""
+
+    @property
+    def nq(self) -> int: ...  # noqa: D102
+
+    def fk(self, q: npt.ArrayLike) -> Array: ...  # noqa: D102
+
+    def jacobian(  # noqa: D102
+        self, q: npt.ArrayLike, ref: Literal["world", "world_aligned"]
+    ) -> Array: ...
+
+
+@dataclass(frozen=True)
+class GuidancePath:
+    """Joint path of a guidance run.
+
+    Attributes:
+        q: (k + 1, nq) joint positions, the start first [rad or m].
+        hand: (k + 1, 4, 4) hand poses reached, base frame.
+        escapes: Indices of the steps before which the singularity escape moved the joints.
+        scale: (k,) fraction of each step's displacement achieved (1 with the thesis solver;
+            below 1 where the resolver stopped short at a joint limit).
+    """
+
+    q: Array
+    hand: Array
+    escapes: tuple[int, ...]
+    scale: Array
+
+
+class Step(NamedTuple):
+    """One step of a guidance type.
+
+    Attributes:
+        twist: (6,) WORLD twist [v; w] of the step (Nadkarni's B, eq. (4-11a)).
+        target: (4, 4) the exact hand pose the step aims at (what the corrections reach).
+    """
+
+    twist: Array
+    target: Array
+
+
+StepTwist = Callable[[int, Array], Step]
+"""``step(i, T)``: the :class:`Step` ``i`` (0-based) from the hand pose ``T`` reached."""
+
+
+def screw_step(twist: Array, T: Array) -> Step:
+    """A step along a screw: the target is ``exp(twist) T`` (Types II-IV)."""
+    return Step(twist, (pin.exp6(pin.Motion(twist)) * pin.SE3(T)).homogeneous)
+
+
+def hand_step(axis: Array, angle: float, translation: Array, T: Array) -> Step:
+    """A turn about ``axis`` through the hand point and a ``translation`` (3,) of it (Type I).
+
+    The target turns the hand by ``angle`` in place and moves its point by the chord.
+    """
+    target = T.copy()
+    target[:3, :3] = pin.exp3(angle * axis) @ T[:3, :3]
+    target[:3, 3] = T[:3, 3] + translation
+    return Step(hand_twist(axis, angle, translation, T[:3, 3]), target)
+
+
+def check_steps(steps: int) -> int:
+    """``steps`` as a positive int (the thesis's k).
+
+    Raises:
+        InvalidInput: ``steps`` is not an integer >= 1.
+    """
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
+        raise InvalidInput("steps", f"expected an integer k >= 1, got {steps!r}")
+    return int(steps)
+
+
+def run_steps(
+    arm: Kinematics,
+    q0: npt.ArrayLike,
+    twist: StepTwist,
+    steps: int,
+    *,
+    solver: Solver = "thesis",
+    correction: Correction = "none",
+) -> GuidancePath:
+    """Take ``steps`` steps, step ``i`` realising ``twist(i, hand pose)``.
+
+    Args:
+        arm: The arm (a :class:`rrc_pin.Robot`, or a :class:`rrc_pin.dh.DHChain` for screw
+            joints).
+        q0: Start configuration (nq,) [rad or m].
+        twist: The step's WORLD twist from its index and the hand pose reached.
+        steps: Number of steps k >= 1.
+        solver: ``"thesis"`` (:class:`ThesisSolver` with its defaults), a
+            :class:`ThesisSolver`, or a :class:`rrc_pin.Resolver` of ``arm`` (joint limits).
+        correction: ``"none"`` (first order, eq. (4-11)), ``"eq5_5"`` (the thesis's
+            eq. (5-5)) or ``"newton"`` (the exact pose of each step).
+
+    Raises:
+        InvalidInput: A bad ``q0``, ``steps``, ``solver`` or ``correction``, named.
+    """
+    steps = check_steps(steps)
+    q = check_q0(arm, q0)
+    if correction not in ("none", "eq5_5", "newton"):
+        raise InvalidInput(
+            "correction", f"expected 'none', 'eq5_5' or 'newton', got {correction!r}"
+        )
+    if isinstance(solver, str) and solver == "thesis":
+        solver = ThesisSolver()
+    if not isinstance(solver, (ThesisSolver, Resolver)):
+        raise InvalidInput(
+            "solver", f"expected 'thesis', a ThesisSolver or a rrc_pin.Resolver, got {solver!r}"
+        )
+    thesis = solver if isinstance(solver, ThesisSolver) else None
+    kick = thesis.kick(q.size) if thesis is not None else None
+    qs, hands, scales, escapes = [q], [arm.fk(q)], [], []
+    for i in range(steps):
+        if thesis is not None and kick is not None:
+            escaped = escape_singularity(arm, q, kick, thesis.singular_cond)
+            if escaped is not None:
+                q = escaped
+                escapes.append(i)
+                qs[-1], hands[-1] = q, arm.fk(q)
+        step = twist(i, hands[-1])
+        dq, scale = first_order(arm, q, step.twist, solver)
+        if correction == "newton" and scale == 1.0:
+            dq = newton(arm, q, dq, step.target)
+        elif correction == "eq5_5" and scale == 1.0:
+            dq = second_order(arm, q, dq, step)
+        q = q + dq
+        qs.append(q)
+        hands.append(arm.fk(q))
+        scales.append(scale)
+    return GuidancePath(np.array(qs), np.array(hands), tuple(escapes), np.array(scales))
+
+
+def first_order(
+    arm: Kinematics, q: Array, B: Array, solver: ThesisSolver | Resolver
+) -> tuple[Array, float]:
+    """Joint increments (nq,) of eq. (4-11b), ``J_world D = B``, and the fraction achieved."""
+    if isinstance(solver, Resolver):
+        r = solver.solve(q, B / solver.dt, ref="world")
+        return np.asarray(r.qdot) * solver.dt, float(r.scale)
+    J = arm.jacobian(q, ref="world")
+    if J.shape[0] == J.shape[1]:
+        return np.asarray(np.linalg.solve(J, B), dtype=np.float64), 1.0
+    return lstsq(J, B), 1.0
+
+
+def escape_singularity(
+    arm: Kinematics, q: Array, kick: Array, singular_cond: float, tries: int = 20
+) -> Array | None:
+    """Nadkarni's escape: a new configuration where ``J`` is regular, or None if ``q``'s is.
+
+    The joints are moved by ``kick`` (nq,) until the condition number of ``J_world`` falls
+    below ``singular_cond`` (at most ``tries`` times).
+    """
+    if _regular(arm, q, singular_cond):
+        return None
+    moved: Array = q.copy()
+    for _ in range(tries):
+        moved = moved + kick
+        if _regular(arm, moved, singular_cond):
+            break
+    return moved
+
+
+def _regular(arm: Kinematics, q: Array, singular_cond: float) -> bool:
+    return bool(np.linalg.cond(arm.jacobian(q, ref="world")) < singular_cond)
+
+
+def newton(arm: Kinematics, q: Array, dq: Array, goal: Array, iterations: int = 3) -> Array:
+    """Refine the increments so that the hand reaches the step's ``goal`` (4, 4) exactly.
+
+    The thesis keeps, in eq. (5-5), the second-order term of each joint's own motion; a Newton
+    iteration on the exact pose keeps every second-order term (the cross terms between joints
+    too) and converges quadratically from the first-order answer of eq. (4-11).
+    """
+    target = pin.SE3(goal)
+    for _ in range(iterations):
+        T = pin.SE3(arm.fk(q + dq))
+        error = pin.log6(target * T.inverse()).vector  # WORLD twist still to go
+        if np.abs(error).max() < 1e-15:
+            break
+        J = arm.jacobian(q + dq, ref="world")
+        dq = dq + lstsq(J, error)
+    return dq
+
+
+def second_order(arm: Kinematics, q: Array, dq: Array, step: Step, iterations: int = 4) -> Array:
+    """Nadkarni's eqs (4-9) and (5-5) solved by fixed-point iterations from eq. (4-11)'s answer.
+
+    .. math::
+
+        delta r u_v = sum_j [h_j dtheta_j u_j + dtheta_j u_j x rho_jH
+                             + dtheta_j^2 / 2 u_j x (u_j x rho_jH)]      (5-5)
+
+    with ``delta r u_v`` the hand point's displacement to the step's target; the rotation
+    keeps eq. (4-9). Prismatic joints have no second-order term. The joint axes
+    ``u_j`` and the arms ``rho_jH`` from the hand point are the Jacobian's (revolute and screw
+    columns: ``w_j = u_j``, ``v_j = u_j x rho_jH + h_j u_j``).
+    """
+    p = arm.fk(q)[:3, 3]
+    w = step.twist[3:]
+    moved = step.target[:3, 3] - p  # the hand point's chord
+    target = np.concatenate([moved - np.cross(w, p), w])  # as a WORLD twist
+    J = arm.jacobian(q, ref="world")
+    Jh = arm.jacobian(q, ref="world_aligned")  # columns at the hand point
+    u = Jh[3:].T  # (nq, 3): zero for prismatic joints
+    # v_j = u_j x rho_jH + h_j u_j at the hand point, so u_j x v_j = u_j x (u_j x rho_jH).
+    square = np.cross(u, Jh[:3].T)  # (nq, 3)
+    for _ in range(iterations):
+        extra = 0.5 * (dq**2) @ square
+        rhs = target - np.concatenate([extra, np.zeros(3)])
+        dq = np.asarray(np.linalg.lstsq(J, rhs, rcond=None)[0], dtype=np.float64)
+    return dq
+
+
+def lstsq(J: Array, b: Array) -> Array:
+    """Least-squares solution of minimum norm of ``J x = b``."""
+    return np.asarray(np.linalg.lstsq(J, b, rcond=None)[0], dtype=np.float64)
+
+
+def hand_twist(axis: Array, angle: float, translation: Array, point: Array) -> Array:
+    """WORLD twist (6,) [v; w]: a turn ``angle`` about ``axis`` through ``point``, a translation.
+
+    Nadkarni's B of eq. (4-11a), ``[dr u_v - dtheta u_w x rho_0; dtheta u_w]`` (rows swapped).
+    """
+    out: Array = np.concatenate([translation - angle * np.cross(axis, point), angle * axis])
+    return out
+
+
+def unit_axis(axis: npt.ArrayLike, name: str) -> Array:
+    """``axis`` (3,) normalised.
+
+    Raises:
+        InvalidInput: Not a finite, nonzero 3-vector.
+    """
+    a = np.asarray(axis, dtype=float) if not isinstance(axis, str) else np.array([np.nan])
+    if a.shape != (3,) or not np.isfinite(a).all() or np.linalg.norm(a) < 1e-12:
+        raise InvalidInput(name, f"expected a finite nonzero axis of shape (3,), got {axis!r}")
+    out: Array = a / float(np.linalg.norm(a))
+    return out
+
+
+def check_q0(arm: Kinematics, q0: npt.ArrayLike) -> Array:
+    """``q0`` as a finite (nq,) float vector (a copy).
+
+    Raises:
+        InvalidInput: Wrong shape or non-finite.
+    """
+    q = np.array(q0, dtype=np.float64)
+    if q.shape != (arm.nq,) or not np.isfinite(q).all():
+        raise InvalidInput("q0", f"expected a finite vector of shape ({arm.nq},), got {q0!r}")
+    return q
