@@ -38,6 +38,8 @@ Array = npt.NDArray[np.float64]
 Correction = Literal["none", "eq5_5", "newton"]
 SINGULAR_COND = 1e4
 """Condition number of the WORLD Jacobian above which the thesis solver escapes."""
+FULL_STEP = 1.0 - 1e-9
+"""A resolver's scale at or above this is a full step (the corrections apply)."""
 ESCAPE_STEP = 0.05
 """Size [rad or m] of the joint increments of the singularity escape."""
 
@@ -203,15 +205,38 @@ def run_steps(
                 qs[-1], hands[-1] = q, arm.fk(q)
         step = twist(i, hands[-1])
         dq, scale = first_order(arm, q, step.twist, solver)
-        if correction == "newton" and scale == 1.0:
-            dq = newton(arm, q, dq, step.target)
-        elif correction == "eq5_5" and scale == 1.0:
-            dq = second_order(arm, q, dq, step)
+        if correction != "none" and scale >= FULL_STEP:
+            dq = corrected(arm, q, dq, step, correction, solver)
         q = q + dq
         qs.append(q)
         hands.append(arm.fk(q))
         scales.append(scale)
     return GuidancePath(np.array(qs), np.array(hands), tuple(escapes), np.array(scales))
+
+
+def corrected(
+    arm: Kinematics,
+    q: Array,
+    dq: Array,
+    step: Step,
+    correction: Correction,
+    solver: ThesisSolver | Resolver,
+) -> Array:
+    """The increments refined by ``correction``.
+
+    The first-order ones stay where the refined step would leave the resolver's joint position
+    limits (the corrections know no limits).
+    """
+    better = (
+        newton(arm, q, dq, step.target)
+        if correction == "newton"
+        else second_order(arm, q, dq, step)
+    )
+    if isinstance(solver, Resolver):
+        moved = q + better
+        if np.any(moved < solver.robot.lower) or np.any(moved > solver.robot.upper):
+            return dq
+    return better
 
 
 def first_order(
@@ -289,11 +314,13 @@ def second_order(arm: Kinematics, q: Array, dq: Array, step: Step, iterations: i
     u = Jh[3:].T  # (nq, 3): zero for prismatic joints
     # v_j = u_j x rho_jH + h_j u_j at the hand point, so u_j x v_j = u_j x (u_j x rho_jH).
     square = np.cross(u, Jh[:3].T)  # (nq, 3)
+    first = dq
     for _ in range(iterations):
         extra = 0.5 * (dq**2) @ square
-        rhs = target - np.concatenate([extra, np.zeros(3)])
-        dq = np.asarray(np.linalg.lstsq(J, rhs, rcond=None)[0], dtype=np.float64)
-    return dq
+        dq = lstsq(J, target - np.concatenate([extra, np.zeros(3)]))
+    # the fixed point diverges where J is ill-conditioned: keep the first-order step there
+    diverged = not np.isfinite(dq).all() or np.linalg.norm(dq - first) > np.linalg.norm(first)
+    return first if diverged else dq
 
 
 def lstsq(J: Array, b: Array) -> Array:

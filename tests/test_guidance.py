@@ -1,0 +1,280 @@
+"""Guidance Types I-IV on any arm: goal reached, path property of each type, joint limits held,
+the second-order correction's order, the velocity analysis, screw joints, bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import rrc_pin
+from rrc_pin.dh import DHChain, DHRow
+from rrc_pin.errors import InvalidInput
+from rrc_pin.guidance import (
+    Command,
+    ThesisSolver,
+    general,
+    general_axes,
+    joint_rates,
+    operator,
+    screw_from_poses,
+    screw_motion,
+    screw_twist,
+    straight_line,
+)
+from rrc_pin.models import CATALOGUE
+
+ARMS = ["barker6", "rrc_k1607", "panda"]
+
+
+@pytest.fixture(scope="module")
+def arms():
+    return {name: rrc_pin.load(name) for name in ARMS}
+
+
+C2 = 10.0
+"""First-order error of one step, at most C2 |step|^2 (step: the norm of its twist, m and rad
+together) for these arms (reach about 1 m): measured up to 5."""
+
+
+def pose_error(A, B):
+    """Size of the WORLD twist from pose B to pose A: [m] and [rad] together."""
+    return float(np.linalg.norm(pin.log6(pin.SE3(A) * pin.SE3(B).inverse()).vector))
+
+
+def start_and_goal(arm, rng, size=0.25):
+    """A well-conditioned start inside the limits (margin 0.3 rad) and the hand pose of a
+    nearby configuration."""
+    lower, upper = arm.lower + 0.3, arm.upper - 0.3
+    q0 = lower + rng.uniform(size=arm.nq) * (upper - lower)
+    while np.linalg.cond(arm.jacobian(q0, ref="world_aligned")) > 50:
+        q0 = lower + rng.uniform(size=arm.nq) * (upper - lower)
+    q1 = np.clip(q0 + rng.uniform(-size, size, arm.nq), arm.lower, arm.upper)
+    return q0, arm.fk(q1)
+
+
+def within_limits(arm, Q):
+    return np.all(Q >= arm.lower - 1e-9) and np.all(Q <= arm.upper + 1e-9)
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_type_ii_moves_the_hand_on_its_screw_and_reaches_the_goal(arms, name, rng):
+    arm = arms[name]
+    q0, goal = start_and_goal(arm, rng)
+    k = 20
+    path = screw_motion(arm, q0, goal, k, solver=rrc_pin.Resolver(arm, dt=1.0))
+    xi = screw_twist(screw_from_poses(arm.fk(q0), goal))
+    step = np.linalg.norm(xi) / k
+    # on the screw: pose i is exp(i xi / k) T0 up to the first-order error of i steps
+    for i, T in enumerate(path.hand):
+        planned = (pin.exp6(pin.Motion(xi * i / k)) * pin.SE3(path.hand[0])).homogeneous
+        assert pose_error(planned, T) <= C2 * i * step**2 + 1e-12, (i, pose_error(planned, T))
+    assert pose_error(goal, path.hand[-1]) <= C2 * k * step**2
+    assert within_limits(arm, path.q) and np.all(path.scale > 1.0 - 1e-9)
+    relocated = screw_motion(arm, q0, goal, k, relocate=True, solver=rrc_pin.Resolver(arm, dt=1.0))
+    assert pose_error(goal, relocated.hand[-1]) <= C2 * step**2  # one step's error
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_type_iii_keeps_the_hand_point_on_its_line(arms, name, rng):
+    arm = arms[name]
+    q0, goal = start_and_goal(arm, rng)
+    k = 20
+    path = straight_line(arm, q0, goal, k, spacing=0.1, solver=rrc_pin.Resolver(arm, dt=1.0))
+    a, b = path.hand[0][:3, 3], goal[:3, 3]
+    line = (b - a) / np.linalg.norm(b - a)
+    step = np.linalg.norm(screw_twist(screw_from_poses(path.hand[0], goal))) / k
+    for T in path.hand:
+        off = T[:3, 3] - a - ((T[:3, 3] - a) @ line) * line
+        assert np.linalg.norm(off) <= C2 * step**2  # the first-order error of one step
+    assert pose_error(goal, path.hand[-1]) <= C2 * step**2
+    assert within_limits(arm, path.q)
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_type_iv_commands_in_the_global_and_the_hand_frame(arms, name, rng):
+    arm = arms[name]
+    q0, _ = start_and_goal(arm, rng)
+    T0 = arm.fk(q0)
+    commands = [
+        Command((0.0, 0.0, 1.0), 0.05, np.radians(-20.0), "global"),
+        Command((1.0, 0.0, 0.0), -0.03, np.radians(10.0), "hand"),
+    ]
+    k = 10
+    paths = operator(arm, q0, commands, k, solver=rrc_pin.Resolver(arm, dt=1.0),
+                     correction="newton")  # fmt: skip
+    first = pin.exp6(pin.Motion(np.r_[0, 0, 0.05, 0, 0, np.radians(-20)]))
+    about_hand = pin.SE3(np.eye(3), T0[:3, 3])
+    T1 = (about_hand * first * about_hand.inverse() * pin.SE3(T0)).homogeneous
+    np.testing.assert_allclose(paths[0].hand[-1], T1, atol=1e-9)
+    x = T1[:3, 0]
+    second = (
+        pin.SE3(np.eye(3), T1[:3, 3])
+        * pin.exp6(pin.Motion(np.r_[-0.03 * x, np.radians(10.0) * x]))
+        * pin.SE3(np.eye(3), -T1[:3, 3])
+    )
+    np.testing.assert_allclose(paths[1].hand[-1], (second * pin.SE3(T1)).homogeneous, atol=1e-9)
+    assert all(within_limits(arm, p.q) for p in paths)
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_type_i_reaches_the_goal_with_straight_hand_point(arms, name, rng):
+    arm = arms[name]
+    q0, goal = start_and_goal(arm, rng)
+    path = general(arm, q0, goal, 15, solver=rrc_pin.Resolver(arm, dt=1.0), correction="newton")
+    assert pose_error(goal, path.hand[-1]) < 1e-9
+    a, b = path.hand[0][:3, 3], goal[:3, 3]
+    for i, T in enumerate(path.hand):  # Example 4: the hand point on the line, k equal parts
+        np.testing.assert_allclose(T[:3, 3], a + i / 15 * (b - a), atol=1e-9)
+    assert within_limits(arm, path.q)
+
+
+def test_resolver_holds_the_joint_limits_where_the_goal_needs_more(arms):
+    arm = arms["panda"]
+    q0 = arm.neutral()
+    q0[3] = arm.upper[3] - 0.05
+    q_far = q0.copy()
+    q_far[3] = arm.upper[3] + 0.4  # past the limit
+    goal = arm.fk(q_far)
+    path = screw_motion(arm, q0, goal, 10, relocate=True, solver=rrc_pin.Resolver(arm, dt=1.0))
+    assert within_limits(arm, path.q)
+    assert np.any(path.scale < 1.0)
+    thesis = screw_motion(arm, q0, goal, 10, relocate=True)  # the thesis's solve knows no limits
+    assert not within_limits(arm, thesis.q)
+
+
+def test_type_i_examples_1_to_3_fixed_axes(arms, rng):
+    """Example 1: a turn about z through the hand point leaves the point in place (first order);
+    Example 3 adds a translation along x."""
+    arm = arms["barker6"]
+    q0, _ = start_and_goal(arm, rng)
+    T0 = arm.fk(q0)
+    k = 10
+    path = general_axes(arm, q0, ((0, 0, 1), 0.4), ((1, 0, 0), 0.0), k, correction="newton")
+    np.testing.assert_allclose(path.hand[-1][:3, 3], T0[:3, 3], atol=1e-9)
+    np.testing.assert_allclose(path.hand[-1][:3, :3], pin.exp3(np.r_[0, 0, 0.4]) @ T0[:3, :3],
+                               atol=1e-9)  # fmt: skip
+    path = general_axes(arm, q0, ((0, 0, 2), 0.4), ((3, 0, 0), 0.05), k)
+    step = np.hypot(0.4, 0.05) / k
+    assert np.linalg.norm(path.hand[-1][:3, 3] - T0[:3, 3] - [0.05, 0, 0]) <= C2 * k * step**2
+
+
+def test_second_order_correction_order_on_random_cases(arms, rng):
+    """Type II, the screw located once: the first-order end error halves when k doubles
+    (order 1/k); Newton's is at rounding level. Eq. (5-5) as printed, without the cross terms
+    between joints, stays of order 1/k on a 6R arm (docs/errata.md)."""
+    arm = arms["barker6"]
+    ratios = {"none": [], "eq5_5": []}
+    for _ in range(3):
+        q0, goal = start_and_goal(arm, rng)
+        for correction in ratios:
+            e10 = pose_error(goal, screw_motion(arm, q0, goal, 10, correction=correction).hand[-1])
+            e20 = pose_error(goal, screw_motion(arm, q0, goal, 20, correction=correction).hand[-1])
+            ratios[correction].append(e10 / e20)
+        newton = screw_motion(arm, q0, goal, 10, correction="newton")
+        assert pose_error(goal, newton.hand[-1]) < 1e-12
+    assert np.all(np.abs(np.array(ratios["none"]) - 2.0) < 0.2)
+    assert np.all(np.abs(np.array(ratios["eq5_5"]) - 2.0) < 0.2)  # not 4: first order
+
+
+def test_eq_5_5_is_second_order_for_one_revolute_joint():
+    """Configuration #2 (three prismatic joints, then the revolute joints): where only joint 4
+    turns there are no cross terms, and eq. (5-5) is second order: the end error falls 4x when
+    k doubles, against 2x without it."""
+    arm = CATALOGUE["nadkarni_c2"].chain
+    q0 = np.asarray(CATALOGUE["nadkarni_c2"].named_poses["table_a2_7"])
+    command = Command((0.0, 0.0, 1.0), 0.1, np.radians(-30.0))
+    T0 = arm.fk(q0)
+    screw = pin.SE3(np.eye(3), T0[:3, 3]) * pin.exp6(pin.Motion(np.r_[0, 0, 0.1, 0, 0, -np.pi / 6]))
+    target = (screw * pin.SE3(np.eye(3), -T0[:3, 3]) * pin.SE3(T0)).translation
+    errors = {}
+    for correction in ("none", "eq5_5"):
+        for k in (10, 20):
+            end = operator(arm, q0, [command], k, correction=correction)[0].hand[-1]
+            errors[correction, k] = np.linalg.norm(end[:3, 3] - target)
+    assert errors["none", 10] / errors["none", 20] == pytest.approx(2.0, abs=0.2)
+    assert errors["eq5_5", 10] < errors["none", 10] / 20
+    assert errors["eq5_5", 10] / errors["eq5_5", 20] == pytest.approx(4.0, abs=0.4)
+
+
+def test_velocity_analysis_eqs_5_1_to_5_4(arms, rng):
+    """Rates from the step's increments (5-3), (5-4) are J^-1 of the hand's twist at that speed."""
+    arm = arms["rrc_k1607"]
+    q0, goal = start_and_goal(arm, rng)
+    path = screw_motion(arm, q0, goal, 10)
+    xi = screw_twist(screw_from_poses(arm.fk(q0), goal)) / 10
+    dtheta = np.linalg.norm(xi[3:])
+    rates = joint_rates(path.q[1] - path.q[0], dtheta, 0.5)
+    expected = np.linalg.lstsq(arm.jacobian(q0, ref="world"), xi / dtheta * 0.5, rcond=None)[0]
+    np.testing.assert_allclose(rates, expected, atol=1e-12)
+    # a pure translation: delta r and |V_H| in place of delta theta and |W_H|
+    np.testing.assert_allclose(joint_rates([0.01, -0.02], 0.01, 0.2), [0.2, -0.4])
+    with pytest.raises(InvalidInput, match="^hand_step:"):
+        joint_rates([0.1], 0.0, 1.0)
+    with pytest.raises(InvalidInput, match="^increments:"):
+        joint_rates([np.nan], 0.1, 1.0)
+
+
+def test_screw_joints_with_the_thesis_solver():
+    """A chain with a screw joint (pitch 0.01 m/rad), not expressible in URDF: the thesis's
+    solve on the DH chain's Jacobian reaches the goal."""
+    rows = (
+        DHRow(a=0.0, alpha=np.pi / 2, d=0.3, theta=0.0, kind="screw", pitch=0.01),
+        DHRow(a=0.4, alpha=0.0, d=0.0, theta=0.0),
+        DHRow(a=0.3, alpha=np.pi / 2, d=0.0, theta=0.0),
+        DHRow(a=0.0, alpha=-np.pi / 2, d=0.2, theta=0.0),
+        DHRow(a=0.0, alpha=np.pi / 2, d=0.0, theta=0.0),
+        DHRow(a=0.0, alpha=0.0, d=0.1, theta=0.0, kind="prismatic"),
+    )
+    arm = DHChain("nadkarni", rows)
+    q0 = np.array([0.2, 0.4, -0.6, 0.3, 0.7, 0.05])
+    goal = arm.fk(q0 + np.array([0.1, -0.1, 0.1, 0.05, -0.1, 0.02]))
+    path = screw_motion(arm, q0, goal, 10, correction="newton")
+    assert pose_error(goal, path.hand[-1]) < 1e-10
+    assert path.escapes == ()
+
+
+def test_singularity_escape():
+    """At a singular start the thesis solver gives the joints its increments first."""
+    arm = rrc_pin.load("barker6")
+    q0 = np.array([0.3, -0.4, 0.5, 0.2, 0.0, 0.1])  # wrist singular (theta5 = 0)
+    goal = arm.fk(q0 + 0.1)
+    solver = ThesisSolver(singular_cond=1e4)
+    assert np.linalg.cond(arm.jacobian(q0, ref="world")) > 1e4
+    path = screw_motion(arm, q0, goal, 10, relocate=True, solver=solver, correction="newton")
+    assert path.escapes == (0,)
+    np.testing.assert_allclose(path.q[0], q0 + 0.05 * np.array([-1, 1, -1, 1, -1, 1]))
+    assert np.isfinite(path.q).all() and pose_error(goal, path.hand[-1]) < 1e-9
+
+
+def test_bad_input_names_the_argument(arms):
+    arm = arms["barker6"]
+    q0 = arm.neutral()
+    goal = arm.fk(q0)
+    for steps in (0, -1, 2.5, True):
+        with pytest.raises(InvalidInput, match="^steps:"):
+            screw_motion(arm, q0, goal, steps)
+    with pytest.raises(InvalidInput, match="^goal:"):
+        general(arm, q0, np.full((4, 4), np.nan), 5)
+    with pytest.raises(InvalidInput, match="^q0:"):
+        straight_line(arm, q0[:3], goal, 5)
+    with pytest.raises(InvalidInput, match="^q0:"):
+        screw_motion(arm, np.full(6, np.inf), goal, 5)
+    with pytest.raises(InvalidInput, match="^solver:"):
+        screw_motion(arm, q0, goal, 5, solver="lstsq")
+    with pytest.raises(InvalidInput, match="^correction:"):
+        screw_motion(arm, q0, goal, 5, correction="third")
+    with pytest.raises(InvalidInput, match="^spacing:"):
+        straight_line(arm, q0, goal, 5, spacing=0.0)
+    with pytest.raises(InvalidInput, match=r"^commands\[0\]\.frame:"):
+        operator(arm, q0, [Command((0, 0, 1), 0.1, 0.1, "tool")], 5)
+    with pytest.raises(InvalidInput, match=r"^commands\[1\]\.axis:"):
+        operator(arm, q0, [Command((0, 0, 1), 0.1, 0.1), Command((0, 0, 0), 0.1, 0.1)], 5)
+    with pytest.raises(InvalidInput, match=r"^commands\[0\]\.d:"):
+        operator(arm, q0, [Command((0, 0, 1), np.nan, 0.1)], 5)
+    with pytest.raises(InvalidInput, match="^rotation:"):
+        general_axes(arm, q0, ((0, 0, 0), 0.1), ((1, 0, 0), 0.1), 5)
+    with pytest.raises(InvalidInput, match="^escape:"):
+        ThesisSolver(escape=(0.0, 0.0))
+    with pytest.raises(InvalidInput, match="^singular_cond:"):
+        ThesisSolver(singular_cond=0.5)
