@@ -278,3 +278,34 @@ def test_bad_input_names_the_argument(arms):
         ThesisSolver(escape=(0.0, 0.0))
     with pytest.raises(InvalidInput, match="^singular_cond:"):
         ThesisSolver(singular_cond=0.5)
+
+
+def test_erratum_examples_1_and_3_sign_of_b(arms, rng):
+    """Example 1: B = [0 0 dtheta  -rho2 dtheta  rho1 dtheta  0] (rows [w; v]) as printed is
+    +dtheta u_w x rho_0: the hand point then moves 2 dtheta |rho_0| instead of staying. Eq.
+    (4-11a) gives B's lower half dr u_v - dtheta u_w x rho_0 = (rho2, -rho1, 0) dtheta."""
+    arm = arms["barker6"]
+    q0, _ = start_and_goal(arm, rng)
+    rho = arm.fk(q0)[:3, 3]
+    dtheta = 1e-6
+    J_hand = arm.jacobian(q0, ref="world_aligned")  # velocity of the hand point
+    J = arm.jacobian(q0, ref="world")
+    printed = np.r_[-rho[1] * dtheta, rho[0] * dtheta, 0.0, 0.0, 0.0, dtheta]  # [v; w]
+    corrected = np.r_[rho[1] * dtheta, -rho[0] * dtheta, 0.0, 0.0, 0.0, dtheta]
+    moved = J_hand[:3] @ np.linalg.solve(J, printed)
+    np.testing.assert_allclose(np.linalg.norm(moved), 2 * dtheta * np.hypot(rho[0], rho[1]))
+    still = J_hand[:3] @ np.linalg.solve(J, corrected)
+    assert np.linalg.norm(still) < 1e-15
+    # Example 3 adds dr along x to the v_x entry, with the same sign slip on the rho terms
+    dr = 2e-6
+    ex3 = np.r_[rho[1] * dtheta + dr, -rho[0] * dtheta, 0.0, 0.0, 0.0, dtheta]
+    np.testing.assert_allclose(J_hand[:3] @ np.linalg.solve(J, ex3), [dr, 0, 0], atol=1e-15)
+
+
+def test_erratum_illustration_4_goal_b2_in_the_text():
+    """The text gives b2 = [-20.65 -9.29 -5.85]; the data cards (Table A2-5) -8.29. With -9.29
+    the point is 1.71 units from a2 (the hand's points are 1 unit apart; 0.995 with -8.29), and
+    the thesis's computed hand prints -8.29."""
+    a2 = np.array([-20.30, -7.83, -6.66])
+    assert np.linalg.norm(np.array([-20.65, -9.29, -5.85]) - a2) == pytest.approx(1.71, abs=0.01)
+    assert np.linalg.norm(np.array([-20.65, -8.29, -5.85]) - a2) == pytest.approx(0.995, abs=0.001)

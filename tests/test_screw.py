@@ -263,3 +263,16 @@ def test_bad_input_names_the_argument():
         screw_of_displacement(np.ones((3, 3)), np.zeros(3))
     with pytest.raises(InvalidInput, match="^q:"):
         screw_of_displacement(np.eye(3), np.zeros(2))
+
+
+def test_eqs_3_18_and_3_45_read_as_dot_product_and_norm(rng):
+    """The OCR prints (3-18) 'u - X_HO1 = u - X_HO2' and (3-45) 'X_HO1 = X_HO2': they are
+    u . X_HO1 = u . X_HO2 (a line of the body keeps its angle with the axis) and
+    |X_HO1| = |X_HO2| (the rotation keeps lengths); X_HO1 = X_HO2 holds only on the axis."""
+    Q = random_rotations(rng, 1)[0]
+    u = screw_of_displacement(Q, np.zeros(3)).u
+    x1 = rng.normal(size=3)
+    x2 = Q @ x1  # eq. (3-14)
+    assert u @ x1 == pytest.approx(u @ x2, abs=1e-12)
+    assert np.linalg.norm(x1) == pytest.approx(np.linalg.norm(x2), abs=1e-12)
+    assert np.linalg.norm(x1 - x2) > 1e-3
