@@ -1,4 +1,4 @@
-"""Command line: ``rrc-pin arms | demo | check | bench | urdf --check|--write``."""
+"""Command line: ``rrc-pin arms | demo | check | bench | urdf --check|--write | guidance``."""
 
 from __future__ import annotations
 
@@ -88,6 +88,12 @@ def parser() -> argparse.ArgumentParser:
         help="interpreter with placo for the tasks benchmark (default: .venv-placo/bin/python "
         "of the checkout, if any; placo pins its own Pinocchio)",
     )
+    guidance = sub.add_parser(
+        "guidance", help="Nadkarni's Appendix II: the thesis's numbers beside the computed ones"
+    )
+    guidance.add_argument(
+        "--illustration", type=int, required=True, choices=(1, 2, 4, 5, 6, 7), metavar="N"
+    )
     urdf = sub.add_parser("urdf", help="compare or rewrite the committed URDFs")
     mode = urdf.add_mutually_exclusive_group(required=True)
     mode.add_argument("--check", action="store_true", help="fail if a committed file differs")
@@ -117,6 +123,11 @@ def run(args: argparse.Namespace) -> int:
             record=args.record,
             placo_python=args.placo_python,
         )
+    if args.command == "guidance":
+        from rrc_pin.guidance.illustrations import format_report
+
+        print(format_report(args.illustration))
+        return 0
     if args.command == "check":
         from rrc_pin.cross_check import run_cross_check
 

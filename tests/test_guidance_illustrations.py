@@ -191,3 +191,17 @@ def test_exact_pose_error_is_zero_with_newton():
     goal = frames_from_points(np.array([[10, -10, 20], [11, -10, 20], [10, -10, 19.0]]) * INCH)
     err = pin.log6(pin.SE3(goal) * pin.SE3(arm.fk(path.q[-1])).inverse()).vector
     assert np.abs(err).max() < 1e-12
+
+
+def test_cli_prints_the_thesis_beside_the_computed(capsys):
+    from rrc_pin.cli import main
+
+    assert main(["guidance", "--illustration", "7"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].startswith("Illustration 7")
+    step_10 = lines.index(next(line for line in lines if line.startswith("step 10 ")))
+    assert lines[step_10].split()[-6:] == ["-2.336", "25.073", "5.714", "25.714", "90.000", "0.000"]
+    computed = [float(x) for x in lines[step_10 + 1].split()[1:]]
+    np.testing.assert_allclose(computed, [-2.3357, 25.0726, 5.7143, 25.7143, 90.0, 0.0], atol=1e-4)
+    with pytest.raises(SystemExit):
+        main(["guidance", "--illustration", "3"])

@@ -266,3 +266,26 @@ def report(number: int) -> list[Row]:
     if number == 7:
         return illustration_7()[0]
     raise InvalidInput("illustration", f"expected 1, 2, 4, 5, 6 or 7, got {number!r}")
+
+
+TITLES = {
+    1: "Illustration 1 (Table A2-1): screw axes between three positions of a body",
+    2: "Illustration 2 (Table A2-2): configuration #1, the hand frame in the global frame",
+    4: "Illustration 4 (Table A2-6): Type II on configuration #1, k = 22, singularity escape",
+    5: "Illustration 5 (Table A2-9): Type III on configuration #2, k = 27 divisions",
+    6: "Illustration 6 (Table A2-11): Type IV on configuration #2, k = 9 and 4",
+    7: "Illustration 7 (Table A2-13): Type I on configuration #2, k = 35",
+}
+
+
+def format_report(number: int) -> str:
+    """Illustration ``number`` as text: each printed line, then the computed numbers under it.
+
+    Lengths in the thesis's units (inches), angles in degrees. Raises as :func:`report`.
+    """
+    rows = report(number)
+    lines = [TITLES[number], ""]
+    for row in rows:
+        lines.append(f"{row.label:<30} thesis   " + " ".join(f"{p:>10}" for p in row.printed))
+        lines.append(f"{'':<30} computed " + " ".join(f"{round(c, 4) + 0.0:10.4f}" for c in row.computed))
+    return "\n".join(lines)
