@@ -159,7 +159,7 @@ def end_error(paths, expected):
 
 
 def test_second_order_correction_on_illustration_6():
-    """Open-loop steps: first order ends 0.14 in off, eq. (5-5) 0.003 in (one revolute joint
+    """Open-loop steps: first order ends 0.20 in off, eq. (5-5) 0.004 in (one revolute joint
     turns, behind the prismatic ones: (5-5) is second order here), Newton 1e-12."""
     expected = [(15.0, -25.0, 16.0), (15.0, -25.0, 17.0)]
     errors = {c: end_error(illustration_6(c)[1], expected) for c in ("none", "eq5_5", "newton")}
