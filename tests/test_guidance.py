@@ -309,3 +309,12 @@ def test_erratum_illustration_4_goal_b2_in_the_text():
     a2 = np.array([-20.30, -7.83, -6.66])
     assert np.linalg.norm(np.array([-20.65, -9.29, -5.85]) - a2) == pytest.approx(1.71, abs=0.01)
     assert np.linalg.norm(np.array([-20.65, -8.29, -5.85]) - a2) == pytest.approx(0.995, abs=0.001)
+
+
+def test_exports_exist_and_are_sorted():
+    from rrc_pin import guidance
+
+    namespace: dict = {}
+    exec("from rrc_pin.guidance import *", namespace)
+    assert set(guidance.__all__) <= set(namespace)
+    assert guidance.__all__ == sorted(guidance.__all__)

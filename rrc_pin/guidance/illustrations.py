@@ -287,5 +287,6 @@ def format_report(number: int) -> str:
     lines = [TITLES[number], ""]
     for row in rows:
         lines.append(f"{row.label:<30} thesis   " + " ".join(f"{p:>10}" for p in row.printed))
-        lines.append(f"{'':<30} computed " + " ".join(f"{round(c, 4) + 0.0:10.4f}" for c in row.computed))
+        computed = (round(c, 4) + 0.0 for c in row.computed)  # no "-0.0000"
+        lines.append(f"{'':<30} computed " + " ".join(f"{c:10.4f}" for c in computed))
     return "\n".join(lines)
