@@ -13,8 +13,9 @@ increments ``D`` with ``J_world(q) D = B`` (eq. (4-11b)) by one of two solvers:
   resolver slows a step down rather than leave them; its report says so).
 
 The second-order correction the thesis suggests (chapter V, suggestion 2) refines the
-first-order increments by a few iterations, aiming at the exact pose of the step,
-``T_target = exp(B) T(q)``: ``correction="eq5_5"`` solves his eqs (4-9) and (5-5) by
+first-order increments by a few iterations, aiming at the exact pose of the step (its
+:class:`Step`'s target: ``exp(B) T`` along a screw, or the turned hand at the moved point for
+Type I): ``correction="eq5_5"`` solves his eqs (4-9) and (5-5) by
 fixed-point iterations (each joint's own second-order term, no cross terms between joints:
 second order only where one revolute joint turns, docs/errata.md); ``correction="newton"``
 iterates on the exact pose (every term, quadratic convergence).
@@ -32,7 +33,7 @@ import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.resolver import Resolver
-from solvers.validation import finite_number
+from solvers.validation import as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
 Correction = Literal["none", "eq5_5", "newton"]
@@ -356,7 +357,5 @@ def check_q0(arm: Kinematics, q0: npt.ArrayLike) -> Array:
     Raises:
         InvalidInput: Wrong shape or non-finite.
     """
-    q = np.array(q0, dtype=np.float64)
-    if q.shape != (arm.nq,) or not np.isfinite(q).all():
-        raise InvalidInput("q0", f"expected a finite vector of shape ({arm.nq},), got {q0!r}")
+    q: Array = as_vector(q0, "q0", arm.nq, InvalidInput).copy()
     return q
