@@ -48,8 +48,14 @@ def assert_rows(rows, slack: float = 0.0) -> None:
             assert_printed(c, p, slack)
 
 
-def test_illustration_2_hand_frame():
-    assert_rows(illustration_2())
+def test_illustration_2_every_printed_number():
+    """All 84 numbers to the printed digits but rho_n(3)'s x, printed 0.65 for 0.065."""
+    rows = illustration_2()
+    assert len(rows) == 28
+    wrong = [r for r in rows if r.label == "rho_n(3)"]
+    assert_rows([r for r in rows if r not in wrong])
+    assert abs(wrong[0].computed[0] - 0.65) > 0.5
+    assert_printed(wrong[0].computed[0], "0.065")
 
 
 def test_illustration_7_every_row_to_the_printed_digits():

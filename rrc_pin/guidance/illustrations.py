@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.dh import DHChain
+from rrc_pin.dh import DHChain, nadkarni_link, translation
 from rrc_pin.errors import InvalidInput
 from rrc_pin.guidance.general import general
 from rrc_pin.guidance.operator import Command, operator
@@ -156,15 +156,41 @@ def illustration_1() -> list[Row]:
     return rows
 
 
+ILLUSTRATION_2 = {  # as printed (rho_n(3) reads 0.65 for 0.065: docs/errata.md)
+    "X*": (("0.00", "0.00", "0.00"), ("0.00", "0.00", "0.00"), ("-11.95", "0.00", "2.488"),
+           ("-11.90", "0.241", "2.771"), ("-21.255", "0.241", "4.42"),
+           ("-21.255", "0.241", "4.42"), ("-24.315", "5.273", "4.059")),
+    "X": (("0.00", "0.00", "0.00"), ("0.065", "0.00", "0.369"), ("-11.90", "0.241", "2.771"),
+          ("-11.90", "0.241", "2.771"), ("-21.255", "0.241", "4.42"),
+          ("-24.315", "5.273", "4.059"), ("-24.833", "6.126", "3.998")),
+    "U": (("0.00", "0.00", "1.00"), ("0.00", "-1.00", "0.00"), ("-0.985", "0.00", "0.174"),
+          ("0.112", "-0.766", "0.633"), ("-0.985", "0.00", "0.174"),
+          ("0.171", "0.174", "0.970"), ("0.171", "0.174", "0.970")),
+    "rho_n": (("0.00", "0.00", "0.00"), ("0.00", "0.00", "0.00"), ("0.65", "0.00", "0.369"),
+              ("-11.927", "0.426", "2.618"), ("0.115", "0.241", "0.652"),
+              ("-21.374", "0.121", "3.747"), ("-24.433", "5.152", "3.386")),
+}  # fmt: skip
+
+
 def illustration_2() -> list[Row]:
-    """Mechanism data of configuration #1 (Table A2-2): the hand frame x*(7) and X(7)."""
-    T = chain("nadkarni_c1").fk(start("nadkarni_c1"))
-    a, _, c = hand_points(T)
-    return [
-        Row("X*(7)", ("-24.315", "5.273", "4.059"), a),
-        Row("U(7)", ("0.171", "0.174", "0.970"), tuple(float(x) for x in T[:3, 2])),
-        Row("X(7)", ("-24.833", "6.126", "3.998"), c),
-    ]
+    """Mechanism data of configuration #1 (Table A2-2) in the global frame.
+
+    For each joint i = 1..7 (7: the hand): the origins of x*(i) and x(i), the unit vector U(i)
+    along the joint axis and the foot rho_n(i) of the normal from the origin to it.
+    """
+    arm = chain("nadkarni_c1")
+    q0 = start("nadkarni_c1")
+    frames = arm.frames(q0)
+    star = [frames[i] @ nadkarni_link(row, q0[i])[0] for i, row in enumerate(arm.rows)]
+    star.append(arm.fk(q0))  # the hand frame is x*(7)
+    x_frames = [*frames[1:], star[-1] @ translation(x=INCH)]  # a_7 = 1.00
+    rows = []
+    for i in range(7):
+        p, u = star[i][:3, 3] / INCH, star[i][:3, 2]
+        computed = {"X*": p, "X": x_frames[i][:3, 3] / INCH, "U": u, "rho_n": p - (p @ u) * u}
+        for key, value in computed.items():
+            rows.append(Row(f"{key}({i + 1})", ILLUSTRATION_2[key][i], tuple(map(float, value))))
+    return rows
 
 
 ESCAPE_4 = np.array([-0.05, 0.05, 0.25, 0.25, -0.25, -0.25])
@@ -270,7 +296,7 @@ def report(number: int) -> list[Row]:
 
 TITLES = {
     1: "Illustration 1 (Table A2-1): screw axes between three positions of a body",
-    2: "Illustration 2 (Table A2-2): configuration #1, the hand frame in the global frame",
+    2: "Illustration 2 (Table A2-2): configuration #1 in the global frame",
     4: "Illustration 4 (Table A2-6): Type II on configuration #1, k = 22, singularity escape",
     5: "Illustration 5 (Table A2-9): Type III on configuration #2, k = 27 divisions",
     6: "Illustration 6 (Table A2-11): Type IV on configuration #2, k = 9 and 4",
