@@ -21,6 +21,7 @@ from rrc_pin.guidance import (
     screw_motion,
     screw_twist,
     straight_line,
+    straight_line_points,
 )
 from rrc_pin.models import CATALOGUE
 
@@ -80,7 +81,7 @@ def test_type_iii_keeps_the_hand_point_on_its_line(arms, name, rng):
     arm = arms[name]
     q0, goal = start_and_goal(arm, rng)
     k = 20
-    path = straight_line(arm, q0, goal, k, spacing=0.1, solver=rrc_pin.Resolver(arm, dt=1.0))
+    path = straight_line(arm, q0, goal, k, solver=rrc_pin.Resolver(arm, dt=1.0))
     a, b = path.hand[0][:3, 3], goal[:3, 3]
     line = (b - a) / np.linalg.norm(b - a)
     step = np.linalg.norm(screw_twist(screw_from_poses(path.hand[0], goal))) / k
@@ -264,8 +265,11 @@ def test_bad_input_names_the_argument(arms):
         screw_motion(arm, q0, goal, 5, solver="lstsq")
     with pytest.raises(InvalidInput, match="^correction:"):
         screw_motion(arm, q0, goal, 5, correction="third")
+    points = [[0, 0, 0], [0, 0, 1], [1, 0, 0]]
     with pytest.raises(InvalidInput, match="^spacing:"):
-        straight_line(arm, q0, goal, 5, spacing=0.0)
+        straight_line_points(arm, q0, points, 5, spacing=0.0)
+    with pytest.raises(InvalidInput, match="^goal_points:"):
+        straight_line_points(arm, q0, [[0, 0, 0], [0, 0, 1], [0, 0, 2]], 5, spacing=0.1)
     with pytest.raises(InvalidInput, match=r"^commands\[0\]\.frame:"):
         operator(arm, q0, [Command((0, 0, 1), 0.1, 0.1, "tool")], 5)
     with pytest.raises(InvalidInput, match=r"^commands\[1\]\.axis:"):

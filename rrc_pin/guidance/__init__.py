@@ -17,7 +17,7 @@ from rrc_pin.guidance.screw import (
 )
 from rrc_pin.guidance.screw_motion import screw_motion
 from rrc_pin.guidance.stepping import GuidancePath, Step, ThesisSolver, run_steps
-from rrc_pin.guidance.straight_line import straight_line
+from rrc_pin.guidance.straight_line import straight_line, straight_line_points
 from rrc_pin.guidance.velocity import joint_rates
 
 __all__ = [
@@ -39,4 +39,5 @@ __all__ = [
     "screw_of_displacement",
     "screw_twist",
     "straight_line",
+    "straight_line_points",
 ]

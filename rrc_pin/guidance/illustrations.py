@@ -14,8 +14,9 @@ Readings that reproduce the printed digits (docs/api.md, "Guidance"):
 - Illustration 4 (Type II, Table A2-6): the escape is (-0.05, 0.05, 0.25, 0.25, -0.25, -0.25)
   rad (read from the table); every printed step is one constant twist; the printed final
   theta1 is 0.05 rad above the configuration whose hand the thesis prints.
-- Illustration 5 (Type III, Table A2-9): the r3 column is k = 27 equal divisions; theta4 is not
-  reproduced (docs/errata.md).
+- Illustration 5 (Type III, Table A2-9): k = 27 divisions toward a goal triangle whose z point
+  is 5 units out (b_2 = (15, -10, 20), docs/errata.md): r3 and theta4 of steps 2-9 to the
+  printed digits; step 1 turns 10.000 deg where the division asks 10.886.
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ from rrc_pin.guidance.general import general
 from rrc_pin.guidance.operator import Command, operator
 from rrc_pin.guidance.screw import frames_from_points, screw_from_points
 from rrc_pin.guidance.stepping import Array, Correction, GuidancePath
-from rrc_pin.guidance.straight_line import straight_line
+from rrc_pin.guidance.straight_line import straight_line_points
 from rrc_pin.models import CATALOGUE, INCH
 
 ILLUSTRATION_1_POSITIONS = (
@@ -229,11 +230,19 @@ def printed_step_twists(arm: DHChain, table: tuple[tuple[str, ...], ...]) -> Arr
     )
 
 
+ILLUSTRATION_5_GOAL = ((10.00, -10.00, 20.00), (15.00, -10.00, 20.00), (10.00, -10.00, 19.00))
+"""The goal triangle the run of Illustration 5 used (docs/errata.md): b_2 5 units out on the
+hand's z axis. Table A2-8 prints (11.00, -10.00, 20.00), the text (15.00, -24.00, 12.00); the
+hand's final pose is the same, the sharing of the turn among the divisions is not."""
+
+
 def illustration_5(correction: Correction = "none") -> tuple[list[Row], GuidancePath]:
     """Type III on configuration #2 (Table A2-9), k = 27 divisions."""
     arm = chain("nadkarni_c2")
-    goal = frames_from_points(np.asarray(CONFIG_2_GOAL) * INCH)
-    path = straight_line(arm, start("nadkarni_c2"), goal, 27, spacing=INCH, correction=correction)
+    goal = np.asarray(ILLUSTRATION_5_GOAL) * INCH
+    path = straight_line_points(
+        arm, start("nadkarni_c2"), goal, 27, spacing=INCH, correction=correction
+    )
     rows = [
         Row(f"step {i + 1}", p, thesis_units(path.q[i + 1], 3)) for i, p in enumerate(TABLE_A2_9)
     ]
