@@ -228,3 +228,43 @@ def test_cli_prints_the_thesis_beside_the_computed(capsys):
     np.testing.assert_allclose(computed, [-2.3357, 25.0726, 5.7143, 25.7143, 90.0, 0.0], atol=1e-4)
     with pytest.raises(SystemExit):
         main(["guidance", "--illustration", "3"])
+
+
+def test_illustration_4_step_is_the_screw_from_the_escape_over_16():
+    """The printed constant step is the screw from the hand at the escape, theta1 taken 0.05 rad
+    below its printed value (as at the end), to the goal, divided by 16, not 22: every component
+    lies in the envelope the goal points' rounding (+-0.005) spans, and one choice of goal
+    points inside it gives the step to 1.7 rounding bounds of a printed step; with k = 15, 17,
+    22 or theta1 as printed, components fall outside the envelope. (The table's "22 steps"
+    would count 6 more than the screw's 16: docs/errata.md.)"""
+    from rrc_pin.guidance import screw_from_poses, screw_twist
+
+    arm = chain("nadkarni_c1")
+    twists = printed_step_twists(arm, TABLE_A2_6)
+    half = np.radians([[0.5 * 10.0 ** -len(v.split(".")[1]) for v in row] for row in TABLE_A2_6])
+    Q = np.radians([[float(v) for v in row] for row in TABLE_A2_6])
+    bound = np.max(
+        [np.abs(arm.jacobian(Q[i], ref="world")) @ (half[i] + half[i + 1]) for i in range(7)],
+        axis=0,
+    )
+    step = np.r_[twists[:2], twists[4:]].mean(axis=0)  # the five steps within the rounding
+    goal = np.asarray(ILLUSTRATION_4_GOAL)
+    jitter = np.random.default_rng(3).uniform(-0.005, 0.005, size=(3000, 3, 3))
+
+    def located(k, d_theta1, moved):
+        """The actual step (the printed frame turned by d_theta1 about z) and screws / k."""
+        turn = pin.exp3(np.r_[0.0, 0.0, d_theta1])
+        actual = np.r_[turn @ step[:3], turn @ step[3:]]
+        T = arm.fk(start("nadkarni_c1") + ESCAPE_4 + np.r_[d_theta1, 0, 0, 0, 0, 0])
+        T = np.broadcast_to(T, (*moved.shape[:-2], 4, 4))
+        return actual, screw_twist(screw_from_poses(T, frames_from_points(moved * INCH))) / k
+
+    for k, d_theta1 in [(16, -0.05), (22, -0.05), (15, -0.05), (17, -0.05), (16, 0.0)]:
+        actual, cloud = located(k, d_theta1, goal + jitter)
+        inside = (cloud.min(axis=0) <= actual) & (actual <= cloud.max(axis=0))
+        assert inside.all() == ((k, d_theta1) == (16, -0.05)), (k, d_theta1, inside)
+    witness = np.array(
+        [[0.0043521, 0.005, -0.005], [0.005, 0.0025686, 0.005], [0.0023453, 0.002554, 0.0023954]]
+    )  # found by bounded least squares (scipy.optimize.least_squares, 9 unknowns)
+    actual, twist = located(16, -0.05, goal + witness)
+    assert np.abs((twist - actual) / bound).max() < 1.7
