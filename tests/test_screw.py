@@ -187,6 +187,8 @@ def test_poses_and_points_give_the_same_screw(rng):
     np.testing.assert_allclose(flat(a), flat(b), atol=1e-12)
     D = displacement(a)
     np.testing.assert_allclose(D @ T[0], T[1], atol=1e-12)
+    c = screw_from_poses(pin.SE3(T[0]), pin.SE3(T[1]))  # pinocchio's SE3 too
+    np.testing.assert_allclose(flat(c), flat(a), atol=1e-14)
 
 
 def thesis_matrices(key):

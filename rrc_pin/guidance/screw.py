@@ -24,6 +24,7 @@ from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
+import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from solvers.validation import real_array
@@ -109,16 +110,16 @@ def screw_from_points(points_1: npt.ArrayLike, points_2: npt.ArrayLike) -> Screw
     return screw_from_poses(T1, T2)
 
 
-def screw_from_poses(T1: npt.ArrayLike, T2: npt.ArrayLike) -> Screw:
-    """Screw taking a body from pose ``T1`` to pose ``T2`` (both (..., 4, 4), base frame).
+def screw_from_poses(T1: npt.ArrayLike | pin.SE3, T2: npt.ArrayLike | pin.SE3) -> Screw:
+    """Screw taking a body from pose ``T1`` to pose ``T2`` (both (..., 4, 4) or ``pin.SE3``).
 
     The displacement is ``T2 T1^-1``: ``Q = Q2 Q1^T``, ``q = q2 - Q q1`` (Nadkarni eq. (3-13)).
 
     Raises:
         InvalidInput: Naming ``T1`` or ``T2``: bad shape, non-finite, not rigid transforms.
     """
-    A = _poses(T1, "T1")
-    B = _poses(T2, "T2")
+    A = _poses(T1.homogeneous if isinstance(T1, pin.SE3) else T1, "T1")
+    B = _poses(T2.homogeneous if isinstance(T2, pin.SE3) else T2, "T2")
     Q = B[..., :3, :3] @ np.swapaxes(A[..., :3, :3], -1, -2)
     q = B[..., :3, 3] - (Q @ A[..., :3, 3, None])[..., 0]
     return screw_of_displacement(Q, q)
