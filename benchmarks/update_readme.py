@@ -30,8 +30,14 @@ BENCHMARKS = {
     "closed_form": ("bench_closed_form.py", "Closed forms against Pinocchio + numpy"),
     "resolver": ("bench_resolver.py", "Resolver step time against pink, as users run it"),
     "tasks": ("bench_tasks.py", "Two grippers and a posture on baxter: rrc-pin, pink, PlaCo"),
+    "study": (
+        "bench_study.py",
+        "Sampling time and velocity conversions (Nguyen & Zhou section 5)",
+    ),
 }
 """Benchmark name: (script, title), in the order of the documents."""
+DOCS_ONLY = ("study",)
+"""Rendered in docs/benchmarks.md only, not in the README's performance section."""
 
 MODES_TEXT = """\
 A step's time is the whole call a user makes (a library, a backend, a set of options: a
@@ -89,6 +95,8 @@ def render_readme(results: Path) -> str:
     found = recorded(results)
     parts = []
     for name, (script, title) in BENCHMARKS.items():
+        if name in DOCS_ONLY:
+            continue
         if name not in found:
             parts.append(f"### {title}\n\nNot recorded yet: run `rrc-pin bench --record`.\n")
             continue
@@ -111,7 +119,7 @@ def render_docs(results: Path, docs: Path) -> str:
         f"`{_shown(results)}/*.json`; do not edit by hand. Rerun on your machine with "
         "`rrc-pin bench` (writes a new folder, never the recorded results) or "
         "`rrc-pin bench --record` (rewrites `benchmarks/results/`, this file and the "
-        "README's table); `--only closed_form|resolver|tasks`, `--quick` for a smoke run.",
+        "README's table); `--only " + "|".join(BENCHMARKS) + "`, `--quick` for a smoke run.",
         "",
         "## How a step is timed",
         "",

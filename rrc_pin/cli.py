@@ -183,9 +183,10 @@ def urdf_command(directory: Path, *, write: bool) -> int:
 CHECKOUT = urdf_export.COMMITTED_DIR.parent
 """The checkout whose ``benchmarks/`` ``rrc-pin bench`` runs."""
 
-BENCHMARKS = ("closed_form", "resolver", "tasks")
+BENCHMARKS = ("closed_form", "resolver", "tasks", "study")
 BENCH_MODULES = {
     "closed_form": ("matplotlib",),
+    "study": ("matplotlib",),
     "resolver": ("pink", "matplotlib"),
     "tasks": ("pink", "matplotlib"),
 }
