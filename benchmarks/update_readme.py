@@ -161,6 +161,8 @@ def _machine_table(found: dict[str, dict[str, Any]]) -> list[str]:
         ("numpy", "numpy"),
         ("pinocchio", "Pinocchio"),
         ("pink", "pink"),
+        ("mink", "mink"),
+        ("mujoco", "MuJoCo"),
         ("qpsolvers", "qpsolvers"),
         ("daqp", "daqp"),
         ("osqp", "osqp"),
