@@ -34,9 +34,10 @@ BENCHMARKS = {
         "bench_study.py",
         "Sampling time and velocity conversions (Nguyen & Zhou section 5)",
     ),
+    "scaling": ("bench_scaling.py", "Scaling: batch size and degrees of freedom"),
 }
 """Benchmark name: (script, title), in the order of the documents."""
-DOCS_ONLY = ("study",)
+DOCS_ONLY = ("study", "scaling")
 """Rendered in docs/benchmarks.md only, not in the README's performance section."""
 
 MODES_TEXT = """\
