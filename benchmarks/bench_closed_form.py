@@ -333,6 +333,7 @@ def main(argv: list[str] | None = None) -> int:
     start_load = os.getloadavg()[0]
     results: dict[str, Any] = {
         "benchmark": "closed_form",
+        "schema": 2,
         "machine": machine_info(),
         "source": source_state(),
         "sizes": sizes,
