@@ -138,3 +138,27 @@ def _scaling(results: dict[str, Any]) -> Iterator[str]:
         for key in (*STATS, "floor_median_us", "vs_floor_median"):
             if not _positive(row.get(key)):
                 yield f"dof.{row.get('arm')}.{key}: expected a positive number"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python benchmarks/schema.py DIR``: check every ``*.json`` of a results folder; exit
+    code 1 (and one line per problem) if one does not follow the schema."""
+    import argparse
+    import json
+    from pathlib import Path
+
+    parser = argparse.ArgumentParser(description=main.__doc__)
+    parser.add_argument("folder", type=Path)
+    args = parser.parse_args(argv)
+    files = sorted(args.folder.glob("*.json"))
+    bad = 0
+    for path in files:
+        for problem in problems(json.loads(path.read_text())):
+            print(f"{path.name}: {problem}")
+            bad += 1
+    print(f"{len(files)} result files, {bad} problems")
+    return 1 if bad or not files else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
