@@ -479,9 +479,47 @@ def docs_section(results: dict[str, Any]) -> str:
             if arm["modes"][mode].get("mink_fastest"):
                 baselines["mink"] = "mink"
             lines += mode_table(arm["modes"][mode], mode, baselines)
-        lines += _floor_table(arm) + _routes_table(arm)
+        lines += _summary(arm) + _floor_table(arm) + _routes_table(arm)
         lines += profile_table(arm["profile"], "the default")
     return "\n".join(lines)
+
+
+def _summary(arm: dict[str, Any]) -> list[str]:
+    """One sentence per mode: rrc-pin's default and tracking against pink's and mink's
+    fastest backends and the floor (ratios, median / p99), and where rrc-pin is behind."""
+    out = []
+    for mode in MODES:
+        m = arm["modes"][mode]
+        rows = m["contenders"]
+        parts, behind = [], []
+        for label in (DEFAULT, TRACKING):
+            r = rows.get(label)
+            if r is None:
+                continue
+            cells = []
+            for key, who in (("baseline", m.get("pink_fastest")), ("mink", m.get("mink_fastest"))):
+                if who and f"vs_{key}_median" in r:
+                    med, p99 = r[f"vs_{key}_median"], r[f"vs_{key}_p99"]
+                    cells.append(f"{med:.2f}x / {p99:.2f}x {who}'s time")
+                    short = "default" if label == DEFAULT else "tracking"
+                    stats = [n for n, v in (("median", med), ("p99", p99)) if v < 1]
+                    behind += [f"{short} {' and '.join(stats)} vs {who}"] if stats else []
+            if "vs_floor_median" in r:
+                cells.append(f"the floor is {1 / r['vs_floor_median']:.1f}x faster (median)")
+            parts.append(f"{label}: " + ", ".join(cells))
+        if not parts:
+            continue
+        tail = "behind: " + "; ".join(behind) if behind else "ahead of every peer's fastest"
+        out.append(f"- {MODE_TITLES[mode]}: " + "; ".join(parts) + f" ({tail}).")
+    if not out:
+        return []
+    return [
+        "Summary (ratios: the peer's time over rrc-pin's, median / p99; above 1 rrc-pin is "
+        "faster):",
+        "",
+        *out,
+        "",
+    ]
 
 
 def _floor_table(arm: dict[str, Any]) -> list[str]:
