@@ -348,9 +348,15 @@ def main(argv: list[str] | None = None) -> int:
     if steps < 2:
         parser.error("--steps: at least 2")
     if args.record and (
-        args.quick or steps != STEPS or args.arms != list(ARMS) or not pink_backends()
+        args.quick
+        or steps != STEPS
+        or args.arms != list(ARMS)
+        or not pink_backends()
+        or not mink_peer.available()
     ):
-        parser.error(f"--record keeps full runs only ({STEPS} steps, every arm, pink installed)")
+        parser.error(
+            f"--record keeps full runs only ({STEPS} steps, every arm, pink and mink installed)"
+        )
     warnings.simplefilter("ignore")
     start = load_average()
     results: dict[str, Any] = {
