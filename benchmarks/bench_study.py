@@ -120,7 +120,7 @@ def docs_section(results: dict[str, Any]) -> str:
     deg = 180.0 / math.pi
 
     def vec(x: list[float], scale: float = 1.0) -> str:
-        return "(" + ", ".join(f"{v * scale:g}" for v in x) + ")"
+        return "(" + ", ".join(f"{v * scale:.4g}" for v in x) + ")"
 
     return "\n".join(
         [
