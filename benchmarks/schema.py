@@ -20,6 +20,8 @@ from typing import Any
 KNOWN = ("closed_form", "resolver", "tasks", "study", "scaling")
 MACHINE = ("cpu", "cores", "python", "numpy", "pinocchio")
 STATS = ("median_us", "p10_us", "p90_us", "p99_us")
+MINK_TOL = 1e-9
+"""Largest MuJoCo-Pinocchio difference accepted beside mink's rows (mink_peer.KINEMATICS_TOL)."""
 
 
 def problems(results: dict[str, Any]) -> list[str]:
@@ -90,6 +92,10 @@ def _resolver(results: dict[str, Any]) -> Iterator[str]:
             yield f"arms.{arm.get('arm')}.modes: empty"
         for mode, m in modes.items():
             yield from _rows(f"arms.{arm.get('arm')}.modes.{mode}", m)
+        minks = any(k.startswith("mink ") for m in modes.values() for k in m.get("contenders", {}))
+        gap = arm.get("mink_kinematics_gap")
+        if minks and not (gap and max(gap.values()) <= MINK_TOL):
+            yield f"arms.{arm.get('arm')}.mink_kinematics_gap: missing or above {MINK_TOL}"
 
 
 def _tasks(results: dict[str, Any]) -> Iterator[str]:

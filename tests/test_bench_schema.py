@@ -49,6 +49,12 @@ def test_schema_names_what_is_missing():
     del row["p99_us"]
     found = schema.problems(broken)
     assert any("p99_us" in p for p in found) and any("no ratio" in p for p in found), found
+    with_mink = copy.deepcopy(resolver)
+    rows = with_mink["arms"][0]["modes"]["tight"]["contenders"]
+    rows["mink daqp"] = copy.deepcopy(next(iter(rows.values())))
+    assert any("mink_kinematics_gap" in p for p in schema.problems(with_mink))
+    with_mink["arms"][0]["mink_kinematics_gap"] = {"position": 1e-15, "jacobian": 2e-15}
+    assert schema.problems(with_mink) == []
     cf = json.loads((ROOT / "benchmarks" / "results" / "closed_form.json").read_text())
     cf = {**cf, "schema": 2}
     cf["arms"][0]["scalar"].pop("closed_form_p99_us", None)
