@@ -53,6 +53,17 @@ def per_call_us(fn: Callable[[], object], number: int, repeat: int) -> list[floa
     return [t / number * 1e6 for t in timeit.repeat(fn, number=number, repeat=repeat)]
 
 
+def spread(prefix: str, samples_us: list[float]) -> dict[str, float]:
+    """``<prefix>_p10_us``, ``_p90_us``, ``_p99_us`` of timing samples [us] (each sample of
+    the scalar timings is the mean of ``number`` calls; of the batch, one whole run)."""
+    p10, p90, p99 = np.percentile(samples_us, [10, 90, 99])
+    return {
+        f"{prefix}_p10_us": float(p10),
+        f"{prefix}_p90_us": float(p90),
+        f"{prefix}_p99_us": float(p99),
+    }
+
+
 def reference_solver(name: str, task_dim: int, nq: int) -> tuple[str, Callable[..., Any]]:
     """The numpy solve that the Pinocchio Jacobian is paired with, and its label."""
     if task_dim == nq:
@@ -113,6 +124,8 @@ def bench_arm(
     }
     if pinv_us:
         scalar["pinocchio_pinv_us"] = statistics.median(pinv_us)
+    scalar.update(spread("closed_form", cf_us))
+    scalar.update(spread("pinocchio", pin_us))
 
     # Batch: N configurations at once against a Python loop over a subset, scaled.
     Q = np.array([arm.random_q(rng) for _ in range(n_batch)])
@@ -152,6 +165,8 @@ def bench_arm(
         "max_relative_difference": batch_worst,
         "max_relative_difference_exact": exact_worst,
         "in_band": int(np.sum(~exact_rows(cf, Q))),
+        **spread("closed_form_run", [t * 1e6 for t in batch_runs]),
+        **spread("loop_run", [t * 1e6 for t in loop_runs]),
     }
     return {
         "arm": name,
@@ -318,6 +333,7 @@ def main(argv: list[str] | None = None) -> int:
     start_load = os.getloadavg()[0]
     results: dict[str, Any] = {
         "benchmark": "closed_form",
+        "schema": 2,
         "machine": machine_info(),
         "source": source_state(),
         "sizes": sizes,

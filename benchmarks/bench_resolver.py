@@ -19,7 +19,14 @@ the whole call, as its users make it:
 - pink (``pink.solve_ik``): ``configuration.update(q)``, the FrameTask target set to the
   pose moved by ``twist * dt``, ``solve_ik(..., limits=[ConfigurationLimit(gain=1),
   VelocityLimit])`` with every qpsolvers backend pink accepts. pink raises when its QP has
-  no solution (a failure, rates taken as zero).
+  no solution (a failure, rates taken as zero);
+- mink (``mink.solve_ik``, :mod:`mink_peer`): the arm's URDF loaded into MuJoCo (meshes
+  stripped; its tool pose and Jacobian checked against Pinocchio's first, the benchmark
+  stops if they differ), the same target pose as pink's, ``ConfigurationLimit`` and
+  ``VelocityLimit``, every qpsolvers backend; absent when mink is not installed;
+- Pinocchio + numpy, the unconstrained step and physical floor (no limits):
+  ``computeFrameJacobian`` then ``numpy.linalg.solve`` on ``J J^T``, ``lstsq``, or damped
+  least squares.
 
 Each contender is timed in the three modes of :mod:`timing` (tight loop, 1 kHz loop with
 ``time.sleep`` to the next tick, interleaved with its peers in an order shuffled at each
@@ -51,6 +58,7 @@ from collections import Counter  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
+import mink_peer  # noqa: E402
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
@@ -71,6 +79,7 @@ from timing import (  # noqa: E402
 )
 
 import rrc_pin  # noqa: E402
+from rrc_pin.robot import frame_id  # noqa: E402
 from solvers.qp_backends import installed_backends  # noqa: E402
 
 ARMS = ("rrc_k1607", "panda")
@@ -82,6 +91,10 @@ STEPS, QUICK_STEPS = 2000, 100
 DEFAULT = "rrc-pin default (daqp, direction)"
 TRACKING = "rrc-pin tracking (daqp)"
 BACKEND_MODULES = ("daqp", "osqp", "proxsuite", "quadprog", "clarabel")
+FLOOR_DAMPING = 0.01
+"""Damping ``lambda`` of the Pinocchio + numpy DLS row (``J^T (J J^T + lambda^2 I)^-1 x``)."""
+FLOOR = "Pinocchio + numpy solve (J J^T)"
+"""The physical floor: one Pinocchio Jacobian and one small dense solve, no limits."""
 """Modules of the QP backends, for the versions recorded."""
 
 Array = np.ndarray
@@ -168,6 +181,65 @@ def pink_contenders(arm: Any) -> list[Contender]:
     return out
 
 
+def floor_contenders(arm: Any) -> list[Contender]:
+    """Pinocchio + numpy, the unconstrained step (no limits): ``computeFrameJacobian``
+    (LOCAL_WORLD_ALIGNED) then the minimum-norm rates by ``numpy.linalg.solve`` on
+    ``J J^T`` (6 x 6), by ``numpy.linalg.lstsq``, or damped least squares."""
+    model = arm.model
+    fid = frame_id(model, arm.tool_frame)
+    lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    eye = np.eye(6) * FLOOR_DAMPING**2
+    d1, d2, d3 = (model.createData() for _ in range(3))  # one workspace per contender
+
+    def jacobian(q: Array, data: Any) -> Array:
+        return pin.computeFrameJacobian(model, data, q, fid, lwa)
+
+    def solve(q: Array, x: Array, data: Any = d1) -> Array:
+        J = jacobian(q, data)
+        return J.T @ np.linalg.solve(J @ J.T, x)
+
+    def lstsq(q: Array, x: Array, data: Any = d2) -> Array:
+        return np.linalg.lstsq(jacobian(q, data), x, rcond=None)[0]
+
+    def dls(q: Array, x: Array, data: Any = d3) -> Array:
+        J = jacobian(q, data)
+        return J.T @ np.linalg.solve(J @ J.T + eye, x)
+
+    return [
+        Contender(FLOOR, solve),
+        Contender("Pinocchio + numpy lstsq", lstsq),
+        Contender(f"Pinocchio + numpy DLS (lambda {FLOOR_DAMPING:g})", dls),
+    ]
+
+
+def tracking_errors(arm: Any, Q: Array, X: Array, rates: Array) -> dict[str, float]:
+    """Relative twist error ``|J(q_k) qdot_k - x_k| / |x_k|`` (rows [v; w], m/s and rad/s
+    summed as one vector) along the trajectory: median, p99 and largest."""
+    J = np.array([arm.jacobian(q) for q in Q])
+    err = np.linalg.norm(np.einsum("kij,kj->ki", J, rates) - X, axis=1)
+    rel = err / np.maximum(np.linalg.norm(X, axis=1), 1e-12)
+    p50, p99 = np.percentile(rel, [50, 99])
+    return {
+        "tracking_median": float(p50),
+        "tracking_p99": float(p99),
+        "tracking_max": float(rel.max()),
+    }
+
+
+def add_peer_ratios(rows: dict[str, dict[str, Any]], prefix: str, key: str) -> str | None:
+    """Ratios to the fastest row (by median) whose label starts with ``prefix``, stored as
+    ``vs_<key>_median`` and ``vs_<key>_p99`` (the peer's time over the row's); its label."""
+    peers = [k for k in rows if k.startswith(prefix)]
+    if not peers:
+        return None
+    fastest = min(peers, key=lambda k: rows[k]["median_us"])
+    base = rows[fastest]
+    for row in rows.values():
+        row[f"vs_{key}_median"] = base["median_us"] / row["median_us"]
+        row[f"vs_{key}_p99"] = base["p99_us"] / row["p99_us"]
+    return fastest
+
+
 def rrc_statistics(resolutions: list[Any]) -> dict[str, Any]:
     """How a contender's steps were answered: status, method and backend counts, active bounds,
     the resolver's own build time (median over every step [us]) and backend solve time
@@ -198,17 +270,34 @@ def bench_arm(name: str, steps: int) -> dict[str, Any]:
     shuffle = np.random.default_rng(SEED + 1)
     modes: dict[str, Any] = {}
     rrc: dict[str, Any] = {}
+    with_mink = mink_peer.available()
+    gap = mink_peer.kinematics_gap(arm) if with_mink else None
+    if gap is not None and max(gap.values()) > mink_peer.KINEMATICS_TOL:
+        # mink would solve another arm's problem: the comparison would be void.
+        raise SystemExit(f"{name}: MuJoCo's kinematics differ from Pinocchio's: {gap}")
     for mode in MODES:
         contenders = rrc_contenders(arm) + pink_contenders(arm)
+        if with_mink:
+            contenders += mink_peer.mink_contenders(arm, DT)
+        contenders += floor_contenders(arm)
         progress(f"{name}: {MODE_TITLES[mode]}, {len(contenders)} contenders")
         with quiet_stdout():  # OSQP's C code prints "Polishing not needed"
             runs = run_mode(mode, contenders, Q, X, shuffle, PERIOD)
         rows = summarise(runs, Q, limits, DT)
+        for label, run in runs.items():
+            rows[label].update(tracking_errors(arm, Q, X, run.rates))
         pinks = [k for k in rows if k.startswith("pink ")]
         fastest = min(pinks, key=lambda k: rows[k]["median_us"]) if pinks else None
         if fastest is not None:
             add_ratios(rows, fastest)
-        modes[mode] = {"pink_fastest": fastest, "contenders": rows}
+        mink_fastest = add_peer_ratios(rows, "mink ", "mink")
+        add_peer_ratios(rows, FLOOR, "floor")
+        modes[mode] = {
+            "pink_fastest": fastest,
+            "mink_fastest": mink_fastest,
+            "floor": FLOOR,
+            "contenders": rows,
+        }
         rrc[mode] = {c.label: rrc_statistics(runs[c.label].kept) for c in contenders if c.keep}
     progress(f"{name}: profile of the default")
     profile = profile_default(arm, Q, X)
@@ -222,6 +311,7 @@ def bench_arm(name: str, steps: int) -> dict[str, Any]:
             "recorded_by": "rrc_pin.Resolver(arm, dt, direction_preserving=False) (DAQP)",
             "active_fraction": recorded.get("active_fraction"),
         },
+        "mink_kinematics_gap": gap,
         "modes": modes,
         "rrc_pin": rrc,
         "profile": profile,
@@ -258,14 +348,20 @@ def main(argv: list[str] | None = None) -> int:
     if steps < 2:
         parser.error("--steps: at least 2")
     if args.record and (
-        args.quick or steps != STEPS or args.arms != list(ARMS) or not pink_backends()
+        args.quick
+        or steps != STEPS
+        or args.arms != list(ARMS)
+        or not pink_backends()
+        or not mink_peer.available()
     ):
-        parser.error(f"--record keeps full runs only ({STEPS} steps, every arm, pink installed)")
+        parser.error(
+            f"--record keeps full runs only ({STEPS} steps, every arm, pink and mink installed)"
+        )
     warnings.simplefilter("ignore")
     start = load_average()
     results: dict[str, Any] = {
         "benchmark": "resolver",
-        "machine": machine_info("qpsolvers", "pink", *BACKEND_MODULES),
+        "machine": machine_info("qpsolvers", "pink", "mink", "mujoco", *BACKEND_MODULES),
         "source": source_state(),
         "settings": {
             "dt": DT,
@@ -385,9 +481,84 @@ def docs_section(results: dict[str, Any]) -> str:
             "",
         ]
         for mode in MODES:
-            lines += mode_table(arm["modes"][mode], mode, {"pink": "baseline"})
-        lines += _routes_table(arm) + profile_table(arm["profile"], "the default")
+            baselines = {"pink": "baseline"}
+            if arm["modes"][mode].get("mink_fastest"):
+                baselines["mink"] = "mink"
+            lines += mode_table(arm["modes"][mode], mode, baselines)
+        lines += _summary(arm) + _floor_table(arm) + _routes_table(arm)
+        lines += profile_table(arm["profile"], "the default")
     return "\n".join(lines)
+
+
+def _summary(arm: dict[str, Any]) -> list[str]:
+    """One sentence per mode: rrc-pin's default and tracking against pink's and mink's
+    fastest backends and the floor (ratios, median / p99), and where rrc-pin is behind."""
+    out = []
+    for mode in MODES:
+        m = arm["modes"][mode]
+        rows = m["contenders"]
+        parts, behind = [], []
+        for label in (DEFAULT, TRACKING):
+            r = rows.get(label)
+            if r is None:
+                continue
+            cells = []
+            for key, who in (("baseline", m.get("pink_fastest")), ("mink", m.get("mink_fastest"))):
+                if who and f"vs_{key}_median" in r:
+                    med, p99 = r[f"vs_{key}_median"], r[f"vs_{key}_p99"]
+                    cells.append(f"{med:.2f}x / {p99:.2f}x {who}'s time")
+                    short = "default" if label == DEFAULT else "tracking"
+                    stats = [n for n, v in (("median", med), ("p99", p99)) if v < 1]
+                    behind += [f"{short} {' and '.join(stats)} vs {who}"] if stats else []
+            if "vs_floor_median" in r:
+                cells.append(f"the floor is {1 / r['vs_floor_median']:.1f}x faster (median)")
+            parts.append(f"{label}: " + ", ".join(cells))
+        if not parts:
+            continue
+        tail = "behind: " + "; ".join(behind) if behind else "ahead of every peer's fastest"
+        out.append(f"- {MODE_TITLES[mode]}: " + "; ".join(parts) + f" ({tail}).")
+    if not out:
+        return []
+    return [
+        "Summary (ratios: the peer's time over rrc-pin's, median / p99; above 1 rrc-pin is "
+        "faster):",
+        "",
+        *out,
+        "",
+    ]
+
+
+def _floor_table(arm: dict[str, Any]) -> list[str]:
+    """Tight loop: each contender's gap to the physical floor and its tracking error."""
+    m = arm["modes"]["tight"]
+    rows = m["contenders"]
+    if m.get("floor") not in rows:
+        return []
+    gap = arm.get("mink_kinematics_gap")
+    lines = [
+        f"Tight loop against the physical floor ({m['floor']}: one Pinocchio Jacobian and one "
+        "6 x 6 solve, no limits): the floor's median over the contender's (below 1: slower "
+        "than the floor), and the tracking error |J qdot - x| / |x| (rows [v; w] as one "
+        "vector; the limits and the direction-preserving scale make it nonzero by design).",
+        "",
+        "| contender | median [us] | floor / contender (median) | floor / contender (p99) | "
+        "tracking error, median | p99 | max |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for label, r in sorted(rows.items(), key=lambda kv: kv[1]["median_us"]):
+        lines.append(
+            f"| {label} | {us(r['median_us'])} | {r.get('vs_floor_median', float('nan')):.2f}x | "
+            f"{r.get('vs_floor_p99', float('nan')):.2f}x | {r.get('tracking_median', 0):.2g} | "
+            f"{r.get('tracking_p99', 0):.2g} | {r.get('tracking_max', 0):.2g} |"
+        )
+    if gap:
+        lines += [
+            "",
+            "mink runs on the arm's URDF loaded into MuJoCo (meshes stripped); its kinematics "
+            f"against Pinocchio's at 50 random configurations: tool position {gap['position']:.1g} "
+            f"m, rotation {gap['rotation']:.1g} rad, Jacobian entries {gap['jacobian']:.1g}.",
+        ]
+    return [*lines, ""]
 
 
 def _routes_table(arm: dict[str, Any]) -> list[str]:

@@ -355,7 +355,9 @@ def mode_table(m: dict[str, Any], mode: str, baselines: dict[str, str]) -> list[
     then the overrun ticks and the first failures."""
     vs = "".join(f" median vs {b} | p99 vs {b} |" for b in baselines)
     lines = [
-        f"**{MODE_TITLES[mode]}** (pink's fastest: {m['pink_fastest'] or '-'})",
+        f"**{MODE_TITLES[mode]}** (pink's fastest: {m['pink_fastest'] or '-'}"
+        + (f"; mink's fastest: {m['mink_fastest']}" if m.get("mink_fastest") else "")
+        + ")",
         "",
         f"| contender | median [us] | p10 | p90 | p99 | mean |{vs} max velocity excess [rad/s] "
         "| max position excess [rad] | failures |",

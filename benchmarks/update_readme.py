@@ -30,8 +30,15 @@ BENCHMARKS = {
     "closed_form": ("bench_closed_form.py", "Closed forms against Pinocchio + numpy"),
     "resolver": ("bench_resolver.py", "Resolver step time against pink, as users run it"),
     "tasks": ("bench_tasks.py", "Two grippers and a posture on baxter: rrc-pin, pink, PlaCo"),
+    "study": (
+        "bench_study.py",
+        "Sampling time and velocity conversions (Nguyen & Zhou section 5)",
+    ),
+    "scaling": ("bench_scaling.py", "Scaling: batch size and degrees of freedom"),
 }
 """Benchmark name: (script, title), in the order of the documents."""
+DOCS_ONLY = ("study", "scaling")
+"""Rendered in docs/benchmarks.md only, not in the README's performance section."""
 
 MODES_TEXT = """\
 A step's time is the whole call a user makes (a library, a backend, a set of options: a
@@ -89,6 +96,8 @@ def render_readme(results: Path) -> str:
     found = recorded(results)
     parts = []
     for name, (script, title) in BENCHMARKS.items():
+        if name in DOCS_ONLY:
+            continue
         if name not in found:
             parts.append(f"### {title}\n\nNot recorded yet: run `rrc-pin bench --record`.\n")
             continue
@@ -111,7 +120,7 @@ def render_docs(results: Path, docs: Path) -> str:
         f"`{_shown(results)}/*.json`; do not edit by hand. Rerun on your machine with "
         "`rrc-pin bench` (writes a new folder, never the recorded results) or "
         "`rrc-pin bench --record` (rewrites `benchmarks/results/`, this file and the "
-        "README's table); `--only closed_form|resolver|tasks`, `--quick` for a smoke run.",
+        "README's table); `--only " + "|".join(BENCHMARKS) + "`, `--quick` for a smoke run.",
         "",
         "## How a step is timed",
         "",
@@ -120,6 +129,7 @@ def render_docs(results: Path, docs: Path) -> str:
     ]
     if found:
         lines += ["## Machine, versions, load", "", *_machine_table(found), ""]
+        lines += ["## Closing note", "", *closing_note(found), ""]
     for name, (script, title) in BENCHMARKS.items():
         lines += [f"## {title}", ""]
         if name not in found:
@@ -138,6 +148,70 @@ def render_docs(results: Path, docs: Path) -> str:
     return "\n".join(lines).rstrip() + "\n"
 
 
+def closing_note(found: dict[str, dict[str, Any]]) -> list[str]:
+    """The recorded ratios in a few lines: closed forms against Pinocchio + numpy, batch
+    against loop, the resolver against pink's and mink's fastest, the study's conclusion,
+    the largest gap to the physical floor (each from its own JSON; "not recorded" if absent)."""
+    out = []
+    cf = found.get("closed_form")
+    if cf:
+        out.append(
+            "- Closed forms against Pinocchio + numpy (one call, median): "
+            + ", ".join(f"{a['arm']} {a['scalar']['speedup']:.2f}x" for a in cf["arms"])
+            + "; batch against a Python loop (N = "
+            + f"{cf['sizes']['n_batch']:,}): "
+            + ", ".join(f"{a['arm']} {a['batch']['speedup']:.0f}x" for a in cf["arms"])
+            + "."
+        )
+    res = found.get("resolver")
+    if res:
+        for arm in res["arms"]:
+            m = arm["modes"]["tight"]
+            rows = m["contenders"]
+            cells = []
+            for label in ("rrc-pin default (daqp, direction)", "rrc-pin tracking (daqp)"):
+                r = rows.get(label, {})
+                for key, who in (
+                    ("baseline", m.get("pink_fastest")),
+                    ("mink", m.get("mink_fastest")),
+                ):
+                    if who and f"vs_{key}_median" in r:
+                        cells.append(
+                            f"{label.split(' (')[0]} vs {who} {r[f'vs_{key}_median']:.2f}x / "
+                            f"{r[f'vs_{key}_p99']:.2f}x"
+                        )
+            if not m.get("mink_fastest"):
+                cells.append("mink not in this recording")
+            out.append(
+                f"- Resolver, {arm['arm']}, tight loop (peer's time over rrc-pin's, median / "
+                "p99): " + "; ".join(cells) + "."
+            )
+    study = found.get("study")
+    if study:
+        match = next((r for r in study["by_speed"] if r.get("report_match")), None)
+        if match:
+            out.append(
+                "- Sampling-time study (Nguyen & Zhou section 5): the errors are first order in "
+                "the sampling time (a half-sample lag); the report's 0.5 in/s at 10 ms is a path "
+                f"with a peak tool acceleration of {match['accel']:.1f} m/s^2, and 10 ms is the "
+                "longest period only for such paths: dt <= 2 e_max / a_max."
+            )
+    scaling = found.get("scaling")
+    if scaling:
+        worst = max(scaling["dof"], key=lambda r: r["median_us"] / r["floor_median_us"])
+        out.append(
+            "- Largest gap to the physical floor (one Pinocchio Jacobian and one small dense "
+            f"solve, same run): {worst['arm']} ({worst['nq']} joints), the resolver's "
+            f"{worst['median_us']:.0f} us against {worst['floor_median_us']:.0f} us "
+            f"({worst['median_us'] / worst['floor_median_us']:.1f}x); every arm: "
+            + ", ".join(
+                f"{r['arm']} {r['median_us'] / r['floor_median_us']:.1f}x" for r in scaling["dof"]
+            )
+            + "."
+        )
+    return out or ["Nothing recorded yet."]
+
+
 def _shown(path: Path) -> str:
     try:
         return path.resolve().relative_to(ROOT).as_posix()
@@ -153,6 +227,8 @@ def _machine_table(found: dict[str, dict[str, Any]]) -> list[str]:
         ("numpy", "numpy"),
         ("pinocchio", "Pinocchio"),
         ("pink", "pink"),
+        ("mink", "mink"),
+        ("mujoco", "MuJoCo"),
         ("qpsolvers", "qpsolvers"),
         ("daqp", "daqp"),
         ("osqp", "osqp"),

@@ -1,0 +1,170 @@
+"""The shape every benchmark's JSON must have (tests/test_bench_schema.py checks it).
+
+:func:`problems` lists what is missing or malformed in one result file, as sentences naming
+the key; an empty list means the file follows the schema. Common to every file: the
+benchmark's name, the machine (CPU, cores, Python, numpy, Pinocchio), the code measured (a
+hash of the sources). Timing benchmarks: per case the median, p10, p90 and p99 [us] and at
+least one ratio to a baseline measured in the same run (``vs_<baseline>_median`` and
+``_p99``); the closed forms: both timings with their spread and the speed-ups; the study:
+an error and a fitted order per quantity. ``schema`` 2 (written by the closed-form benchmark
+since it records the spread of its timings) also requires the closed forms' p10, p90, p99;
+files without the key are version 1.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+KNOWN = ("closed_form", "resolver", "tasks", "study", "scaling")
+MACHINE = ("cpu", "cores", "python", "numpy", "pinocchio")
+STATS = ("median_us", "p10_us", "p90_us", "p99_us")
+MINK_TOL = 1e-9
+"""Largest MuJoCo-Pinocchio difference accepted beside mink's rows (mink_peer.KINEMATICS_TOL)."""
+
+
+def problems(results: dict[str, Any]) -> list[str]:
+    """What does not follow the schema in one benchmark's JSON (empty: all follows)."""
+    out = []
+    name = results.get("benchmark")
+    if name not in KNOWN:
+        return [f"benchmark: expected one of {KNOWN}, got {name!r}"]
+    machine = results.get("machine", {})
+    out += [f"machine.{k}: missing" for k in MACHINE if machine.get(k) in (None, "")]
+    if not results.get("source", {}).get("source_sha256"):
+        out.append("source.source_sha256: missing")
+    check = {
+        "closed_form": _closed_form,
+        "resolver": _resolver,
+        "tasks": _tasks,
+        "study": _study,
+        "scaling": _scaling,
+    }[name]
+    out += list(check(results))
+    return out
+
+
+def _positive(value: Any) -> bool:
+    return isinstance(value, (int, float)) and math.isfinite(value) and value > 0
+
+
+def _rows(where: str, mode: dict[str, Any]) -> Iterator[str]:
+    rows = mode.get("contenders") or {}
+    if not rows:
+        yield f"{where}.contenders: empty"
+    for label, row in rows.items():
+        for key in STATS:
+            if not _positive(row.get(key)):
+                yield f"{where}.{label}.{key}: expected a positive time"
+        if not any(k.startswith("vs_") and k.endswith("_median") for k in row):
+            yield f"{where}.{label}: no ratio to a baseline (vs_<baseline>_median)"
+        if mode.get("pink_fastest") and not _positive(row.get("vs_baseline_p99")):
+            yield f"{where}.{label}.vs_baseline_p99: missing though pink ran"
+
+
+def _closed_form(results: dict[str, Any]) -> Iterator[str]:
+    arms = results.get("arms") or []
+    if not arms:
+        yield "arms: empty"
+    for arm in arms:
+        where = f"arms.{arm.get('arm')}"
+        scalar, batch = arm.get("scalar", {}), arm.get("batch", {})
+        for key in ("closed_form_us", "pinocchio_us", "speedup"):
+            if not _positive(scalar.get(key)):
+                yield f"{where}.scalar.{key}: expected a positive number"
+        for who in ("closed_form", "pinocchio") if results.get("schema", 1) >= 2 else ():
+            for p in ("p10", "p90", "p99"):
+                if not _positive(scalar.get(f"{who}_{p}_us")):
+                    yield f"{where}.scalar.{who}_{p}_us: expected a positive time"
+        for key in ("n", "closed_form_per_s", "loop_per_s", "speedup"):
+            if not _positive(batch.get(key)):
+                yield f"{where}.batch.{key}: expected a positive number"
+
+
+def _resolver(results: dict[str, Any]) -> Iterator[str]:
+    arms = results.get("arms") or []
+    if not arms:
+        yield "arms: empty"
+    for arm in arms:
+        modes = arm.get("modes") or {}
+        if not modes:
+            yield f"arms.{arm.get('arm')}.modes: empty"
+        for mode, m in modes.items():
+            yield from _rows(f"arms.{arm.get('arm')}.modes.{mode}", m)
+        minks = any(k.startswith("mink ") for m in modes.values() for k in m.get("contenders", {}))
+        gap = arm.get("mink_kinematics_gap")
+        if minks and not (gap and max(gap.values()) <= MINK_TOL):
+            yield f"arms.{arm.get('arm')}.mink_kinematics_gap: missing or above {MINK_TOL}"
+
+
+def _tasks(results: dict[str, Any]) -> Iterator[str]:
+    modes = results.get("modes") or {}
+    if not modes:
+        yield "modes: empty"
+    for mode, m in modes.items():
+        yield from _rows(f"modes.{mode}", m)
+
+
+def _study(results: dict[str, Any]) -> Iterator[str]:
+    dts = results.get("dts") or []
+    if len(dts) < 2:
+        yield "dts: expected at least two sampling times"
+    errors, orders = results.get("errors") or {}, results.get("orders") or {}
+    if not errors:
+        yield "errors: empty"
+    for key, values in errors.items():
+        if len(values) != len(dts) or not all(
+            isinstance(v, (int, float)) and math.isfinite(v) and v >= 0 for v in values
+        ):
+            yield f"errors.{key}: expected {len(dts)} finite errors >= 0"
+        if not isinstance(orders.get(key), (int, float)):
+            yield f"orders.{key}: missing"
+    if "trajectory" not in results:
+        yield "trajectory: missing"
+
+
+def _scaling(results: dict[str, Any]) -> Iterator[str]:
+    batch = results.get("batch") or []
+    if not batch:
+        yield "batch: empty"
+    for curve in batch:
+        where = f"batch.{curve.get('arm')}"
+        points = curve.get("points") or []
+        if not points:
+            yield f"{where}.points: empty"
+        for point in points:
+            for key in ("n", "per_config_us", "p10_us", "p90_us", "p99_us", "vs_loop"):
+                if not _positive(point.get(key)):
+                    yield f"{where}.n={point.get('n')}.{key}: expected a positive number"
+    dof = results.get("dof") or []
+    if not dof:
+        yield "dof: empty"
+    for row in dof:
+        for key in (*STATS, "floor_median_us", "vs_floor_median"):
+            if not _positive(row.get(key)):
+                yield f"dof.{row.get('arm')}.{key}: expected a positive number"
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python benchmarks/schema.py DIR``: check every ``*.json`` of a results folder; exit
+    code 1 (and one line per problem) if one does not follow the schema."""
+    import argparse
+    import json
+    from pathlib import Path
+
+    parser = argparse.ArgumentParser(description=main.__doc__)
+    parser.add_argument("folder", type=Path)
+    args = parser.parse_args(argv)
+    files = sorted(args.folder.glob("*.json"))
+    bad = 0
+    for path in files:
+        for problem in problems(json.loads(path.read_text())):
+            print(f"{path.name}: {problem}")
+            bad += 1
+    print(f"{len(files)} result files, {bad} problems")
+    return 1 if bad or not files else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,73 @@
+"""The benchmarks' JSON schema (benchmarks/schema.py), on the recorded results and on a fresh
+quick run of rrc-pin's own study through ``rrc-pin bench`` (no peer library needed).
+
+The whole ``rrc-pin bench --quick`` with the peers (pink, mink) runs in .ci/run with the
+bench extra installed; the README and docs/benchmarks.md against the JSON:
+tests/test_cli.py::test_readme_performance_section_is_generated_from_the_results.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import sys
+from pathlib import Path
+
+import pytest
+
+from rrc_pin.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "benchmarks"))
+try:
+    import schema
+finally:
+    sys.path.remove(str(ROOT / "benchmarks"))
+
+RECORDED = sorted((ROOT / "benchmarks" / "results").glob("*.json"))
+
+
+@pytest.mark.parametrize("path", RECORDED, ids=[p.stem for p in RECORDED])
+def test_recorded_results_follow_the_schema(path):
+    assert schema.problems(json.loads(path.read_text())) == []
+
+
+def test_every_benchmark_of_the_cli_has_a_schema_and_a_recorded_result():
+    import rrc_pin.cli as cli
+
+    assert set(cli.BENCHMARKS) <= set(schema.KNOWN)
+    assert {p.stem for p in RECORDED} == set(cli.BENCHMARKS)
+
+
+def test_schema_names_what_is_missing():
+    """The schema can fail: a timing row without its ratio, a closed form without p99."""
+    resolver = json.loads((ROOT / "benchmarks" / "results" / "resolver.json").read_text())
+    broken = copy.deepcopy(resolver)
+    row = next(iter(broken["arms"][0]["modes"]["tight"]["contenders"].values()))
+    for key in [k for k in row if k.startswith("vs_")]:
+        del row[key]
+    del row["p99_us"]
+    found = schema.problems(broken)
+    assert any("p99_us" in p for p in found) and any("no ratio" in p for p in found), found
+    with_mink = copy.deepcopy(resolver)
+    rows = with_mink["arms"][0]["modes"]["tight"]["contenders"]
+    rows["mink daqp"] = copy.deepcopy(next(iter(rows.values())))
+    assert any("mink_kinematics_gap" in p for p in schema.problems(with_mink))
+    with_mink["arms"][0]["mink_kinematics_gap"] = {"position": 1e-15, "jacobian": 2e-15}
+    assert schema.problems(with_mink) == []
+    cf = json.loads((ROOT / "benchmarks" / "results" / "closed_form.json").read_text())
+    cf = {**cf, "schema": 2}
+    cf["arms"][0]["scalar"].pop("closed_form_p99_us", None)
+    assert any("closed_form_p99_us" in p for p in schema.problems(cf))
+    assert schema.problems({"benchmark": "nope"})[0].startswith("benchmark:")
+
+
+def test_quick_study_through_the_cli_writes_json_that_follows_the_schema(tmp_path, monkeypatch):
+    import rrc_pin.cli as cli
+
+    monkeypatch.setattr(cli, "_installed", lambda module: True)  # matplotlib may be absent
+    out = tmp_path / "run"
+    assert main(["bench", "--only", "study", "--quick", "--out", str(out)]) == 0
+    results = json.loads((out / "study.json").read_text())
+    assert results["quick"] is True and schema.problems(results) == []
+    assert "## Sampling time and velocity conversions" in (out / "benchmarks.md").read_text()
