@@ -1,0 +1,33 @@
+"""Cartesian error of a tool pose: position difference and the quaternion orientation error.
+
+The orientation error is Nguyen & Zhou's eqs. (32)-(37), computed by
+:mod:`solvers.closed_form.quaternion` (not rewritten here): the quaternion of ``R_d R^T``
+from those of ``R`` and ``R_d`` (eqs. (32)-(34)), and the differential rotation
+``2 delta s`` (eq. (37)), in base axes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from solvers.closed_form.quaternion import (
+    differential_rotation,
+    quaternion_difference,
+    quaternion_from_matrix,
+)
+
+Array = npt.NDArray[np.float64]
+
+
+def pose_error(T: Array, T_d: Array) -> Array:
+    """``[p_d - p; delta]`` (6,) [m, rad], base axes: what takes pose ``T`` to ``T_d``.
+
+    Args:
+        T: Current tool pose (4, 4).
+        T_d: Desired tool pose (4, 4).
+    """
+    dq = quaternion_difference(
+        quaternion_from_matrix(T[:3, :3]), quaternion_from_matrix(T_d[:3, :3])
+    )
+    return np.concatenate([T_d[:3, 3] - T[:3, 3], differential_rotation(dq)])
