@@ -68,13 +68,18 @@ class CartesianAdaptivePD(Controller):
         J = self.robot.jacobian(state.q)
         e = pose_error(self.robot.fk(state.q), ref.pose)
         wrench = self.adaptation.update(e, ref.twist - J @ state.v)
-        return np.asarray(J.T @ wrench + null_space_pd(self, J, state, ref), dtype=float)
+        hold = null_space_pd(self.null_kp, self.null_kv, J, state, ref)
+        return np.asarray(J.T @ wrench + hold, dtype=float)
 
 
-def null_space_pd(ctl: CartesianAdaptivePD, J: Array, state: State, ref: Reference) -> Array:
-    """``(I - J^+ J)^T (K_n e + D_n edot)`` (nq,) [N m]: the self-motion hold."""
-    if ctl.robot.nq <= 6 or not (ctl.null_kp.any() or ctl.null_kv.any()):
-        return np.zeros(ctl.robot.nq)
-    N = np.eye(ctl.robot.nq) - np.linalg.pinv(J) @ J
-    joint = ctl.null_kp * (ref.q - state.q) + ctl.null_kv * (ref.v - state.v)
+def null_space_pd(kp: Array, kv: Array, J: Array, state: State, ref: Reference) -> Array:
+    """``(I - J^+ J)^T (K_n e + D_n edot)`` (nq,) [N m]: the self-motion hold.
+
+    Zero (not computed) on an arm of six joints or fewer, or with zero gains.
+    """
+    n = J.shape[1]
+    if n <= 6 or not (kp.any() or kv.any()):
+        return np.zeros(n)
+    N = np.eye(n) - np.linalg.pinv(J) @ J
+    joint = kp * (ref.q - state.q) + kv * (ref.v - state.v)
     return np.asarray(N.T @ joint, dtype=float)

@@ -33,8 +33,9 @@ class Record:
         force: Force the tool exerts (N, 3) [N], base axes.
         force_ref: Desired force (N, 3) [N].
         clipped: Steps at which a commanded torque was saturated by the simulator.
-        step_seconds: Wall time per step [s], controller + simulator (mean).
-        controller_seconds: Wall time per step [s] of the controller alone (mean).
+        controller_seconds: Wall time per step [s] of the controller (mean).
+        simulator_seconds: Wall time per step [s] of the simulator (mean).
+        dt: The simulator's step [s].
     """
 
     t: Array
@@ -45,8 +46,14 @@ class Record:
     force: Array
     force_ref: Array
     clipped: int
-    step_seconds: float
     controller_seconds: float
+    simulator_seconds: float
+    dt: float
+
+    @property
+    def real_time_factor(self) -> float:
+        """Simulated time per wall time of controller + simulator (> 1: faster than real time)."""
+        return self.dt / (self.controller_seconds + self.simulator_seconds)
 
 
 def run(
@@ -83,8 +90,7 @@ def run(
     pending = sorted(events, key=lambda e: e[0])
     state = sim.state()
     clipped = 0
-    control_time = 0.0
-    start = time.perf_counter()
+    control_time = simulation_time = 0.0
     for k in range(steps):
         while pending and pending[0][0] <= state.t + 1e-12:
             pending.pop(0)[1](sim)
@@ -96,10 +102,11 @@ def run(
         t_out[k], out["q"][k], out["q_ref"][k] = state.t, state.q, ref.q
         err[k] = pose_error(sim.robot.fk(state.q), ref.pose)
         f[k], f_ref[k] = state.force, wanted
+        tick = time.perf_counter()
         state = sim.step(tau)
+        simulation_time += time.perf_counter() - tick
         out["tau"][k] = sim.report.tau
         clipped += sim.report.clipped
-    elapsed = time.perf_counter() - start
     return Record(
         t=t_out,
         q=out["q"],
@@ -109,6 +116,7 @@ def run(
         force=f,
         force_ref=f_ref,
         clipped=clipped,
-        step_seconds=elapsed / max(steps, 1),
         controller_seconds=control_time / max(steps, 1),
+        simulator_seconds=simulation_time / max(steps, 1),
+        dt=sim.dt,
     )
