@@ -27,7 +27,6 @@ def pose_error(T: Array, T_d: Array) -> Array:
         T: Current tool pose (4, 4).
         T_d: Desired tool pose (4, 4).
     """
-    dq = quaternion_difference(
-        quaternion_from_matrix(T[:3, :3]), quaternion_from_matrix(T_d[:3, :3])
-    )
+    q, q_d = quaternion_from_matrix(np.stack([T[:3, :3], T_d[:3, :3]]))  # one call for both
+    dq = quaternion_difference(q, q_d)
     return np.concatenate([T_d[:3, 3] - T[:3, 3], differential_rotation(dq)])
