@@ -93,3 +93,17 @@ def test_generated_urdfs_carry_the_inertial_data():
     q[1] = np.pi / 2
     g = pin.computeGeneralizedGravity(barker.model, barker.model.createData(), q)
     assert 35.0 < abs(g[1]) < 60.0
+
+
+def test_published_puma_link3_breaks_the_triangle_inequality():
+    """docs/errata.md: the source's link 3 moments are refused; the raised Izz is accepted.
+
+    Link 1 as published (mass 0) is refused too; the data used are physical.
+    """
+    with pytest.raises(InvalidInput, match="triangle"):
+        make(4.8, np.zeros(3), np.diag([0.066, 0.086, 0.0125]))
+    with pytest.raises(InvalidInput, match="mass"):
+        make(0.0, np.zeros(3), np.diag([0.0, 0.35, 0.0]))
+    used = puma.corke_inertials()
+    assert np.allclose(np.diag(used[2].inertia_array), (0.066, 0.086, 0.020))
+    assert np.allclose(np.diag(used[0].inertia_array), (0.175, 0.35, 0.175))

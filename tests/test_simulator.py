@@ -130,3 +130,12 @@ def test_bad_input_is_refused_by_name_before_any_change(arm):
         Simulator(arm, dt=0.0)
     with pytest.raises(InvalidInput, match="payload"):
         sim.set_payload(2.0)  # type: ignore[arg-type]
+
+
+def test_dynamics_exports_exist_and_are_sorted():
+    import rrc_pin.dynamics as dynamics
+
+    namespace: dict = {}
+    exec("from rrc_pin.dynamics import *", namespace)
+    assert set(dynamics.__all__) <= set(namespace)
+    assert dynamics.__all__ == sorted(dynamics.__all__)
