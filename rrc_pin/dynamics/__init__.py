@@ -15,6 +15,7 @@ from rrc_pin.dynamics.controller import Controller
 from rrc_pin.dynamics.drives import Drives, drives_of
 from rrc_pin.dynamics.environment import ContactPlane
 from rrc_pin.dynamics.harness import Record, run
+from rrc_pin.dynamics.hybrid import HybridForcePosition
 from rrc_pin.dynamics.joint_adaptive import JointAdaptivePD
 from rrc_pin.dynamics.pd import FixedPD
 from rrc_pin.dynamics.reference import HandPath, JointTrajectory
@@ -29,6 +30,7 @@ __all__ = [
     "Drives",
     "FixedPD",
     "HandPath",
+    "HybridForcePosition",
     "JointAdaptivePD",
     "JointTrajectory",
     "Record",

@@ -81,12 +81,8 @@ def run(
     steps = round(duration / sim.dt)
     nq = sim.robot.nq
     out = {k: np.zeros((steps, nq)) for k in ("q", "q_ref", "tau")}
-    err, f, f_ref, t_out = (
-        np.zeros((steps, 6)),
-        np.zeros((steps, 3)),
-        np.zeros((steps, 3)),
-        np.zeros(steps),
-    )
+    poses, ref_poses = np.zeros((steps, 4, 4)), np.zeros((steps, 4, 4))
+    f, f_ref, t_out = np.zeros((steps, 3)), np.zeros((steps, 3)), np.zeros(steps)
     pending = sorted(events, key=lambda e: e[0])
     state = sim.state()
     clipped = 0
@@ -100,7 +96,7 @@ def run(
         tau = controller.torques(state, ref)
         control_time += time.perf_counter() - tick
         t_out[k], out["q"][k], out["q_ref"][k] = state.t, state.q, ref.q
-        err[k] = pose_error(sim.robot.fk(state.q), ref.pose)
+        poses[k], ref_poses[k] = sim.robot.fk(state.q), ref.pose
         f[k], f_ref[k] = state.force, wanted
         tick = time.perf_counter()
         state = sim.step(tau)
@@ -112,7 +108,7 @@ def run(
         q=out["q"],
         q_ref=out["q_ref"],
         tau=out["tau"],
-        pose_error=err,
+        pose_error=pose_error(poses, ref_poses),
         force=f,
         force_ref=f_ref,
         clipped=clipped,

@@ -24,9 +24,17 @@ def pose_error(T: Array, T_d: Array) -> Array:
     """``[p_d - p; delta]`` (6,) [m, rad], base axes: what takes pose ``T`` to ``T_d``.
 
     Args:
-        T: Current tool pose (4, 4).
-        T_d: Desired tool pose (4, 4).
+        T: Current tool pose (4, 4), or a stack (N, 4, 4).
+        T_d: Desired tool pose, same shape.
+
+    Returns:
+        (6,), or (N, 6) for stacks.
     """
-    q, q_d = quaternion_from_matrix(np.stack([T[:3, :3], T_d[:3, :3]]))  # one call for both
-    dq = quaternion_difference(q, q_d)
-    return np.concatenate([T_d[:3, 3] - T[:3, 3], differential_rotation(dq)])
+    Ts, Tds = np.asarray(T, dtype=float), np.asarray(T_d, dtype=float)
+    single = Ts.ndim == 2
+    Ts, Tds = Ts.reshape(-1, 4, 4), Tds.reshape(-1, 4, 4)
+    n = Ts.shape[0]
+    quats = quaternion_from_matrix(np.concatenate([Ts[:, :3, :3], Tds[:, :3, :3]]))  # one call
+    delta = differential_rotation(quaternion_difference(quats[:n], quats[n:]))
+    out = np.concatenate([Tds[:, :3, 3] - Ts[:, :3, 3], delta], axis=1)
+    return out[0] if single else out
