@@ -179,3 +179,19 @@ def test_seraji_gains_grow_while_the_error_persists():
 def test_bad_gains_selection_and_names_are_refused_by_name(barker, build, argument):
     with pytest.raises(InvalidInput, match=argument):
         build(barker)
+
+
+def test_the_tracking_scenario_measures_the_payload_transient(barker):
+    """A 0.3 s run with the payload at 0.1 s: the deviation from the quiet run is measured."""
+    outcome = scenario("tracking", barker, "fixed_pd", duration=0.3, change_at=0.1, segment=0.3)
+    m = outcome.metrics
+    assert outcome.baseline is not None
+    assert m["payload_deviation_peak_mm"] > 1.0  # 2.5 kg sags a fixed-gain loop
+    assert m["recovery_s"] == float("inf")  # and it stays sagged
+    assert all(np.isfinite(v) for k, v in m.items() if k != "recovery_s")
+
+
+def test_the_loop_refuses_a_controller_at_another_rate(barker):
+    _, trajectory = short_move(barker)
+    with pytest.raises(InvalidInput, match="controller"):
+        run(Simulator(barker), FixedPD(barker, 100.0, 10.0, dt=2e-3), trajectory, 0.1)

@@ -13,6 +13,8 @@ from rrc_pin.dynamics.controller import Controller
 from rrc_pin.dynamics.pose_error import pose_error
 from rrc_pin.dynamics.reference import JointTrajectory
 from rrc_pin.dynamics.simulator import Simulator
+from rrc_pin.errors import InvalidInput
+from solvers.validation import finite_number
 
 Array = npt.NDArray[np.float64]
 Event = tuple[float, Callable[[Simulator], None]]
@@ -77,7 +79,16 @@ def run(
 
     Returns:
         The :class:`Record`, one sample per step (before the step).
+
+    Raises:
+        InvalidInput: The controller's period differs from the simulator's step, or a bad
+            ``duration``.
     """
+    if abs(controller.dt - sim.dt) > 1e-12:
+        raise InvalidInput(
+            "controller", f"its period {controller.dt} s differs from the simulator's {sim.dt} s"
+        )
+    duration = finite_number(duration, "duration", 0.0, inclusive=False, error=InvalidInput)
     steps = round(duration / sim.dt)
     nq = sim.robot.nq
     out = {k: np.zeros((steps, nq)) for k in ("q", "q_ref", "tau")}

@@ -121,6 +121,7 @@ def controller(name: str, robot: Robot, q0: Array, dt: float = 1e-3) -> Controll
     Raises:
         InvalidInput: Unknown ``name`` (lists the choices).
     """
+    check_controller(name)
     kp, kv = joint_gains(robot)
     g0, wrench0 = holding(robot, q0)
     if name == "fixed_pd":
@@ -145,19 +146,28 @@ def controller(name: str, robot: Robot, q0: Array, dt: float = 1e-3) -> Controll
         return CartesianAdaptivePD(
             robot, cartesian_gains(True), null_kp=NULL_KP, null_kv=NULL_KV, f0=wrench0, dt=dt
         )
-    if name in ("hybrid_fixed", "hybrid_adaptive"):
-        adapt = name == "hybrid_adaptive"
-        return HybridForcePosition(
-            robot,
-            cartesian_gains(adapt),
-            force_gains(adapt),
-            (0.0, 0.0, 1.0),
-            null_kp=NULL_KP,
-            null_kv=NULL_KV,
-            f0=wrench0,
-            dt=dt,
-        )
-    raise InvalidInput("controller", f"unknown controller {name!r}; choose from {CONTROLLERS}")
+    adapt = name == "hybrid_adaptive"  # the last two: hybrid_fixed, hybrid_adaptive
+    return HybridForcePosition(
+        robot,
+        cartesian_gains(adapt),
+        force_gains(adapt),
+        (0.0, 0.0, 1.0),
+        null_kp=NULL_KP,
+        null_kv=NULL_KV,
+        f0=wrench0,
+        dt=dt,
+    )
+
+
+def check_controller(name: str, allowed: tuple[str, ...] = CONTROLLERS) -> str:
+    """``name`` if it is one of ``allowed``.
+
+    Raises:
+        InvalidInput: Naming ``controller`` and listing the choices.
+    """
+    if name not in allowed:
+        raise InvalidInput("controller", f"unknown controller {name!r}; choose from {allowed}")
+    return name
 
 
 def cartesian_gains(adapt: bool) -> SerajiGains:
@@ -226,6 +236,7 @@ def tracking(
     Raises:
         InvalidInput: A bad duration or time (named), an unknown controller.
     """
+    check_controller(controller_name)
     duration = finite_number(duration, "duration", 0.0, inclusive=False, error=InvalidInput)
     change_at = finite_number(change_at, "change_at", 0.0, upper=duration, error=InvalidInput)
     q0 = start(robot)
@@ -255,6 +266,7 @@ def force(
     Raises:
         InvalidInput: A bad stiffness or duration (named), an unknown controller.
     """
+    check_controller(controller_name)
     stiffness = finite_number(stiffness, "stiffness", 0.0, inclusive=False, error=InvalidInput)
     duration = finite_number(duration, "duration", 0.0, inclusive=False, error=InvalidInput)
     q0 = start(robot)

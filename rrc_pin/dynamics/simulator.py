@@ -139,7 +139,11 @@ class Simulator:
         self.plane = plane
 
     def state(self) -> State:
-        """The current :class:`State` (the force sensor reads minus the plane's push)."""
+        """The current :class:`State`.
+
+        Its force is minus the plane's push during the last step (computed at the step's
+        start, so it lags the position by one step).
+        """
         return State(t=self.t, q=self.q.copy(), v=self.v.copy(), force=-self.report.contact)
 
     def step(self, tau: npt.ArrayLike) -> State:
