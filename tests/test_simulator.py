@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 
 import rrc_pin
-from rrc_pin.dynamics import ContactPlane, Simulator, drives_of
+from rrc_pin.dynamics import ContactPlane, Drives, Simulator, drives_of
 from rrc_pin.errors import InvalidInput
 from rrc_pin.models.inertia import make
 
@@ -130,6 +130,12 @@ def test_bad_input_is_refused_by_name_before_any_change(arm):
         Simulator(arm, dt=0.0)
     with pytest.raises(InvalidInput, match="payload"):
         sim.set_payload(2.0)  # type: ignore[arg-type]
+    with pytest.raises(InvalidInput, match="viscous"):
+        Drives(np.ones(arm.nq), np.ones(2), np.ones(arm.nq))
+    with pytest.raises(InvalidInput, match="coulomb"):
+        Drives(np.ones(arm.nq), np.ones(arm.nq), -np.ones(arm.nq))
+    with pytest.raises(InvalidInput, match="drives"):
+        Simulator(arm, drives=Drives(np.ones(3), np.ones(3), np.ones(3)))
 
 
 def test_dynamics_exports_exist_and_are_sorted():

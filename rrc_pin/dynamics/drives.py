@@ -48,9 +48,10 @@ class Drives:
     coulomb: npt.NDArray[np.float64]
 
     def __post_init__(self) -> None:
-        n = np.asarray(self.armature).shape[0] if np.ndim(self.armature) == 1 else -1
+        size: int | None = None  # the armature's length; the others must match it
         for label in ("armature", "viscous", "coulomb"):
-            values = as_array(getattr(self, label), label, (n,), InvalidInput)
+            values = as_array(getattr(self, label), label, (size,), InvalidInput)
+            size = values.shape[0]
             if np.any(values < 0.0):
                 raise InvalidInput(label, "every entry must be >= 0")
 
