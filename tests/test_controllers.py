@@ -195,3 +195,26 @@ def test_the_loop_refuses_a_controller_at_another_rate(barker):
     _, trajectory = short_move(barker)
     with pytest.raises(InvalidInput, match="controller"):
         run(Simulator(barker), FixedPD(barker, 100.0, 10.0, dt=2e-3), trajectory, 0.1)
+
+
+def test_hybrid_splits_the_wrench_along_the_task_frame(barker, rng):
+    """At the reference, at rest: the wrench is the force loop's, on the force axes only.
+
+    Task frame turned by a random rotation, S = diag(1, 0, 1): ``F = R S (f_d + kp0 (f_d -
+    f))`` in task axes (no position error, no speed), checked through ``J^T`` (square J).
+    """
+    import pinocchio as pin
+
+    from rrc_pin.dynamics import Reference, State
+
+    q0 = start(barker)
+    R = pin.exp3(rng.normal(size=3))
+    s = np.array([1.0, 0.0, 1.0])
+    ctl = HybridForcePosition(barker, cartesian_gains(False), force_gains(False), s, task_frame=R)
+    f_d, f = rng.normal(size=3) * 10, rng.normal(size=3) * 10
+    ref = Reference(q0, np.zeros(6), np.zeros(6), barker.fk(q0), np.zeros(6), f_d)
+    tau = ctl.law(State(0.0, q0, np.zeros(6), f), ref)
+    wrench = np.linalg.solve(barker.jacobian(q0).T, tau)
+    expected = R @ (s * (R.T @ f_d + 0.5 * (R.T @ (f_d - f))))
+    assert np.allclose(wrench[:3], expected, atol=1e-9)
+    assert np.allclose(wrench[3:], 0.0, atol=1e-9)
