@@ -110,13 +110,16 @@ def test_adaptive_controllers_recover_from_a_payload_that_fixed_pd_cannot(barker
     assert end["cartesian_adaptive_pd"] < 0.3 * end["fixed_pd"]
 
 
-@pytest.mark.parametrize("stiffness", [1e3, 1e5])
-def test_hybrid_holds_the_force_along_z_while_tracking_x_and_y(barker, stiffness):
-    """20 N down on planes of 1e3 and 1e5 N/m while moving along them, 0.8 s.
+@pytest.mark.parametrize(("stiffness", "tilt"), [(1e3, 0.0), (1e5, np.deg2rad(30.0))])
+def test_hybrid_holds_the_force_along_the_normal_while_tracking_in_the_plane(
+    barker, stiffness, tilt
+):
+    """20 N into a horizontal 1e3 N/m plane and a 1e5 N/m plane tilted by 30 deg, 0.8 s.
 
-    Measured after the 0.5 s settling: force error below 1.5 N, in-plane error below 15 mm.
+    Bounds: force error below 3 N after the 0.5 s settling (measured below 1.5 N), in-plane
+    error below 30 mm (measured below 15 mm), contact kept.
     """
-    outcome = force(barker, "hybrid_adaptive", stiffness=stiffness, duration=0.8)
+    outcome = force(barker, "hybrid_adaptive", stiffness=stiffness, duration=0.8, tilt=tilt)
     m = outcome.metrics
     assert m["force_max_N"] < 3.0
     assert m["contact_lost_s"] == 0.0

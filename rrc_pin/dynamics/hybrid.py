@@ -1,7 +1,8 @@
 r"""Hybrid position/force control (Nguyen & Zhou Fig. 13, after Raibert and Craig), adaptive gains.
 
 M. H. Raibert and J. J. Craig, "Hybrid position/force control of manipulators", ASME J.
-Dynamic Systems, Measurement and Control 103(2):126-133, 1981. In a task frame with axes
+Dynamic Systems, Measurement and Control 103(2):126-133, 1981 (the report's reference [12]
+prints volume 102). In a task frame with axes
 ``R`` (base axes of its x, y, z), a compliance selection matrix ``S = diag(s)``, ``s_i = 1``
 for a force-controlled axis and 0 for a position-controlled one, splits the three
 translational axes; orientation is always position-controlled (the plane senses no moment).

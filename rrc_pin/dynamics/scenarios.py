@@ -6,10 +6,12 @@
   measured against the same run without the change: the payload deviation
   ``d(t) = |p(t) - p_nochange(t)|`` and the time after the change until ``d`` stays below
   :data:`RECOVERED` (1 mm).
-- ``force``: the tool presses on a horizontal plane (normal +z, at the tool's start height)
-  with a desired force of :data:`FORCE` (20 N, straight down) while moving along it. The
-  hybrid controller selects ``s = (0, 0, 1)``; the joint-space baselines chase the same path
-  pushed ``|f_d| / k_assumed`` into the plane (:data:`ASSUMED_STIFFNESS`, 1e4 N/m): a
+- ``force``: the tool presses on a plane through its start position with a desired force of
+  :data:`FORCE` (20 N) along the inward normal while moving along it. The plane is horizontal
+  (normal +z) or turned by ``tilt`` about the base x axis; the task frame is the plane's
+  (``R = Rx(tilt)``, z along the normal), the path's waypoints are turned with it, and the
+  hybrid controller selects ``s = (0, 0, 1)`` in it. The joint-space baselines chase the same
+  path pushed ``|f_d| / k_assumed`` into the plane (:data:`ASSUMED_STIFFNESS`, 1e4 N/m): a
   position-based force, right only on a surface of the assumed stiffness.
 
 Gains (stated once, here): joint loops ``kp = 2 (a + 0.5) wn^2``, ``kv = 2 (a + 0.5) wn``
@@ -28,6 +30,7 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
+from rrc_pin.dh import rot_x
 from rrc_pin.dynamics.adaptation import SerajiGains
 from rrc_pin.dynamics.cartesian_adaptive import CartesianAdaptivePD
 from rrc_pin.dynamics.computed_torque import ComputedTorque
@@ -54,8 +57,8 @@ PAYLOAD = make(2.5, (0.0, 0.0, 0.05), np.diag([4e-3, 4e-3, 2e-3]))
 """The payload picked up mid-run [kg, m, kg m^2], tool frame."""
 RECOVERED = 1e-3
 """Payload deviation [m] below which the tracking counts as recovered."""
-FORCE = np.array([0.0, 0.0, -20.0])
-"""Desired force the tool exerts on the plane [N], base axes."""
+FORCE = 20.0
+"""Desired force [N] the tool exerts on the plane, along its inward normal."""
 ASSUMED_STIFFNESS = 1e4
 """Plane stiffness [N/m] the position-based force baselines assume."""
 SETTLE = 0.5
@@ -115,8 +118,12 @@ def holding(robot: Robot, q: Array) -> tuple[Array, Array]:
     return np.array(g), wrench
 
 
-def controller(name: str, robot: Robot, q0: Array, dt: float = 1e-3) -> Controller:
+def controller(
+    name: str, robot: Robot, q0: Array, dt: float = 1e-3, task_frame: Array | None = None
+) -> Controller:
     """One of :data:`CONTROLLERS`, with the gains of this module, starting at rest at ``q0``.
+
+    ``task_frame`` (3, 3) is the hybrid controllers' (default: the base axes).
 
     Raises:
         InvalidInput: Unknown ``name`` (lists the choices).
@@ -152,6 +159,7 @@ def controller(name: str, robot: Robot, q0: Array, dt: float = 1e-3) -> Controll
         cartesian_gains(adapt),
         force_gains(adapt),
         (0.0, 0.0, 1.0),
+        task_frame=task_frame,
         null_kp=NULL_KP,
         null_kv=NULL_KV,
         f0=wrench0,
@@ -260,8 +268,11 @@ def force(
     stiffness: float = 1e4,
     duration: float = 3.0,
     segment: float = 1.0,
+    tilt: float = 0.0,
 ) -> Outcome:
     """Press with :data:`FORCE` on a plane of ``stiffness`` [N/m] while moving along it.
+
+    ``tilt`` [rad] turns the plane (and the task frame, and the path) about the base x axis.
 
     Raises:
         InvalidInput: A bad stiffness or duration (named), an unknown controller.
@@ -269,27 +280,36 @@ def force(
     check_controller(controller_name)
     stiffness = finite_number(stiffness, "stiffness", 0.0, inclusive=False, error=InvalidInput)
     duration = finite_number(duration, "duration", 0.0, inclusive=False, error=InvalidInput)
+    tilt = finite_number(tilt, "tilt", -np.pi / 2, upper=np.pi / 2, error=InvalidInput)
+    R = rot_x(tilt)[:3, :3]
+    normal = R[:, 2]
+    wanted = -FORCE * normal
     q0 = start(robot)
     T0 = robot.fk(q0)
-    ctl = controller(controller_name, robot, q0)
-    path = HandPath(T0, np.array(FORCE_PATH), segment)
+    ctl = controller(controller_name, robot, q0, task_frame=R)
+    path = HandPath(T0, np.array(FORCE_PATH) @ R.T, segment)
     if not isinstance(ctl, HybridForcePosition):
         # Position-based force: the path pushed into the plane (the resolver's pull on the
         # pose error takes the reference there from q0 within some 0.3 s).
         pressed = np.array(T0)
-        pressed[:3, 3] += FORCE / ASSUMED_STIFFNESS
+        pressed[:3, 3] += wanted / ASSUMED_STIFFNESS
         path = replace(path, start=pressed)
     trajectory = JointTrajectory(robot, q0, path, duration)
-    plane = ContactPlane(T0[:3, 3], np.array([0.0, 0.0, 1.0]), stiffness)
+    plane = ContactPlane(T0[:3, 3], normal, stiffness)
     sim = Simulator(robot, friction=True, plane=plane)
     sim.reset(q0)
-    rec = run(sim, ctl, trajectory, duration, force=lambda t: FORCE)
-    return Outcome(rec, {**tracking_metrics(rec, axes=(0, 1)), **force_metrics(rec)})
+    rec = run(sim, ctl, trajectory, duration, force=lambda t: wanted)
+    metrics = {**tracking_metrics(rec, R[:, :2]), **force_metrics(rec, normal)}
+    return Outcome(rec, metrics)
 
 
-def tracking_metrics(rec: Record, axes: tuple[int, ...] = (0, 1, 2)) -> dict[str, float]:
-    """Tool position error RMS and max [mm] on ``axes``, orientation max [mrad], torque peaks."""
-    e = np.linalg.norm(rec.pose_error[:, list(axes)], axis=1)
+def tracking_metrics(rec: Record, basis: Array | None = None) -> dict[str, float]:
+    """Tool position error RMS and max [mm], orientation max [mrad], torque peaks [N m].
+
+    ``basis`` (3, k): measure the position error along its columns only (default: all).
+    """
+    position = rec.pose_error[:, :3] if basis is None else rec.pose_error[:, :3] @ basis
+    e = np.linalg.norm(position, axis=1)
     out = {
         "position_rms_mm": 1e3 * float(np.sqrt(np.mean(e**2))),
         "position_max_mm": 1e3 * float(e.max()),
@@ -327,13 +347,16 @@ def transient(rec: Record, quiet: Record, change_at: float) -> dict[str, float]:
     }
 
 
-def force_metrics(rec: Record) -> dict[str, float]:
-    """After :data:`SETTLE`: force error along z [N] (RMS, max, end), time out of contact [s]."""
+def force_metrics(rec: Record, normal: Array) -> dict[str, float]:
+    """Force error along ``normal`` [N] (RMS, max, end) and time out of contact [s].
+
+    Both after :data:`SETTLE`.
+    """
     late = rec.t >= SETTLE
-    err = rec.force[late, 2] - rec.force_ref[late, 2]
+    err = (rec.force[late] - rec.force_ref[late]) @ normal
     return {
         "force_rms_N": float(np.sqrt(np.mean(err**2))),
         "force_max_N": float(np.abs(err).max()),
         "force_end_N": float(err[-1]),
-        "contact_lost_s": float(np.sum(rec.force[late, 2] == 0.0) * rec.dt),
+        "contact_lost_s": float(np.sum(~rec.force[late].any(axis=1)) * rec.dt),
     }
