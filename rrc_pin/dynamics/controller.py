@@ -20,7 +20,7 @@ class Controller(ABC):
     """A control law at a fixed rate, saturated at the motors' torque limits.
 
     Subclasses write :meth:`law`; :meth:`torques` clips its answer to ``torque_limit``, and
-    answers the gravity-free zero torque (counted in :attr:`faults`) should the law ever
+    answers zero torque (counted in :attr:`faults`) should the law ever
     produce a non-finite number, so that no NaN reaches the motors.
 
     Args:
