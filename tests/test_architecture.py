@@ -15,7 +15,7 @@ import rrc_pin
 import solvers
 
 ROOT = Path(__file__).resolve().parents[1]
-UPPER = {"resolver", "control", "controller", "guidance", "cell", "cli", "demo"}
+UPPER = {"resolver", "control", "controller", "guidance", "cell", "cli", "demo", "dynamics"}
 LOWER = {"dh", "models", "urdf_export", "urdf_compare", "robot", "loading", "errors", "cross_check"}
 
 

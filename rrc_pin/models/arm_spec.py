@@ -10,6 +10,7 @@ import numpy as np
 
 from rrc_pin.dh import DHChain
 from rrc_pin.errors import InvalidInput
+from rrc_pin.models.inertia import LinkInertial
 from solvers.validation import finite_number
 
 if TYPE_CHECKING:
@@ -35,6 +36,9 @@ class ArmSpec:
         named_poses: Named configurations (nq,) from the paper, e.g. ``"paper_start"``.
         closed_form: Zero-argument factory of the paper's closed-form fast path, or None.
         parameters: The builder's keyword arguments (for variants and for the CLI table).
+        inertials: One :class:`LinkInertial` per link, each in the DH frame i attached to link
+            i (standard: at its far joint; modified: at its own joint), or empty for the
+            placeholder inertia of :mod:`rrc_pin.urdf_export`.
     """
 
     name: str
@@ -48,9 +52,12 @@ class ArmSpec:
     named_poses: dict[str, tuple[float, ...]] = field(default_factory=dict)
     closed_form: Callable[[], ClosedForm] | None = None
     parameters: dict[str, float] = field(default_factory=dict)
+    inertials: tuple[LinkInertial, ...] = ()
 
     def __post_init__(self) -> None:
         n = self.chain.nq
+        if self.inertials and len(self.inertials) != n:
+            raise InvalidInput("inertials", f"expected {n} links, got {len(self.inertials)}")
         for label in ("lower", "upper", "velocity_limit", "effort_limit"):
             values = np.asarray(getattr(self, label), dtype=float)
             if values.shape != (n,):

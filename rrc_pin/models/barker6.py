@@ -4,7 +4,9 @@ Standard DH (Barker eq. (1)), theta'_i = theta_i + offset with offsets 180, 90, 
 deg, so that q = 0 is the initial position of Barker's figure 3. The report leaves NO, ES, SN,
 WE, A3, R3 and alpha3 symbolic; the defaults are PUMA 560 values (assumed). The tool frame is
 the wrist centre (frames 4, 5 and 6 coincide: r5 = r6 = 0 in the resolved-rate equations); the
-``flange`` frame sits HW further along z6.
+``flange`` frame sits HW further along z6. Link inertial data: the PUMA 560's published values
+(Corke & Armstrong-Helouvry 1994), mapped onto Barker's frames by
+:mod:`rrc_pin.models.puma560_inertia`.
 """
 
 from __future__ import annotations
@@ -15,6 +17,7 @@ import numpy as np
 
 from rrc_pin.dh import DHChain, DHRow, pose, translation
 from rrc_pin.models.arm_spec import ArmSpec, check_parameters
+from rrc_pin.models.puma560_inertia import barker_inertials
 
 if TYPE_CHECKING:
     from solvers.closed_form.base import ClosedForm
@@ -87,6 +90,8 @@ def build(
     assumed = [
         "joint velocity limits (2, 2, 2, 4, 4, 4) rad/s and efforts",
         "r6 = 0: tool frame at the wrist centre; HW moved to the `flange` frame",
+        "link inertial data: PUMA 560 (Corke & Armstrong-Helouvry 1994), mirrored onto "
+        "Barker's frames; link 1 mass and transverse moments, link 3 Izz raised",
     ]
     symbolic = {k: v for k, v in params.items() if not np.isclose(v, PUMA560[k])}
     if len(symbolic) < len(params):
@@ -113,6 +118,7 @@ def build(
         named_poses={"paper_start": (0.0,) * 6},
         closed_form=closed_form,
         parameters=params,
+        inertials=barker_inertials(chain),
     )
 
 

@@ -2,7 +2,9 @@
 
 Craig's modified DH (Nguyen eq. (2)), Table 1 in inches converted here. Tool frame: frame 7's
 origin. q = 0 is the home configuration of Nguyen's figure 2. Joint position and velocity
-limits are not in the report (assumed, K-1607 class).
+limits are not in the report (assumed, K-1607 class). Link inertial data are not in the report
+either: each link is assumed a uniform solid cylinder along its segment (:data:`LINK_MASSES`,
+:data:`LINK_RADII`), physically consistent by construction.
 """
 
 from __future__ import annotations
@@ -11,8 +13,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from rrc_pin.dh import DHChain, DHRow
+from rrc_pin.dh import DHChain, DHRow, link_transform
 from rrc_pin.models.arm_spec import INCH, ArmSpec
+from rrc_pin.models.inertia import LinkInertial, cylinder
 
 if TYPE_CHECKING:
     from solvers.closed_form.base import ClosedForm
@@ -31,6 +34,21 @@ TABLE_1 = (
 LIMITS_DEG = (170.0, 120.0, 170.0, 135.0, 170.0, 120.0, 170.0)  # assumed
 VELOCITY_LIMIT = (1.0, 1.0, 1.5, 1.5, 2.0, 2.0, 2.0)  # [rad/s], assumed
 EFFORT_LIMIT = (140.0, 140.0, 70.0, 70.0, 20.0, 20.0, 20.0)  # [N m], assumed
+LINK_MASSES = (8.0, 5.0, 2.0, 3.5, 1.5, 1.0, 0.5)  # [kg], assumed (upper arm: 2, forearm: 4)
+LINK_RADII = (0.08, 0.06, 0.06, 0.05, 0.05, 0.04, 0.04)  # [m], assumed
+
+
+def cylinder_links(rows: tuple[DHRow, ...]) -> tuple[LinkInertial, ...]:
+    """Link i as a solid cylinder from joint i to joint i + 1 (modified DH frame i).
+
+    The segment's far end is the origin of frame i + 1 at q = 0 (the tool for the last link,
+    a stub of one diameter along z).
+    """
+    ends = [link_transform(row, 0.0, "modified")[:3, 3] for row in rows[1:]] + [np.zeros(3)]
+    return tuple(
+        cylinder(mass, radius, end)
+        for mass, radius, end in zip(LINK_MASSES, LINK_RADII, ends, strict=True)
+    )
 
 
 def build(name: str = NAME) -> ArmSpec:
@@ -57,9 +75,11 @@ def build(name: str = NAME) -> ArmSpec:
         assumed=(
             "joint limits +-(170, 120, 170, 135, 170, 120, 170) deg",
             "velocity limits (1, 1, 1.5, 1.5, 2, 2, 2) rad/s and efforts",
+            "link inertial data: solid cylinders of masses (8, 5, 2, 3.5, 1.5, 1, 0.5) kg",
         ),
         named_poses={"home": (0.0,) * 7},
         closed_form=closed_form,
+        inertials=cylinder_links(rows),
     )
 
 
