@@ -9,22 +9,28 @@ from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.drift import DriftCorrection
 from rrc_pin.control.strategies import (
     STRATEGIES,
+    AuxiliaryHand,
     Decision,
+    Freezing,
     GeneralizedInverse,
     ResolverOnly,
     Situation,
     Slowdown,
     Strategy,
+    Uncoupled,
+    WristChoice,
     make_strategy,
 )
 from rrc_pin.control.trajectory_log import LogRecord, TrajectoryLog
 
 __all__ = [
     "STRATEGIES",
+    "AuxiliaryHand",
     "Controller",
     "Deadman",
     "Decision",
     "DriftCorrection",
+    "Freezing",
     "GeneralizedInverse",
     "LogRecord",
     "ResolverOnly",
@@ -34,5 +40,7 @@ __all__ = [
     "Step",
     "Strategy",
     "TrajectoryLog",
+    "Uncoupled",
+    "WristChoice",
     "make_strategy",
 ]

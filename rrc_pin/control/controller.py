@@ -224,7 +224,7 @@ class Controller:
         J_task = J[self._rows]
         sv = np.asarray(np.linalg.svd(J_task, compute_uv=False), dtype=np.float64)
         decision = self.strategy.decide(Situation(self.robot, q, command_wa + correction,
-                                                  J_task, sv, self.dt))  # fmt: skip
+                                                  J_task, sv, self.dt, command))  # fmt: skip
         if decision.rates is None:
             in_frame = command + (_rotated(R.T, correction) if local else correction)
             r = self.resolver.solve(q, decision.factor * in_frame, ref=self._command_frame)

@@ -7,16 +7,24 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
+from rrc_pin.control.strategies.auxiliary_hand import AuxiliaryHand
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
+from rrc_pin.control.strategies.freezing import Freezing
 from rrc_pin.control.strategies.generalized_inverse import GeneralizedInverse
 from rrc_pin.control.strategies.resolver_only import ResolverOnly
 from rrc_pin.control.strategies.slowdown import Slowdown
+from rrc_pin.control.strategies.uncoupled import Uncoupled
+from rrc_pin.control.strategies.wrist_choice import WristChoice
 from rrc_pin.errors import InvalidInput
 
 STRATEGIES: dict[str, Callable[[], Strategy]] = {
     "resolver": ResolverOnly,
     "slowdown": Slowdown,
     "generalized_inverse": GeneralizedInverse,
+    "freezing": Freezing,
+    "auxiliary_hand": AuxiliaryHand,
+    "wrist_choice": WristChoice,
+    "uncoupled": Uncoupled,
 }
 """Names :func:`make_strategy` takes, with the strategy each builds (default settings)."""
 
@@ -41,11 +49,15 @@ def make_strategy(strategy: Strategy | str | None) -> Strategy:
 
 __all__ = [
     "STRATEGIES",
+    "AuxiliaryHand",
     "Decision",
+    "Freezing",
     "GeneralizedInverse",
     "ResolverOnly",
     "Situation",
     "Slowdown",
     "Strategy",
+    "Uncoupled",
+    "WristChoice",
     "make_strategy",
 ]

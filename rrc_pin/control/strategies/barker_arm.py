@@ -2,9 +2,17 @@
 
 from __future__ import annotations
 
+import math
+from typing import NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
 from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
 from solvers.closed_form.barker import BarkerClosedForm
+
+Array = npt.NDArray[np.float64]
 
 
 def barker_closed_form(robot: Robot, strategy: str) -> BarkerClosedForm:
@@ -20,3 +28,30 @@ def barker_closed_form(robot: Robot, strategy: str) -> BarkerClosedForm:
             f"{robot.name} has none: use 'slowdown' or 'resolver'",
         )  # fmt: skip
     return cf
+
+
+class Nearness(NamedTuple):
+    """How near Barker's singular sets a configuration is, each in [0, 1]-ish units.
+
+    Attributes:
+        shoulder: ``|eq. (32)| / L`` (``L`` the reach from joint 2 to the wrist centre).
+        elbow: ``|eq. (33)| / L``.
+        wrist: ``|sin theta5|``.
+    """
+
+    shoulder: float
+    elbow: float
+    wrist: float
+
+
+def nearness(cf: BarkerClosedForm, q: Array) -> Nearness:
+    """Barker's singularity conditions (32), (33) and S5 at ``q`` (6,), normalised."""
+    s = cf.singularity(q)
+    reach = cf.geometry.reach
+    return Nearness(abs(s.eq32) / reach, abs(s.eq33) / reach, abs(s.s5))
+
+
+def elbow_singular_angle(cf: BarkerClosedForm) -> float:
+    """theta3 [rad] nearest 0 where eq. (33) vanishes: ``SAL3 WE S3 + A3 C3 = 0``."""
+    g = cf.geometry
+    return math.atan2(-g.a3, g.sal3 * g.we)

@@ -25,6 +25,8 @@ class Situation(NamedTuple):
             (all six rows, or the three linear ones for an arm of fewer than six joints).
         singular_values: Singular values of ``jacobian``, descending (min(m, nq),).
         dt: Control period [s].
+        command: The operator's twist (6,) as given, in its frame (speed override and
+            deadman applied, no drift correction).
     """
 
     robot: Robot
@@ -33,6 +35,7 @@ class Situation(NamedTuple):
     jacobian: Array
     singular_values: Array
     dt: float
+    command: Array
 
 
 class Decision(NamedTuple):
