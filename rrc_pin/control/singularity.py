@@ -23,10 +23,9 @@ class SingularityLabel:
     32)"`` when ``|S2 ES + F5 - F1| < near * L``, ``"elbow (eq. 33)"`` when ``|SAL3 WE S3 + A3
     C3| < near * L`` (``L`` the reach from joint 2 to the wrist centre), ``"wrist (S5 = 0)"``
     when ``|sin theta5| < near``; several joined by ``+``. Any other arm: when the smallest
-    singular value of the task Jacobian is below ``near`` (same units), the joints that
-    carry its right singular vector (components at least half the largest) and the task
-    direction lost (the largest component of the left one), e.g. ``"panda_joint5+panda_joint7
-    (wz)"``.
+    singular value of the task Jacobian is below ``near`` (same units), the joint that
+    carries most of its right singular vector and the task direction lost (the largest
+    component of the left one), e.g. ``"panda_joint5 (wz)"``.
 
     Args:
         robot: The robot.
@@ -60,5 +59,4 @@ class SingularityLabel:
             return ""
         U, _, Vt = np.linalg.svd(jacobian, full_matrices=False)
         v, u = np.abs(Vt[-1]), np.abs(U[:, -1])
-        joints = [self.robot.joint_names[i] for i in np.flatnonzero(v >= 0.5 * v.max())]
-        return f"{'+'.join(joints)} ({AXES[int(np.argmax(u))]})"
+        return f"{self.robot.joint_names[int(np.argmax(v))]} ({AXES[int(np.argmax(u))]})"
