@@ -202,7 +202,8 @@ def teleoperation(out: Path | None = None, quick: bool = False) -> int:
     runs = [(s, name) for s in SESSIONS for name in s.strategies]
     print(f"== Teleoperation sessions, dt = {DT * 1e3:g} ms, margin {MARGIN} rad from every "
           f"limit{' (quick)' if quick else ''}: {len(runs)} runs -> {out}\n")  # fmt: skip
-    rows, logs = [], {}
+    rows: list[Row] = []
+    logs: dict[str, TrajectoryLog] = {}
     for k, (session, strategy) in enumerate(runs, 1):
         start = time.perf_counter()
         log = run_session(session, strategy, quick)
