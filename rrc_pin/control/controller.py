@@ -40,7 +40,7 @@ from solvers.validation import as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
 Frame = Literal["local", "world_aligned"]
-ZERO_ERROR = (np.zeros(3), np.zeros(3))
+NO_DRIFT = (0.0, 0.0)
 LINEAR = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
 FRAMES: tuple[str, ...] = ("local", "world_aligned")
 REANCHOR = ("damped", "singular", "least_squares", "recovering", "fallback")
@@ -155,7 +155,7 @@ class Controller:
         self._reanchor = False
         self._period = DriftCorrection().period if drift is None else drift.period
         self._next_check = 0.0  # the pose error is measured every period, the log's too
-        self._error = ZERO_ERROR
+        self._drift = NO_DRIFT  # [m], [rad]: the last measured pose error's size
         self._correction = np.zeros(6)
 
     # -- settings ---------------------------------------------------------------------------
@@ -211,15 +211,16 @@ class Controller:
         R = pose[:3, :3]
         if self._reanchor:
             self._reference, self._reanchor = pose, False
-            self._error, self._correction = ZERO_ERROR, np.zeros(6)
+            self._drift, self._correction = NO_DRIFT, np.zeros(6)
         command_wa = _rotated(R, command) if local else command
         if self.t >= self._next_check - 1e-9 * self.dt:
-            self._error = pose_error(pose, self._reference)
+            linear, angular = pose_error(pose, self._reference)
             if not self._full:  # position rows only: the orientation is not commanded
-                self._error = (self._error[0], np.zeros(3))
+                angular = np.zeros(3)
+            self._drift = (float(np.linalg.norm(linear)), float(np.linalg.norm(angular)))
             self._next_check = self.t + self._period
             if self.drift is not None:
-                self._correction = self.drift.twist(*self._error)
+                self._correction = self.drift.twist(linear, angular)
         correction = self._correction
         J_task = J[self._rows]
         sv = np.asarray(np.linalg.svd(J_task, compute_uv=False), dtype=np.float64)
@@ -230,7 +231,7 @@ class Controller:
             r = self.resolver.solve(q, decision.factor * in_frame, ref=self._command_frame)
         else:
             r = self.resolver.solve(q, [RatesTask(decision.rates)], priority="strict")
-        self._record(q, J, self._error, r, command_wa, decision.factor, sv, "teleop", decision.note)
+        self._record(q, J, self._drift, r, command_wa, decision.factor, sv, "teleop", decision.note)
         if decision.rates is None and r.status not in REANCHOR:
             fraction = decision.factor * r.scale
             if self._full:
@@ -281,7 +282,7 @@ class Controller:
                 rates = (target - q) / self.dt
                 r = self.resolver.solve(q, [RatesTask(rates, "reverse")], priority="strict")
                 sv = np.asarray(np.linalg.svd(J[self._rows], compute_uv=False), dtype=np.float64)
-                self._record(q, J, ZERO_ERROR, r, np.zeros(6), 1.0, sv, "reverse", "")
+                self._record(q, J, NO_DRIFT, r, np.zeros(6), 1.0, sv, "reverse", "")
                 self._advance(r)
                 steps += 1
                 if r.status == "exact":  # reached (to rounding): on to the next one
@@ -312,18 +313,17 @@ class Controller:
         return Step(self.q.copy(), r)
 
     def _record(
-        self, q: Array, J: Array, error: tuple[Array, Array], r: Resolution, commanded: Array,
+        self, q: Array, J: Array, drift: tuple[float, float], r: Resolution, commanded: Array,
         factor: float, sv: Array, mode: str, note: str,
     ) -> None:  # fmt: skip
-        """Append the tick to the log (``error``: the pose error of :func:`pose_error`)."""
-        linear, angular = error
+        """Append the tick to the log (``drift``: the last measured pose error [m], [rad])."""
         active = ";".join(f"{a.name or a.joint}:{a.side}:{a.kind}" for a in r.active)
         label = self.label(q, J[self._rows], sv)
         self.log.append(LogRecord(
             t=self.t, q=q.copy(), qdot=r.qdot.copy(), commanded=commanded, achieved=J @ r.qdot,
             scale=r.scale, factor=factor, sigma_min=float(sv[-1]),
-            manipulability=float(np.prod(sv)), drift_position=float(np.linalg.norm(linear)),
-            drift_rotation=float(np.linalg.norm(angular)), mode=mode, method=r.method,
+            manipulability=float(np.prod(sv)), drift_position=drift[0],
+            drift_rotation=drift[1], mode=mode, method=r.method,
             status=r.status, active=active, singularity=label, note=note,
         ))  # fmt: skip
 

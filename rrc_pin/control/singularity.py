@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.control.strategies.barker_arm import nearness
 from rrc_pin.robot import Robot
 from solvers.closed_form.barker import BarkerClosedForm
 
@@ -48,11 +49,10 @@ class SingularityLabel:
             singular_values: Its singular values, descending.
         """
         if self.barker is not None:
-            s = self.barker.singularity(q)
-            reach = self.barker.geometry.reach
-            names = [name for name, value in (("shoulder (eq. 32)", abs(s.eq32) / reach),
-                                              ("elbow (eq. 33)", abs(s.eq33) / reach),
-                                              ("wrist (S5 = 0)", abs(s.s5)))
+            near = nearness(self.barker, q)
+            names = [name for name, value in (("shoulder (eq. 32)", near.shoulder),
+                                              ("elbow (eq. 33)", near.elbow),
+                                              ("wrist (S5 = 0)", near.wrist))
                      if value < self.near]  # fmt: skip
             return "+".join(names)
         if singular_values[-1] >= self.near:
