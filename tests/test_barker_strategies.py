@@ -45,7 +45,7 @@ SINGULARITIES = {
 def test_through_each_singularity_rates_are_finite_and_within_the_limits(strategy, singularity):
     q0, twist = SINGULARITIES[singularity]
     ctl = Controller(ARM, q0=q0, strategy=strategy)
-    for _ in range(100):
+    for _ in range(70):  # through the singular value at 50
         ctl.step(twist, "world_aligned")
     q, qdot = ctl.log.column("q"), ctl.log.column("qdot")
     assert np.isfinite(q).all() and np.isfinite(qdot).all()
