@@ -1,12 +1,13 @@
 """``rrc-pin demo``: a scripted teleoperation session on the paper arms, every strategy.
 
 Each paper arm (``barker6``, ``rrc_k1607``, ``kr5_3r``) is driven by the same kind of operator
-script: hand-frame commands (Barker eq. (20)) that reach out to the stretched arm and back,
-cross the base axis, turn the wrist through theta5 = 0 (Barker's arm), roll the hand against
-a joint limit, let go (the deadman fades the command), and reverse the last two seconds
-(Barker's evacuation). The script runs once per applicable singularity strategy; a summary
-table is printed, the trajectories are written as CSV, the table as ``summary.csv`` and a
-figure as ``session.png`` (needs matplotlib, the ``plot`` extra) into the output folder.
+script: hand-frame commands (Barker eq. (20)) that turn the wrist through theta5 = 0
+(Barker's arm), cross the base axis, reach out to the stretched arm and back (the other
+arms: reach, then cross), roll the hand against a joint limit, let go (the deadman fades the
+command), and reverse the last two seconds (Barker's evacuation). The script runs once per
+applicable singularity strategy; a summary table is printed, the trajectories are written
+as CSV, the table as ``summary.csv`` and a figure as ``session.png`` (needs matplotlib, the
+``plot`` extra) into the output folder.
 """
 
 from __future__ import annotations
@@ -116,25 +117,26 @@ def shoulder_frame(robot: Robot) -> str:
     return str(robot.model.frames[robot.model.getFrameId(robot.joint_names[1])].name)
 
 
+ACROSS = Segment("across the base axis", toward_axis(0.15), 4.0)
 REACH = (
     Segment("reach out to the stretched arm", reach(0.15), 2.5),
     Segment("back in", reach(-0.15), 1.5),
-    Segment("across the base axis", toward_axis(0.15), 4.0),
 )
 LET_GO = Segment("let go (deadman)", None, 0.5)
 SESSIONS = (
-    Session("barker6", (0.35, 0.52, 1.05, 0.17, 0.20, 0.0),
-            (Segment("wrist through theta5 = 0", fixed([0, 0, 0, 0, -0.8, 0]), 1.0), *REACH,
+    Session("barker6", (0.35, -0.2, 0.9, 0.17, 0.20, 0.0),
+            (Segment("wrist through theta5 = 0", fixed([0, 0, 0, 0, -0.8, 0]), 1.0), ACROSS, *REACH,
              Segment("roll against joint 6's limit", fixed([0, 0, 0, 0, 0, 2.0]), 3.0),
              LET_GO),
             ("resolver", "slowdown", "generalized_inverse", "freezing", "auxiliary_hand",
              "wrist_choice", "uncoupled")),
     Session("rrc_k1607", (0.0, 0.5, 0.0, 1.2, 0.0, 0.6, 0.0),
-            (*REACH, Segment("roll against joint 7's limit", fixed([0, 0, 0, 0, 0, 2.0]), 3.0),
-             LET_GO),
+            (*REACH, ACROSS,
+             Segment("roll against joint 7's limit", fixed([0, 0, 0, 0, 0, 2.0]), 3.0), LET_GO),
             ("resolver", "slowdown")),
     Session("kr5_3r", (0.0, 0.785, -0.785),
-            (*REACH, Segment("sideways against joint 1's limit", sideways(0.5), 6.0), LET_GO),
+            (*REACH, ACROSS, Segment("sideways against joint 1's limit", sideways(0.5), 6.0),
+             LET_GO),
             ("resolver", "slowdown")),
 )  # fmt: skip
 
@@ -158,7 +160,7 @@ def summarise(arm: str, strategy: str, log: TrajectoryLog, robot: Robot) -> Row:
     q, qdot = log.column("q"), log.column("qdot")
     margin = float(np.min(np.minimum(q - robot.lower, robot.upper - q)))
     statuses = Counter(str(s) for s in log.column("status"))
-    met = sorted({str(s) for s in log.column("singularity") if s})
+    met = sorted({name for s in log.column("singularity") if s for name in str(s).split("+")})
     return Row(
         arm, strategy, len(log), 1e3 * float(np.max(log.column("drift_position"))), margin,
         float(np.max(np.abs(qdot) / robot.velocity_limit)),

@@ -57,8 +57,10 @@ def test_the_table_holds_the_numbers_of_the_trajectories(quick_demo):
         assert line.split()[2:6] == [steps, drift, margin, rate]
         assert float(margin) >= 0.02 - 1e-9 and float(rate) <= 1.0 + 1e-9
         assert statuses.split()[0] in ("exact", "scaled")
-    barker = [r for r in rows[1:] if r[0] == "barker6"]
-    assert len(barker) == 7 and all("wrist (S5 = 0)" in r[7] for r in barker)
+    barker = {r[1]: r[7] for r in rows[1:] if r[0] == "barker6"}
+    assert len(barker) == 7 and all("shoulder (eq. 32)" in met for met in barker.values())
+    # the slowdown keeps the hand from the wrist singularity in the quick script's time
+    assert all("wrist (S5 = 0)" in met for name, met in barker.items() if name != "slowdown")
 
 
 def test_the_figure_is_skipped_without_matplotlib(tmp_path, monkeypatch):
