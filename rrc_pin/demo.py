@@ -205,13 +205,14 @@ def teleoperation(out: Path | None = None, quick: bool = False) -> int:
     print(f"== Teleoperation sessions, dt = {DT * 1e3:g} ms, margin {MARGIN} rad from every "
           f"limit{' (quick)' if quick else ''}: {len(runs)} runs -> {out}\n")  # fmt: skip
     rows: list[Row] = []
-    logs: dict[str, TrajectoryLog] = {}
+    logs: dict[str, dict[str, TrajectoryLog]] = {}
     for k, (session, strategy) in enumerate(runs, 1):
         start = time.perf_counter()
         log = run_session(session, strategy, quick)
         log.save(out / f"{session.arm}-{strategy}.csv")
         rows.append(summarise(session.arm, strategy, log, load(session.arm)))
-        logs.setdefault(session.arm, log)
+        if strategy in ("resolver", "slowdown"):
+            logs.setdefault(session.arm, {})[strategy] = log
         print(f"[{k:2d}/{len(runs)}] {session.arm} / {strategy}: {len(log)} ticks in "
               f"{time.perf_counter() - start:.1f} s", flush=True)  # fmt: skip
     print()
@@ -219,7 +220,7 @@ def teleoperation(out: Path | None = None, quick: bool = False) -> int:
     write_summary(rows, out / "summary.csv")
     from rrc_pin.demo_figure import draw
 
-    figure = draw({arm: (load(arm), log) for arm, log in logs.items()}, out / "session.png")
+    figure = draw({arm: (load(arm), by) for arm, by in logs.items()}, out / "session.png")
     for session in SESSIONS:
         labels = ", ".join(s.label for s in session.segments)
         print(f"\n{session.arm}: {labels}, then reverse {REVERSE:g} s.", end="")

@@ -14,8 +14,12 @@ from rrc_pin.control import TrajectoryLog
 from rrc_pin.robot import Robot
 
 
-def draw(sessions: dict[str, tuple[Robot, TrajectoryLog]], path: Path) -> bool:
-    """Write the figure to ``path``; False (nothing written) when matplotlib is absent."""
+def draw(sessions: dict[str, tuple[Robot, dict[str, TrajectoryLog]]], path: Path) -> bool:
+    """Write the figure to ``path``; False (nothing written) when matplotlib is absent.
+
+    Per arm: the joints of its first strategy's log (angles, rates), and the smallest
+    singular value under every strategy given.
+    """
     try:
         import matplotlib
 
@@ -25,17 +29,21 @@ def draw(sessions: dict[str, tuple[Robot, TrajectoryLog]], path: Path) -> bool:
         return False
     fig, axes = plt.subplots(3, len(sessions), figsize=(5 * len(sessions), 8), sharex="col",
                              squeeze=False)  # fmt: skip
-    for col, (arm, (robot, log)) in enumerate(sessions.items()):
+    for col, (arm, (robot, logs)) in enumerate(sessions.items()):
+        strategy, log = next(iter(logs.items()))
         t, q, qdot = log.column("t"), log.column("q"), log.column("qdot")
         span = robot.upper - robot.lower
         axes[0, col].plot(t, (q - robot.lower) / span, lw=1)
         axes[0, col].axhline(0.0, color="k", lw=0.8)
         axes[0, col].axhline(1.0, color="k", lw=0.8)
-        axes[0, col].set_title(f"{arm} ({log.column('mode')[0]} and reverse)")
+        axes[0, col].set_title(f"{arm}: {strategy}, then reverse")
         axes[1, col].plot(t, qdot / robot.velocity_limit, lw=1)
         axes[1, col].axhline(1.0, color="k", lw=0.8)
         axes[1, col].axhline(-1.0, color="k", lw=0.8)
-        axes[2, col].semilogy(t, np.maximum(log.column("sigma_min"), 1e-6), lw=1)
+        for name, other in logs.items():
+            sigma = np.maximum(other.column("sigma_min"), 1e-6)
+            axes[2, col].semilogy(other.column("t"), sigma, lw=1, label=name)
+        axes[2, col].legend(fontsize=6, loc="lower right")
         axes[2, col].set_xlabel("t [s]")
         if col == 0:
             axes[0, col].set_ylabel("(q - lower) / range")
