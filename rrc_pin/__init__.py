@@ -3,10 +3,13 @@
 Entry points: :func:`arms`, :func:`load`, :class:`Robot`; :class:`Resolver` with its options
 (:class:`JointLimits`, :class:`QPOptions`, :class:`Damping`), tasks (:class:`FrameTask`,
 :class:`RelativeFrameTask`, :class:`PostureTask`, :class:`JointTask`, :class:`DampingTask`)
-and its answer, :class:`Resolution`.
+and its answer, :class:`Resolution`; the teleoperation loop :class:`Controller` (with
+:class:`Deadman`, :class:`DriftCorrection`, :class:`TrajectoryLog`; strategies in
+:mod:`rrc_pin.control.strategies`).
 """
 
 from rrc_pin.combine import combine
+from rrc_pin.control import Controller, Deadman, DriftCorrection, TrajectoryLog
 from rrc_pin.errors import (
     FrameNotFound,
     InvalidInput,
@@ -25,8 +28,11 @@ from solvers.resolution import ActiveLimit, Resolution, TaskReport
 
 __all__ = [
     "ActiveLimit",
+    "Controller",
     "Damping",
     "DampingTask",
+    "Deadman",
+    "DriftCorrection",
     "FrameNotFound",
     "FrameTask",
     "InvalidInput",
@@ -42,6 +48,7 @@ __all__ = [
     "Task",
     "TaskReport",
     "ToolFrameRequired",
+    "TrajectoryLog",
     "URDFError",
     "UnknownArm",
     "UnknownBackend",

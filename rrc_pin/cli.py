@@ -50,7 +50,8 @@ def parser() -> argparse.ArgumentParser:
     sub.add_parser("arms", help="table of the robots rrc_pin.load accepts, with their tool frames")
     demo = sub.add_parser(
         "demo",
-        help="a short tour: kinematics, closed forms and resolved-rate control (paper arms, panda)",
+        help="a scripted teleoperation session on the paper arms under every singularity "
+        "strategy: summary table, trajectories (CSV) and a figure (PNG) in a folder",
     )
     demo.add_argument(
         "--arm",
@@ -59,6 +60,14 @@ def parser() -> argparse.ArgumentParser:
         help="print only the kinematics row of this arm (DOF, tool position, cond(J) at a "
         "named pose) instead of the tour",
     )
+    demo.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="folder for the outputs (default: a new ./rrc-pin-demo-<timestamp>)",
+    )
+    demo.add_argument("--quick", action="store_true", help="shorter scripts (a smoke test)")
     check = sub.add_parser("check", help="cross-check every catalogue arm: DH, Pinocchio, yourdfpy")
     check.add_argument("--samples", type=int, default=200, help="configurations per arm (>= 1)")
     bench = sub.add_parser(
@@ -134,7 +143,7 @@ def run(args: argparse.Namespace) -> int:
         return run_cross_check(samples=args.samples)
     from rrc_pin.demo import run_demo
 
-    return run_demo(args.arm)
+    return run_demo(args.arm, out=args.out, quick=args.quick)
 
 
 def _discard_stdout() -> None:

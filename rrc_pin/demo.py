@@ -1,23 +1,236 @@
-"""``rrc-pin demo``: kinematics, closed forms and resolved-rate control in one short run."""
+"""``rrc-pin demo``: a scripted teleoperation session on the paper arms, every strategy.
+
+Each paper arm (``barker6``, ``rrc_k1607``, ``kr5_3r``) is driven by the same kind of operator
+script: hand-frame commands (Barker eq. (20)) that turn the wrist through theta5 = 0
+(Barker's arm), cross the base axis, reach out to the stretched arm and back (the other
+arms: reach, then cross), roll the hand against a joint limit, let go (the deadman fades the
+command), and reverse the last two seconds (Barker's evacuation). The script runs once per
+applicable singularity strategy; a summary table is printed, the trajectories are written
+as CSV, the table as ``summary.csv`` and a figure as ``session.png`` (needs matplotlib, the
+``plot`` extra) into the output folder.
+"""
 
 from __future__ import annotations
 
+import csv
 import time
 from collections import Counter
+from collections.abc import Callable
+from datetime import datetime
+from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
 from rrc_pin import models
+from rrc_pin.control import Controller, TrajectoryLog
+from rrc_pin.limits import JointLimits
 from rrc_pin.loading import load
-from rrc_pin.resolver import Resolver
 from rrc_pin.robot import Robot
-from rrc_pin.tasks import FrameTask
-from solvers.closed_form.barker import BarkerClosedForm
-from solvers.closed_form.quaternion import quaternion_from_matrix, rotation_vector
 
 Array = npt.NDArray[np.float64]
 DT = 0.01  # [s], control period
+MARGIN = 0.02  # [rad], kept from every joint limit
+REVERSE = 2.0  # [s], the evacuation at the end
+Command = Callable[[Controller], Array]
+"""A segment's hand-frame twist, chosen from the state at the segment's start."""
+
+
+class Segment(NamedTuple):
+    """One line of the operator's script: a hand-frame twist held for ``seconds``."""
+
+    label: str
+    command: Command | None  # None: the operator lets go
+    seconds: float
+
+
+class Session(NamedTuple):
+    """An arm's script and the strategies it runs under."""
+
+    arm: str
+    q0: tuple[float, ...]
+    segments: tuple[Segment, ...]
+    strategies: tuple[str, ...]
+
+
+class Row(NamedTuple):
+    """One line of the summary table (the numbers of one session's log)."""
+
+    arm: str
+    strategy: str
+    steps: int
+    drift_mm: float
+    margin_rad: float
+    rate: float
+    statuses: str
+    singularities: str
+
+
+def to_hand(ctl: Controller, linear: Array, angular: Array | None = None) -> Array:
+    """A twist given in base axes, expressed in the hand frame (what the operator sends)."""
+    R = ctl.robot.fk(ctl.q)[:3, :3]
+    w = np.zeros(3) if angular is None else angular
+    return np.concatenate([R.T @ linear, R.T @ w])
+
+
+def reach(speed: float) -> Command:
+    """Along the line from the arm's shoulder (its second joint) to the hand, [m/s]."""
+
+    def command(ctl: Controller) -> Array:
+        robot = ctl.robot
+        d = robot.fk(ctl.q)[:3, 3] - robot.fk(ctl.q, shoulder_frame(robot))[:3, 3]
+        return to_hand(ctl, speed * d / np.linalg.norm(d))
+
+    return command
+
+
+def toward_axis(speed: float) -> Command:
+    """Horizontally toward the base's z axis (the shoulder singularity lies on it), [m/s]."""
+
+    def command(ctl: Controller) -> Array:
+        p = ctl.robot.fk(ctl.q)[:3, 3]
+        horizontal = np.array([-p[0], -p[1], 0.0])
+        return to_hand(ctl, speed * horizontal / np.linalg.norm(horizontal))
+
+    return command
+
+
+def sideways(speed: float) -> Command:
+    """Horizontally around the base's z axis (turning joint 1 toward its limit), [m/s]."""
+
+    def command(ctl: Controller) -> Array:
+        p = ctl.robot.fk(ctl.q)[:3, 3]
+        around = np.array([-p[1], p[0], 0.0])
+        return to_hand(ctl, speed * around / np.linalg.norm(around))
+
+    return command
+
+
+def fixed(twist: list[float]) -> Command:
+    """The same hand-frame twist whatever the state."""
+    return lambda ctl: np.array(twist, dtype=np.float64)
+
+
+def shoulder_frame(robot: Robot) -> str:
+    """The frame of the second joint (the shoulder of the paper arms)."""
+    return str(robot.model.frames[robot.model.getFrameId(robot.joint_names[1])].name)
+
+
+ACROSS = Segment("across the base axis", toward_axis(0.15), 4.0)
+REACH = (
+    Segment("reach out to the stretched arm", reach(0.15), 2.5),
+    Segment("back in", reach(-0.15), 1.5),
+)
+LET_GO = Segment("let go (deadman)", None, 0.5)
+SESSIONS = (
+    Session("barker6", (0.35, -0.2, 0.9, 0.17, 0.20, 0.0),
+            (Segment("wrist through theta5 = 0", fixed([0, 0, 0, 0, -0.8, 0]), 1.0), ACROSS, *REACH,
+             Segment("roll against joint 6's limit", fixed([0, 0, 0, 0, 0, 2.0]), 3.0),
+             LET_GO),
+            ("resolver", "slowdown", "generalized_inverse", "freezing", "auxiliary_hand",
+             "wrist_choice", "uncoupled")),
+    Session("rrc_k1607", (0.0, 0.5, 0.0, 1.2, 0.0, 0.6, 0.0),
+            (*REACH, ACROSS,
+             Segment("roll against joint 7's limit", fixed([0, 0, 0, 0, 0, 2.0]), 3.0), LET_GO),
+            ("resolver", "slowdown")),
+    Session("kr5_3r", (0.0, 0.785, -0.785),
+            (*REACH, ACROSS, Segment("sideways against joint 1's limit", sideways(0.5), 6.0),
+             LET_GO),
+            ("resolver", "slowdown")),
+)  # fmt: skip
+
+
+def run_session(session: Session, strategy: str, quick: bool) -> TrajectoryLog:
+    """The script of ``session`` under ``strategy``; the controller's log."""
+    robot = load(session.arm)
+    ctl = Controller(robot, DT, session.q0, strategy=strategy,
+                     limits=JointLimits(margin=MARGIN))  # fmt: skip
+    scale = 0.3 if quick else 1.0
+    for segment in session.segments:
+        twist = None if segment.command is None else segment.command(ctl)
+        for _ in range(round(scale * segment.seconds / DT)):
+            ctl.step(twist, "local")  # re-sent every tick; None: let go, the command ages
+    ctl.reverse(min(scale * REVERSE, len(ctl.log) * DT))
+    return ctl.log
+
+
+def summarise(arm: str, strategy: str, log: TrajectoryLog, robot: Robot) -> Row:
+    """The summary row of one session's log."""
+    q, qdot = log.column("q"), log.column("qdot")
+    margin = float(np.min(np.minimum(q - robot.lower, robot.upper - q)))
+    statuses = Counter(str(s) for s in log.column("status"))
+    met = sorted({name for s in log.column("singularity") if s for name in str(s).split("+")})
+    return Row(
+        arm, strategy, len(log), 1e3 * float(np.max(log.column("drift_position"))), margin,
+        float(np.max(np.abs(qdot) / robot.velocity_limit)),
+        " ".join(f"{k} {n}" for k, n in statuses.most_common()),
+        "; ".join(met[:3]) + (f"; +{len(met) - 3} more" if len(met) > 3 else ""),
+    )  # fmt: skip
+
+
+HEADER = ("arm", "strategy", "steps", "max drift [mm]", "min margin [rad]", "max |qdot|/limit",
+          "statuses", "singularities met")  # fmt: skip
+
+
+def print_table(rows: list[Row]) -> None:
+    """The summary table."""
+    print(f"{HEADER[0]:10s} {HEADER[1]:20s} {HEADER[2]:>6s} {HEADER[3]:>14s} {HEADER[4]:>16s} "
+          f"{HEADER[5]:>16s}  {HEADER[6]} | {HEADER[7]}")  # fmt: skip
+    for r in rows:
+        print(f"{r.arm:10s} {r.strategy:20s} {r.steps:6d} {r.drift_mm:14.4f} {r.margin_rad:16.6f} "
+              f"{r.rate:16.4f}  {r.statuses} | {r.singularities or '-'}")  # fmt: skip
+
+
+def write_summary(rows: list[Row], path: Path) -> None:
+    """The table as CSV, numbers as printed."""
+    with path.open("w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow(HEADER)
+        for r in rows:
+            writer.writerow([r.arm, r.strategy, r.steps, f"{r.drift_mm:.4f}", f"{r.margin_rad:.6f}",
+                             f"{r.rate:.4f}", r.statuses, r.singularities])  # fmt: skip
+
+
+def default_out() -> Path:
+    """A new folder under the working directory."""
+    return Path.cwd() / f"rrc-pin-demo-{datetime.now().strftime('%Y%m%d-%H%M%S')}"
+
+
+def teleoperation(out: Path | None = None, quick: bool = False) -> int:
+    """The scripted sessions, the table, the CSV files and the figure; the exit code."""
+    out = default_out() if out is None else out
+    out.mkdir(parents=True, exist_ok=True)
+    runs = [(s, name) for s in SESSIONS for name in s.strategies]
+    print(f"== Teleoperation sessions, dt = {DT * 1e3:g} ms, margin {MARGIN} rad from every "
+          f"limit{' (quick)' if quick else ''}: {len(runs)} runs -> {out}\n")  # fmt: skip
+    rows: list[Row] = []
+    logs: dict[str, dict[str, TrajectoryLog]] = {}
+    for k, (session, strategy) in enumerate(runs, 1):
+        start = time.perf_counter()
+        log = run_session(session, strategy, quick)
+        log.save(out / f"{session.arm}-{strategy}.csv")
+        rows.append(summarise(session.arm, strategy, log, load(session.arm)))
+        if strategy in ("resolver", "slowdown"):
+            logs.setdefault(session.arm, {})[strategy] = log
+        print(f"[{k:2d}/{len(runs)}] {session.arm} / {strategy}: {len(log)} ticks in "
+              f"{time.perf_counter() - start:.1f} s", flush=True)  # fmt: skip
+    print()
+    print_table(rows)
+    write_summary(rows, out / "summary.csv")
+    from rrc_pin.demo_figure import draw
+
+    figure = draw({arm: (load(arm), by) for arm, by in logs.items()}, out / "session.png")
+    for session in SESSIONS:
+        labels = ", ".join(s.label for s in session.segments)
+        print(f"\n{session.arm}: {labels}, then reverse {REVERSE:g} s.", end="")
+    print("\n\ndrift: distance from the commanded pose (corrected every 0.1 s; Barker's "
+          "strategies choose\nthe rates themselves and leave that pose, so none is measured); "
+          "margin: closest approach to a\njoint limit; statuses: how the resolver answered.")
+    print(f"\nwritten: {len(runs)} trajectories (CSV), summary.csv"
+          + (", session.png" if figure else "; session.png skipped: matplotlib is not "
+             "installed (pip install -e '.[plot]')"))  # fmt: skip
+    return 0
 
 
 def kinematics_tour(names: list[str]) -> None:
@@ -34,150 +247,9 @@ def kinematics_tour(names: list[str]) -> None:
             print(f"{name:12s} {arm.nq:3d} {pose_name:12s} {frame:16s} {position:>28s} {cond:9.2e}")
 
 
-def closed_form_check(rng: np.random.Generator) -> None:
-    """Closed-form joint rates of the paper arms against a solve with Pinocchio's Jacobian.
-
-    Barker's closed form is asked for its exact inverse: by default it damps the rates in a
-    narrow band around its singularities (continuous there), where it differs from lstsq.
-    """
-    print(f"{'arm':12s} {'closed form':>22s} {'max rel. diff vs Pinocchio':>28s}")
-    for name in ("barker6", "rrc_k1607", "kr5_3r"):
-        arm = load(name)
-        cf = arm.closed_form
-        assert cf is not None  # every paper arm has one at its tool frame
-        worst = 0.0
-        for _ in range(200):
-            q = arm.random_q(rng)
-            x = rng.normal(size=cf.task_dim)
-            J = arm.jacobian(q)[: cf.task_dim]
-            if np.linalg.cond(J) > 1e6:
-                continue
-            reference = np.linalg.lstsq(J, x, rcond=None)[0]
-            if isinstance(cf, BarkerClosedForm):
-                rates = cf.joint_rates(q, x, exact=True)
-            else:
-                rates = cf.joint_rates(q, x)
-            worst = max(worst, float(np.linalg.norm(rates - reference) / np.linalg.norm(reference)))
-        print(f"{name:12s} {type(cf).__name__:>22s} {worst:28.1e}")
-
-
-def teleoperate(arm: Robot, q0: Array, segments: list[tuple[str, Array, float]]) -> Array:
-    """Drive ``arm`` with hand-frame twists (Barker eq. (20)), Euler-integrated (eq. (21)).
-
-    Returns:
-        The joint path, (steps + 1, nq).
-    """
-    resolver = Resolver(arm, dt=DT)
-    q = q0.copy()
-    path = [q]
-    print(
-        f"{'command (hand frame)':28s} {'asked':>8s} {'done':>10s} {'veer':>6s} "
-        f"{'max|qdot|':>10s} {'limit excess':>12s} {'step [us]':>9s}  answers"
-    )
-    for label, twist, duration in segments:
-        T0 = arm.fk(q)
-        methods: Counter[str] = Counter()
-        times, peak, excess = [], 0.0, 0.0
-        for _ in range(round(duration / DT)):
-            start = time.perf_counter()
-            r = resolver.solve(q, twist, ref="local")
-            times.append(time.perf_counter() - start)
-            q = q + r.qdot * DT
-            path.append(q)
-            methods[r.status] += 1
-            peak = max(peak, float(np.abs(r.qdot).max()))
-            excess = max(
-                excess,
-                float(np.max(np.abs(r.qdot) - arm.velocity_limit)),
-                float(np.max(q - arm.upper)),
-                float(np.max(arm.lower - q)),
-            )
-        T1 = arm.fk(q)
-        if np.any(twist[:3]):  # translation: compare displacements in base axes
-            asked_vec = T0[:3, :3] @ twist[:3] * duration
-            done_vec = T1[:3, 3] - T0[:3, 3]
-            unit = "m  "
-        else:  # rotation: compare rotation vectors in the starting hand frame
-            asked_vec = twist[3:] * duration
-            done_vec = rotation_vector(quaternion_from_matrix(T0[:3, :3].T @ T1[:3, :3]))
-            unit = "rad"
-        asked, done = float(np.linalg.norm(asked_vec)), float(np.linalg.norm(done_vec))
-        cos = float(asked_vec @ done_vec) / max(asked * done, 1e-300)
-        veer = float(np.rad2deg(np.arccos(np.clip(cos, -1.0, 1.0))))
-        used = ", ".join(f"{m} {n}" for m, n in methods.most_common())
-        print(
-            f"{label:28s} {asked:6.3f} {unit} {done:6.3f} {unit} {veer:6.2f} {peak:8.3f}   "
-            f"{max(excess, 0.0):12.1e} {1e6 * np.median(times):9.0f}  {used}"
-        )
-    return np.array(path)
-
-
-def run_demo(arm: str | None = None) -> int:
-    """Run the demo (all paper arms plus panda, or the tour of one ``arm``); exit code."""
-    rng = np.random.default_rng(0)
-    names = [arm] if arm else [*models.CATALOGUE, "panda"]
-    print("== Forward kinematics and Jacobians (Pinocchio)\n")
-    kinematics_tour(names)
+def run_demo(arm: str | None = None, out: Path | None = None, quick: bool = False) -> int:
+    """The teleoperation sessions, or (``arm``) the kinematics row of one arm; the exit code."""
     if arm:
+        kinematics_tour([arm])
         return 0
-    print("\n== Closed forms of the papers, 200 random configurations each\n")
-    closed_form_check(rng)
-
-    print("\n== Barker's arm teleoperated in the hand frame, dt = 10 ms (QP resolver, DAQP)\n")
-    barker = load("barker6")
-    q0 = np.deg2rad([20.0, 30.0, 60.0, 10.0, 40.0, 0.0])
-    path = teleoperate(
-        barker,
-        q0,
-        [
-            ("0.80 rad/s about -y6, 1.5 s", np.array([0, 0, 0, 0, -0.8, 0.0]), 1.5),
-            ("0.10 m/s along x6, 1 s", np.array([0.1, 0, 0, 0, 0, 0.0]), 1.0),
-            ("0.30 rad/s about z6, 1 s", np.array([0, 0, 0, 0, 0, 0.3]), 1.0),
-            ("5 m/s along -z6, 0.5 s", np.array([0, 0, -5.0, 0, 0, 0.0]), 0.5),
-        ],
-    )
-    theta5 = np.rad2deg(path[:151, 4])
-    print(
-        f"veer: angle [deg] between the commanded and the achieved motion. About -y6, theta5 "
-        f"went from {theta5[0]:.1f}\nto {theta5[-1]:.1f} deg through Barker's wrist singularity "
-        f"theta5 = 0 (closest {np.min(np.abs(theta5)):.2f} deg). 5 m/s exceeds the\njoint "
-        "speed limits: the hand slowed down along the commanded direction (the veer left comes\n"
-        "from Euler integration). answers: exact, scaled (direction kept, slower), damped\n"
-        "(near a singularity)."
-    )
-
-    print("\n== Panda: an absurd command (1e6 m/s) from a start outside the joint limits\n")
-    panda = load("panda")
-    q = panda.neutral()
-    q[0] = panda.upper[0] + 0.05
-    r = Resolver(panda, dt=DT).solve(q, np.array([1e6, 0, 0, 0, 0, 0.0]))
-    active = ", ".join(f"{a.name} {a.side} {a.kind}" for a in r.active[:4])
-    print(
-        f"{r.status}: scale {r.scale:.2e}, qdot[0] = {r.qdot[0]:+.3f} rad/s (back into "
-        f"range), max|qdot|/limit = {np.max(np.abs(r.qdot) / panda.velocity_limit):.3f}"
-    )
-    print(f"active limits: {active}{' ...' if len(r.active) > 4 else ''}")
-    two_hands()
-    return 0
-
-
-def two_hands() -> None:
-    """Baxter's grippers with the left one commanded beyond its speed.
-
-    Both at one priority level, they slow down together with their directions kept; with the
-    right one first, it stays exact and the left one gets the least squares of what is left.
-    """
-    print("\n== Baxter, two grippers on one model (15 joints), strict priorities\n")
-    baxter = load("baxter")
-    left, right = baxter.tool_frames
-    q = baxter.neutral() + 0.3
-    fast, slow = np.array([2.0, 0, 0, 0, 0, 0.0]), np.array([0, 0.05, 0, 0, 0, 0.0])
-    resolver = Resolver(baxter, dt=DT)
-    print(f"{'levels':32s} {left + ' scale':>20s} {right + ' scale':>20s}  status")
-    for label, levels in (
-        ("[left, right] together", [[FrameTask(left, fast), FrameTask(right, slow)]]),
-        ("[right] above [left]", [FrameTask(right, slow), FrameTask(left, fast)]),
-    ):
-        r = resolver.solve(q, levels, priority="strict")
-        scale = {t.name: t.scale for t in r.tasks}
-        print(f"{label:32s} {scale[left]:20.3f} {scale[right]:20.3f}  {r.status}")
+    return teleoperation(out, quick)

@@ -149,29 +149,6 @@ def test_check_command_cross_validates(capsys):
     assert out.count(" ok") == 5
 
 
-def test_demo_runs_as_a_console_script():
-    out = run_console_script("demo")
-    assert out.returncode == 0, out.stderr
-    assert "nan" not in out.stdout.lower()
-    rows = [
-        line.split()
-        for line in out.stdout.splitlines()
-        if " rad/s about " in line or " m/s along " in line
-    ]
-    assert len(rows) == 4
-    for row in rows:
-        unit_at = row.index("rad") if "rad" in row[:9] else row.index("m")
-        asked, done, veer, excess = (
-            float(row[unit_at - 1]),
-            float(row[unit_at + 1]),
-            float(row[unit_at + 3]),
-            float(row[unit_at + 5]),
-        )
-        assert excess <= 1e-12 and done <= asked * (1 + 1e-3) and veer < 1.0, row
-    closed_form_rows = [line.split() for line in out.stdout.splitlines() if "ClosedForm" in line]
-    assert len(closed_form_rows) == 3 and all(float(r[-1]) < 1e-9 for r in closed_form_rows)
-
-
 # ---- rrc-pin bench (issue 18 item 11) ---------------------------------------------------------
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -1,0 +1,334 @@
+r"""Controller: Barker's operator loop on the resolver, one tick per call.
+
+Every :meth:`Controller.step` takes the operator's twist in the hand frame (Barker eq. (20),
+``frame="local"``) or in base axes (``"world_aligned"``), weights it by the speed override
+and the deadman (:class:`~rrc_pin.control.deadman.Deadman`), adds the bounded pull back to
+the commanded pose (:class:`~rrc_pin.control.drift.DriftCorrection`), lets the singularity
+strategy adjust it (:mod:`rrc_pin.control.strategies`), resolves it with the
+:class:`~rrc_pin.resolver.Resolver` (joint limits, margins) and integrates the rates for one
+period (Barker eq. (21)) on the configuration manifold:
+
+.. math:: q_{k+1} = q_k \oplus \dot q_k\, \Delta t \quad (\texttt{pinocchio.integrate}),
+
+recording the tick in a :class:`~rrc_pin.control.trajectory_log.TrajectoryLog`.
+:meth:`Controller.reverse` retraces the recorded joint positions back in time (Barker's
+"speedy and effortless evacuation of the robot hand from a congested workspace").
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
+
+from rrc_pin.control.deadman import Deadman
+from rrc_pin.control.drift import DriftCorrection, advance, pose_error
+from rrc_pin.control.rates_task import RatesTask
+from rrc_pin.control.singularity import SingularityLabel
+from rrc_pin.control.strategies import Situation, Strategy, make_strategy
+from rrc_pin.control.trajectory_log import LogRecord, TrajectoryLog
+from rrc_pin.errors import InvalidInput
+from rrc_pin.limits import JointLimits
+from rrc_pin.loading import load
+from rrc_pin.resolver import Damping, QPOptions, Resolver
+from rrc_pin.robot import Robot
+from solvers.resolution import Resolution
+from solvers.validation import as_vector, finite_number
+
+Array = npt.NDArray[np.float64]
+Frame = Literal["local", "world_aligned"]
+NO_DRIFT = (0.0, 0.0)
+LINEAR = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
+FRAMES: tuple[str, ...] = ("local", "world_aligned")
+REANCHOR = ("damped", "singular", "least_squares", "recovering", "fallback")
+"""Statuses whose motion departs from the command's direction: the reference pose is reset to
+the reached pose instead of pulling the hand back to a pose it could not follow."""
+
+
+class Step(NamedTuple):
+    """One tick's outcome.
+
+    Attributes:
+        q: Joint positions after the tick (nq,) [rad or m] (a copy).
+        resolution: The resolver's answer for the tick.
+    """
+
+    q: Array
+    resolution: Resolution
+
+
+class Retrace(NamedTuple):
+    """What :meth:`Controller.reverse` did.
+
+    Attributes:
+        steps: Ticks taken.
+        reached: Whether every recorded configuration was reached (no limit intervened
+            beyond the extra ticks allowed).
+        error: Largest joint distance [rad or m] from the segment's start at the end.
+    """
+
+    steps: int
+    reached: bool
+    error: float
+
+
+class Controller:
+    """A resolved-rate teleoperation loop holding the arm's configuration.
+
+    Args:
+        robot: A :class:`rrc_pin.Robot` with one tool frame, or a name :func:`rrc_pin.load`
+            takes.
+        dt: Control period [s], > 0.
+        q0: Initial joint positions (nq,) [rad or m]; default ``robot.neutral()``.
+        strategy: A singularity strategy: a :class:`Strategy` or its name
+            (:data:`~rrc_pin.control.strategies.STRATEGIES`); default ``"resolver"`` (the
+            resolver's own handling).
+        limits: Joint limits and margins of the resolver (default ``JointLimits()``).
+        qp: QP backend and fallbacks of the resolver.
+        damping: Damping of the resolver near singularities, or None.
+        deadman: How a command ages (default ``Deadman()``), or None: a command stays in
+            force until the next.
+        drift: Pose-drift correction (default ``DriftCorrection()``), or None for none.
+        speed: Speed override in [0, 1] (a teach pendant's percentage), settable.
+        near: Width of the neighbourhood in which singularities are named in the log
+            (:class:`~rrc_pin.control.singularity.SingularityLabel`).
+
+    Raises:
+        InvalidInput: A bad argument, named (a robot with several tool frames included).
+        UnknownArm, URDFError: ``robot`` is a name or path that does not load.
+    """
+
+    def __init__(
+        self,
+        robot: Robot | str,
+        dt: float = 0.01,
+        q0: npt.ArrayLike | None = None,
+        *,
+        strategy: Strategy | str | None = None,
+        limits: JointLimits | None = None,
+        qp: QPOptions | None = None,
+        damping: Damping | None = Damping(),  # noqa: B008 - immutable
+        deadman: Deadman | None = Deadman(),  # noqa: B008 - immutable
+        drift: DriftCorrection | None = DriftCorrection(),  # noqa: B008 - immutable
+        speed: float = 1.0,
+        near: float = 0.05,
+    ) -> None:
+        if isinstance(robot, str):
+            robot = load(robot)
+        if not isinstance(robot, Robot):
+            raise InvalidInput("robot", f"expected a rrc_pin.Robot or a name, got {robot!r}")
+        if robot.tool_frame is None:
+            raise InvalidInput(
+                "robot", f"{robot.name} has several tool frames ({', '.join(robot.tool_frames)}); "
+                "load it with tool_frame=... for one hand",
+            )  # fmt: skip
+        if deadman is not None and not isinstance(deadman, Deadman):
+            raise InvalidInput("deadman", f"expected a Deadman or None, got {deadman!r}")
+        if drift is not None and not isinstance(drift, DriftCorrection):
+            raise InvalidInput("drift", f"expected a DriftCorrection or None, got {drift!r}")
+        self.robot = robot
+        self.resolver = Resolver(robot, dt, limits=limits, qp=qp, damping=damping)
+        self.dt = self.resolver.dt
+        self.strategy = make_strategy(strategy)
+        self.strategy.check(robot)
+        self.q = robot.neutral() if q0 is None else robot.check_q(q0, "q0").copy()
+        self.speed = speed
+        self.deadman = deadman
+        self.drift = drift
+        self.label = SingularityLabel(robot, finite_number(near, "near", 0.0, inclusive=False,
+                                                           error=InvalidInput))  # fmt: skip
+        self.log = TrajectoryLog(robot.joint_names)
+        self.t = 0.0
+        assert self.resolver.task is not None  # one tool frame: the resolver has its task
+        self._rows = list(self.resolver.task.selected)
+        self._full = len(self._rows) == 6
+        self._data = robot.model.createData()
+        self._frame_id = robot.model.getFrameId(robot.tool_frame)
+        self._manifold = robot.model.nq != robot.model.nv  # continuous joints as (cos, sin)
+        self._command = np.zeros(6)
+        self._command_frame: Frame = "local"
+        self._command_time = -math.inf
+        self._reference: Array = self._kinematics(self.q)[1]
+        self._reanchor = False
+        self._period = DriftCorrection().period if drift is None else drift.period
+        self._next_check = 0.0  # the pose error is measured every period, the log's too
+        self._drift = NO_DRIFT  # [m], [rad]: the last measured pose error's size
+        self._correction = np.zeros(6)
+
+    # -- settings ---------------------------------------------------------------------------
+
+    @property
+    def speed(self) -> float:
+        """Speed override in [0, 1]: every command is multiplied by it."""
+        return self._speed
+
+    @speed.setter
+    def speed(self, value: float) -> None:
+        value = finite_number(value, "speed", 0.0, error=InvalidInput)
+        if value > 1.0:
+            raise InvalidInput("speed", f"expected a finite number in [0, 1], got {value}")
+        self._speed = value
+
+    @property
+    def reference(self) -> Array:
+        """The commanded pose (4, 4) the drift correction pulls toward (a copy)."""
+        out: Array = self._reference.copy()
+        return out
+
+    # -- the loop ---------------------------------------------------------------------------
+
+    def step(self, twist: npt.ArrayLike | None = None, frame: Frame = "local") -> Step:
+        """Resolve and integrate one tick of the operator's command.
+
+        Args:
+            twist: Commanded twist [v; w] (6,) [m/s, rad/s] of the tool frame in ``frame``,
+                or None: no new command this tick (the last one ages, see ``deadman``).
+            frame: ``"local"`` (hand axes, Barker eq. (20)) or ``"world_aligned"`` (base
+                axes).
+
+        Returns:
+            The new configuration and the tick's resolution.
+
+        Raises:
+            InvalidInput: A bad ``twist`` (shape, NaN, inf) or ``frame``, raised before any
+                state changes.
+        """
+        if frame not in FRAMES:
+            raise InvalidInput("frame", f"expected one of {', '.join(FRAMES)}, got {frame!r}")
+        if twist is not None:
+            command = as_vector(twist, "twist", 6, InvalidInput).copy()
+            self._command, self._command_frame, self._command_time = command, frame, self.t
+        age = self.t - self._command_time
+        weight = self._speed * (1.0 if self.deadman is None else self.deadman.factor(age))
+        command = weight * self._command
+        local = self._command_frame == "local"
+
+        q = self.q
+        J, pose = self._kinematics(q)
+        R = pose[:3, :3]
+        if self._reanchor:
+            self._reference, self._reanchor = pose, False
+            self._drift, self._correction = NO_DRIFT, np.zeros(6)
+        command_wa = _rotated(R, command) if local else command
+        if self.t >= self._next_check - 1e-9 * self.dt:
+            linear, angular = pose_error(pose, self._reference)
+            if not self._full:  # position rows only: the orientation is not commanded
+                angular = np.zeros(3)
+            self._drift = (float(np.linalg.norm(linear)), float(np.linalg.norm(angular)))
+            self._next_check = self.t + self._period
+            if self.drift is not None:
+                self._correction = self.drift.twist(linear, angular)
+        correction = self._correction
+        J_task = J[self._rows]
+        sv = np.asarray(np.linalg.svd(J_task, compute_uv=False), dtype=np.float64)
+        decision = self.strategy.decide(Situation(self.robot, q, command_wa + correction,
+                                                  J_task, sv, self.dt, command))  # fmt: skip
+        if decision.rates is None:
+            in_frame = command + (_rotated(R.T, correction) if local else correction)
+            r = self.resolver.solve(q, decision.factor * in_frame, ref=self._command_frame)
+        else:
+            r = self.resolver.solve(q, [RatesTask(decision.rates)], priority="strict")
+        self._record(q, J, self._drift, r, command_wa, decision.factor, sv, "teleop", decision.note)
+        if decision.rates is None and r.status not in REANCHOR:
+            fraction = decision.factor * r.scale
+            if self._full:
+                self._reference = advance(self._reference, fraction * command, self.dt, local)
+            else:  # the commanded position, at the orientation reached
+                self._reference = advance(self._reference, fraction * command_wa * LINEAR,
+                                          self.dt, False)  # fmt: skip
+        else:
+            self._reanchor = True
+        return self._advance(r)
+
+    def reverse(self, seconds: float, extra: float = 1.0) -> Retrace:
+        """Retrace the last ``seconds`` of the record back to where that segment started.
+
+        Each tick aims at the previous recorded configuration, at the rates that reach it in
+        one period, kept inside the joint limits by the resolver (scaled when they do not
+        fit; then further ticks aim at the same configuration). When no limit intervenes the
+        arm passes through the recorded configurations up to rounding. The command is
+        cleared (the operator must command again) and the reference pose reset.
+
+        Args:
+            seconds: Length of the segment [s], > 0, at most the recorded time.
+            extra: Extra ticks allowed, as a fraction of the segment's, for configurations a
+                limit delays, >= 0.
+
+        Returns:
+            What was done (:class:`Retrace`).
+
+        Raises:
+            InvalidInput: ``seconds`` not > 0 or longer than the record, or a bad ``extra``;
+                raised before any state changes.
+        """
+        seconds = finite_number(seconds, "seconds", 0.0, inclusive=False, error=InvalidInput)
+        extra = finite_number(extra, "extra", 0.0, error=InvalidInput)
+        n = max(1, round(seconds / self.dt))
+        if n > len(self.log):
+            raise InvalidInput(
+                "seconds", f"asked to reverse {seconds} s ({n} ticks); the record holds "
+                f"{len(self.log)} ticks ({len(self.log) * self.dt:.6g} s)",
+            )  # fmt: skip
+        targets = [r.q for r in self.log.records[-n:]][::-1]
+        budget = n + math.ceil(extra * n)
+        steps = 0
+        for target in targets:
+            while steps < budget:
+                q = self.q
+                J = self._kinematics(q)[0]
+                rates = (target - q) / self.dt
+                r = self.resolver.solve(q, [RatesTask(rates, "reverse")], priority="strict")
+                sv = np.asarray(np.linalg.svd(J[self._rows], compute_uv=False), dtype=np.float64)
+                self._record(q, J, NO_DRIFT, r, np.zeros(6), 1.0, sv, "reverse", "")
+                self._advance(r)
+                steps += 1
+                if r.status == "exact":  # reached (to rounding): on to the next one
+                    break
+        self._command, self._command_time = np.zeros(6), -math.inf
+        self._reanchor = True
+        error = float(np.max(np.abs(self.q - targets[-1])))
+        return Retrace(steps, error <= 1e-9 and steps <= budget, error)
+
+    # -- helpers ----------------------------------------------------------------------------
+
+    def _kinematics(self, q: Array) -> tuple[Array, Array]:
+        """Tool Jacobian (6, nq) ``world_aligned`` and tool pose (4, 4) at ``q``: one pass."""
+        model, data = self.robot.model, self._data
+        J: Array = pin.computeFrameJacobian(model, data, self.robot.to_pinocchio(q),
+                                            self._frame_id, pin.LOCAL_WORLD_ALIGNED)  # fmt: skip
+        pose: Array = pin.updateFramePlacement(model, data, self._frame_id).homogeneous
+        return J, pose
+
+    def _advance(self, r: Resolution) -> Step:
+        """Integrate ``r.qdot`` over one period (Barker eq. (21), ``pinocchio.integrate``)."""
+        model = self.robot.model
+        q_pin = self.robot.to_pinocchio(self.q)
+        moved = pin.integrate(model, q_pin, r.qdot * self.dt)
+        # Continuous joints: back to angles by the manifold's difference (= qdot dt).
+        self.q = self.q + pin.difference(model, q_pin, moved) if self._manifold else moved
+        self.t += self.dt
+        return Step(self.q.copy(), r)
+
+    def _record(
+        self, q: Array, J: Array, drift: tuple[float, float], r: Resolution, commanded: Array,
+        factor: float, sv: Array, mode: str, note: str,
+    ) -> None:  # fmt: skip
+        """Append the tick to the log (``drift``: the last measured pose error [m], [rad])."""
+        active = ";".join(f"{a.name or a.joint}:{a.side}:{a.kind}" for a in r.active)
+        label = self.label(q, J[self._rows], sv)
+        self.log.append(LogRecord(
+            t=self.t, q=q.copy(), qdot=r.qdot.copy(), commanded=commanded, achieved=J @ r.qdot,
+            scale=r.scale, factor=factor, sigma_min=float(sv[-1]),
+            manipulability=float(np.prod(sv)), drift_position=drift[0],
+            drift_rotation=drift[1], mode=mode, method=r.method,
+            status=r.status, active=active, singularity=label, note=note,
+        ))  # fmt: skip
+
+
+def _rotated(R: Array, twist: Array) -> Array:
+    """``[R v; R w]``: a twist's linear and angular parts in other axes."""
+    out: Array = np.concatenate([R @ twist[:3], R @ twist[3:]])
+    return out

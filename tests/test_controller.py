@@ -1,0 +1,210 @@
+"""The teleoperation controller (issue 8): frames, one-step order, reverse, sessions, deadman,
+speed override, margins, bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+import rrc_pin
+from rrc_pin.control import Controller, Deadman, DriftCorrection
+from rrc_pin.control.random_operator import random_commands
+
+BARKER_Q0 = np.deg2rad([20.0, 30.0, 60.0, 10.0, 40.0, 0.0])
+PANDA_Q0 = np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.8, 0.7])
+START = {"barker6": BARKER_Q0, "panda": PANDA_Q0}
+
+
+def start(name: str) -> np.ndarray:
+    arm = rrc_pin.load(name)
+    return START.get(name, arm.neutral())
+
+
+@pytest.fixture(scope="module")
+def barker():
+    return rrc_pin.load("barker6")
+
+
+@pytest.fixture(scope="module")
+def panda():
+    return rrc_pin.load("panda")
+
+
+def test_a_hand_frame_command_moves_the_tool_as_the_same_command_in_base_axes(barker):
+    twist = np.array([0.05, -0.02, 0.03, 0.2, -0.1, 0.3])
+    local = Controller(barker, q0=BARKER_Q0, drift=None)  # one command, its two spellings
+    base = Controller(barker, q0=BARKER_Q0, drift=None)
+    for _ in range(20):
+        R = barker.fk(base.q)[:3, :3]
+        local.step(twist, "local")
+        base.step(np.concatenate([R @ twist[:3], R @ twist[3:]]), "world_aligned")
+        assert np.max(np.abs(local.q - base.q)) < 1e-12
+
+
+@pytest.mark.parametrize("name", ["barker6", "panda"])
+def test_one_step_follows_the_twist_to_second_order_in_dt(name):
+    """Euler's step (Barker eq. (21)) leaves O(dt^2) of pose error: halving dt quarters it."""
+    arm = rrc_pin.load(name)
+    twist = np.array([0.05, -0.03, 0.04, 0.3, -0.2, 0.25])
+    T0 = arm.fk(start(name))
+    errors = []
+    dts = [8e-3, 4e-3, 2e-3, 1e-3]
+    for dt in dts:
+        ctl = Controller(arm, dt=dt, q0=start(name), drift=None)
+        step = ctl.step(twist, "local")
+        assert step.resolution.status == "exact" and not step.resolution.active
+        wanted = T0 @ pin.exp6(pin.Motion(twist[:3] * dt, twist[3:] * dt)).homogeneous
+        reached = arm.fk(step.q)
+        errors.append(np.linalg.norm(pin.log6(np.linalg.inv(wanted) @ reached).vector))
+    orders = np.log2(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all(np.abs(orders - 2.0) < 0.1), orders
+
+
+@pytest.mark.parametrize("name", ["barker6", "rrc_k1607", "kr5_3r", "panda"])
+def test_reverse_returns_to_the_recorded_start(name, rng):
+    arm = rrc_pin.load(name)
+    ctl = Controller(arm, q0=start(name))
+    q_start = ctl.q.copy()
+    for twist in random_commands(rng, 2.0, ctl.dt, speed=0.03, turn=0.1, pause=0.0):
+        ctl.step(twist)
+    assert not any(ctl.log.column("active"))  # no limit intervened
+    moved = np.max(np.abs(ctl.q - q_start))
+    result = ctl.reverse(2.0)
+    assert moved > 0.05
+    assert result.reached and result.steps == 200
+    assert np.max(np.abs(ctl.q - q_start)) <= 1e-9
+    assert set(ctl.log.column("mode")[-200:]) == {"reverse"}
+
+
+def test_reverse_keeps_the_limits_when_they_intervene(panda):
+    """Acceleration limits make the turn-around slower: more ticks, no excess, same start."""
+    limits = rrc_pin.JointLimits(acceleration=20.0)
+    ctl = Controller(panda, q0=PANDA_Q0, limits=limits)
+    for _ in range(100):
+        ctl.step([0.1, 0.0, 0.0, 0.0, 0.0, 0.5])
+    result = ctl.reverse(1.0)
+    qdot = ctl.log.column("qdot")[-result.steps:]
+    assert result.steps > 100
+    assert np.all(np.abs(np.diff(qdot, axis=0)) <= 20.0 * ctl.dt * (1 + 1e-9) + 1e-12)
+    assert result.reached and np.max(np.abs(ctl.q - PANDA_Q0)) <= 1e-9
+
+
+@pytest.mark.parametrize("name", ["barker6", "rrc_k1607", "kr5_3r", "panda"])
+def test_a_simulated_session_stays_in_the_limits_with_bounded_drift(name):
+    """20 s at 100 Hz of random operator commands (benchmarks/session_controller.py: 10 min)."""
+    arm = rrc_pin.load(name)
+    ctl = Controller(arm, q0=start(name))
+    for twist in random_commands(np.random.default_rng(1), 20.0, ctl.dt):
+        ctl.step(twist)
+    q, qdot = ctl.log.column("q"), ctl.log.column("qdot")
+    assert np.isfinite(q).all() and np.isfinite(qdot).all()
+    assert np.all(q >= arm.lower - 1e-12) and np.all(q <= arm.upper + 1e-12)
+    assert np.all(np.abs(qdot) <= arm.velocity_limit * (1 + 1e-9))
+    assert ctl.log.column("drift_position").max() < 1e-3  # [m]
+    assert ctl.log.column("drift_rotation").max() < 3e-3  # [rad]
+
+
+def test_drift_grows_without_the_correction_and_stays_small_with_it(barker):
+    drift = {}
+    for correction in (DriftCorrection(), None):
+        ctl = Controller(barker, q0=BARKER_Q0, drift=correction)
+        for twist in random_commands(np.random.default_rng(1), 8.0, ctl.dt):
+            ctl.step(twist)
+        drift[correction is None] = ctl.log.column("drift_position")
+    assert drift[False].max() < 0.5 * drift[True].max()
+    assert drift[False][-100:].mean() < 0.2 * drift[True][-100:].mean()
+    assert drift[True][-100:].max() > drift[True][:100].max()  # grows without correction
+
+
+def test_deadman_fades_an_old_command_smoothly_to_zero(panda):
+    deadman = Deadman(timeout=0.1, fade=0.2)
+    ctl = Controller(panda, q0=PANDA_Q0, deadman=deadman, drift=None)
+    first = ctl.step([0.05, 0.0, 0.0, 0.0, 0.0, 0.0]).resolution.qdot
+    speeds = [np.linalg.norm(ctl.step().resolution.qdot) for _ in range(40)]
+    ages = ctl.dt * np.arange(1, 41)
+    factors = np.array([deadman.factor(a) for a in ages])
+    # The rates follow the factor (the Jacobian changes little over 0.4 s).
+    assert np.allclose(speeds, factors * np.linalg.norm(first), rtol=0.05, atol=1e-12)
+    assert factors[9] == 1.0 and 0.0 < factors[15] < 1.0 and speeds[-1] == 0.0
+    assert np.max(np.abs(np.diff(factors))) < 0.1  # no jump
+
+
+def test_speed_override_scales_the_command(panda):
+    full = Controller(panda, q0=PANDA_Q0)
+    half = Controller(panda, q0=PANDA_Q0, speed=0.5)
+    twist = [0.05, 0.02, 0.0, 0.0, 0.1, 0.0]
+    assert np.allclose(half.step(twist).resolution.qdot,
+                       0.5 * full.step(twist).resolution.qdot, atol=1e-12)
+    half.speed = 0.0
+    assert np.all(half.step(twist).resolution.qdot == 0.0)
+
+
+def test_joint_limit_margins_are_kept(panda):
+    margin = 0.1
+    ctl = Controller(panda, q0=PANDA_Q0, limits=rrc_pin.JointLimits(margin=margin))
+    for _ in range(300):  # rotate the hand about its z axis far beyond joint 7's range
+        ctl.step([0.0, 0.0, 0.0, 0.0, 0.0, 2.0])
+    q = ctl.log.column("q")
+    assert np.all(q >= panda.lower + margin - 1e-12) and np.all(q <= panda.upper - margin + 1e-12)
+    assert abs(ctl.q[6] - (panda.upper[6] - margin)) < 1e-9 or abs(
+        ctl.q[6] - (panda.lower[6] + margin)) < 1e-9
+    assert any("panda_joint7" in a for a in ctl.log.column("active"))
+
+
+@pytest.mark.parametrize(
+    ("call", "argument"),
+    [
+        (lambda c: c.step([0.0, 0.0, np.nan, 0.0, 0.0, 0.0]), "twist"),
+        (lambda c: c.step([0.0, 0.0, 0.1]), "twist"),
+        (lambda c: c.step([0.1, 0, 0, 0, 0, 0], frame="tool"), "frame"),
+        (lambda c: c.step([0.1, 0, 0, 0, 0, 0], frame="world"), "frame"),
+        (lambda c: c.reverse(10.0), "seconds"),
+        (lambda c: c.reverse(-1.0), "seconds"),
+        (lambda c: setattr(c, "speed", 1.5), "speed"),
+        (lambda c: setattr(c, "speed", float("nan")), "speed"),
+    ],
+)
+def test_bad_input_names_the_argument_and_changes_nothing(panda, call, argument):
+    ctl = Controller(panda, q0=PANDA_Q0)
+    for _ in range(5):
+        ctl.step([0.01, 0.0, 0.0, 0.0, 0.0, 0.0])
+    q, t, n, reference = ctl.q.copy(), ctl.t, len(ctl.log), ctl.reference
+    with pytest.raises(rrc_pin.InvalidInput) as info:
+        call(ctl)
+    assert info.value.argument == argument and argument in str(info.value)
+    assert np.array_equal(ctl.q, q) and ctl.t == t and len(ctl.log) == n
+    assert np.array_equal(ctl.reference, reference) and ctl.speed == 1.0
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "argument"),
+    [
+        ({"dt": 0.0}, "dt"),
+        ({"dt": -0.01}, "dt"),
+        ({"strategy": "magic"}, "strategy"),
+        ({"strategy": 3}, "strategy"),
+        ({"q0": [0.0] * 3}, "q0"),
+        ({"speed": -0.1}, "speed"),
+        ({"deadman": 0.2}, "deadman"),
+        ({"strategy": "generalized_inverse"}, "strategy"),  # panda has no Barker closed form
+    ],
+)
+def test_bad_construction_names_the_argument(panda, kwargs, argument):
+    with pytest.raises(rrc_pin.InvalidInput) as info:
+        Controller(panda, **kwargs)
+    assert info.value.argument == argument
+
+
+def test_a_robot_with_two_hands_is_refused():
+    with pytest.raises(rrc_pin.InvalidInput, match="several tool frames") as info:
+        Controller("baxter")
+    assert info.value.argument == "robot"
+
+
+def test_records_name_the_singularity_met(barker):
+    ctl = Controller(barker, q0=np.deg2rad([20.0, 30.0, 60.0, 10.0, 3.0, 0.0]))
+    for _ in range(15):
+        ctl.step([0.0, 0.0, 0.0, 0.0, -0.5, 0.0])  # theta5 towards and through 0
+    labels = set(ctl.log.column("singularity"))
+    assert "wrist (S5 = 0)" in labels
