@@ -18,7 +18,8 @@ bends ordinary commands far from any singularity):
 - for each singular direction :math:`v_i`, :math:`r_i = 1/\max_j |v_{ij}|/\dot q_{max,j}` is
   the largest rate along it within the velocity limits and :math:`c_i = \sigma_i r_i` the
   task speed it then delivers; the direction is weak when :math:`c_i < c_{on} =
-  \max_k c_k/\kappa` (``Damping.ratio`` :math:`\kappa`);
+  \max_k c_k/\kappa` (``Damping.ratio`` :math:`\kappa`), or when one step along it would
+  reach the singularity (below);
 - the exact rates are tried first: if they fit the step's bounds the command is met
   exactly, however weak a direction. Otherwise, with :math:`s_e \in [0, 1]` the uniform
   scale that brings them into the bounds, a weak direction gets the squared damping
@@ -26,19 +27,28 @@ bends ordinary commands far from any singularity):
 
   .. math::
 
-      \lambda_i^2 = \Big(1 - \big(c_i/c_{on}\big)^2\Big)\,\big(c_{on}/r_i\big)^2\,(1 - s_e),
+      \lambda_i^2 = \max\Big(\Big(1 - \big(c_i/c_{on}\big)^2\Big)\big(c_{on}/r_i\big)^2,\
+          g_i\,\big(\sigma_1 |u_i^T\dot x|\,\Delta t - \sigma_i^2\big),\ 0\Big)\,(1 - s_e),
+      \qquad g_i = \max\Big(1 - \frac{\sigma_i}{\sigma_1 R\,\Delta t},\ 0\Big),
 
-  and its rates become :math:`\sigma_i/(\sigma_i^2 + \lambda_i^2)\,u_i^T\dot x\,v_i`.
+  and its rates become :math:`\sigma_i/(\sigma_i^2 + \lambda_i^2)\,u_i^T\dot x\,v_i`. The
+  second term is for the step :math:`\Delta t`: near a singularity :math:`\sigma_i` changes
+  by about :math:`\sigma_1` (the arm's size) per radian along :math:`v_i`, so the
+  singularity is :math:`\sigma_i/\sigma_1` away, and a step of :math:`\Delta t\,\sigma_i
+  |u_i^T\dot x|/(\sigma_i^2 + \lambda_i^2)` along :math:`v_i` stays short of it when
+  :math:`\sigma_i^2 + \lambda_i^2 \ge \sigma_1 |u_i^T\dot x| \Delta t`. A step that crosses
+  it is undone by the next (a stretched elbow pushed outward: without the term the joints
+  flipped between opposite rate limits at every tick). No rates within the bounds reach
+  further than :math:`R\Delta t` (R the norm of the largest rates the bounds allow), so the
+  term fades out (:math:`g_i`, continuously) where the singularity is further away.
 
-The damping is zero away from singularities (every :math:`c_i \ge c_{on}`), zero for commands
-whose exact rates fit the limits (:math:`s_e = 1`), continuous in the configuration and in
-the command, and at most :math:`c_{on}/r_i` (the onset's own singular value) at an exact
-singularity.
+The damping is zero away from singularities (every :math:`c_i \ge c_{on}`, and steps short
+of them), zero for commands whose exact rates fit the limits (:math:`s_e = 1`), continuous
+in the configuration and in the command.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -168,8 +178,9 @@ class Damping:
         finite_number(self.ratio, "ratio", 1.0, inclusive=False)
 
     def lambda_sq(
-        self, svd: JacobianSVD, velocity: Array, exact: Array, lb: Array, ub: Array
-    ) -> Array | None:
+        self, svd: JacobianSVD, velocity: Array, exact: Array, lb: Array, ub: Array,
+        dt: float | None = None,
+    ) -> Array | None:  # fmt: skip
         r"""Squared damping per singular direction (k,), or None where none is needed.
 
         Args:
@@ -178,6 +189,8 @@ class Damping:
             exact: The exact least-squares rates (n,), outside the bounds.
             lb: Lower joint-rate bounds of the step (n,).
             ub: Upper joint-rate bounds (n,).
+            dt: The step [s], for the floor that keeps a step from crossing the singularity
+                (module docstring); None: no such floor.
 
         Returns:
             :math:`\lambda_i^2` (k,), or None when every one is zero.
@@ -185,20 +198,20 @@ class Damping:
         r = svd.rank
         if r == 0:
             return None
-        # min(v) <= r_i <= sqrt(n) max(v): no direction is weak while sigma_max / sigma_min
-        # is below ratio min(v) / (sqrt(n) max(v)), known without V (most steps)
-        v = velocity.tolist()
-        if float(svd.sigma[0]) * math.sqrt(len(v)) * max(v) <= (
-            float(svd.sigma[r - 1]) * min(v) * self.ratio
-        ):
-            return None
+        sigma = svd.sigma[:r]
         reach = 1.0 / (np.abs(svd.Vt[:r]) / velocity).max(axis=1)  # r_i
-        speed = svd.sigma[:r] * reach  # c_i
+        speed = sigma * reach  # c_i
         onset = float(np.max(speed)) / self.ratio  # c_on
-        if float(np.min(speed)) >= onset:
-            return None  # no weak direction: far from singularities
+        lam_r = np.maximum(1.0 - (speed / onset) ** 2, 0.0) * (onset / reach) ** 2
+        if dt is not None:  # g_i (sigma_1 |u_i^T xdot| dt - sigma_i^2), u_i^T xdot = sigma_i v_i w
+            step = float(sigma[0]) * dt  # sigma_1 dt
+            radius = norm(np.maximum(-lb, ub))  # R
+            fade = np.maximum(1.0 - sigma / (step * radius), 0.0) if step * radius > 0.0 else 0.0
+            crossing = step * sigma * np.abs(svd.Vt[:r] @ exact) - sigma * sigma
+            lam_r = np.maximum(lam_r, fade * crossing)
+        if not (lam_r > 0.0).any():
+            return None  # far from singularities
         s_exact = 0.0 if excludes_zero(lb, ub) else uniform_scale(exact, lb, ub)
-        weak = np.maximum(1.0 - (speed / onset) ** 2, 0.0)
         lam = np.zeros(svd.sigma.size)
-        lam[:r] = weak * (onset / reach) ** 2 * (1.0 - s_exact)
+        lam[:r] = lam_r * (1.0 - s_exact)
         return lam if lam.any() else None

@@ -54,6 +54,7 @@ class StepBounds(NamedTuple):
             (the arm cannot stop in one step), which is not recovering.
         velocity: The velocity limits (n,) the bounds were clipped into.
         position: The position bounds ``(lower, upper)`` (n,) before that clip.
+        dt: The step [s].
         acceleration: The acceleration bounds ``(lower, upper)`` (n,) before they were clipped
             into the velocity and position bounds, or None without acceleration limits.
     """
@@ -64,6 +65,7 @@ class StepBounds(NamedTuple):
     recovering: bool
     velocity: Array
     position: tuple[Array, Array]
+    dt: float
     acceleration: tuple[Array, Array] | None = None
 
     def kind(self, joint: int, side: Literal["lower", "upper"]) -> BoundKind:
@@ -161,13 +163,13 @@ class JointBounds:
         position = (lb.copy(), ub.copy())
         np.minimum(np.maximum(b, self._minus_velocity, out=b), self.velocity, out=b)
         if self.acceleration is None:
-            return StepBounds(lb, ub, not outside, outside, self.velocity, position)
+            return StepBounds(lb, ub, not outside, outside, self.velocity, position, dt)
         prev = np.zeros(self.n) if qdot_prev is None else qdot_prev
         reach = self.acceleration * dt
         wanted = (prev - reach, prev + reach)
         lb, ub = np.minimum(np.maximum(wanted, lb), ub)
         zero_ok = not excludes_zero(lb, ub)
-        return StepBounds(lb, ub, zero_ok, outside, self.velocity, position, wanted)
+        return StepBounds(lb, ub, zero_ok, outside, self.velocity, position, dt, wanted)
 
 
 def excludes_zero(lb: Array, ub: Array) -> bool:

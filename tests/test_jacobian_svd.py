@@ -120,7 +120,7 @@ def test_damped_rates_are_the_damped_least_squares(rng: np.random.Generator) -> 
 
 def reference_lambda_sq(
     J: np.ndarray, velocity: np.ndarray, b: np.ndarray, lb: np.ndarray, ub: np.ndarray,
-    ratio: float,
+    ratio: float, dt: float | None = None,
 ) -> np.ndarray:  # fmt: skip
     """The module docstring's schedule, from numpy's SVD and a brute-force uniform scale."""
     _, s, Vt = np.linalg.svd(J)
@@ -138,8 +138,33 @@ def reference_lambda_sq(
     else:
         s_exact = 0.0
     lam = np.zeros(s.size)
-    lam[:r] = np.maximum(1.0 - (speed / onset) ** 2, 0.0) * (onset / reach) ** 2 * (1 - s_exact)
-    return lam
+    lam[:r] = np.maximum(1.0 - (speed / onset) ** 2, 0.0) * (onset / reach) ** 2
+    if dt is not None:
+        U = np.linalg.svd(J)[0]
+        crossing = s[0] * np.abs(U[:, :r].T @ (J @ exact)) * dt - s[:r] ** 2
+        fade = np.maximum(1.0 - s[:r] / (s[0] * dt * np.linalg.norm(np.maximum(-lb, ub))), 0.0)
+        lam[:r] = np.maximum(lam[:r], fade * crossing)
+    return lam * (1 - s_exact)
+
+
+def test_a_step_that_would_reach_the_singularity_is_damped(rng: np.random.Generator) -> None:
+    """The step floor (sigma_1 |u_i^T xdot| dt - sigma_i^2, faded out where no step within
+    the bounds reaches the singularity) as the reference computes it, damping steps that the
+    onset alone leaves undamped."""
+    checked = 0
+    for _ in range(300):
+        theta2 = rng.uniform(-0.2, 0.2)
+        J = two_link(theta2)
+        v = np.array([2.0, 3.0])
+        b = rng.normal(size=2) * rng.choice([0.05, 0.5, 5.0])
+        svd = JacobianSVD(J)
+        exact = svd.rates(b)
+        for dt in (0.001, 0.01, 0.1):
+            lam = Damping().lambda_sq(svd, v, exact, -v, v, dt)
+            want = reference_lambda_sq(J, v, b, -v, v, 100.0, dt)
+            np.testing.assert_allclose(0.0 if lam is None else lam, want, rtol=1e-5, atol=1e-14)
+            checked += lam is not None and Damping().lambda_sq(svd, v, exact, -v, v) is None
+    assert checked > 20
 
 
 def two_link(theta2: float, theta1: float = 0.3, l1: float = 0.5, l2: float = 0.4) -> np.ndarray:
