@@ -21,7 +21,11 @@ runs it.
   small dense solve (no limits; ``J J^T`` for more than 6 joints, ``J`` for 6, the position
   rows, square, for 3).
 
-The library has no controller or cell objects yet: their tick rates are not measured.
+- **Controller tick against DOF**: ``Controller(arm).step(twist, "world_aligned")`` (the
+  teleoperation loop's tick: the same resolver plus the controller's kinematics, drift
+  check, integration and log) driven by the same twists from the trajectory's start, in a
+  second pass interleaved with the same floor; its ticks per second. There is no cell (a
+  loop over several arms) in the library: no cell tick rate.
 """
 
 from __future__ import annotations
@@ -43,9 +47,10 @@ from typing import Any  # noqa: E402
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
-from timing import progress  # noqa: E402
+from timing import progress, statistics  # noqa: E402
 
 import rrc_pin  # noqa: E402
+from rrc_pin.control import Controller  # noqa: E402
 from rrc_pin.robot import frame_id  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parent / "results"
@@ -193,7 +198,7 @@ def dof_row(name: str, tool: str | None, steps: int) -> dict[str, Any]:
     p10, p50, p90, p99 = np.percentile(ours * 1e6, [10, 50, 90, 99])
     f50, f99 = np.percentile(base * 1e6, [50, 99])
     progress(f"{name} ({arm.nq} joints): {p50:.0f} us per step, floor {f50:.0f} us")
-    return {
+    row = {
         "arm": name,
         "tool_frame": arm.tool_frame,
         "nq": arm.nq,
@@ -207,6 +212,37 @@ def dof_row(name: str, tool: str | None, steps: int) -> dict[str, Any]:
         "vs_floor_median": float(f50 / p50),
         "vs_floor_p99": float(f99 / p99),
     }
+    row["controller"] = controller_ticks(arm, Q, X, floor)
+    return row
+
+
+def controller_ticks(
+    arm: Any, Q: Array, X: Array, floor: Callable[[Array, Array], Array]
+) -> dict[str, Any]:
+    """``Controller.step`` along the trajectory's twists from its start, interleaved with the
+    floor at the trajectory's configurations."""
+    ctl = Controller(arm, dt=DT, q0=Q[0])
+    ctl.step(X[0], "world_aligned")  # untimed first call
+    ticks, base = np.empty(len(Q)), np.empty(len(Q))
+    clock = time.perf_counter
+    for k in range(len(Q)):
+        t0 = clock()
+        ctl.step(X[k], "world_aligned")
+        ticks[k] = clock() - t0
+        t0 = clock()
+        floor(Q[k], X[k])
+        base[k] = clock() - t0
+    row = statistics(ticks)
+    f50, f99 = np.percentile(base * 1e6, [50, 99])
+    row.update(
+        floor_median_us=float(f50),
+        floor_p99_us=float(f99),
+        vs_floor_median=float(f50 / row["median_us"]),
+        vs_floor_p99=float(f99 / row["p99_us"]),
+        ticks_per_s=1e6 / row["median_us"],
+    )
+    progress(f"{arm.name} ({arm.nq} joints): controller tick {row['median_us']:.0f} us")
+    return row
 
 
 def run(quick: bool) -> dict[str, Any]:
@@ -262,7 +298,31 @@ def docs_section(results: dict[str, Any]) -> str:
             f"{r['floor_median_us']:.1f} | {r['vs_floor_median']:.2f}x | "
             f"{r['vs_floor_p99']:.2f}x |"
         )
+    if all("controller" in r for r in results["dof"]):
+        lines += ["", *controller_table(results)]
     return "\n".join(lines)
+
+
+def controller_table(results: dict[str, Any]) -> list[str]:
+    """Controller tick time against DOF (results recorded since the controller exists)."""
+    lines = [
+        'Controller tick against DOF: `Controller(arm).step(twist, "world_aligned")` on the '
+        "same twists from the trajectory's start, in a second pass interleaved with the floor. "
+        "No cell (a loop over several arms) exists in the library: no cell tick rate.",
+        "",
+        "| arm | joints | tick median [us] | p10 | p90 | p99 | ticks per s (median) | "
+        "floor median [us] | floor / tick (median) | (p99) |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for r in results["dof"]:
+        c = r["controller"]
+        lines.append(
+            f"| {r['arm']} | {r['nq']} | {c['median_us']:.0f} | {c['p10_us']:.0f} | "
+            f"{c['p90_us']:.0f} | {c['p99_us']:.0f} | {c['ticks_per_s']:,.0f} | "
+            f"{c['floor_median_us']:.1f} | {c['vs_floor_median']:.2f}x | "
+            f"{c['vs_floor_p99']:.2f}x |"
+        )
+    return lines
 
 
 def _times(ratio: float) -> str:
@@ -310,6 +370,10 @@ def plot(results: dict[str, Any], path: Path) -> bool:
         color="k",
         capsize=3,
     )  # fmt: skip
+    if all("controller" in r for r in rows):
+        right.plot(
+            x - 0.2, [r["controller"]["median_us"] for r in rows], "kD", label="Controller.step"
+        )
     right.bar(x + 0.2, [r["floor_median_us"] for r in rows], 0.4, label="floor (J + solve)")
     right.set_xticks(x, [f"{r['arm']}\n{r['nq']} DOF" for r in rows], fontsize=8)
     right.set(ylabel="time per step [us]", title="step time against DOF (p10-p90 bars)")
