@@ -38,8 +38,7 @@ from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
-from machine import load_average, machine_info, source_state  # noqa: E402
-from script import arguments, parser, pyplot, write  # noqa: E402
+from script import arguments, make_parser, measure, pyplot, write  # noqa: E402
 from timing import add_ratios, progress, statistics, us  # noqa: E402
 
 import rrc_pin  # noqa: E402
@@ -272,19 +271,18 @@ def plot(result: dict[str, Any], path: Path) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = arguments(parser(__doc__, "control_schemes", "short scenarios (smoke test)"), argv)
-    start = load_average()
+    args = arguments(make_parser(__doc__, "control_schemes", "short scenarios (smoke test)"), argv)
     steps = QUICK_STEPS if args.quick else STEPS
-    result: dict[str, Any] = {
-        "benchmark": "control_schemes",
-        "machine": machine_info("scipy"),
-        "source": source_state(),
-        "quick": bool(args.quick),
-        "settings": {"steps": steps, "baseline": BASELINE},
-        **bench(args.quick),
-        "timing": [step_time(arm, steps) for arm in ARMS],
-    }
-    result["load_average"] = {"start": start, "end": load_average()}
+    result = measure(
+        "control_schemes",
+        args.quick,
+        lambda: {
+            "settings": {"steps": steps, "baseline": BASELINE},
+            **bench(args.quick),
+            "timing": [step_time(arm, steps) for arm in ARMS],
+        },
+        "scipy",
+    )
     write(args, "control_schemes", result, lambda path: plot(result, path), indent=1)
     print(markdown(result))
     return 0

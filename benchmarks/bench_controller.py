@@ -40,8 +40,7 @@ from typing import Any  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from machine import load_average, machine_info, source_state  # noqa: E402
-from script import arguments, parser, write  # noqa: E402
+from script import arguments, make_parser, measure, write  # noqa: E402
 from timing import add_ratios, one_core, progress, statistics, timing_chart, us  # noqa: E402
 
 import rrc_pin  # noqa: E402
@@ -263,20 +262,12 @@ def plot(results: dict[str, Any], path: Path) -> bool:
         ({"interleaved": a["contenders"]}, f"{a['arm']}: one tick of the operator's loop")
         for a in results["arms"]
     ]
-    return timing_chart(panels, path, (6.5 * len(panels), 2.6))
+    return timing_chart(panels, path, (6.5 * len(panels), 3.4))
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = arguments(parser(__doc__, "controller", f"{QUICK_STEPS} ticks, 6 s sessions"), argv)
-    start = load_average()
-    results: dict[str, Any] = {
-        "benchmark": "controller",
-        "machine": machine_info(),
-        "source": source_state(),
-        "quick": bool(args.quick),
-        **run(args.quick),
-    }
-    results["load_average"] = {"start": start, "end": load_average()}
+    args = arguments(make_parser(__doc__, "controller", f"{QUICK_STEPS} ticks, 6 s sessions"), argv)
+    results = measure("controller", args.quick, lambda: run(args.quick))
     write(args, "controller", results, lambda path: plot(results, path))
     print(docs_section(results))
     return 0

@@ -35,8 +35,6 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-import argparse  # noqa: E402
-import json  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 import warnings  # noqa: E402
@@ -46,14 +44,13 @@ from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
-from machine import load_average, machine_info, source_state  # noqa: E402
-from timing import progress, statistics  # noqa: E402
+from script import arguments, make_parser, measure, pyplot, write  # noqa: E402
+from timing import progress, record_trajectory, statistics  # noqa: E402
 
 import rrc_pin  # noqa: E402
 from rrc_pin.control import Controller  # noqa: E402
 from rrc_pin.robot import frame_id  # noqa: E402
 
-RESULTS = Path(__file__).resolve().parent / "results"
 SEED = 20261202
 DT = 0.01
 SEGMENT = 50
@@ -163,25 +160,11 @@ def batch_curve(name: str, sizes: tuple[int, ...], rng: np.random.Generator) -> 
     return {"arm": name, "nq": arm.nq, "task_dim": m, "points": points, "flattens_at": flat}
 
 
-def record_trajectory(arm: Any, steps: int, rng: np.random.Generator) -> tuple[Array, Array]:
-    """Configurations and twists of an rrc-pin tracking run (as ``bench_resolver.py``)."""
-    resolver = rrc_pin.Resolver(arm, dt=DT, direction_preserving=False)
-    q = arm.random_q(rng)
-    Q, X = np.empty((steps, arm.nq)), np.empty((steps, 6))
-    twist = np.zeros(6)
-    for k in range(steps):
-        if k % SEGMENT == 0:
-            twist = np.concatenate([rng.normal(size=3) * 0.23, rng.normal(size=3) * 0.35])
-        Q[k], X[k] = q, twist
-        q = q + resolver.solve(q, twist).qdot * DT
-    return Q, X
-
-
 def dof_row(name: str, tool: str | None, steps: int) -> dict[str, Any]:
     """Resolver step time along one trajectory, interleaved with the floor."""
     arm = rrc_pin.load(name, tool_frame=tool) if tool else rrc_pin.load(name)
     rng = np.random.default_rng(SEED)
-    Q, X = record_trajectory(arm, steps, rng)
+    Q, X = record_trajectory(arm, steps, rng, DT, SEGMENT)
     resolver = rrc_pin.Resolver(arm, dt=DT)
     floor = floor_step(arm)
     resolver.solve(Q[0], X[0])  # untimed first call
@@ -332,13 +315,9 @@ def _times(ratio: float) -> str:
 def plot(results: dict[str, Any], path: Path) -> bool:
     """Time per configuration against N (log-log) and step time against DOF; False without
     matplotlib."""
-    try:
-        import matplotlib
-    except ImportError:
+    plt = pyplot()
+    if plt is None:
         return False
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
     fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.5))
     for curve in results["batch"]:
@@ -385,31 +364,10 @@ def plot(results: dict[str, Any], path: Path) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="N up to 10^4, 100 steps")
-    where = parser.add_mutually_exclusive_group()
-    where.add_argument("--out", type=Path, help="folder for scaling.json and .png")
-    where.add_argument("--record", action="store_true", help="write benchmarks/results/")
-    args = parser.parse_args(argv)
-    if args.record and args.quick:
-        parser.error("--record keeps full runs only")
+    args = arguments(make_parser(__doc__, "scaling", "N up to 10^4, 100 steps"), argv)
     warnings.simplefilter("ignore")
-    start = load_average()
-    results: dict[str, Any] = {
-        "benchmark": "scaling",
-        "machine": machine_info(),
-        "source": source_state(),
-        "quick": bool(args.quick),
-        **run(args.quick),
-    }
-    results["load_average"] = {"start": start, "end": load_average()}
-    out = RESULTS if args.record else args.out
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "scaling.json").write_text(json.dumps(results, indent=2) + "\n")
-        drawn = plot(results, out / "scaling.png")
-        what = " and scaling.png" if drawn else " (matplotlib not installed: no plot)"
-        progress(f"wrote {out / 'scaling.json'}{what}")
+    results = measure("scaling", args.quick, lambda: run(args.quick))
+    write(args, "scaling", results, lambda path: plot(results, path))
     print(docs_section(results))
     return 0
 

@@ -13,12 +13,13 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
+from machine import load_average, machine_info, source_state
 from timing import progress
 
 RESULTS = Path(__file__).resolve().parent / "results"
 
 
-def parser(doc: str | None, name: str, quick: str = "short run") -> argparse.ArgumentParser:
+def make_parser(doc: str | None, name: str, quick: str = "short run") -> argparse.ArgumentParser:
     """The parser of a script (``doc``: its module docstring) with ``--quick`` and ``--out`` or
     ``--record``; add the script's own options, then read them with :func:`arguments`."""
     out = argparse.ArgumentParser(description=(doc or "").splitlines()[0])
@@ -35,6 +36,24 @@ def arguments(parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> ar
     if args.record and args.quick:
         parser.error("--record keeps full runs only")
     return args
+
+
+def measure(
+    name: str, quick: bool, run: Callable[[], dict[str, Any]], *packages: str
+) -> dict[str, Any]:
+    """The JSON of benchmark ``name``: what ran it (the machine, with the versions of
+    ``packages`` too; the code measured), ``quick``, what ``run()`` returns, and the load
+    average at the start and end."""
+    start = load_average()
+    results: dict[str, Any] = {
+        "benchmark": name,
+        "machine": machine_info(*packages),
+        "source": source_state(),
+        "quick": bool(quick),
+        **run(),
+    }
+    results["load_average"] = {"start": start, "end": load_average()}
+    return results
 
 
 def write(

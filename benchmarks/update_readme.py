@@ -303,7 +303,9 @@ def render_schemes(results: Path) -> str | None:
 
 
 def update_readme(readme: Path, section: str, start: str = START, end: str = END) -> bool:
-    """Rewrite ``readme`` between the markers; False if the markers are missing."""
+    """Rewrite ``readme`` between the markers; False if the file or the markers are missing."""
+    if not readme.is_file():
+        return False
     text = readme.read_text()
     if start not in text or end not in text:
         return False
