@@ -39,7 +39,7 @@ from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 from script import arguments, make_parser, measure, pyplot, write  # noqa: E402
-from timing import add_ratios, progress, statistics, us  # noqa: E402
+from timing import add_ratios, progress, statistics, stats_cells  # noqa: E402
 
 import rrc_pin  # noqa: E402
 from rrc_pin.dynamics import scenarios  # noqa: E402
@@ -166,11 +166,7 @@ def step_table(result: dict[str, Any]) -> str:
     ]
     for arm in result["timing"]:
         for name, r in arm["contenders"].items():
-            lines.append(
-                f"| {arm['arm']} | {name} | {us(r['median_us'])} | {us(r['p10_us'])} | "
-                f"{us(r['p90_us'])} | {us(r['p99_us'])} | {r['vs_baseline_median']:.2f}x | "
-                f"{r['vs_baseline_p99']:.2f}x | {1e3 / r['median_us']:.1f} |"
-            )
+            lines.append(f"| {arm['arm']} | {name} |{stats_cells(r)} {1e3 / r['median_us']:.1f} |")
     return "\n".join(lines)
 
 

@@ -41,7 +41,15 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from script import arguments, make_parser, measure, write  # noqa: E402
-from timing import add_ratios, one_core, progress, statistics, timing_chart, us  # noqa: E402
+from timing import (  # noqa: E402
+    add_ratios,
+    one_core,
+    progress,
+    statistics,
+    stats_cells,
+    timing_chart,
+    us,
+)
 
 import rrc_pin  # noqa: E402
 from rrc_pin.control import Controller, DriftCorrection  # noqa: E402
@@ -211,9 +219,8 @@ def docs_section(results: dict[str, Any]) -> str:
     for a in results["arms"]:
         for label, r in a["contenders"].items():
             lines.append(
-                f"| {a['arm']} | {a['nq']} | {label} | {us(r['median_us'])} | {us(r['p10_us'])} "
-                f"| {us(r['p90_us'])} | {us(r['p99_us'])} | {r['vs_baseline_median']:.2f}x | "
-                f"{r['vs_baseline_p99']:.2f}x | {1e6 / r['median_us']:,.0f} |"
+                f"| {a['arm']} | {a['nq']} | {label} |{stats_cells(r)} "
+                f"{1e6 / r['median_us']:,.0f} |"
             )
     verdicts = [
         f"{a['arm']} {100 * a['overhead_median']:.0f} % (p99 {100 * a['overhead_p99']:.0f} %)"

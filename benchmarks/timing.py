@@ -364,6 +364,15 @@ def us(x: float) -> str:
     return f"{x:,.0f}" if x >= 10 else f"{x:.1f}"
 
 
+def stats_cells(row: dict[str, Any]) -> str:
+    """Table cells of a row: median, p10, p90, p99 [us] and the two ratios to the baseline
+    (:func:`add_ratios`), as ``" a | b | ... |"``."""
+    return (
+        f" {us(row['median_us'])} | {us(row['p10_us'])} | {us(row['p90_us'])} | "
+        f"{us(row['p99_us'])} | {row['vs_baseline_median']:.2f}x | {row['vs_baseline_p99']:.2f}x |"
+    )
+
+
 def ratio(row: dict[str, Any], key: str) -> str:
     """A ratio of a contender's row for a table ("-" where there is none)."""
     value = row.get(key)
