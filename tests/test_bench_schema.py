@@ -88,6 +88,9 @@ def test_schema_names_what_the_controller_and_control_schemes_miss():
     assert any("no ratio" in p for p in found), found
     assert any(p.startswith("sessions.") and "tick.p99_us" in p for p in found), found
     assert any("drift_max_mm" in p for p in found), found
+    scaling = json.loads((ROOT / "benchmarks" / "results" / "scaling.json").read_text())
+    scaling["dof"][0]["controller"] = {"median_us": 200.0, "p10_us": 150.0, "p90_us": 300.0}
+    assert any("dof." in p and "controller.p99_us" in p for p in schema.problems(scaling))
     cs = json.loads((ROOT / "benchmarks" / "results" / "control_schemes.json").read_text())
     assert schema.problems(cs) == []
     del next(iter(cs["timing"][0]["contenders"].values()))["p99_us"]
