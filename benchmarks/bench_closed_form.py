@@ -24,8 +24,6 @@ docs/benchmarks.md (``update_readme.py``) and is printed at the end.
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
 import statistics
 import sys
@@ -37,12 +35,12 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 from machine import machine_info, source_state
+from script import arguments, make_parser, pyplot, write
 
 import rrc_pin
 from rrc_pin.robot import frame_id
 
 ARMS = ("barker6", "rrc_k1607", "kr5_3r")
-RESULTS = Path(__file__).resolve().parent / "results"
 SEED = 20261122
 BATCH_RUNS = 11
 """Interleaved runs of the batch and of the loop; the medians are recorded."""
@@ -258,13 +256,9 @@ def docs_section(results: dict[str, Any]) -> str:
 def plot(results: dict[str, Any], path: Path) -> bool:
     """Bar plot: per-call times (left) and batch throughput (right, log scale); False
     without matplotlib (nothing written)."""
-    try:
-        import matplotlib
-    except ImportError:
+    plt = pyplot()
+    if plt is None:
         return False
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
     arms = [r["arm"] for r in results["arms"]]
     x = np.arange(len(arms))
@@ -317,14 +311,7 @@ def plot(results: dict[str, Any], path: Path) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="short run")
-    where = parser.add_mutually_exclusive_group()
-    where.add_argument("--out", type=Path, help="folder for closed_form.json and .png")
-    where.add_argument("--record", action="store_true", help="write benchmarks/results/")
-    args = parser.parse_args(argv)
-    if args.record and args.quick:
-        parser.error("--record keeps full runs only")
+    args = arguments(make_parser(__doc__, "closed_form"), argv)
     sizes = (
         {"n_scalar": 3, "number": 200, "n_batch": 5000, "n_loop": 200}
         if args.quick
@@ -357,13 +344,7 @@ def main(argv: list[str] | None = None) -> int:
         results["arms"].append(bench_arm(name, **sizes))
     results["machine"]["load_average"] = [start_load, os.getloadavg()[0]]  # 1-minute
     table = markdown_table(results)
-    out = RESULTS if args.record else args.out
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "closed_form.json").write_text(json.dumps(results, indent=2) + "\n")
-        drawn = plot(results, out / "closed_form.png")
-        what = " and closed_form.png" if drawn else " (matplotlib not installed: no plot)"
-        print(f"wrote {out / 'closed_form.json'}{what}", file=sys.stderr)
+    write(args, "closed_form", results, lambda path: plot(results, path))
     print(table)
     return 0
 

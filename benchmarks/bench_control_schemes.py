@@ -1,9 +1,10 @@
 """Nguyen & Zhou's control schemes against the baselines, on Pinocchio dynamics, both paper arms.
 
-Run from a checkout: ``python benchmarks/bench_control_schemes.py --record`` writes
-``benchmarks/results/control_schemes.json`` and ``control_schemes.png`` and regenerates
-``docs/control_schemes.md``; ``--out DIR`` writes the JSON and PNG to DIR instead (no docs),
-``--quick`` runs short scenarios (a smoke test; nothing recorded unless asked).
+Run from a checkout: ``python benchmarks/bench_control_schemes.py --out DIR`` writes
+``control_schemes.json`` and ``control_schemes.png`` to DIR (``--record``: to
+``benchmarks/results/``; ``--quick``: short scenarios, a smoke test); ``rrc-pin bench --only
+control_schemes`` runs it, and ``benchmarks/update_readme.py`` renders the tables into
+``docs/control_schemes.md`` (scenarios) and ``docs/benchmarks.md`` (step time).
 
 For barker6 and rrc_k1607 (scenarios and gains in :mod:`rrc_pin.dynamics.scenarios`):
 
@@ -16,31 +17,43 @@ For barker6 and rrc_k1607 (scenarios and gains in :mod:`rrc_pin.dynamics.scenari
   right for 1e4 N/m only), hybrid control with fixed gains and with adapted gains (Fig. 13),
   20 N into horizontal planes of 1e3, 1e4 and 1e5 N/m and into a 1e4 N/m plane tilted by
   30 deg about the base x axis, while moving along them;
-- timing: controller and simulator time per 1 kHz step (means over each run), and the
-  real-time factor (simulated time / wall time of controller + simulator).
+- step time: every controller with its own simulator (friction on, no plane) following the
+  tracking path's joint reference, interleaved: at every 1 kHz tick each controller + simulator
+  step runs once, in an order shuffled per tick; median, p10, p90, p99 [us] of the step
+  (``torques`` then ``Simulator.step``; the reference is computed untimed), the ratio to the
+  fixed-gain PD's step (its time over the controller's) and the real-time factor (1 ms over
+  the median step). BLAS threads pinned to 1.
 """
 
 from __future__ import annotations
 
-import argparse
-import json
 import os
-import sys
-from pathlib import Path
-from typing import Any
 
-import numpy as np
-from machine import load_average, machine_info, source_state
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
-import rrc_pin
-from rrc_pin.dynamics import scenarios
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Any  # noqa: E402
+
+import numpy as np  # noqa: E402
+from script import arguments, make_parser, measure, pyplot, write  # noqa: E402
+from timing import add_ratios, progress, statistics, stats_cells  # noqa: E402
+
+import rrc_pin  # noqa: E402
+from rrc_pin.dynamics import scenarios  # noqa: E402
+from rrc_pin.dynamics.reference import HandPath, JointTrajectory  # noqa: E402
+from rrc_pin.dynamics.simulator import Simulator  # noqa: E402
 
 ARMS = ("barker6", "rrc_k1607")
 PLANES = ((1e3, 0.0), (1e4, 0.0), (1e5, 0.0), (1e4, 30.0))
 """(stiffness [N/m], tilt about the base x axis [deg]) of the force runs."""
-RESULTS = Path(__file__).resolve().parent / "results"
-DOC = Path(__file__).resolve().parents[1] / "docs" / "control_schemes.md"
-START, END = "<!-- control-schemes:start -->", "<!-- control-schemes:end -->"
+QUICK_PLANES = ((1e4, 0.0),)
+BASELINE = "fixed_pd"
+"""The step-time baseline: the simplest law in the same harness."""
+STEPS, QUICK_STEPS = 3000, 300
+"""1 kHz ticks of the step-time part, per arm."""
 
 
 def bench(quick: bool) -> dict[str, Any]:
@@ -65,7 +78,7 @@ def bench(quick: bool) -> dict[str, Any]:
                     "t": rec.t[::10].tolist(),
                     "error_mm": (1e3 * np.linalg.norm(rec.pose_error[::10, :3], axis=1)).tolist(),
                 }
-        for stiffness, tilt in PLANES:
+        for stiffness, tilt in QUICK_PLANES if quick else PLANES:
             for name in scenarios.FORCE_CONTROLLERS:
                 outcome = scenarios.force(
                     arm, name, stiffness=stiffness, tilt=np.deg2rad(tilt), **force_options
@@ -135,26 +148,84 @@ def markdown(result: dict[str, Any]) -> str:
             f"{r['force_max_N']:.2f} | {r['contact_lost_s']:.3f} | {r['position_rms_mm']:.2f} | "
             f"{r['position_max_mm']:.2f} | {_peaks(r)} |"
         )
-    lines += [
-        "",
-        "### Step time at 1 kHz (controller + simulator, means over the tracking runs)",
-        "",
-        "| arm | controller | step [us] | real-time factor |",
-        "|---|---|---:|---:|",
-    ]
-    for r in (r for r in rows if r["scenario"] == "tracking"):
-        lines.append(
-            f"| {r['arm']} | {r['controller']} | {r['step_us']:.0f} | {r['real_time_factor']:.2f} |"
-        )
-    m = result["machine"]
-    lines += [
-        "",
-        f"Machine: {m['cpu']}, {m['cores']} cores (shared: load {result['load']}), Python "
-        f"{m['python']}, Pinocchio {m['pinocchio']}; code {result['source']['commit']}"
-        f"{' (modified)' if result['source'].get('dirty') else ''}.",
-        "",
-    ]
+    lines += ["", "### Step time at 1 kHz (controller + simulator, interleaved)", ""]
+    lines += [step_table(result), "", machine_line(result), ""]
     return "\n".join(lines)
+
+
+def step_table(result: dict[str, Any]) -> str:
+    """The step times of every controller + simulator, with the ratio to the baseline."""
+    lines = [
+        f"{result['settings']['steps']:,} ticks of the tracking path per arm, every controller "
+        "with its own simulator, interleaved; ratio: the fixed-gain PD's step time over the "
+        "controller's; real-time factor: 1 ms over the median step.",
+        "",
+        "| arm | controller | median [us] | p10 | p90 | p99 | vs fixed_pd (median) | (p99) | "
+        "real-time factor (median) |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    for arm in result["timing"]:
+        for name, r in arm["contenders"].items():
+            lines.append(f"| {arm['arm']} | {name} |{stats_cells(r)} {1e3 / r['median_us']:.1f} |")
+    return "\n".join(lines)
+
+
+def machine_line(result: dict[str, Any]) -> str:
+    """Where and on what code the result was recorded."""
+    m, source = result["machine"], result["source"]
+    return (
+        f"Machine: {m['cpu']}, {m['cores']} cores (shared: load "
+        f"{result['load_average']['start']}), Python {m['python']}, Pinocchio "
+        f"{m['pinocchio']}; code {source['commit']}"
+        f"{' (modified)' if source.get('uncommitted_changes') else ''}."
+    )
+
+
+def readme_table(result: dict[str, Any]) -> str:
+    """Not in the README (update_readme.DOCS_ONLY): the step-time table."""
+    return step_table(result)
+
+
+def docs_section(result: dict[str, Any]) -> str:
+    """The docs/benchmarks.md section: the step times; the scenarios' tables are in
+    docs/control_schemes.md (:func:`markdown`, rendered from the same JSON)."""
+    return (
+        "The scenarios (tracking with a payload change, force regulation on planes of several "
+        "stiffnesses) and their tables: [control_schemes.md](control_schemes.md), generated "
+        "from the same JSON. Step time:\n\n" + step_table(result)
+    )
+
+
+def step_time(arm_name: str, steps: int) -> dict[str, Any]:
+    """Every controller + simulator step along the tracking path's reference, interleaved."""
+    arm = rrc_pin.load(arm_name)
+    q0 = scenarios.start(arm)
+    path = HandPath(arm.fk(q0), np.array(scenarios.TRACKING_PATH), 1.0)
+    trajectory = JointTrajectory(arm, q0, path, steps * 1e-3)
+    loops = {}
+    for name in scenarios.CONTROLLERS:
+        sim = Simulator(arm, friction=True)
+        sim.reset(q0)
+        loops[name] = (scenarios.controller(name, arm, q0), sim, [sim.state()])
+    times: dict[str, list[float]] = {name: [] for name in loops}
+    rng = np.random.default_rng(0)
+    clock = time.perf_counter
+    wanted = np.zeros(3)
+    for _ in range(steps):
+        for name in rng.permutation(list(loops)):
+            ctl, sim, state = loops[name]
+            ref = trajectory.at(state[0].t, wanted)
+            start = clock()
+            tau = ctl.torques(state[0], ref)
+            state[0] = sim.step(tau)
+            times[name].append(clock() - start)
+    rows = {name: statistics(np.array(t)) for name, t in times.items()}
+    add_ratios(rows, BASELINE)
+    progress(
+        f"{arm_name}: step time "
+        + ", ".join(f"{k} {r['median_us']:.0f} us" for k, r in rows.items())
+    )
+    return {"arm": arm_name, "steps": steps, "baseline": BASELINE, "contenders": rows}
 
 
 def _peaks(r: dict[str, Any]) -> str:
@@ -164,13 +235,9 @@ def _peaks(r: dict[str, Any]) -> str:
 
 def plot(result: dict[str, Any], path: Path) -> bool:
     """Tool error (tracking) and contact force (force, 1e4 N/m) of barker6 over time."""
-    try:
-        import matplotlib
-    except ImportError:
+    plt = pyplot()
+    if plt is None:
         return False
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(12, 4.2))
     for key, trace in result["traces"].items():
         kind, name = key.split("/")
@@ -199,39 +266,21 @@ def plot(result: dict[str, Any], path: Path) -> bool:
     return True
 
 
-def update_doc(section: str) -> None:
-    """Put ``section`` between the markers of docs/control_schemes.md."""
-    text = DOC.read_text()
-    head, rest = text.split(START, 1)
-    _, tail = rest.split(END, 1)
-    DOC.write_text(f"{head}{START}\n{section}{END}{tail}")
-
-
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--record", action="store_true", help="write results/ and the docs")
-    parser.add_argument("--out", type=Path, help="folder for the JSON and PNG")
-    parser.add_argument("--quick", action="store_true", help="short scenarios (smoke test)")
-    args = parser.parse_args(argv)
-    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
-    result = bench(args.quick)
-    result.update(
-        machine=machine_info("scipy"),
-        load=load_average(),
-        source=source_state(),
-        quick=args.quick,
+    args = arguments(make_parser(__doc__, "control_schemes", "short scenarios (smoke test)"), argv)
+    steps = QUICK_STEPS if args.quick else STEPS
+    result = measure(
+        "control_schemes",
+        args.quick,
+        lambda: {
+            "settings": {"steps": steps, "baseline": BASELINE},
+            **bench(args.quick),
+            "timing": [step_time(arm, steps) for arm in ARMS],
+        },
+        "scipy",
     )
-    section = markdown(result)
-    print(section)
-    out = RESULTS if args.record else args.out
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "control_schemes.json").write_text(json.dumps(result, indent=1) + "\n")
-        drawn = plot(result, out / "control_schemes.png")
-        print(f"wrote {out / 'control_schemes.json'}" + (" and the PNG" if drawn else ""))
-    if args.record:
-        update_doc(section)
-        print(f"updated {DOC}")
+    write(args, "control_schemes", result, lambda path: plot(result, path), indent=1)
+    print(markdown(result))
     return 0
 
 

@@ -49,8 +49,6 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-import argparse  # noqa: E402
-import json  # noqa: E402
 import logging  # noqa: E402
 import sys  # noqa: E402
 import warnings  # noqa: E402
@@ -62,6 +60,7 @@ import mink_peer  # noqa: E402
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
+from script import make_parser, write  # noqa: E402
 from stage_profile import profile_steps, profile_table  # noqa: E402
 from timing import (  # noqa: E402
     MODE_TITLES,
@@ -72,6 +71,7 @@ from timing import (  # noqa: E402
     mode_table,
     progress,
     quiet_stdout,
+    record_trajectory,
     run_mode,
     summarise,
     timing_chart,
@@ -83,7 +83,6 @@ from rrc_pin.robot import frame_id  # noqa: E402
 from solvers.qp_backends import installed_backends  # noqa: E402
 
 ARMS = ("rrc_k1607", "panda")
-RESULTS = Path(__file__).resolve().parent / "results"
 SEED = 20261122
 DT = 0.01
 SEGMENT = 50
@@ -98,21 +97,6 @@ FLOOR = "Pinocchio + numpy solve (J J^T)"
 """Modules of the QP backends, for the versions recorded."""
 
 Array = np.ndarray
-
-
-def record_trajectory(arm: Any, steps: int, rng: np.random.Generator) -> tuple[Array, Array]:
-    """Configurations (steps, nq) and twists (steps, 6) of one rrc-pin run (module docstring)."""
-    resolver = rrc_pin.Resolver(arm, dt=DT, direction_preserving=False)
-    q = arm.random_q(rng)
-    Q = np.empty((steps, arm.nq))
-    X = np.empty((steps, 6))
-    twist = np.zeros(6)
-    for k in range(steps):
-        if k % SEGMENT == 0:
-            twist = np.concatenate([rng.normal(size=3) * 0.23, rng.normal(size=3) * 0.35])
-        Q[k], X[k] = q, twist
-        q = q + resolver.solve(q, twist).qdot * DT
-    return Q, X
 
 
 def rrc_options() -> dict[str, dict[str, Any]]:
@@ -265,7 +249,7 @@ def bench_arm(name: str, steps: int) -> dict[str, Any]:
     """Every contender in every mode along one trajectory of arm ``name``, then the profile."""
     arm = rrc_pin.load(name)
     progress(f"{name}: recording {steps} steps (rrc-pin tracking)")
-    Q, X = record_trajectory(arm, steps, np.random.default_rng(SEED))
+    Q, X = record_trajectory(arm, steps, np.random.default_rng(SEED), DT, SEGMENT)
     limits = (arm.lower, arm.upper, arm.velocity_limit)
     shuffle = np.random.default_rng(SEED + 1)
     modes: dict[str, Any] = {}
@@ -336,12 +320,8 @@ def profile_default(arm: Any, Q: Array, X: Array) -> dict[str, Any]:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark; write JSON and PNG to --out or (--record) benchmarks/results."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help=f"{QUICK_STEPS} steps per arm")
+    parser = make_parser(__doc__, "resolver", f"{QUICK_STEPS} steps per arm")
     parser.add_argument("--steps", type=int, default=None, help=f"trajectory length ({STEPS})")
-    where = parser.add_mutually_exclusive_group()
-    where.add_argument("--out", type=Path, help="folder for resolver.json and resolver.png")
-    where.add_argument("--record", action="store_true", help="write benchmarks/results/")
     parser.add_argument("--arms", nargs="+", default=list(ARMS), help="arms (rrc_k1607 panda)")
     args = parser.parse_args(argv)
     steps = args.steps or (QUICK_STEPS if args.quick else STEPS)
@@ -377,14 +357,7 @@ def main(argv: list[str] | None = None) -> int:
         "arms": [bench_arm(a, steps) for a in args.arms],
     }
     results["load_average"] = {"start": start, "end": load_average()}
-    out = RESULTS if args.record else args.out
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "resolver.json").write_text(json.dumps(results, indent=2) + "\n")
-        if plot(results, out / "resolver.png"):
-            progress(f"wrote {out / 'resolver.json'} and resolver.png")
-        else:
-            progress(f"wrote {out / 'resolver.json'} (matplotlib not installed: no plot)")
+    write(args, "resolver", results, lambda path: plot(results, path))
     print(readme_table(results))
     return 0
 

@@ -21,7 +21,11 @@ runs it.
   small dense solve (no limits; ``J J^T`` for more than 6 joints, ``J`` for 6, the position
   rows, square, for 3).
 
-The library has no controller or cell objects yet: their tick rates are not measured.
+- **Controller tick against DOF**: ``Controller(arm).step(twist, "world_aligned")`` (the
+  teleoperation loop's tick: the same resolver plus the controller's kinematics, drift
+  check, integration and log) driven by the same twists from the trajectory's start, in a
+  second pass interleaved with the same floor; its ticks per second. There is no cell (a
+  loop over several arms) in the library: no cell tick rate.
 """
 
 from __future__ import annotations
@@ -31,8 +35,6 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-import argparse  # noqa: E402
-import json  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 import warnings  # noqa: E402
@@ -42,13 +44,13 @@ from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
-from machine import load_average, machine_info, source_state  # noqa: E402
-from timing import progress  # noqa: E402
+from script import arguments, make_parser, measure, pyplot, write  # noqa: E402
+from timing import progress, record_trajectory, statistics  # noqa: E402
 
 import rrc_pin  # noqa: E402
+from rrc_pin.control import Controller  # noqa: E402
 from rrc_pin.robot import frame_id  # noqa: E402
 
-RESULTS = Path(__file__).resolve().parent / "results"
 SEED = 20261202
 DT = 0.01
 SEGMENT = 50
@@ -158,25 +160,11 @@ def batch_curve(name: str, sizes: tuple[int, ...], rng: np.random.Generator) -> 
     return {"arm": name, "nq": arm.nq, "task_dim": m, "points": points, "flattens_at": flat}
 
 
-def record_trajectory(arm: Any, steps: int, rng: np.random.Generator) -> tuple[Array, Array]:
-    """Configurations and twists of an rrc-pin tracking run (as ``bench_resolver.py``)."""
-    resolver = rrc_pin.Resolver(arm, dt=DT, direction_preserving=False)
-    q = arm.random_q(rng)
-    Q, X = np.empty((steps, arm.nq)), np.empty((steps, 6))
-    twist = np.zeros(6)
-    for k in range(steps):
-        if k % SEGMENT == 0:
-            twist = np.concatenate([rng.normal(size=3) * 0.23, rng.normal(size=3) * 0.35])
-        Q[k], X[k] = q, twist
-        q = q + resolver.solve(q, twist).qdot * DT
-    return Q, X
-
-
 def dof_row(name: str, tool: str | None, steps: int) -> dict[str, Any]:
     """Resolver step time along one trajectory, interleaved with the floor."""
     arm = rrc_pin.load(name, tool_frame=tool) if tool else rrc_pin.load(name)
     rng = np.random.default_rng(SEED)
-    Q, X = record_trajectory(arm, steps, rng)
+    Q, X = record_trajectory(arm, steps, rng, DT, SEGMENT)
     resolver = rrc_pin.Resolver(arm, dt=DT)
     floor = floor_step(arm)
     resolver.solve(Q[0], X[0])  # untimed first call
@@ -193,7 +181,7 @@ def dof_row(name: str, tool: str | None, steps: int) -> dict[str, Any]:
     p10, p50, p90, p99 = np.percentile(ours * 1e6, [10, 50, 90, 99])
     f50, f99 = np.percentile(base * 1e6, [50, 99])
     progress(f"{name} ({arm.nq} joints): {p50:.0f} us per step, floor {f50:.0f} us")
-    return {
+    row = {
         "arm": name,
         "tool_frame": arm.tool_frame,
         "nq": arm.nq,
@@ -207,6 +195,37 @@ def dof_row(name: str, tool: str | None, steps: int) -> dict[str, Any]:
         "vs_floor_median": float(f50 / p50),
         "vs_floor_p99": float(f99 / p99),
     }
+    row["controller"] = controller_ticks(arm, Q, X, floor)
+    return row
+
+
+def controller_ticks(
+    arm: Any, Q: Array, X: Array, floor: Callable[[Array, Array], Array]
+) -> dict[str, Any]:
+    """``Controller.step`` along the trajectory's twists from its start, interleaved with the
+    floor at the trajectory's configurations."""
+    ctl = Controller(arm, dt=DT, q0=Q[0])
+    ctl.step(X[0], "world_aligned")  # untimed first call
+    ticks, base = np.empty(len(Q)), np.empty(len(Q))
+    clock = time.perf_counter
+    for k in range(len(Q)):
+        t0 = clock()
+        ctl.step(X[k], "world_aligned")
+        ticks[k] = clock() - t0
+        t0 = clock()
+        floor(Q[k], X[k])
+        base[k] = clock() - t0
+    row = statistics(ticks)
+    f50, f99 = np.percentile(base * 1e6, [50, 99])
+    row.update(
+        floor_median_us=float(f50),
+        floor_p99_us=float(f99),
+        vs_floor_median=float(f50 / row["median_us"]),
+        vs_floor_p99=float(f99 / row["p99_us"]),
+        ticks_per_s=1e6 / row["median_us"],
+    )
+    progress(f"{arm.name} ({arm.nq} joints): controller tick {row['median_us']:.0f} us")
+    return row
 
 
 def run(quick: bool) -> dict[str, Any]:
@@ -262,7 +281,31 @@ def docs_section(results: dict[str, Any]) -> str:
             f"{r['floor_median_us']:.1f} | {r['vs_floor_median']:.2f}x | "
             f"{r['vs_floor_p99']:.2f}x |"
         )
+    if all("controller" in r for r in results["dof"]):
+        lines += ["", *controller_table(results)]
     return "\n".join(lines)
+
+
+def controller_table(results: dict[str, Any]) -> list[str]:
+    """Controller tick time against DOF (results recorded since the controller exists)."""
+    lines = [
+        'Controller tick against DOF: `Controller(arm).step(twist, "world_aligned")` on the '
+        "same twists from the trajectory's start, in a second pass interleaved with the floor. "
+        "No cell (a loop over several arms) exists in the library: no cell tick rate.",
+        "",
+        "| arm | joints | tick median [us] | p10 | p90 | p99 | ticks per s (median) | "
+        "floor median [us] | floor / tick (median) | (p99) |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for r in results["dof"]:
+        c = r["controller"]
+        lines.append(
+            f"| {r['arm']} | {r['nq']} | {c['median_us']:.0f} | {c['p10_us']:.0f} | "
+            f"{c['p90_us']:.0f} | {c['p99_us']:.0f} | {c['ticks_per_s']:,.0f} | "
+            f"{c['floor_median_us']:.1f} | {c['vs_floor_median']:.2f}x | "
+            f"{c['vs_floor_p99']:.2f}x |"
+        )
+    return lines
 
 
 def _times(ratio: float) -> str:
@@ -272,13 +315,9 @@ def _times(ratio: float) -> str:
 def plot(results: dict[str, Any], path: Path) -> bool:
     """Time per configuration against N (log-log) and step time against DOF; False without
     matplotlib."""
-    try:
-        import matplotlib
-    except ImportError:
+    plt = pyplot()
+    if plt is None:
         return False
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
     fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.5))
     for curve in results["batch"]:
@@ -310,6 +349,10 @@ def plot(results: dict[str, Any], path: Path) -> bool:
         color="k",
         capsize=3,
     )  # fmt: skip
+    if all("controller" in r for r in rows):
+        right.plot(
+            x - 0.2, [r["controller"]["median_us"] for r in rows], "kD", label="Controller.step"
+        )
     right.bar(x + 0.2, [r["floor_median_us"] for r in rows], 0.4, label="floor (J + solve)")
     right.set_xticks(x, [f"{r['arm']}\n{r['nq']} DOF" for r in rows], fontsize=8)
     right.set(ylabel="time per step [us]", title="step time against DOF (p10-p90 bars)")
@@ -321,31 +364,10 @@ def plot(results: dict[str, Any], path: Path) -> bool:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="N up to 10^4, 100 steps")
-    where = parser.add_mutually_exclusive_group()
-    where.add_argument("--out", type=Path, help="folder for scaling.json and .png")
-    where.add_argument("--record", action="store_true", help="write benchmarks/results/")
-    args = parser.parse_args(argv)
-    if args.record and args.quick:
-        parser.error("--record keeps full runs only")
+    args = arguments(make_parser(__doc__, "scaling", "N up to 10^4, 100 steps"), argv)
     warnings.simplefilter("ignore")
-    start = load_average()
-    results: dict[str, Any] = {
-        "benchmark": "scaling",
-        "machine": machine_info(),
-        "source": source_state(),
-        "quick": bool(args.quick),
-        **run(args.quick),
-    }
-    results["load_average"] = {"start": start, "end": load_average()}
-    out = RESULTS if args.record else args.out
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "scaling.json").write_text(json.dumps(results, indent=2) + "\n")
-        drawn = plot(results, out / "scaling.png")
-        what = " and scaling.png" if drawn else " (matplotlib not installed: no plot)"
-        progress(f"wrote {out / 'scaling.json'}{what}")
+    results = measure("scaling", args.quick, lambda: run(args.quick))
+    write(args, "scaling", results, lambda path: plot(results, path))
     print(docs_section(results))
     return 0
 

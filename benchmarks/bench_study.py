@@ -11,8 +11,6 @@ It is a simulation study, not a timing: no baseline or ratio applies.
 
 from __future__ import annotations
 
-import argparse
-import json
 import math
 import os
 import sys
@@ -22,8 +20,8 @@ from typing import Any
 import numpy as np
 import sampling_study as st
 from machine import machine_info, source_state
+from script import arguments, make_parser, pyplot, write
 
-RESULTS = Path(__file__).resolve().parent / "results"
 FULL_DTS = (0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1)
 REPORT_VX = {0.01: 0.5, 0.1: 6.0}
 """The report's largest x-velocity errors [in/s] at 10 and 100 ms (its fig. 4)."""
@@ -217,13 +215,9 @@ def _speed_factor(results: dict[str, Any]) -> float:
 
 def plot(results: dict[str, Any], runs: dict[float, st.Sampled], path: Path) -> bool:
     """Figures like the report's 4-7 and 9-10, and errors against dt; False without matplotlib."""
-    try:
-        import matplotlib
-    except ImportError:
+    plt = pyplot()
+    if plt is None:
         return False
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
     shown = [dt for dt in (0.01, 0.1) if dt in runs]
     fig, axes = plt.subplots(3, 3, figsize=(14, 11))
@@ -318,14 +312,7 @@ def plot(results: dict[str, Any], runs: dict[float, st.Sampled], path: Path) -> 
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help="short run")
-    where = parser.add_mutually_exclusive_group()
-    where.add_argument("--out", type=Path, help="folder for study.json and .png")
-    where.add_argument("--record", action="store_true", help="write benchmarks/results/")
-    args = parser.parse_args(argv)
-    if args.record and args.quick:
-        parser.error("--record keeps full runs only")
+    args = arguments(make_parser(__doc__, "study"), argv)
     start_load = os.getloadavg()[0]
     results, runs = run(args.quick)
     results = {
@@ -336,13 +323,7 @@ def main(argv: list[str] | None = None) -> int:
         **results,
     }
     results["machine"]["load_average"] = [start_load, os.getloadavg()[0]]
-    out = RESULTS if args.record else args.out
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "study.json").write_text(json.dumps(results, indent=2) + "\n")
-        drawn = plot(results, runs, out / "study.png")
-        what = " and study.png" if drawn else " (matplotlib not installed: no plot)"
-        print(f"wrote {out / 'study.json'}{what}", file=sys.stderr)
+    write(args, "study", results, lambda path: plot(results, runs, path))
     print(error_table(results))
     return 0
 

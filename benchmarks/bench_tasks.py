@@ -53,8 +53,6 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-import argparse  # noqa: E402
-import json  # noqa: E402
 import logging  # noqa: E402
 import shutil  # noqa: E402
 import sys  # noqa: E402
@@ -70,6 +68,7 @@ from machine import load_average, machine_info, source_state  # noqa: E402
 from placo_peer import PlacoPeer, Worker, placo_checks, placo_python, placo_urdf  # noqa: E402
 from render_tasks import MODES, PLACO, STRICT, WEIGHTED, plot, readme_table  # noqa: E402
 from render_tasks import docs_section as docs_section  # noqa: E402 (update_readme.py)
+from script import make_parser, write  # noqa: E402
 from stage_profile import profile_steps  # noqa: E402
 from timing import (  # noqa: E402
     MODE_TITLES,
@@ -86,7 +85,6 @@ import rrc_pin  # noqa: E402
 from rrc_pin import FrameTask, PostureTask  # noqa: E402
 
 ROBOT = "baxter"
-RESULTS = Path(__file__).resolve().parent / "results"
 SEED = 20261122
 DT = 0.01
 SEGMENT = 50
@@ -432,13 +430,9 @@ def _close(peer: Any) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark; write JSON and PNG to --out or (--record) benchmarks/results."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--quick", action="store_true", help=f"{QUICK_STEPS} steps")
+    parser = make_parser(__doc__, "tasks", f"{QUICK_STEPS} steps")
     parser.add_argument("--steps", type=int, default=None, help=f"trajectory length ({STEPS})")
     parser.add_argument("--placo-python", default=None, help="PlaCo's interpreter")
-    where = parser.add_mutually_exclusive_group()
-    where.add_argument("--out", type=Path, help="folder for tasks.json and tasks.png")
-    where.add_argument("--record", action="store_true", help="write benchmarks/results/")
     args = parser.parse_args(argv)
     steps = args.steps or (QUICK_STEPS if args.quick else STEPS)
     if steps < 2:
@@ -472,12 +466,7 @@ def main(argv: list[str] | None = None) -> int:
         **bench(steps, placo_where, placo_why),
     }
     results["load_average"] = {"start": start, "end": load_average()}
-    out = RESULTS if args.record else args.out
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
-        (out / "tasks.json").write_text(json.dumps(results, indent=2) + "\n")
-        drawn = plot(results, out / "tasks.png")
-        progress(f"wrote {out / 'tasks.json'}" + (" and tasks.png" if drawn else " (no plot)"))
+    write(args, "tasks", results, lambda path: plot(results, path))
     print(readme_table(results))
     return 0
 

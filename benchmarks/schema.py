@@ -6,9 +6,11 @@ benchmark's name, the machine (CPU, cores, Python, numpy, Pinocchio), the code m
 hash of the sources). Timing benchmarks: per case the median, p10, p90 and p99 [us] and at
 least one ratio to a baseline measured in the same run (``vs_<baseline>_median`` and
 ``_p99``); the closed forms: both timings with their spread and the speed-ups; the study:
-an error and a fitted order per quantity. ``schema`` 2 (written by the closed-form benchmark
-since it records the spread of its timings) also requires the closed forms' p10, p90, p99;
-files without the key are version 1.
+an error and a fitted order per quantity; the controller: its tick rows, and per session the
+tick times, NaN, limit excess and drift; the control schemes: the scenarios' errors and the
+step-time rows. ``schema`` 2 (written by the closed-form benchmark since it records the
+spread of its timings) also requires the closed forms' p10, p90, p99; files without the key
+are version 1.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ import math
 from collections.abc import Iterator
 from typing import Any
 
-KNOWN = ("closed_form", "resolver", "tasks", "study", "scaling")
+KNOWN = ("closed_form", "resolver", "tasks", "study", "scaling", "controller", "control_schemes")
 MACHINE = ("cpu", "cores", "python", "numpy", "pinocchio")
 STATS = ("median_us", "p10_us", "p90_us", "p99_us")
 MINK_TOL = 1e-9
@@ -40,6 +42,8 @@ def problems(results: dict[str, Any]) -> list[str]:
         "tasks": _tasks,
         "study": _study,
         "scaling": _scaling,
+        "controller": _controller,
+        "control_schemes": _control_schemes,
     }[name]
     out += list(check(results))
     return out
@@ -144,6 +148,59 @@ def _scaling(results: dict[str, Any]) -> Iterator[str]:
         for key in (*STATS, "floor_median_us", "vs_floor_median"):
             if not _positive(row.get(key)):
                 yield f"dof.{row.get('arm')}.{key}: expected a positive number"
+        ctl = row.get("controller")  # recorded since the controller exists (issue 8)
+        for key in (*STATS, "floor_median_us", "vs_floor_median") if ctl is not None else ():
+            if not _positive(ctl.get(key)):
+                yield f"dof.{row.get('arm')}.controller.{key}: expected a positive number"
+
+
+def _controller(results: dict[str, Any]) -> Iterator[str]:
+    arms = results.get("arms") or []
+    if not arms:
+        yield "arms: empty"
+    for arm in arms:
+        where = f"arms.{arm.get('arm')}"
+        yield from _rows(where, arm)
+        for key in ("overhead_median", "overhead_p99"):
+            if not _finite(arm.get(key)):
+                yield f"{where}.{key}: expected a number"
+    sessions = results.get("sessions") or []
+    if not sessions:
+        yield "sessions: empty"
+    for s in sessions:
+        where = f"sessions.{s.get('arm')}.{'on' if s.get('drift_correction') else 'off'}"
+        for key in STATS:
+            if not _positive(s.get("tick", {}).get(key)):
+                yield f"{where}.tick.{key}: expected a positive time"
+        if not isinstance(s.get("nan"), bool):
+            yield f"{where}.nan: expected true or false"
+        for key in ("position_excess", "velocity_excess", "drift_max_mm", "drift_final_mm"):
+            if not (_finite(s.get(key)) and s[key] >= 0):
+                yield f"{where}.{key}: expected a finite number >= 0"
+        if not _positive(s.get("steps")):
+            yield f"{where}.steps: expected a positive number"
+
+
+def _control_schemes(results: dict[str, Any]) -> Iterator[str]:
+    rows = results.get("rows") or []
+    if not rows:
+        yield "rows: empty"
+    for r in rows:
+        where = f"rows.{r.get('arm')}.{r.get('scenario')}.{r.get('controller')}"
+        for key in ("position_rms_mm", "position_max_mm") + (
+            ("force_rms_N",) if r.get("scenario") == "force" else ()
+        ):
+            if not (_finite(r.get(key)) and r[key] >= 0):
+                yield f"{where}.{key}: expected a finite number >= 0"
+    timing = results.get("timing") or []
+    if not timing:
+        yield "timing: empty"
+    for arm in timing:
+        yield from _rows(f"timing.{arm.get('arm')}", arm)
+
+
+def _finite(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -198,6 +198,27 @@ def _record(run: Run, c: Contender, k: int, out: Any, seconds: float, error: str
         run.kept.append(out)
 
 
+def record_trajectory(
+    arm: Any, steps: int, rng: np.random.Generator, dt: float = 0.01, segment: int = 50
+) -> tuple[Array, Array]:
+    """Configurations (steps, nq) [rad] and twists (steps, 6) of an rrc-pin run to time the
+    contenders along: ``Resolver(arm, dt, direction_preserving=False)`` (the tracking mode)
+    from ``arm.random_q(rng)``, a new random twist every ``segment`` steps (linear parts
+    N(0, 0.23) [m/s], angular N(0, 0.35) [rad/s] per axis), Euler steps of ``dt`` [s]."""
+    import rrc_pin
+
+    resolver = rrc_pin.Resolver(arm, dt=dt, direction_preserving=False)
+    q = arm.random_q(rng)
+    Q, X = np.empty((steps, arm.nq)), np.empty((steps, 6))
+    twist = np.zeros(6)
+    for k in range(steps):
+        if k % segment == 0:
+            twist = np.concatenate([rng.normal(size=3) * 0.23, rng.normal(size=3) * 0.35])
+        Q[k], X[k] = q, twist
+        q = q + resolver.solve(q, twist).qdot * dt
+    return Q, X
+
+
 def statistics(seconds: Array) -> dict[str, float]:
     """Median, 10th, 90th and 99th percentiles, mean and maximum of step times [us]."""
     us = np.asarray(seconds) * 1e6
@@ -341,6 +362,15 @@ def timing_chart(
 def us(x: float) -> str:
     """A time [us] for a table: thousands separated, one decimal below 10."""
     return f"{x:,.0f}" if x >= 10 else f"{x:.1f}"
+
+
+def stats_cells(row: dict[str, Any]) -> str:
+    """Table cells of a row: median, p10, p90, p99 [us] and the two ratios to the baseline
+    (:func:`add_ratios`), as ``" a | b | ... |"``."""
+    return (
+        f" {us(row['median_us'])} | {us(row['p10_us'])} | {us(row['p90_us'])} | "
+        f"{us(row['p99_us'])} | {row['vs_baseline_median']:.2f}x | {row['vs_baseline_p99']:.2f}x |"
+    )
 
 
 def ratio(row: dict[str, Any], key: str) -> str:

@@ -35,10 +35,18 @@ BENCHMARKS = {
         "Sampling time and velocity conversions (Nguyen & Zhou section 5)",
     ),
     "scaling": ("bench_scaling.py", "Scaling: batch size and degrees of freedom"),
+    "controller": ("bench_controller.py", "Teleoperation controller: tick time and sessions"),
+    "control_schemes": (
+        "bench_control_schemes.py",
+        "Control schemes on Pinocchio dynamics (Nguyen & Zhou section 6)",
+    ),
 }
 """Benchmark name: (script, title), in the order of the documents."""
-DOCS_ONLY = ("study", "scaling")
+DOCS_ONLY = ("study", "scaling", "control_schemes")
 """Rendered in docs/benchmarks.md only, not in the README's performance section."""
+SCHEMES_DOC = ROOT / "docs" / "control_schemes.md"
+SCHEMES_START, SCHEMES_END = "<!-- control-schemes:start -->", "<!-- control-schemes:end -->"
+"""docs/control_schemes.md's results section: ``bench_control_schemes.markdown`` of the JSON."""
 
 MODES_TEXT = """\
 A step's time is the whole call a user makes (a library, a backend, a set of options: a
@@ -209,6 +217,15 @@ def closing_note(found: dict[str, dict[str, Any]]) -> list[str]:
             )
             + "."
         )
+    ctl = found.get("controller")
+    if ctl:
+        target = 100 * ctl["settings"]["target_overhead"]
+        out.append(
+            "- Teleoperation controller: its overhead over a bare `Resolver.solve` + Euler loop "
+            "(interleaved, share of the controller's median step): "
+            + ", ".join(f"{a['arm']} {100 * a['overhead_median']:.0f} %" for a in ctl["arms"])
+            + f" (issue 8's target: under {target:.0f} %)."
+        )
     return out or ["Nothing recorded yet."]
 
 
@@ -279,24 +296,37 @@ def _machine_table(found: dict[str, dict[str, Any]]) -> list[str]:
     return lines
 
 
-def update_readme(readme: Path, section: str) -> bool:
-    """Rewrite ``readme`` between the markers; False if the markers are missing."""
-    text = readme.read_text()
-    if START not in text or END not in text:
+def render_schemes(results: Path) -> str | None:
+    """docs/control_schemes.md's results section, or None when not recorded."""
+    found = recorded(results).get("control_schemes")
+    return None if found is None else load_module("control_schemes").markdown(found)
+
+
+def update_readme(readme: Path, section: str, start: str = START, end: str = END) -> bool:
+    """Rewrite ``readme`` between the markers; False if the file or the markers are missing."""
+    if not readme.is_file():
         return False
-    head, rest = text.split(START, 1)
-    _, tail = rest.split(END, 1)
-    readme.write_text(f"{head}{START}\n{section}{END}{tail}")
+    text = readme.read_text()
+    if start not in text or end not in text:
+        return False
+    head, rest = text.split(start, 1)
+    _, tail = rest.split(end, 1)
+    readme.write_text(f"{head}{start}\n{section}{end}{tail}")
     return True
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Write the docs (and the README's section); exit code 1 if the markers are missing."""
+    """Write the docs (and the README's section and docs/control_schemes.md's results); exit
+    code 1 if the markers are missing."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--results", type=Path, default=RESULTS, help="folder of the JSON files")
     parser.add_argument("--docs", type=Path, default=DOCS, help="the Markdown file to write")
     parser.add_argument("--readme", type=Path, default=README, help="the README to update")
-    parser.add_argument("--no-readme", action="store_true", help="leave the README alone")
+    parser.add_argument(
+        "--no-readme",
+        action="store_true",
+        help="leave the README and docs/control_schemes.md alone",
+    )
     args = parser.parse_args(argv)
     args.docs.parent.mkdir(parents=True, exist_ok=True)
     args.docs.write_text(render_docs(args.results, args.docs))
@@ -307,6 +337,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{args.readme}: markers {START} ... {END} not found", file=sys.stderr)
         return 1
     print(f"updated {args.readme}")
+    schemes = render_schemes(args.results)
+    if schemes is not None:
+        if not update_readme(SCHEMES_DOC, schemes, SCHEMES_START, SCHEMES_END):
+            print(f"{SCHEMES_DOC}: markers {SCHEMES_START} ... not found", file=sys.stderr)
+            return 1
+        print(f"updated {SCHEMES_DOC}")
     return 0
 
 

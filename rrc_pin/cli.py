@@ -203,13 +203,23 @@ def urdf_command(directory: Path, *, write: bool) -> int:
 CHECKOUT = urdf_export.COMMITTED_DIR.parent
 """The checkout whose ``benchmarks/`` ``rrc-pin bench`` runs."""
 
-BENCHMARKS = ("closed_form", "resolver", "tasks", "study", "scaling")
+BENCHMARKS = (
+    "closed_form",
+    "resolver",
+    "tasks",
+    "study",
+    "scaling",
+    "controller",
+    "control_schemes",
+)
 BENCH_MODULES = {
     "closed_form": ("matplotlib",),
     "study": ("matplotlib",),
     "scaling": ("matplotlib",),
     "resolver": ("pink", "matplotlib"),
     "tasks": ("pink", "matplotlib"),
+    "controller": ("matplotlib",),
+    "control_schemes": ("matplotlib",),
 }
 """What each benchmark needs from the bench extra (placo and mink are optional: their rows are
 skipped when they are absent)."""

@@ -71,3 +71,39 @@ def test_quick_study_through_the_cli_writes_json_that_follows_the_schema(tmp_pat
     results = json.loads((out / "study.json").read_text())
     assert results["quick"] is True and schema.problems(results) == []
     assert "## Sampling time and velocity conversions" in (out / "benchmarks.md").read_text()
+
+
+def test_schema_names_what_the_controller_and_control_schemes_miss():
+    """A controller tick row without its ratio, a session without its tick times or with a
+    NaN drift, a control-scheme step row without p99: each named."""
+    ctl = json.loads((ROOT / "benchmarks" / "results" / "controller.json").read_text())
+    assert schema.problems(ctl) == []
+    rows = ctl["arms"][0]["contenders"]
+    for key in [k for row in rows.values() for k in list(row) if k.startswith("vs_")]:
+        for row in rows.values():
+            row.pop(key, None)
+    del ctl["sessions"][0]["tick"]
+    ctl["sessions"][1]["drift_max_mm"] = float("nan")
+    found = schema.problems(ctl)
+    assert any("no ratio" in p for p in found), found
+    assert any(p.startswith("sessions.") and "tick.p99_us" in p for p in found), found
+    assert any("drift_max_mm" in p for p in found), found
+    scaling = json.loads((ROOT / "benchmarks" / "results" / "scaling.json").read_text())
+    scaling["dof"][0]["controller"] = {"median_us": 200.0, "p10_us": 150.0, "p90_us": 300.0}
+    assert any("dof." in p and "controller.p99_us" in p for p in schema.problems(scaling))
+    cs = json.loads((ROOT / "benchmarks" / "results" / "control_schemes.json").read_text())
+    assert schema.problems(cs) == []
+    del next(iter(cs["timing"][0]["contenders"].values()))["p99_us"]
+    assert any(p.startswith("timing.") and "p99_us" in p for p in schema.problems(cs))
+
+
+def test_control_schemes_doc_is_generated_from_the_results():
+    """docs/control_schemes.md's results section is what update_readme.py renders."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    try:
+        import update_readme
+    finally:
+        sys.path.remove(str(ROOT / "benchmarks"))
+    text = (ROOT / "docs" / "control_schemes.md").read_text()
+    section = text.split(update_readme.SCHEMES_START, 1)[1].split(update_readme.SCHEMES_END)[0]
+    assert section == "\n" + update_readme.render_schemes(update_readme.RESULTS)

@@ -92,7 +92,7 @@ def test_reverse_keeps_the_limits_when_they_intervene(panda):
 
 @pytest.mark.parametrize("name", ["barker6", "rrc_k1607", "kr5_3r", "panda"])
 def test_a_simulated_session_stays_in_the_limits_with_bounded_drift(name):
-    """20 s at 100 Hz of random operator commands (benchmarks/session_controller.py: 10 min)."""
+    """20 s at 100 Hz of random operator commands (benchmarks/bench_controller.py: 10 min)."""
     arm = rrc_pin.load(name)
     ctl = Controller(arm, q0=start(name))
     for twist in random_commands(np.random.default_rng(1), 20.0, ctl.dt):
