@@ -49,6 +49,7 @@ in the configuration and in the command.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -197,6 +198,15 @@ class Damping:
         """
         r = svd.rank
         if r == 0:
+            return None
+        # min(v) <= r_i <= sqrt(n) max(v): no direction is weak while sigma_1 / sigma_r is
+        # below ratio min(v) / (sqrt(n) max(v)); and |u_i^T xdot| <= sigma_i |w|, so no step
+        # reaches a singularity while sigma_r >= sigma_1 dt min(R, |w|): most steps, known
+        # without V
+        v = velocity.tolist()
+        first, last = float(svd.sigma[0]), float(svd.sigma[r - 1])
+        reachable = 0.0 if dt is None else first * dt * min(norm(np.maximum(-lb, ub)), norm(exact))
+        if first * math.sqrt(len(v)) * max(v) <= last * min(v) * self.ratio and last >= reachable:
             return None
         sigma = svd.sigma[:r]
         reach = 1.0 / (np.abs(svd.Vt[:r]) / velocity).max(axis=1)  # r_i
