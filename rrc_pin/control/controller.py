@@ -243,7 +243,7 @@ class Controller:
             if weight != 1.0:
                 correction *= weight
             wanted = command + (correction if local else to_base_axes(pose.rotation, correction))
-        hand = pose.rotation if local else None
+        hand = pose if local else None
         decision = self.strategy.decide(Situation(self.robot, q, wanted, self.dt, command,
                                                   self._rows, hand))  # fmt: skip
         factor = decision.factor
@@ -252,18 +252,18 @@ class Controller:
                                     ref=self._command_frame)  # fmt: skip
         else:
             r = self.resolver.solve(q, [RatesTask(decision.rates)], priority="strict")
-        self.log.append_tick(Tick(self.t, q.copy(), r, command, pose if local else None,
-                                  factor, error, "teleop", decision.note))  # fmt: skip
+        self.log.append_tick(Tick(self.t, q.copy(), r, command, hand, factor, error, "teleop",
+                                  decision.note))  # fmt: skip
         fraction = None if decision.rates is not None else _followed(r)
         if fraction is None:
             self._reanchor = True
-        elif self._full:
-            self._reference = advance(self._reference, factor * fraction * command, self.dt,
+        elif self._full:  # the command, for the time it was followed
+            self._reference = advance(self._reference, command, factor * fraction * self.dt,
                                       local)  # fmt: skip
         else:  # the commanded position, at the orientation reached
             moved = to_base_axes(pose.rotation, command) if local else command
-            self._reference = advance(self._reference, factor * fraction * moved * LINEAR,
-                                      self.dt, False)  # fmt: skip
+            self._reference = advance(self._reference, moved * LINEAR,
+                                      factor * fraction * self.dt, False)  # fmt: skip
         return self._advance(r)
 
     def reverse(self, seconds: float, extra: float = 1.0) -> Retrace:

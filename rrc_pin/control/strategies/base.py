@@ -8,6 +8,7 @@ from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
+import pinocchio as pin
 
 from rrc_pin.robot import Robot
 
@@ -31,7 +32,7 @@ class Situation:
             deadman applied, no drift correction).
         rows: The task rows of the tool Jacobian: all six, or the three linear ones for an
             arm of fewer than six joints.
-        hand: The tool's orientation (3, 3) when ``twist`` is in hand axes, else None.
+        hand: The tool's pose when ``twist`` is in hand axes, else None.
 
     Attributes:
         robot, q, dt, command, rows: As given.
@@ -39,7 +40,7 @@ class Situation:
 
     def __init__(
         self, robot: Robot, q: Array, twist: Array, dt: float, command: Array,
-        rows: tuple[int, ...], hand: Array | None = None,
+        rows: tuple[int, ...], hand: pin.SE3 | None = None,
     ) -> None:  # fmt: skip
         self.robot, self.q, self.dt, self.command, self.rows = robot, q, dt, command, rows
         self._twist, self._hand = twist, hand
@@ -47,7 +48,9 @@ class Situation:
     @cached_property
     def twist(self) -> Array:
         """The command to serve (6,) [m/s, rad/s], ``world_aligned`` (Barker eq. (20))."""
-        return self._twist if self._hand is None else to_base_axes(self._hand, self._twist)
+        if self._hand is None:
+            return self._twist
+        return to_base_axes(self._hand.rotation, self._twist)
 
     @cached_property
     def jacobian(self) -> Array:
@@ -83,6 +86,10 @@ class Decision(NamedTuple):
     factor: float = 1.0
     rates: Array | None = None
     note: str = ""
+
+
+KEEP = Decision()
+"""The command unchanged."""
 
 
 class Strategy(ABC):
