@@ -1,16 +1,26 @@
-"""The controller's pose error is Nguyen's (eqs. (32)-(34), (37)), computed by Pinocchio."""
+"""The controller's drift correction: Nguyen's pose error (eqs. (32)-(34), (37)) by Pinocchio,
+the clipped twist, the reference's advance by the fraction of the command followed."""
 
 from __future__ import annotations
 
 import numpy as np
 import pinocchio as pin
+import pytest
 
+import rrc_pin
+from rrc_pin.control import Controller
+from rrc_pin.control.controller import REANCHOR, _followed
 from rrc_pin.control.drift import DriftCorrection, advance, pose_error
 from solvers.closed_form.quaternion import (
     differential_rotation,
     quaternion_difference,
     quaternion_from_matrix,
 )
+
+
+@pytest.fixture(scope="module")
+def panda_arm():
+    return rrc_pin.load("panda")
 
 
 def test_pose_error_is_nguyens_in_hand_axes(rng):
@@ -53,3 +63,25 @@ def test_the_reference_advances_along_the_twist():
     assert np.allclose(base.translation - reference.translation, 0.01 * twist[:3], atol=1e-15)
     turn = pin.log3(base.rotation @ reference.rotation.T)
     assert np.allclose(turn, 0.01 * twist[3:], atol=1e-15)
+
+
+def test_the_followed_fraction_is_the_resolutions_scale(panda_arm):
+    """The controller's shortcut (no bound touched: the whole command) agrees with ``scale``.
+
+    Commands beyond the velocity limits and toward the joint limits, so that the answers are
+    exact, scaled and damped.
+    """
+    ctl = Controller(panda_arm, q0=np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.8, 0.7]))
+    rng = np.random.default_rng(3)
+    seen = set()
+    for k in range(150):
+        twist = rng.normal(size=6) * (0.05 if k % 3 else 2.0)
+        r = ctl.step(twist).resolution
+        expected = None if r.status in REANCHOR else r.scale
+        got = _followed(r)
+        seen.add(r.status)
+        if expected is None:
+            assert got is None
+        else:
+            assert got is not None and abs(got - expected) <= 1e-12, (r.status, got, expected)
+    assert {"exact", "scaled"} <= seen

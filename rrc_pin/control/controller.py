@@ -36,7 +36,7 @@ from rrc_pin.limits import JointLimits
 from rrc_pin.loading import load
 from rrc_pin.resolver import Damping, QPOptions, Resolver
 from rrc_pin.robot import Robot
-from solvers.resolution import Resolution, norm, scale_along
+from solvers.resolution import ACTIVE_TOL, Resolution, norm
 from solvers.validation import as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
@@ -45,9 +45,7 @@ LINEAR = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
 FRAMES: tuple[str, ...] = ("local", "world_aligned")
 REANCHOR = ("damped", "singular", "least_squares", "recovering", "fallback")
 """Statuses whose motion departs from the command's direction: the reference pose is reset to
-the reached pose instead of pulling the hand back to a pose it could not follow. The
-resolver's pipeline decides all but ``least_squares`` (``Resolution.known_status``), which
-its direction-preserving solve of one twist does not give."""
+the reached pose instead of pulling the hand back to a pose it could not follow."""
 
 
 class Step(NamedTuple):
@@ -356,12 +354,19 @@ class Controller:
 def _followed(r: Resolution) -> float | None:
     """Fraction in [0, 1] of a twist's command the resolution achieved along its direction.
 
-    None when the answer departs from the command's direction (:data:`REANCHOR`). The
-    fraction is ``Resolution.scale``'s (``scale_along`` of the top rows), computed here
-    without the resolution's task reports (its active limits), which cost more than the
-    rest of the controller's tick.
+    None when the answer departs from the command's direction (:data:`REANCHOR`). A status
+    the pipeline decides (``Resolution.known_status``) is known at once; otherwise the answer
+    is ``exact`` or ``scaled``, and ``scaled`` means that the limits reduced the speed: a
+    joint-rate bound stops the answer. So an answer that touches no bound (within
+    :data:`~solvers.resolution.ACTIVE_TOL`, as ``Resolution.active``) follows the whole
+    command, without reading ``Resolution.scale`` and ``status`` (their task reports cost
+    some 20 us, more than the rest of the tick); one that touches a bound reads them.
     """
     if r.known_status is not None:
         return None
-    top = r.levels[0][0]
-    return scale_along(top.A @ r.qdot, top.b, top.weight)
+    bounds = r.bounds
+    for rate, low, high in zip(r.qdot.tolist(), bounds.lb.tolist(), bounds.ub.tolist(),
+                               strict=True):  # fmt: skip
+        if rate - low <= ACTIVE_TOL or high - rate <= ACTIVE_TOL:
+            return None if r.status in REANCHOR else r.scale
+    return 1.0
