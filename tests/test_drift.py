@@ -68,8 +68,8 @@ def test_the_reference_advances_along_the_twist():
 def test_the_followed_fraction_is_the_resolutions_scale(panda_arm):
     """The controller's shortcut (no bound touched: the whole command) agrees with ``scale``.
 
-    Commands beyond the velocity limits and toward the joint limits, so that the answers are
-    exact, scaled and damped.
+    Every third command beyond the velocity limits, so that the answers are exact (100 of 150)
+    and scaled (50, all below 1).
     """
     ctl = Controller(panda_arm, q0=np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.8, 0.7]))
     rng = np.random.default_rng(3)
