@@ -293,7 +293,7 @@ class Controller:
                 "seconds", f"asked to reverse {seconds} s ({n} ticks); the record holds "
                 f"{len(self.log)} ticks ({len(self.log) * self.dt:.6g} s)",
             )  # fmt: skip
-        targets = [r.q for r in self.log.records[-n:]][::-1]
+        targets = self.log.positions(n)[::-1]
         budget = n + math.ceil(extra * n)
         steps = 0
         for target in targets:

@@ -77,8 +77,8 @@ class TrajectoryLog:
 
     Args:
         joint_names: Names of the joints (the CSV's column names).
-        derive: Makes the record of a tick passed to :meth:`append_tick` (the controller's),
-            or None for a log of records only.
+        derive: Makes the record of a tick passed to :meth:`append_tick` (the controller's;
+            a tick has the record's ``q``), or None for a log of records only.
     """
 
     def __init__(
@@ -111,6 +111,18 @@ class TrajectoryLog:
         if self._derive is None:
             raise InvalidInput("tick", "this log has no derive: append records")
         self._ticks.append(tick)
+
+    def positions(self, n: int) -> list[Array]:
+        """Joint positions ``q`` of the last ``n`` ticks, oldest first, no record derived.
+
+        (What :meth:`Controller.reverse` retraces: reading ``records`` after a long session
+        would derive every record first.) A tick of :meth:`append_tick` has ``q`` as a
+        record has.
+        """
+        ticks = self._ticks[len(self._ticks) - n:] if n > 0 else []
+        rest = n - len(ticks)
+        records = self._records[len(self._records) - rest:] if rest > 0 else []
+        return [r.q for r in records] + [t.q for t in ticks]
 
     def clear(self) -> None:
         """Forget every record."""
