@@ -52,3 +52,19 @@ def test_bad_paths_and_columns_are_refused(log, tmp_path):
         TrajectoryLog.load(tmp_path / "other.csv")
     with pytest.raises(rrc_pin.InvalidInput, match="columns: t, q"):
         log.column("speed")
+
+
+def test_positions_of_the_last_ticks_need_no_records(log):
+    """The last q's, from derived records and pending ticks alike, oldest first."""
+    arm = rrc_pin.load("panda")
+    ctl = Controller(arm, q0=np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.8, 0.7]))
+    for _ in range(5):
+        ctl.step([0.02, 0.0, 0.0, 0.0, 0.0, 0.1])
+    assert len(ctl.log.records) == 5  # derived
+    for _ in range(3):
+        ctl.step([0.0, 0.02, 0.0, 0.0, 0.1, 0.0])  # pending
+    tail = ctl.log.positions(6)
+    assert len(ctl.log._ticks) == 3  # still pending: nothing derived
+    wanted = [r.q for r in ctl.log.records[-6:]]
+    assert len(tail) == 6 and all(np.array_equal(a, b) for a, b in zip(tail, wanted, strict=True))
+    assert ctl.log.positions(0) == [] and len(log.positions(60)) == 60

@@ -29,18 +29,18 @@ from rrc_pin.control.drift import DriftCorrection, advance, pose_error
 from rrc_pin.control.rates_task import RatesTask
 from rrc_pin.control.singularity import SingularityLabel
 from rrc_pin.control.strategies import Situation, Strategy, make_strategy
+from rrc_pin.control.strategies.base import to_base_axes
 from rrc_pin.control.trajectory_log import LogRecord, TrajectoryLog
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import JointLimits
 from rrc_pin.loading import load
 from rrc_pin.resolver import Damping, QPOptions, Resolver
 from rrc_pin.robot import Robot
-from solvers.resolution import Resolution
+from solvers.resolution import ACTIVE_TOL, Resolution, norm
 from solvers.validation import as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
 Frame = Literal["local", "world_aligned"]
-NO_DRIFT = (0.0, 0.0)
 LINEAR = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
 FRAMES: tuple[str, ...] = ("local", "world_aligned")
 REANCHOR = ("damped", "singular", "least_squares", "recovering", "fallback")
@@ -73,6 +73,32 @@ class Retrace(NamedTuple):
     steps: int
     reached: bool
     error: float
+
+
+class Tick(NamedTuple):
+    """One tick as the controller keeps it; the log derives its :class:`LogRecord` when read.
+
+    Attributes:
+        t: Time at the start of the tick [s].
+        q: Joint positions at the start of the tick (nq,) [rad or m].
+        resolution: The resolver's answer.
+        command: The operator's command (6,) [m/s, rad/s] (speed override, deadman).
+        hand: The tool's pose when ``command`` is in hand axes, else None (base axes).
+        factor: The strategy's speed factor.
+        error: The pose error to the reference (6,) [m, rad] (:func:`pose_error`).
+        mode: ``"teleop"`` or ``"reverse"``.
+        note: What the strategy did.
+    """
+
+    t: float
+    q: Array
+    resolution: Resolution
+    command: Array
+    hand: pin.SE3 | None
+    factor: float
+    error: Array
+    mode: str
+    note: str
 
 
 class Controller:
@@ -140,10 +166,10 @@ class Controller:
         self.drift = drift
         self.label = SingularityLabel(robot, finite_number(near, "near", 0.0, inclusive=False,
                                                            error=InvalidInput))  # fmt: skip
-        self.log = TrajectoryLog(robot.joint_names)
+        self.log = TrajectoryLog(robot.joint_names, self._log_record)
         self.t = 0.0
         assert self.resolver.task is not None  # one tool frame: the resolver has its task
-        self._rows = list(self.resolver.task.selected)
+        self._rows = tuple(self.resolver.task.selected)
         self._full = len(self._rows) == 6
         self._data = robot.model.createData()
         self._frame_id = robot.model.getFrameId(robot.tool_frame)
@@ -151,12 +177,8 @@ class Controller:
         self._command = np.zeros(6)
         self._command_frame: Frame = "local"
         self._command_time = -math.inf
-        self._reference: Array = self._kinematics(self.q)[1]
+        self._reference = self._pose(self.q)
         self._reanchor = False
-        self._period = DriftCorrection().period if drift is None else drift.period
-        self._next_check = 0.0  # the pose error is measured every period, the log's too
-        self._drift = NO_DRIFT  # [m], [rad]: the last measured pose error's size
-        self._correction = np.zeros(6)
 
     # -- settings ---------------------------------------------------------------------------
 
@@ -175,7 +197,7 @@ class Controller:
     @property
     def reference(self) -> Array:
         """The commanded pose (4, 4) the drift correction pulls toward (a copy)."""
-        out: Array = self._reference.copy()
+        out: Array = self._reference.homogeneous
         return out
 
     # -- the loop ---------------------------------------------------------------------------
@@ -203,44 +225,43 @@ class Controller:
             self._command, self._command_frame, self._command_time = command, frame, self.t
         age = self.t - self._command_time
         weight = self._speed * (1.0 if self.deadman is None else self.deadman.factor(age))
-        command = weight * self._command
+        command = self._command if weight == 1.0 else weight * self._command
         local = self._command_frame == "local"
 
         q = self.q
-        J, pose = self._kinematics(q)
-        R = pose[:3, :3]
+        pose = self._pose(q)
         if self._reanchor:
             self._reference, self._reanchor = pose, False
-            self._drift, self._correction = NO_DRIFT, np.zeros(6)
-        command_wa = _rotated(R, command) if local else command
-        if self.t >= self._next_check - 1e-9 * self.dt:
-            linear, angular = pose_error(pose, self._reference)
-            if not self._full:  # position rows only: the orientation is not commanded
-                angular = np.zeros(3)
-            self._drift = (float(np.linalg.norm(linear)), float(np.linalg.norm(angular)))
-            self._next_check = self.t + self._period
-            if self.drift is not None:
-                self._correction = self.drift.twist(linear, angular)
-        correction = self._correction
-        J_task = J[self._rows]
-        sv = np.asarray(np.linalg.svd(J_task, compute_uv=False), dtype=np.float64)
-        decision = self.strategy.decide(Situation(self.robot, q, command_wa + correction,
-                                                  J_task, sv, self.dt, command))  # fmt: skip
+        error = pose_error(pose, self._reference)  # hand axes
+        if not self._full:  # position rows only: the orientation is not commanded
+            error[3:] = 0.0
+        wanted = command  # in the command's frame
+        if self.drift is not None and weight > 0.0:  # an arm stopped or let go stands still
+            correction = self.drift.twist(error)
+            if weight != 1.0:
+                correction *= weight
+            wanted = command + (correction if local else to_base_axes(pose.rotation, correction))
+        hand = pose if local else None
+        decision = self.strategy.decide(Situation(self.robot, q, wanted, self.dt, command,
+                                                  self._rows, hand))  # fmt: skip
+        factor = decision.factor
         if decision.rates is None:
-            in_frame = command + (_rotated(R.T, correction) if local else correction)
-            r = self.resolver.solve(q, decision.factor * in_frame, ref=self._command_frame)
+            r = self.resolver.solve(q, wanted if factor == 1.0 else factor * wanted,
+                                    ref=self._command_frame)  # fmt: skip
         else:
             r = self.resolver.solve(q, [RatesTask(decision.rates)], priority="strict")
-        self._record(q, J, self._drift, r, command_wa, decision.factor, sv, "teleop", decision.note)
-        if decision.rates is None and r.status not in REANCHOR:
-            fraction = decision.factor * r.scale
-            if self._full:
-                self._reference = advance(self._reference, fraction * command, self.dt, local)
-            else:  # the commanded position, at the orientation reached
-                self._reference = advance(self._reference, fraction * command_wa * LINEAR,
-                                          self.dt, False)  # fmt: skip
-        else:
+        self.log.append_tick(Tick(self.t, q.copy(), r, command, hand, factor, error, "teleop",
+                                  decision.note))  # fmt: skip
+        fraction = None if decision.rates is not None else _followed(r)
+        if fraction is None:
             self._reanchor = True
+        elif self._full:  # the command, for the time it was followed
+            self._reference = advance(self._reference, command, factor * fraction * self.dt,
+                                      local)  # fmt: skip
+        else:  # the commanded position, at the orientation reached
+            moved = to_base_axes(pose.rotation, command) if local else command
+            self._reference = advance(self._reference, moved * LINEAR,
+                                      factor * fraction * self.dt, False)  # fmt: skip
         return self._advance(r)
 
     def reverse(self, seconds: float, extra: float = 1.0) -> Retrace:
@@ -272,17 +293,16 @@ class Controller:
                 "seconds", f"asked to reverse {seconds} s ({n} ticks); the record holds "
                 f"{len(self.log)} ticks ({len(self.log) * self.dt:.6g} s)",
             )  # fmt: skip
-        targets = [r.q for r in self.log.records[-n:]][::-1]
+        targets = self.log.positions(n)[::-1]
         budget = n + math.ceil(extra * n)
         steps = 0
         for target in targets:
             while steps < budget:
                 q = self.q
-                J = self._kinematics(q)[0]
                 rates = (target - q) / self.dt
                 r = self.resolver.solve(q, [RatesTask(rates, "reverse")], priority="strict")
-                sv = np.asarray(np.linalg.svd(J[self._rows], compute_uv=False), dtype=np.float64)
-                self._record(q, J, NO_DRIFT, r, np.zeros(6), 1.0, sv, "reverse", "")
+                self.log.append_tick(Tick(self.t, q.copy(), r, np.zeros(6), None, 1.0,
+                                          np.zeros(6), "reverse", ""))  # fmt: skip
                 self._advance(r)
                 steps += 1
                 if r.status == "exact":  # reached (to rounding): on to the next one
@@ -294,41 +314,59 @@ class Controller:
 
     # -- helpers ----------------------------------------------------------------------------
 
-    def _kinematics(self, q: Array) -> tuple[Array, Array]:
-        """Tool Jacobian (6, nq) ``world_aligned`` and tool pose (4, 4) at ``q``: one pass."""
+    def _pose(self, q: Array) -> pin.SE3:
+        """Tool pose at ``q`` (one forward-kinematics pass in the controller's own data)."""
         model, data = self.robot.model, self._data
-        J: Array = pin.computeFrameJacobian(model, data, self.robot.to_pinocchio(q),
-                                            self._frame_id, pin.LOCAL_WORLD_ALIGNED)  # fmt: skip
-        pose: Array = pin.updateFramePlacement(model, data, self._frame_id).homogeneous
-        return J, pose
+        pin.forwardKinematics(model, data, self.robot.to_pinocchio(q) if self._manifold else q)
+        pose: pin.SE3 = pin.updateFramePlacement(model, data, self._frame_id)
+        return pose
 
     def _advance(self, r: Resolution) -> Step:
         """Integrate ``r.qdot`` over one period (Barker eq. (21), ``pinocchio.integrate``)."""
         model = self.robot.model
-        q_pin = self.robot.to_pinocchio(self.q)
+        q_pin = self.robot.to_pinocchio(self.q) if self._manifold else self.q
         moved = pin.integrate(model, q_pin, r.qdot * self.dt)
         # Continuous joints: back to angles by the manifold's difference (= qdot dt).
         self.q = self.q + pin.difference(model, q_pin, moved) if self._manifold else moved
         self.t += self.dt
         return Step(self.q.copy(), r)
 
-    def _record(
-        self, q: Array, J: Array, drift: tuple[float, float], r: Resolution, commanded: Array,
-        factor: float, sv: Array, mode: str, note: str,
-    ) -> None:  # fmt: skip
-        """Append the tick to the log (``drift``: the last measured pose error [m], [rad])."""
+    def _log_record(self, tick: Tick) -> LogRecord:
+        """The log's record of a tick: the kinematics and the resolution's fields read now."""
+        r = tick.resolution
+        J = self.robot.jacobian(tick.q)  # world_aligned, the tick's start
+        J_task = J if self._full else J[list(self._rows)]
+        sv: Array = np.asarray(np.linalg.svd(J_task, compute_uv=False), np.float64)
         active = ";".join(f"{a.name or a.joint}:{a.side}:{a.kind}" for a in r.active)
-        label = self.label(q, J[self._rows], sv)
-        self.log.append(LogRecord(
-            t=self.t, q=q.copy(), qdot=r.qdot.copy(), commanded=commanded, achieved=J @ r.qdot,
-            scale=r.scale, factor=factor, sigma_min=float(sv[-1]),
-            manipulability=float(np.prod(sv)), drift_position=drift[0],
-            drift_rotation=drift[1], mode=mode, method=r.method,
-            status=r.status, active=active, singularity=label, note=note,
-        ))  # fmt: skip
+        commanded = tick.command
+        if tick.hand is not None:
+            commanded = to_base_axes(tick.hand.rotation, commanded)
+        return LogRecord(
+            t=tick.t, q=tick.q, qdot=r.qdot.copy(), commanded=commanded, achieved=J @ r.qdot,
+            scale=r.scale, factor=tick.factor, sigma_min=float(sv[-1]),
+            manipulability=float(np.prod(sv)), drift_position=norm(tick.error[:3]),
+            drift_rotation=norm(tick.error[3:]), mode=tick.mode, method=r.method,
+            status=r.status, active=active, singularity=self.label(tick.q, J_task, sv),
+            note=tick.note,
+        )  # fmt: skip
 
 
-def _rotated(R: Array, twist: Array) -> Array:
-    """``[R v; R w]``: a twist's linear and angular parts in other axes."""
-    out: Array = np.concatenate([R @ twist[:3], R @ twist[3:]])
-    return out
+def _followed(r: Resolution) -> float | None:
+    """Fraction in [0, 1] of a twist's command the resolution achieved along its direction.
+
+    None when the answer departs from the command's direction (:data:`REANCHOR`). A status
+    the pipeline decides (``Resolution.known_status``) is known at once; otherwise the answer
+    is ``exact`` or ``scaled``, and ``scaled`` means that the limits reduced the speed: a
+    joint-rate bound stops the answer. So an answer that touches no bound (within
+    :data:`~solvers.resolution.ACTIVE_TOL`, as ``Resolution.active``) follows the whole
+    command, without reading ``Resolution.scale`` and ``status`` (their task reports cost
+    some 20 us, more than the rest of the tick); one that touches a bound reads them.
+    """
+    if r.known_status is not None:
+        return None
+    bounds = r.bounds
+    for rate, low, high in zip(r.qdot.tolist(), bounds.lb.tolist(), bounds.ub.tolist(),
+                               strict=True):  # fmt: skip
+        if rate - low <= ACTIVE_TOL or high - rate <= ACTIVE_TOL:
+            return None if r.status in REANCHOR else r.scale
+    return 1.0

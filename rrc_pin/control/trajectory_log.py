@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NamedTuple
 
@@ -31,8 +32,7 @@ class LogRecord(NamedTuple):
         factor: The strategy's speed factor, in [0, 1].
         sigma_min: Smallest singular value of the task Jacobian at ``q``.
         manipulability: Product of its singular values.
-        drift_position: Distance [m] from the reference pose, as last measured (the
-            controller measures it every ``DriftCorrection.period``).
+        drift_position: Distance [m] from the reference pose at the start of the tick.
         drift_rotation: Angle [rad] from the reference orientation (Nguyen eq. (37) norm).
         mode: ``"teleop"`` or ``"reverse"``.
         method: The resolution's method (``qp``, ``scipy``, ...).
@@ -69,24 +69,65 @@ SCALARS = ("t", "scale", "factor", "sigma_min", "manipulability", "drift_positio
 class TrajectoryLog:
     """The records of one controller, in time order, with array views for analysis.
 
+    A controller appends its ticks as they are (:meth:`append_tick`) and the log derives
+    their records when it is read (``records``, :meth:`column`, :meth:`save`): what a record
+    adds to a tick (the singular values, the singularity's name, the achieved twist, the
+    resolution's status, scale and active limits) costs more than the rest of a controller's
+    tick, and is paid once, when someone looks.
+
     Args:
         joint_names: Names of the joints (the CSV's column names).
+        derive: Makes the record of a tick passed to :meth:`append_tick` (the controller's;
+            a tick has the record's ``q``), or None for a log of records only.
     """
 
-    def __init__(self, joint_names: list[str] | tuple[str, ...]) -> None:
+    def __init__(
+        self, joint_names: list[str] | tuple[str, ...],
+        derive: Callable[[Any], LogRecord] | None = None,
+    ) -> None:  # fmt: skip
         self.joint_names = tuple(joint_names)
-        self.records: list[LogRecord] = []
+        self._records: list[LogRecord] = []
+        self._ticks: list[Any] = []
+        self._derive = derive
 
     def __len__(self) -> int:
-        return len(self.records)
+        return len(self._records) + len(self._ticks)
+
+    @property
+    def records(self) -> list[LogRecord]:
+        """Every record, in time order (the ticks appended so far derived now)."""
+        if self._ticks:
+            assert self._derive is not None  # append_tick refuses a log without derive
+            self._records.extend(map(self._derive, self._ticks))
+            self._ticks.clear()
+        return self._records
 
     def append(self, record: LogRecord) -> None:
         """Add one tick's record."""
         self.records.append(record)
 
+    def append_tick(self, tick: object) -> None:
+        """Add one tick, its record derived when the log is read (``derive``)."""
+        if self._derive is None:
+            raise InvalidInput("tick", "this log has no derive: append records")
+        self._ticks.append(tick)
+
+    def positions(self, n: int) -> list[Array]:
+        """Joint positions ``q`` of the last ``n`` ticks, oldest first, no record derived.
+
+        (What :meth:`Controller.reverse` retraces: reading ``records`` after a long session
+        would derive every record first.) A tick of :meth:`append_tick` has ``q`` as a
+        record has.
+        """
+        ticks = self._ticks[len(self._ticks) - n:] if n > 0 else []
+        rest = n - len(ticks)
+        records = self._records[len(self._records) - rest:] if rest > 0 else []
+        return [r.q for r in records] + [t.q for t in ticks]
+
     def clear(self) -> None:
         """Forget every record."""
-        self.records.clear()
+        self._records.clear()
+        self._ticks.clear()
 
     def column(self, name: str) -> Array | npt.NDArray[np.str_]:
         """One field over every record: (N,) for scalars and text, (N, k) for vectors.

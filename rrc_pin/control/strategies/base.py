@@ -3,39 +3,73 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
+from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
+import pinocchio as pin
 
 from rrc_pin.robot import Robot
 
 Array = npt.NDArray[np.float64]
 
 
-class Situation(NamedTuple):
+class Situation:
     """What a strategy sees at one tick.
 
-    Attributes:
+    The base-axes twist, the task Jacobian and its singular values are computed on first
+    access: a strategy that does not read them (the resolver's) does not pay for them at
+    every tick.
+
+    Args:
         robot: The robot.
         q: Joint positions (nq,) [rad or m].
-        twist: The command to serve this tick (6,) [m/s, rad/s], ``world_aligned`` (speed
-            override, deadman and drift correction applied).
-        jacobian: The task rows of the tool Jacobian at ``q``, ``world_aligned`` (m, nq)
-            (all six rows, or the three linear ones for an arm of fewer than six joints).
-        singular_values: Singular values of ``jacobian``, descending (min(m, nq),).
+        twist: The command to serve this tick (6,) [m/s, rad/s] (speed override, deadman
+            and drift correction applied), in base axes, or in hand axes with ``hand``.
         dt: Control period [s].
         command: The operator's twist (6,) as given, in its frame (speed override and
             deadman applied, no drift correction).
+        rows: The task rows of the tool Jacobian: all six, or the three linear ones for an
+            arm of fewer than six joints.
+        hand: The tool's pose when ``twist`` is in hand axes, else None.
+
+    Attributes:
+        robot, q, dt, command, rows: As given.
     """
 
-    robot: Robot
-    q: Array
-    twist: Array
-    jacobian: Array
-    singular_values: Array
-    dt: float
-    command: Array
+    def __init__(
+        self, robot: Robot, q: Array, twist: Array, dt: float, command: Array,
+        rows: tuple[int, ...], hand: pin.SE3 | None = None,
+    ) -> None:  # fmt: skip
+        self.robot, self.q, self.dt, self.command, self.rows = robot, q, dt, command, rows
+        self._twist, self._hand = twist, hand
+
+    @cached_property
+    def twist(self) -> Array:
+        """The command to serve (6,) [m/s, rad/s], ``world_aligned`` (Barker eq. (20))."""
+        if self._hand is None:
+            return self._twist
+        return to_base_axes(self._hand.rotation, self._twist)
+
+    @cached_property
+    def jacobian(self) -> Array:
+        """The task rows of the tool Jacobian at ``q``, ``world_aligned`` (m, nq)."""
+        J = self.robot.jacobian(self.q)
+        out: Array = J if len(self.rows) == 6 else J[list(self.rows)]
+        return out
+
+    @cached_property
+    def singular_values(self) -> Array:
+        """Singular values of :attr:`jacobian`, descending (min(m, nq),)."""
+        out: Array = np.asarray(np.linalg.svd(self.jacobian, compute_uv=False), np.float64)
+        return out
+
+
+def to_base_axes(R: Array, twist: Array) -> Array:
+    """``[R v; R w]``: a hand-axes twist (6,) in base axes, ``R`` the hand's orientation."""
+    out: Array = (twist.reshape(2, 3) @ R.T).reshape(6)
+    return out
 
 
 class Decision(NamedTuple):
@@ -52,6 +86,10 @@ class Decision(NamedTuple):
     factor: float = 1.0
     rates: Array | None = None
     note: str = ""
+
+
+KEEP = Decision()
+"""The command unchanged."""
 
 
 class Strategy(ABC):

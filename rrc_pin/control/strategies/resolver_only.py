@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from rrc_pin.control.strategies.base import Decision, Situation, Strategy
+from rrc_pin.control.strategies.base import KEEP, Decision, Situation, Strategy
 
 
 class ResolverOnly(Strategy):
@@ -16,4 +16,4 @@ class ResolverOnly(Strategy):
 
     def decide(self, situation: Situation) -> Decision:
         """The command unchanged."""
-        return Decision()
+        return KEEP
