@@ -209,15 +209,20 @@ class Resolution(_Record):
 
     @cached_property
     def _top(self) -> tuple[float, float, float]:
-        """(scale, residual, norm of the command) of the top level's stacked rows."""
-        first = self.tasks[: len(self.levels[0])]
-        if len(first) == 1:
-            r = first[0]
-            return r.scale, r.residual, norm(r.commanded)
-        y = np.concatenate([r.achieved for r in first])
-        b = np.concatenate([r.commanded for r in first])
-        w = np.concatenate([t.weight if t.weight is not None else np.ones(t.b.size)
-                            for t in self.levels[0]])  # fmt: skip
+        """(scale, residual, norm of the command) of the top level's stacked rows.
+
+        From the rows themselves, not :attr:`tasks` (whose bound reports a loop that reads
+        only ``status`` and ``scale`` need not pay for).
+        """
+        level = self.levels[0]
+        if len(level) == 1:
+            t = level[0]
+            y, b, w = t.A @ self.qdot, t.b, t.weight
+        else:
+            y = np.concatenate([t.A @ self.qdot for t in level])
+            b = np.concatenate([t.b for t in level])
+            w = np.concatenate([t.weight if t.weight is not None else np.ones(t.b.size)
+                                for t in level])  # fmt: skip
         return scale_along(y, b, w), norm(y - b), norm(b)
 
     def __setattr__(self, name: str, value: object) -> None:
