@@ -157,12 +157,14 @@ def run_session(session: Session, strategy: str, quick: bool) -> TrajectoryLog:
 
 def summarise(arm: str, strategy: str, log: TrajectoryLog, robot: Robot) -> Row:
     """The summary row of one session's log."""
-    q, qdot = log.column("q"), log.column("qdot")
+    q = np.asarray(log.column("q"), dtype=np.float64)
+    qdot = np.asarray(log.column("qdot"), dtype=np.float64)
+    drift = np.asarray(log.column("drift_position"), dtype=np.float64)
     margin = float(np.min(np.minimum(q - robot.lower, robot.upper - q)))
     statuses = Counter(str(s) for s in log.column("status"))
     met = sorted({name for s in log.column("singularity") if s for name in str(s).split("+")})
     return Row(
-        arm, strategy, len(log), 1e3 * float(np.max(log.column("drift_position"))), margin,
+        arm, strategy, len(log), 1e3 * float(np.max(drift)), margin,
         float(np.max(np.abs(qdot) / robot.velocity_limit)),
         " ".join(f"{k} {n}" for k, n in statuses.most_common()),
         "; ".join(met[:3]) + (f"; +{len(met) - 3} more" if len(met) > 3 else ""),

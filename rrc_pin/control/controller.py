@@ -174,7 +174,7 @@ class Controller:
         self._data = robot.model.createData()
         self._frame_id = robot.model.getFrameId(robot.tool_frame)
         self._manifold = robot.model.nq != robot.model.nv  # continuous joints as (cos, sin)
-        self._command = np.zeros(6)
+        self._command: Array = np.zeros(6)
         self._command_frame: Frame = "local"
         self._command_time = -math.inf
         self._reference = self._pose(self.q)
@@ -221,7 +221,7 @@ class Controller:
         if frame not in FRAMES:
             raise InvalidInput("frame", f"expected one of {', '.join(FRAMES)}, got {frame!r}")
         if twist is not None:
-            command = as_vector(twist, "twist", 6, InvalidInput).copy()
+            command: Array = as_vector(twist, "twist", 6, InvalidInput).copy()
             self._command, self._command_frame, self._command_time = command, frame, self.t
         age = self.t - self._command_time
         weight = self._speed * (1.0 if self.deadman is None else self.deadman.factor(age))

@@ -93,7 +93,8 @@ class SerajiLaw:
     def reset(self) -> None:
         """Back to the initial gains and auxiliary signal."""
         n = self.kp0.size
-        self.int_f, self.int_kp, self.int_kv = np.zeros(n), np.zeros(n), np.zeros(n)
+        zero: Array = np.zeros(n)
+        self.int_f, self.int_kp, self.int_kv = zero, zero.copy(), zero.copy()
         self.f, self.kp, self.kv = self.f0.copy(), self.kp0.copy(), self.kv0.copy()
 
     def update(self, e: Array, edot: Array) -> Array:

@@ -37,4 +37,4 @@ def pose_error(T: Array, T_d: Array) -> Array:
     quats = quaternion_from_matrix(np.concatenate([Ts[:, :3, :3], Tds[:, :3, :3]]))  # one call
     delta = differential_rotation(quaternion_difference(quats[:n], quats[n:]))
     out = np.concatenate([Tds[:, :3, 3] - Ts[:, :3, 3], delta], axis=1)
-    return out[0] if single else out
+    return np.asarray(out[0] if single else out, dtype=np.float64)

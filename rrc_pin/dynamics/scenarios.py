@@ -312,8 +312,8 @@ def tracking_metrics(rec: Record, basis: Array | None = None) -> dict[str, float
     e = np.linalg.norm(position, axis=1)
     out = {
         "position_rms_mm": 1e3 * float(np.sqrt(np.mean(e**2))),
-        "position_max_mm": 1e3 * float(e.max()),
-        "orientation_max_mrad": 1e3 * float(np.linalg.norm(rec.pose_error[:, 3:], axis=1).max()),
+        "position_max_mm": 1e3 * float(np.max(e)),
+        "orientation_max_mrad": 1e3 * float(np.max(np.linalg.norm(rec.pose_error[:, 3:], axis=1))),
         "clipped_steps": float(rec.clipped),
         "real_time_factor": rec.real_time_factor,
         "step_us": 1e6 * (rec.controller_seconds + rec.simulator_seconds),
@@ -340,7 +340,7 @@ def transient(rec: Record, quiet: Record, change_at: float) -> dict[str, float]:
         recovery = float(t[above[-1] + 1])
     window = t < 1.0
     return {
-        "payload_deviation_peak_mm": 1e3 * float(d.max()),
+        "payload_deviation_peak_mm": 1e3 * float(np.max(d)),
         "payload_deviation_mean_1s_mm": 1e3 * float(d[window].mean()),
         "payload_deviation_end_mm": 1e3 * float(d[-1]),
         "recovery_s": recovery,

@@ -107,13 +107,13 @@ class Simulator:
         self.set_payload(payload)
         self.t = 0.0
         self.q = robot.neutral()
-        self.v = np.zeros(n)
+        self.v: Array = np.zeros(n)
         self.report = StepReport(np.zeros(n), False, np.zeros(3))
 
     def reset(self, q: npt.ArrayLike, v: npt.ArrayLike | None = None, t: float = 0.0) -> State:
         """Put the arm at ``q`` [rad] with speed ``v`` [rad/s] (default rest) at time ``t``."""
         position = as_vector(q, "q", self.robot.nq, InvalidInput).copy()
-        speed = (
+        speed: Array = (
             np.zeros(self.robot.nq) if v is None else as_vector(v, "v", self.robot.nq, InvalidInput)
         )
         self.t = finite_number(t, "t", error=InvalidInput)
@@ -158,7 +158,7 @@ class Simulator:
         if self.friction:
             d = self.drives
             total -= d.viscous * self.v + d.coulomb * np.tanh(self.v / STICTION_SPEED)
-        contact = np.zeros(3)
+        contact: Array = np.zeros(3)
         if self.plane is not None:
             pin.forwardKinematics(self.model, self.data, self.q, self.v)
             pin.updateFramePlacements(self.model, self.data)

@@ -104,6 +104,8 @@ def cylinder(mass: float, radius: float, end: npt.ArrayLike) -> LinkInertial:
     radius = finite_number(radius, "radius", error=InvalidInput, lower=0.0, inclusive=False)
     end = as_array(end, "end", (3,), InvalidInput)
     length = float(np.linalg.norm(end))
+    u: npt.NDArray[np.float64]
+    centre: npt.NDArray[np.float64]
     if length < 2.0 * radius:
         u, length, centre = np.array([0.0, 0.0, 1.0]), 2.0 * radius, np.zeros(3)
     else:

@@ -36,6 +36,7 @@ Rotor inertias (``Jm G^2``) and friction of the source are not part of a URDF an
 from __future__ import annotations
 
 import numpy as np
+import numpy.typing as npt
 
 from rrc_pin.dh import DHChain, DHRow, translation
 from rrc_pin.models.inertia import LinkInertial, make
@@ -77,7 +78,7 @@ def corke_inertials() -> tuple[LinkInertial, ...]:
     return tuple(make(m, com, np.diag(moments)) for m, com, moments in CORKE_LINKS)
 
 
-def link_to_corke(barker: DHChain) -> list[np.ndarray]:
+def link_to_corke(barker: DHChain) -> list[npt.NDArray[np.float64]]:
     """``X_i``: pose of Corke's frame i in Barker's DH frame i, i = 1..6, (4, 4) each.
 
     Args:
