@@ -226,7 +226,7 @@ def teleoperation(out: Path | None = None, quick: bool = False) -> int:
     for session in SESSIONS:
         labels = ", ".join(s.label for s in session.segments)
         print(f"\n{session.arm}: {labels}, then reverse {REVERSE:g} s.", end="")
-    print("\n\ndrift: distance from the commanded pose (corrected every 0.1 s; Barker's "
+    print("\n\ndrift: distance from the commanded pose (corrected at every tick; Barker's "
           "strategies choose\nthe rates themselves and leave that pose, so none is measured); "
           "margin: closest approach to a\njoint limit; statuses: how the resolver answered.")
     print(f"\nwritten: {len(runs)} trajectories (CSV), summary.csv"
