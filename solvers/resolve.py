@@ -189,6 +189,7 @@ class _TopLevel:
     fits: bool  # the exact rates satisfy the bounds and rows: the answer
     factor: JacobianSVD | None  # the SVD, once a step needs it (see svd)
     lam: Array | None = None  # squared damping per singular direction where it may help
+    damping_svd: JacobianSVD | None = None  # the SVD lam is for (rows without clamped joints)
     damped: bool = False  # the damped rates answered
 
     @property
@@ -201,7 +202,9 @@ class _TopLevel:
     @property
     def smooth(self) -> Array:
         """The damped rates where damping may help, else the exact ones (for fallbacks)."""
-        return self.exact if self.lam is None else self.svd.rates(self.b, self.lam)
+        if self.lam is None or self.damping_svd is None:
+            return self.exact
+        return self.damping_svd.rates(self.b, self.lam)
 
     @property
     def lambda_sq(self) -> float:
@@ -330,10 +333,35 @@ def _top_level(
     fits = _inside(exact, bounds, rows)
     top = _TopLevel(A, b, exact, fits, factor)
     if damp and not fits and options.damping is not None:
+        svd, rates = _clamped(top, bounds)
         top.lam = options.damping.lambda_sq(
-            top.svd, bounds.velocity, exact, bounds.lb, bounds.ub, bounds.dt
+            svd, bounds.velocity, rates, bounds.lb, bounds.ub, bounds.dt
         )
+        top.damping_svd = svd
     return top
+
+
+def _clamped(top: _TopLevel, bounds: StepBounds) -> tuple[JacobianSVD, Array]:
+    """The rows' SVD and exact rates for the damping, with clamped joints taken out.
+
+    A joint is clamped where the exact rates push it against a bound that holds it still
+    (Baerlocher & Boulic 2004's clamping), as long as the rows keep their rank without it
+    (else the command needs it, and the rows' own SVD serves: the answer stops). Such a
+    joint is lost to the command, and the singularity that matters is that of the other
+    joints (rolling rrc_k1607's hand with joint 7 on its limit: without the clamp the damping
+    saw a regular Jacobian, and the joints flipped between opposite rate limits at 283 of 300
+    ticks, the hand at 0.3 % of the command).
+    """
+    exact = top.exact
+    pushed = ((bounds.ub <= 0.0) & (exact > 0.0)) | ((bounds.lb >= 0.0) & (exact < 0.0))
+    if not pushed.any():
+        return top.svd, exact
+    A = top.A.copy()
+    A[:, pushed] = 0.0
+    svd = JacobianSVD(A)
+    if svd.rank < top.svd.rank:  # the command needs them: the original problem (it stops)
+        return top.svd, exact
+    return svd, svd.rates(top.b)
 
 
 def _solve_top(
@@ -370,7 +398,7 @@ def _damped_or_exact(top: _TopLevel, along: Callable[[Array], _Solved]) -> _Solv
     if top.lam is None:
         return along(top.exact)
     top.damped = True
-    damped = top.svd.rates(top.b, top.lam)
+    damped = top.smooth
     solved = along(damped)
     size = float(damped @ damped)
     if float(solved.qdot @ damped) > EXACT_TOL * size or size == 0.0:
