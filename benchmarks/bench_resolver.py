@@ -79,6 +79,7 @@ from timing import (  # noqa: E402
 )
 
 import rrc_pin  # noqa: E402
+from rrc_pin.control.drift import advance  # noqa: E402
 from rrc_pin.robot import frame_id  # noqa: E402
 from solvers.qp_backends import installed_backends  # noqa: E402
 
@@ -156,7 +157,7 @@ def pink_contenders(arm: Any) -> list[Contender]:
         ) -> Array:
             configuration.update(q)
             T = configuration.get_transform_frame_to_world(frame)
-            task.set_target(pin.SE3(pin.exp3(x[3:] * DT) @ T.rotation, T.translation + x[:3] * DT))
+            task.set_target(advance(T, x, DT, local=False))
             return pink.solve_ik(
                 configuration, [task], DT, solver=solver, limits=limits, safety_break=False
             )

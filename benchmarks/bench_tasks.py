@@ -62,7 +62,6 @@ from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
-import pinocchio as pin  # noqa: E402
 from bench_resolver import BACKEND_MODULES, rrc_statistics  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
 from placo_peer import PlacoPeer, Worker, placo_checks, placo_python, placo_urdf  # noqa: E402
@@ -83,6 +82,7 @@ from timing import (  # noqa: E402
 
 import rrc_pin  # noqa: E402
 from rrc_pin import FrameTask, PostureTask  # noqa: E402
+from rrc_pin.control.drift import advance  # noqa: E402
 
 ROBOT = "baxter"
 SEED = 20261122
@@ -204,8 +204,7 @@ def pink_step(robot: Any, solver: str, h: float = DT) -> Any:
         configuration.update(q)
         for i, (frame, task) in enumerate(zip(frames, hands, strict=True)):
             T = configuration.get_transform_frame_to_world(frame)
-            v, w = x[6 * i : 6 * i + 3], x[6 * i + 3 : 6 * i + 6]
-            task.set_target(pin.SE3(pin.exp3(w * h) @ T.rotation, T.translation + v * h))
+            task.set_target(advance(T, x[6 * i : 6 * i + 6], h, local=False))
         return pink.solve_ik(
             configuration, tasks, h, solver=solver, limits=limits, safety_break=False
         )

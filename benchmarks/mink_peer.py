@@ -28,6 +28,8 @@ import numpy as np
 import pinocchio as pin
 from timing import Contender
 
+from rrc_pin.control.drift import advance
+
 CHECKOUT = Path(__file__).resolve().parents[1]
 KINEMATICS_TOL = 1e-9
 """Largest accepted difference of the tool pose [m, rad] and Jacobian entries between
@@ -168,11 +170,8 @@ def mink_contenders(arm: Any, dt: float) -> list[Contender]:
         ) -> Array:
             qpos[index] = q
             configuration.update(qpos)
-            T = configuration.get_transform_frame_to_world(body, "body").as_matrix()
-            target = np.eye(4)
-            target[:3, :3] = pin.exp3(x[3:] * dt) @ T[:3, :3]
-            target[:3, 3] = T[:3, 3] + x[:3] * dt
-            task.set_target(mink.SE3.from_matrix(target))
+            T = pin.SE3(configuration.get_transform_frame_to_world(body, "body").as_matrix())
+            task.set_target(mink.SE3.from_matrix(advance(T, x, dt, local=False).homogeneous))
             v = mink.solve_ik(configuration, [task], dt, solver, limits=limits)
             return v[index]
 
