@@ -30,7 +30,8 @@ from rrc_pin.dh import DHChain, nadkarni_link, translation
 from rrc_pin.errors import InvalidInput
 from rrc_pin.guidance.general import general
 from rrc_pin.guidance.operator import Command, operator
-from rrc_pin.guidance.screw import frames_from_points, screw_from_points
+from rrc_pin.guidance.screw import Screw, frames_from_points, screw_from_points
+from rrc_pin.guidance.screw_motion import screw_motion
 from rrc_pin.guidance.stepping import Array, Correction, GuidancePath
 from rrc_pin.guidance.straight_line import straight_line_points
 from rrc_pin.models import CATALOGUE, INCH
@@ -198,27 +199,49 @@ ESCAPE_4 = np.array([-0.05, 0.05, 0.25, 0.25, -0.25, -0.25])
 """The singularity escape of Illustration 4 [rad], as Table A2-6's first row shows it."""
 
 
-def illustration_4() -> list[Row]:
-    """Type II on configuration #1 (Table A2-6): the escape, the constant step, the final hand.
+ILLUSTRATION_4_OFFSET = np.array(
+    [
+        [0.002008, 0.000733, -0.002869],
+        [0.003305, 0.000070, 0.002493],
+        [0.000447, 0.000342, -0.000046],
+    ]
+)
+"""Offsets [in] within the cards' rounding (+-0.005) of Illustration 4's goal points that the
+run reproduces Table A2-6 with (a least-squares witness over the 54 printed joint values, the
+8.608 left out). Near the singular start the rows move by up to 1.3 deg with the goal; the
+offsets stand for what the two-decimal cards and the three-decimal data leave open."""
 
-    The rows compare the twist of each printed step with the first one's (constant within the
-    printed digits) and the hand of the printed final joints with theta1 lowered by 0.05 rad.
+
+def illustration_4_path(goal_offset: npt.ArrayLike = ILLUSTRATION_4_OFFSET) -> GuidancePath:
+    """The run of Table A2-6 (DISP's reading of Type II).
+
+    From the escape (theta1 0.05 rad below the table's), 16 steps of DISP's B along the screw
+    to the goal cards + ``goal_offset`` [in], and one closing step.
     """
-    q0 = start("nadkarni_c1")
     arm = chain("nadkarni_c1")
-    kicked = np.radians([float(v) for v in TABLE_A2_6[0]]) - q0
+    q = start("nadkarni_c1") + ESCAPE_4 + np.r_[ESCAPE_4[0], 0.0, 0.0, 0.0, 0.0, 0.0]
+    points = (np.asarray(ILLUSTRATION_4_GOAL) + np.asarray(goal_offset)) * INCH
+    return screw_motion(arm, q, frames_from_points(points), 16, b_form="disp", closing=1)
+
+
+def illustration_4() -> list[Row]:
+    """Type II on configuration #1 (Table A2-6) as DISP ran it (:func:`illustration_4_path`).
+
+    The rows: the escape, every printed step and the final joints (theta1 printed 0.05 rad
+    above the run's: the computed theta1 is shown raised by it), and the computed final hand.
+    """
+    path = illustration_4_path()
+    printed = [*TABLE_A2_6[1:], TABLE_A2_6_FINAL]
+    raised = path.q + np.r_[-ESCAPE_4[0], 0.0, 0.0, 0.0, 0.0, 0.0]
+    kicked = np.radians([float(v) for v in TABLE_A2_6[0]]) - start("nadkarni_c1")
     rows = [Row("escape [rad]", tuple(f"{x:.2f}" for x in ESCAPE_4), tuple(map(float, kicked)))]
-    twists = printed_step_twists(arm, TABLE_A2_6)
-    for i, B in enumerate(twists[1:], start=2):
-        rows.append(
-            Row(f"step {i} twist / step 1", ("1",) * 6, tuple(float(x) for x in B / twists[0]))
-        )
-    final = np.radians([float(v) for v in TABLE_A2_6_FINAL])
-    final[0] += ESCAPE_4[0]
-    for label, printed, computed in zip(
-        "abc", ILLUSTRATION_4_HAND, hand_points(arm.fk(final)), strict=True
+    for i, p in enumerate(printed[:-1], start=1):
+        rows.append(Row(f"step {i}", p, thesis_units(raised[i], 0)))
+    rows.append(Row("final (step 17)", printed[-1], thesis_units(raised[-1], 0)))
+    for label, point, computed in zip(
+        "abc", ILLUSTRATION_4_HAND, hand_points(path.hand[-1]), strict=True
     ):
-        rows.append(Row(f"{label}2 (theta1 - 0.05 rad)", printed, computed))
+        rows.append(Row(f"{label}2", point, computed))
     return rows
 
 
@@ -236,15 +259,36 @@ hand's z axis. Table A2-8 prints (11.00, -10.00, 20.00), the text (15.00, -24.00
 hand's final pose is the same, the sharing of the turn among the divisions is not."""
 
 
+DISP_STEP_ANGLE = np.radians(3.55)
+"""The turn [rad] per step by which the reading of Table A2-9 sets a division's steps.
+
+Not stated in the thesis: the printed rows fix the steps of divisions 1-9 at 3, 3, 3, 3, 2, 2,
+1, 1, 1 (their turns 10.89, 10.92, 10.20, 9.00, 7.64, 6.36, 5.25, 4.34, 3.61 deg), which
+rounding the turn over any angle in (3.498, 3.602] deg gives; the later divisions (3.02 deg
+and less) take one step with any of them."""
+
+
+def disp_substeps(screw: Screw) -> int:
+    """A division's steps by the reading of Table A2-9: its turn over 3.55 deg, rounded (>= 1)."""
+    return max(1, int(np.floor(abs(float(screw.theta)) / DISP_STEP_ANGLE + 0.5)))
+
+
 def illustration_5(correction: Correction = "none") -> tuple[list[Row], GuidancePath]:
-    """Type III on configuration #2 (Table A2-9), k = 27 divisions."""
+    """Type III on configuration #2 (Table A2-9) as DISP ran it.
+
+    k = 27 divisions toward the goal triangle of the run, each division a Type II run of
+    :func:`disp_substeps` steps with DISP's vector B, and one closing step: 38 steps. The rows
+    are the ends of divisions 1-9; step 1's theta4 prints 10.000 for 10.886 (docs/errata.md).
+    """
     arm = chain("nadkarni_c2")
     goal = np.asarray(ILLUSTRATION_5_GOAL) * INCH
     path = straight_line_points(
-        arm, start("nadkarni_c2"), goal, 27, spacing=INCH, correction=correction
-    )
+        arm, start("nadkarni_c2"), goal, 27, spacing=INCH, substeps=disp_substeps,
+        b_form="disp", closing=1, correction=correction,
+    )  # fmt: skip
+    ends = path.division_ends
     rows = [
-        Row(f"step {i + 1}", p, thesis_units(path.q[i + 1], 3)) for i, p in enumerate(TABLE_A2_9)
+        Row(f"step {i + 1}", p, thesis_units(path.q[ends[i]], 3)) for i, p in enumerate(TABLE_A2_9)
     ]
     rows.append(Row("final", TABLE_A2_9_FINAL, thesis_units(path.q[-1], 3)))
     return rows, path
@@ -306,8 +350,8 @@ def report(number: int) -> list[Row]:
 TITLES = {
     1: "Illustration 1 (Table A2-1): screw axes between three positions of a body",
     2: "Illustration 2 (Table A2-2): configuration #1 in the global frame",
-    4: "Illustration 4 (Table A2-6): Type II on configuration #1, k = 22, singularity escape",
-    5: "Illustration 5 (Table A2-9): Type III on configuration #2, k = 27 divisions",
+    4: "Illustration 4 (Table A2-6): Type II on configuration #1, escape, k = 16 + 1 closing",
+    5: "Illustration 5 (Table A2-9): Type III on configuration #2, 27 divisions in 37 steps + 1",
     6: "Illustration 6 (Table A2-11): Type IV on configuration #2, k = 9 and 4",
     7: "Illustration 7 (Table A2-13): Type I on configuration #2, k = 35",
 }

@@ -106,12 +106,16 @@ class GuidancePath:
         escapes: Indices of the steps before which the singularity escape moved the joints.
         scale: (k,) fraction of each step's displacement achieved (1 with the thesis solver;
             below 1 where the resolver stopped short at a joint limit).
+        division_ends: Indices into ``q`` of the rows that end each division of Type III
+            when its divisions are taken in several steps (``substeps``); empty where every
+            row ends one.
     """
 
     q: Array
     hand: Array
     escapes: tuple[int, ...]
     scale: Array
+    division_ends: tuple[int, ...] = ()
 
 
 class Step(NamedTuple):

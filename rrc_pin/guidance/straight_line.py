@@ -5,15 +5,25 @@ eq. (4-20)) are carried from their start to their goal positions
 along straight lines divided into k equal parts; each step is the screw displacement (Type II,
 one step) from the hand reached to the next triangle of divided points. The origin keeps to its
 line within the first-order error of a step, while the orientation changes gradually.
+
+The thesis's program hands each division to its Type II routine (DISPM, Appendix I), which may
+take it in several steps along the division's screw, located once: ``substeps`` (a number, or
+a rule from the division's screw) says how many; ``b_form="disp"`` is DISPM's vector B and
+``closing`` the steps it adds at the end (rrc_pin.guidance.screw_motion; Table A2-9 to every
+printed digit with all three, docs/api.md).
 """
 
 from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Union
 
 import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.guidance.screw import frames_from_points, screw_from_poses, screw_twist
+from rrc_pin.guidance.screw import Screw, frames_from_points, screw_from_poses
+from rrc_pin.guidance.screw_motion import BForm, check_b_form, check_closing, screw_step_b
 from rrc_pin.guidance.stepping import (
     Array,
     Correction,
@@ -26,6 +36,9 @@ from rrc_pin.guidance.stepping import (
     run_steps,
 )
 from solvers.validation import finite_number, rigid_transform
+
+Substeps = Union[int, Callable[[Screw], int]]  # noqa: UP007 (a runtime alias on 3.10)
+"""Steps per division: a number, or a rule from the division's screw (from the hand reached)."""
 
 
 def hand_points(T: Array, spacing: float) -> Array:
@@ -73,6 +86,9 @@ def straight_line_points(
     steps: int,
     *,
     spacing: float,
+    substeps: Substeps = 1,
+    b_form: BForm = "twist",
+    closing: int = 0,
     solver: Solver = "thesis",
     correction: Correction = "none",
 ) -> GuidancePath:
@@ -90,21 +106,78 @@ def straight_line_points(
             plane on the +x side [m].
         steps: Number of divisions k >= 1.
         spacing: Distance [m] of the start triangle's z and x points from the origin, > 0.
+        substeps: Steps per division (>= 1), or a rule giving them from the screw from the
+            hand reached to the division's triangle; a division's steps share one vector B
+            (Type II on the division, its screw located once).
+        b_form: ``"twist"`` (eq. (4-19a)) or ``"disp"`` (the thesis's program's B,
+            :mod:`rrc_pin.guidance.screw_motion`).
+        closing: Steps added after the k divisions, each the screw from the hand reached to the
+            goal triangle's frame in one step (DISP took one).
         solver: ``"thesis"``, a :class:`ThesisSolver` or a :class:`rrc_pin.Resolver`.
         correction: ``"eq5_5"`` or ``"newton"`` for the second-order correction.
 
+    Returns:
+        The path, one row per step; ``division_ends`` marks the rows that end the divisions
+        (and the closing steps).
+
     Raises:
-        InvalidInput: Bad ``goal_points`` (collinear, non-finite), ``q0``, ``steps`` or
-            ``spacing``, named.
+        InvalidInput: Bad ``goal_points`` (collinear, non-finite), ``q0``, ``steps``,
+            ``spacing``, ``substeps``, ``b_form`` or ``closing``, named.
     """
     k = check_steps(steps)
     gap = finite_number(spacing, "spacing", lower=0.0, inclusive=False, error=InvalidInput)
-    frames_from_points(goal_points, "goal_points")
+    goal = frames_from_points(goal_points, "goal_points")
+    extra = check_closing(closing)
+    if not callable(substeps):
+        check_substeps(substeps)
     end = np.asarray(goal_points, dtype=np.float64)
-    start = hand_points(arm.fk(check_q0(arm, q0)), gap)
+    q = check_q0(arm, q0)
+    start = hand_points(arm.fk(q), gap)
+    check_b_form(b_form)
+    targets = [frames_from_points(start + (i + 1) / k * (end - start)) for i in range(k)]
+    pieces = []
+    for target in [*targets, *([goal] * extra)]:
+        screw = screw_from_poses(arm.fk(q), target)
+        n = check_substeps(substeps(screw) if callable(substeps) else substeps)
 
-    def twist(i: int, T: Array) -> Step:
-        planned = frames_from_points(start + (i + 1) / k * (end - start))
-        return Step(screw_twist(screw_from_poses(T, planned)), planned)
+        def twist(_: int, T: Array, screw: Screw = screw, n: int = n) -> Step:
+            return screw_step_b(screw, n, b_form, T)
 
-    return run_steps(arm, q0, twist, k, solver=solver, correction=correction)
+        piece = run_steps(arm, q, twist, n, solver=solver, correction=correction)
+        pieces.append(piece)
+        q = piece.q[-1]
+    return joined(pieces)
+
+
+def check_substeps(n: int) -> int:
+    """A division's number of steps as an int >= 1.
+
+    Raises:
+        InvalidInput: Not an integer >= 1 (named ``substeps``).
+    """
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise InvalidInput("substeps", f"expected an integer >= 1 per division, got {n!r}")
+    return int(n)
+
+
+def joined(pieces: list[GuidancePath]) -> GuidancePath:
+    """One path from consecutive runs, each starting where the last ended.
+
+    A run whose first row is an escape (``escapes`` holds 0) replaces the previous run's last
+    row, as :func:`run_steps` does within a run.
+    """
+    q, hand = [pieces[0].q[0]], [pieces[0].hand[0]]
+    escapes: list[int] = []
+    scale: list[Array] = []
+    ends: list[int] = []
+    for piece in pieces:
+        offset = len(q) - 1
+        q[-1], hand[-1] = piece.q[0], piece.hand[0]
+        q += list(piece.q[1:])
+        hand += list(piece.hand[1:])
+        escapes += [offset + i for i in piece.escapes]
+        scale.append(piece.scale)
+        ends.append(len(q) - 1)
+    return GuidancePath(
+        np.array(q), np.array(hand), tuple(escapes), np.concatenate(scale), tuple(ends)
+    )
