@@ -12,7 +12,7 @@ import pinocchio as pin
 import pytest
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.guidance import ThesisSolver, screw_motion
+from rrc_pin.guidance import screw_motion
 from rrc_pin.guidance.illustrations import (
     ESCAPE_4,
     ILLUSTRATION_4_GOAL,
@@ -233,21 +233,39 @@ def test_illustration_4_printed_final_theta1_is_off_by_the_escape():
     assert np.abs(shifted - printed).max() <= 0.005 + 1e-9
 
 
-def test_illustration_4_type_ii_from_the_escape_ends_at_the_printed_hand():
-    """From the escape, 22 steps (the screw located again at each) end where the thesis's run
-    ended, to the printed digits but for b2's z (-5.838 against -5.83): the last first-order
-    step leaves 0.01 in, as the thesis's own end (-6.65 for the goal's -6.66) shows."""
+def test_illustration_4_rows_final_and_hand_as_disp_ran_it():
+    """Type II as DISP ran it: from the escape (theta1 0.05 rad below the table's), 16 steps of
+    DISP's B along the screw to the goal and one closing step (17; the table says 22), toward
+    goal points within the cards' rounding (+-0.005 in, ILLUSTRATION_4_OFFSET): every printed
+    step and the final joints within one unit of the last printed digit (0.001 deg; the row
+    71.373 ... 8.608 has 8.604, the erratum), the computed hand to the printed digits. With the
+    same goal, eq. (4-19a)'s B misses the rows by 0.57 deg; without the closing step the final
+    joints are 4.2 deg off, with two 0.24 deg."""
+    from rrc_pin.guidance.illustrations import ILLUSTRATION_4_OFFSET, illustration_4_path
+
+    assert np.abs(ILLUSTRATION_4_OFFSET).max() <= 0.005
+    path = illustration_4_path()
+    assert len(path.q) - 1 == 17 and path.escapes == ()
+    printed = [*TABLE_A2_6[1:], TABLE_A2_6_FINAL]
+    raised = np.degrees(path.q[[1, 2, 3, 4, 5, 6, 7, -1]]) + np.r_[np.degrees(0.05), 0, 0, 0, 0, 0]
+    for n, (row, computed) in enumerate(zip(printed, raised, strict=True)):
+        for j, (c, p) in enumerate(zip(computed, row, strict=True)):
+            if (n, j) == (2, 5):
+                assert abs(c - 8.604) < 0.0005 and abs(c - float(p)) < 0.004
+            else:
+                assert_printed(c, p, slack=0.5 * 10.0 ** -len(p.split(".")[1]))
+    for computed, p in zip(hand_points(path.hand[-1]), ILLUSTRATION_4_HAND, strict=True):
+        for c, v in zip(computed, p, strict=True):
+            assert_printed(c, v)
+
     arm = chain("nadkarni_c1")
-    goal = frames_from_points(np.asarray(ILLUSTRATION_4_GOAL) * INCH)
-    q0 = start("nadkarni_c1")
-    solver = ThesisSolver(singular_cond=5e3, escape=tuple(ESCAPE_4))  # start: cond 9.8e3
-    path = screw_motion(arm, q0, goal, 22, relocate=True, solver=solver)
-    assert path.escapes == (0,)
-    np.testing.assert_allclose(path.q[0], q0 + ESCAPE_4)
-    points = np.array(hand_points(path.hand[-1]))
-    printed = np.array([[float(x) for x in p] for p in ILLUSTRATION_4_HAND])
-    assert np.abs(points - printed).max() <= 0.01
-    assert np.sum(np.abs(points - printed) > 0.005) == 1
+    goal = frames_from_points((np.asarray(ILLUSTRATION_4_GOAL) + ILLUSTRATION_4_OFFSET) * INCH)
+    final = np.radians([float(v) for v in TABLE_A2_6_FINAL]) - np.r_[0.05, 0, 0, 0, 0, 0]
+    twist = screw_motion(arm, path.q[0], goal, 16, b_form="twist", closing=1)
+    assert np.degrees(np.abs(twist.q[1:8] - path.q[1:8])).max() > 0.5
+    for closing, off in ((0, 4.0), (2, 0.2)):
+        other = screw_motion(arm, path.q[0], goal, 16, b_form="disp", closing=closing)
+        assert np.degrees(np.abs(other.q[-1] - final)).max() > off
 
 
 def end_error(paths, expected):
@@ -312,13 +330,14 @@ def test_cli_prints_the_thesis_beside_the_computed(capsys):
 
 
 def test_illustration_4_step_is_the_screw_from_the_escape_over_16():
-    """The printed constant step is the screw from the hand at the escape, theta1 taken 0.05 rad
-    below its printed value (as at the end), to the goal, divided by 16, not 22: every component
-    lies in the envelope the goal points' rounding (+-0.005) spans, and one choice of goal
-    points inside it gives the step to 1.7 rounding bounds of a printed step; with k = 15, 17,
-    22 or theta1 as printed, components fall outside the envelope. (The table's "22 steps"
-    would count 6 more than the screw's 16: docs/errata.md.)"""
-    from rrc_pin.guidance import screw_from_poses, screw_twist
+    """The printed constant step is DISP's B for the screw from the hand at the escape, theta1
+    taken 0.05 rad below its printed value (as at the end), to the goal, divided by 16, not 22:
+    every component lies in the envelope the goal points' rounding (+-0.005) spans (with
+    DISP's B and with eq. (4-19a)'s), and the goal of the run (ILLUSTRATION_4_OFFSET) gives the
+    step within 0.13 rounding bounds of a printed step (eq. (4-19a)'s B at best 1.7); with
+    k = 15, 17, 22 or theta1 as printed, components fall outside the envelope."""
+    from rrc_pin.guidance import screw_from_poses
+    from rrc_pin.guidance.screw_motion import disp_step
 
     arm = chain("nadkarni_c1")
     twists = printed_step_twists(arm, TABLE_A2_6)
@@ -332,20 +351,21 @@ def test_illustration_4_step_is_the_screw_from_the_escape_over_16():
     goal = np.asarray(ILLUSTRATION_4_GOAL)
     jitter = np.random.default_rng(3).uniform(-0.005, 0.005, size=(3000, 3, 3))
 
-    def located(k, d_theta1, moved):
-        """The actual step (the printed frame turned by d_theta1 about z) and screws / k."""
+    def located(k, d_theta1, moved, b_form="disp"):
+        """The actual step (the printed frame turned by d_theta1 about z) and B of screws / k."""
         turn = pin.exp3(np.r_[0.0, 0.0, d_theta1])
         actual = np.r_[turn @ step[:3], turn @ step[3:]]
         T = arm.fk(start("nadkarni_c1") + ESCAPE_4 + np.r_[d_theta1, 0, 0, 0, 0, 0])
         T = np.broadcast_to(T, (*moved.shape[:-2], 4, 4))
-        return actual, screw_twist(screw_from_poses(T, frames_from_points(moved * INCH))) / k
+        screw = screw_from_poses(T, frames_from_points(moved * INCH))
+        return actual, disp_step(screw, k, b_form)
 
-    for k, d_theta1 in [(16, -0.05), (22, -0.05), (15, -0.05), (17, -0.05), (16, 0.0)]:
-        actual, cloud = located(k, d_theta1, goal + jitter)
-        inside = (cloud.min(axis=0) <= actual) & (actual <= cloud.max(axis=0))
-        assert inside.all() == ((k, d_theta1) == (16, -0.05)), (k, d_theta1, inside)
-    witness = np.array(
-        [[0.0043521, 0.005, -0.005], [0.005, 0.0025686, 0.005], [0.0023453, 0.002554, 0.0023954]]
-    )  # found by bounded least squares (scipy.optimize.least_squares, 9 unknowns)
-    actual, twist = located(16, -0.05, goal + witness)
-    assert np.abs((twist - actual) / bound).max() < 1.7
+    for b_form in ("disp", "twist"):
+        for k, d_theta1 in [(16, -0.05), (22, -0.05), (15, -0.05), (17, -0.05), (16, 0.0)]:
+            actual, cloud = located(k, d_theta1, goal + jitter, b_form)
+            inside = (cloud.min(axis=0) <= actual) & (actual <= cloud.max(axis=0))
+            assert inside.all() == ((k, d_theta1) == (16, -0.05)), (k, d_theta1, inside)
+    from rrc_pin.guidance.illustrations import ILLUSTRATION_4_OFFSET
+
+    actual, B = located(16, -0.05, goal + ILLUSTRATION_4_OFFSET)
+    assert np.abs((B - actual) / bound).max() < 1.0

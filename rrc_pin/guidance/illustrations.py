@@ -11,12 +11,15 @@ Readings that reproduce the printed digits (docs/api.md, "Guidance"):
   located again at every step from the hand reached to the goal, a ``1 / (k - i)`` share each.
 - Illustration 6 (Type IV, Table A2-11): k = 9 and 4; each command's twist is constant, its
   axis through the hand point where the command starts.
-- Illustration 4 (Type II, Table A2-6): the escape is (-0.05, 0.05, 0.25, 0.25, -0.25, -0.25)
-  rad (read from the table); every printed step is one constant twist; the printed final
-  theta1 is 0.05 rad above the configuration whose hand the thesis prints.
-- Illustration 5 (Type III, Table A2-9): k = 27 divisions toward a goal triangle whose z point
-  is 5 units out (b_2 = (15, -10, 20), docs/errata.md): r3 and theta4 of steps 2-9 to the
-  printed digits; step 1 turns 10.000 deg where the division asks 10.886.
+- Illustrations 4 and 5 (Types II and III, Tables A2-6 and A2-9) as the thesis's program DISP
+  ran them: its vector B is eq. (4-19a) with the second-order term of the base origin's
+  displacement (``b_form="disp"``, rrc_pin.guidance.screw_motion), and one closing step ends
+  the run. Illustration 4: the escape is (-0.05, 0.05, 0.25, 0.25, -0.25, -0.25) rad (read
+  from the table), then 16 steps along one screw and the closing step, toward goal points
+  within the cards' rounding; the printed theta1 is 0.05 rad above the run's. Illustration 5:
+  k = 27 divisions toward a goal triangle whose z point is 5 units out (b_2 = (15, -10, 20),
+  docs/errata.md), each division a Type II run of :func:`disp_substeps` steps: every printed
+  digit but step 1's theta4 (10.000 printed for 10.886), 38 steps.
 """
 
 from __future__ import annotations

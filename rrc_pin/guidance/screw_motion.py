@@ -48,10 +48,10 @@ BForm = Literal["twist", "disp"]
 
 
 def disp_step(screw: Screw, k: int, b_form: BForm = "disp") -> Array:
-    """The vector B (6,) [v; w], WORLD, of one of ``k`` equal steps along ``screw``.
+    """The vector B (..., 6) [v; w], WORLD, of one of ``k`` equal steps along ``screw``.
 
     Args:
-        screw: The screw of the whole displacement (base frame, SI).
+        screw: The screw (batched or not) of the whole displacement (base frame, SI).
         k: Number of steps >= 1.
         b_form: ``"twist"`` (eq. (4-19a), the screw's twist / k) or ``"disp"`` (with DISP's
             second-order term of the base origin's displacement, module docstring).
@@ -64,9 +64,9 @@ def disp_step(screw: Screw, k: int, b_form: BForm = "disp") -> Array:
     if check_b_form(b_form) == "twist":
         return twist
     u, rho = np.asarray(screw.u), np.asarray(screw.rho)
-    dtheta = float(screw.theta) / k
+    dtheta = np.asarray(screw.theta)[..., None] / k
     out: Array = twist.copy()
-    out[:3] -= 0.5 * dtheta**2 * np.cross(u, np.cross(u, rho))
+    out[..., :3] -= 0.5 * dtheta**2 * np.cross(u, np.cross(u, rho))
     return out
 
 
