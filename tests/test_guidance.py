@@ -278,10 +278,73 @@ def test_bad_input_names_the_argument(arms):
         operator(arm, q0, [Command((0, 0, 1), np.nan, 0.1)], 5)
     with pytest.raises(InvalidInput, match="^rotation:"):
         general_axes(arm, q0, ((0, 0, 0), 0.1), ((1, 0, 0), 0.1), 5)
+    with pytest.raises(InvalidInput, match="^b_form:"):
+        screw_motion(arm, q0, goal, 5, b_form="second")
+    with pytest.raises(InvalidInput, match="^b_form:"):
+        straight_line_points(arm, q0, points, 5, spacing=0.1, b_form="second")
+    for closing in (-1, 1.5, True):
+        with pytest.raises(InvalidInput, match="^closing:"):
+            screw_motion(arm, q0, goal, 5, closing=closing)
+        with pytest.raises(InvalidInput, match="^closing:"):
+            straight_line_points(arm, q0, points, 5, spacing=0.1, closing=closing)
+    for substeps in (0, 2.0, lambda screw: 0):
+        with pytest.raises(InvalidInput, match="^substeps:"):
+            straight_line_points(arm, q0, points, 5, spacing=0.1, substeps=substeps)
     with pytest.raises(InvalidInput, match="^escape:"):
         ThesisSolver(escape=(0.0, 0.0))
     with pytest.raises(InvalidInput, match="^singular_cond:"):
         ThesisSolver(singular_cond=0.5)
+
+
+def test_disps_b_is_the_twist_with_the_origins_second_order_term(rng):
+    """disp_step: the twist / k less dtheta^2 / 2 U x (U x rho_n), batched as the screws are;
+    equal to the twist for a pure translation and for an axis through the base origin."""
+    from rrc_pin.guidance import Screw, disp_step
+
+    T1 = [pin.SE3.Random().homogeneous for _ in range(4)]
+    T2 = [pin.SE3.Random().homogeneous for _ in range(4)]
+    screws = screw_from_poses(np.array(T1), np.array(T2))
+    B = disp_step(screws, 3)
+    for n in range(4):
+        s = screw_from_poses(T1[n], T2[n])
+        term = 0.5 * (float(s.theta) / 3) ** 2 * np.cross(s.u, np.cross(s.u, s.rho))
+        np.testing.assert_allclose(B[n], screw_twist(s) / 3 - np.r_[term, 0, 0, 0], atol=1e-14)
+        np.testing.assert_allclose(disp_step(s, 3, "twist"), screw_twist(s) / 3, atol=1e-15)
+        assert np.linalg.norm(term) > 1e-4
+    shift = Screw(np.array([0.0, 0, 1]), np.zeros(3), np.array(0.3), np.array(0.0), np.inf)
+    through = Screw(np.array([0.0, 0, 1]), np.zeros(3), np.array(0.1), np.array(0.5), 0.2)
+    for s in (shift, through):
+        np.testing.assert_allclose(disp_step(s, 2), screw_twist(s) / 2, atol=1e-15)
+
+
+@pytest.mark.parametrize("name", ARMS)
+def test_type_iii_divisions_in_several_steps_with_disps_b(arms, name, rng):
+    """Type III with each division a Type II run of 3 steps of DISP's B and one closing step:
+    3k + 1 steps, ``division_ends`` every third row and the last, the hand point within one
+    step's error of its line at the division ends, and the closing step lands on the goal
+    to second order in the remaining displacement (DISP's B is not the exact twist: its extra
+    term is second order too)."""
+    arm = arms[name]
+    q0, goal = start_and_goal(arm, rng)
+    k = 8
+    T0 = arm.fk(q0)
+    points = np.stack(
+        [goal[:3, 3], goal[:3, 3] + 0.1 * goal[:3, 2], goal[:3, 3] + 0.1 * goal[:3, 0]]
+    )
+    path = straight_line_points(
+        arm, q0, points, k, spacing=0.1, substeps=3, b_form="disp", closing=1
+    )
+    assert len(path.q) == 3 * k + 2 and path.escapes == ()
+    assert path.division_ends == (*range(3, 3 * k + 1, 3), 3 * k + 1)
+    a, b = T0[:3, 3], goal[:3, 3]
+    line = (b - a) / np.linalg.norm(b - a)
+    step = np.linalg.norm(screw_twist(screw_from_poses(T0, goal))) / k
+    for e in path.division_ends:
+        p = path.hand[e][:3, 3]
+        assert np.linalg.norm(p - a - ((p - a) @ line) * line) <= C2 * step**2
+    before = pose_error(goal, path.hand[-2])
+    after = pose_error(goal, path.hand[-1])
+    assert after <= 20.0 * before**2 < 0.1 * before  # second order (measured up to 8.7)
 
 
 def test_erratum_examples_1_and_3_sign_of_b(arms, rng):

@@ -15,7 +15,7 @@ from rrc_pin.guidance.screw import (
     screw_of_displacement,
     screw_twist,
 )
-from rrc_pin.guidance.screw_motion import screw_motion
+from rrc_pin.guidance.screw_motion import disp_step, screw_motion
 from rrc_pin.guidance.stepping import GuidancePath, Step, ThesisSolver, run_steps
 from rrc_pin.guidance.straight_line import straight_line, straight_line_points
 from rrc_pin.guidance.velocity import joint_rates
@@ -26,6 +26,7 @@ __all__ = [
     "Screw",
     "Step",
     "ThesisSolver",
+    "disp_step",
     "displacement",
     "frames_from_points",
     "general",

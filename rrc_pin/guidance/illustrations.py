@@ -211,8 +211,9 @@ ILLUSTRATION_4_OFFSET = np.array(
 )
 """Offsets [in] within the cards' rounding (+-0.005) of Illustration 4's goal points that the
 run reproduces Table A2-6 with (a least-squares witness over the 54 printed joint values, the
-8.608 left out). Near the singular start the rows move by up to 1.3 deg with the goal; the
-offsets stand for what the two-decimal cards and the three-decimal data leave open."""
+8.608 left out). Near the singular start the goal matters: with the cards as printed the rows
+are 0.7 deg and the end 1.2 deg off. The offsets stand for what the two-decimal cards and the
+three-decimal data leave open."""
 
 
 def illustration_4_path(goal_offset: npt.ArrayLike = ILLUSTRATION_4_OFFSET) -> GuidancePath:

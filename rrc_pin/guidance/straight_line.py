@@ -136,9 +136,9 @@ def straight_line_points(
     check_b_form(b_form)
     targets = [frames_from_points(start + (i + 1) / k * (end - start)) for i in range(k)]
     pieces = []
-    for target in [*targets, *([goal] * extra)]:
+    for i, target in enumerate([*targets, *([goal] * extra)]):
         screw = screw_from_poses(arm.fk(q), target)
-        n = check_substeps(substeps(screw) if callable(substeps) else substeps)
+        n = 1 if i >= k else check_substeps(substeps(screw) if callable(substeps) else substeps)
 
         def twist(_: int, T: Array, screw: Screw = screw, n: int = n) -> Step:
             return screw_step_b(screw, n, b_form, T)
