@@ -21,6 +21,7 @@ from rrc_pin.guidance.illustrations import (
     TABLE_A2_6,
     TABLE_A2_6_FINAL,
     TABLE_A2_9,
+    TABLE_A2_11,
     chain,
     frames_from_points,
     hand_points,
@@ -87,6 +88,27 @@ def test_illustration_6_stage_1_to_the_printed_digits_stage_2_within_one_unit():
     assert_rows([r for r in rows if r not in stage_1], slack=0.005)
 
 
+def test_illustration_6_refutes_disps_b_for_type_iv():
+    """Type IV (GUIDM) keeps the twist of eq. (4-21): with DISP's second-order term added to
+    stage 1's constant step, the end of stage 1 (printed -1.20 30.07 4.00 30.00) moves by
+    more than 0.3 in, where the twist gives it to the printed digits."""
+    from rrc_pin.guidance import Screw, disp_step
+
+    arm, q = chain("nadkarni_c2"), start("nadkarni_c2")
+    foot = np.array([15.0, -25.0, 0.0]) * INCH  # the normal from the origin to the axis
+    screw = Screw(np.array([0.0, 0, 1]), foot, np.array(4.0 * INCH), np.radians(-30.0), 0.0)
+    ends = {}
+    for b_form in ("twist", "disp"):
+        B, qi = disp_step(screw, 9, b_form), q.copy()
+        for _ in range(9):
+            qi = qi + np.linalg.solve(arm.jacobian(qi, ref="world"), B)
+        ends[b_form] = np.r_[qi[:3] / INCH, np.degrees(qi[3])]
+    printed = [float(v) for v in TABLE_A2_11[3][1][:4]]
+    for c, p in zip(ends["twist"], TABLE_A2_11[3][1][:4], strict=True):
+        assert_printed(c, p)
+    assert np.abs(ends["disp"] - printed)[:2].max() > 0.3
+
+
 def test_illustration_5_every_row_to_the_printed_digits():
     """Type III as DISP ran it: 27 divisions toward the goal triangle of the run (b_2 5 units
     out), each division a Type II run of 3, 3, 3, 3, 2, 2, 1, 1, 1, ... steps with DISP's B,
@@ -104,6 +126,14 @@ def test_illustration_5_every_row_to_the_printed_digits():
         for j, (c, p) in enumerate(zip(row.computed, row.printed, strict=True)):
             if (n, j) != (0, 3):
                 assert_printed(c, p)
+
+
+def planned_divisions(arm, q0, goal_points, k=27, count=9):
+    """The first ``count`` division frames of Type III from the hand at q0 (spacing 1 in)."""
+    corners = np.array(hand_points(arm.fk(q0))) * INCH
+    return [
+        frames_from_points(corners + i / k * (goal_points - corners)) for i in range(1, count + 1)
+    ]
 
 
 def one_division(arm, q, target, n, b_form):
@@ -178,9 +208,11 @@ def test_illustration_5_disps_b_from_the_single_steps():
 def test_illustration_5_each_part_of_the_reading_is_needed():
     """Without sub-steps, with eq. (4-19a)'s B, or without the closing step, the run misses the
     printed rows or the printed end: r1 or r2 off by > 0.05 in on some row, or the final r2
-    20.0006 (which prints 20.001). A cap of 10 deg on the joint steps (step 1 scaled to 10.000)
-    misses row 1's r3 by 0.024 in (its r1, r2, r3 are those of a whole first division)."""
-    from rrc_pin.guidance import straight_line_points
+    20.0006 (which prints 20.001). The steps per division, 3, 3, 3, 3, 2, 2, 1, 1, 1, are the
+    division's turn over c rounded for c in (3.498, 3.602] deg only. A cap of 10 deg on the
+    joint steps (step 1 scaled to 10.000) misses row 1's r3 by 0.024 in (its r1, r2, r3 are
+    those of a whole first division)."""
+    from rrc_pin.guidance import screw_from_poses, straight_line_points
     from rrc_pin.guidance.illustrations import disp_substeps
 
     arm, q0 = chain("nadkarni_c2"), start("nadkarni_c2")
@@ -200,6 +232,12 @@ def test_illustration_5_each_part_of_the_reading_is_needed():
     path, rows = run(substeps=disp_substeps, b_form="disp", closing=0)
     assert np.abs(rows - printed).max() < 0.0005 + 1e-9
     assert path.q[-1][1] / INCH == pytest.approx(20.0006, abs=5e-5)
+    # the steps per division: the turn over c, rounded, for c in (3.498, 3.602] deg only
+    turns = [abs(float(screw_from_poses(path.hand[e], P).theta)) for e, P in zip(
+        (0, *path.division_ends[:8]), planned_divisions(arm, q0, goal), strict=False)]  # fmt: skip
+    for c, same in ((3.49, False), (3.50, True), (3.60, True), (3.61, False)):
+        counts = [max(1, int(np.floor(t / np.radians(c) + 0.5))) for t in turns]
+        assert (counts == [3, 3, 3, 3, 2, 2, 1, 1, 1]) == same, (c, counts)
     step_1 = run(substeps=disp_substeps, b_form="disp", closing=0)[0].q[3]
     capped = q0 + (step_1 - q0) * np.radians(10.0) / step_1[3]
     assert abs(capped[2] / INCH - float(TABLE_A2_9[0][2])) > 0.02
