@@ -107,8 +107,8 @@ class GuidancePath:
         scale: (k,) fraction of each step's displacement achieved (1 with the thesis solver;
             below 1 where the resolver stopped short at a joint limit).
         division_ends: Indices into ``q`` of the rows that end each division of Type III
-            when its divisions are taken in several steps (``substeps``); empty where every
-            row ends one.
+            (and each closing step), its divisions possibly taken in several steps
+            (``substeps``); empty for the other types.
     """
 
     q: Array
