@@ -31,6 +31,7 @@ import numpy as np
 import numpy.typing as npt
 
 from solvers.errors import ProblemError
+from solvers.joint_bounds import radius
 from solvers.qp import QP, Decoding
 from solvers.resolution import norm
 
@@ -77,13 +78,13 @@ def direction_qp(w: Array, null: Array, lb: Array, ub: Array, key: str) -> tuple
         The QP (its rows are the joint-rate bounds) and its decoding ``qdot = M z``.
     """
     d, n = null.shape
-    radius = norm(np.maximum(-lb, ub))
+    R = radius(lb, ub)
     length = norm(w)
     M = np.empty((n, d + 1))
     M[:, :d] = null.T
-    M[:, d] = w * (radius / length) if length > radius else w
+    M[:, d] = w * (R / length) if length > R else w
     eps = REGULARIZATION
-    P = np.diag([eps / (radius * radius or 1.0)] * d + [eps])
+    P = np.diag([eps / (R * R or 1.0)] * d + [eps])
     q = np.array([0.0] * d + [-1.0])
     z_lb = np.array([-np.inf] * d + [0.0])
     z_ub = np.array([np.inf] * d + [1.0])

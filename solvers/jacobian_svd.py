@@ -57,7 +57,7 @@ import numpy.typing as npt
 from scipy.linalg.lapack import dgesvd, dposv
 
 from solvers.direction import uniform_scale
-from solvers.joint_bounds import excludes_zero
+from solvers.joint_bounds import excludes_zero, radius
 from solvers.resolution import norm
 from solvers.validation import finite_number
 
@@ -205,7 +205,8 @@ class Damping:
         # without V
         v = velocity.tolist()
         first, last = float(svd.sigma[0]), float(svd.sigma[r - 1])
-        reachable = 0.0 if dt is None else first * dt * min(norm(np.maximum(-lb, ub)), norm(exact))
+        R = radius(lb, ub)
+        reachable = 0.0 if dt is None else first * dt * min(R, norm(exact))
         if first * math.sqrt(len(v)) * max(v) <= last * min(v) * self.ratio and last >= reachable:
             return None
         sigma = svd.sigma[:r]
@@ -215,8 +216,7 @@ class Damping:
         lam_r = np.maximum(1.0 - (speed / onset) ** 2, 0.0) * (onset / reach) ** 2
         if dt is not None:  # g_i (sigma_1 |u_i^T xdot| dt - sigma_i^2), u_i^T xdot = sigma_i v_i w
             step = float(sigma[0]) * dt  # sigma_1 dt
-            radius = norm(np.maximum(-lb, ub))  # R
-            fade = np.maximum(1.0 - sigma / (step * radius), 0.0) if step * radius > 0.0 else 0.0
+            fade = np.maximum(1.0 - sigma / (step * R), 0.0) if step * R > 0.0 else 0.0
             crossing = step * sigma * np.abs(svd.Vt[:r] @ exact) - sigma * sigma
             lam_r = np.maximum(lam_r, fade * crossing)
         if not (lam_r > 0.0).any():

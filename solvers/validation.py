@@ -42,7 +42,7 @@ def as_array(
             refused), NaN or inf.
     """
     if type(x) is np.ndarray and x.dtype == _F64 and x.shape == shape:  # the common case
-        if not np.isfinite(x).all():
+        if not all_finite(x):
             _non_finite(x, name, error)
         return x
     arr = real_array(x, name, error, f"expected a real numeric array of shape {_fmt(shape)}")
@@ -50,9 +50,24 @@ def as_array(
         want is not None and got != want for got, want in zip(arr.shape, shape, strict=True)
     ):
         raise error(name, f"expected shape {_fmt(shape)}, got {arr.shape}")
-    if not np.isfinite(arr).all():
+    if not all_finite(arr):
         _non_finite(arr, name, error)
     return arr
+
+
+def all_finite(x: npt.NDArray[np.float64]) -> bool:
+    """Whether every entry of ``x`` is finite (no NaN or infinity).
+
+    Small arrays (a twist, a configuration: checked at every control tick) through a Python
+    list: 0.3 us against 1.3 us for ``np.isfinite(x).all()``.
+    """
+    if x.size <= _SMALL:
+        return all(map(isfinite, x.ravel().tolist()))
+    return bool(np.isfinite(x).all())
+
+
+_SMALL = 64
+"""Arrays up to this size are checked through a Python list (:func:`all_finite`)."""
 
 
 def real_array(

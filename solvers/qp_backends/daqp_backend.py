@@ -21,6 +21,7 @@ import numpy as np
 from solvers.errors import ProblemError
 from solvers.qp import QP
 from solvers.qp_backends.base import Array, QPBackend, QPSolution
+from solvers.validation import all_finite
 
 DEFAULT_SETTINGS = {"primal_tol": 1e-9}
 """DAQP settings used unless overridden. DAQP's default primal tolerance (1e-6) lets an
@@ -67,7 +68,7 @@ class DaqpBackend(QPBackend):
         except Exception as exc:
             raise ProblemError(f"daqp: {exc}") from exc
         solve_time = time.perf_counter() - t0
-        found = exitflag > 0 and bool(np.isfinite(x).all())
+        found = exitflag > 0 and all_finite(x)
         self._remember(qp, x if found else None)
         status = "solved" if found else f"exitflag {exitflag}"
         iterations = int(info["iterations"])
