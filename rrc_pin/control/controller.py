@@ -43,6 +43,7 @@ Array = npt.NDArray[np.float64]
 Frame = Literal["local", "world_aligned"]
 LINEAR = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
 FRAMES: tuple[str, ...] = ("local", "world_aligned")
+F64 = np.dtype(np.float64)
 REANCHOR = ("damped", "singular", "least_squares", "recovering", "fallback")
 """Statuses whose motion departs from the command's direction: the reference pose is reset to
 the reached pose instead of pulling the hand back to a pose it could not follow."""
@@ -381,7 +382,7 @@ def _checked_twist(twist: npt.ArrayLike) -> Array:
         InvalidInput: Naming ``twist``: not a real (6,) vector, or NaN or inf in it.
     """
     out: Array
-    if type(twist) is np.ndarray and twist.dtype == np.float64 and twist.shape == (6,):
+    if type(twist) is np.ndarray and twist.dtype == F64 and twist.shape == (6,):
         if math.isfinite(sum(twist.tolist())):
             out = twist.copy()
             return out
