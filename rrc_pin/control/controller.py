@@ -81,8 +81,8 @@ class Retrace(NamedTuple):
 class Tick(NamedTuple):
     """One tick as the controller keeps it; the log derives its :class:`LogRecord` when read.
 
-    The controller appends a plain tuple in this order (0.45 us less per tick than making
-    the named tuple, measured), made a Tick when the log is read.
+    The controller appends a plain tuple in this order (3.7 k instructions less per tick
+    than making the named tuple, callgrind), made a Tick when the log is read.
 
     Attributes:
         t: Time at the start of the tick [s].
@@ -247,7 +247,7 @@ class Controller:
         # What to serve, in the command's frame: the command plus the correction.
         if self.drift is None or weight == 0.0:  # an arm stopped or let go stands still
             wanted = command
-        elif local:  # added on Python floats: one array instead of three (0.7 us less)
+        elif local:  # on Python floats: one array, not three (8 k instructions less)
             wanted = self.drift.twist(error, self._command.tolist())
             if weight != 1.0:
                 wanted *= weight
@@ -375,8 +375,8 @@ def _checked_twist(twist: npt.ArrayLike) -> Array:
     """``twist`` as a new finite (6,) float array.
 
     A float (6,) array, the usual command, is checked on Python floats: finite entries have a
-    finite sum (up to an overflow beyond 1e307, which ``as_vector`` then judges); 0.5 us
-    against 1.9 us for ``as_vector``'s ``np.isfinite(x).all()`` and the copy (measured).
+    finite sum (up to an overflow beyond 1e307, which ``as_vector`` then judges); 6.4 k
+    instructions against 16.4 k for ``as_vector`` and the copy (callgrind), 0.5 us against 1.9.
 
     Raises:
         InvalidInput: Naming ``twist``: not a real (6,) vector, or NaN or inf in it.
