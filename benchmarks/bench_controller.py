@@ -6,7 +6,7 @@ Run from a checkout: ``python benchmarks/bench_controller.py --out DIR`` (``--re
 
 - **Tick time** (issue 8), on barker6 and panda: random operator commands
   (``random_commands``, seeded, hand frame, no pauses) drive a default ``Controller``
-  (deadman, drift correction every 0.1 s, log, resolver strategy). At every tick, in an order
+  (deadman, drift correction at every tick, log, resolver strategy). At every tick, in an order
   shuffled per tick (interleaved), the two contenders run at the controller's current q with
   the same command: the baseline ``Resolver.solve(q, twist, ref="local")`` with the Euler
   update ``q + qdot dt``, and ``Controller.step(twist, "local")`` (the kinematics and singular

@@ -9,7 +9,10 @@ import pytest
 
 import rrc_pin
 from rrc_pin.control import Controller, Deadman, DriftCorrection
+from rrc_pin.control.controller import _checked_twist
 from rrc_pin.control.random_operator import random_commands
+from rrc_pin.control.strategies import Decision, ResolverOnly, Situation, Strategy
+from rrc_pin.control.strategies.base import KEEP
 
 BARKER_Q0 = np.deg2rad([20.0, 30.0, 60.0, 10.0, 40.0, 0.0])
 PANDA_Q0 = np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.8, 0.7])
@@ -158,6 +161,11 @@ def test_joint_limit_margins_are_kept(panda):
     ("call", "argument"),
     [
         (lambda c: c.step([0.0, 0.0, np.nan, 0.0, 0.0, 0.0]), "twist"),
+        # float (6,) arrays, checked on Python floats (Controller's fast path)
+        (lambda c: c.step(np.array([0.0, 0.0, np.nan, 0.0, 0.0, 0.0])), "twist"),
+        (lambda c: c.step(np.array([0.0, np.inf, 0.0, 0.0, 0.0, 0.0])), "twist"),
+        (lambda c: c.step(np.array([np.inf, -np.inf, 0.0, 0.0, 0.0, 0.0])), "twist"),
+        (lambda c: c.step(np.zeros((6, 1))), "twist"),
         (lambda c: c.step([0.0, 0.0, 0.1]), "twist"),
         (lambda c: c.step([0.1, 0, 0, 0, 0, 0], frame="tool"), "frame"),
         (lambda c: c.step([0.1, 0, 0, 0, 0, 0], frame="world"), "frame"),
@@ -196,6 +204,43 @@ def test_bad_construction_names_the_argument(panda, kwargs, argument):
     with pytest.raises(rrc_pin.InvalidInput) as info:
         Controller(panda, **kwargs)
     assert info.value.argument == argument
+
+
+def test_a_float_array_command_is_kept_as_a_copy_and_judged_like_any_other(panda):
+    """The twist checked on Python floats: finite entries whose sum overflows are accepted
+    (as ``as_vector`` accepts them), integers too, and the caller's array may be reused."""
+    reused = Controller(panda, q0=PANDA_Q0)
+    fresh = Controller(panda, q0=PANDA_Q0)
+    buffer = np.array([0.02, -0.01, 0.0, 0.0, 0.1, 0.0])
+    reused.step(buffer)
+    fresh.step(buffer.copy())
+    buffer[:] = 5.0  # the caller's buffer changes after the call: the held command does not
+    for _ in range(3):
+        assert np.array_equal(reused.step().q, fresh.step().q)
+    huge = np.array([1e308, 1e308, 0.0, 0.0, 0.0, 0.0])  # finite, its sum is not
+    kept = _checked_twist(huge)
+    assert np.array_equal(kept, huge) and kept is not huge
+    ints = Controller(panda, q0=PANDA_Q0)
+    assert np.array_equal(ints.step(np.array([0, 0, 0, 0, 0, 0])).q, PANDA_Q0)
+
+
+def test_the_resolvers_strategy_is_skipped_as_its_decision_would_keep_the_command(panda):
+    """``ResolverOnly.passive``: the controller builds no Situation for it; a strategy that
+    decides KEEP through the ordinary path moves the arm identically."""
+
+    class Keep(Strategy):
+        def decide(self, situation: Situation) -> Decision:
+            assert situation.q.shape == (7,)
+            return KEEP
+
+    assert ResolverOnly.passive and not Keep.passive
+    rng = np.random.default_rng(5)
+    passive = Controller(panda, q0=PANDA_Q0)
+    ordinary = Controller(panda, q0=PANDA_Q0, strategy=Keep())
+    for twist in random_commands(rng, 0.3, 0.01, hold=0.05):
+        assert np.array_equal(passive.step(twist).q, ordinary.step(twist).q)
+    assert np.array_equal(passive.log.column("drift_position"),
+                          ordinary.log.column("drift_position"))  # fmt: skip
 
 
 def test_a_robot_with_two_hands_is_refused():

@@ -77,8 +77,8 @@ class TrajectoryLog:
 
     Args:
         joint_names: Names of the joints (the CSV's column names).
-        derive: Makes the record of a tick passed to :meth:`append_tick` (the controller's;
-            a tick has the record's ``q``), or None for a log of records only.
+        derive: Makes the record of a tick passed to :meth:`append_tick` (the controller's),
+            or None for a log of records only.
     """
 
     def __init__(
@@ -87,7 +87,7 @@ class TrajectoryLog:
     ) -> None:  # fmt: skip
         self.joint_names = tuple(joint_names)
         self._records: list[LogRecord] = []
-        self._ticks: list[Any] = []
+        self._ticks: list[tuple[Any, ...]] = []
         self._derive = derive
 
     def __len__(self) -> int:
@@ -106,8 +106,12 @@ class TrajectoryLog:
         """Add one tick's record."""
         self.records.append(record)
 
-    def append_tick(self, tick: object) -> None:
-        """Add one tick, its record derived when the log is read (``derive``)."""
+    def append_tick(self, tick: tuple[Any, ...]) -> None:
+        """Add one tick, its record derived when the log is read (``derive``).
+
+        Args:
+            tick: What ``derive`` takes: a tuple that starts as its record, ``(t, q, ...)``.
+        """
         if self._derive is None:
             raise InvalidInput("tick", "this log has no derive: append records")
         self._ticks.append(tick)
@@ -116,13 +120,12 @@ class TrajectoryLog:
         """Joint positions ``q`` of the last ``n`` ticks, oldest first, no record derived.
 
         (What :meth:`Controller.reverse` retraces: reading ``records`` after a long session
-        would derive every record first.) A tick of :meth:`append_tick` has ``q`` as a
-        record has.
+        would derive every record first.)
         """
         ticks = self._ticks[len(self._ticks) - n:] if n > 0 else []
         rest = n - len(ticks)
         records = self._records[len(self._records) - rest:] if rest > 0 else []
-        return [r.q for r in records] + [t.q for t in ticks]
+        return [r.q for r in records] + [t[1] for t in ticks]  # a tick's (t, q, ...)
 
     def clear(self) -> None:
         """Forget every record."""

@@ -101,6 +101,9 @@ class Strategy(ABC):
     """
 
     name: str = "strategy"
+    passive: bool = False
+    """Whether :meth:`decide` always keeps the command (:data:`KEEP`): the controller then
+    builds no :class:`Situation` for it."""
 
     def check(self, robot: Robot) -> None:  # noqa: B027 - a hook: most strategies take any arm
         """Refuse a robot this strategy cannot work on.

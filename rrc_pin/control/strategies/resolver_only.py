@@ -13,6 +13,7 @@ class ResolverOnly(Strategy):
     """
 
     name = "resolver"
+    passive = True
 
     def decide(self, situation: Situation) -> Decision:
         """The command unchanged."""
