@@ -112,13 +112,16 @@ def direction_lp(M: Array, C: Array, lo: Array, hi: Array) -> Array:
     cost = np.zeros(d + 1)
     cost[d] = -1.0
     finite = np.isfinite(lo)
-    result = linprog(
-        cost,
-        A_ub=np.vstack([C, -C[finite]]),
-        b_ub=np.concatenate([hi, -lo[finite]]),
-        bounds=[(None, None)] * d + [(0.0, 1.0)],
-        method="highs",
-    )
+    try:
+        result = linprog(
+            cost,
+            A_ub=np.vstack([C, -C[finite]]),
+            b_ub=np.concatenate([hi, -lo[finite]]),
+            bounds=[(None, None)] * d + [(0.0, 1.0)],
+            method="highs",
+        )
+    except ValueError as exc:  # data linprog refuses (non-finite entries)
+        raise ProblemError(f"linprog: {exc}") from exc
     if result.status != 0 or result.x is None:
         raise ProblemError(f"linprog: {result.message}")
     return np.asarray(M @ result.x, dtype=np.float64)

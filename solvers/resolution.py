@@ -158,8 +158,9 @@ class Resolution(_Record):
         bounds: The joint-rate bounds of the step.
         levels: The task rows by priority level (copies).
         joint_names: Joint names for :attr:`ActiveLimit.name`, or None.
-        known_status: The status when the pipeline decided it (``fallback``, ``recovering``,
-            ``damped``, ``singular``), else None (decided from the residual on access).
+        known_status: The status when the pipeline decided it (``exact`` for the box-free
+            optimum of one level, ``fallback``, ``recovering``, ``damped``, ``singular``),
+            else None (decided from the residual on access).
     """
 
     @cached_property
@@ -193,23 +194,28 @@ class Resolution(_Record):
     @cached_property
     def residual(self) -> float:
         r"""Top level's task error :math:`\|J\dot q - \dot x\|_2` (mixed units)."""
-        return self._top[1]
+        _, residual, _, unit = self._top
+        return residual * unit
 
     @cached_property
     def status(self) -> Status:
         """What the answer is, for the top priority level (:data:`Status`)."""
         if self.known_status is not None:
             return self.known_status
-        scale, residual, size = self._top
-        if residual <= EXACT_TOL * (1.0 + size):
+        scale, residual, size, unit = self._top
+        tol = EXACT_TOL * (1.0 / unit + size)  # EXACT_TOL (1 + |command|), in units of unit
+        if residual <= tol:
             return "exact"
-        if residual <= (1.0 - scale) * size + EXACT_TOL * (1.0 + size):
+        if residual <= (1.0 - scale) * size + tol:
             return "scaled"  # the achieved rates are scale times the command
         return "least_squares"
 
     @cached_property
-    def _top(self) -> tuple[float, float, float]:
-        """(scale, residual, norm of the command) of the top level's stacked rows.
+    def _top(self) -> tuple[float, float, float, float]:
+        """(scale, residual, norm of the command, unit) of the top level's stacked rows.
+
+        The residual and the norm are in units of ``unit``: 1, or the command's largest entry
+        where they would overflow (commands with entries near 1e308).
 
         From the rows themselves, not :attr:`tasks` (whose bound reports a loop that reads
         only ``status`` and ``scale`` need not pay for).
@@ -223,7 +229,11 @@ class Resolution(_Record):
             b = np.concatenate([t.b for t in level])
             w = np.concatenate([t.weight if t.weight is not None else np.ones(t.b.size)
                                 for t in level])  # fmt: skip
-        return scale_along(y, b, w), norm(y - b), norm(b)
+        residual, size = norm(y - b), norm(b)
+        if math.isfinite(residual) and math.isfinite(size):
+            return scale_along(y, b, w), residual, size, 1.0
+        unit = float(np.abs(b).max())
+        return scale_along(y, b, w), norm(y / unit - b / unit), norm(b / unit), unit
 
     def __setattr__(self, name: str, value: object) -> None:
         raise AttributeError(f"a Resolution is immutable: {name!r} cannot be set")

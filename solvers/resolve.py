@@ -90,6 +90,12 @@ factorisation well conditioned (at 1e-9 it declared some feasible lower levels i
 The box-free optimum, used whenever it is inside the bounds, has no such term."""
 
 
+HUGE = 1e150
+"""A direction-preserving command with an entry beyond this is resolved for its direction
+(divided by its largest entry): its exact rates would overflow, and the answer's speed is
+set by the bounds either way."""
+
+
 class Inequalities(NamedTuple):
     """Rows ``G qdot <= h`` that every answer must satisfy (collision, workspace walls).
 
@@ -325,6 +331,9 @@ def _top_level(
 ) -> _TopLevel:
     """The top level's exact rates, and (if ``damp``) the damping it may need."""
     A, b = _stack(tasks)
+    peak = float(np.abs(b).max()) if damp and b.size else 0.0
+    if peak > HUGE:  # the direction problem depends on the command's direction only
+        b = b / peak
     factor = None
     # direction-preserving: every step whose exact rates leave the bounds needs the SVD (the
     # null space), so it comes first (panda's benchmark trajectory: 77 % of the steps)
@@ -332,7 +341,7 @@ def _top_level(
     if exact is None:  # not well posed for the normal equations, or needed: the SVD
         factor = JacobianSVD(A)
         exact = factor.rates(b)
-    fits = _inside(exact, bounds, rows)
+    fits = peak <= HUGE and _inside(exact, bounds, rows)
     top = _TopLevel(A, b, exact, fits, factor)
     if damp and not fits and options.damping is not None:
         svd, rates = _clamped(top, bounds)
@@ -594,8 +603,11 @@ def _scipy_bvls(top: _TopLevel, bounds: StepBounds, rows: Inequalities | None) -
     free = bounds.lb < bounds.ub
     if free.any():
         A = top.A[:, free]
-        result = lsq_linear(A, top.b - top.A[:, ~free] @ x[~free],
-                            bounds=(bounds.lb[free], bounds.ub[free]), method="bvls")  # fmt: skip
+        try:
+            rhs = top.b - top.A[:, ~free] @ x[~free]
+            result = lsq_linear(A, rhs, bounds=(bounds.lb[free], bounds.ub[free]), method="bvls")
+        except ValueError as exc:  # data lsq_linear refuses (non-finite entries)
+            raise _Failed(f"lsq_linear: {exc}") from exc
         if not result.success:
             raise _Failed(f"lsq_linear: {result.message}")
         x[free] = result.x
@@ -623,6 +635,8 @@ def _report(
         status = "damped"
     elif not weighted and top is not None and _outside_range(top):
         status = "singular"
+    elif not weighted and top is not None and top.fits and len(levels) == 1:
+        status = "exact"  # the box-free optimum of a full-rank command
     return Resolution(
         solved.qdot, method, solved.backend, solved.iterations, tuple(attempts), solved.clip,
         top.lambda_sq if top is not None else 0.0, elapsed - solved.solve_time,

@@ -182,6 +182,27 @@ def test_an_absurd_command_is_scaled_along_its_direction(arms: dict) -> None:
         assert np.isfinite(huge.residual) and 0.0 <= huge.scale < 1e-290
 
 
+@pytest.mark.parametrize("ref", ["local", "world_aligned"])
+def test_commands_near_the_float_range_never_raise(ref: str, arms: dict) -> None:
+    """Entries up to 1.7e308: their exact rates overflow. The direction-preserving resolver
+    answers for the command's direction (without a warning); the tracking one falls back.
+    Before, the direction QP got NaN rates and scipy's LP raised a ValueError."""
+    arm = arms["panda"]
+    q = np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.8, 0.7])
+    for twist in ([1e307, 1e307, 0.0, 0.0, 0.0, 0.0], [1.7e308, -1.7e308, 0.0, 0.0, 0.0, 1e308]):
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            r = Resolver(arm).solve(q, twist, ref=ref)
+        check_step(arm, q, r.qdot, 0.01)
+        assert r.method == "qp" and r.status == "scaled" and 0.0 <= r.scale < 1e-300
+        J = arm.jacobian(q, ref=ref)
+        assert angle(J @ r.qdot, np.array(twist) / 1e300) < 1e-6
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the tracking QP's costs overflow
+            tracked = Resolver(arm, direction_preserving=False).solve(q, twist, ref=ref)
+        check_step(arm, q, tracked.qdot, 0.01)
+
+
 def test_start_outside_the_limits_moves_back(arms: dict) -> None:
     arm = arms["rrc_k1607"]
     q = arm.neutral() + 0.3

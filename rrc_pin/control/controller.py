@@ -36,7 +36,7 @@ from rrc_pin.limits import JointLimits
 from rrc_pin.loading import load
 from rrc_pin.resolver import Damping, QPOptions, Resolver
 from rrc_pin.robot import Robot
-from solvers.resolution import ACTIVE_TOL, Resolution
+from solvers.resolution import Resolution
 from solvers.validation import as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
@@ -393,19 +393,13 @@ def _checked_twist(twist: npt.ArrayLike) -> Array:
 def _followed(r: Resolution) -> float | None:
     """Fraction in [0, 1] of a twist's command the resolution achieved along its direction.
 
-    None when the answer departs from the command's direction (:data:`REANCHOR`). A status
-    the pipeline decides (``Resolution.known_status``) is known at once; otherwise the answer
-    is ``exact`` or ``scaled``, and ``scaled`` means that the limits reduced the speed: a
-    joint-rate bound stops the answer. So an answer that touches no bound (within
-    :data:`~solvers.resolution.ACTIVE_TOL`, as ``Resolution.active``) follows the whole
-    command, without reading ``Resolution.scale`` and ``status`` (their task reports cost
-    some 20 us, more than the rest of the tick); one that touches a bound reads them.
+    None when the answer departs from the command's direction (:data:`REANCHOR`). The status
+    the pipeline decided (``Resolution.known_status``: ``exact`` for the box-free optimum)
+    is known at once, without computing the achieved twist; otherwise the answer is
+    ``exact``, ``scaled`` or ``least_squares``, read from ``Resolution.status`` and ``scale``.
     """
+    if r.known_status == "exact":
+        return 1.0
     if r.known_status is not None:
         return None
-    bounds, tol = r.bounds, ACTIVE_TOL
-    for rate, low, high in zip(r.qdot.tolist(), bounds.lb.tolist(), bounds.ub.tolist(),
-                               strict=False):  # fmt: skip (one length)
-        if rate - low <= tol or high - rate <= tol:
-            return None if r.status in REANCHOR else r.scale
-    return 1.0
+    return None if r.status in REANCHOR else r.scale
