@@ -136,8 +136,6 @@ class JointBounds:
             if np.any(a <= 0.0):
                 raise InputError("acceleration", f"expected acceleration limits > 0, got {a}")
             self.acceleration = a
-        self._minus_velocity = -v
-        self._range = np.stack([self.low, self.high])  # (2, n)
 
     def step(self, q: Array, dt: float, qdot_prev: Array | None = None) -> StepBounds:
         """The bounds of one step of ``dt`` from ``q`` (module docstring); inputs not checked.
@@ -152,9 +150,9 @@ class JointBounds:
         """
         # Exact in floating point: with k shrunk by SHRINK, fl(ub * dt) <= high - q for
         # high >= q (six roundings of at most eps each), so fl(q + qdot * dt) <= high for
-        # every qdot <= ub, fused multiply-add or not; the same for lb. Rows: lower, upper.
-        b = (self._range - q) * (self.gain / dt * SHRINK)
-        lb, ub = b
+        # every qdot <= ub, fused multiply-add or not; the same for lb.
+        k = self.gain / dt * SHRINK
+        lb, ub = (self.low - q) * k, (self.high - q) * k
         outside = excludes_zero(lb, ub)
         if outside:  # a joint outside its range: on its limit, or recovering
             on_limit = (q <= self.high + ON_LIMIT) & (q >= self.low - ON_LIMIT)
@@ -162,7 +160,8 @@ class JointBounds:
             ub[on_limit] = np.maximum(ub[on_limit], 0.0)
             outside = excludes_zero(lb, ub)
         position = (lb, ub)
-        lb, ub = np.minimum(np.maximum(b, self._minus_velocity), self.velocity)
+        v = self.velocity
+        lb, ub = np.minimum(np.maximum(lb, -v), v), np.minimum(np.maximum(ub, -v), v)
         if self.acceleration is None:
             return StepBounds(lb, ub, not outside, outside, self.velocity, position, dt)
         prev = np.zeros(self.n) if qdot_prev is None else qdot_prev

@@ -91,8 +91,8 @@ The box-free optimum, used whenever it is inside the bounds, has no such term.""
 
 
 HUGE = 1e150
-"""A direction-preserving command with an entry beyond this is resolved for its direction
-(divided by its largest entry): its exact rates would overflow, and the answer's speed is
+"""A direction-preserving command longer than this is resolved for its direction (divided by
+its largest entry): its exact rates would overflow, and the answer's speed is
 set by the bounds either way."""
 
 
@@ -331,9 +331,9 @@ def _top_level(
 ) -> _TopLevel:
     """The top level's exact rates, and (if ``damp``) the damping it may need."""
     A, b = _stack(tasks)
-    peak = float(np.abs(b).max()) if damp and b.size else 0.0
-    if peak > HUGE:  # the direction problem depends on the command's direction only
-        b = b / peak
+    size = norm(b) if damp else 0.0
+    if size > HUGE:  # the direction problem depends on the command's direction only
+        b = b / float(np.abs(b).max())
     factor = None
     # direction-preserving: every step whose exact rates leave the bounds needs the SVD (the
     # null space), so it comes first (panda's benchmark trajectory: 77 % of the steps)
@@ -341,7 +341,7 @@ def _top_level(
     if exact is None:  # not well posed for the normal equations, or needed: the SVD
         factor = JacobianSVD(A)
         exact = factor.rates(b)
-    fits = peak <= HUGE and _inside(exact, bounds, rows)
+    fits = size <= HUGE and _inside(exact, bounds, rows)
     top = _TopLevel(A, b, exact, fits, factor)
     if damp and not fits and options.damping is not None:
         svd, rates = _clamped(top, bounds)
@@ -391,8 +391,9 @@ def _solve_top(
         qp, decoding = _least_squares_qp(top, bounds, rows)
         return _backend_solve(qp, decoding, bounds, backend, rows)
 
-    def along(w: Array) -> _Solved:
-        return _Solved(w) if _inside(w, bounds, rows) else _along(w, top, bounds, backend, rows)
+    def along(w: Array) -> _Solved:  # the exact rates are known not to fit (top.fits)
+        inside = w is not top.exact and _inside(w, bounds, rows)
+        return _Solved(w) if inside else _along(w, top, bounds, backend, rows)
 
     return _damped_or_exact(top, along)
 
