@@ -92,8 +92,8 @@ The box-free optimum, used whenever it is inside the bounds, has no such term.""
 
 HUGE = 1e150
 """A direction-preserving command longer than this is resolved for its direction (divided by
-its largest entry): its exact rates would overflow, and the answer's speed is
-set by the bounds either way."""
+its largest entry): its exact rates would overflow, and the bounds set the answer's speed
+either way."""
 
 
 class Inequalities(NamedTuple):

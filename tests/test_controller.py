@@ -207,8 +207,8 @@ def test_bad_construction_names_the_argument(panda, kwargs, argument):
 
 
 def test_a_float_array_command_is_kept_as_a_copy_and_judged_like_any_other(panda):
-    """The twist checked on Python floats: finite entries whose sum overflows are accepted
-    (as ``as_vector`` accepts them), integers too, and the caller's array may be reused."""
+    """The twist is kept as a copy (the caller's array may be reused); finite entries whose
+    sum overflows are accepted, integers too."""
     reused = Controller(panda, q0=PANDA_Q0)
     fresh = Controller(panda, q0=PANDA_Q0)
     buffer = np.array([0.02, -0.01, 0.0, 0.0, 0.1, 0.0])
