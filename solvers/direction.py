@@ -84,7 +84,9 @@ def direction_qp(w: Array, null: Array, lb: Array, ub: Array, key: str) -> tuple
     M[:, :d] = null.T
     M[:, d] = w * (R / length) if length > R else w
     eps = REGULARIZATION
-    P = np.diag([eps / (R * R or 1.0)] * d + [eps])
+    P = np.zeros((d + 1, d + 1))
+    P.flat[:: d + 2] = eps / (R * R or 1.0)
+    P[d, d] = eps
     q = np.array([0.0] * d + [-1.0])
     z_lb = np.array([-np.inf] * d + [0.0])
     z_ub = np.array([np.inf] * d + [1.0])

@@ -136,6 +136,7 @@ class JointBounds:
             if np.any(a <= 0.0):
                 raise InputError("acceleration", f"expected acceleration limits > 0, got {a}")
             self.acceleration = a
+        self._minus_velocity = -v
 
     def step(self, q: Array, dt: float, qdot_prev: Array | None = None) -> StepBounds:
         """The bounds of one step of ``dt`` from ``q`` (module docstring); inputs not checked.
@@ -160,8 +161,11 @@ class JointBounds:
             ub[on_limit] = np.maximum(ub[on_limit], 0.0)
             outside = excludes_zero(lb, ub)
         position = (lb, ub)
-        v = self.velocity
-        lb, ub = np.minimum(np.maximum(lb, -v), v), np.minimum(np.maximum(ub, -v), v)
+        v, minus_v = self.velocity, self._minus_velocity
+        if outside:  # the interval excludes zero: either side may lie beyond either limit
+            lb, ub = np.minimum(np.maximum(lb, minus_v), v), np.minimum(np.maximum(ub, minus_v), v)
+        else:  # lb <= 0 <= ub: one side each
+            lb, ub = np.maximum(lb, minus_v), np.minimum(ub, v)
         if self.acceleration is None:
             return StepBounds(lb, ub, not outside, outside, self.velocity, position, dt)
         prev = np.zeros(self.n) if qdot_prev is None else qdot_prev

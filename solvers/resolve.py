@@ -366,7 +366,9 @@ def _clamped(top: _TopLevel, bounds: StepBounds) -> tuple[JacobianSVD, Array]:
     """
     exact, still = top.exact, ON_LIMIT / bounds.dt  # a bound within rounding of zero holds
     pushed = ((bounds.ub <= still) & (exact > 0.0)) | ((bounds.lb >= -still) & (exact < 0.0))
-    if not pushed.any():
+    clamped = int(np.count_nonzero(pushed))
+    # fewer free joints than the rank: the rank is lost for sure, no SVD needed to know it
+    if clamped == 0 or exact.size - clamped < top.svd.rank:
         return top.svd, exact
     A = top.A.copy()
     A[:, pushed] = 0.0
