@@ -113,37 +113,30 @@ def _solved(
     closed: Callable[[], Sequence[Entry]], band: _Band, bad: Entry, eps: float, exact: bool,
     repair: bool = True,
 ) -> Sequence[Entry]:  # fmt: skip
-    """A block's rates: the closed form ``closed()`` outside its band, :func:`_band_solve` in.
+    """A block's rates: the closed form ``closed()`` outside its band, ``band()`` solved in it.
 
-    One configuration (Python floats, ``bad`` a bool): one answer or the other (the closed
-    form divides by zero on the singular set). A batch ((N,) arrays, ``bad`` (N,)): the closed
+    In the band by :func:`damped_solve`, or by :func:`truncated_solve` with ``exact``. One
+    configuration (Python floats, ``bad`` a bool): one answer or the other (the closed form
+    divides by zero on the singular set). A batch ((N,) arrays, ``bad`` (N,)): the closed
     form at every row (inf or NaN in the band), then with ``repair`` the rows in the band
     solved again.
     """
     if not isinstance(bad, np.ndarray):
-        return _band_solve(band, eps, exact) if bad else closed()
+        if not bad:
+            return closed()
+        A, b, s2 = band()
+        if not exact:
+            return damped_solve(A, b, s2, eps)
+        return [v.item() for v in truncated_solve(A, b, eps, 1)]
     out = closed()
     idx = np.flatnonzero(bad) if repair else None
     if idx is not None and idx.size:
-        for o, xi in zip(out, _band_solve(band, eps, exact, idx), strict=True):
+        A, b, s2 = band()
+        A, b = [[_at(v, idx) for v in r] for r in A], [_at(v, idx) for v in b]
+        x = truncated_solve(A, b, eps, idx.size) if exact else damped_solve(A, b, s2[idx], eps)
+        for o, xi in zip(out, x, strict=True):
             o[idx] = xi
     return out
-
-
-def _band_solve(
-    band: _Band, eps: float, exact: bool, idx: npt.NDArray[np.intp] | None = None
-) -> list[Entry]:
-    """``band()`` solved by :func:`damped_solve`, or by :func:`truncated_solve` with ``exact``.
-
-    At the rows ``idx`` of a batch, or (``idx`` None) for one configuration, as floats.
-    """
-    A, b, s2 = band()
-    if idx is not None:
-        A, b, s2 = [[_at(v, idx) for v in r] for r in A], [_at(v, idx) for v in b], s2[idx]
-    if not exact:
-        return damped_solve(A, b, s2, eps)
-    x = truncated_solve(A, b, eps, 1 if idx is None else idx.size)
-    return x if idx is not None else [v.item() for v in x]
 
 
 # -- the closed form -----------------------------------------------------------------------

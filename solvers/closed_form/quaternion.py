@@ -21,14 +21,9 @@ Every function takes one item or a stack: ``R`` (3, 3) or (N, 3, 3), quaternions
   of off-diagonal pairs divided by it (never less than 1/2), which is eq. (26) itself when
   ``eta`` is the largest. At exactly 180 deg (``eta = 0``) the sign is fixed by the largest
   component of ``s`` being positive.
-- :func:`matrix_from_quaternion`: ``Q^-1{eta, s}``, eqs. (27)-(28) corrected.
-- :func:`quaternion_difference`: the quaternion of ``R2 R1^T`` from those of ``R1`` and
-  ``R2``, eqs. (32)-(34) (as printed: ``delta eta = eta1 eta2 + s1.s2``,
-  ``delta s = eta1 s2 - eta2 s1 + s1 x s2``).
-- :func:`differential_rotation`: ``(delta_x, delta_y, delta_z) = 2 delta s``, eq. (37);
-  exact to second order in the angle (error ``theta^3 / 24``); :func:`rotation_vector` is the
-  exact log map, :func:`small_rotation` the matrix ``I + delta^x`` of eqs. (35)-(36)
-  corrected.
+- :func:`matrix_from_quaternion` (eqs. (27)-(28) corrected), :func:`quaternion_difference`
+  (eqs. (32)-(34)), :func:`differential_rotation` (eq. (37)), :func:`small_rotation`
+  (eqs. (35)-(36) corrected) and :func:`rotation_vector` (the exact log map).
 """
 
 from __future__ import annotations
@@ -59,7 +54,14 @@ def quaternion_from_matrix(R: npt.ArrayLike) -> Array:
             (tolerance :data:`ORTHONORMAL_TOL`).
     """
     Rs, single = _stack(R, "R", (3, 3))
-    _check_rotation(Rs)
+    gram = np.einsum("nki,nkj->nij", Rs, Rs) - np.eye(3)
+    det = np.linalg.det(Rs)
+    bad = (np.abs(gram).max(axis=(1, 2)) > ORTHONORMAL_TOL) | (np.abs(det - 1.0) > ORTHONORMAL_TOL)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise InputError(
+            "R", f"expected a rotation matrix (orthonormal, det +1); item {i} has det {det[i]:.6g}"
+        )
     r11, r12, r13 = Rs[:, 0, 0], Rs[:, 0, 1], Rs[:, 0, 2]
     r21, r22, r23 = Rs[:, 1, 0], Rs[:, 1, 1], Rs[:, 1, 2]
     r31, r32, r33 = Rs[:, 2, 0], Rs[:, 2, 1], Rs[:, 2, 2]
@@ -245,18 +247,3 @@ def _stack(x: npt.ArrayLike, name: str, item: tuple[int, ...]) -> tuple[Array, b
         return as_array(x, name, item)[None], True
     return as_array(x, name, (None, *item)), False
 
-
-def _check_rotation(Rs: Array) -> None:
-    """Refuse matrices that are not rotations (orthonormal, det +1).
-
-    Raises:
-        InputError: Naming ``R``.
-    """
-    gram = np.einsum("nki,nkj->nij", Rs, Rs) - np.eye(3)
-    det = np.linalg.det(Rs)
-    bad = (np.abs(gram).max(axis=(1, 2)) > ORTHONORMAL_TOL) | (np.abs(det - 1.0) > ORTHONORMAL_TOL)
-    if np.any(bad):
-        i = int(np.argmax(bad))
-        raise InputError(
-            "R", f"expected a rotation matrix (orthonormal, det +1); item {i} has det {det[i]:.6g}"
-        )

@@ -45,7 +45,7 @@ import numpy.typing as npt
 
 from solvers.closed_form._batch import blocks, cos_sin
 from solvers.closed_form.base import Array, ClosedForm, Entry, dot, stack_entries
-from solvers.closed_form.weighted import svd_rates, weight_factor
+from solvers.closed_form.weighted import pseudo_inverse, weight_factor
 from solvers.validation import as_array, as_vector, finite_number
 
 NQ = 7
@@ -122,11 +122,7 @@ def _kinematics(
     for k in range(NQ - 2, 1, -1):
         bx, by, bz = z[k]
         cols[k] = (by * rz - bz * ry, bz * rx - bx * rz, bx * ry - by * rx, bx, by, bz)
-        if d[k]:
-            rx, ry, rz = rx + d[k] * bx, ry + d[k] * by, rz + d[k] * bz
-        if a[k]:
-            xx, xy, xz = x[k]
-            rx, ry, rz = rx + a[k] * xx, ry + a[k] * xy, rz + a[k] * xz
+        rx, ry, rz = _step(rx, ry, rz, a[k], x[k], d[k], z[k])
     # b_2 = (-s1, c1, 0): Nguyen eq. (18), second column, with r_2 in place of p.
     cols[1] = (c1 * rz, s1 * rz, -s1 * ry - c1 * rx, -s1, c1, 0.0)
     rx, ry, rz = _step(rx, ry, rz, a[1], x[1], d[1], z[1])
@@ -316,7 +312,7 @@ def _weighted_rates(J: Any, b: Array, z: Array | None, L: Array | None, rcond: f
 
     ``y`` by :func:`_solve_spd6`; where the solve proves ``lambda_min(B B^T) < tau`` (``|b| <
     tau |y|`` with ``tau = rcond^2 trace(B B^T)``, or NaN), the SVD form
-    :func:`~solvers.closed_form.weighted.svd_rates` instead (module docstring).
+    :func:`~solvers.closed_form.weighted.pseudo_inverse` instead (module docstring).
 
     Each step is written once for both kinds of argument; only the matrix products are
     spelled two ways:
@@ -351,7 +347,8 @@ def _weighted_rates(J: Any, b: Array, z: Array | None, L: Array | None, rcond: f
     if not (ok if one else np.all(ok)):  # one configuration: a bool (np.all costs 2 us)
         bad = np.flatnonzero(~np.atleast_1d(ok))
         Js = J[None] if one else stack_entries(J, len(qdot))
-        qdot.reshape(-1, NQ)[bad] = svd_rates(Js[bad], b.T.reshape(-1, TASK_DIM)[bad], L, rcond)
+        rhs = b.T.reshape(-1, TASK_DIM, 1)[bad]
+        qdot.reshape(-1, NQ)[bad] = (pseudo_inverse(Js[bad], L, rcond) @ rhs)[..., 0]
     return qdot if z is None else qdot + z.T
 
 
