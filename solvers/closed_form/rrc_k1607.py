@@ -272,21 +272,10 @@ class RrcK1607ClosedForm(ClosedForm):
         self, Q: npt.ArrayLike, X: npt.ArrayLike, W: npt.ArrayLike | None = None,
         Z: npt.ArrayLike | None = None,
     ) -> Array:  # fmt: skip
-        """Joint rates at N configurations, Nguyen eqs. (21)-(22); see :meth:`joint_rates`.
+        """Batch :meth:`joint_rates`: ``Q`` (N, 7) [rad], ``X`` (N, 6) -> (N, 7) [rad/s].
 
-        Args:
-            Q: Joint angles (N, 7) [rad].
-            X: Hand twists (N, 6), ``world_aligned``.
-            W: One weighting matrix for all N, as in :meth:`joint_rates`.
-            Z: Joint-rate vectors (N, 7) [rad/s] whose null-space parts are added; None for
-                zero.
-
-        Returns:
-            Joint rates (N, 7) [rad/s].
-
-        Raises:
-            InputError: Wrong shape or non-finite entries in any argument (named), or ``W``
-                not symmetric positive definite.
+        ``X``: hand twists, ``world_aligned``; ``W``: one weighting matrix for all N; ``Z``:
+        (N, 7) [rad/s] or None. Raises as :meth:`joint_rates`.
         """
         Q, X = self._check_batch(Q, X)
         L = weight_factor(W, NQ)
@@ -314,16 +303,12 @@ def _weighted_rates(J: Any, b: Array, z: Array | None, L: Array | None, rcond: f
     tau |y|`` with ``tau = rcond^2 trace(B B^T)``, or NaN), the SVD form
     :func:`~solvers.closed_form.weighted.pseudo_inverse` instead (module docstring).
 
-    Each step is written once for both kinds of argument; only the matrix products are
-    spelled two ways:
-
-    - one configuration: ``J`` a numpy (6, 7) matrix, ``b`` = xdot (6,), ``z`` (7,) or None;
-      the products by numpy, the solve on Python floats (16 us a call, against 38 us with
-      the products by :func:`~solvers.closed_form.base.dot` on floats and 250 us for a block
-      of one, measured). Returns (7,).
-    - a block of M configurations: ``J`` its 6 rows of 7 entries ((M,) arrays or constant
-      floats), ``b`` (6, M), ``z`` (7, M) or None; the products by
-      :func:`~solvers.closed_form.base.dot`, which skips the constant entries. Returns (M, 7).
+    Each step is written once; only the products are spelled two ways. One configuration:
+    ``J`` a numpy (6, 7), ``b`` = xdot (6,), ``z`` (7,) or None -> (7,); the products by
+    numpy, the solve on floats (16 us a call against 38 us with :func:`dot` on floats, 250 us
+    for a block of one, measured). A block of M: ``J`` 6 rows of 7 entries ((M,) arrays or
+    constant floats), ``b`` (6, M), ``z`` (7, M) or None -> (M, 7); the products by
+    :func:`dot`, which skips the constant entries.
     """
     one = isinstance(J, np.ndarray)
     if z is not None:

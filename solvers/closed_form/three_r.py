@@ -150,13 +150,9 @@ class ThreeRClosedForm(ClosedForm):
     # -- scalar ----------------------------------------------------------------------------
 
     def jacobian(self, q: npt.ArrayLike) -> Array:
-        """Linear Jacobian ``J_L`` of O3 (exam, above eq. (1)).
+        """Linear Jacobian ``J_L`` (3, 3) [m/rad] of O3 at ``q`` (3,) [rad] (exam, above eq. (1)).
 
-        Args:
-            q: Joint angles (3,) [rad].
-
-        Returns:
-            (3, 3) [m/rad], ``world_aligned`` (the first three rows of Pinocchio's Jacobian).
+        ``world_aligned``: the first three rows of Pinocchio's Jacobian.
 
         Raises:
             InputError: ``q`` is not a finite (3,) vector.
@@ -180,15 +176,10 @@ class ThreeRClosedForm(ClosedForm):
         return np.vstack([self.jacobian(q), self.angular_jacobian(q)])
 
     def joint_rates(self, q: npt.ArrayLike, xdot: npt.ArrayLike) -> Array:
-        """Joint rates ``J_L^-1 v`` realising the velocity ``xdot`` of O3 (exam, step 3).
+        """Joint rates ``J_L^-1 v`` (3,) [rad/s] realising the velocity of O3 (exam, step 3).
 
-        Args:
-            q: Joint angles (3,) [rad].
-            xdot: Linear velocity of O3 (3,) [m/s], base axes.
-
-        Returns:
-            thetadot (3,) [rad/s]; near a singularity the pseudo-inverse answer of the module
-            docstring.
+        ``q`` (3,) [rad]; ``xdot`` (3,) [m/s], base axes. Near a singularity the pseudo-inverse
+        answer of the module docstring.
 
         Raises:
             InputError: ``q`` or ``xdot`` not a finite (3,) vector.
@@ -199,14 +190,9 @@ class ThreeRClosedForm(ClosedForm):
         return np.array(self._rates(t, as_vector(xdot, "xdot", 3).tolist()))
 
     def angular_velocity(self, q: npt.ArrayLike, qdot: npt.ArrayLike) -> Array:
-        """Angular velocity ``omega = J_A thetadot`` of frame 3 (exam eq. (1), step 4).
+        """Angular velocity ``omega = J_A thetadot`` (3,) [rad/s] of frame 3, base axes.
 
-        Args:
-            q: Joint angles (3,) [rad].
-            qdot: Joint rates (3,) [rad/s].
-
-        Returns:
-            omega (3,) [rad/s], base axes.
+        ``q`` (3,) [rad], ``qdot`` (3,) [rad/s] (exam eq. (1), step 4).
 
         Raises:
             InputError: ``q`` or ``qdot`` not a finite (3,) vector.
@@ -229,12 +215,7 @@ class ThreeRClosedForm(ClosedForm):
         ``beta = thetadot_2 + thetadot_3``; all solutions are
         ``particular + gamma * null_direction``.
 
-        Args:
-            q: Joint angles (3,) [rad].
-            omega: Angular velocity (3,) [rad/s], base axes.
-
-        Returns:
-            :class:`AngularRates`.
+        ``q`` (3,) [rad]; ``omega`` (3,) [rad/s], base axes.
 
         Raises:
             InputError: ``q`` or ``omega`` not a finite (3,) vector.
@@ -274,8 +255,7 @@ class ThreeRClosedForm(ClosedForm):
     def joint_rates_batch(self, Q: npt.ArrayLike, X: npt.ArrayLike) -> Array:
         """``J_L^-1 v`` at N configurations: ``Q``, ``X`` (N, 3) -> (N, 3) [rad/s].
 
-        The arithmetic of :meth:`joint_rates`, in blocks of
-        :data:`~solvers.closed_form._batch.CHUNK` configurations (cache-sized intermediates).
+        The arithmetic of :meth:`joint_rates`, in blocks of :data:`~_batch.CHUNK` rows.
 
         Raises:
             InputError: ``Q`` or ``X`` not a finite (N, 3) array.
