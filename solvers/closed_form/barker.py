@@ -306,11 +306,7 @@ class BarkerClosedForm(ClosedForm):
     def _rates(
         self, t: Trig, x: Sequence[Entry], reduced: bool, exact: bool, repair: bool
     ) -> tuple[list[Entry], Entry]:
-        """Joint rates at ``t`` for ``x`` (6 entries): arm, eq. (48), wrist; whether in a band.
-
-        Floats (one configuration) or (N,) arrays (a batch) alike: :meth:`_arm`,
-        :meth:`_wrist`.
-        """
+        """Rates at ``t`` for ``x`` (6 floats or (N,) arrays): arm, eq. (48), wrist; bad rows."""
         arm, arm_bad = self._arm(t, x[:3], reduced, exact, repair)
         wrist, wrist_bad = self._wrist(t, rvel_tilde(t, arm, x[3:]), exact, repair)
         return [*arm, *wrist], arm_bad | wrist_bad

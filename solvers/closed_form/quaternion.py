@@ -157,13 +157,8 @@ def differential_rotation(dq: npt.ArrayLike) -> Array:
 
     For a small rotation about the base axes (Nguyen eq. (36)); equals the rotation vector
     :func:`rotation_vector` up to ``theta^3 / 24`` (third order in the angle), taking the
-    sign of ``delta eta`` into account (``dq`` and ``-dq`` are the same rotation).
-
-    Args:
-        dq: Quaternion of the orientation difference, (4,) or (N, 4).
-
-    Returns:
-        (3,) or (N, 3) [rad].
+    sign of ``delta eta`` into account (``dq`` and ``-dq`` are the same rotation). ``dq``:
+    quaternion of the orientation difference, (4,) or (N, 4); returns (3,) or (N, 3) [rad].
 
     Raises:
         InputError: Wrong shape or non-finite entries.
@@ -175,13 +170,9 @@ def differential_rotation(dq: npt.ArrayLike) -> Array:
 
 
 def rotation_vector(dq: npt.ArrayLike) -> Array:
-    """Exact rotation vector ``theta k`` of a quaternion (the log map), ``theta`` in [0, pi].
+    """Exact rotation vector ``theta k`` (3,) or (N, 3) [rad] of a quaternion (the log map).
 
-    Args:
-        dq: Quaternion, (4,) or (N, 4), nonzero (normalised here).
-
-    Returns:
-        (3,) or (N, 3) [rad].
+    ``theta`` in [0, pi]; ``dq`` (4,) or (N, 4), nonzero (normalised here).
 
     Raises:
         InputError: Wrong shape, non-finite entries, or a zero quaternion.
@@ -209,12 +200,8 @@ def small_rotation(delta: npt.ArrayLike) -> Array:
          [-dy, dx,  1]]
 
     Equals the exact rotation to first order (error O(|delta|^2)); not orthonormal.
-
-    Args:
-        delta: ``(delta_x, delta_y, delta_z)`` [rad], (3,) or (N, 3).
-
-    Returns:
-        (3, 3) or (N, 3, 3).
+    ``delta``: ``(delta_x, delta_y, delta_z)`` [rad], (3,) or (N, 3); returns (3, 3) or
+    (N, 3, 3).
 
     Raises:
         InputError: Wrong shape or non-finite entries.

@@ -180,13 +180,9 @@ class RrcK1607ClosedForm(ClosedForm):
                            pose)  # fmt: skip
 
     def fk(self, q: npt.ArrayLike) -> Array:
-        """Pose of frame 7 in frame 0, Nguyen eqs. (4)-(11).
+        """Pose (4, 4) of frame 7 in frame 0, translation [m], Nguyen eqs. (4)-(11).
 
-        Args:
-            q: Joint angles theta_1..theta_7 (7,) [rad].
-
-        Returns:
-            (4, 4) homogeneous transform, translation [m].
+        ``q``: joint angles theta_1..theta_7 (7,) [rad].
 
         Raises:
             InputError: ``q`` is not a finite (7,) vector.
@@ -207,13 +203,9 @@ class RrcK1607ClosedForm(ClosedForm):
                               [0.0, 0.0, 0.0, 1.0]], Q.shape[0])  # fmt: skip
 
     def jacobian(self, q: npt.ArrayLike) -> Array:
-        """Jacobian of frame 7, Nguyen eqs. (12)-(17), all seven columns.
+        """Jacobian (6, 7) of frame 7 at ``q`` (7,) [rad], Nguyen eqs. (12)-(17), all columns.
 
-        Args:
-            q: Joint angles (7,) [rad].
-
-        Returns:
-            (6, 7) array, rows [v; w], ``world_aligned`` ([m/rad] then [1]).
+        Rows [v; w], ``world_aligned`` ([m/rad] then [1]).
 
         Raises:
             InputError: ``q`` is not a finite (7,) vector.
