@@ -139,9 +139,6 @@ def _solved(
     return out
 
 
-# -- the closed form -----------------------------------------------------------------------
-
-
 class BarkerClosedForm(ClosedForm):
     """Closed-form Jacobian and joint rates of Barker's arm, wrist centre as tool frame.
 
@@ -192,8 +189,6 @@ class BarkerClosedForm(ClosedForm):
         """Band of the arm [m] and of the wrist [1] (``rcond`` scaled for ``exact``)."""
         width = self.rcond if exact else self.band
         return width * self.geometry.reach, width
-
-    # -- Jacobian, F terms, M ---------------------------------------------------------------
 
     def jacobian(self, q: npt.ArrayLike) -> Array:
         """Wrist-centre Jacobian (6, 6) at ``q`` (6,) [rad], rows [v; w], base axes (eq. (22)).
@@ -257,8 +252,6 @@ class BarkerClosedForm(ClosedForm):
             arm_singular=arm_in_band(det, adj2, eps_arm),
             wrist_singular=wrist_s2(t) <= eps_wrist * eps_wrist,
         )  # fmt: skip
-
-    # -- joint rates ------------------------------------------------------------------------
 
     def _arm(
         self, t: Trig, tvel: Sequence[Entry], reduced: bool, exact: bool, repair: bool = True
@@ -429,8 +422,6 @@ class BarkerClosedForm(ClosedForm):
                 i = idx[part]  # np.take: a third of the time of Q[i] (measured)
                 out[i] = np.stack(rates(np.take(Q, i, 0), np.take(X, i, 0), True)[0], axis=1)
         return out
-
-    # -- hand frame (Appendix B) ------------------------------------------------------------
 
     def hand_to_base(self, q: npt.ArrayLike) -> Array:
         """R0_6 (3, 3) by eqs (B2)-(B24): hand (frame 6) axes in base axes."""

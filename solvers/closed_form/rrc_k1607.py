@@ -285,15 +285,10 @@ class RrcK1607ClosedForm(ClosedForm):
         return out
 
 
-# ---------------------------------------------------------------------- helpers
-
-
 def _weighted_rates(J: Any, b: Array, z: Array | None, L: Array | None, rcond: float) -> Array:
     r"""Nguyen eq. (22) as ``qdot = L B^T y + z`` with ``B = J L``, ``B B^T y = xdot - J z``.
 
-    ``y`` by :func:`_solve_spd6`; where the solve proves ``lambda_min(B B^T) < tau`` (``|b| <
-    tau |y|`` with ``tau = rcond^2 trace(B B^T)``, or NaN), the SVD form
-    :func:`~solvers.closed_form.weighted.pseudo_inverse` instead (module docstring).
+    ``y`` by :func:`_solve_spd6`, or the SVD form where it fails (module docstring).
 
     Each step is written once; only the products are spelled two ways. One configuration:
     ``J`` a numpy (6, 7), ``b`` = xdot (6,), ``z`` (7,) or None -> (7,); the products by

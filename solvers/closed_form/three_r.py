@@ -104,8 +104,6 @@ class ThreeRClosedForm(ClosedForm):
     def __repr__(self) -> str:
         return f"ThreeRClosedForm(a1={self.a1}, a2={self.a2}, a3={self.a3})"
 
-    # -- the equations (floats or arrays) ------------------------------------------------
-
     def _terms(self, c: Sequence[Entry], s: Sequence[Entry]) -> Terms:
         """``(c1, s1, r, h, c23, s23, s3)`` from the cosines ``c`` and sines ``s`` of q."""
         c23 = c[1] * c[2] - s[1] * s[2]
@@ -146,8 +144,6 @@ class ThreeRClosedForm(ClosedForm):
         """:meth:`_terms` of ``Q`` (N, 3), (N,) arrays."""
         C, S = cos_sin(np.ascontiguousarray(Q.T))
         return self._terms(list(C), list(S))
-
-    # -- scalar ----------------------------------------------------------------------------
 
     def jacobian(self, q: npt.ArrayLike) -> Array:
         """Linear Jacobian ``J_L`` (3, 3) [m/rad] of O3 at ``q`` (3,) [rad] (exam, above eq. (1)).
@@ -230,8 +226,6 @@ class ThreeRClosedForm(ClosedForm):
             minimum_norm=np.array([wz, 0.5 * beta, 0.5 * beta]),
             residual=abs(c1 * wx + s1 * wy),
         )
-
-    # -- batch -----------------------------------------------------------------------------
 
     def jacobian_batch(self, Q: npt.ArrayLike) -> Array:
         """``J_L`` at N configurations: ``Q`` (N, 3) -> (N, 3, 3); see :meth:`jacobian`.
