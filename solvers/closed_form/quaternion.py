@@ -43,11 +43,8 @@ ORTHONORMAL_TOL = 1e-6
 def quaternion_from_matrix(R: npt.ArrayLike) -> Array:
     """``Q{R}``: the unit quaternion of a rotation matrix (Nguyen eqs. (24)-(26), Shepperd).
 
-    Args:
-        R: Rotation matrix (3, 3) or stack (N, 3, 3), orthonormal with det +1.
-
-    Returns:
-        ``[eta, beta, gamma, xi]``, shape (4,) or (N, 4), ``eta >= 0``.
+    ``R`` (3, 3) or (N, 3, 3), orthonormal with det +1 -> ``[eta, beta, gamma, xi]`` (4,) or
+    (N, 4), ``eta >= 0``.
 
     Raises:
         InputError: ``R`` has the wrong shape, a non-finite entry, or is not a rotation
@@ -100,13 +97,8 @@ def matrix_from_quaternion(q: npt.ArrayLike) -> Array:
 
     .. math:: R = \frac{(\eta^2 - s^T s) I_3 + 2 s s^T + 2 \eta\, s^\times}{\eta^2 + s^T s}
 
-    (the denominator is 1 for a unit quaternion; a non-unit one is normalised).
-
-    Args:
-        q: ``[eta, beta, gamma, xi]``, shape (4,) or (N, 4), nonzero.
-
-    Returns:
-        Rotation matrix (3, 3) or (N, 3, 3).
+    (the denominator is 1 for a unit quaternion; a non-unit one is normalised). ``q``
+    ``[eta, beta, gamma, xi]`` (4,) or (N, 4), nonzero -> rotation matrix (3, 3) or (N, 3, 3).
 
     Raises:
         InputError: Wrong shape, non-finite entries, or a zero quaternion.
@@ -129,14 +121,9 @@ def quaternion_difference(q1: npt.ArrayLike, q2: npt.ArrayLike) -> Array:
     ``R2 R1^T`` is the rotation about the base frame that brings frame 1 to frame 2
     (Nguyen eq. (31)); its quaternion is ``q2 * conj(q1)``:
 
-    ``delta eta = eta1 eta2 + s1 . s2``, ``delta s = eta1 s2 - eta2 s1 + s1 x s2``.
-
-    Args:
-        q1: Quaternion of ``R1``, (4,) or (N, 4).
-        q2: Quaternion of ``R2``, same shape.
-
-    Returns:
-        ``[delta eta, delta s]``, same shape (not sign-normalised: ``delta eta`` may be < 0).
+    ``delta eta = eta1 eta2 + s1 . s2``, ``delta s = eta1 s2 - eta2 s1 + s1 x s2``. ``q1``,
+    ``q2``: quaternions of ``R1``, ``R2``, (4,) or (N, 4); the result has their shape (not
+    sign-normalised: ``delta eta`` may be < 0).
 
     Raises:
         InputError: Wrong or mismatched shapes, non-finite entries.

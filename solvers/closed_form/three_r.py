@@ -270,12 +270,8 @@ def minimum_norm_shift(qdot: npt.ArrayLike, direction: npt.ArrayLike) -> float:
 
     .. math:: \gamma = -\frac{\dot\theta^T \dot\theta_0}{\dot\theta_0^T \dot\theta_0}
 
-    Args:
-        qdot: A joint-rate vector (n,).
-        direction: A nonzero direction (n,), e.g. a null-space vector.
-
-    Returns:
-        gamma [same units as ``qdot`` per unit of ``direction``].
+    ``qdot`` (n,), ``direction`` (n,) nonzero (e.g. a null-space vector); gamma is in units of
+    ``qdot`` per unit of ``direction``.
 
     Raises:
         InputError: Non-finite or mismatched vectors, or a zero ``direction``.
