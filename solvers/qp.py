@@ -67,15 +67,6 @@ class QP(NamedTuple):
         G = np.vstack(rows) if h is not None and h.size else None  # no finite side: no rows
         return qpsolvers.Problem(self.P, self.q, G, h if G is not None else None, lb=lb, ub=ub)
 
-    def feasible(self, z: Array, tol: float = 0.0) -> bool:
-        """True when ``z`` satisfies every bound and row within ``tol`` (False for NaN)."""
-        if not ((z >= self.lb - tol).all() and (z <= self.ub + tol).all()):
-            return False
-        if self.C is None or self.l is None or self.u is None:
-            return True
-        c = self.C @ z
-        return bool((c >= self.l - tol).all() and (c <= self.u + tol).all())
-
 
 class Decoding(NamedTuple):
     r"""Joint rates of a solution z: :math:`\dot q = x_0 + M z` (n,).

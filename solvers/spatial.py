@@ -47,10 +47,3 @@ def from_world_aligned(M: Array, rotation: Array, position: Array, ref: Referenc
         return np.concatenate([rotation.T @ v, rotation.T @ w])
     return np.concatenate([v - np.cross(w, position, axis=0), w])
 
-
-def to_world_aligned(M: Array, rotation: Array, position: Array, ref: Reference) -> Array:
-    """Inverse of :func:`from_world_aligned`: ``M`` from frame ``ref`` to ``world_aligned``.
-
-    The same change with the rotation transposed and the position negated.
-    """
-    return from_world_aligned(M, rotation.T, -position, ref)

@@ -27,13 +27,9 @@ import numpy.typing as npt
 Array = npt.NDArray[np.float64]
 
 CHUNK = 8192
-"""Configurations per block in the batch methods.
-
-The closed forms keep tens of (CHUNK,) intermediates alive at once; blocks keep them in the
-cache (a few MB) instead of streaming N-sized arrays through memory (at N = 10^5 about
-twice as fast as one block). 8192 doubles (64 kB) also stay below glibc's default mmap
-threshold (128 kB), so that no intermediate costs a fresh mapping and its page faults.
-"""
+"""Configurations per block in the batch methods: tens of (CHUNK,) intermediates fit in the
+cache, and 8192 doubles (64 kB) stay below glibc's default mmap threshold (128 kB), so that
+no intermediate costs a fresh mapping and its page faults."""
 
 TABLE_SIZE = 1024
 """Table entries per turn: angles are reduced to ``|r| <= pi / 1024`` about ``k pi / 512``."""
@@ -90,8 +86,7 @@ def cos_sin(q: Array, out: tuple[Array, Array] | None = None) -> tuple[Array, Ar
     ``sin r = r - r^3/6 + r^5/120``, ``cos r - 1 = -r^2/2 + r^4/24``, truncated below
     2e-18. Absolute error: within about 1.1e-16 of ``numpy.sin`` / ``numpy.cos`` (an ulp of
     the table entry plus the final rounding); near a multiple of ``pi`` the sine is exact to
-    that absolute error, not to its own ulp. Work goes in blocks of :data:`CHUNK` elements, so
-    that the scratch arrays stay in the cache.
+    that absolute error, not to its own ulp. Works in blocks of :data:`CHUNK` elements.
 
     Args:
         q: Angles, float64, finite (any shape; validated by the caller).

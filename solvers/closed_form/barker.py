@@ -113,40 +113,30 @@ def _solved(
     closed: Callable[[], Sequence[Entry]], band: _Band, bad: Entry, eps: float, exact: bool,
     repair: bool = True,
 ) -> Sequence[Entry]:  # fmt: skip
-    """A block's rates: the closed form ``closed()`` outside its band, :func:`_band_solve` in.
+    """A block's rates: the closed form ``closed()`` outside its band, ``band()`` solved in it.
 
-    One configuration (Python floats, ``bad`` a bool): one answer or the other (the closed
-    form divides by zero on the singular set). A batch ((N,) arrays, ``bad`` (N,)): the closed
+    In the band by :func:`damped_solve`, or by :func:`truncated_solve` with ``exact``. One
+    configuration (Python floats, ``bad`` a bool): one answer or the other (the closed form
+    divides by zero on the singular set). A batch ((N,) arrays, ``bad`` (N,)): the closed
     form at every row (inf or NaN in the band), then with ``repair`` the rows in the band
     solved again.
     """
     if not isinstance(bad, np.ndarray):
-        return _band_solve(band, eps, exact) if bad else closed()
+        if not bad:
+            return closed()
+        A, b, s2 = band()
+        if not exact:
+            return damped_solve(A, b, s2, eps)
+        return [v.item() for v in truncated_solve(A, b, eps, 1)]
     out = closed()
     idx = np.flatnonzero(bad) if repair else None
     if idx is not None and idx.size:
-        for o, xi in zip(out, _band_solve(band, eps, exact, idx), strict=True):
+        A, b, s2 = band()
+        A, b = [[_at(v, idx) for v in r] for r in A], [_at(v, idx) for v in b]
+        x = truncated_solve(A, b, eps, idx.size) if exact else damped_solve(A, b, s2[idx], eps)
+        for o, xi in zip(out, x, strict=True):
             o[idx] = xi
     return out
-
-
-def _band_solve(
-    band: _Band, eps: float, exact: bool, idx: npt.NDArray[np.intp] | None = None
-) -> list[Entry]:
-    """``band()`` solved by :func:`damped_solve`, or by :func:`truncated_solve` with ``exact``.
-
-    At the rows ``idx`` of a batch, or (``idx`` None) for one configuration, as floats.
-    """
-    A, b, s2 = band()
-    if idx is not None:
-        A, b, s2 = [[_at(v, idx) for v in r] for r in A], [_at(v, idx) for v in b], s2[idx]
-    if not exact:
-        return damped_solve(A, b, s2, eps)
-    x = truncated_solve(A, b, eps, 1 if idx is None else idx.size)
-    return x if idx is not None else [v.item() for v in x]
-
-
-# -- the closed form -----------------------------------------------------------------------
 
 
 class BarkerClosedForm(ClosedForm):
@@ -199,8 +189,6 @@ class BarkerClosedForm(ClosedForm):
         """Band of the arm [m] and of the wrist [1] (``rcond`` scaled for ``exact``)."""
         width = self.rcond if exact else self.band
         return width * self.geometry.reach, width
-
-    # -- Jacobian, F terms, M ---------------------------------------------------------------
 
     def jacobian(self, q: npt.ArrayLike) -> Array:
         """Wrist-centre Jacobian (6, 6) at ``q`` (6,) [rad], rows [v; w], base axes (eq. (22)).
@@ -265,8 +253,6 @@ class BarkerClosedForm(ClosedForm):
             wrist_singular=wrist_s2(t) <= eps_wrist * eps_wrist,
         )  # fmt: skip
 
-    # -- joint rates ------------------------------------------------------------------------
-
     def _arm(
         self, t: Trig, tvel: Sequence[Entry], reduced: bool, exact: bool, repair: bool = True
     ) -> tuple[Sequence[Entry], Entry]:
@@ -313,11 +299,7 @@ class BarkerClosedForm(ClosedForm):
     def _rates(
         self, t: Trig, x: Sequence[Entry], reduced: bool, exact: bool, repair: bool
     ) -> tuple[list[Entry], Entry]:
-        """Joint rates at ``t`` for ``x`` (6 entries): arm, eq. (48), wrist; whether in a band.
-
-        Floats (one configuration) or (N,) arrays (a batch) alike: :meth:`_arm`,
-        :meth:`_wrist`.
-        """
+        """Rates at ``t`` for ``x`` (6 floats or (N,) arrays): arm, eq. (48), wrist; bad rows."""
         arm, arm_bad = self._arm(t, x[:3], reduced, exact, repair)
         wrist, wrist_bad = self._wrist(t, rvel_tilde(t, arm, x[3:]), exact, repair)
         return [*arm, *wrist], arm_bad | wrist_bad
@@ -440,8 +422,6 @@ class BarkerClosedForm(ClosedForm):
                 i = idx[part]  # np.take: a third of the time of Q[i] (measured)
                 out[i] = np.stack(rates(np.take(Q, i, 0), np.take(X, i, 0), True)[0], axis=1)
         return out
-
-    # -- hand frame (Appendix B) ------------------------------------------------------------
 
     def hand_to_base(self, q: npt.ArrayLike) -> Array:
         """R0_6 (3, 3) by eqs (B2)-(B24): hand (frame 6) axes in base axes."""

@@ -358,16 +358,8 @@ def damped_solve(
     .. math:: x = (A^T A + \lambda^2 I)^{-1} A^T b, \quad \lambda^2 = \epsilon^2 - s^2 > 0,
 
     by Cholesky's method (``A^T A + lambda^2 I`` has eigenvalues ``>= eps^2``: backward
-    stable, relative error about ``eps_machine sigma_max^2 / eps^2``).
-
-    Args:
-        A: Entries of the block, by rows.
-        b: Right-hand side.
-        s2: The block's squared singular-value measure ``s^2 < eps^2``.
-        eps: The band [units of A].
-
-    Returns:
-        The solution, one entry per unknown.
+    stable, relative error about ``eps_machine sigma_max^2 / eps^2``). ``A`` by rows, ``s2``
+    the block's measure ``s^2 < eps^2``, ``eps`` the band [units of A]; one entry per unknown.
     """
     n, lam2 = len(A), eps * eps - s2
     cols = list(zip(*A, strict=True))

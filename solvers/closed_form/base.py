@@ -40,13 +40,7 @@ class ClosedForm(ABC):
 
     @abstractmethod
     def jacobian_batch(self, Q: npt.ArrayLike) -> Array:
-        """Jacobians at N configurations.
-
-        Args:
-            Q: Joint positions, shape (N, nq), [rad] or [m].
-
-        Returns:
-            Array of shape (N, task_dim, nq).
+        """Jacobians (N, task_dim, nq) at N configurations ``Q`` (N, nq) [rad] or [m].
 
         Raises:
             InputError: Wrong shape or non-finite entries.
@@ -54,15 +48,10 @@ class ClosedForm(ABC):
 
     @abstractmethod
     def joint_rates_batch(self, Q: npt.ArrayLike, X: npt.ArrayLike) -> Array:
-        """Joint rates realising the task velocities at N configurations.
+        """Joint rates (N, nq) realising the task velocities ``X`` (N, task_dim) at ``Q`` (N, nq).
 
-        Args:
-            Q: Joint positions, shape (N, nq).
-            X: Task velocities, shape (N, task_dim), [m/s] then [rad/s].
-
-        Returns:
-            Joint rates, shape (N, nq): the exact solution where the Jacobian is square and
-            regular, the minimum-norm one where the arm is redundant.
+        ``X`` in [m/s] then [rad/s]. The exact solution where the Jacobian is square and
+        regular, the minimum-norm one where the arm is redundant.
 
         Raises:
             InputError: Wrong shapes or non-finite entries.

@@ -21,14 +21,9 @@ Every function takes one item or a stack: ``R`` (3, 3) or (N, 3, 3), quaternions
   of off-diagonal pairs divided by it (never less than 1/2), which is eq. (26) itself when
   ``eta`` is the largest. At exactly 180 deg (``eta = 0``) the sign is fixed by the largest
   component of ``s`` being positive.
-- :func:`matrix_from_quaternion`: ``Q^-1{eta, s}``, eqs. (27)-(28) corrected.
-- :func:`quaternion_difference`: the quaternion of ``R2 R1^T`` from those of ``R1`` and
-  ``R2``, eqs. (32)-(34) (as printed: ``delta eta = eta1 eta2 + s1.s2``,
-  ``delta s = eta1 s2 - eta2 s1 + s1 x s2``).
-- :func:`differential_rotation`: ``(delta_x, delta_y, delta_z) = 2 delta s``, eq. (37);
-  exact to second order in the angle (error ``theta^3 / 24``); :func:`rotation_vector` is the
-  exact log map, :func:`small_rotation` the matrix ``I + delta^x`` of eqs. (35)-(36)
-  corrected.
+- :func:`matrix_from_quaternion` (eqs. (27)-(28) corrected), :func:`quaternion_difference`
+  (eqs. (32)-(34)), :func:`differential_rotation` (eq. (37)), :func:`small_rotation`
+  (eqs. (35)-(36) corrected) and :func:`rotation_vector` (the exact log map).
 """
 
 from __future__ import annotations
@@ -48,18 +43,22 @@ ORTHONORMAL_TOL = 1e-6
 def quaternion_from_matrix(R: npt.ArrayLike) -> Array:
     """``Q{R}``: the unit quaternion of a rotation matrix (Nguyen eqs. (24)-(26), Shepperd).
 
-    Args:
-        R: Rotation matrix (3, 3) or stack (N, 3, 3), orthonormal with det +1.
-
-    Returns:
-        ``[eta, beta, gamma, xi]``, shape (4,) or (N, 4), ``eta >= 0``.
+    ``R`` (3, 3) or (N, 3, 3), orthonormal with det +1 -> ``[eta, beta, gamma, xi]`` (4,) or
+    (N, 4), ``eta >= 0``.
 
     Raises:
         InputError: ``R`` has the wrong shape, a non-finite entry, or is not a rotation
             (tolerance :data:`ORTHONORMAL_TOL`).
     """
     Rs, single = _stack(R, "R", (3, 3))
-    _check_rotation(Rs)
+    gram = np.einsum("nki,nkj->nij", Rs, Rs) - np.eye(3)
+    det = np.linalg.det(Rs)
+    bad = (np.abs(gram).max(axis=(1, 2)) > ORTHONORMAL_TOL) | (np.abs(det - 1.0) > ORTHONORMAL_TOL)
+    if np.any(bad):
+        i = int(np.argmax(bad))
+        raise InputError(
+            "R", f"expected a rotation matrix (orthonormal, det +1); item {i} has det {det[i]:.6g}"
+        )
     r11, r12, r13 = Rs[:, 0, 0], Rs[:, 0, 1], Rs[:, 0, 2]
     r21, r22, r23 = Rs[:, 1, 0], Rs[:, 1, 1], Rs[:, 1, 2]
     r31, r32, r33 = Rs[:, 2, 0], Rs[:, 2, 1], Rs[:, 2, 2]
@@ -98,13 +97,8 @@ def matrix_from_quaternion(q: npt.ArrayLike) -> Array:
 
     .. math:: R = \frac{(\eta^2 - s^T s) I_3 + 2 s s^T + 2 \eta\, s^\times}{\eta^2 + s^T s}
 
-    (the denominator is 1 for a unit quaternion; a non-unit one is normalised).
-
-    Args:
-        q: ``[eta, beta, gamma, xi]``, shape (4,) or (N, 4), nonzero.
-
-    Returns:
-        Rotation matrix (3, 3) or (N, 3, 3).
+    (the denominator is 1 for a unit quaternion; a non-unit one is normalised). ``q``
+    ``[eta, beta, gamma, xi]`` (4,) or (N, 4), nonzero -> rotation matrix (3, 3) or (N, 3, 3).
 
     Raises:
         InputError: Wrong shape, non-finite entries, or a zero quaternion.
@@ -127,14 +121,9 @@ def quaternion_difference(q1: npt.ArrayLike, q2: npt.ArrayLike) -> Array:
     ``R2 R1^T`` is the rotation about the base frame that brings frame 1 to frame 2
     (Nguyen eq. (31)); its quaternion is ``q2 * conj(q1)``:
 
-    ``delta eta = eta1 eta2 + s1 . s2``, ``delta s = eta1 s2 - eta2 s1 + s1 x s2``.
-
-    Args:
-        q1: Quaternion of ``R1``, (4,) or (N, 4).
-        q2: Quaternion of ``R2``, same shape.
-
-    Returns:
-        ``[delta eta, delta s]``, same shape (not sign-normalised: ``delta eta`` may be < 0).
+    ``delta eta = eta1 eta2 + s1 . s2``, ``delta s = eta1 s2 - eta2 s1 + s1 x s2``. ``q1``,
+    ``q2``: quaternions of ``R1``, ``R2``, (4,) or (N, 4); the result has their shape (not
+    sign-normalised: ``delta eta`` may be < 0).
 
     Raises:
         InputError: Wrong or mismatched shapes, non-finite entries.
@@ -155,13 +144,8 @@ def differential_rotation(dq: npt.ArrayLike) -> Array:
 
     For a small rotation about the base axes (Nguyen eq. (36)); equals the rotation vector
     :func:`rotation_vector` up to ``theta^3 / 24`` (third order in the angle), taking the
-    sign of ``delta eta`` into account (``dq`` and ``-dq`` are the same rotation).
-
-    Args:
-        dq: Quaternion of the orientation difference, (4,) or (N, 4).
-
-    Returns:
-        (3,) or (N, 3) [rad].
+    sign of ``delta eta`` into account (``dq`` and ``-dq`` are the same rotation). ``dq``:
+    quaternion of the orientation difference, (4,) or (N, 4); returns (3,) or (N, 3) [rad].
 
     Raises:
         InputError: Wrong shape or non-finite entries.
@@ -173,13 +157,9 @@ def differential_rotation(dq: npt.ArrayLike) -> Array:
 
 
 def rotation_vector(dq: npt.ArrayLike) -> Array:
-    """Exact rotation vector ``theta k`` of a quaternion (the log map), ``theta`` in [0, pi].
+    """Exact rotation vector ``theta k`` (3,) or (N, 3) [rad] of a quaternion (the log map).
 
-    Args:
-        dq: Quaternion, (4,) or (N, 4), nonzero (normalised here).
-
-    Returns:
-        (3,) or (N, 3) [rad].
+    ``theta`` in [0, pi]; ``dq`` (4,) or (N, 4), nonzero (normalised here).
 
     Raises:
         InputError: Wrong shape, non-finite entries, or a zero quaternion.
@@ -207,12 +187,8 @@ def small_rotation(delta: npt.ArrayLike) -> Array:
          [-dy, dx,  1]]
 
     Equals the exact rotation to first order (error O(|delta|^2)); not orthonormal.
-
-    Args:
-        delta: ``(delta_x, delta_y, delta_z)`` [rad], (3,) or (N, 3).
-
-    Returns:
-        (3, 3) or (N, 3, 3).
+    ``delta``: ``(delta_x, delta_y, delta_z)`` [rad], (3,) or (N, 3); returns (3, 3) or
+    (N, 3, 3).
 
     Raises:
         InputError: Wrong shape or non-finite entries.
@@ -245,18 +221,3 @@ def _stack(x: npt.ArrayLike, name: str, item: tuple[int, ...]) -> tuple[Array, b
         return as_array(x, name, item)[None], True
     return as_array(x, name, (None, *item)), False
 
-
-def _check_rotation(Rs: Array) -> None:
-    """Refuse matrices that are not rotations (orthonormal, det +1).
-
-    Raises:
-        InputError: Naming ``R``.
-    """
-    gram = np.einsum("nki,nkj->nij", Rs, Rs) - np.eye(3)
-    det = np.linalg.det(Rs)
-    bad = (np.abs(gram).max(axis=(1, 2)) > ORTHONORMAL_TOL) | (np.abs(det - 1.0) > ORTHONORMAL_TOL)
-    if np.any(bad):
-        i = int(np.argmax(bad))
-        raise InputError(
-            "R", f"expected a rotation matrix (orthonormal, det +1); item {i} has det {det[i]:.6g}"
-        )

@@ -45,7 +45,7 @@ import numpy.typing as npt
 
 from solvers.closed_form._batch import blocks, cos_sin
 from solvers.closed_form.base import Array, ClosedForm, Entry, dot, stack_entries
-from solvers.closed_form.weighted import svd_rates, weight_factor
+from solvers.closed_form.weighted import pseudo_inverse, weight_factor
 from solvers.validation import as_array, as_vector, finite_number
 
 NQ = 7
@@ -122,11 +122,7 @@ def _kinematics(
     for k in range(NQ - 2, 1, -1):
         bx, by, bz = z[k]
         cols[k] = (by * rz - bz * ry, bz * rx - bx * rz, bx * ry - by * rx, bx, by, bz)
-        if d[k]:
-            rx, ry, rz = rx + d[k] * bx, ry + d[k] * by, rz + d[k] * bz
-        if a[k]:
-            xx, xy, xz = x[k]
-            rx, ry, rz = rx + a[k] * xx, ry + a[k] * xy, rz + a[k] * xz
+        rx, ry, rz = _step(rx, ry, rz, a[k], x[k], d[k], z[k])
     # b_2 = (-s1, c1, 0): Nguyen eq. (18), second column, with r_2 in place of p.
     cols[1] = (c1 * rz, s1 * rz, -s1 * ry - c1 * rx, -s1, c1, 0.0)
     rx, ry, rz = _step(rx, ry, rz, a[1], x[1], d[1], z[1])
@@ -184,13 +180,9 @@ class RrcK1607ClosedForm(ClosedForm):
                            pose)  # fmt: skip
 
     def fk(self, q: npt.ArrayLike) -> Array:
-        """Pose of frame 7 in frame 0, Nguyen eqs. (4)-(11).
+        """Pose (4, 4) of frame 7 in frame 0, translation [m], Nguyen eqs. (4)-(11).
 
-        Args:
-            q: Joint angles theta_1..theta_7 (7,) [rad].
-
-        Returns:
-            (4, 4) homogeneous transform, translation [m].
+        ``q``: joint angles theta_1..theta_7 (7,) [rad].
 
         Raises:
             InputError: ``q`` is not a finite (7,) vector.
@@ -211,13 +203,9 @@ class RrcK1607ClosedForm(ClosedForm):
                               [0.0, 0.0, 0.0, 1.0]], Q.shape[0])  # fmt: skip
 
     def jacobian(self, q: npt.ArrayLike) -> Array:
-        """Jacobian of frame 7, Nguyen eqs. (12)-(17), all seven columns.
+        """Jacobian (6, 7) of frame 7 at ``q`` (7,) [rad], Nguyen eqs. (12)-(17), all columns.
 
-        Args:
-            q: Joint angles (7,) [rad].
-
-        Returns:
-            (6, 7) array, rows [v; w], ``world_aligned`` ([m/rad] then [1]).
+        Rows [v; w], ``world_aligned`` ([m/rad] then [1]).
 
         Raises:
             InputError: ``q`` is not a finite (7,) vector.
@@ -276,21 +264,10 @@ class RrcK1607ClosedForm(ClosedForm):
         self, Q: npt.ArrayLike, X: npt.ArrayLike, W: npt.ArrayLike | None = None,
         Z: npt.ArrayLike | None = None,
     ) -> Array:  # fmt: skip
-        """Joint rates at N configurations, Nguyen eqs. (21)-(22); see :meth:`joint_rates`.
+        """Batch :meth:`joint_rates`: ``Q`` (N, 7) [rad], ``X`` (N, 6) -> (N, 7) [rad/s].
 
-        Args:
-            Q: Joint angles (N, 7) [rad].
-            X: Hand twists (N, 6), ``world_aligned``.
-            W: One weighting matrix for all N, as in :meth:`joint_rates`.
-            Z: Joint-rate vectors (N, 7) [rad/s] whose null-space parts are added; None for
-                zero.
-
-        Returns:
-            Joint rates (N, 7) [rad/s].
-
-        Raises:
-            InputError: Wrong shape or non-finite entries in any argument (named), or ``W``
-                not symmetric positive definite.
+        ``X``: hand twists, ``world_aligned``; ``W``: one weighting matrix for all N; ``Z``:
+        (N, 7) [rad/s] or None. Raises as :meth:`joint_rates`.
         """
         Q, X = self._check_batch(Q, X)
         L = weight_factor(W, NQ)
@@ -308,26 +285,17 @@ class RrcK1607ClosedForm(ClosedForm):
         return out
 
 
-# ---------------------------------------------------------------------- helpers
-
-
 def _weighted_rates(J: Any, b: Array, z: Array | None, L: Array | None, rcond: float) -> Array:
     r"""Nguyen eq. (22) as ``qdot = L B^T y + z`` with ``B = J L``, ``B B^T y = xdot - J z``.
 
-    ``y`` by :func:`_solve_spd6`; where the solve proves ``lambda_min(B B^T) < tau`` (``|b| <
-    tau |y|`` with ``tau = rcond^2 trace(B B^T)``, or NaN), the SVD form
-    :func:`~solvers.closed_form.weighted.svd_rates` instead (module docstring).
+    ``y`` by :func:`_solve_spd6`, or the SVD form where it fails (module docstring).
 
-    Each step is written once for both kinds of argument; only the matrix products are
-    spelled two ways:
-
-    - one configuration: ``J`` a numpy (6, 7) matrix, ``b`` = xdot (6,), ``z`` (7,) or None;
-      the products by numpy, the solve on Python floats (16 us a call, against 38 us with
-      the products by :func:`~solvers.closed_form.base.dot` on floats and 250 us for a block
-      of one, measured). Returns (7,).
-    - a block of M configurations: ``J`` its 6 rows of 7 entries ((M,) arrays or constant
-      floats), ``b`` (6, M), ``z`` (7, M) or None; the products by
-      :func:`~solvers.closed_form.base.dot`, which skips the constant entries. Returns (M, 7).
+    Each step is written once; only the products are spelled two ways. One configuration:
+    ``J`` a numpy (6, 7), ``b`` = xdot (6,), ``z`` (7,) or None -> (7,); the products by
+    numpy, the solve on floats (16 us a call against 38 us with :func:`dot` on floats, 250 us
+    for a block of one, measured). A block of M: ``J`` 6 rows of 7 entries ((M,) arrays or
+    constant floats), ``b`` (6, M), ``z`` (7, M) or None -> (M, 7); the products by
+    :func:`dot`, which skips the constant entries.
     """
     one = isinstance(J, np.ndarray)
     if z is not None:
@@ -351,7 +319,8 @@ def _weighted_rates(J: Any, b: Array, z: Array | None, L: Array | None, rcond: f
     if not (ok if one else np.all(ok)):  # one configuration: a bool (np.all costs 2 us)
         bad = np.flatnonzero(~np.atleast_1d(ok))
         Js = J[None] if one else stack_entries(J, len(qdot))
-        qdot.reshape(-1, NQ)[bad] = svd_rates(Js[bad], b.T.reshape(-1, TASK_DIM)[bad], L, rcond)
+        rhs = b.T.reshape(-1, TASK_DIM, 1)[bad]
+        qdot.reshape(-1, NQ)[bad] = (pseudo_inverse(Js[bad], L, rcond) @ rhs)[..., 0]
     return qdot if z is None else qdot + z.T
 
 

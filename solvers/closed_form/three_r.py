@@ -104,8 +104,6 @@ class ThreeRClosedForm(ClosedForm):
     def __repr__(self) -> str:
         return f"ThreeRClosedForm(a1={self.a1}, a2={self.a2}, a3={self.a3})"
 
-    # -- the equations (floats or arrays) ------------------------------------------------
-
     def _terms(self, c: Sequence[Entry], s: Sequence[Entry]) -> Terms:
         """``(c1, s1, r, h, c23, s23, s3)`` from the cosines ``c`` and sines ``s`` of q."""
         c23 = c[1] * c[2] - s[1] * s[2]
@@ -147,16 +145,10 @@ class ThreeRClosedForm(ClosedForm):
         C, S = cos_sin(np.ascontiguousarray(Q.T))
         return self._terms(list(C), list(S))
 
-    # -- scalar ----------------------------------------------------------------------------
-
     def jacobian(self, q: npt.ArrayLike) -> Array:
-        """Linear Jacobian ``J_L`` of O3 (exam, above eq. (1)).
+        """Linear Jacobian ``J_L`` (3, 3) [m/rad] of O3 at ``q`` (3,) [rad] (exam, above eq. (1)).
 
-        Args:
-            q: Joint angles (3,) [rad].
-
-        Returns:
-            (3, 3) [m/rad], ``world_aligned`` (the first three rows of Pinocchio's Jacobian).
+        ``world_aligned``: the first three rows of Pinocchio's Jacobian.
 
         Raises:
             InputError: ``q`` is not a finite (3,) vector.
@@ -180,15 +172,10 @@ class ThreeRClosedForm(ClosedForm):
         return np.vstack([self.jacobian(q), self.angular_jacobian(q)])
 
     def joint_rates(self, q: npt.ArrayLike, xdot: npt.ArrayLike) -> Array:
-        """Joint rates ``J_L^-1 v`` realising the velocity ``xdot`` of O3 (exam, step 3).
+        """Joint rates ``J_L^-1 v`` (3,) [rad/s] realising the velocity of O3 (exam, step 3).
 
-        Args:
-            q: Joint angles (3,) [rad].
-            xdot: Linear velocity of O3 (3,) [m/s], base axes.
-
-        Returns:
-            thetadot (3,) [rad/s]; near a singularity the pseudo-inverse answer of the module
-            docstring.
+        ``q`` (3,) [rad]; ``xdot`` (3,) [m/s], base axes. Near a singularity the pseudo-inverse
+        answer of the module docstring.
 
         Raises:
             InputError: ``q`` or ``xdot`` not a finite (3,) vector.
@@ -199,14 +186,9 @@ class ThreeRClosedForm(ClosedForm):
         return np.array(self._rates(t, as_vector(xdot, "xdot", 3).tolist()))
 
     def angular_velocity(self, q: npt.ArrayLike, qdot: npt.ArrayLike) -> Array:
-        """Angular velocity ``omega = J_A thetadot`` of frame 3 (exam eq. (1), step 4).
+        """Angular velocity ``omega = J_A thetadot`` (3,) [rad/s] of frame 3, base axes.
 
-        Args:
-            q: Joint angles (3,) [rad].
-            qdot: Joint rates (3,) [rad/s].
-
-        Returns:
-            omega (3,) [rad/s], base axes.
+        ``q`` (3,) [rad], ``qdot`` (3,) [rad/s] (exam eq. (1), step 4).
 
         Raises:
             InputError: ``q`` or ``qdot`` not a finite (3,) vector.
@@ -229,12 +211,7 @@ class ThreeRClosedForm(ClosedForm):
         ``beta = thetadot_2 + thetadot_3``; all solutions are
         ``particular + gamma * null_direction``.
 
-        Args:
-            q: Joint angles (3,) [rad].
-            omega: Angular velocity (3,) [rad/s], base axes.
-
-        Returns:
-            :class:`AngularRates`.
+        ``q`` (3,) [rad]; ``omega`` (3,) [rad/s], base axes.
 
         Raises:
             InputError: ``q`` or ``omega`` not a finite (3,) vector.
@@ -249,8 +226,6 @@ class ThreeRClosedForm(ClosedForm):
             minimum_norm=np.array([wz, 0.5 * beta, 0.5 * beta]),
             residual=abs(c1 * wx + s1 * wy),
         )
-
-    # -- batch -----------------------------------------------------------------------------
 
     def jacobian_batch(self, Q: npt.ArrayLike) -> Array:
         """``J_L`` at N configurations: ``Q`` (N, 3) -> (N, 3, 3); see :meth:`jacobian`.
@@ -274,8 +249,7 @@ class ThreeRClosedForm(ClosedForm):
     def joint_rates_batch(self, Q: npt.ArrayLike, X: npt.ArrayLike) -> Array:
         """``J_L^-1 v`` at N configurations: ``Q``, ``X`` (N, 3) -> (N, 3) [rad/s].
 
-        The arithmetic of :meth:`joint_rates`, in blocks of
-        :data:`~solvers.closed_form._batch.CHUNK` configurations (cache-sized intermediates).
+        The arithmetic of :meth:`joint_rates`, in blocks of :data:`~_batch.CHUNK` rows.
 
         Raises:
             InputError: ``Q`` or ``X`` not a finite (N, 3) array.
@@ -296,12 +270,8 @@ def minimum_norm_shift(qdot: npt.ArrayLike, direction: npt.ArrayLike) -> float:
 
     .. math:: \gamma = -\frac{\dot\theta^T \dot\theta_0}{\dot\theta_0^T \dot\theta_0}
 
-    Args:
-        qdot: A joint-rate vector (n,).
-        direction: A nonzero direction (n,), e.g. a null-space vector.
-
-    Returns:
-        gamma [same units as ``qdot`` per unit of ``direction``].
+    ``qdot`` (n,), ``direction`` (n,) nonzero (e.g. a null-space vector); gamma is in units of
+    ``qdot`` per unit of ``direction``.
 
     Raises:
         InputError: Non-finite or mismatched vectors, or a zero ``direction``.

@@ -10,7 +10,7 @@ invertible, finite where it is not. Among the least-squares solutions of ``J qdo
 it minimises ``(qdot - z)^T W^-1 (qdot - z)`` (Nguyen eq. (20)).
 
 These work for any Jacobian (m, n); :class:`~solvers.closed_form.rrc_k1607.RrcK1607ClosedForm`
-uses them (through :func:`svd_rates`, on stacks) wherever its normal equations are not safe.
+uses them (through :func:`pseudo_inverse`, on stacks) wherever its normal equations are not safe.
 """
 
 from __future__ import annotations
@@ -63,11 +63,6 @@ def pseudo_inverse(J: Array, L: Array | None, rcond: float) -> Array:
     return np.asarray(P if L is None else L @ P, dtype=np.float64)
 
 
-def svd_rates(J: Array, b: Array, L: Array | None, rcond: float) -> Array:
-    """``L (J L)^+ b`` for stacks: ``J`` (..., m, n), ``b`` (..., m) -> (..., n)."""
-    return (pseudo_inverse(J, L, rcond) @ b[..., None])[..., 0]
-
-
 def weighted_pseudo_inverse(
     J: npt.ArrayLike, W: npt.ArrayLike | None = None, rcond: float = RANK_TOL
 ) -> Array:
@@ -113,14 +108,12 @@ def weighted_rates(
         InputError: Wrong shapes, non-finite entries, invalid ``W`` or ``rcond``, naming it.
     """
     J = as_array(J, "J", (None, None))
-    m, n = J.shape
-    b = as_vector(xdot, "xdot", m)
-    rcond = finite_number(rcond, "rcond", 0.0, upper=1.0)
-    L = weight_factor(W, n)
+    b = as_vector(xdot, "xdot", J.shape[0])
+    P = weighted_pseudo_inverse(J, W, rcond)
     if z is None:
-        return svd_rates(J, b, L, rcond)
-    zv = as_vector(z, "z", n)
-    return svd_rates(J, b - J @ zv, L, rcond) + zv
+        return P @ b
+    zv = as_vector(z, "z", J.shape[1])
+    return P @ (b - J @ zv) + zv
 
 
 def null_space_projector(
