@@ -313,8 +313,9 @@ def _rows_hold(x: Array, rows: Inequalities | None, tol: float = 0.0) -> bool:
 
 
 def _inside(x: Array, bounds: StepBounds, rows: Inequalities | None) -> bool:
-    """Whether the rates ``x`` satisfy the bounds and the rows exactly."""
-    return _clipped(x, bounds)[1] == 0.0 and _rows_hold(x, rows)
+    """Whether the rates ``x`` satisfy the bounds and the rows exactly (False for NaN)."""
+    within = zip(bounds.lb.tolist(), x.tolist(), bounds.ub.tolist(), strict=True)
+    return all(lo <= v <= hi for lo, v, hi in within) and _rows_hold(x, rows)
 
 
 def _scaled(w: Array, bounds: StepBounds) -> _Solved:
@@ -365,10 +366,11 @@ def _clamped(top: _TopLevel, bounds: StepBounds) -> tuple[JacobianSVD, Array]:
     between opposite rate limits at 283 of 300 ticks, the hand at 0.3 % of the command).
     """
     exact, still = top.exact, ON_LIMIT / bounds.dt  # a bound within rounding of zero holds
-    pushed = ((bounds.ub <= still) & (exact > 0.0)) | ((bounds.lb >= -still) & (exact < 0.0))
-    clamped = int(np.count_nonzero(pushed))
+    joints = zip(bounds.lb.tolist(), exact.tolist(), bounds.ub.tolist(), strict=True)
+    pushed = [j for j, (lo, w, hi) in enumerate(joints)
+              if (w > 0.0 and hi <= still) or (w < 0.0 and lo >= -still)]  # fmt: skip
     # fewer free joints than the rank: the rank is lost for sure, no SVD needed to know it
-    if clamped == 0 or exact.size - clamped < top.svd.rank:
+    if not pushed or exact.size - len(pushed) < top.svd.rank:
         return top.svd, exact
     A = top.A.copy()
     A[:, pushed] = 0.0
