@@ -118,14 +118,17 @@ def finite_number(
             finite, or out of bounds; the message
             states the expected range (``>= 0``, ``> 0``, ``in (0, 1)``, ``in [0, 0.5)``).
     """
-    real = (int, float, np.integer, np.floating)  # not complex numbers (np.number)
-    if isinstance(value, (bool, np.bool_, np.timedelta64)) or not isinstance(value, real):
-        raise error(name, f"expected {_wanted(lower, inclusive, upper)}, got {value!r}")
-    try:
-        out = float(value)
-    except OverflowError:  # an int beyond the float range
-        got = f"an int of {len(str(value))} digits"
-        raise error(name, f"expected {_wanted(lower, inclusive, upper)}, got {got}") from None
+    if type(value) is float:  # the common case, first: 0.3 us against 1.5 us for the checks
+        out = value
+    else:
+        real = (int, float, np.integer, np.floating)  # not complex numbers (np.number)
+        if isinstance(value, (bool, np.bool_, np.timedelta64)) or not isinstance(value, real):
+            raise error(name, f"expected {_wanted(lower, inclusive, upper)}, got {value!r}")
+        try:
+            out = float(value)
+        except OverflowError:  # an int beyond the float range
+            got = f"an int of {len(str(value))} digits"
+            raise error(name, f"expected {_wanted(lower, inclusive, upper)}, got {got}") from None
     if (
         not isfinite(out)
         or (lower is not None and (out < lower or (out == lower and not inclusive)))

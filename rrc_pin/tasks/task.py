@@ -59,7 +59,7 @@ def check_weight(weight: float | npt.ArrayLike, size: int | None = None) -> floa
     Raises:
         InvalidInput: Not positive, not finite, or the wrong shape.
     """
-    if np.ndim(weight) == 0:
+    if type(weight) is float or np.ndim(weight) == 0:
         return finite_number(weight, "weight", 0.0, inclusive=False, error=InvalidInput)  # type: ignore[arg-type]
     if size is None:
         raise InvalidInput("weight", f"expected a number > 0, got {weight!r}")
