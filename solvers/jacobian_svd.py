@@ -99,8 +99,8 @@ def normal_rates(J: Array, b: Array) -> Array | None:
     factor, y, info = dposv(G, b if wide else b @ J)
     if info != 0:
         return None
-    diagonal = np.abs(factor.diagonal())
-    if float(diagonal.min()) < NORMAL_RCOND * float(diagonal.max()):
+    diagonal = factor.diagonal().tolist()  # the Cholesky factor's, positive
+    if min(diagonal) < NORMAL_RCOND * max(diagonal):
         return None
     if not wide:
         return np.asarray(y, dtype=np.float64)
