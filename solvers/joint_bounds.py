@@ -27,7 +27,7 @@ import numpy as np
 import numpy.typing as npt
 
 from solvers.errors import InputError
-from solvers.validation import as_vector, finite_number, positive, real_array
+from solvers.validation import as_vector, finite_number, real_array
 
 Array = npt.NDArray[np.float64]
 
@@ -185,34 +185,6 @@ def excludes_zero(lb: Array, ub: Array) -> bool:
 def radius(lb: Array, ub: Array) -> float:
     """R, the norm of the largest joint rates within ``lb <= qdot <= ub`` [rad/s or m/s]."""
     return math.hypot(*np.maximum(-lb, ub).tolist())  # without overflow, as resolution.norm
-
-
-def joint_velocity_bounds(
-    q: npt.ArrayLike,
-    lower: npt.ArrayLike,
-    upper: npt.ArrayLike,
-    velocity: npt.ArrayLike,
-    dt: float,
-    margin: float = 0.0,
-    qdot_prev: npt.ArrayLike | None = None,
-    acceleration: npt.ArrayLike | None = None,
-    gain: float = 1.0,
-) -> StepBounds:
-    """The bounds of one step, every input checked (:class:`JointBounds` for a loop).
-
-    Raises:
-        InputError: Any invalid argument, named (see :class:`JointBounds`), or
-            ``acceleration`` without ``qdot_prev``.
-    """
-    limits = JointBounds(lower, upper, velocity, margin, acceleration, gain)
-    q = as_vector(q, "q", limits.n)
-    dt = positive(dt, "dt")
-    prev = None
-    if acceleration is not None:
-        if qdot_prev is None:
-            raise InputError("qdot_prev", "required with acceleration limits")
-        prev = as_vector(qdot_prev, "qdot_prev", limits.n)
-    return limits.step(q, dt, prev)
 
 
 def _limits(lower: npt.ArrayLike, upper: npt.ArrayLike, n: int) -> tuple[Array, Array]:

@@ -15,7 +15,6 @@ from solvers.joint_bounds import (
     SHRINK,
     JointBounds,
     StepBounds,
-    joint_velocity_bounds,
 )
 
 EPS = float(np.finfo(np.float64).eps)
@@ -287,20 +286,6 @@ def test_bounds_are_ordered_and_within_the_velocity_limits(rng: np.random.Genera
                 assert b.kind(j, side) in KINDS
 
 
-def test_the_checked_function_equals_the_loop_one(rng: np.random.Generator) -> None:
-    lower, upper = -np.ones(4), np.ones(4)
-    v, acc = np.full(4, 2.0), np.full(4, 30.0)
-    q, prev = rng.uniform(-1.2, 1.2, 4), rng.uniform(-2.0, 2.0, 4)
-    got = joint_velocity_bounds(q.tolist(), lower, upper, v, 0.01, 0.05, prev, acc, 0.7)
-    want = JointBounds(lower, upper, v, 0.05, acc, 0.7).step(q, 0.01, prev)
-    np.testing.assert_array_equal(got.lb, want.lb)
-    np.testing.assert_array_equal(got.ub, want.ub)
-    assert got.contains_zero == want.contains_zero
-    got = joint_velocity_bounds(q, lower, upper, v, 0.01)
-    assert got.acceleration is None
-    np.testing.assert_array_equal(got.ub, JointBounds(lower, upper, v).step(q, 0.01).ub)
-
-
 def test_limits_are_copies_of_the_callers_arrays() -> None:
     lower, upper = -np.ones(2), np.ones(2)
     limits = JointBounds(lower, upper, [1.0, 1.0])
@@ -350,27 +335,6 @@ def test_bad_limits_are_refused_naming_the_argument(changes: dict, argument: str
         JointBounds(**{**GOOD, **changes})
     assert info.value.argument == argument
     assert str(info.value).startswith(f"{argument}: ")
-
-
-@pytest.mark.parametrize(
-    ("changes", "argument"),
-    [({"q": [0.0]}, "q"),
-     ({"q": [0.0, np.nan]}, "q"),
-     ({"q": [True, False]}, "q"),
-     ({"dt": 0.0}, "dt"),
-     ({"dt": -0.01}, "dt"),
-     ({"dt": True}, "dt"),
-     ({"dt": "0.01"}, "dt"),
-     ({"dt": np.inf}, "dt"),
-     ({"acceleration": [1.0, 1.0]}, "qdot_prev"),  # required with acceleration limits
-     ({"acceleration": [1.0, 1.0], "qdot_prev": [0.0]}, "qdot_prev"),
-     ({"acceleration": [1.0, 1.0], "qdot_prev": [0.0, np.inf]}, "qdot_prev")],
-)  # fmt: skip
-def test_bad_step_input_is_refused_naming_the_argument(changes: dict, argument: str) -> None:
-    kwargs = {**GOOD, "q": [0.0, 0.0], "dt": 0.01, **changes}
-    with pytest.raises(InputError) as info:
-        joint_velocity_bounds(**kwargs)
-    assert info.value.argument == argument
 
 
 def test_recovering_is_a_position_outside_the_range_not_an_arm_that_cannot_stop() -> None:
