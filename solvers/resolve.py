@@ -336,10 +336,8 @@ def _top_level(
     if size > HUGE:  # the direction problem depends on the command's direction only
         b = b / float(np.abs(b).max())
     factor = None
-    # direction-preserving: every step whose exact rates leave the bounds needs the SVD (the
-    # null space), so it comes first (panda's benchmark trajectory: 77 % of the steps)
-    exact = None if damp else normal_rates(A, b)
-    if exact is None:  # not well posed for the normal equations, or needed: the SVD
+    exact = normal_rates(A, b)
+    if exact is None:  # not well posed for the normal equations: the SVD
         factor = JacobianSVD(A)
         exact = factor.rates(b)
     fits = size <= HUGE and _inside(exact, bounds, rows)
