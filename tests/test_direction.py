@@ -178,11 +178,13 @@ def test_every_backend_finds_the_largest_scale(
 ) -> None:
     """Every answer within 1e-6 relative of the LP's maximum, exactly along J w; refusals (the
     resolver's exact scipy fallback answers them) as measured: none for daqp, quadprog and
-    clarabel; OSQP does not converge on one of these 300 problems with any setting tried;
-    proxqp declares about 14% of them (feasible, LP-like: P is tiny) primal infeasible."""
+    clarabel; OSQP does not converge on one or two of these 300 problems (which ones and how
+    many depend on the CPU's numerical kernels: 1 here, 2 under Sandybridge's) with any
+    setting tried; proxqp declares about 14% of them (feasible, LP-like: P is tiny) primal
+    infeasible."""
     answers = backend_answers(name, exact_scales)
     refused = [(i, status) for i, (_, _, status) in enumerate(answers) if isinstance(status, str)]
-    allowed = {"osqp": 1, "proxqp": 60}.get(name, 0)
+    allowed = {"osqp": 2, "proxqp": 60}.get(name, 0)
     assert len(refused) <= allowed, f"{name} refused {len(refused)} of {len(answers)}"
     scale_errors, bends = errors(answers)
     given = [u for _, u, a in answers if isinstance(a, tuple)]

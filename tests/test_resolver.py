@@ -316,7 +316,11 @@ def test_singular_configurations_give_finite_rates_within_limits(arms: dict) -> 
                     twist = rng.standard_normal(6) * rng.choice([0.1, 10.0, 1e6])
                     r = resolver.solve(q, twist)
                     check_step(arm, q, r.qdot, 0.01)
-                    assert r.method == "qp" and 0.0 <= r.scale <= 1.0
+                    assert 0.0 <= r.scale <= 1.0
+                    # OSQP may not converge on these LP-like problems (on some CPUs' kernels):
+                    # then the exact scipy fallback answers, and the attempt says why
+                    assert r.method == "qp" or (backend == "osqp" and r.method == "scipy"
+                                                and r.attempts[0][0] == "qp"), r.attempts
 
 
 def test_so101_at_a_limit_keeps_moving_with_every_backend(arms: dict) -> None:
