@@ -178,7 +178,7 @@ class JointBounds:
 
 def excludes_zero(lb: Array, ub: Array) -> bool:
     """True when zero rates are outside ``lb <= qdot <= ub`` (lb > 0 or ub < 0 somewhere)."""
-    # over Python lists: 1.5 us against 4 us for numpy's reductions, at every tick
+    # over Python lists: 8k instructions against 17k for numpy's reduction, at every tick
     return bool(max(lb.tolist()) > 0.0 or min(ub.tolist()) < 0.0)
 
 

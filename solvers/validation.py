@@ -59,7 +59,7 @@ def all_finite(x: npt.NDArray[np.float64]) -> bool:
     """Whether every entry of ``x`` is finite (no NaN or infinity).
 
     Small arrays (a twist, a configuration: checked at every control tick) through a Python
-    list: 0.3 us against 1.3 us for ``np.isfinite(x).all()``.
+    list: 5k instructions against 12k for ``np.isfinite(x).all()`` on a 6-vector.
     """
     if x.size <= _SMALL:
         return all(map(isfinite, x.ravel().tolist()))
@@ -118,7 +118,8 @@ def finite_number(
             finite, or out of bounds; the message
             states the expected range (``>= 0``, ``> 0``, ``in (0, 1)``, ``in [0, 0.5)``).
     """
-    if type(value) is float:  # the common case, first: 0.3 us against 1.5 us for the checks
+    if type(value) is float:  # the common case first (FrameTask construction 34k -> 20k
+        # instructions: the isinstance checks against numpy's abstract types are slow)
         out = value
     else:
         real = (int, float, np.integer, np.floating)  # not complex numbers (np.number)
