@@ -215,12 +215,14 @@ class Resolver:
             levels, weighted = self._levels(cast(TaskCommand, command), priority)
             kin = Kinematics(self.robot.model, self._data, self._layout, q, q_pin)
             rows = [[t.rows(kin) for t in level] for level in levels]
+            owned = False  # the tasks' arrays may be the caller's: the resolution copies them
         else:
             rows = [[self._twist_rows(q, q_pin, cast(npt.ArrayLike, command), ref)]]
-            weighted = False
+            weighted, owned = False, True  # a fresh Jacobian and a copy of the twist
         bounds = self._bounds.step(q, step, prev)
         result = resolve(
             rows, bounds, self.backend, self.options, weighted=weighted, joint_names=self._names,
+            copy_rows=not owned,
         )  # fmt: skip
         self._last_qdot = result.qdot
         return result
@@ -247,7 +249,7 @@ class Resolver:
                 f"({', '.join(self.robot.tool_frames)}): pass tasks, e.g. [FrameTask(frame, "
                 "twist)], or Resolver(robot, task=FrameTask(frame))",
             )  # fmt: skip
-        b = task.check_twist(twist)
+        b = task.check_twist(twist).copy()  # the resolution keeps it
         ref = task.ref if ref is None else task.check_ref(ref)
         if self._closed_form is not None:
             if ref != "world_aligned":

@@ -227,6 +227,7 @@ def resolve(
     weighted: bool = False,
     rows: Inequalities | None = None,
     joint_names: tuple[str, ...] | None = None,
+    copy_rows: bool = True,
 ) -> Resolution:
     """Joint rates serving ``levels`` in priority order within ``bounds`` (module docstring).
 
@@ -242,6 +243,9 @@ def resolve(
             direction preservation).
         rows: Inequality rows every answer must satisfy, or None.
         joint_names: Names for the report.
+        copy_rows: Keep copies of the task rows in the resolution (a snapshot: the caller
+            may change its arrays afterwards); False when the caller hands over rows that
+            nobody changes (the resolver's twist rows: a fresh Jacobian).
 
     Returns:
         The :class:`~solvers.resolution.Resolution`; never raises for numerical trouble.
@@ -280,8 +284,9 @@ def resolve(
                 attempts.append((f"level {k}", f"{exc}; the levels above kept"))
                 break
     solved.qdot.flags.writeable = False
+    kept = _copies(levels) if copy_rows else tuple(tuple(level) for level in levels)
     return _report(
-        levels, bounds, method, top, solved, attempts, time.perf_counter() - t0, joint_names,
+        kept, bounds, method, top, solved, attempts, time.perf_counter() - t0, joint_names,
         weighted,
     )  # fmt: skip
 
@@ -618,7 +623,7 @@ def _scipy_bvls(top: _TopLevel, bounds: StepBounds, rows: Inequalities | None) -
 
 
 def _report(
-    levels: Sequence[Sequence[TaskRows]],
+    levels: tuple[tuple[TaskRows, ...], ...],
     bounds: StepBounds,
     method: Method,
     top: _TopLevel | None,
@@ -643,7 +648,7 @@ def _report(
     return Resolution(
         solved.qdot, method, solved.backend, solved.iterations, tuple(attempts), solved.clip,
         top.lambda_sq if top is not None else 0.0, elapsed - solved.solve_time,
-        solved.solve_time, bounds, _copies(levels), names, status,
+        solved.solve_time, bounds, levels, names, status,
     )  # fmt: skip
 
 

@@ -63,7 +63,7 @@ def check_weight(weight: float | npt.ArrayLike, size: int | None = None) -> floa
         return finite_number(weight, "weight", 0.0, inclusive=False, error=InvalidInput)  # type: ignore[arg-type]
     if size is None:
         raise InvalidInput("weight", f"expected a number > 0, got {weight!r}")
-    w = as_vector(weight, "weight", size, InvalidInput)
+    w: Array = as_vector(weight, "weight", size, InvalidInput).copy()  # the task's own
     if (w <= 0.0).any():
         raise InvalidInput("weight", f"expected weights > 0, got {w}")
     return w
