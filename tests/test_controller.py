@@ -173,6 +173,8 @@ def test_joint_limit_margins_are_kept(panda):
         (lambda c: c.reverse(-1.0), "seconds"),
         (lambda c: setattr(c, "speed", 1.5), "speed"),
         (lambda c: setattr(c, "speed", float("nan")), "speed"),
+        (lambda c: setattr(c, "q", [0.0] * 6), "q"),
+        (lambda c: setattr(c, "q", [np.nan] * 7), "q"),
     ],
 )
 def test_bad_input_names_the_argument_and_changes_nothing(panda, call, argument):
@@ -222,6 +224,25 @@ def test_a_float_array_command_is_kept_as_a_copy_and_judged_like_any_other(panda
     assert np.array_equal(kept, huge) and kept is not huge
     ints = Controller(panda, q0=PANDA_Q0)
     assert np.array_equal(ints.step(np.array([0, 0, 0, 0, 0, 0])).q, PANDA_Q0)
+
+
+def test_q_is_read_only_and_set_checked_the_tick_resolves_as_solve_does(panda):
+    """The controller holds q read-only (the log and every Step share it), takes a new one
+    through the checked setter, and resolves its own q and checked command without checking
+    them again: the same rates as the public ``Resolver.solve`` on the same arguments."""
+    ctl = Controller(panda, q0=PANDA_Q0, drift=None)
+    start = PANDA_Q0 + 0.05
+    ctl.q = start
+    start[0] = 1.0  # the caller's array is copied
+    with pytest.raises(ValueError):
+        ctl.q[0] = 0.0
+    twist = np.array([0.05, -0.02, 0.03, 0.1, 0.0, -0.2])
+    step = ctl.step(twist)
+    with pytest.raises(ValueError):
+        step.q[0] = 0.0
+    expected = rrc_pin.Resolver(panda).solve(PANDA_Q0 + 0.05, twist, ref="local")
+    np.testing.assert_array_equal(step.resolution.qdot, expected.qdot)
+    assert step.resolution.tasks[0].commanded.tolist() == twist.tolist()
 
 
 def test_the_resolvers_strategy_is_skipped_as_its_decision_would_keep_the_command(panda):

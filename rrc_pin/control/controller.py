@@ -54,7 +54,7 @@ class Step(NamedTuple):
     """One tick's outcome.
 
     Attributes:
-        q: Joint positions after the tick (nq,) [rad or m] (a copy).
+        q: Joint positions after the tick (nq,) [rad or m] (read-only).
         resolution: The resolver's answer for the tick.
     """
 
@@ -166,7 +166,7 @@ class Controller:
         self.dt = self.resolver.dt
         self.strategy = make_strategy(strategy)
         self.strategy.check(robot)
-        self.q = robot.neutral() if q0 is None else robot.check_q(q0, "q0").copy()
+        self.q = robot.neutral() if q0 is None else robot.check_q(q0, "q0")
         self.speed = speed
         self.deadman = deadman
         self.drift = drift
@@ -183,10 +183,21 @@ class Controller:
         self._command: Array = np.zeros(6)
         self._command_frame: Frame = "local"
         self._command_time = -math.inf
-        self._reference = self._pose(self.q)
+        self._reference = self._pose(robot.to_pinocchio(self._q) if self._manifold else self._q)
         self._reanchor = False
 
     # -- settings ---------------------------------------------------------------------------
+
+    @property
+    def q(self) -> Array:
+        """Joint positions (nq,) [rad or m], read-only: set the attribute to move the arm."""
+        return self._q
+
+    @q.setter
+    def q(self, value: npt.ArrayLike) -> None:
+        q: Array = self.robot.check_q(value, "q").copy()
+        q.flags.writeable = False
+        self._q = q
 
     @property
     def speed(self) -> float:
@@ -236,8 +247,9 @@ class Controller:
         command = self._command if weight == 1.0 else weight * self._command
         local = self._command_frame == "local"
 
-        q = self.q
-        pose = self._pose(q)
+        q = self._q
+        q_pin = self.robot.to_pinocchio(q) if self._manifold else q
+        pose = self._pose(q_pin)
         if self._reanchor:
             self._reference, self._reanchor = pose, False
         error = pose_error_values(pose, self._reference)  # hand axes
@@ -259,12 +271,13 @@ class Controller:
             decision = self.strategy.decide(Situation(self.robot, q, wanted, self.dt, command,
                                                       self._rows, hand))  # fmt: skip
         factor = decision.factor
-        if decision.rates is None:
-            r = self.resolver.solve(q, wanted if factor == 1.0 else factor * wanted,
-                                    ref=self._command_frame)  # fmt: skip
+        if decision.rates is None:  # q is its own and the command checked: no second check
+            r = self.resolver._solve_checked_twist(
+                q, q_pin, wanted if factor == 1.0 else factor * wanted, self._command_frame
+            )
         else:
             r = self.resolver.solve(q, [RatesTask(decision.rates)], priority="strict")
-        # q itself, not a copy: the controller replaces self.q at every tick, never changes it.
+        # q itself, not a copy: read-only, replaced at every tick.
         self.log.append_tick((self.t, q, r, command, hand, factor, error, "teleop",
                               decision.note))  # fmt: skip (a Tick)
         fraction = None if decision.rates is not None else _followed(r)
@@ -329,22 +342,24 @@ class Controller:
 
     # -- helpers ----------------------------------------------------------------------------
 
-    def _pose(self, q: Array) -> pin.SE3:
-        """Tool pose at ``q`` (one forward-kinematics pass in the controller's own data)."""
+    def _pose(self, q_pin: Array) -> pin.SE3:
+        """Tool pose at ``q_pin``, Pinocchio's configuration (one FK pass, own data)."""
         model, data = self.robot.model, self._data
-        pin.forwardKinematics(model, data, self.robot.to_pinocchio(q) if self._manifold else q)
+        pin.forwardKinematics(model, data, q_pin)
         pose: pin.SE3 = pin.updateFramePlacement(model, data, self._frame_id)
         return pose
 
     def _advance(self, r: Resolution) -> Step:
         """Integrate ``r.qdot`` over one period (Barker eq. (21), ``pinocchio.integrate``)."""
-        model = self.robot.model
-        q_pin = self.robot.to_pinocchio(self.q) if self._manifold else self.q
+        model, q = self.robot.model, self._q
+        q_pin = self.robot.to_pinocchio(q) if self._manifold else q
         moved = pin.integrate(model, q_pin, r.qdot * self.dt)
         # Continuous joints: back to angles by the manifold's difference (= qdot dt).
-        self.q = self.q + pin.difference(model, q_pin, moved) if self._manifold else moved
+        q = q + pin.difference(model, q_pin, moved) if self._manifold else moved
+        q.flags.writeable = False  # the log and the Step hold it: never changed, replaced
+        self._q = q
         self.t += self.dt
-        return Step(self.q.copy(), r)
+        return Step(q, r)
 
     def _log_record(self, values: tuple[Any, ...]) -> LogRecord:
         """The log's record of a tick (:class:`Tick`'s fields), computed now.
@@ -377,8 +392,6 @@ def _checked_twist(twist: npt.ArrayLike) -> Array:
         InvalidInput: Naming ``twist``: not a real (6,) vector, or NaN or inf in it.
     """
     out: Array = as_vector(twist, "twist", 6, InvalidInput).copy()
-    return out
-    out = as_vector(twist, "twist", 6, InvalidInput).copy()
     return out
 
 

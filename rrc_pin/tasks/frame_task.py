@@ -80,11 +80,15 @@ class FrameTask(Task):
         m = len(self.selected)
         size = np.shape(twist)
         if size == (6,) and m != 6:
-            return as_vector(twist, "twist", 6, InvalidInput)[list(self.selected)]
+            return self.selected_rates(as_vector(twist, "twist", 6, InvalidInput))
         if size != (m,):
             want = "(6,)" if m == 6 else f"(6,) or ({m},)"
             raise InvalidInput("twist", f"expected shape {want}, got {size}")
         return as_vector(twist, "twist", m, InvalidInput)
+
+    def selected_rates(self, twist: Array) -> Array:
+        """The selected rows' rates of a checked twist (6,) (``twist`` itself when all six)."""
+        return twist if len(self.selected) == 6 else twist[list(self.selected)]
 
     def check_ref(self, ref: str) -> Reference:
         """``ref`` if it names a reference frame that this task's rows can use.
