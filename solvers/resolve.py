@@ -243,9 +243,8 @@ def resolve(
             direction preservation).
         rows: Inequality rows every answer must satisfy, or None.
         joint_names: Names for the report.
-        copy_rows: Keep copies of the task rows in the resolution (a snapshot: the caller
-            may change its arrays afterwards); False when the caller hands over rows that
-            nobody changes (the resolver's twist rows: a fresh Jacobian).
+        copy_rows: Keep copies of the rows in the resolution (the caller may change its
+            arrays); False for rows nobody changes (the resolver's fresh Jacobian).
 
     Returns:
         The :class:`~solvers.resolution.Resolution`; never raises for numerical trouble.

@@ -483,6 +483,37 @@ def test_daqp_failure_returns_the_exitflag(
     assert daqp_calls[-1]["primal_start"] is None
 
 
+def test_daqp_retries_a_declared_infeasible_problem_once_at_a_looser_tolerance(
+    monkeypatch: pytest.MonkeyPatch, rng: np.random.Generator
+) -> None:
+    """DAQP calls some feasible degenerate problems infeasible at 1e-9 (daqp_backend.RETRY_TOL):
+    one cold retry at 1e-8 answers them, its iterations counted; a truly infeasible problem
+    is tried twice and reported; a tolerance already that loose is not retried."""
+    import daqp
+
+    calls: list[dict] = []
+    original = daqp.solve
+
+    def first_call_infeasible(*args: Any, **kwargs: Any) -> Any:
+        calls.append(kwargs)
+        x, fval, exitflag, info = original(*args, **kwargs)
+        if len(calls) == 1:
+            return x, fval, -1, {**info, "iterations": 7}
+        return x, fval, exitflag, info
+
+    monkeypatch.setattr(daqp, "solve", first_call_infeasible)
+    qp = box_and_rows(rng, 4, 3, key="degenerate")
+    sol = DaqpBackend().solve(qp)
+    assert sol.x is not None and sol.status == "solved" and feasible(qp, sol.x, 1e-8)
+    assert [c["primal_tol"] for c in calls] == [1e-9, daqp_backend.RETRY_TOL]
+    assert calls[1]["primal_start"] is None and sol.iterations >= 7
+    calls.clear()
+    assert DaqpBackend().solve(INFEASIBLE).x is None
+    assert len(calls) == 2  # the first call made to fail, then the real retry
+    calls.clear()
+    assert DaqpBackend(primal_tol=1e-6).solve(INFEASIBLE).x is None and len(calls) == 1
+
+
 def test_daqp_exception_becomes_problem_error() -> None:
     with pytest.raises(ProblemError, match="^daqp:") as info:
         DaqpBackend(iter_limt=5).solve(INFEASIBLE)
