@@ -216,7 +216,7 @@ class Resolver:
         task = self._twist_task()
         b = task.check_twist(cast(npt.ArrayLike, command)).copy()  # the resolution keeps it
         ref = task.ref if ref is None else task.check_ref(ref)
-        return self._resolve([[self._twist_rows(q, q_pin, b, ref)]], q, step, prev)
+        return self._resolve([[self._twist_rows(task, q, q_pin, b, ref)]], q, step, prev)
 
     def _solve_checked_twist(
         self, q: Array, q_pin: Array, twist: Array, ref: Reference
@@ -234,8 +234,9 @@ class Resolver:
             twist: A finite (6,) twist nobody changes afterwards (the resolution keeps it).
             ref: ``local`` or ``world_aligned``.
         """
-        b = self._twist_task().selected_rates(twist)
-        return self._resolve([[self._twist_rows(q, q_pin, b, ref)]], q, self.dt, None)
+        task = self._twist_task()
+        b = task.selected_rates(twist)
+        return self._resolve([[self._twist_rows(task, q, q_pin, b, ref)]], q, self.dt, None)
 
     def _resolve(
         self,
@@ -280,8 +281,10 @@ class Resolver:
             )  # fmt: skip
         return self.task
 
-    def _twist_rows(self, q: Array, q_pin: Array, b: Array, ref: Reference) -> TaskRows:
-        """The resolver's task at ``q``, rates ``b`` of its rows in frame ``ref`` (one call)."""
+    def _twist_rows(
+        self, task: FrameTask, q: Array, q_pin: Array, b: Array, ref: Reference
+    ) -> TaskRows:
+        """``task`` at ``q``, rates ``b`` of its rows in frame ``ref`` (one Jacobian call)."""
         if self._closed_form is not None:
             if ref != "world_aligned":
                 raise InvalidInput("ref", f"the closed form gives world_aligned rows, got {ref!r}")
@@ -290,7 +293,7 @@ class Resolver:
             J = pin.computeFrameJacobian(
                 self.robot.model, self._data, q_pin, self._frame, PIN_REFERENCE[ref]
             )
-        return self._twist_task().rows_from(J, b)
+        return task.rows_from(J, b)
 
     def _levels(
         self, command: TaskCommand, priority: str

@@ -183,7 +183,7 @@ class Controller:
         self._command: Array = np.zeros(6)
         self._command_frame: Frame = "local"
         self._command_time = -math.inf
-        self._reference = self._pose(robot.to_pinocchio(self._q) if self._manifold else self._q)
+        self._reference = self._pose(self._pinocchio_q(self._q))
         self._reanchor = False
 
     # -- settings ---------------------------------------------------------------------------
@@ -248,7 +248,7 @@ class Controller:
         local = self._command_frame == "local"
 
         q = self._q
-        q_pin = self.robot.to_pinocchio(q) if self._manifold else q
+        q_pin = self._pinocchio_q(q)
         pose = self._pose(q_pin)
         if self._reanchor:
             self._reference, self._reanchor = pose, False
@@ -342,6 +342,10 @@ class Controller:
 
     # -- helpers ----------------------------------------------------------------------------
 
+    def _pinocchio_q(self, q: Array) -> Array:
+        """Pinocchio's configuration of the controller's own ``q`` (valid: not checked again)."""
+        return self.robot.to_pinocchio(q) if self._manifold else q
+
     def _pose(self, q_pin: Array) -> pin.SE3:
         """Tool pose at ``q_pin``, Pinocchio's configuration (one FK pass, own data)."""
         model, data = self.robot.model, self._data
@@ -352,7 +356,7 @@ class Controller:
     def _advance(self, r: Resolution) -> Step:
         """Integrate ``r.qdot`` over one period (Barker eq. (21), ``pinocchio.integrate``)."""
         model, q = self.robot.model, self._q
-        q_pin = self.robot.to_pinocchio(q) if self._manifold else q
+        q_pin = self._pinocchio_q(q)
         moved = pin.integrate(model, q_pin, r.qdot * self.dt)
         # Continuous joints: back to angles by the manifold's difference (= qdot dt).
         q = q + pin.difference(model, q_pin, moved) if self._manifold else moved
