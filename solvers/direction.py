@@ -17,11 +17,15 @@ moves the hand along the command at the fraction u of its speed, whatever y. The
 no rank-deficient equality rows), then the least-norm y. Solved here:
 
 - no null space (d = 0): the largest u of uniform scaling (:func:`uniform_scale`);
+- a null space of one dimension (d = 1: a 7-joint arm's six rows): exactly, by eliminating
+  y (:func:`line_scale`);
 - otherwise as a QP (:func:`direction_qp`) for the backend, or as an LP by scipy's HiGHS
   (:func:`direction_lp`, exact: the fallback when the backend fails).
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 import numpy.typing as npt
@@ -55,6 +59,51 @@ def uniform_scale(x: Array, lb: Array, ub: Array) -> float:
         elif xi < 0.0:
             s = min(s, low / xi)
     return s
+
+
+def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
+    r"""The direction problem with a null space of one dimension, exactly: u and y.
+
+    Every row :math:`lb_i \le u w_i + y v_i \le ub_i` is two half-planes
+    :math:`\alpha u + \beta y \le \gamma` (:math:`\gamma \ge 0`: u = y = 0 is feasible).
+    Eliminating y (Fourier-Motzkin) between each half-plane bounding y from above
+    (:math:`\beta > 0`) and each bounding it from below leaves bounds on u alone; the largest
+    u in [0, 1] meets them all, and y is the value nearest zero that it allows (the
+    lexicographic answer the QP's small regularisation approximates: where the largest u
+    leaves one y, the QP may give up some 1e-6 of u for a smaller y). n rows make at most
+    n^2 pairs: 49 for seven joints, over Python floats.
+
+    Args:
+        w: Rates of the command (n,).
+        v: Null-space direction (n,).
+        lb: Lower joint-rate bounds (n,) <= 0 (not checked).
+        ub: Upper joint-rate bounds (n,) >= 0 (not checked).
+
+    Returns:
+        u in [0, 1] and y; the rates are ``u w + y v``.
+    """
+    above, below = [], []  # half-planes (alpha, beta, gamma) bounding y from above / below
+    u = 1.0
+    for wi, vi, lo, hi in zip(w.tolist(), v.tolist(), lb.tolist(), ub.tolist(), strict=True):
+        if vi > 0.0:
+            above.append((wi, vi, hi))
+            below.append((-wi, -vi, -lo))
+        elif vi < 0.0:
+            above.append((-wi, -vi, -lo))
+            below.append((wi, vi, hi))
+        elif wi > 0.0 and hi < u * wi:  # a row without y: a bound on u alone
+            u = hi / wi
+        elif wi < 0.0 and lo > u * wi:
+            u = lo / wi
+    for a1, b1, g1 in above:
+        for a2, b2, g2 in below:  # -b2 * (plane 1) + b1 * (plane 2): y eliminated
+            coefficient = b1 * a2 - b2 * a1
+            if coefficient > 0.0 and b1 * g2 - b2 * g1 < u * coefficient:
+                u = (b1 * g2 - b2 * g1) / coefficient
+    u = max(u, 0.0)
+    y_hi = min([(g - a * u) / b for a, b, g in above], default=math.inf)
+    y_lo = max([(g - a * u) / b for a, b, g in below], default=-math.inf)
+    return u, min(max(0.0, y_lo), y_hi)
 
 
 def direction_qp(w: Array, null: Array, lb: Array, ub: Array, key: str) -> tuple[QP, Decoding]:

@@ -19,11 +19,11 @@ The top level (level 0):
      (and rows); the task velocity is :math:`u c` times the command's, whatever y, so the
      hand slows down along the command instead of veering (Drake's formulation; the null
      space parametrised, so no rank-deficient equality rows). The cap c <= 1 keeps u of order
-     one for absurd commands. Without a null space, the largest feasible u is computed
-     directly. Near a singularity (:class:`~solvers.jacobian_svd.Damping`: a weak singular
-     direction, and exact rates beyond the bounds) w is the damped rates instead
-     (``damped``): along the exact ones a step crosses the singularity and the next one
-     comes back;
+     one for absurd commands. Without a null space, or with one of one dimension (seven
+     joints, six rows), the largest feasible u is computed directly (no QP). Near a
+     singularity (:class:`~solvers.jacobian_svd.Damping`: a weak singular direction, and
+     exact rates beyond the bounds) w is the damped rates instead (``damped``): along the
+     exact ones a step crosses the singularity and the next one comes back;
    - least squares (tracking mode, weighted priorities, or a joint recovering into its
      range): :math:`\min \|A\dot q - b\|^2 + \epsilon\|\dot q\|^2` within the bounds,
      exactly the least squares of the tasks' costs (a damping task adds Levenberg-Marquardt
@@ -56,7 +56,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.linalg.lapack import dsyevr
 
-from solvers.direction import direction_lp, direction_qp, uniform_scale
+from solvers.direction import direction_lp, direction_qp, line_scale, uniform_scale
 from solvers.errors import InputError, ProblemError
 from solvers.jacobian_svd import Damping, JacobianSVD, normal_rates
 from solvers.joint_bounds import ON_LIMIT, StepBounds
@@ -442,6 +442,10 @@ def _along(
     null = top.svd.null_basis()
     if rows is None and null.shape[0] == 0:  # no null space: the largest uniform scale
         return _scaled(w, bounds)
+    if rows is None and null.shape[0] == 1:  # one null direction: exactly, no QP; against
+        # the QP, panda's benchmark median -25 % and p99 -17 %, rrc_k1607's -13 % / -16 %
+        u, y = line_scale(w, null[0], bounds.lb, bounds.ub)
+        return _Solved(*_clipped(u * w + y * null[0], bounds))
     d, n = null.shape
     qp, decoding = direction_qp(w, null, bounds.lb, bounds.ub, f"direction:{n}:{d}")
     if rows is not None:

@@ -7,7 +7,13 @@ import itertools
 import numpy as np
 import pytest
 
-from solvers.direction import REGULARIZATION, direction_lp, direction_qp, uniform_scale
+from solvers.direction import (
+    REGULARIZATION,
+    direction_lp,
+    direction_qp,
+    line_scale,
+    uniform_scale,
+)
 from solvers.errors import ProblemError
 from solvers.jacobian_svd import JacobianSVD
 from solvers.qp_backends import installed_backends, make_backend
@@ -277,3 +283,51 @@ def test_direction_lp_with_extra_one_sided_rows() -> None:
     hi[3] = -2.5  # y + u <= -2.5 with y >= -1 and u >= 0: infeasible
     with pytest.raises(ProblemError, match="linprog"):
         direction_lp(M, C, lo, hi)
+
+
+# -- one null direction: the exact elimination -------------------------------------------------
+
+
+def least_norm_y(u: float, w: np.ndarray, v: np.ndarray, lb: np.ndarray, ub: np.ndarray) -> float:
+    """The y nearest zero with ``lb <= u w + y v <= ub``, row by row (no elimination)."""
+    lo, hi = -np.inf, np.inf
+    for wi, vi, low, high in zip(w, v, lb, ub, strict=True):
+        if vi != 0.0:
+            a, b = sorted(((low - u * wi) / vi, (high - u * wi) / vi))
+            lo, hi = max(lo, a), min(hi, b)
+    return float(min(max(0.0, lo), hi))
+
+
+@pytest.mark.parametrize("fixture", ["exact_scales", "exact_scales_on_limits"])
+def test_line_scale_is_the_exact_lp_answer_with_the_least_norm_y(
+    fixture: str, request: pytest.FixtureRequest
+) -> None:
+    cases = [(p, u) for p, u in request.getfixturevalue(fixture) if p["d"] == 1]
+    assert len(cases) == 100
+    for p, u_exact in cases:
+        w, v, lb, ub = p["w"], p["null"][0], p["lb"], p["ub"]
+        u, y = line_scale(w, v, lb, ub)
+        qdot = u * w + y * v
+        radius = float(np.abs(np.concatenate([lb, ub])).max())
+        assert (qdot >= lb - 1e-12 * radius).all() and (qdot <= ub + 1e-12 * radius).all()
+        # HiGHS's u is for w capped to the bounds' radius R (direction_qp's M[:, -1])
+        _, decoding = direction_qp(w, p["null"], lb, ub, "direction")
+        assert decoding.M is not None
+        capped = decoding.M[:, -1]
+        assert u * float(w @ w) / float(capped @ w) == pytest.approx(u_exact, abs=1e-9)
+        assert y == pytest.approx(least_norm_y(u, w, v, lb, ub), abs=1e-12 * radius)
+        np.testing.assert_allclose(p["J"] @ qdot, u * (p["J"] @ w), atol=1e-9)
+
+
+def test_line_scale_edge_cases() -> None:
+    lb, ub = -np.ones(3), np.ones(3)
+    v = np.array([0.0, 0.6, 0.8])
+    assert line_scale(np.zeros(3), v, lb, ub) == (1.0, 0.0)  # no command: all of it, y = 0
+    assert line_scale(np.array([0.5, 0.0, 0.0]), v, lb, ub) == (1.0, 0.0)  # already inside
+    u, y = line_scale(np.array([4.0, 0.0, 0.0]), v, lb, ub)  # a joint without y: uniform
+    assert (u, y) == (0.25, 0.0)
+    held = np.array([0.0, 1.0, 1.0])  # joint 0 on its upper limit, pushed further
+    assert line_scale(np.array([1.0, 0.0, 0.0]), v, lb, held)[0] == 0.0
+    # w leaves joint 1's bound; the null direction brings it back, as little as needed
+    u, y = line_scale(np.array([0.0, 1.6, -1.2]), v, np.array([-1.0, -1.0, -3.0]), ub)
+    assert u == 1.0 and y == pytest.approx(-1.0, abs=1e-15)
