@@ -30,9 +30,11 @@ the whole call, as its users make it:
 
 Each contender is timed in the three modes of :mod:`timing` (tight loop, 1 kHz loop with
 ``time.sleep`` to the next tick, interleaved with its peers in an order shuffled at each
-step), each mode from fresh contenders. Per contender and mode: median, p10, p90, p99 and
-mean [us], the ratio to pink's fastest backend of that mode (its median over the
-contender's, its p99 over the contender's: above 1, faster than pink), the largest
+step), each mode from fresh contenders, :data:`timing.REPEATS` rounds of the three modes
+(one with ``--quick``), combined by their medians (:func:`timing.combine_rounds`). Per
+contender and mode: median, p10, p90, p99 and mean [us], the ratio to pink's fastest
+backend of that mode (its median over the contender's, its p99 over the contender's: above
+1, faster than pink), the largest
 velocity and position excess, failures; per rrc-pin contender how its steps were answered
 (status, method, backend share, active bounds). Then where the default's step time goes:
 :mod:`stage_profile` (``time.perf_counter`` wrappers around each stage). BLAS threads are
@@ -66,12 +68,14 @@ from timing import (  # noqa: E402
     MODE_TITLES,
     MODES,
     PERIOD,
+    REPEATS,
     Contender,
-    add_ratios,
+    combine_rounds,
     mode_table,
     progress,
     quiet_stdout,
     record_trajectory,
+    rounds_note,
     run_mode,
     summarise,
     timing_chart,
@@ -211,18 +215,22 @@ def tracking_errors(arm: Any, Q: Array, X: Array, rates: Array) -> dict[str, flo
     }
 
 
-def add_peer_ratios(rows: dict[str, dict[str, Any]], prefix: str, key: str) -> str | None:
+def add_peer_ratios(rows: dict[str, dict[str, Any]], prefix: str, key: str) -> None:
     """Ratios to the fastest row (by median) whose label starts with ``prefix``, stored as
-    ``vs_<key>_median`` and ``vs_<key>_p99`` (the peer's time over the row's); its label."""
-    peers = [k for k in rows if k.startswith(prefix)]
-    if not peers:
-        return None
-    fastest = min(peers, key=lambda k: rows[k]["median_us"])
+    ``vs_<key>_median`` and ``vs_<key>_p99`` (the peer's time over the row's)."""
+    fastest = fastest_of(rows, prefix)
+    if fastest is None:
+        return
     base = rows[fastest]
     for row in rows.values():
         row[f"vs_{key}_median"] = base["median_us"] / row["median_us"]
         row[f"vs_{key}_p99"] = base["p99_us"] / row["p99_us"]
-    return fastest
+
+
+def fastest_of(rows: dict[str, dict[str, Any]], prefix: str) -> str | None:
+    """The row whose label starts with ``prefix`` with the lowest median, or None."""
+    peers = [k for k in rows if k.startswith(prefix)]
+    return min(peers, key=lambda k: rows[k]["median_us"]) if peers else None
 
 
 def rrc_statistics(resolutions: list[Any]) -> dict[str, Any]:
@@ -246,8 +254,9 @@ def rrc_statistics(resolutions: list[Any]) -> dict[str, Any]:
     }
 
 
-def bench_arm(name: str, steps: int) -> dict[str, Any]:
-    """Every contender in every mode along one trajectory of arm ``name``, then the profile."""
+def bench_arm(name: str, steps: int, repeats: int) -> dict[str, Any]:
+    """Every contender in every mode along one trajectory of arm ``name``, ``repeats`` rounds
+    (:func:`timing.combine_rounds`), then the profile."""
     arm = rrc_pin.load(name)
     progress(f"{name}: recording {steps} steps (rrc-pin tracking)")
     Q, X = record_trajectory(arm, steps, np.random.default_rng(SEED), DT, SEGMENT)
@@ -260,30 +269,36 @@ def bench_arm(name: str, steps: int) -> dict[str, Any]:
     if gap is not None and max(gap.values()) > mink_peer.KINEMATICS_TOL:
         # mink would solve another arm's problem: the comparison would be void.
         raise SystemExit(f"{name}: MuJoCo's kinematics differ from Pinocchio's: {gap}")
+    rounds: dict[str, list[dict[str, Any]]] = {mode: [] for mode in MODES}
+    for round_ in range(repeats):
+        for mode in MODES:
+            contenders = rrc_contenders(arm) + pink_contenders(arm)
+            if with_mink:
+                contenders += mink_peer.mink_contenders(arm, DT)
+            contenders += floor_contenders(arm)
+            progress(f"{name}: {MODE_TITLES[mode]}, {len(contenders)} contenders, "
+                     f"round {round_ + 1} of {repeats}")  # fmt: skip
+            with quiet_stdout():  # OSQP's C code prints "Polishing not needed"
+                runs = run_mode(mode, contenders, Q, X, shuffle, PERIOD)
+            rows = summarise(runs, Q, limits, DT)
+            for label, run in runs.items():
+                rows[label].update(tracking_errors(arm, Q, X, run.rates))
+            add_peer_ratios(rows, "pink ", "baseline")
+            add_peer_ratios(rows, "mink ", "mink")
+            add_peer_ratios(rows, FLOOR, "floor")
+            rounds[mode].append(rows)
+            if round_ == 0:  # the answers are the same in every round
+                rrc[mode] = {
+                    c.label: rrc_statistics(runs[c.label].kept) for c in contenders if c.keep
+                }
     for mode in MODES:
-        contenders = rrc_contenders(arm) + pink_contenders(arm)
-        if with_mink:
-            contenders += mink_peer.mink_contenders(arm, DT)
-        contenders += floor_contenders(arm)
-        progress(f"{name}: {MODE_TITLES[mode]}, {len(contenders)} contenders")
-        with quiet_stdout():  # OSQP's C code prints "Polishing not needed"
-            runs = run_mode(mode, contenders, Q, X, shuffle, PERIOD)
-        rows = summarise(runs, Q, limits, DT)
-        for label, run in runs.items():
-            rows[label].update(tracking_errors(arm, Q, X, run.rates))
-        pinks = [k for k in rows if k.startswith("pink ")]
-        fastest = min(pinks, key=lambda k: rows[k]["median_us"]) if pinks else None
-        if fastest is not None:
-            add_ratios(rows, fastest)
-        mink_fastest = add_peer_ratios(rows, "mink ", "mink")
-        add_peer_ratios(rows, FLOOR, "floor")
+        rows = combine_rounds(rounds[mode])
         modes[mode] = {
-            "pink_fastest": fastest,
-            "mink_fastest": mink_fastest,
+            "pink_fastest": fastest_of(rows, "pink "),
+            "mink_fastest": fastest_of(rows, "mink "),
             "floor": FLOOR,
             "contenders": rows,
         }
-        rrc[mode] = {c.label: rrc_statistics(runs[c.label].kept) for c in contenders if c.keep}
     progress(f"{name}: profile of the default")
     profile = profile_default(arm, Q, X)
     recorded = rrc["tight"].get(TRACKING, {})
@@ -339,6 +354,7 @@ def main(argv: list[str] | None = None) -> int:
             f"--record keeps full runs only ({STEPS} steps, every arm, pink and mink installed)"
         )
     warnings.simplefilter("ignore")
+    repeats = 1 if args.quick else REPEATS
     start = load_average()
     results: dict[str, Any] = {
         "benchmark": "resolver",
@@ -351,11 +367,12 @@ def main(argv: list[str] | None = None) -> int:
             "seed": SEED,
             "period_s": PERIOD,
             "khz_wait": "time.sleep to the next tick",
+            "rounds": repeats,
             "quick": bool(args.quick),
             "pink_backends": pink_backends(),
         },
         "notes": [] if pink_backends() else ["pink is not installed: its rows are absent"],
-        "arms": [bench_arm(a, steps) for a in args.arms],
+        "arms": [bench_arm(a, steps, repeats) for a in args.arms],
     }
     results["load_average"] = {"start": start, "end": load_average()}
     write(args, "resolver", results, lambda path: plot(results, path))
@@ -421,7 +438,7 @@ def _setup_line(results: dict[str, Any]) -> str:
         "ms. rrc-pin default: `Resolver(arm)` (DAQP, direction-preserving); tracking: "
         "`direction_preserving=False`; pink: `solve_ik` with the same frame task and limits, "
         "its fastest qpsolvers backend in each mode. Ratios: pink's time over rrc-pin's (above "
-        "1: rrc-pin faster), median / p99. Measured on "
+        f"1: rrc-pin faster), median / p99; {rounds_note(s)}. Measured on "
         f"{m['cpu']} ({m['cores']} cores), Python {m['python']}, Pinocchio {m['pinocchio']}, "
         f"pink {m.get('pink')}"
     )
@@ -440,7 +457,8 @@ def docs_section(results: dict[str, Any]) -> str:
         f"{s['segment']} steps (seed {s['seed']}), recorded by rrc-pin in tracking mode. The "
         "1 kHz loop waits with `time.sleep` until the next 1 ms tick. Ratios: pink's fastest "
         "backend of the same mode (by median) over the contender: its median over the "
-        "contender's median, its p99 over the contender's p99 (above 1: faster than pink).",
+        "contender's median, its p99 over the contender's p99 (above 1: faster than pink); "
+        f"{rounds_note(s)}.",
         "",
     ]
     for note in results.get("notes", []):

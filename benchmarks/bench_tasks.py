@@ -62,7 +62,7 @@ from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
-from bench_resolver import BACKEND_MODULES, rrc_statistics  # noqa: E402
+from bench_resolver import BACKEND_MODULES, fastest_of, rrc_statistics  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
 from placo_peer import PlacoPeer, Worker, placo_checks, placo_python, placo_urdf  # noqa: E402
 from render_tasks import MODES, PLACO, STRICT, WEIGHTED, plot, readme_table  # noqa: E402
@@ -71,8 +71,10 @@ from script import make_parser, write  # noqa: E402
 from stage_profile import profile_steps  # noqa: E402
 from timing import (  # noqa: E402
     MODE_TITLES,
+    REPEATS,
     Contender,
     add_ratios,
+    combine_rounds,
     one_core,
     progress,
     quiet_stdout,
@@ -336,8 +338,11 @@ def _order(h: tuple[float, ...], d: list[float]) -> float | None:
     return float(np.polyfit(x, y, 1)[0])
 
 
-def bench(steps: int, placo_where: str | None, placo_why: str) -> dict[str, Any]:
-    """Every contender in both modes along one baxter trajectory, then the checks."""
+def bench(
+    steps: int, placo_where: str | None, placo_why: str, repeats: int
+) -> dict[str, Any]:
+    """Every contender in every mode along one baxter trajectory, ``repeats`` rounds
+    (:func:`timing.combine_rounds`), then the checks."""
     robot = rrc_pin.load(ROBOT)
     progress(f"{ROBOT}: recording {steps} steps (rrc-pin weighted)")
     Q, X = record_trajectory(robot, steps, np.random.default_rng(SEED))
@@ -358,39 +363,46 @@ def bench(steps: int, placo_where: str | None, placo_why: str) -> dict[str, Any]
         pids = [peer.process.pid] if isinstance(peer, Worker) else []
         with one_core(pids) as cpu:
             placo["pinned_to_cpu"] = cpu
-            for mode in MODES:
-                contenders = rrc_contenders(robot) + pink_contenders(robot)
-                if peer is not None:
-                    if mode != MODES[0]:  # a fresh peer per mode, as for the others
-                        _close(peer)
-                        peer = placo_peer(robot, placo_where, urdf)  # type: ignore[arg-type]
-                        if isinstance(peer, Worker) and cpu is not None:
-                            os.sched_setaffinity(peer.process.pid, {cpu})
-                    contenders.append(
-                        Contender(PLACO, peer.timed_step, remote=True, loop=peer.loop)
-                    )
-                progress(f"{ROBOT}: {MODE_TITLES[mode]}, {len(contenders)} contenders")
-                with quiet_stdout():
-                    runs = run_mode(mode, contenders, Q, X, shuffle)
-                rows = summarise(runs, Q, limits, DT)
-                pinks = [k for k in rows if k.startswith("pink ")]
-                fastest = min(pinks, key=lambda k: rows[k]["median_us"]) if pinks else None
-                if fastest is not None:
-                    add_ratios(rows, fastest)
-                if PLACO in rows:
-                    for row in rows.values():
-                        row["vs_placo_median"] = rows[PLACO]["median_us"] / row["median_us"]
-                        row["vs_placo_p99"] = rows[PLACO]["p99_us"] / row["p99_us"]
-                modes[mode] = {"pink_fastest": fastest, "contenders": rows}
-                rrc[mode] = {
-                    c.label: rrc_statistics(runs[c.label].kept) for c in contenders if c.keep
-                }
-                if mode == "tight":  # rates NaN where the call failed (not compared)
-                    kept_rates = {
-                        label: np.where(run.failed[:, None], np.nan, run.rates)
-                        for label, run in runs.items()
+            rounds: dict[str, list[dict[str, Any]]] = {mode: [] for mode in MODES}
+            for round_ in range(repeats):
+                for mode in MODES:
+                    contenders = rrc_contenders(robot) + pink_contenders(robot)
+                    if peer is not None:
+                        if round_ or mode != MODES[0]:  # a fresh peer per mode, as the others
+                            _close(peer)
+                            peer = placo_peer(robot, placo_where, urdf)  # type: ignore[arg-type]
+                            if isinstance(peer, Worker) and cpu is not None:
+                                os.sched_setaffinity(peer.process.pid, {cpu})
+                        contenders.append(
+                            Contender(PLACO, peer.timed_step, remote=True, loop=peer.loop)
+                        )
+                    progress(f"{ROBOT}: {MODE_TITLES[mode]}, {len(contenders)} contenders, "
+                             f"round {round_ + 1} of {repeats}")  # fmt: skip
+                    with quiet_stdout():
+                        runs = run_mode(mode, contenders, Q, X, shuffle)
+                    rows = summarise(runs, Q, limits, DT)
+                    fastest = fastest_of(rows, "pink ")
+                    if fastest is not None:
+                        add_ratios(rows, fastest)
+                    if PLACO in rows:
+                        for row in rows.values():
+                            row["vs_placo_median"] = rows[PLACO]["median_us"] / row["median_us"]
+                            row["vs_placo_p99"] = rows[PLACO]["p99_us"] / row["p99_us"]
+                    rounds[mode].append(rows)
+                    if round_:
+                        continue  # the answers are the same in every round
+                    rrc[mode] = {
+                        c.label: rrc_statistics(runs[c.label].kept) for c in contenders if c.keep
                     }
-                    kept_resolutions = runs[WEIGHTED].kept
+                    if mode == "tight":  # rates NaN where the call failed (not compared)
+                        kept_rates = {
+                            label: np.where(run.failed[:, None], np.nan, run.rates)
+                            for label, run in runs.items()
+                        }
+                        kept_resolutions = runs[WEIGHTED].kept
+            for mode in MODES:
+                rows = combine_rounds(rounds[mode])
+                modes[mode] = {"pink_fastest": fastest_of(rows, "pink "), "contenders": rows}
         if peer is not None:
             _close(peer)
     finally:
@@ -441,6 +453,7 @@ def main(argv: list[str] | None = None) -> int:
     warnings.simplefilter("ignore")
     placo_where, placo_why = placo_python(args.placo_python)
     progress(f"PlaCo: {placo_why}")
+    repeats = 1 if args.quick else REPEATS
     start = load_average()
     notes = [] if pink_backends() else ["pink is not installed: its rows are absent"]
     if placo_where is None:
@@ -459,10 +472,11 @@ def main(argv: list[str] | None = None) -> int:
             "posture_gain": POSTURE_GAIN,
             "weights": {"frame": FRAME_COST**2, "posture": POSTURE_COST**2},
             "quick": bool(args.quick),
+            "rounds": repeats,
             "pink_backends": pink_backends(),
         },
         "notes": notes,
-        **bench(steps, placo_where, placo_why),
+        **bench(steps, placo_where, placo_why, repeats),
     }
     results["load_average"] = {"start": start, "end": load_average()}
     write(args, "tasks", results, lambda path: plot(results, path))

@@ -11,7 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from stage_profile import profile_table
-from timing import MODE_TITLES, mode_table, timing_chart, us
+from timing import MODE_TITLES, mode_table, rounds_note, timing_chart, us
 
 MODES = ("tight", "interleaved")
 """The modes the tasks benchmark times (:mod:`timing`)."""
@@ -74,7 +74,7 @@ def _setup_line(results: dict[str, Any]) -> str:
         f"{t['steps']} steps (a bound active at {100 * t['active_fraction']:.0f}% of them), "
         f"dt = {1000 * s['dt']:g} ms; pink's costs (frame 1, posture {s['posture_cost']:g}), "
         "rrc-pin's and PlaCo's weights their squares. Ratios: the peer's time over rrc-pin's "
-        "(above 1: rrc-pin faster), median / p99."
+        f"(above 1: rrc-pin faster), median / p99; {rounds_note(s)}."
     )
     if placo and placo["max_difference"] is not None:
         text += (

@@ -61,6 +61,11 @@ PERIOD = 1e-3
 """[s] Period of the ``khz`` mode."""
 BLOCK = 250
 """Steps a contender runs in one turn of the ``tight`` and ``khz`` modes."""
+REPEATS = 5
+"""Rounds of every mode in a full run (``--quick``: one), each from fresh contenders: one
+round's medians moved by up to 2x between runs on the project's 2-core virtual machine, and
+pink's with them (its median on panda 85 us in one record, 146 us in the next, rrc_k1607's
+ratio 3.0x then 1.4x): :func:`combine_rounds` keeps the median of the rounds."""
 
 
 @dataclass
@@ -260,6 +265,44 @@ def summarise(
             row["first_error"] = run.first_error
         out[label] = row
     return out
+
+
+def combine_rounds(rounds: Sequence[dict[str, dict[str, Any]]]) -> dict[str, dict[str, Any]]:
+    """One row per contender from its rows in several rounds of one mode.
+
+    Each time statistic and each ratio (``vs_*``, computed within its round, so that a
+    contender and its peer are compared on the same machine state) is the median over the
+    rounds; the largest time, excess and error (``max*``), failures and overruns are the
+    worst round's; other entries are the first round's. ``rounds`` lists each round's
+    median, p99 and ratios, to show the spread.
+    """
+    out: dict[str, dict[str, Any]] = {}
+    for label, first in rounds[0].items():
+        rows = [r[label] for r in rounds]
+        row: dict[str, Any] = {}
+        for key, value in first.items():
+            values = [r[key] for r in rows]
+            if key.startswith("max") or key in ("failures", "overruns"):
+                row[key] = max(values)
+            elif isinstance(value, float):
+                row[key] = float(np.median(values))
+            else:
+                row[key] = value
+        timing = [k for k in first if k in ("median_us", "p99_us") or k.startswith("vs_")]
+        row["rounds"] = [{k: r[k] for k in timing} for r in rows]
+        out[label] = row
+    return out
+
+
+def rounds_note(settings: dict[str, Any]) -> str:
+    """How the rounds of a mode were combined (:func:`combine_rounds`), for the tables' notes."""
+    n = settings.get("rounds", 1)
+    if n == 1:
+        return "one round of each mode"
+    return (
+        f"{n} rounds of each mode, from fresh contenders: every time and ratio is the median "
+        "of the rounds' (each ratio taken within its round)"
+    )
 
 
 def add_ratios(rows: dict[str, dict[str, Any]], baseline: str) -> None:
