@@ -338,9 +338,19 @@ def _order(h: tuple[float, ...], d: list[float]) -> float | None:
     return float(np.polyfit(x, y, 1)[0])
 
 
-def bench(
-    steps: int, placo_where: str | None, placo_why: str, repeats: int
-) -> dict[str, Any]:
+def _with_ratios(rows: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
+    """``rows`` of one round with every row's ratios to pink's fastest and to PlaCo."""
+    fastest = fastest_of(rows, "pink ")
+    if fastest is not None:
+        add_ratios(rows, fastest)
+    if PLACO in rows:
+        for row in rows.values():
+            row["vs_placo_median"] = rows[PLACO]["median_us"] / row["median_us"]
+            row["vs_placo_p99"] = rows[PLACO]["p99_us"] / row["p99_us"]
+    return rows
+
+
+def bench(steps: int, placo_where: str | None, placo_why: str, repeats: int) -> dict[str, Any]:
     """Every contender in every mode along one baxter trajectory, ``repeats`` rounds
     (:func:`timing.combine_rounds`), then the checks."""
     robot = rrc_pin.load(ROBOT)
@@ -380,15 +390,7 @@ def bench(
                              f"round {round_ + 1} of {repeats}")  # fmt: skip
                     with quiet_stdout():
                         runs = run_mode(mode, contenders, Q, X, shuffle)
-                    rows = summarise(runs, Q, limits, DT)
-                    fastest = fastest_of(rows, "pink ")
-                    if fastest is not None:
-                        add_ratios(rows, fastest)
-                    if PLACO in rows:
-                        for row in rows.values():
-                            row["vs_placo_median"] = rows[PLACO]["median_us"] / row["median_us"]
-                            row["vs_placo_p99"] = rows[PLACO]["p99_us"] / row["p99_us"]
-                    rounds[mode].append(rows)
+                    rounds[mode].append(_with_ratios(summarise(runs, Q, limits, DT)))
                     if round_:
                         continue  # the answers are the same in every round
                     rrc[mode] = {

@@ -146,7 +146,8 @@ class Resolution(_Record):
         qdot: Joint rates (n,) [rad/s or m/s], finite and within the step's bounds
             (read-only).
         method: How they were obtained (:data:`Method`).
-        backend: Name of the QP backend that ran, or "" (box-free optimum, or a fallback).
+        backend: Name of the QP backend that ran, or "" (box-free optimum, a direction
+            problem solved directly, or a fallback).
         iterations: Backend iterations (0 without a backend).
         attempts: ``(method or level, reason)`` of every method that failed.
         clip: Size (Euclidean norm) of the change made by clipping the answer into the

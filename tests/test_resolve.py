@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import qpsolvers
 
+import solvers.resolve as resolve_module
 from solvers.direction import uniform_scale
 from solvers.errors import InputError, ProblemError
 from solvers.joint_bounds import JointBounds, StepBounds
@@ -186,6 +187,21 @@ def test_fallback_chain_order_attempts_and_never_raise(rng: np.random.Generator)
     np.testing.assert_array_equal(r.qdot, np.clip(0.0, recovering.lb, recovering.ub))
     r = resolve(levels, recovering, Broken("raise"), ResolveOptions())
     assert r.method == "scipy"  # bounded least squares (BVLS)
+
+
+def test_one_null_direction_is_solved_without_the_backend_or_falls_back(
+    rng: np.random.Generator, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Nine rows on ten joints: the exact solve answers (no backend ran), and an answer of it
+    outside the bounds (NaN here) is a failure that the fallback chain takes over."""
+    levels = levels_at(rng, (N - 1,), 50.0)
+    b = bounds_at(rng)
+    r = resolve(levels, b, Broken("raise"), ResolveOptions(damping=None))
+    assert r.method == "qp" and r.backend == "" and not r.attempts and r.status == "scaled"
+    monkeypatch.setattr(resolve_module, "line_scale", lambda *args: (1.0, float("nan")))
+    r = resolve(levels, b, Broken("raise"), ResolveOptions(damping=None))
+    assert r.method == "scipy" and r.attempts[0][0] == "qp" and "exact" in r.attempts[0][1]
+    assert np.all(r.qdot >= b.lb) and np.all(r.qdot <= b.ub)
 
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")
