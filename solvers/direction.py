@@ -39,9 +39,9 @@ Array = npt.NDArray[np.float64]
 
 REGULARIZATION = 1e-4
 r"""Weight :math:`\epsilon` of :math:`\tfrac12 u^2 + \tfrac12\|y\|^2/R^2` in the direction QP
-(R the radius of the bounds). Measured along panda's benchmark trajectory (1,500 QPs): the
-scale is within 1.3e-10 of the exact LP maximum; below 1e-6 DAQP declares up to 12% of these
-(feasible) problems infeasible."""
+(R the radius of the bounds). Measured on panda's benchmark trajectory (1,500 QPs, one null
+direction, before :func:`line_scale` took those): the scale within 1.3e-10 of the exact LP
+maximum; below 1e-6 DAQP declared up to 12% of these (feasible) problems infeasible."""
 
 
 def uniform_scale(x: Array, lb: Array, ub: Array) -> float:
