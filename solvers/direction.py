@@ -101,9 +101,15 @@ def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
             if coefficient > 0.0 and b1 * g2 - b2 * g1 < u * coefficient:
                 u = (b1 * g2 - b2 * g1) / coefficient
     u = max(u, 0.0)
-    y_hi = min([(g - a * u) / b for a, b, g in above], default=math.inf)
-    y_lo = max([(g - a * u) / b for a, b, g in below], default=-math.inf)
-    return u, min(max(0.0, y_lo), y_hi)
+    y_hi, v_hi = min([((g - a * u) / b, b) for a, b, g in above], default=(math.inf, 1.0))
+    y_lo, v_lo = max([((g - a * u) / b, -b) for a, b, g in below], default=(-math.inf, 1.0))
+    if y_lo <= y_hi:
+        return u, min(max(0.0, y_lo), y_hi)
+    # Rounding at a vertex: the y that leaves both rows by the same rate. A row with a tiny
+    # v_i (the SVD leaves 1e-15 where a joint is outside the null space) pins u, and its y
+    # bound, rounding over v_i, is off by up to 0.1: min(y_lo, y_hi) took it and left the
+    # other row 0.02 rad/s outside its bound (rrc_k1607 at q = 0, commands of 1e6).
+    return u, (v_lo * y_lo + v_hi * y_hi) / (v_lo + v_hi)
 
 
 def direction_qp(w: Array, null: Array, lb: Array, ub: Array, key: str) -> tuple[QP, Decoding]:

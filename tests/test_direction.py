@@ -319,6 +319,30 @@ def test_line_scale_is_the_exact_lp_answer_with_the_least_norm_y(
         np.testing.assert_allclose(p["J"] @ qdot, u * (p["J"] @ w), atol=1e-9)
 
 
+def test_line_scale_with_null_components_of_rounding_size() -> None:
+    """At a singularity the SVD leaves components of 1e-15 in the null direction: the answer
+    stays within the bounds (to 1e-12, before the pipeline's clip) and at HiGHS's scale (the
+    pipeline answered 0.02 rad/s outside the bounds at rrc_k1607's q = 0 before)."""
+    rng = np.random.default_rng(3)
+    for _ in range(1000):
+        J = rng.standard_normal((6, 7))
+        v = JacobianSVD(J).null_basis()[0]
+        tiny = rng.random(7) < 0.4
+        v[tiny] *= 10.0 ** rng.uniform(-17.0, -7.0, tiny.sum())
+        v /= np.linalg.norm(v)
+        w = rng.standard_normal(7) * 10.0 ** rng.uniform(-1.0, 7.0)
+        w -= (w @ v) * v
+        lb, ub = -rng.uniform(0.05, 4.0, 7), rng.uniform(0.05, 4.0, 7)
+        lb[rng.random(7) < 0.1] = 0.0
+        u, y = line_scale(w, v, lb, ub)
+        qdot = u * w + y * v
+        assert (qdot >= lb - 1e-12).all() and (qdot <= ub + 1e-12).all()
+        _, decoding = direction_qp(w, v[None, :], lb, ub, "direction")
+        assert decoding.M is not None
+        exact = direction_lp(decoding.M, decoding.M, lb, ub)  # to HiGHS's tolerance (1e-7)
+        assert u == pytest.approx(float(exact @ w) / float(w @ w), rel=1e-6, abs=1e-7)
+
+
 def test_line_scale_edge_cases() -> None:
     lb, ub = -np.ones(3), np.ones(3)
     v = np.array([0.0, 0.6, 0.8])
