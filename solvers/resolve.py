@@ -443,7 +443,7 @@ def _along(
     if rows is None and null.shape[0] == 0:  # no null space: the largest uniform scale
         return _scaled(w, bounds)
     if rows is None and null.shape[0] == 1:  # one null direction: exactly, no QP; against
-        # the QP, panda's benchmark median -25 % and p99 -17 %, rrc_k1607's -13 % / -16 %
+        # the QP, panda's benchmark median -24 % and p99 -17 %, rrc_k1607's -9 % / -16 %
         u, y = line_scale(w, null[0], bounds.lb, bounds.ub)
         return _tolerated(_Solved(*_clipped(u * w + y * null[0], bounds)), bounds, None, "exact")
     d, n = null.shape
