@@ -19,7 +19,8 @@ runs it.
   gripper as the one FrameTask over its 15 joints (head, both arms). The baseline, timed
   interleaved with it at every step, is the physical floor: one Pinocchio Jacobian and one
   small dense solve (no limits; ``J J^T`` for more than 6 joints, ``J`` for 6, the position
-  rows, square, for 3).
+  rows, square, for 3). This pass and the next run :data:`timing.REPEATS` rounds (one with
+  ``--quick``), each from a fresh resolver or controller, combined by their medians.
 
 - **Controller tick against DOF**: ``Controller(arm).step(twist, "world_aligned")`` (the
   teleoperation loop's tick: the same resolver plus the controller's kinematics, drift
@@ -45,7 +46,14 @@ from typing import Any  # noqa: E402
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 from script import arguments, make_parser, measure, pyplot, write  # noqa: E402
-from timing import progress, record_trajectory, statistics  # noqa: E402
+from timing import (  # noqa: E402
+    REPEATS,
+    combine_rounds,
+    progress,
+    record_trajectory,
+    rounds_note,
+    statistics,
+)
 
 import rrc_pin  # noqa: E402
 from rrc_pin.control import Controller  # noqa: E402
@@ -160,42 +168,57 @@ def batch_curve(name: str, sizes: tuple[int, ...], rng: np.random.Generator) -> 
     return {"arm": name, "nq": arm.nq, "task_dim": m, "points": points, "flattens_at": flat}
 
 
-def dof_row(name: str, tool: str | None, steps: int) -> dict[str, Any]:
-    """Resolver step time along one trajectory, interleaved with the floor."""
+def dof_row(name: str, tool: str | None, steps: int, rounds: int) -> dict[str, Any]:
+    """Resolver step time along one trajectory, interleaved with the floor, and the
+    controller's tick: ``rounds`` rounds, combined by their medians (``timing.combine_rounds``)."""
     arm = rrc_pin.load(name, tool_frame=tool) if tool else rrc_pin.load(name)
     rng = np.random.default_rng(SEED)
     Q, X = record_trajectory(arm, steps, rng, DT, SEGMENT)
-    resolver = rrc_pin.Resolver(arm, dt=DT)
     floor = floor_step(arm)
+    row = combine_rounds([{name: resolver_steps(arm, Q, X, floor)} for _ in range(rounds)])[name]
+    progress(
+        f"{name} ({arm.nq} joints): {row['median_us']:.0f} us per step, "
+        f"floor {row['floor_median_us']:.0f} us"
+    )
+    ticks = [{name: controller_ticks(arm, Q, X, floor)} for _ in range(rounds)]
+    return {
+        "arm": name,
+        "tool_frame": arm.tool_frame,
+        "nq": arm.nq,
+        "steps": steps,
+        **row,
+        "controller": combine_rounds(ticks)[name],
+    }
+
+
+def resolver_steps(
+    arm: Any, Q: Array, X: Array, floor: Callable[[Array, Array], Array]
+) -> dict[str, Any]:
+    """A fresh default ``Resolver`` along the trajectory, interleaved with the floor."""
+    resolver = rrc_pin.Resolver(arm, dt=DT)
     resolver.solve(Q[0], X[0])  # untimed first call
     floor(Q[0], X[0])
-    ours, base = np.empty(steps), np.empty(steps)
+    ours, base = np.empty(len(Q)), np.empty(len(Q))
     clock = time.perf_counter
-    for k in range(steps):
+    for k in range(len(Q)):
         t0 = clock()
         resolver.solve(Q[k], X[k])
         ours[k] = clock() - t0
         t0 = clock()
         floor(Q[k], X[k])
         base[k] = clock() - t0
-    p10, p50, p90, p99 = np.percentile(ours * 1e6, [10, 50, 90, 99])
+    return _against_floor(statistics(ours), base)
+
+
+def _against_floor(row: dict[str, float], base: Array) -> dict[str, float]:
+    """``row`` with the floor's median and p99 [us] and the ratios to them."""
     f50, f99 = np.percentile(base * 1e6, [50, 99])
-    progress(f"{name} ({arm.nq} joints): {p50:.0f} us per step, floor {f50:.0f} us")
-    row = {
-        "arm": name,
-        "tool_frame": arm.tool_frame,
-        "nq": arm.nq,
-        "steps": steps,
-        "median_us": float(p50),
-        "p10_us": float(p10),
-        "p90_us": float(p90),
-        "p99_us": float(p99),
-        "floor_median_us": float(f50),
-        "floor_p99_us": float(f99),
-        "vs_floor_median": float(f50 / p50),
-        "vs_floor_p99": float(f99 / p99),
-    }
-    row["controller"] = controller_ticks(arm, Q, X, floor)
+    row.update(
+        floor_median_us=float(f50),
+        floor_p99_us=float(f99),
+        vs_floor_median=float(f50 / row["median_us"]),
+        vs_floor_p99=float(f99 / row["p99_us"]),
+    )
     return row
 
 
@@ -215,16 +238,8 @@ def controller_ticks(
         t0 = clock()
         floor(Q[k], X[k])
         base[k] = clock() - t0
-    row = statistics(ticks)
-    f50, f99 = np.percentile(base * 1e6, [50, 99])
-    row.update(
-        floor_median_us=float(f50),
-        floor_p99_us=float(f99),
-        vs_floor_median=float(f50 / row["median_us"]),
-        vs_floor_p99=float(f99 / row["p99_us"]),
-        ticks_per_s=1e6 / row["median_us"],
-    )
-    progress(f"{arm.name} ({arm.nq} joints): controller tick {row['median_us']:.0f} us")
+    row = _against_floor(statistics(ticks), base)
+    row["ticks_per_s"] = 1e6 / row["median_us"]
     return row
 
 
@@ -233,10 +248,17 @@ def run(quick: bool) -> dict[str, Any]:
     rng = np.random.default_rng(SEED)
     sizes = QUICK_SIZES if quick else SIZES
     steps = 100 if quick else 1000
+    rounds = 1 if quick else REPEATS
     return {
-        "settings": {"sizes": list(sizes), "loop_n": LOOP_N, "steps": steps, "dt": DT},
+        "settings": {
+            "sizes": list(sizes),
+            "loop_n": LOOP_N,
+            "steps": steps,
+            "dt": DT,
+            "rounds": rounds,
+        },
         "batch": [batch_curve(a, sizes, rng) for a in CLOSED_FORM_ARMS],
-        "dof": [dof_row(a, tool, steps) for a, tool in DOF_ARMS],
+        "dof": [dof_row(a, tool, steps, rounds) for a, tool in DOF_ARMS],
     }
 
 
@@ -268,7 +290,7 @@ def docs_section(results: dict[str, Any]) -> str:
         "Resolver step time against DOF: `Resolver(arm).solve` (default: DAQP, "
         f"direction-preserving), {results['settings']['steps']} steps of a seeded random "
         "teleoperation in a tight loop, interleaved with the physical floor (one Pinocchio "
-        "Jacobian and one small dense solve, no limits).",
+        f"Jacobian and one small dense solve, no limits); {rounds_note(results['settings'])}.",
         "",
         "| arm | tool frame | joints | median [us] | p10 | p90 | p99 | floor median [us] | "
         "floor / resolver (median) | (p99) |",
