@@ -70,7 +70,9 @@ from timing import (  # noqa: E402
     PERIOD,
     REPEATS,
     Contender,
+    add_peer_ratios,
     combine_rounds,
+    fastest_of,
     mode_table,
     progress,
     quiet_stdout,
@@ -213,24 +215,6 @@ def tracking_errors(arm: Any, Q: Array, X: Array, rates: Array) -> dict[str, flo
         "tracking_p99": float(p99),
         "tracking_max": float(rel.max()),
     }
-
-
-def add_peer_ratios(rows: dict[str, dict[str, Any]], prefix: str, key: str) -> None:
-    """Ratios to the fastest row (by median) whose label starts with ``prefix``, stored as
-    ``vs_<key>_median`` and ``vs_<key>_p99`` (the peer's time over the row's)."""
-    fastest = fastest_of(rows, prefix)
-    if fastest is None:
-        return
-    base = rows[fastest]
-    for row in rows.values():
-        row[f"vs_{key}_median"] = base["median_us"] / row["median_us"]
-        row[f"vs_{key}_p99"] = base["p99_us"] / row["p99_us"]
-
-
-def fastest_of(rows: dict[str, dict[str, Any]], prefix: str) -> str | None:
-    """The row whose label starts with ``prefix`` with the lowest median, or None."""
-    peers = [k for k in rows if k.startswith(prefix)]
-    return min(peers, key=lambda k: rows[k]["median_us"]) if peers else None
 
 
 def rrc_statistics(resolutions: list[Any]) -> dict[str, Any]:

@@ -62,7 +62,7 @@ from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
-from bench_resolver import BACKEND_MODULES, fastest_of, rrc_statistics  # noqa: E402
+from bench_resolver import BACKEND_MODULES, rrc_statistics  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
 from placo_peer import PlacoPeer, Worker, placo_checks, placo_python, placo_urdf  # noqa: E402
 from render_tasks import MODES, PLACO, STRICT, WEIGHTED, plot, readme_table  # noqa: E402
@@ -73,8 +73,9 @@ from timing import (  # noqa: E402
     MODE_TITLES,
     REPEATS,
     Contender,
-    add_ratios,
+    add_peer_ratios,
     combine_rounds,
+    fastest_of,
     one_core,
     progress,
     quiet_stdout,
@@ -340,13 +341,8 @@ def _order(h: tuple[float, ...], d: list[float]) -> float | None:
 
 def _with_ratios(rows: dict[str, dict[str, Any]]) -> dict[str, dict[str, Any]]:
     """``rows`` of one round with every row's ratios to pink's fastest and to PlaCo."""
-    fastest = fastest_of(rows, "pink ")
-    if fastest is not None:
-        add_ratios(rows, fastest)
-    if PLACO in rows:
-        for row in rows.values():
-            row["vs_placo_median"] = rows[PLACO]["median_us"] / row["median_us"]
-            row["vs_placo_p99"] = rows[PLACO]["p99_us"] / row["p99_us"]
+    add_peer_ratios(rows, "pink ")
+    add_peer_ratios(rows, PLACO, "placo")
     return rows
 
 

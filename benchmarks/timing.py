@@ -305,13 +305,26 @@ def rounds_note(settings: dict[str, Any]) -> str:
     )
 
 
-def add_ratios(rows: dict[str, dict[str, Any]], baseline: str) -> None:
-    """Add each row's ratio to the baseline row, in place: ``vs_baseline_median`` is the
+def add_ratios(rows: dict[str, dict[str, Any]], baseline: str, key: str = "baseline") -> None:
+    """Add each row's ratio to the baseline row, in place: ``vs_<key>_median`` is the
     baseline's median over the row's (above 1: faster than the baseline), the same for p99."""
     base = rows[baseline]
     for row in rows.values():
-        row["vs_baseline_median"] = base["median_us"] / row["median_us"]
-        row["vs_baseline_p99"] = base["p99_us"] / row["p99_us"]
+        row[f"vs_{key}_median"] = base["median_us"] / row["median_us"]
+        row[f"vs_{key}_p99"] = base["p99_us"] / row["p99_us"]
+
+
+def fastest_of(rows: dict[str, dict[str, Any]], prefix: str) -> str | None:
+    """The row whose label starts with ``prefix`` with the lowest median, or None."""
+    peers = [k for k in rows if k.startswith(prefix)]
+    return min(peers, key=lambda k: rows[k]["median_us"]) if peers else None
+
+
+def add_peer_ratios(rows: dict[str, dict[str, Any]], prefix: str, key: str = "baseline") -> None:
+    """:func:`add_ratios` to the fastest row whose label starts with ``prefix`` (if any)."""
+    fastest = fastest_of(rows, prefix)
+    if fastest is not None:
+        add_ratios(rows, fastest, key)
 
 
 @contextlib.contextmanager

@@ -83,18 +83,18 @@ def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
         u in [0, 1] and y; the rates are ``u w + y v``.
     """
     above, below = [], []  # half-planes (alpha, beta, gamma) bounding y from above / below
-    u = 1.0
-    for wi, vi, lo, hi in zip(w.tolist(), v.tolist(), lb.tolist(), ub.tolist(), strict=True):
+    without_y = []  # rows that bound u alone: the uniform scale of their rates
+    rows = zip(w.tolist(), v.tolist(), lb.tolist(), ub.tolist(), strict=True)
+    for i, (wi, vi, lo, hi) in enumerate(rows):
         if vi > 0.0:
             above.append((wi, vi, hi))
             below.append((-wi, -vi, -lo))
         elif vi < 0.0:
             above.append((-wi, -vi, -lo))
             below.append((wi, vi, hi))
-        elif wi > 0.0 and hi < u * wi:  # a row without y: a bound on u alone
-            u = hi / wi
-        elif wi < 0.0 and lo > u * wi:
-            u = lo / wi
+        else:
+            without_y.append(i)
+    u = uniform_scale(w[without_y], lb[without_y], ub[without_y]) if without_y else 1.0
     for a1, b1, g1 in above:
         for a2, b2, g2 in below:  # -b2 * (plane 1) + b1 * (plane 2): y eliminated
             coefficient = b1 * a2 - b2 * a1
