@@ -26,7 +26,10 @@ the whole call, as its users make it:
   ``VelocityLimit``, every qpsolvers backend; absent when mink is not installed;
 - Pinocchio + numpy, the unconstrained step and physical floor (no limits):
   ``computeFrameJacobian`` then ``numpy.linalg.solve`` on ``J J^T``, ``lstsq``, or damped
-  least squares.
+  least squares;
+- the floor within the limits (:data:`LIMITS_FLOOR`): the least a direction-preserving step
+  in the limits does in Python, rrc-pin's default without its damping, checks, fallbacks
+  and report (:func:`limits_floor`), what pure Python can reach on this problem.
 
 Each contender is timed in the three modes of :mod:`timing` (tight loop, 1 kHz loop with
 ``time.sleep`` to the next tick, interleaved with its peers in an order shuffled at each
@@ -62,6 +65,7 @@ import mink_peer  # noqa: E402
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
+from scipy.linalg.lapack import dgesvd  # noqa: E402
 from script import make_parser, write  # noqa: E402
 from stage_profile import profile_steps, profile_table  # noqa: E402
 from timing import (  # noqa: E402
@@ -87,6 +91,7 @@ from timing import (  # noqa: E402
 import rrc_pin  # noqa: E402
 from rrc_pin.control.drift import advance  # noqa: E402
 from rrc_pin.robot import frame_id  # noqa: E402
+from solvers.direction import line_scale, uniform_scale  # noqa: E402
 from solvers.qp_backends import installed_backends  # noqa: E402
 
 ARMS = ("rrc_k1607", "panda")
@@ -101,6 +106,8 @@ FLOOR_DAMPING = 0.01
 """Damping ``lambda`` of the Pinocchio + numpy DLS row (``J^T (J J^T + lambda^2 I)^-1 x``)."""
 FLOOR = "Pinocchio + numpy solve (J J^T)"
 """The physical floor: one Pinocchio Jacobian and one small dense solve, no limits."""
+LIMITS_FLOOR = "Pinocchio + SVD + exact scale in the limits"
+"""The floor within the limits (:func:`limits_floor`)."""
 """Modules of the QP backends, for the versions recorded."""
 
 Array = np.ndarray
@@ -200,7 +207,37 @@ def floor_contenders(arm: Any) -> list[Contender]:
         Contender(FLOOR, solve),
         Contender("Pinocchio + numpy lstsq", lstsq),
         Contender(f"Pinocchio + numpy DLS (lambda {FLOOR_DAMPING:g})", dls),
+        limits_floor(arm),
     ]
+
+
+def limits_floor(arm: Any) -> Contender:
+    """The least work of a direction-preserving step within the limits, in Python: the
+    Jacobian, rrc-pin's step bounds (``JointLimits().bounds(arm).step``), the SVD's exact
+    rates, and where they leave the bounds the largest scale along them, exactly, with one
+    null direction (:func:`solvers.direction.line_scale`) or none (the uniform scale).
+    rrc-pin's default answers the same wherever it does not damp; what it does beyond this
+    (input checks, the damping near singularities, the fallbacks, the Resolution) is its
+    gap to this floor."""
+    model = arm.model
+    fid = frame_id(model, arm.tool_frame)
+    lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    data = model.createData()
+    bounds = rrc_pin.JointLimits().bounds(arm)
+
+    def step(q: Array, x: Array) -> Array:
+        J = pin.computeFrameJacobian(model, data, q, fid, lwa)
+        b = bounds.step(q, DT)
+        U, s, Vt, _ = dgesvd(J, full_matrices=1)
+        w = (x @ U / s) @ Vt[:6]
+        if ((b.lb <= w) & (w <= b.ub)).all():
+            return w
+        if Vt.shape[0] == 7:
+            u, y = line_scale(w, Vt[6], b.lb, b.ub)
+            return np.minimum(np.maximum(u * w + y * Vt[6], b.lb), b.ub)
+        return uniform_scale(w, b.lb, b.ub) * w
+
+    return Contender(LIMITS_FLOOR, step)
 
 
 def tracking_errors(arm: Any, Q: Array, X: Array, rates: Array) -> dict[str, float]:
@@ -378,8 +415,7 @@ def readme_table(results: dict[str, Any]) -> str:
     lines = [head, rule]
     for arm in results["arms"]:
         modes = arm["modes"]
-        labels = [DEFAULT, TRACKING]
-        for label in [*labels, "pink fastest"]:
+        for label in [DEFAULT, TRACKING, "pink fastest", LIMITS_FLOOR]:
             cells = f"| {arm['arm']} | {label} |"
             if label == "pink fastest":
                 names = [modes[m]["pink_fastest"] or "-" for m in MODES]

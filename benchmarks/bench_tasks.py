@@ -62,10 +62,11 @@ from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
+import pinocchio as pin  # noqa: E402
 from bench_resolver import BACKEND_MODULES, rrc_statistics  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
 from placo_peer import PlacoPeer, Worker, placo_checks, placo_python, placo_urdf  # noqa: E402
-from render_tasks import MODES, PLACO, STRICT, WEIGHTED, plot, readme_table  # noqa: E402
+from render_tasks import FLOOR, MODES, PLACO, STRICT, WEIGHTED, plot, readme_table  # noqa: E402
 from render_tasks import docs_section as docs_section  # noqa: E402 (update_readme.py)
 from script import make_parser, write  # noqa: E402
 from stage_profile import profile_steps  # noqa: E402
@@ -140,8 +141,43 @@ def _frame(frame: str, twist: Array) -> FrameTask:
 
 
 def rrc_contenders(robot: Any) -> list[Contender]:
-    """rrc-pin weighted and strict, fresh, keeping their Resolutions."""
-    return [rrc_contender(robot, WEIGHTED)[0], rrc_contender(robot, STRICT)[0]]
+    """rrc-pin weighted and strict, fresh, keeping their Resolutions, and the weighted floor."""
+    return [rrc_contender(robot, WEIGHTED)[0], rrc_contender(robot, STRICT)[0], floor(robot)]
+
+
+def floor(robot: Any) -> Contender:
+    """The least work of the weighted problem in Python: one Pinocchio pass, the two frame
+    Jacobians and the posture rows stacked with the square roots of their weights, rrc-pin's
+    step bounds, the normal equations' optimum, and DAQP on the same costs where it leaves the
+    bounds. rrc-pin weighted solves the same problem (with a 1e-6 least-norm term in its QP);
+    what it does beyond this (the tasks' objects and checks, the fallbacks, the Resolution)
+    is its gap to this floor."""
+    import daqp
+
+    model, data = robot.model, robot.model.createData()
+    frames = [model.getFrameId(f) for f in robot.tool_frames]
+    lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+    bounds = rrc_pin.JointLimits().bounds(robot)
+    n, target = robot.nq, robot.neutral()
+    A = np.zeros((12 + n, n))
+    A[12:] = np.eye(n) * POSTURE_COST
+    sense = np.zeros(n, dtype=np.intc)
+
+    def step(q: Array, x: Array) -> Array:
+        q, q_pin = robot.configuration(q)
+        pin.computeJointJacobians(model, data, q_pin)
+        pin.updateFramePlacements(model, data)
+        for k, frame in enumerate(frames):
+            A[6 * k : 6 * k + 6] = pin.getFrameJacobian(model, data, frame, lwa)
+        b = np.concatenate([x, POSTURE_COST * POSTURE_GAIN * (target - q)])
+        P, c = A.T @ A, b @ A
+        w = np.linalg.solve(P, c)
+        s = bounds.step(q, DT)
+        if ((s.lb <= w) & (w <= s.ub)).all():
+            return w
+        return daqp.solve(P, -c, np.zeros((0, n)), s.ub, s.lb, sense)[0]
+
+    return Contender(FLOOR, step)
 
 
 def rrc_contender(robot: Any, label: str) -> tuple[Contender, Any]:
@@ -277,7 +313,7 @@ def equivalence(
         with np.errstate(invalid="ignore"):  # NaN rates: a failed step, never "inside"
             both = free & (limit_slack(Q, theirs, robot) > FREE)
         out["peers"][label] = {"steps": int(both.sum()), **_differences(theirs, ours, both)}
-        out["peers"][label]["same_problem"] = label == PLACO
+        out["peers"][label]["same_problem"] = label in (PLACO, FLOOR)
         if label == PLACO and regularization and both.any():
             damped = _with_damping(robot, Q, X, both, regularization)
             out["peers"][label]["with_damping_task"] = {

@@ -16,6 +16,7 @@ from timing import MODE_TITLES, mode_table, rounds_note, timing_chart, us
 MODES = ("tight", "interleaved")
 """The modes the tasks benchmark times (:mod:`timing`)."""
 WEIGHTED, STRICT, PLACO = "rrc-pin weighted", "rrc-pin strict", "PlaCo"
+FLOOR = "Pinocchio + numpy + DAQP (weighted floor)"
 """Labels of the contenders the tables name."""
 
 
@@ -32,7 +33,7 @@ def readme_table(results: dict[str, Any]) -> str:
     )
     lines = [head, "| --- |" + " ---: | ---: | ---: |" * len(MODES)]
     fastest = [modes[m]["pink_fastest"] for m in MODES]
-    for label in (WEIGHTED, STRICT, "pink fastest", PLACO):
+    for label in (WEIGHTED, STRICT, "pink fastest", PLACO, FLOOR):
         name = label
         if label == "pink fastest":
             name = f"pink fastest ({', '.join((f or '-').removeprefix('pink ') for f in fastest)})"
@@ -47,7 +48,7 @@ def readme_table(results: dict[str, Any]) -> str:
             if row is None:
                 cells += " - | - | - |"
                 continue
-            ours = label.startswith("rrc-pin")
+            ours = label in (WEIGHTED, STRICT, FLOOR)
             vs_pink = (
                 f"{_x(row.get('vs_baseline_median'))} / {_x(row.get('vs_baseline_p99'))}"
                 if ours and "vs_baseline_median" in row
