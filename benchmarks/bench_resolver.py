@@ -240,6 +240,17 @@ def limits_floor(arm: Any) -> Contender:
     return Contender(LIMITS_FLOOR, step)
 
 
+def floor_agreement(default: Any, floor: Any) -> dict[str, Any]:
+    """The largest difference [rad/s] between rrc-pin's default and the floor in the limits
+    over the steps the default did not damp (there they solve the same problem)."""
+    undamped = np.array([r.status != "damped" for r in default.kept])
+    diff = np.abs(default.rates - floor.rates)[undamped]
+    return {
+        "steps": int(undamped.sum()),
+        "max_difference": float(diff.max()) if diff.size else None,
+    }
+
+
 def tracking_errors(arm: Any, Q: Array, X: Array, rates: Array) -> dict[str, float]:
     """Relative twist error ``|J(q_k) qdot_k - x_k| / |x_k|`` (rows [v; w], m/s and rad/s
     summed as one vector) along the trajectory: median, p99 and largest."""
@@ -312,6 +323,7 @@ def bench_arm(name: str, steps: int, repeats: int) -> dict[str, Any]:
                 rrc[mode] = {
                     c.label: rrc_statistics(runs[c.label].kept) for c in contenders if c.keep
                 }
+                agreement = floor_agreement(runs[DEFAULT], runs[LIMITS_FLOOR])
     for mode in MODES:
         rows = combine_rounds(rounds[mode])
         modes[mode] = {
@@ -333,6 +345,7 @@ def bench_arm(name: str, steps: int, repeats: int) -> dict[str, Any]:
             "active_fraction": recorded.get("active_fraction"),
         },
         "mink_kinematics_gap": gap,
+        "floor_agreement": agreement,
         "modes": modes,
         "rrc_pin": rrc,
         "profile": profile,
@@ -457,8 +470,12 @@ def _setup_line(results: dict[str, Any]) -> str:
         f"{s['steps']} steps of a seeded random teleoperation ({arms}), dt = {1000 * s['dt']:g} "
         "ms. rrc-pin default: `Resolver(arm)` (DAQP, direction-preserving); tracking: "
         "`direction_preserving=False`; pink: `solve_ik` with the same frame task and limits, "
-        "its fastest qpsolvers backend in each mode. Ratios: pink's time over rrc-pin's (above "
-        f"1: rrc-pin faster), median / p99; {rounds_note(s)}. Measured on "
+        "its fastest qpsolvers backend in each mode. The floor in the limits: Pinocchio's "
+        "Jacobian, rrc-pin's step bounds, the SVD's exact rates and, where they leave the "
+        "bounds, their largest scale with the null direction, exactly; no damping, checks, "
+        f"fallbacks or report: what plain Python reaches on this problem{_agreement(results)}. "
+        "Ratios: pink's time over rrc-pin's or the floor's (above 1: faster), median / p99; "
+        f"{rounds_note(s)}. Measured on "
         f"{m['cpu']} ({m['cores']} cores), Python {m['python']}, Pinocchio {m['pinocchio']}, "
         f"pink {m.get('pink')}"
     )
@@ -467,6 +484,17 @@ def _setup_line(results: dict[str, Any]) -> str:
             f", load average {load['start'][0]:.2f} at the start, {load['end'][0]:.2f} at the end"
         )
     return text + "."
+
+
+def _agreement(results: dict[str, Any]) -> str:
+    """Where the default and the floor agree (recorded since the floor's first record)."""
+    parts = [
+        f"{a['arm']} {a['floor_agreement']['max_difference']:.0e} rad/s over "
+        f"{a['floor_agreement']['steps']} steps"
+        for a in results["arms"]
+        if (a.get("floor_agreement") or {}).get("max_difference") is not None
+    ]
+    return f" (rrc-pin's default where it does not damp: {', '.join(parts)})" if parts else ""
 
 
 def docs_section(results: dict[str, Any]) -> str:

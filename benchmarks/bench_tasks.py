@@ -29,7 +29,9 @@ configuration, as its users call it, the whole call timed:
   ``twist * dt``, the PostureTask (gain ``k dt``) toward neutral, ``solve_ik`` with every
   qpsolvers backend pink accepts; failures (pink raises) count, rates taken as zero;
 - PlaCo (:mod:`placo_peer`: its own Pinocchio, in its own interpreter when it cannot share
-  ours): two frame tasks with the targets moved by ``twist * dt`` and a joints task.
+  ours): two frame tasks with the targets moved by ``twist * dt`` and a joints task;
+- the weighted floor (:func:`floor`): rrc-pin weighted's problem with nothing but the
+  numerics, what plain Python reaches on it.
 
 Modes (:mod:`timing`): the tight loop and the interleaved one (every contender at every
 step, shuffled). When PlaCo runs as a worker process, its call is timed by the worker's

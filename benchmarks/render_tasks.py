@@ -74,8 +74,11 @@ def _setup_line(results: dict[str, Any]) -> str:
         f"baxter ({results['nq']} joints), both grippers commanded and a posture task, "
         f"{t['steps']} steps (a bound active at {100 * t['active_fraction']:.0f}% of them), "
         f"dt = {1000 * s['dt']:g} ms; pink's costs (frame 1, posture {s['posture_cost']:g}), "
-        "rrc-pin's and PlaCo's weights their squares. Ratios: the peer's time over rrc-pin's "
-        f"(above 1: rrc-pin faster), median / p99; {rounds_note(s)}."
+        "rrc-pin's and PlaCo's weights their squares. The weighted floor: the same costs with "
+        "one Pinocchio pass, the rows stacked into one array, the normal equations and DAQP "
+        "where they leave the bounds, and nothing else (no task objects, checks, fallbacks or "
+        "report): what plain Python reaches on this problem. Ratios: the peer's time over "
+        f"rrc-pin's or the floor's (above 1: faster), median / p99; {rounds_note(s)}."
     )
     if placo and placo["max_difference"] is not None:
         text += (
@@ -180,7 +183,7 @@ def _equivalence_lines(eq: dict[str, Any]) -> list[str]:
     ]
     for label, p in eq["peers"].items():
         same = (
-            "yes, but for PlaCo's regularisation"
+            ("yes, but for PlaCo's regularisation" if label == PLACO else "yes")
             if p["same_problem"]
             else ("no: a pose target (log6 error, Jlog6 rows), the same to first order in dt")
         )

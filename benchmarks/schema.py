@@ -24,6 +24,8 @@ MACHINE = ("cpu", "cores", "python", "numpy", "pinocchio")
 STATS = ("median_us", "p10_us", "p90_us", "p99_us")
 MINK_TOL = 1e-9
 """Largest MuJoCo-Pinocchio difference accepted beside mink's rows (mink_peer.KINEMATICS_TOL)."""
+FLOOR_TOL = 1e-9
+"""[rad/s] Largest difference accepted between rrc-pin and a floor row solving its problem."""
 
 
 def problems(results: dict[str, Any]) -> list[str]:
@@ -100,6 +102,9 @@ def _resolver(results: dict[str, Any]) -> Iterator[str]:
         gap = arm.get("mink_kinematics_gap")
         if minks and not (gap and max(gap.values()) <= MINK_TOL):
             yield f"arms.{arm.get('arm')}.mink_kinematics_gap: missing or above {MINK_TOL}"
+        agreement = arm.get("floor_agreement")
+        if agreement and not _within(agreement.get("max_difference"), FLOOR_TOL):
+            yield f"arms.{arm.get('arm')}.floor_agreement: above {FLOOR_TOL} rad/s"
 
 
 def _tasks(results: dict[str, Any]) -> Iterator[str]:
@@ -108,6 +113,15 @@ def _tasks(results: dict[str, Any]) -> Iterator[str]:
         yield "modes: empty"
     for mode, m in modes.items():
         yield from _rows(f"modes.{mode}", m)
+    peers = (results.get("equivalence") or {}).get("peers") or {}
+    for label, peer in peers.items():  # PlaCo's regularisation makes its problem another
+        if peer.get("same_problem") and label != "PlaCo":
+            if not _within(peer.get("max_difference"), FLOOR_TOL):
+                yield f"equivalence.peers.{label}: above {FLOOR_TOL} rad/s"
+
+
+def _within(value: Any, tol: float) -> bool:
+    return value is None or (_finite(value) and value <= tol)
 
 
 def _study(results: dict[str, Any]) -> Iterator[str]:

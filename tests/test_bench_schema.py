@@ -63,6 +63,25 @@ def test_schema_names_what_is_missing():
     assert schema.problems({"benchmark": "nope"})[0].startswith("benchmark:")
 
 
+def test_schema_refuses_a_floor_that_solves_another_problem():
+    """The floor rows stand for rrc-pin's own problem: the default against the floor in the
+    limits (resolver), a peer that solves the same problem (tasks), above 1e-9 rad/s."""
+    resolver = json.loads((ROOT / "benchmarks" / "results" / "resolver.json").read_text())
+    resolver["arms"][0]["floor_agreement"] = {"steps": 1000, "max_difference": 1e-12}
+    assert schema.problems(resolver) == []
+    resolver["arms"][0]["floor_agreement"]["max_difference"] = 1e-3
+    assert any("floor_agreement" in p for p in schema.problems(resolver))
+    tasks = json.loads((ROOT / "benchmarks" / "results" / "tasks.json").read_text())
+    peers = tasks["equivalence"]["peers"]
+    floor = next(k for k, p in peers.items() if p["same_problem"] and k != "PlaCo")
+    assert schema.problems(tasks) == []
+    peers[floor]["max_difference"] = float("nan")
+    assert any(floor in p for p in schema.problems(tasks))
+    peers["PlaCo"]["max_difference"] = 1e-6  # its regularisation: not rrc-pin's problem
+    peers[floor]["max_difference"] = 1e-14
+    assert schema.problems(tasks) == []
+
+
 def test_quick_study_through_the_cli_writes_json_that_follows_the_schema(tmp_path, monkeypatch):
     import rrc_pin.cli as cli
 
