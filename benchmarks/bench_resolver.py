@@ -102,13 +102,13 @@ STEPS, QUICK_STEPS = 2000, 100
 DEFAULT = "rrc-pin default (daqp, direction)"
 TRACKING = "rrc-pin tracking (daqp)"
 BACKEND_MODULES = ("daqp", "osqp", "proxsuite", "quadprog", "clarabel")
+"""Modules of the QP backends, for the versions recorded."""
 FLOOR_DAMPING = 0.01
 """Damping ``lambda`` of the Pinocchio + numpy DLS row (``J^T (J J^T + lambda^2 I)^-1 x``)."""
 FLOOR = "Pinocchio + numpy solve (J J^T)"
 """The physical floor: one Pinocchio Jacobian and one small dense solve, no limits."""
 LIMITS_FLOOR = "Pinocchio + SVD + exact scale in the limits"
 """The floor within the limits (:func:`limits_floor`)."""
-"""Modules of the QP backends, for the versions recorded."""
 
 Array = np.ndarray
 
@@ -229,12 +229,13 @@ def limits_floor(arm: Any) -> Contender:
         J = pin.computeFrameJacobian(model, data, q, fid, lwa)
         b = bounds.step(q, DT)
         U, s, Vt, _ = dgesvd(J, full_matrices=1)
-        w = (x @ U / s) @ Vt[:6]
+        m = s.size  # six rows: the rest of Vt spans the null space
+        w = (x @ U / s) @ Vt[:m]
         if ((b.lb <= w) & (w <= b.ub)).all():
             return w
-        if Vt.shape[0] == 7:
-            u, y = line_scale(w, Vt[6], b.lb, b.ub)
-            return np.minimum(np.maximum(u * w + y * Vt[6], b.lb), b.ub)
+        if Vt.shape[0] == m + 1:
+            u, y = line_scale(w, Vt[m], b.lb, b.ub)
+            return np.minimum(np.maximum(u * w + y * Vt[m], b.lb), b.ub)
         return uniform_scale(w, b.lb, b.ub) * w
 
     return Contender(LIMITS_FLOOR, step)
@@ -487,7 +488,7 @@ def _setup_line(results: dict[str, Any]) -> str:
 
 
 def _agreement(results: dict[str, Any]) -> str:
-    """Where the default and the floor agree (recorded since the floor's first record)."""
+    """The recorded agreement of the default and the floor, for the setup line ("" if none)."""
     parts = [
         f"{a['arm']} {a['floor_agreement']['max_difference']:.0e} rad/s over "
         f"{a['floor_agreement']['steps']} steps"
