@@ -19,15 +19,18 @@ from rrc_pin.errors import (
     UnknownBackend,
     URDFError,
 )
-from rrc_pin.limits import JointLimits
+from rrc_pin.limits import JointLimits, Limit
 from rrc_pin.loading import arms, load
 from rrc_pin.resolver import Damping, QPOptions, Resolver
 from rrc_pin.robot import Robot
 from rrc_pin.tasks import DampingTask, FrameTask, JointTask, PostureTask, RelativeFrameTask, Task
-from solvers.resolution import ActiveLimit, Resolution, TaskReport
+from solvers.problem import Constraints
+from solvers.resolution import ActiveLimit, ActiveRow, Resolution, TaskReport
 
 __all__ = [
     "ActiveLimit",
+    "ActiveRow",
+    "Constraints",
     "Controller",
     "Damping",
     "DampingTask",
@@ -38,6 +41,7 @@ __all__ = [
     "InvalidInput",
     "JointLimits",
     "JointTask",
+    "Limit",
     "PostureTask",
     "QPOptions",
     "RelativeFrameTask",

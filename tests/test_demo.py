@@ -58,7 +58,11 @@ def test_the_table_holds_the_numbers_of_the_trajectories(quick_demo):
         assert float(margin) >= 0.02 - 1e-9 and float(rate) <= 1.0 + 1e-9
         assert statuses.split()[0] in ("exact", "scaled")
     barker = {r[1]: r[7] for r in rows[1:] if r[0] == "barker6"}
-    assert len(barker) == 7 and all("shoulder (eq. 32)" in met for met in barker.values())
+    # the resolver's own handling scales a command along itself below the damping threshold
+    # (condition number 100), so it slows down toward the shoulder singularity and reaches it
+    # only past the quick script's time; the strategies that act on it meet it
+    assert len(barker) == 7
+    assert all("shoulder (eq. 32)" in met for name, met in barker.items() if name != "resolver")
     # the slowdown keeps the hand from the wrist singularity in the quick script's time
     assert all("wrist (S5 = 0)" in met for name, met in barker.items() if name != "slowdown")
 

@@ -16,7 +16,7 @@ def log() -> TrajectoryLog:
     for _ in range(30):
         ctl.step([0.02, 0.0, -0.01, 0.0, -0.4, 0.1])
     for _ in range(10):
-        ctl.step([5.0, 0.0, 0.0, 0.0, 0.0, 0.0], frame="world_aligned")  # beyond the limits
+        ctl.step([5.0, 0.0, 0.0, 0.0, 0.0, 0.0], ref="world_aligned")  # beyond the limits
     ctl.reverse(0.2)
     return ctl.log
 
