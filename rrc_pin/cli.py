@@ -65,7 +65,8 @@ def parser() -> argparse.ArgumentParser:
         type=Path,
         default=None,
         metavar="DIR",
-        help="folder for the outputs (default: a new ./rrc-pin-demo-<timestamp>)",
+        help="folder for the outputs (default: a new rrc-pin-demo-<timestamp>-* folder in the "
+        "system's temporary directory, printed)",
     )
     demo.add_argument("--quick", action="store_true", help="shorter scripts (a smoke test)")
     check = sub.add_parser("check", help="cross-check every catalogue arm: DH, Pinocchio, yourdfpy")
