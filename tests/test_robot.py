@@ -416,3 +416,35 @@ def test_arrays_and_booleans_where_names_and_numbers_go_are_refused():
         arm.jacobian(q, ref=np.array(["local"]))
     with pytest.raises(InvalidInput, match="^q: expected a real numeric array"):
         arm.fk([0.0, True, 0.0, -1.5, 0.0, 1.5, 0.0])
+
+
+BAD = [None, object(), "x", np.array(["a", "b"]), [True, 0.0], 3 + 1j, {"a": 1}, float("nan"),
+       np.zeros((2, 2)), [[0.0] * 7], np.full(7, np.inf), [0.0, True, 0, 0, 0, 0, 0]]  # fmt: skip
+
+
+def test_bad_input_of_every_robot_method_raises_only_the_package_errors():
+    """Issue 28 item 8: every bad-input class, at every Robot call site, raises an RrcPinError
+    naming the argument, and changes nothing."""
+    arm = rrc_pin.load("panda")
+    q = arm.ready()
+    calls = {
+        "q": [lambda v: arm.fk(v), lambda v: arm.jacobian(v), lambda v: arm.check_q(v),
+              lambda v: arm.to_pinocchio(v), lambda v: arm.frame_pose(v, "panda_hand_tcp")],
+        "frame": [lambda v: arm.fk(q, v), lambda v: arm.jacobian(q, frame=v),
+                  lambda v: arm.frame_pose(q, v)],
+        "ref": [lambda v: arm.jacobian(q, ref=v)],
+        "rng": [lambda v: arm.random_q(v)],
+    }  # fmt: skip
+    before = (arm.ready(), arm.fk(q), arm.lower.copy(), dict(arm.poses))
+    for argument, sites in calls.items():
+        for site in sites:
+            for value in BAD:
+                if value is None and argument in ("frame", "rng"):
+                    continue  # None: the tool frame, fresh entropy
+                with pytest.raises(rrc_pin.RrcPinError) as info:
+                    site(value)
+                assert getattr(info.value, "argument", argument) == argument, (argument, value)
+    np.testing.assert_array_equal(before[0], arm.ready())
+    np.testing.assert_array_equal(before[1], arm.fk(q))
+    np.testing.assert_array_equal(before[2], arm.lower)
+    assert before[3].keys() == arm.poses.keys()
