@@ -52,9 +52,16 @@ try:
 except ImportError:
     print("matplotlib not installed: no figure (pip install -e '.[plot]')")
 else:
-    fig, ax = plt.subplots(figsize=(7, 3))
-    ax.plot(log.column("t"), log.column("qdot") / ctl.robot.velocity_limit, lw=1)
-    ax.set(xlabel="t [s]", ylabel="qdot / velocity limit", title="panda: teleoperation, reverse")
+    t = log.column("t")
+    fig, ax = plt.subplots(figsize=(8, 3.2))
+    ax.plot(t, log.column("qdot") / ctl.robot.velocity_limit, lw=1, label=ctl.robot.joint_names)
+    reverse = t[list(log.column("mode")).index("reverse")]
+    ax.axvline(reverse, color="grey", ls=":", lw=1)
+    ax.annotate("reverse", (reverse, 1.0), xycoords=("data", "axes fraction"), xytext=(3, -12),
+                textcoords="offset points", fontsize=8, color="grey")  # fmt: skip
+    ax.set(xlabel="t [s]", ylabel="qdot / velocity limit",
+           title="panda: commands, let go (deadman), then reverse")  # fmt: skip
+    ax.legend(fontsize=6, loc="center left", bbox_to_anchor=(1.0, 0.5))
     fig.tight_layout()
     fig.savefig(out / "rates.png", dpi=100)
     print(f"figure written to {out / 'rates.png'}")
