@@ -66,7 +66,7 @@ import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
 from scipy.linalg.lapack import dgesvd  # noqa: E402
-from script import make_parser, write  # noqa: E402
+from script import QUICK_NOTE, is_quick, make_parser, write  # noqa: E402
 from stage_profile import profile_steps, profile_table  # noqa: E402
 from timing import (  # noqa: E402
     MODE_TITLES,
@@ -651,7 +651,8 @@ def plot(results: dict[str, Any], path: Path) -> bool:
          f"{arm['arm']}: one resolved-rate step")
         for arm in arms
     ]  # fmt: skip
-    return timing_chart(panels, path, (7.5 * len(arms), 6))
+    note = QUICK_NOTE if is_quick(results) else None
+    return timing_chart(panels, path, (7.5 * len(arms), 6), note=note)
 
 
 if __name__ == "__main__":

@@ -276,3 +276,12 @@ def test_records_name_the_singularity_met(barker):
         ctl.step([0.0, 0.0, 0.0, 0.0, -0.5, 0.0])  # theta5 towards and through 0
     labels = set(ctl.log.column("singularity"))
     assert "wrist (S5 = 0)" in labels
+
+
+def test_the_default_start_is_the_ready_pose():
+    """Issue 33 item 2: Controller(panda) started on joint 4's limit, with a recovering tick."""
+    ctl = Controller(rrc_pin.load("panda"))
+    np.testing.assert_array_equal(ctl.q, ctl.robot.ready())
+    for _ in range(3):
+        _, r = ctl.step([0.02, 0.0, 0.0, 0.0, 0.0, 0.0], frame="world_aligned")
+        assert r.status == "exact"

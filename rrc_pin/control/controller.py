@@ -114,7 +114,7 @@ class Controller:
         robot: A :class:`rrc_pin.Robot` with one tool frame, or a name :func:`rrc_pin.load`
             takes.
         dt: Control period [s], > 0.
-        q0: Initial joint positions (nq,) [rad or m]; default ``robot.neutral()``.
+        q0: Initial joint positions (nq,) [rad or m]; default ``robot.ready()``.
         strategy: A singularity strategy: a :class:`Strategy` or its name
             (:data:`~rrc_pin.control.strategies.STRATEGIES`); default ``"resolver"`` (the
             resolver's own handling).
@@ -166,7 +166,7 @@ class Controller:
         self.dt = self.resolver.dt
         self.strategy = make_strategy(strategy)
         self.strategy.check(robot)
-        self.q = robot.neutral() if q0 is None else robot.check_q(q0, "q0")
+        self.q = robot.ready() if q0 is None else robot.check_q(q0, "q0")
         self.speed = speed
         self.deadman = deadman
         self.drift = drift
