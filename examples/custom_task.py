@@ -14,8 +14,8 @@ import os
 import numpy as np
 
 import rrc_pin
+from rrc_pin import TaskRows
 from rrc_pin.kinematics import Kinematics
-from solvers.resolution import TaskRows
 
 QUICK = os.environ.get("RRC_PIN_EXAMPLES_QUICK") == "1"
 ticks = 20 if QUICK else 200

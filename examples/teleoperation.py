@@ -26,7 +26,7 @@ start = ctl.q
 for k in range(round(seconds / ctl.dt)):
     # forward and turning for the first half, then up; hand axes [m/s, rad/s]
     twist = [0.05, 0.0, 0.0, 0.0, 0.0, 0.3] if k < seconds / ctl.dt / 2 else [0, 0, 0.05, 0, 0, 0]
-    ctl.step(twist, frame="local")
+    ctl.step(twist, ref="local")
 for _ in range(round(0.6 / ctl.dt)):
     ctl.step()  # no new command: the deadman fades the last one after 0.2 s
 

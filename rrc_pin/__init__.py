@@ -23,7 +23,15 @@ from rrc_pin.limits import JointLimits, Limit
 from rrc_pin.loading import arms, load
 from rrc_pin.resolver import Damping, QPOptions, Resolver
 from rrc_pin.robot import Robot
-from rrc_pin.tasks import DampingTask, FrameTask, JointTask, PostureTask, RelativeFrameTask, Task
+from rrc_pin.tasks import (
+    DampingTask,
+    FrameTask,
+    JointTask,
+    PostureTask,
+    RelativeFrameTask,
+    Task,
+    TaskRows,
+)
 from solvers.problem import Constraints
 from solvers.resolution import ActiveLimit, ActiveRow, Resolution, TaskReport
 
@@ -51,6 +59,7 @@ __all__ = [
     "RrcPinError",
     "Task",
     "TaskReport",
+    "TaskRows",
     "ToolFrameRequired",
     "TrajectoryLog",
     "URDFError",

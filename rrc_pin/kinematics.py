@@ -57,7 +57,7 @@ class Layout(NamedTuple):
     def of(cls, robot: Robot, closed_form: Any = None) -> Layout:
         """The layout of ``robot`` (with ``closed_form`` for its tool frame, if given)."""
         model = robot.model
-        continuous = np.array([model.joints[j].nq == 2 for j in range(1, model.njoints)])
+        continuous = robot.continuous
         joints = {n: i for i, n in enumerate(robot.joint_names)}
         frames = frame_index(model)
         reaches = {name: reach(model, fid) for name, fid in frames.items()}
@@ -129,12 +129,13 @@ class Kinematics:
         J: Array
         if not self._whole and (self._first is None or self._first == frame):
             self._first = frame
-            J = pin.computeFrameJacobian(self._model, self._data, self.q_pin, fid,
-                                         PIN_REFERENCE[ref])  # fmt: skip
-            return J
-        self._compute_whole()
-        J = pin.getFrameJacobian(self._model, self._data, fid, PIN_REFERENCE[ref])
-        return J
+            J = pin.computeFrameJacobian(
+                self._model, self._data, self.q_pin, fid, PIN_REFERENCE[ref]
+            )
+        else:
+            self._compute_whole()
+            J = pin.getFrameJacobian(self._model, self._data, fid, PIN_REFERENCE[ref])
+        return J if J.ndim == 2 else J.reshape(6, 1)  # one joint: Pinocchio gives (6,)
 
     def joint_index(self, joint: str) -> int:
         """Index in q of the joint named ``joint``."""

@@ -69,6 +69,7 @@ class Robot:
         poses: Named configurations (nq,) [rad or m] (read-only arrays); ``"ready"``, where
             present, is :meth:`ready`'s.
         mimic_joints: Joints that follow another (URDF ``<mimic>``): in the model, not in q.
+        continuous: Mask (nq,) of the continuous (unbounded revolute) joints.
     """
 
     def __init__(
@@ -136,14 +137,6 @@ class Robot:
             else:
                 angle_api.append(joint.idx_v)
                 angle_pin.append(joint.idx_q)
-        if mimic and angle_api:
-            # rrc_pin.kinematics.Layout masks the continuous joints over every joint of the
-            # model, mimic joints included: the two together would misalign that mask.
-            raise URDFError(
-                source,
-                f"mimic joints ({', '.join(mimic)}) beside continuous joints are not supported "
-                "yet; lock one kind (pinocchio.buildReducedModel)",
-            )
         self._frame_ids = frame_index(model)
         if tool_frames is None:
             ends = end_links(model)
@@ -174,6 +167,9 @@ class Robot:
         self.mimic_joints: tuple[str, ...] = tuple(mimic)
         self._scalar = (np.array(scalar_api, dtype=int), np.array(scalar_pin, dtype=int))
         self._angle = (np.array(angle_api, dtype=int), np.array(angle_pin, dtype=int))
+        self.continuous = np.zeros(self.nq, dtype=bool)
+        self.continuous[self._angle[0]] = True
+        self.continuous.flags.writeable = False
         self._identity_map = not angle_api and model.nq == model.nv
 
         self.lower = np.full(self.nq, -np.inf)

@@ -283,5 +283,5 @@ def test_the_default_start_is_the_ready_pose():
     ctl = Controller(rrc_pin.load("panda"))
     np.testing.assert_array_equal(ctl.q, ctl.robot.ready())
     for _ in range(3):
-        _, r = ctl.step([0.02, 0.0, 0.0, 0.0, 0.0, 0.0], frame="world_aligned")
+        _, r = ctl.step([0.02, 0.0, 0.0, 0.0, 0.0, 0.0], ref="world_aligned")
         assert r.status == "exact"

@@ -319,9 +319,12 @@ def test_a_mimic_joint_follows_its_primary(tmp_path):
     v = [-0.15 * np.sin(q[1]), 0.15 * np.cos(q[1]), 0.05, 0.0, 0.0, 0.0]
     r = rrc_pin.Resolver(arm, dt=0.01).solve(q, v)
     np.testing.assert_allclose(r.qdot, [0.05, 0.3], atol=1e-9)
-    path.write_text(MIMIC.format(kind="continuous"))
-    with pytest.raises(URDFError, match=r"mimic joints \(j2\) beside continuous joints"):
-        rrc_pin.load(path)
+    path.write_text(MIMIC.format(kind="continuous"))  # a continuous joint beside the mimic
+    arm = rrc_pin.load(path)
+    assert arm.nq == 2 and arm.continuous.tolist() == [True, False]
+    posture = rrc_pin.PostureTask([3.0, 0.0], gain=1.0)  # the short way round: -3.28 rad
+    r = rrc_pin.Resolver(arm, dt=0.01).solve([-3.0, 0.0], [posture])
+    assert r.qdot[0] < 0.0 and r.qdot[1] == pytest.approx(0.0, abs=1e-12)
 
 
 def test_without_mimic_support_a_mimic_joint_is_refused_by_name(tmp_path, monkeypatch):

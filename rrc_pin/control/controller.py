@@ -1,7 +1,7 @@
 r"""Controller: Barker's operator loop on the resolver, one tick per call.
 
 Every :meth:`Controller.step` takes the operator's twist in the hand frame (Barker eq. (20),
-``frame="local"``) or in base axes (``"world_aligned"``), weights it by the speed override
+``ref="local"``) or in base axes (``"world_aligned"``), weights it by the speed override
 and the deadman (:class:`~rrc_pin.control.deadman.Deadman`), adds the bounded pull back to
 the commanded pose (:class:`~rrc_pin.control.drift.DriftCorrection`), lets the singularity
 strategy adjust it (:mod:`rrc_pin.control.strategies`), resolves it with the
