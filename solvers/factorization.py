@@ -40,16 +40,18 @@ class Factorization:
         J: The rows.
         Q: Orthogonal factor (n, n) of :math:`J^T`.
         R: Triangular factor (n, m).
+        regular: Whether J has full row rank (m <= n, every pivot of R above 1e-12 times the
+            largest), known once :meth:`least_norm` ran: its rates then meet any rates.
     """
 
-    __slots__ = ("J", "Q", "R", "_regular", "_svd")
+    __slots__ = ("J", "Q", "R", "_svd", "regular")
 
     def __init__(self, J: Array) -> None:
         m, n = J.shape
         self.J = J
         self.Q, self.R = np.empty((n, n)), np.empty((n, m))
         kernels.householder_qr(J.T, self.Q, self.R)
-        self._regular = False  # full row rank, known once least_norm's forward solve ran
+        self.regular = False  # full row rank, known once least_norm's forward solve ran
         self._svd: tuple[Array, Array, Array, int] | None = None
 
     def least_norm(self, b: Array) -> Array:
@@ -57,7 +59,7 @@ class Factorization:
         m, n = self.J.shape
         x = np.empty(n)
         if m <= n and kernels.least_norm_rates(self.Q, self.R, b, x):
-            self._regular = True
+            self.regular = True
             return x
         return self.rates(b, None)
 
@@ -92,7 +94,7 @@ class Factorization:
     def null_basis(self) -> Array:
         """Orthonormal rows (n - rank, n) spanning the null space of J."""
         m, n = self.J.shape
-        if self._regular:
+        if self.regular:
             null: Array = self.Q[:, m:].T
             return null
         _, _, right, rank = self.svd

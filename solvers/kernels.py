@@ -325,6 +325,17 @@ def inside(x: Array, lb: Array, ub: Array) -> bool:
 
 
 @kernel
+def clip_into(x: Array, lb: Array, ub: Array) -> float:
+    """``x`` clipped into ``[lb, ub]`` in place; returns the Euclidean size of the change."""
+    s = 0.0
+    for i in range(x.size):
+        y = min(max(x[i], lb[i]), ub[i])
+        s += (y - x[i]) * (y - x[i])
+        x[i] = y
+    return math.sqrt(s)
+
+
+@kernel
 def rows_hold(G: Array, x: Array, h: Array, tol: float) -> bool:
     """Whether ``G x <= h + tol`` holds (False for NaN)."""
     p, n = G.shape
@@ -406,6 +417,35 @@ def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
 
 
 # -- least squares of a stack -----------------------------------------------------------------
+
+
+@kernel
+def weighted_rows(
+    A: Array, b: Array, weight: Array, top: float, unit: Array, A_out: Array, b_out: Array
+) -> float:
+    r"""Rows and rates in a level's metric: each row times :math:`\sqrt{w_i/w_{top}}/u_i`.
+
+    Args:
+        A: Task rows (m, n).
+        b: Their rates (m,).
+        weight: Row weights (m,) > 0.
+        top: The level's largest weight.
+        unit: Each row's unit (m,) (the arm's reach for linear rows, else 1).
+        A_out: Out (m, n).
+        b_out: Out (m,).
+
+    Returns:
+        The largest magnitude of ``b_out``.
+    """
+    m, n = A.shape
+    peak = 0.0
+    for i in range(m):
+        f = math.sqrt(weight[i] / top) / unit[i]
+        for j in range(n):
+            A_out[i, j] = A[i, j] * f
+        b_out[i] = b[i] * f
+        peak = max(peak, abs(b_out[i]))
+    return peak
 
 
 @kernel

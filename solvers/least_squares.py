@@ -58,11 +58,11 @@ class Subspace(NamedTuple):
     """Where a level may move: rates ``x + N^T z``.
 
     Attributes:
-        x: The rates so far (n,).
+        x: The rates so far (n,), or None (zero) with N None.
         N: Orthonormal rows (d, n) spanning the free directions, or None for all of them.
     """
 
-    x: Array
+    x: Array | None
     N: Array | None
 
 
@@ -120,7 +120,7 @@ def least_squares(
     """
     x, N = space
     B = A if N is None else A @ N.T
-    c = b if N is None else b - A @ x
+    c = b if N is None or x is None else b - A @ x
     z, factor, definite = optimum(B, c)
     candidate = z if N is None else x + z @ N
     feasible = kernels.inside(candidate, box.lb, box.ub) and (

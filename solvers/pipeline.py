@@ -220,7 +220,7 @@ def solve(problem: Problem, backend: QPBackend, options: Options) -> Answer:
             null = None
             continue
         levels.append(_served(problem, k, qdot))
-    qdot, clip = _clipped(qdot, box)
+    clip = kernels.clip_into(qdot, box.lb, box.ub)  # the kernels' answers to rounding
     qdot, shrink = _within_rows(qdot, box, rows)
     qdot.flags.writeable = False
     status = top.status
@@ -250,7 +250,7 @@ def _top(
     z = factor.least_norm(b)
     w = z if space.N is None else z @ space.N
     null = factor.null_basis() if space.N is None else factor.null_basis() @ space.N
-    outside_range = factor.J.shape[0] > factor.J.shape[1] or not _met(B @ z, b)
+    outside_range = not factor.regular and not _met(B @ z, b)
     if _feasible(w, box, rows):
         if outside_range:
             return _Top(w, "singular", *_along_command(problem, w), 0.0, null)
@@ -333,7 +333,7 @@ def _equality_space(problem: Problem) -> Subspace:
     """The rates that meet the equality rows, ``x0 + N^T z`` (least norm x0), or all rates."""
     n = problem.n
     if problem.equalities is None:
-        return Subspace(np.zeros(n), None)
+        return Subspace(None, None)
     C, d = problem.equalities
     factor = Factorization(C)
     x0 = factor.least_norm(d)
@@ -418,12 +418,6 @@ def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:
 
 
 _EPS = float(np.finfo(np.float64).eps)
-
-
-def _clipped(x: Array, box: Box) -> tuple[Array, float]:
-    """``x`` clipped into the box, and the Euclidean size of the clip."""
-    y = np.minimum(np.maximum(x, box.lb), box.ub)
-    return y, _norm(y - x)
 
 
 def _norm(x: Array) -> float:

@@ -31,6 +31,8 @@ from typing import Literal, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from solvers import kernels
+
 Array = npt.NDArray[np.float64]
 
 Mode = Literal["direction", "least_squares", "weighted"]
@@ -175,33 +177,61 @@ def build(
             mode = "least_squares"  # rates to keep: no scale of the command stands still
     else:
         mode = "least_squares"
+    stacked, rate_factor = [], 1.0
+    for k, level in enumerate(levels):
+        A, b, factor = _stack(level, normalised=(k == 0 and mode == "direction"))
+        stacked.append((A, b))
+        rate_factor = factor if k == 0 else rate_factor
     kept = tuple(tuple(level) for level in levels)
-    stacks = [_stack(level, normalised=(k == 0 and mode == "direction"))
-              for k, level in enumerate(kept)]  # fmt: skip
-    stacked = tuple((A, b) for A, b, _ in stacks)
-    return Problem(kept, stacked, stacks[0][2], box, rows, equalities, equality_names, mode, dt)
+    return Problem(kept, tuple(stacked), rate_factor, box, rows, equalities, equality_names,
+                   mode, dt)  # fmt: skip
 
 
 def _stack(tasks: Sequence[TaskRows], normalised: bool) -> tuple[Array, Array, float]:
     """Rows and rates of ``tasks`` stacked in the level's metric, and the rates' factor.
 
-    Each row times :func:`row_factors` (the direction level's with the rows' units); the
+    Each row times the square root of its weight over the level's largest (and in the
+    normalised metric divided by its unit, :func:`solvers.kernels.weighted_rows`); the
     direction level's rates divided by their largest entry beyond :data:`LARGE`, a
     least-squares level's divided down to :data:`LARGE`.
     """
     top = largest_weight(tasks)
-    As, bs = [], []
+    if len(tasks) == 1 and top == 1.0 and tasks[0].weight is None:
+        if not normalised or tasks[0].unit is None:  # the rows as they are
+            A, b = tasks[0].A, tasks[0].b
+            peak = float(np.abs(b).max()) if b.size else 0.0
+            return _capped(A, b, peak, normalised)
+    m = sum(t.b.size for t in tasks)
+    A, b = np.empty((m, tasks[0].A.shape[1])), np.empty(m)
+    peak, r = 0.0, 0
     for t in tasks:
-        factor = row_factors(t, top, normalised)
-        As.append(t.A if factor is None else t.A * factor[:, None])
-        bs.append(t.b if factor is None else t.b * factor)
-    A = As[0] if len(As) == 1 else np.vstack(As)
-    b = bs[0] if len(bs) == 1 else np.concatenate(bs)
-    peak = float(np.abs(b).max()) if b.size else 0.0
+        k = t.b.size
+        weight = _ones(k) if t.weight is None else t.weight
+        unit = t.unit if normalised and t.unit is not None else _ones(k)
+        peak = max(peak, kernels.weighted_rows(t.A, t.b, weight, top, unit, A[r : r + k],
+                                               b[r : r + k]))  # fmt: skip
+        r += k
+    return _capped(A, b, peak, normalised)
+
+
+def _capped(A: Array, b: Array, peak: float, normalised: bool) -> tuple[Array, Array, float]:
+    """``(A, b)`` with b divided as :func:`_stack` says where it exceeds :data:`LARGE`."""
     if peak <= LARGE:
         return A, b, 1.0
     rate_factor = 1.0 / peak if normalised else LARGE / peak
     return A, b * rate_factor, rate_factor
+
+
+_ONES: dict[int, Array] = {}
+
+
+def _ones(m: int) -> Array:
+    """A read-only (m,) array of ones, made once per size."""
+    ones = _ONES.get(m)
+    if ones is None:
+        ones = _ONES[m] = np.ones(m)
+        ones.flags.writeable = False
+    return ones
 
 
 def largest_weight(tasks: Sequence[TaskRows]) -> float:

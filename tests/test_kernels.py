@@ -120,3 +120,20 @@ def test_normal_equations_and_cholesky(rng: np.random.Generator) -> None:
         if definite:
             np.testing.assert_allclose(x, np.linalg.solve(H, g), rtol=1e-9, atol=1e-12)
     assert not kernels.cholesky_solve(np.zeros((2, 2)), np.ones(2), np.empty(2))
+
+
+def test_weighted_rows_and_clip_into(rng: np.random.Generator) -> None:
+    A, b = rng.normal(size=(6, 7)), rng.normal(size=6)
+    w, unit = rng.uniform(0.1, 10.0, 6), rng.uniform(0.5, 2.0, 6)
+    A_out, b_out = np.empty((6, 7)), np.empty(6)
+    peak = kernels.weighted_rows(A, b, w, 10.0, unit, A_out, b_out)
+    f = np.sqrt(w / 10.0) / unit
+    np.testing.assert_allclose(A_out, A * f[:, None], rtol=1e-15)
+    np.testing.assert_allclose(b_out, b * f, rtol=1e-15)
+    assert peak == np.abs(b * f).max()
+    x = rng.normal(size=9) * 2.0
+    lb, ub = -np.ones(9), np.ones(9)
+    before, clipped = x.copy(), np.clip(x, lb, ub)
+    size = kernels.clip_into(x, lb, ub)
+    np.testing.assert_array_equal(x, clipped)
+    assert size == pytest.approx(np.linalg.norm(clipped - before), rel=1e-15)
