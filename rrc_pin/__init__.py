@@ -21,7 +21,7 @@ from rrc_pin.errors import (
 )
 from rrc_pin.limits import JointLimits, Limit
 from rrc_pin.loading import arms, load
-from rrc_pin.resolver import Damping, QPOptions, Resolver
+from rrc_pin.resolver import QPOptions, Resolver
 from rrc_pin.robot import Robot
 from rrc_pin.tasks import (
     DampingTask,
@@ -32,6 +32,7 @@ from rrc_pin.tasks import (
     Task,
     TaskRows,
 )
+from solvers.damping import Damping
 from solvers.problem import Constraints
 from solvers.resolution import ActiveLimit, ActiveRow, Resolution, TaskReport
 

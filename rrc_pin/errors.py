@@ -1,4 +1,4 @@
-"""Exceptions of rrc_pin: one root, :class:`RrcPinError`.
+"""Exceptions of rrc_pin: one root, :class:`RrcPinError`, shared with :mod:`solvers.errors`.
 
 Bad input raises before any state changes, with a message naming the argument. Numerical
 trouble (singularities, infeasible QPs) is never an exception: the resolver falls back and
@@ -7,15 +7,17 @@ reports which method answered.
 
 from __future__ import annotations
 
-from solvers.errors import BackendNotFound, InputError
+from solvers.errors import InvalidInput, RrcPinError, UnknownBackend
 
-
-class RrcPinError(Exception):
-    """Root of every exception raised by :mod:`rrc_pin`."""
-
-
-class InvalidInput(RrcPinError, InputError):
-    """An argument has the wrong shape, a non-finite entry or an invalid value (a ValueError)."""
+__all__ = [
+    "FrameNotFound",
+    "InvalidInput",
+    "RrcPinError",
+    "ToolFrameRequired",
+    "URDFError",
+    "UnknownArm",
+    "UnknownBackend",
+]
 
 
 class UnknownArm(RrcPinError, ValueError):
@@ -80,7 +82,3 @@ class ToolFrameRequired(InvalidInput):
     def __init__(self, argument: str, context: str, candidates: list[str]) -> None:
         self.candidates = candidates
         super().__init__(argument, f"{context}; name one of: {', '.join(candidates)}")
-
-
-class UnknownBackend(RrcPinError, BackendNotFound):
-    """A QP backend that is not installed (the error lists the installed ones)."""

@@ -39,14 +39,13 @@ from rrc_pin.limits import JointLimits, Limit
 from rrc_pin.loading import load
 from rrc_pin.robot import Robot
 from rrc_pin.tasks import FrameTask, Task
-from solvers import damping as solver_damping
-from solvers.errors import BackendNotFound, InputError
+from solvers.damping import Damping
 from solvers.pipeline import DEFAULT_FALLBACKS, Method, Options, solve
 from solvers.problem import TaskRows, build
 from solvers.qp_backends import make_backend
 from solvers.resolution import Resolution
 from solvers.spatial import Reference
-from solvers.validation import positive
+from solvers.validation import finite_number, positive
 
 Array = npt.NDArray[np.float64]
 
@@ -55,26 +54,12 @@ TaskCommand = Task | Sequence[Task | Sequence[Task]]
 
 Priority = Literal["weighted", "strict"]
 
+MIN_DT = 1e-6
+"""[s] The shortest control period accepted (a 1 MHz loop): below it the one-step position
+bounds divide by a step that no joint can use (dt = 1e-310 made them infinite, and NaN)."""
+
 DEFAULT_TIME_LIMIT = 0.05
 """[s] The backend's time cap per QP by default (:class:`QPOptions`): five periods at 100 Hz."""
-
-
-class Damping(solver_damping.Damping):
-    """Damping near singularities (:class:`solvers.damping.Damping`), for the resolver.
-
-    Attributes:
-        threshold: The condition number of the top level's normalised rows beyond which a
-            command that cannot be met is damped (>= 10; default 100).
-
-    Raises:
-        InvalidInput: ``threshold`` not a finite number >= 10.
-    """
-
-    def __post_init__(self) -> None:
-        try:
-            super().__post_init__()
-        except InputError as exc:
-            raise InvalidInput(exc.argument, exc.reason) from exc
 
 
 @dataclass(frozen=True)
@@ -166,9 +151,9 @@ class Resolver:
             self.options = Options(damping, self.qp.fallbacks)  # type: ignore[arg-type]
             self.backend = make_backend(self.qp.backend, self.qp.time_limit,
                                         **dict(self.qp.options))  # fmt: skip
-        except BackendNotFound as exc:
-            raise UnknownBackend(exc.backend, exc.available) from exc
-        except InputError as exc:
+        except UnknownBackend:
+            raise
+        except InvalidInput as exc:  # the options' names as the caller spells them
             name = {"backend_options": "qp.options", "fallbacks": "qp.fallbacks"}
             raise InvalidInput(name.get(exc.argument, exc.argument), exc.reason) from exc
         self.direction_preserving = direction_preserving
@@ -243,9 +228,9 @@ class Resolver:
             levels, weighted = self._levels(cast(TaskCommand, command), priority)
             twist = None
         else:
-            if priority != "weighted":
+            if not isinstance(priority, str) or priority != "weighted":
                 raise InvalidInput("priority", "a twist is one task: priority is for lists of "
-                                   "tasks")  # fmt: skip
+                                   f"tasks, got {priority!r}")  # fmt: skip
             task = self._twist_task()
             twist = task.check_twist(cast(npt.ArrayLike, command))
             levels, weighted = [[task]], False
@@ -345,7 +330,8 @@ class Resolver:
 
 
 def _dt(dt: float) -> float:
-    return positive(dt, "dt", InvalidInput)
+    """A control period: finite, at least :data:`MIN_DT` [s]."""
+    return finite_number(dt, "dt", MIN_DT, error=InvalidInput)
 
 
 def _typed(value: Any, kind: type, name: str) -> Any:

@@ -28,7 +28,6 @@ import pinocchio as pin
 from rrc_pin.errors import FrameNotFound, InvalidInput, ToolFrameRequired, URDFError
 from rrc_pin.models.arm_spec import ArmSpec
 from solvers.closed_form.base import ClosedForm
-from solvers.errors import InputError
 from solvers.spatial import Reference, check_reference
 from solvers.validation import as_vector
 
@@ -210,7 +209,7 @@ class Robot:
             if self._closed_form is None:
                 try:
                     self._closed_form = factory()
-                except InputError as exc:  # e.g. kr5_3r with a2 = 0: no closed form exists
+                except InvalidInput as exc:  # e.g. kr5_3r with a2 = 0: no closed form exists
                     raise InvalidInput(
                         exc.argument, f"{self.name} has no closed form for this geometry ({exc})"
                     ) from exc

@@ -1,13 +1,20 @@
-"""Exceptions of the numerical kernels: one root, :class:`SolverError`."""
+"""Exceptions of rrc-pin: one root, :class:`RrcPinError`, for both of its packages.
+
+The numerical layer (:mod:`solvers`) raises the classes defined here; :mod:`rrc_pin.errors`
+adds the framework's own (unknown arm, URDF, frames) as subclasses of the same root, so that
+``except rrc_pin.RrcPinError`` catches everything either package raises for bad input.
+Numerical trouble is never an exception at the public calls: :class:`NumericalFailure` and
+:class:`ProblemError` stay inside the pipeline, which falls back and reports.
+"""
 
 from __future__ import annotations
 
 
-class SolverError(Exception):
-    """Root of every exception raised by :mod:`solvers`."""
+class RrcPinError(Exception):
+    """Root of every exception raised by :mod:`rrc_pin` and :mod:`solvers`."""
 
 
-class InputError(SolverError, ValueError):
+class InvalidInput(RrcPinError, ValueError):
     """An argument has the wrong shape, a non-finite entry or an invalid value.
 
     Attributes:
@@ -21,21 +28,7 @@ class InputError(SolverError, ValueError):
         super().__init__(f"{argument}: {message}")
 
 
-class ProblemError(SolverError):
-    """A QP backend failed in a way that is not a numerical answer (bad setup, crash)."""
-
-
-class NumericalFailure(SolverError):
-    """A method of the numerics found no usable answer.
-
-    No solution, an answer outside the constraints, a backend's fault or time-out.
-
-    Internal: the pipeline records it in the resolution's ``attempts`` and goes on to the
-    next method; it never reaches a caller of the resolver.
-    """
-
-
-class BackendNotFound(SolverError, ValueError):
+class UnknownBackend(InvalidInput):
     """An unknown or uninstalled QP backend was requested.
 
     Attributes:
@@ -47,6 +40,27 @@ class BackendNotFound(SolverError, ValueError):
         self.backend = backend
         self.available = available
         super().__init__(
-            f"backend: unknown or not installed {backend!r}; installed: {', '.join(available)} "
-            "(install more with `pip install rrc-pin[bench]`)"
-        )
+            "backend", f"unknown or not installed {backend!r}; installed: {', '.join(available)} "
+            "(install more with `pip install rrc-pin[bench]`)",
+        )  # fmt: skip
+
+
+class ProblemError(RrcPinError):
+    """A QP backend failed in a way that is not a numerical answer (bad setup, crash).
+
+    Internal: the pipeline treats it as a :class:`NumericalFailure`.
+    """
+
+
+class NumericalFailure(RrcPinError):
+    """A method of the numerics found no usable answer.
+
+    No solution, an answer outside the constraints, a backend's fault or time-out.
+
+    Internal: the pipeline records it in the resolution's ``attempts`` and goes on to the
+    next method; it never reaches a caller of the resolver.
+    """
+
+
+SolverError = RrcPinError  # the closed forms' modules still say these names:
+InputError = InvalidInput  # removed once they are rewritten as kernels

@@ -54,6 +54,33 @@ class Factorization:
         self.regular = False  # full row rank, known once least_norm's forward solve ran
         self._svd: tuple[Array, Array, Array, int] | None = None
 
+    @classmethod
+    def fitted(cls, J: Array, b: Array, lb: Array, ub: Array) -> tuple[Factorization, Array, bool]:
+        """The factorisation of J, the least-norm rates of ``J x ~= b`` and whether they fit.
+
+        One kernel call where J has full row rank (:func:`~solvers.kernels.least_norm_fit`),
+        the SVD otherwise.
+
+        Args:
+            J: The rows (m, n).
+            b: Their rates (m,).
+            lb: Lower bounds (n,) of the rates.
+            ub: Upper bounds (n,).
+
+        Returns:
+            The factorisation, the rates (n,), and whether ``lb <= x <= ub``.
+        """
+        m, n = J.shape
+        factor = cls.__new__(cls)
+        factor.J, factor._svd = J, None
+        factor.Q, factor.R, x = np.empty((n, n)), np.empty((n, m)), np.empty(n)
+        fit = kernels.least_norm_fit(J, b, lb, ub, factor.Q, factor.R, x)
+        factor.regular = fit > 0
+        if fit:
+            return factor, x, fit == 2
+        x = factor.rates(b, None)
+        return factor, x, kernels.inside(x, lb, ub)
+
     def least_norm(self, b: Array) -> Array:
         """The least-squares rates of least norm, :math:`J^+ b` (n,), rank by :data:`RANK_TOL`."""
         m, n = self.J.shape

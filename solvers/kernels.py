@@ -223,6 +223,35 @@ def least_norm_rates(Q: Array, R: Array, b: Array, x: Array) -> bool:
 
 
 @kernel
+def least_norm_fit(
+    J: Array, b: Array, lb: Array, ub: Array, Q: Array, R: Array, x: Array
+) -> int:
+    """One step of a tick: the QR of the rows, their least-norm rates, and whether they fit.
+
+    :func:`householder_qr` of :math:`J^T`, :func:`least_norm_rates` and :func:`inside`, in
+    one call.
+
+    Args:
+        J: Rows (m, n).
+        b: Their rates (m,).
+        lb: Lower bounds (n,).
+        ub: Upper bounds (n,).
+        Q: Out: orthogonal factor (n, n).
+        R: Out: triangular factor (n, m).
+        x: Out: the rates (n,), set unless 0 is returned.
+
+    Returns:
+        0 where the rows are numerically dependent or more than the joints (x not set), 1
+        where x is set outside ``[lb, ub]``, 2 inside.
+    """
+    m, n = J.shape
+    householder_qr(J.T, Q, R)
+    if m > n or not least_norm_rates(Q, R, b, x):
+        return 0
+    return 2 if inside(x, lb, ub) else 1
+
+
+@kernel
 def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
     r"""One-sided Jacobi SVD of a small ``A`` (m, k): ``A V = U diag(sigma)`` (Hestenes 1958).
 
@@ -313,6 +342,15 @@ def svd_rates(
 
 
 # -- feasibility and scales -------------------------------------------------------------------
+
+
+@kernel
+def all_finite(x: Array) -> bool:
+    """Whether every entry of ``x`` (n,) is finite (no NaN or infinity)."""
+    for i in range(x.size):
+        if not math.isfinite(x[i]):
+            return False
+    return True
 
 
 @kernel

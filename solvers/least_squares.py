@@ -122,7 +122,7 @@ def least_squares(
     B = A if N is None else A @ N.T
     c = b if N is None or x is None else b - A @ x
     z, factor, definite = optimum(B, c)
-    candidate = z if N is None else x + z @ N
+    candidate = z if N is None or x is None else x + z @ N
     feasible = kernels.inside(candidate, box.lb, box.ub) and (
         rows is None or kernels.rows_hold(rows.G, candidate, rows.h, 0.0)
     )

@@ -38,7 +38,7 @@ import numpy.typing as npt
 from solvers import kernels
 from solvers.damping import Damping
 from solvers.direction import Along, along, direction_qp
-from solvers.errors import InputError, NumericalFailure
+from solvers.errors import InvalidInput, NumericalFailure
 from solvers.factorization import Factorization
 from solvers.least_squares import Subspace, least_squares
 from solvers.problem import Box, Problem, Rows, largest_weight, row_factors
@@ -101,7 +101,7 @@ class Options:
             except ``qp``); ``hold`` always ends the chain.
 
     Raises:
-        InputError: An unknown or repeated fallback, ``qp`` among them, or ``hold`` before
+        InvalidInput: An unknown or repeated fallback, ``qp`` among them, or ``hold`` before
             another one.
     """
 
@@ -113,17 +113,17 @@ class Options:
         if isinstance(given, str):
             given = (given,)
         if not isinstance(given, (tuple, list)) or not all(isinstance(m, str) for m in given):
-            raise InputError("fallbacks", f"expected a sequence of method names, got {given!r}")
+            raise InvalidInput("fallbacks", f"expected a sequence of method names, got {given!r}")
         for name in given:
             if name not in METHODS or name == "qp":
                 choices = ", ".join(m for m in METHODS if m != "qp")
-                raise InputError("fallbacks", f"unknown method {name!r}; expected {choices}")
+                raise InvalidInput("fallbacks", f"unknown method {name!r}; expected {choices}")
         if len(set(given)) != len(given):
-            raise InputError("fallbacks", f"repeated method in {tuple(given)}")
+            raise InvalidInput("fallbacks", f"repeated method in {tuple(given)}")
         if "hold" in given[:-1]:
-            raise InputError("fallbacks", f"'hold' always answers, so it comes last: {given}")
+            raise InvalidInput("fallbacks", f"'hold' always answers, so it comes last: {given}")
         if self.damping is not None and not isinstance(self.damping, Damping):
-            raise InputError("damping", f"expected a Damping or None, got {self.damping!r}")
+            raise InvalidInput("damping", f"expected a Damping or None, got {self.damping!r}")
         chain = tuple(given) if given[-1:] == ("hold",) else (*given, "hold")
         object.__setattr__(self, "fallbacks", chain)
 
@@ -245,16 +245,21 @@ def _top(
         status: Status = "recovering" if box.recovering or _broken(rows) else (
             "exact" if met else "least_squares")  # fmt: skip
         return _Top(qdot, status, *_along_command(problem, qdot), 0.0, null)
-    B = A if space.N is None else A @ space.N.T
-    factor = Factorization(B)
-    z = factor.least_norm(b)
-    w = z if space.N is None else z @ space.N
-    null = factor.null_basis() if space.N is None else factor.null_basis() @ space.N
-    outside_range = not factor.regular and not _met(B @ z, b)
-    if _feasible(w, box, rows):
+    if space.N is None:
+        factor, w, fits = Factorization.fitted(A, b, box.lb, box.ub)
+        z = w
+    else:
+        factor = Factorization(A @ space.N.T)
+        z = factor.least_norm(b)
+        w = z @ space.N
+        fits = kernels.inside(w, box.lb, box.ub)
+    outside_range = not factor.regular and not _met(factor.J @ z, b)
+    if fits and (rows is None or kernels.rows_hold(rows.G, w, rows.h, 0.0)):
+        null = _null(factor, space) if len(problem.levels) > 1 else None
         if outside_range:
             return _Top(w, "singular", *_along_command(problem, w), 0.0, null)
         return _Top(w, "exact", 1.0, 0.0, 0.0, null)
+    null = _null(factor, space)
     u_w = _scaled(A, w, null, box, rows, backend, work)
     if not outside_range and u_w.u >= 1.0 - EXACT_TOL:
         return _Top(u_w.qdot, "exact", 1.0, 0.0, 0.0, null)
@@ -329,9 +334,14 @@ def _scaled(
     return Along(qdot, scale)
 
 
+def _null(factor: Factorization, space: Subspace) -> Array:
+    """The null space of a level's rows in the joint rates, within ``space``."""
+    null = factor.null_basis()
+    return null if space.N is None else null @ space.N
+
+
 def _equality_space(problem: Problem) -> Subspace:
     """The rates that meet the equality rows, ``x0 + N^T z`` (least norm x0), or all rates."""
-    n = problem.n
     if problem.equalities is None:
         return Subspace(None, None)
     C, d = problem.equalities
@@ -340,13 +350,6 @@ def _equality_space(problem: Problem) -> Subspace:
     if not _met(C @ x0, d):
         raise NumericalFailure("the equality rows contradict each other")
     return Subspace(x0, factor.null_basis())
-
-
-def _feasible(x: Array, box: Box, rows: Rows | None) -> bool:
-    """Whether ``x`` satisfies the box and the rows exactly (False for NaN)."""
-    return kernels.inside(x, box.lb, box.ub) and (
-        rows is None or kernels.rows_hold(rows.G, x, rows.h, 0.0)
-    )
 
 
 def _broken(rows: Rows | None) -> bool:

@@ -236,6 +236,8 @@ def _ones(m: int) -> Array:
 
 def largest_weight(tasks: Sequence[TaskRows]) -> float:
     """The largest row weight of ``tasks`` (1 for a task without weights)."""
+    if len(tasks) == 1 and tasks[0].weight is None:
+        return 1.0
     return max(1.0 if t.weight is None else float(t.weight.max()) for t in tasks)
 
 
@@ -255,6 +257,8 @@ def row_factors(t: TaskRows, top: float, units: bool) -> Array | None:
 
 def _box(constraints: Sequence[Constraints], n: int) -> Box:
     """The boxes intersected; where two are disjoint the first one's bound wins."""
+    if len(constraints) == 1 and constraints[0].box is not None:
+        return constraints[0].box
     boxes = [c.box for c in constraints if c.box is not None]
     if not boxes:
         free = np.full(n, math.inf)

@@ -14,14 +14,14 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 
 Array = npt.NDArray[np.float64]
 Reference = Literal["world_aligned", "local", "world"]
 REFERENCES: tuple[str, ...] = ("world_aligned", "local", "world")
 
 
-def check_reference(ref: str, error: type[InputError] = InputError) -> Reference:
+def check_reference(ref: str, error: type[InvalidInput] = InvalidInput) -> Reference:
     """Return ``ref`` if it names one of :data:`REFERENCES`, else raise naming ``ref``."""
     if not isinstance(ref, str) or ref not in REFERENCES:
         raise error("ref", f"expected one of {', '.join(REFERENCES)}, got {ref!r}")

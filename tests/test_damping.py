@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from solvers.damping import MIN_THRESHOLD, Damping
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 
 
 def test_none_below_the_threshold_or_where_the_command_can_be_met() -> None:
@@ -36,7 +36,7 @@ def test_the_schedule_and_its_continuity() -> None:
 
 @pytest.mark.parametrize("threshold", [9.99, 0.0, -1.0, np.nan, np.inf, "100", True])
 def test_bad_thresholds_are_refused(threshold: object) -> None:
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InvalidInput) as info:
         Damping(threshold=threshold)  # type: ignore[arg-type]
     assert info.value.argument == "threshold"
     assert Damping(threshold=MIN_THRESHOLD).threshold == 10.0

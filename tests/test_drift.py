@@ -54,18 +54,6 @@ def test_correction_is_clipped_part_by_part():
     assert np.allclose(twist[3:], [0.0, 0.0, -0.05], rtol=0, atol=1e-15)
 
 
-def test_the_correction_is_added_to_a_twist_in_one_array(rng):
-    """``twist(error, plus)`` is ``plus + twist(error)``, bit for bit, from an array or
-    Python floats, clipped or not."""
-    drift = DriftCorrection()
-    for scale in (1e-4, 1.0):
-        error = rng.normal(size=6) * scale
-        plus = rng.normal(size=6)
-        expected = plus + drift.twist(error)
-        assert np.array_equal(drift.twist(error, plus.tolist()), expected)
-        assert np.array_equal(drift.twist(tuple(error.tolist()), tuple(plus.tolist())), expected)
-
-
 def test_the_reference_advances_along_the_twist():
     reference = pin.SE3(pin.exp3(np.array([0.3, -0.2, 0.1])), np.array([0.5, 0.1, 0.2]))
     twist = np.array([0.1, 0.0, -0.2, 0.0, 0.5, 0.3])

@@ -12,7 +12,7 @@ from scipy.optimize import linprog, lsq_linear
 import solvers.pipeline as pipeline_module
 from solvers import kernels
 from solvers.damping import Damping
-from solvers.errors import InputError, ProblemError
+from solvers.errors import InvalidInput, ProblemError
 from solvers.pipeline import Answer, Options, solve
 from solvers.problem import Box, Constraints, Problem, TaskRows, build
 from solvers.qp_backends import QPBackend, QPSolution, make_backend
@@ -338,17 +338,17 @@ def test_numerical_trouble_never_raises(rng: np.random.Generator) -> None:
 
 
 def test_options_are_checked() -> None:
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InvalidInput) as info:
         Options(fallbacks=("qp",))
     assert info.value.argument == "fallbacks"
-    with pytest.raises(InputError):
+    with pytest.raises(InvalidInput):
         Options(fallbacks=("scaling", "scaling"))
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InvalidInput) as info:
         Options(damping=0.1)  # type: ignore[arg-type]
     assert info.value.argument == "damping"
-    with pytest.raises(InputError, match="fallbacks: 'hold' always answers"):
+    with pytest.raises(InvalidInput, match="fallbacks: 'hold' always answers"):
         Options(fallbacks=("hold", "scipy"))
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InvalidInput) as info:
         Options(fallbacks=np.array([["scipy"]]))  # type: ignore[arg-type]
     assert info.value.argument == "fallbacks"
     assert Options(fallbacks="scaling").fallbacks == ("scaling", "hold")  # type: ignore[arg-type]

@@ -16,7 +16,7 @@ from test_qp import feasible
 import solvers.qp_backends.daqp_backend as daqp_backend
 import solvers.qp_backends.osqp_backend as osqp_backend
 import solvers.qp_backends.qpsolvers_backend as qpsolvers_backend
-from solvers.errors import BackendNotFound, InputError, ProblemError
+from solvers.errors import InvalidInput, ProblemError, UnknownBackend
 from solvers.qp import QP
 from solvers.qp_backends import (
     NATIVE,
@@ -75,7 +75,7 @@ def test_installed_backends_lists_daqp_and_osqp_first() -> None:
 
 @pytest.mark.parametrize("name", ["gurobi-not-installed", "DAQP", "", None, 3])
 def test_unknown_backend_lists_the_installed_ones(name: object) -> None:
-    with pytest.raises(BackendNotFound) as info:
+    with pytest.raises(UnknownBackend) as info:
         make_backend(name)  # type: ignore[arg-type]
     assert info.value.backend == str(name)
     assert info.value.available == installed_backends()
@@ -94,7 +94,7 @@ def test_unknown_backend_lists_the_installed_ones(name: object) -> None:
 )  # fmt: skip
 def test_misspelt_options_are_refused_at_construction(name: str, options: dict) -> None:
     pytest.importorskip(MODULES[name])
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InvalidInput) as info:
         make_backend(name, **options)
     assert info.value.argument == "backend_options"
     assert name in str(info.value) and next(iter(options)) in str(info.value)
@@ -119,7 +119,7 @@ def test_valid_options_are_kept_and_the_backend_starts_cold(name: str, options: 
 
 def test_options_that_fail_the_probe_are_refused() -> None:
     """Accepted settings that cannot solve the probe QP (one iteration) are refused too."""
-    with pytest.raises(InputError, match="fails a 2-variable QP") as info:
+    with pytest.raises(InvalidInput, match="fails a 2-variable QP") as info:
         make_backend("osqp", max_iter=1, polishing=False)
     assert info.value.argument == "backend_options"
 

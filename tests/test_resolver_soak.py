@@ -1,25 +1,32 @@
-"""A soak over every arm rrc_pin.load knows and every installed backend (issue 18): random
-twists from 1e-3 to 1e3, starts inside, on and beyond the limits. No backend answers zero
-rates where another moves the arm; commands the arm can meet are met without veer; scale is
-always in [0, 1] and the fraction achieved along the command."""
+"""The attack made permanent (issue 28): random steps over every arm ``rrc_pin.arms()`` knows
+and every installed backend, extreme commands included. Every answer finite, inside the
+velocity and one-step position limits, a ``scaled`` answer along its command, no exception.
+
+Fresh seeds at every run (printed on failure). ``RRC_PIN_SOAK=N`` sets the steps per arm for
+the default backend (a tenth for each other one); the suite's default is small, ``.ci/run``
+runs a long soak, and docs/api.md ("Reliability") records a run of 10^5 steps per arm.
+"""
 
 from __future__ import annotations
 
-import math
-import zlib
+import os
+import time
 
 import numpy as np
 import pytest
 
 import rrc_pin
-from rrc_pin import FrameTask, QPOptions, Resolver
+from rrc_pin import FrameTask, PostureTask, QPOptions, Resolver
 from solvers.qp_backends import installed_backends
 
-CASES = 80
+STEPS = int(os.environ.get("RRC_PIN_SOAK", "60"))
+"""Steps per arm for the default backend; each other backend gets a tenth (at least 10)."""
+
+EXTREME = (1e308, -1.7e308, 1e200, 1e-310, 5e-324, 1e150)
 
 
 def start(arm: rrc_pin.Robot, rng: np.random.Generator) -> np.ndarray:
-    """Inside (60%), on a limit (20%) or beyond one (20%) for a few joints."""
+    """Inside (60 %), on a limit (20 %) or beyond one (20 %) for a few joints."""
     q = arm.random_q(rng)
     finite = np.flatnonzero(np.isfinite(arm.lower) & np.isfinite(arm.upper))
     kind = rng.random()
@@ -33,44 +40,66 @@ def start(arm: rrc_pin.Robot, rng: np.random.Generator) -> np.ndarray:
     return q
 
 
-def veer(a: np.ndarray, b: np.ndarray) -> float:
-    a, b = a / np.linalg.norm(a), b / np.linalg.norm(b)
-    return math.degrees(2.0 * math.atan2(np.linalg.norm(a - b), np.linalg.norm(a + b)))
+def command(rng: np.random.Generator) -> np.ndarray:
+    """A twist from 1e-3 to 1e3, or (one in ten) with extreme entries up to 1.7e308."""
+    twist = rng.normal(size=6) * 10.0 ** rng.uniform(-3, 3)
+    if rng.random() < 0.1:
+        picks = rng.random(6) < 0.5
+        twist[picks] = rng.choice(EXTREME, picks.sum()) * rng.choice([-1.0, 1.0], picks.sum())
+    return twist
+
+
+def check(arm: rrc_pin.Robot, q: np.ndarray, r: rrc_pin.Resolution, dt: float) -> None:
+    qdot = r.qdot
+    assert np.isfinite(qdot).all(), r
+    assert np.all(np.abs(qdot) <= arm.velocity_limit), r
+    inside = (q >= arm.lower) & (q <= arm.upper)
+    after = q + qdot * dt
+    assert np.all(after[inside] >= arm.lower[inside]) and np.all(after[inside] <= arm.upper[inside])
+    assert 0.0 <= r.scale <= 1.0 and np.isfinite(r.veer)
+    if r.status == "scaled":  # the command's direction kept: achieved = scale * command
+        level = r.problem.levels[0]
+        for t in level:
+            unit = np.ones(t.b.size) if t.unit is None else t.unit
+            y, b = t.A @ qdot / unit, t.b / unit
+            top = np.abs(b).max()
+            np.testing.assert_allclose(y / top, r.scale * b / top, atol=1e-6 * (1 + r.scale))
+
+
+def tasks_for(robot: rrc_pin.Robot, rng: np.random.Generator) -> tuple[list, str]:
+    """For a robot with several hands: a random stack of both hands and a posture."""
+    left, right = robot.tool_frames[:2]
+    hands = [FrameTask(left, command(rng)), FrameTask(right, command(rng))]
+    posture = PostureTask(robot.ready(), gain=float(rng.uniform(0.1, 2.0)))
+    if rng.random() < 0.5:
+        return [*hands, posture], "weighted"
+    return [hands, posture], "strict"
 
 
 @pytest.mark.parametrize("name", rrc_pin.arms())
 def test_soak_every_arm_every_backend(name: str) -> None:
+    seed = int(np.random.SeedSequence().entropy % 2**63)
+    rng = np.random.default_rng(seed)
     arm = rrc_pin.load(name)
-    task = FrameTask(arm.tool_frame or arm.tool_frames[0],
-                     rows="full" if arm.nq >= 6 else "position")  # fmt: skip
-    resolvers = {b: Resolver(arm, task=task, qp=QPOptions(backend=b)) for b in installed_backends()}
-    rng = np.random.default_rng(zlib.crc32(name.encode()))
-    frozen, veers = [], []
-    for _ in range(CASES):
-        q = start(arm, rng)
-        twist = rng.normal(size=6) * 10.0 ** rng.uniform(-3, 3)
-        J = arm.jacobian(q, frame=task.frame)[list(task.selected)]
-        b = twist[list(task.selected)]
-        answers = {k: r.solve(q, twist) for k, r in resolvers.items()}
-        moving = {k for k, r in answers.items() if np.linalg.norm(r.qdot) > 1e-6 and r.scale > 1e-6}
-        for k, r in answers.items():
-            step = q + r.qdot * 0.01
-            inside = (q >= arm.lower) & (q <= arm.upper)
-            assert np.all(np.abs(r.qdot) <= arm.velocity_limit)
-            assert np.all(step[inside] >= arm.lower[inside])
-            assert np.all(step[inside] <= arm.upper[inside])
-            assert 0.0 <= r.scale <= 1.0
-            unit = r.problem.levels[0][0].unit  # the normalised metric: linear rows / reach
-            y, bn = J @ r.qdot / unit, b / unit
-            along = min(1.0, max(0.0, float(y @ bn) / float(bn @ bn)))
-            assert r.scale == pytest.approx(along, abs=1e-9 + 1e-9 * along)
-            if moving and k not in moving and np.linalg.norm(r.qdot) <= 1e-9:
-                frozen.append((k, r.status, r.attempts))
-        exact = np.linalg.pinv(J) @ b
-        bounds = answers["daqp"].box
-        if np.all(exact >= bounds.lb) and np.all(exact <= bounds.ub) and np.any(b):
-            for r in answers.values():
-                veers.append(veer(J @ r.qdot, b))
-    assert frozen == []  # no backend answers zero where another moves the arm
-    if veers:
-        assert np.percentile(veers, 90) < 0.1, np.percentile(veers, 90)
+    several = arm.tool_frame is None
+    slowest = 0.0
+    for backend in installed_backends():
+        steps = STEPS if backend == "daqp" else max(10, STEPS // 10)
+        resolvers = [Resolver(arm, qp=QPOptions(backend=backend), direction_preserving=d)
+                     for d in (True, False)]  # fmt: skip
+        for k in range(steps):
+            q = start(arm, rng)
+            dt = float(rng.choice([1e-3, 0.01, 0.05]))
+            resolver = resolvers[k % 2]
+            t0 = time.perf_counter()
+            try:
+                if several:
+                    tasks, priority = tasks_for(arm, rng)
+                    r = resolver.solve(q, tasks, priority=priority, dt=dt)
+                else:
+                    r = resolver.solve(q, command(rng), dt=dt)
+                slowest = max(slowest, time.perf_counter() - t0)
+                check(arm, q, r, dt)
+            except Exception as exc:
+                raise AssertionError(f"{name}/{backend} step {k}: seed {seed}: {exc!r}") from exc
+    print(f"{name}: slowest tick {slowest * 1e3:.1f} ms (seed {seed})")

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import rrc_pin
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 from solvers.spatial import REFERENCES, check_reference, from_world_aligned
 
 
@@ -26,5 +26,5 @@ def test_conversion_reproduces_pinocchio_frames(rng, ref):
 
 
 def test_unknown_reference_lists_the_valid_ones():
-    with pytest.raises(InputError, match="^ref: expected one of world_aligned, local, world"):
+    with pytest.raises(InvalidInput, match="^ref: expected one of world_aligned, local, world"):
         check_reference("base")

@@ -7,11 +7,11 @@ import warnings
 import numpy as np
 import pytest
 
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 from solvers.validation import as_array, as_vector, finite_number, positive
 
 
-class _MyError(InputError):
+class _MyError(InvalidInput):
     """A caller's own subclass, as rrc_pin passes one."""
 
 
@@ -60,7 +60,7 @@ def test_good_input_comes_back_as_float_arrays(rng: np.random.Generator) -> None
 def test_what_is_not_real_numbers_is_refused(value: object) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # refused outright: no ComplexWarning, no cast
-        with pytest.raises(InputError, match=r"^q: expected a real numeric array of shape \(3,\)"
+        with pytest.raises(InvalidInput, match=r"^q: expected a real numeric array of shape \(3,\)"
                            ) as info:  # fmt: skip
             as_vector(value, "q", 3)  # type: ignore[arg-type]
     assert info.value.argument == "q"
@@ -81,7 +81,7 @@ def test_what_is_not_real_numbers_is_refused(value: object) -> None:
      (np.array([np.inf, np.nan, 0.0]), r"^q: non-finite entry inf at index \(0,\)$")],
 )  # fmt: skip
 def test_bad_shapes_and_non_finite_entries_name_the_argument(value: object, message: str) -> None:
-    with pytest.raises(InputError, match=message) as info:
+    with pytest.raises(InvalidInput, match=message) as info:
         as_vector(value, "q", 3)  # type: ignore[arg-type]
     assert info.value.argument == "q"
     with pytest.raises(_MyError, match=message):
@@ -89,15 +89,15 @@ def test_bad_shapes_and_non_finite_entries_name_the_argument(value: object, mess
 
 
 def test_batch_shapes() -> None:
-    with pytest.raises(InputError, match=r"^X: expected shape \(N, 6\), got \(3, 5\)$"):
+    with pytest.raises(InvalidInput, match=r"^X: expected shape \(N, 6\), got \(3, 5\)$"):
         as_array(np.zeros((3, 5)), "X", (None, 6))
-    with pytest.raises(InputError, match=r"^X: expected shape \(N, 6\), got \(6,\)$"):
+    with pytest.raises(InvalidInput, match=r"^X: expected shape \(N, 6\), got \(6,\)$"):
         as_array(np.zeros(6), "X", (None, 6))
-    with pytest.raises(InputError, match=r"^X: non-finite entry nan at index \(2, 4\)$"):
+    with pytest.raises(InvalidInput, match=r"^X: non-finite entry nan at index \(2, 4\)$"):
         bad = np.zeros((3, 6))
         bad[2, 4] = np.nan
         as_array(bad, "X", (None, 6))
-    with pytest.raises(InputError, match=r"^X: expected a real numeric array of shape \(N, 6\)"):
+    with pytest.raises(InvalidInput, match=r"^X: expected a real numeric array of shape \(N, 6\)"):
         as_array(np.zeros((3, 6), dtype=bool), "X", (None, 6))
 
 
@@ -122,7 +122,7 @@ def test_finite_number_accepts_and_bounds() -> None:
 def test_finite_number_refuses_what_is_not_a_real_number(value: object) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        with pytest.raises(InputError, match=r"^dt: expected a finite number") as info:
+        with pytest.raises(InvalidInput, match=r"^dt: expected a finite number") as info:
             finite_number(value, "dt")  # type: ignore[arg-type]
     assert info.value.argument == "dt"
     with pytest.raises(_MyError):
@@ -144,7 +144,7 @@ def test_finite_number_refuses_what_is_not_a_real_number(value: object) -> None:
      ("1", {"lower": 0.0, "upper": 2.0}, r"^x: expected a finite number in \[0, 2\), got '1'$")],
 )  # fmt: skip
 def test_finite_number_states_the_expected_range(value: object, bounds: dict, message: str) -> None:
-    with pytest.raises(InputError, match=message) as info:
+    with pytest.raises(InvalidInput, match=message) as info:
         finite_number(value, "x", **bounds)  # type: ignore[arg-type]
     assert info.value.argument == "x"
     with pytest.raises(_MyError):
@@ -153,7 +153,7 @@ def test_finite_number_states_the_expected_range(value: object, bounds: dict, me
 
 @pytest.mark.parametrize("dt", [True, "0.01", 0.0, -0.01, np.nan, np.inf, None])
 def test_positive_refuses_dt(dt: object) -> None:
-    with pytest.raises(InputError, match=r"^dt: expected a finite number > 0, got ") as info:
+    with pytest.raises(InvalidInput, match=r"^dt: expected a finite number > 0, got ") as info:
         positive(dt, "dt")  # type: ignore[arg-type]
     assert info.value.argument == "dt"
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from rrc_pin.kinematics import Kinematics
-from rrc_pin.tasks.task import Task, check_weight
+from rrc_pin.tasks.task import Task, check_weight, task_name
 from solvers.problem import TaskRows
 
 
@@ -26,7 +26,7 @@ class DampingTask(Task):
 
     def __init__(self, weight: float = 1e-3, *, name: str = "damping") -> None:
         self.weight = check_weight(weight)
-        self.name = name
+        self.name = task_name(name)
 
     def frames(self) -> tuple[str, ...]:
         """None."""

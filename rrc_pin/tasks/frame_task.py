@@ -9,7 +9,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics
-from rrc_pin.tasks.task import Task, check_weight
+from rrc_pin.tasks.task import Task, check_weight, task_name
 from solvers.problem import TaskRows
 from solvers.spatial import Reference, check_reference
 from solvers.validation import as_vector
@@ -60,7 +60,7 @@ class FrameTask(Task):
         self.selected = task_rows(rows)
         self.ref = self.check_ref(ref)
         self.weight = check_weight(weight, len(self.selected))
-        self.name = frame if name is None else name
+        self.name = frame if name is None else task_name(name)
         self.twist = np.zeros(len(self.selected)) if twist is None else self.check_twist(twist)
         self._units: dict[float, Array] = {}  # row units by reach: one array per robot frame
 

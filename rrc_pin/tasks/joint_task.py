@@ -6,7 +6,7 @@ import numpy as np
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
-from rrc_pin.tasks.task import Task, check_weight
+from rrc_pin.tasks.task import Task, check_weight, task_name
 from solvers.problem import TaskRows
 from solvers.validation import finite_number
 
@@ -32,7 +32,7 @@ class JointTask(Task):
         self.joint = joint
         self.rate = finite_number(rate, "rate", error=InvalidInput)
         self.weight = check_weight(weight)
-        self.name = f"joint:{joint}" if name is None else name
+        self.name = f"joint:{joint}" if name is None else task_name(name)
 
     def frames(self) -> tuple[str, ...]:
         """None."""

@@ -7,7 +7,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
-from rrc_pin.tasks.task import Task, check_weight
+from rrc_pin.tasks.task import Task, check_weight, task_name
 from solvers.problem import TaskRows
 from solvers.validation import as_vector, positive
 
@@ -40,7 +40,7 @@ class PostureTask(Task):
         self.q_ref = as_vector(q_ref, "q_ref", np.size(q_ref), InvalidInput)
         self.gain = positive(gain, "gain", InvalidInput)
         self.weight = check_weight(weight, self.q_ref.size)
-        self.name = name
+        self.name = task_name(name)
 
     def frames(self) -> tuple[str, ...]:
         """None."""

@@ -67,3 +67,14 @@ def check_weight(weight: float | npt.ArrayLike, size: int | None = None) -> floa
     if (w <= 0.0).any():
         raise InvalidInput("weight", f"expected weights > 0, got {w}")
     return w
+
+
+def task_name(name: object) -> str:
+    """A task's name for the report: a non-empty string.
+
+    Raises:
+        InvalidInput: Anything else, naming ``name``.
+    """
+    if not isinstance(name, str) or not name:
+        raise InvalidInput("name", f"expected a non-empty string, got {name!r}")
+    return name

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from solvers.errors import BackendNotFound, InputError, ProblemError
+from solvers.errors import InvalidInput, ProblemError, UnknownBackend
 from solvers.qp import QP
 from solvers.qp_backends.base import QPBackend, QPSolution
 from solvers.qp_backends.daqp_backend import DaqpBackend
@@ -46,20 +46,20 @@ def make_backend(name: str, time_limit: float | None = None, **options: Any) -> 
         **options: Backend settings (e.g. DAQP's ``iter_limit``, OSQP's ``eps_abs``).
 
     Raises:
-        BackendNotFound: ``name`` is not installed; the error lists the installed ones.
-        InputError: The backend refuses ``options`` (argument ``backend_options``).
+        UnknownBackend: ``name`` is not installed; the error lists the installed ones.
+        InvalidInput: The backend refuses ``options`` (argument ``backend_options``).
     """
     installed = installed_backends()
     if not isinstance(name, str) or name not in installed:
-        raise BackendNotFound(str(name), installed)
+        raise UnknownBackend(str(name), installed)
     try:
         backend = NATIVE[name](**options) if name in NATIVE else QpsolversBackend(name, **options)
         probe = backend.solve(_PROBE)  # every setting is read at the first solve
     except ProblemError as exc:
         reason = str(exc).splitlines()[0][:300]
-        raise InputError("backend_options", f"{name} refused {options}: {reason}") from exc
+        raise InvalidInput("backend_options", f"{name} refused {options}: {reason}") from exc
     if probe.x is None or not np.allclose(probe.x, [0.5, 0.5], atol=1e-3):
-        raise InputError("backend_options", f"{name} with {options} fails a 2-variable QP")
+        raise InvalidInput("backend_options", f"{name} with {options} fails a 2-variable QP")
     backend.reset()
     backend.time_limit = time_limit
     return backend
