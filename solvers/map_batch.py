@@ -71,18 +71,15 @@ class Chain:
 
     def pose(self, q: npt.ArrayLike) -> tuple[Array, Array]:
         """The tool's rotation (3, 3) and origin (3,) [m] at ``q`` (n,), in the base frame."""
-        R, p, _, _ = self._pose(q)
-        return R, p
+        R, P, _ = self.batch(np.reshape(q, (1, self.n)))
+        return R[0], P[0]
 
     def jacobian(self, q: npt.ArrayLike, rows: int = 6) -> Array:
         """Geometric Jacobian (rows, n) of the tool origin, rows [v; w] in base axes.
 
         ``rows`` = 6 (full twist) or 3 (linear velocity only).
         """
-        _, p, origins, axes = self._pose(q)
-        J = np.empty((rows, self.n))
-        _k.chain_jacobian(origins, axes, self.kind, p, J)
-        return J
+        return self.batch(np.reshape(q, (1, self.n)), rows)[2][0]
 
     def batch(self, Q: npt.ArrayLike, rows: int = 6) -> tuple[Array, Array, Array]:
         """Tool rotations (N, 3, 3), origins (N, 3) [m] and Jacobians (N, rows, n) at ``Q``.
@@ -94,13 +91,6 @@ class Chain:
         R, P, J = np.empty((N, 3, 3)), np.empty((N, 3)), np.empty((N, rows, self.n))
         _k.chain_batch(self.rot, self.trans, self.kind, Qa, R, P, J)
         return R, P, J
-
-    def _pose(self, q: npt.ArrayLike) -> tuple[Array, Array, Array, Array]:
-        qv = np.ascontiguousarray(q, dtype=np.float64)
-        R, p = np.empty((3, 3)), np.empty(3)
-        origins, axes = np.empty((self.n, 3)), np.empty((self.n, 3))
-        _k.chain_pose(self.rot, self.trans, self.kind, qv, R, p, origins, axes)
-        return R, p, origins, axes
 
     def reach(self) -> float:
         """Bound on the tool's distance to the first joint's origin [m].
@@ -205,12 +195,14 @@ class GridArrays:
     """A voxel grid as the kernels take it.
 
     Attributes:
-        origin: Corner of voxel (0, 0, 0) (3,) [m], base frame.
+        start: Index (3,) of the grid's first voxel along x, y, z, int64: voxels are
+            aligned on multiples of ``voxel`` in the base frame, voxel ``(i, j, k)`` of the
+            grid spans ``[(start_x + i) voxel, (start_x + i + 1) voxel)`` and alike.
         voxel: Edge of a voxel [m].
         shape: Voxels along x, y, z (3,), int64; keys are ``(ix ny + iy) nz + iz``.
     """
 
-    origin: Array
+    start: IntArray
     voxel: float
     shape: IntArray
 
@@ -238,7 +230,7 @@ def chain_rows(
         out: Rows with at least N rows and no condition columns.
     """
     _k.chain_rows(
-        chain.rot, chain.trans, chain.kind, Q, chain.lower, chain.span, grid.origin,
+        chain.rot, chain.trans, chain.kind, Q, chain.lower, chain.span, grid.start,
         grid.voxel, grid.shape, rows, dexterity, quanta, first, out.keys, out.dirs, out.fmax,
         out.isum, out.imin,
     )  # fmt: skip
@@ -246,7 +238,7 @@ def chain_rows(
 
 def batch_rows(
     P: Array,
-    R: Array,
+    Z: Array,
     J: Array,
     flags: npt.NDArray[np.bool_],
     Q: Array,
@@ -261,7 +253,7 @@ def batch_rows(
 
     Args:
         P: Tool origins (N, 3) [m].
-        R: Tool rotations (N, 3, 3).
+        Z: Tool z axes (N, 3) (the third column of the tool's rotation).
         J: Task Jacobians (N, rows, n) (read with ``dexterity`` only).
         flags: Conditions holding at each sample (N, C), counted and witnessed per voxel.
         Q: The samples (N, n) [rad] (their joint-limit margins).
@@ -273,18 +265,18 @@ def batch_rows(
         out: Rows with at least N rows and C condition columns.
     """
     _k.batch_rows(
-        P, R, J, flags, Q, chain.lower, chain.span, grid.origin, grid.voxel, grid.shape,
+        P, Z, J, flags, Q, chain.lower, chain.span, grid.start, grid.voxel, grid.shape,
         dexterity, quanta, first, out.keys, out.dirs, out.fmax, out.isum, out.imin,
     )  # fmt: skip
 
 
 def singular_values(J: npt.ArrayLike) -> Array:
     """Singular values of ``J`` (m, n), m <= n, descending, by one-sided Jacobi (m,)."""
-    A = np.ascontiguousarray(J, dtype=np.float64)
-    m = A.shape[0]
-    sv = np.empty(m)
-    _k.singular_values(A, np.empty_like(A), np.empty(m), sv)
-    return sv
+    A = np.array(J, dtype=np.float64)[:, :, None]  # a tile of one matrix
+    sv = np.zeros((A.shape[0], 1))
+    _k.singular_values(A, 1, sv)
+    out: Array = sv[:, 0]
+    return out
 
 
 def direction_bins(Z: npt.ArrayLike) -> IntArray:

@@ -4,8 +4,9 @@ Two evaluators, one interface (:class:`ArmKinematics`), numpy and numba only (so
 worker process imports no Pinocchio):
 
 - :class:`BarkerKinematics`: ``barker6`` through its batch closed form (Barker's wrist centre
-  ``(F7, F6, NO + F3)``, R0_6 of Appendix B and the Jacobian of eq. (22), vectorised over the
-  block), with his singular conditions (32), (33) and theta_5 = 0 evaluated at each sample;
+  ``(F7, F6, NO + F3)``, the hand's z axis z5 of eq. (C13) and the Jacobian of eq. (22),
+  vectorised over the block), with his singular conditions (32), (33) and theta_5 = 0
+  evaluated at each sample;
 - :class:`ChainKinematics`: any serial chain through the compiled kernel
   (:mod:`solvers.map_kernels`); ``rrc_pin.maps.kinematics.chain_of`` builds the chain from a
   Pinocchio model.
@@ -121,11 +122,12 @@ class BarkerKinematics(ArmKinematics):
     ) -> None:
         """See :meth:`ArmKinematics.block_rows`."""
         g, n = self.closed_form.geometry, Q.shape[0]
-        t = eqs.trig_batch(Q, six=True)
+        t = eqs.trig_batch(Q)
         F = eqs.f_terms(g, t)
         P = np.stack(np.broadcast_arrays(*eqs.wrist_centre(g, t, F)), axis=1)
-        R = stack_entries(eqs.hand_to_base_rows(g, t), n)
+        _, _, z5 = eqs.wrist_axes(g, t)  # R0_6's third column (eq. C13): the tool's z axis
+        Z = np.stack(np.broadcast_arrays(*z5), axis=1)
         J = stack_entries(eqs.jacobian_rows(g, t), n) if dexterity else np.empty((n, 6, 6))
         values = np.stack([np.abs(F.f1), np.abs(eqs.eq33(g, t)), np.abs(t.s5)], axis=1)
         flags = values <= np.asarray(self.tolerances)
-        map_batch.batch_rows(P, R, J, flags, Q, self.chain, grid, dexterity, quanta, first, out)
+        map_batch.batch_rows(P, Z, J, flags, Q, self.chain, grid, dexterity, quanta, first, out)

@@ -158,12 +158,12 @@ def test_direction_bins(rng):
 
 
 def test_voxel_key_matches_numpy_floor(rng):
-    origin, voxel, shape = np.array([-1.0, -0.5, 0.25]), 0.07, np.array([30, 20, 12])
+    start, voxel, shape = np.array([-14, -7, 3]), 0.07, np.array([30, 20, 12])
     P = rng.uniform(-1.3, 2.0, size=(5000, 3))
-    idx = np.floor((P - origin) / voxel).astype(np.int64)
+    idx = np.floor(P / voxel).astype(np.int64) - start
     inside = np.all((idx >= 0) & (idx < shape), axis=1)
     ref = np.where(inside, (idx[:, 0] * shape[1] + idx[:, 1]) * shape[2] + idx[:, 2], -1)
-    got = [map_kernels.voxel_key(p, origin, voxel, shape) for p in P]
+    got = [map_kernels.voxel_key(x, y, z, start, voxel, shape) for x, y, z in P]
     assert got == ref.tolist()
     assert inside.any() and not inside.all()
 
@@ -231,12 +231,12 @@ JIT_FREE = textwrap.dedent(
     out = {}
     for name in ("panda", "barker6"):
         kin = arm_kinematics(rrc_pin.load(name))
-        plan = Plan(96, 64)
+        plan = Plan(40, 32)
         grid = chain_grid(kin.chain, 0.05)
         table = VoxelTable(2 + len(kin.conditions), 1 + len(kin.conditions))
         for b in range(plan.blocks):
             Q = block_samples(kin.chain, 7, plan, b)
-            rows = Rows.empty(64, len(kin.conditions)).head(len(Q))
+            rows = Rows.empty(32, len(kin.conditions)).head(len(Q))
             kin.block_rows(Q, grid.arrays, True, quanta(kin.chain, kin.rows), plan.first(b), rows)
             table.add(rows)
         s = table.sparse()
@@ -258,4 +258,4 @@ def test_the_same_source_runs_without_the_jit():
     with contextlib.redirect_stdout(here):
         exec(JIT_FREE, {"__name__": "jit_free"})
     assert json.loads(done.stdout) == json.loads(here.getvalue())
-    assert len(json.loads(here.getvalue())["panda"][0]) > 10
+    assert len(json.loads(here.getvalue())["panda"][0]) > 5

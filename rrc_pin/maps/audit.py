@@ -174,7 +174,7 @@ def audit(
     voxels: int = 1000,
     *,
     seed: int = 0,
-    starts: int = 16,
+    starts: int = 32,
     max_steps: int = 150,
 ) -> AuditReport:
     """Confirm by IK a seeded random choice of ``voxels`` voxels the map reports reached.
