@@ -266,8 +266,11 @@ def run(quick: bool) -> dict[str, Any]:
         "steps": report.steps_total, "starts_max": int(report.starts.max()),
     }  # fmt: skip
     return {
-        "sizes": {"per_core_samples": QUICK_SAMPLES if quick else SAMPLES,
-                  "rounds": 1 if quick else ROUNDS, "voxel": VOXEL},  # fmt: skip
+        "sizes": {
+            "per_core_samples": QUICK_SAMPLES if quick else SAMPLES,
+            "rounds": 1 if quick else ROUNDS,
+            "voxel": VOXEL,
+        },
         **rates,
         "scaling": scale,
         "projection": projection,
@@ -292,9 +295,10 @@ def readme_table(results: dict[str, Any]) -> str:
     ]
     for c in results["cases"]:
         key = f"{c['arm']}/{c['method']}/{'dexterity' if c['dexterity'] else 'reach'}"
+        how = "batch closed form" if c["method"] == "closed_form" else "compiled chain"
+        what = "reach + dexterity" if c["dexterity"] else "reach"
         rows.append(
-            f"| {c['arm']} | {'batch closed form' if c['method'] == 'closed_form' else 'compiled chain'} "
-            f"| {'reach + dexterity' if c['dexterity'] else 'reach'} | {_rate(c['per_core_per_s'])} "
+            f"| {c['arm']} | {how} | {what} | {_rate(c['per_core_per_s'])} "
             f"| {c['vs_pinocchio_loop']:.1f}x | {results['projection'][key]:.0f} s |"
         )
     s, q, a = results["scaling"], results["query"], results["audit"]

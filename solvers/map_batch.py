@@ -79,7 +79,8 @@ class Chain:
 
         ``rows`` = 6 (full twist) or 3 (linear velocity only).
         """
-        return self.batch(np.reshape(q, (1, self.n)), rows)[2][0]
+        J: Array = self.batch(np.reshape(q, (1, self.n)), rows)[2][0]
+        return J
 
     def batch(self, Q: npt.ArrayLike, rows: int = 6) -> tuple[Array, Array, Array]:
         """Tool rotations (N, 3, 3), origins (N, 3) [m] and Jacobians (N, rows, n) at ``Q``.

@@ -89,9 +89,8 @@ class Grid:
     @property
     def arrays(self) -> GridArrays:
         """The grid as the kernels take it."""
-        return GridArrays(
-            np.asarray(self.start, dtype=np.int64), self.voxel, np.asarray(self.shape, dtype=np.int64)
-        )
+        start = np.asarray(self.start, dtype=np.int64)
+        return GridArrays(start, self.voxel, np.asarray(self.shape, dtype=np.int64))
 
     def keys_of(self, points: npt.ArrayLike) -> IntArray:
         """Voxel keys (N,) of ``points`` (N, 3) [m]; -1 outside the grid."""
