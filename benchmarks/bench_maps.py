@@ -22,6 +22,8 @@ Run from a checkout: ``python benchmarks/bench_maps.py --out DIR`` (``--record``
 - **1 -> 2 workers**: the wall time of ``maps.capability(panda, 2^20, 5 cm)`` with 1 and
   with 2 worker threads of the in-process cluster (the driver's loop: tasks, merges; no
   cluster start-up), interleaved for the rounds; the machine has 2 cores shared with others.
+  Beside it, the control: ``numpy.sin`` over 2^21 angles, twice on one thread against once
+  on each of two threads, what the machine gives two threads of plain numerics.
 - **Projection**: a 10^9-sample map on 64 cores at the measured per-core rate, assuming the
   tasks scale linearly (each task is independent; the driver's merge of a sparse result
   costs about 1 % of the task's compute at 5 cm, measured in the scaling run).
@@ -178,10 +180,38 @@ def per_core(quick: bool) -> dict[str, Any]:
     return {"cases": out, "pinocchio_loop": loops, "round_loads": loads}
 
 
+def control_speedup(rounds: int) -> list[float]:
+    """What the machine gives two threads of plain numerics: ``numpy.sin`` over 2^21
+    angles (it releases the GIL) on one thread twice, then on two threads at once."""
+    import threading
+
+    x = np.random.default_rng(0).uniform(-3.0, 3.0, 2**21)
+
+    def work() -> None:
+        for _ in range(4):
+            np.sin(x)
+
+    out = []
+    for _ in range(rounds):
+        t = time.perf_counter()
+        work()
+        work()
+        one = time.perf_counter() - t
+        threads = [threading.Thread(target=work) for _ in range(2)]
+        t = time.perf_counter()
+        for th in threads:
+            th.start()
+        for th in threads:
+            th.join()
+        out.append(one / (time.perf_counter() - t))
+    return out
+
+
 def scaling(quick: bool) -> tuple[dict[str, Any], maps.CapabilityMap]:
     """Wall time of one map with 1 and 2 worker threads, interleaved."""
     samples = QUICK_SCALE if quick else SCALE
     rounds = 1 if quick else ROUNDS
+    control = control_speedup(rounds)
     walls: dict[int, list[float]] = {1: [], 2: []}
     computes: dict[int, list[float]] = {1: [], 2: []}
     last = None
@@ -206,6 +236,8 @@ def scaling(quick: bool) -> tuple[dict[str, Any], maps.CapabilityMap]:
         "speedup": statistics.median(speedups),
         "speedup_min": min(speedups),
         "speedup_max": max(speedups),
+        "control_speedup": statistics.median(control),
+        "control_rounds": control,
         "rounds": {"1": walls[1], "2": walls[2]},
         "compute_s": {"1": computes[1], "2": computes[2]},
         "memory": last.meta["memory"],
@@ -312,7 +344,9 @@ def readme_table(results: dict[str, Any]) -> str:
         "in docs/benchmarks.md). 1 -> 2 workers "
         f"(panda, {s['samples']:,} samples, reach): {s['one_worker_s']:.2f} s -> "
         f"{s['two_workers_s']:.2f} s, {s['speedup']:.2f}x (rounds {s['speedup_min']:.2f}-"
-        f"{s['speedup_max']:.2f}x). Query `map.at`: {q['one_point_us']:.0f} us a point, "
+        f"{s['speedup_max']:.2f}x; numpy's sin on two threads at the same time: "
+        f"{s.get('control_speedup', float('nan')):.2f}x). Query `map.at`: "
+        f"{q['one_point_us']:.0f} us a point, "
         f"{q['batch_us_per_point']:.2f} us a point in batches of {q['batch_points']:,}. IK "
         f"audit (panda, 7 joints): {100 * a['confirmed']:.1f} % of {a['voxels']} voxels "
         f"confirmed ({a['seconds']:.0f} s). Load average {load['start'][0]:.2f} at the start, "
@@ -360,12 +394,12 @@ def plot(results: dict[str, Any], path: Path) -> bool:
     plt = pyplot()
     if plt is None:
         return False
-    fig, (left, right) = plt.subplots(1, 2, figsize=(13, 4.8), width_ratios=[2.2, 1])
+    fig, (left, right) = plt.subplots(1, 2, figsize=(13, 5.2), width_ratios=[2.2, 1])
     cases = results["cases"]
     y = np.arange(len(cases))
     left.barh(y + 0.2, [c["per_core_per_s"] for c in cases], 0.4, label="rrc_pin.maps")
     left.barh(y - 0.2, [c["pinocchio_loop_per_s"] for c in cases], 0.4,
-              label="Pinocchio in a Python loop (same statistics' kinematics)")  # fmt: skip
+              label="Pinocchio in a Python loop: FK (reach), FK + J + SVD (dexterity)")  # fmt: skip
     for i, c in enumerate(cases):
         left.text(c["per_core_per_s"] * 1.1, i + 0.2, f"{c['vs_pinocchio_loop']:.1f}x",
                   va="center", fontsize=8)  # fmt: skip
@@ -373,13 +407,17 @@ def plot(results: dict[str, Any], path: Path) -> bool:
     left.set_xscale("log")
     left.set_xlabel("samples per CPU-second of one thread (median of the rounds)")
     left.axvline(1e6, color="grey", ls=":", lw=1)
-    left.text(1e6, len(cases) - 0.4, " 10^6/s", color="grey", fontsize=8)
-    left.legend(loc="lower right", fontsize=8)
+    left.text(1e6, len(cases) - 0.6, " 10^6 / s", color="grey", fontsize=8, va="top")
+    left.set_xlim(right=4e6)
+    left.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, fontsize=8)
     left.set_title("Per-core rate of a map's work (draw, evaluate, accumulate)")
     s = results["scaling"]
     right.bar(["1 worker", "2 workers"], [s["one_worker_s"], s["two_workers_s"]])
     right.set_ylabel("wall time [s] (median of the rounds)")
-    right.set_title(f"panda, {s['samples']:,} samples: {s['speedup']:.2f}x")
+    right.set_title(
+        f"1 -> 2 workers, panda, {s['samples']:,} samples:\n{s['speedup']:.2f}x (numpy's sin "
+        f"on 2 threads: {s.get('control_speedup', float('nan')):.2f}x)", fontsize=10
+    )
     load = results["load_average"]
     fig.suptitle(f"Capability maps, 2 shared cores, load average {load['start'][0]:.2f} -> "
                  f"{load['end'][0]:.2f}")  # fmt: skip

@@ -233,3 +233,18 @@ def test_outputs_summary_and_queries(tmp_path):
     # means from the fixed-point sums: within half a quantum of the float means
     k = m.grid.keys_of([[0.4, 0.1, 0.5]])[0]
     assert m.column("count")[k] == q.samples[0]
+
+
+def test_the_readmes_maps_example_runs():
+    """README's maps example, with fewer samples and the progress bar off."""
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    block = text.split("## Capability maps", 1)[1].split("```python", 1)[1].split("```", 1)[0]
+    block = block.replace("samples=10**6", "samples=2**13, progress=False")
+    block = block.replace("maps.audit(m, rrc_pin.load(\"panda\"), 100)",
+                          "maps.audit(m, rrc_pin.load(\"panda\"), 3)")  # fmt: skip
+    namespace: dict = {}
+    exec(compile(block, "README.md", "exec"), namespace)
+    assert namespace["q"].samples.shape == (2,) and namespace["report"].confirmed == 1.0
+    assert namespace["c"].frames == ("left/panda_hand_tcp", "right/panda_hand_tcp")
