@@ -265,6 +265,7 @@ def test_file_system_errors_are_one_line_and_exit_2(tmp_path, capsys, monkeypatc
         assert err.startswith(f"rrc-pin {argv[0]}: ") and err.count("\n") == 1, err
 
 
+@pytest.mark.compiled
 def test_map_writes_the_map_its_summary_plots_and_audit(tmp_path, monkeypatch, capsys):
     """`rrc-pin map ARM`: the Zarr store, the summary, the plots and the IK audit; by default
     in a new ./rrc-pin-map-<timestamp>; a cell (two hands) gets the cell's summary."""
@@ -298,6 +299,7 @@ def test_map_writes_the_map_its_summary_plots_and_audit(tmp_path, monkeypatch, c
         (["--seed", "5"], "rrc-pin map: out: "),
     ],
 )
+@pytest.mark.compiled
 def test_map_errors_are_one_line_and_change_nothing(extra, message, tmp_path, capsys):
     pytest.importorskip("distributed")
     out = tmp_path / "m"

@@ -16,6 +16,8 @@ from rrc_pin import maps
 from rrc_pin.errors import InvalidInput
 from rrc_pin.maps.audit import boundary
 
+pytestmark = pytest.mark.compiled
+
 
 @pytest.mark.parametrize(("arm", "voxel"), [("panda", 0.05), ("rrc_k1607", 0.05),
                                             ("kr5_3r", 0.1)])  # fmt: skip

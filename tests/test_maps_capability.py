@@ -15,6 +15,8 @@ import rrc_pin
 from rrc_pin import maps
 from rrc_pin.errors import ForeignMap, FrameNotFound, InvalidInput
 
+pytestmark = pytest.mark.compiled
+
 QUIET = {"progress": False, "workers": 2}
 
 

@@ -10,6 +10,8 @@ pytest.importorskip("distributed")
 import rrc_pin
 from rrc_pin import maps
 
+pytestmark = pytest.mark.compiled
+
 KW = {"block_size": 2**12, "progress": False, "workers": 2, "seed": 6}
 
 

@@ -14,6 +14,8 @@ from rrc_pin import maps  # noqa: E402
 from rrc_pin.errors import InvalidInput, SchedulerUnreachable  # noqa: E402
 from rrc_pin.maps import driver  # noqa: E402
 
+pytestmark = pytest.mark.compiled
+
 SMALL = {"block_size": 2**10, "progress": False}
 """Blocks of 2^10 samples keep these maps fast; one test uses the default 2^15."""
 

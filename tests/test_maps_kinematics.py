@@ -14,6 +14,8 @@ from solvers.map_batch import Rows
 from solvers.map_kinematics import BarkerKinematics, ChainKinematics, task_rows
 from solvers.map_sampling import Plan, block_samples
 
+pytestmark = pytest.mark.compiled
+
 
 def test_the_evaluator_follows_the_arm():
     assert isinstance(arm_kinematics(rrc_pin.load("barker6")), BarkerKinematics)

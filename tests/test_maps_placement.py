@@ -10,6 +10,8 @@ pytest.importorskip("distributed")
 from rrc_pin import maps
 from rrc_pin.errors import InvalidInput
 
+pytestmark = pytest.mark.compiled
+
 
 @pytest.fixture(scope="module")
 def first():

@@ -13,6 +13,8 @@ pytest.importorskip("distributed")
 from rrc_pin import maps
 from rrc_pin.maps import plots
 
+pytestmark = pytest.mark.compiled
+
 
 def test_without_matplotlib_nothing_is_drawn(tmp_path, monkeypatch):
     m = maps.capability("kr5_3r", 2**10, 0.3, seed=1, progress=False, workers=1,

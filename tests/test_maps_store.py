@@ -10,6 +10,8 @@ pytest.importorskip("zarr")
 from rrc_pin import maps
 from rrc_pin.errors import InvalidInput
 
+pytestmark = pytest.mark.compiled
+
 
 def test_round_trip(tmp_path):
     m = maps.capability("barker6", 3000, 0.1, seed=2, block_size=1024, progress=False,
