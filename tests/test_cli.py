@@ -294,7 +294,6 @@ def test_map_writes_the_map_its_summary_plots_and_audit(tmp_path, monkeypatch, c
     [
         (["--voxel", "0"], "rrc-pin map: voxel: expected a finite length > 0 [m], got 0.0"),
         (["--samples", "0"], "rrc-pin map: samples: expected 1 <= samples"),
-        (["--scheduler", "tcp://127.0.0.1:9"], "rrc-pin map: scheduler: no Dask scheduler at"),
         (["--workers", "0"], "rrc-pin map: workers: expected an int >= 1, got 0"),
         (["--seed", "5"], "rrc-pin map: out: "),
     ],
