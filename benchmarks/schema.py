@@ -19,7 +19,9 @@ import math
 from collections.abc import Iterator
 from typing import Any
 
-KNOWN = ("closed_form", "resolver", "tasks", "study", "scaling", "controller", "control_schemes")
+KNOWN = (
+    "closed_form", "resolver", "tasks", "study", "scaling", "controller", "control_schemes", "maps",
+)
 MACHINE = ("cpu", "cores", "python", "numpy", "pinocchio")
 STATS = ("median_us", "p10_us", "p90_us", "p99_us")
 MINK_TOL = 1e-9
@@ -46,6 +48,7 @@ def problems(results: dict[str, Any]) -> list[str]:
         "scaling": _scaling,
         "controller": _controller,
         "control_schemes": _control_schemes,
+        "maps": _maps,
     }[name]
     out += list(check(results))
     return out
@@ -211,6 +214,32 @@ def _control_schemes(results: dict[str, Any]) -> Iterator[str]:
         yield "timing: empty"
     for arm in timing:
         yield from _rows(f"timing.{arm.get('arm')}", arm)
+
+
+def _maps(results: dict[str, Any]) -> Iterator[str]:
+    cases = results.get("cases") or []
+    if not cases:
+        yield "cases: empty"
+    for c in cases:
+        where = f"cases.{c.get('label')}"
+        for key in ("per_core_per_s", "wall_per_s", "pinocchio_loop_per_s", "vs_pinocchio_loop"):
+            if not _positive(c.get(key)):
+                yield f"{where}.{key}: expected a positive number"
+    scaling = results.get("scaling") or {}
+    for key in ("one_worker_s", "two_workers_s", "speedup"):
+        if not _positive(scaling.get(key)):
+            yield f"scaling.{key}: expected a positive number"
+    projection = results.get("projection") or {}
+    if not projection or not all(
+        _positive(v) for k, v in projection.items() if k not in ("assumes", "samples", "cores")
+    ):
+        yield "projection: expected positive times"
+    for key in ("one_point_us", "batch_us_per_point"):
+        if not _positive((results.get("query") or {}).get(key)):
+            yield f"query.{key}: expected a positive time"
+    confirmed = (results.get("audit") or {}).get("confirmed")
+    if not (_finite(confirmed) and 0.0 <= confirmed <= 1.0):
+        yield "audit.confirmed: expected a share in [0, 1]"
 
 
 def _finite(value: Any) -> bool:

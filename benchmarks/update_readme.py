@@ -40,6 +40,7 @@ BENCHMARKS = {
         "bench_control_schemes.py",
         "Control schemes on Pinocchio dynamics (Nguyen & Zhou section 6)",
     ),
+    "maps": ("bench_maps.py", "Capability maps: samples per second per core, workers, queries"),
 }
 """Benchmark name: (script, title), in the order of the documents."""
 DOCS_ONLY = ("study", "scaling", "control_schemes")
@@ -217,6 +218,18 @@ def closing_note(found: dict[str, dict[str, Any]]) -> list[str]:
             )
             + "."
         )
+    mp = found.get("maps")
+    if mp:
+        panda = [c for c in mp["cases"] if c["arm"] == "panda"]
+        out.append(
+            "- Capability maps, samples per CPU-second of one thread: "
+            + ", ".join(
+                f"{c['label']} {c['per_core_per_s'] / 1e3:,.0f} k ({c['vs_pinocchio_loop']:.1f}x "
+                "Pinocchio in a loop)"
+                for c in panda
+            )
+            + f"; 1 -> 2 workers {mp['scaling']['speedup']:.2f}x."
+        )
     ctl = found.get("controller")
     if ctl:
         target = 100 * ctl["settings"]["target_overhead"]
@@ -252,6 +265,9 @@ def _machine_table(found: dict[str, dict[str, Any]]) -> list[str]:
         ("proxsuite", "proxsuite"),
         ("quadprog", "quadprog"),
         ("clarabel", "clarabel"),
+        ("numba", "numba"),
+        ("dask", "Dask"),
+        ("zarr", "zarr"),
         ("blas_threads", "BLAS threads"),
     ]
     names = list(found)

@@ -1,4 +1,4 @@
-"""Command line: ``rrc-pin arms | demo | check | bench | urdf --check|--write | guidance``."""
+"""Command line: ``rrc-pin arms | demo | check | bench | urdf --check|--write | guidance | map``."""
 
 from __future__ import annotations
 
@@ -124,6 +124,44 @@ def parser() -> argparse.ArgumentParser:
         help="the illustration: " + ", ".join(map(str, ILLUSTRATIONS[:-1]))
         + f" or {ILLUSTRATIONS[-1]} (3 is 1 and 2 in one run)",
     )
+    mapping = sub.add_parser(
+        "map",
+        help="capability map of an arm or a cell (needs the maps extra): reachability, "
+        "orientation coverage, manipulability, singular conditions per voxel, on Dask",
+    )
+    mapping.add_argument("robot", metavar="ARM|CELL", help="a name or a URDF path")
+    mapping.add_argument("--samples", type=int, default=10**6, help="samples per tool frame")
+    mapping.add_argument("--voxel", type=float, default=0.05, help="voxel edge [m]")
+    mapping.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="folder for the map (default: a new ./rrc-pin-map-<timestamp>); the same folder "
+        "resumes an interrupted run",
+    )
+    mapping.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="a dask.distributed scheduler (tcp://host:8786); default: this machine",
+    )
+    mapping.add_argument(
+        "--workers", type=int, default=None, help="threads on this machine (default: its cores)"
+    )
+    mapping.add_argument("--seed", type=int, default=0, help="seed of the samples")
+    mapping.add_argument(
+        "--no-dexterity",
+        action="store_true",
+        help="skip the singular values (manipulability, sigma_min): faster",
+    )
+    mapping.add_argument(
+        "--audit",
+        type=int,
+        default=0,
+        metavar="K",
+        help="confirm K random reached voxels by resolved-rate IK through the resolver",
+    )
     urdf = sub.add_parser("urdf", help="compare or rewrite the committed URDFs")
     mode = urdf.add_mutually_exclusive_group(required=True)
     mode.add_argument("--check", action="store_true", help="fail if a committed file differs")
@@ -162,6 +200,8 @@ def run(args: argparse.Namespace) -> int:
         from rrc_pin.cross_check import run_cross_check
 
         return run_cross_check(samples=args.samples)
+    if args.command == "map":
+        return map_command(args)
     from rrc_pin.demo import run_demo
 
     return run_demo(args.arm, out=args.out, quick=args.quick)
@@ -238,6 +278,7 @@ BENCHMARKS = (
     "scaling",
     "controller",
     "control_schemes",
+    "maps",
 )
 BENCH_MODULES = {
     "closed_form": ("matplotlib",),
@@ -247,6 +288,7 @@ BENCH_MODULES = {
     "tasks": ("pink", "matplotlib"),
     "controller": ("matplotlib",),
     "control_schemes": ("matplotlib",),
+    "maps": ("distributed", "zarr", "matplotlib"),
 }
 """What each benchmark needs from the bench extra (placo and mink are optional: their rows are
 skipped when they are absent)."""
@@ -314,6 +356,51 @@ def bench_command(
     return code
 
 
+def map_command(args: argparse.Namespace) -> int:
+    """``rrc-pin map``: the map of an arm (one tool frame) or a cell (several) into a folder.
+
+    Writes ``map.zarr`` (per frame for a cell), ``summary.md``/``.json``, the plots (with
+    matplotlib) and, with ``--audit K``, ``audit.json``; prints the summary table.
+
+    Raises:
+        RrcPinError: Bad arguments (named), an unreachable scheduler, another map's blocks
+            in the folder, the maps extra missing.
+    """
+    import json
+
+    from rrc_pin import maps
+
+    robot = load(args.robot)
+    out: Path = args.out if args.out is not None else _fresh(Path.cwd(), "rrc-pin-map")
+    dexterity = not args.no_dexterity
+    if len(robot.tool_frames) > 1:
+        cell = maps.cell_map(robot, args.samples, args.voxel, args.scheduler, seed=args.seed,
+                             out=out, workers=args.workers, dexterity=dexterity)  # fmt: skip
+        maps.plot_cell(cell, out)
+        print(cell.summary_table())
+    else:
+        m = maps.capability(robot, args.samples, args.voxel, args.scheduler, seed=args.seed,
+                            out=out, workers=args.workers, dexterity=dexterity)  # fmt: skip
+        maps.plot_map(m, out)
+        print(m.summary_table())
+        if args.audit > 0:
+            report = maps.audit(m, robot, args.audit, seed=args.seed)
+            record = {
+                "voxels": int(report.keys.size),
+                "confirmed": report.confirmed,
+                "failures": report.failures.tolist(),
+                "seconds": report.seconds,
+                "steps": report.steps_total,
+            }
+            (out / "audit.json").write_text(json.dumps(record, indent=1) + "\n")
+            print(
+                f"audit: {report.confirmed:.1%} of {report.keys.size} reached voxels confirmed "
+                f"by IK through the resolver ({report.seconds:.1f} s)"
+            )
+    print(f"rrc-pin map: wrote {out} (resume with --out {out})")
+    return 0
+
+
 def _installed(module: str) -> bool:
     """Whether ``module`` can be imported (a None entry in sys.modules counts as missing)."""
     try:
@@ -322,17 +409,27 @@ def _installed(module: str) -> bool:
         return False
 
 
-def _new_folder(parent: Path) -> Path:
-    """A folder ``rrc-pin-bench-<timestamp>`` in ``parent`` that did not exist (created)."""
+def _fresh(parent: Path, prefix: str) -> Path:
+    """A path ``<prefix>-<timestamp>`` in ``parent`` that does not exist (not created)."""
     stamp = time.strftime("%Y%m%d-%H%M%S")
     for k in range(1000):
-        path = parent / (f"rrc-pin-bench-{stamp}" + (f"-{k}" if k else ""))
+        path = parent / (f"{prefix}-{stamp}" + (f"-{k}" if k else ""))
+        if not path.exists():
+            return path
+    raise FileExistsError(f"{parent}: no free {prefix}-{stamp}-N name")
+
+
+def _new_folder(parent: Path, prefix: str = "rrc-pin-bench") -> Path:
+    """A folder ``<prefix>-<timestamp>`` in ``parent`` that did not exist (created)."""
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    for k in range(1000):
+        path = parent / (f"{prefix}-{stamp}" + (f"-{k}" if k else ""))
         try:
             path.mkdir(parents=True)
         except FileExistsError:
             continue
         return path
-    raise FileExistsError(f"{parent}: no free rrc-pin-bench-{stamp}-N folder")
+    raise FileExistsError(f"{parent}: no free {prefix}-{stamp}-N folder")
 
 
 def _run_script(script: Path, args: list[str]) -> int:

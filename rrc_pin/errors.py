@@ -10,9 +10,12 @@ from __future__ import annotations
 from solvers.errors import InvalidInput, RrcPinError, UnknownBackend
 
 __all__ = [
+    "ForeignMap",
     "FrameNotFound",
     "InvalidInput",
+    "MissingExtra",
     "RrcPinError",
+    "SchedulerUnreachable",
     "ToolFrameRequired",
     "URDFError",
     "UnknownArm",
@@ -82,3 +85,45 @@ class ToolFrameRequired(InvalidInput):
     def __init__(self, argument: str, context: str, candidates: list[str]) -> None:
         self.candidates = candidates
         super().__init__(argument, f"{context}; name one of: {', '.join(candidates)}")
+
+
+class ForeignMap(InvalidInput):
+    """An output folder that holds another map's partial results (refused, never mixed).
+
+    Attributes:
+        folder: The folder of partial results.
+    """
+
+    def __init__(self, folder: object, reason: str) -> None:
+        self.folder = folder
+        super().__init__(
+            "out", f"{folder} holds {reason}; give another folder or delete this one"
+        )
+
+
+class SchedulerUnreachable(InvalidInput):
+    """No Dask scheduler answered at the address given (within the connection timeout).
+
+    Attributes:
+        address: The address tried.
+    """
+
+    def __init__(self, address: str, reason: str) -> None:
+        self.address = address
+        super().__init__("scheduler", f"no Dask scheduler at {address!r} ({reason})")
+
+
+class MissingExtra(RrcPinError, ImportError):
+    """A feature needs packages of an optional extra that are not installed.
+
+    Attributes:
+        extra: The extra to install (``pip install "rrc-pin[<extra>]"``).
+        missing: The modules that failed to import.
+    """
+
+    def __init__(self, extra: str, missing: list[str]) -> None:
+        self.extra = extra
+        self.missing = missing
+        super().__init__(
+            f"{', '.join(missing)} not installed: pip install \"rrc-pin[{extra}]\""
+        )

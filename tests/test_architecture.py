@@ -15,7 +15,8 @@ import rrc_pin
 import solvers
 
 ROOT = Path(__file__).resolve().parents[1]
-UPPER = {"resolver", "control", "controller", "guidance", "cell", "cli", "demo", "dynamics"}
+UPPER = {"resolver", "control", "controller", "guidance", "cell", "cli", "demo", "dynamics", "maps",
+         "console"}
 LOWER = {"dh", "models", "urdf_export", "urdf_compare", "robot", "loading", "errors", "cross_check"}
 
 
@@ -51,6 +52,31 @@ def test_lower_layers_never_import_upper_ones():
                     rel,
                     name,
                 )
+
+
+def _imports(path: Path) -> list[str]:
+    names = []
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.module:
+            names += [node.module] + [f"{node.module}.{a.name}" for a in node.names]
+        elif isinstance(node, ast.Import):
+            names += [a.name for a in node.names]
+    return names
+
+
+def test_only_the_entry_points_import_the_maps():
+    """The capability maps sit above the resolver and the control loop (beside guidance and
+    dynamics): only they themselves and the entry points (cli, console) import them; and
+    the maps import no entry point."""
+    for path in (ROOT / "rrc_pin").rglob("*.py"):
+        rel = path.relative_to(ROOT / "rrc_pin").with_suffix("")
+        names = _imports(path)
+        if rel.parts[0] in ("maps", "cli", "console"):
+            if rel.parts[0] == "maps":
+                assert not any(n.split(".")[:2] in (["rrc_pin", "cli"], ["rrc_pin", "console"])
+                               for n in names), rel  # fmt: skip
+            continue
+        assert not any(n.startswith("rrc_pin.maps") for n in names), (rel, names)
 
 
 @pytest.mark.parametrize("package", [rrc_pin, solvers])

@@ -287,3 +287,53 @@ def test_file_system_errors_are_one_line_and_exit_2(tmp_path, capsys, monkeypatc
         assert main(argv) == 2
         err = capsys.readouterr().err
         assert err.startswith(f"rrc-pin {argv[0]}: ") and err.count("\n") == 1, err
+
+
+@pytest.mark.compiled
+def test_map_writes_the_map_its_summary_plots_and_audit(tmp_path, monkeypatch, capsys):
+    """`rrc-pin map ARM`: the Zarr store, the summary, the plots and the IK audit; by default
+    in a new ./rrc-pin-map-<timestamp>; a cell (two hands) gets the cell's summary."""
+    pytest.importorskip("distributed")
+    out = tmp_path / "kr5"
+    args = ["map", "kr5_3r", "--samples", "20000", "--voxel", "0.2", "--workers", "1"]
+    assert main([*args, "--out", str(out), "--audit", "5"]) == 0
+    text = capsys.readouterr().out
+    assert "| voxels_reached |" in text and "audit: 100.0% of 5 reached voxels" in text
+    for name in ("map.zarr", "summary.md", "summary.json", "audit.json", "blocks"):
+        assert (out / name).exists(), name
+    for name in ("slices.png", "view3d.png"):
+        assert (out / name).stat().st_size > 10_000, name
+    assert json.loads((out / "audit.json").read_text())["confirmed"] == 1.0
+    monkeypatch.chdir(tmp_path)
+    assert main(["map", "baxter", "--samples", "2048", "--voxel", "0.3", "--no-dexterity"]) == 0
+    (folder,) = tmp_path.glob("rrc-pin-map-*")
+    assert re.fullmatch(r"rrc-pin-map-\d{8}-\d{6}", folder.name)
+    assert (folder / "cell_slices.png").stat().st_size > 10_000
+    assert (folder / "cell_view3d.png").stat().st_size > 10_000 and (folder / "summary.md").exists()
+    assert "shared_volume_m3" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--voxel", "0"], "rrc-pin map: voxel: expected a finite length > 0 [m], got 0.0"),
+        (["--samples", "0"], "rrc-pin map: samples: expected 1 <= samples"),
+        (["--workers", "0"], "rrc-pin map: workers: expected an int >= 1, got 0"),
+        (["--seed", "5"], "rrc-pin map: out: "),
+    ],
+)
+@pytest.mark.compiled
+def test_map_errors_are_one_line_and_change_nothing(extra, message, tmp_path, capsys):
+    pytest.importorskip("distributed")
+    out = tmp_path / "m"
+    base = ["map", "kr5_3r", "--samples", "3000", "--voxel", "0.2", "--out", str(out)]
+    if extra[0] == "--seed":  # another map already in the folder
+        assert main([*base, "--workers", "1"]) == 0
+        capsys.readouterr()
+    files = sorted(p for p in out.rglob("*") if p.is_file()) if out.exists() else []
+    before = snapshot(files)
+    assert main([*base, *extra]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith(message), err
+    after = sorted(p for p in out.rglob("*") if p.is_file()) if out.exists() else []
+    assert after == files and snapshot(after) == before

@@ -66,6 +66,7 @@ from solvers.closed_form.barker_equations import (
     trig_batch,
     truncated_solve,
     tvel_frame2,
+    wrist_centre,
     wrist_regular,
     wrist_s2,
     wrist_terms,
@@ -421,6 +422,24 @@ class BarkerClosedForm(ClosedForm):
             for part in blocks(idx.size):
                 i = idx[part]  # np.take: a third of the time of Q[i] (measured)
                 out[i] = np.stack(rates(np.take(Q, i, 0), np.take(X, i, 0), True)[0], axis=1)
+        return out
+
+    def wrist_centre(self, q: npt.ArrayLike) -> Array:
+        """The wrist centre p06 (3,) [m] in base coordinates at ``q`` (6,) [rad]."""
+        return first(self.wrist_centre_batch(row(q, "q", 6)))
+
+    def wrist_centre_batch(self, Q: npt.ArrayLike) -> Array:
+        """The wrist centres (N, 3) [m] at ``Q`` (N, 6): ``(F7, F6, NO + F3)``.
+
+        Raises:
+            InputError: ``Q`` is not a finite (N, 6) array.
+        """
+        Q = as_array(Q, "Q", (None, 6))
+        t = trig_batch(Q)
+        out: Array = np.stack(
+            np.broadcast_arrays(*wrist_centre(self.geometry, t, f_terms(self.geometry, t))),
+            axis=1,
+        )
         return out
 
     def hand_to_base(self, q: npt.ArrayLike) -> Array:

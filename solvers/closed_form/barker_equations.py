@@ -152,6 +152,17 @@ def f_terms(g: BarkerGeometry, t: Trig) -> FTerms:
     return FTerms(f1, g.f2, f3, f4, f5, f6, f7)
 
 
+def wrist_centre(g: BarkerGeometry, t: Trig, F: FTerms) -> tuple[Entry, Entry, Entry]:
+    """p06, the wrist centre in base coordinates [m]: ``(F7, F6, NO + F3)``.
+
+    M's first column (eq. (26)) is ``z0 x p06 = (-F6, F7, 0)`` (eqs (14)-(16), p00 = 0),
+    which gives the horizontal components; the height is the third entry of the fourth
+    column of ``A1 A2 A3 A4`` (Appendix A): ``NO + ES C2 + SAL3 WE C23 - A3 S23 = NO + F3``
+    (eqs (29), (30)).
+    """
+    return F.f7, F.f6, g.no + F.f3
+
+
 def eq33(g: BarkerGeometry, t: Trig) -> Entry:
     """SAL3 WE S3 + A3 C3 [m]: zero on Barker's singularity (33) (Appendix D, eq. (D8))."""
     return g.swe * t.s3 + g.a3 * t.c3
