@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 
 import rrc_pin
-from rrc_pin.console.scene import ARROW_TIME, Scene, wxyz
+from rrc_pin.console.scene import ARROW_TIME, Scene, pose_of, wxyz
 from rrc_pin.console.visuals import visuals_of
 
 viser = pytest.importorskip("viser")
@@ -82,3 +82,12 @@ def test_wxyz_is_the_rotation():
     R = pin.rpy.rpyToMatrix(0.3, -1.0, 2.0)
     w, x, y, z = wxyz(R)
     np.testing.assert_allclose(pin.Quaternion(w, x, y, z).matrix(), R, atol=1e-12)
+
+
+def test_pose_of_refuses_what_is_not_a_pose():
+    T = pose_of([0.1, 0.2, 0.3], [2.0, 0.0, 0.0, 0.0])  # normalised
+    np.testing.assert_allclose(T, np.r_[np.c_[np.eye(3), [0.1, 0.2, 0.3]], [[0, 0, 0, 1]]])
+    assert pose_of([0, 0, np.nan], [1, 0, 0, 0]) is None
+    assert pose_of([0, 0, 0], [0, 0, 0, 0]) is None
+    assert pose_of([0, 0], [1, 0, 0, 0]) is None
+    assert pose_of("abc", [1, 0, 0, 0]) is None

@@ -39,6 +39,26 @@ DRAG_QUIET = 0.5
 """The gizmo follows the hand again only this long [s] after it was last dragged."""
 
 
+def pose_of(position: npt.ArrayLike, quaternion: npt.ArrayLike) -> Array | None:
+    """The pose (4, 4) of a position (3,) [m] and a quaternion (w, x, y, z), or None.
+
+    None when either is not finite or the quaternion is far from unit length (norm outside
+    [0.5, 2]); a quaternion near unit length is normalised.
+    """
+    try:
+        p = np.asarray(position, np.float64).reshape(3)
+        w, x, y, z = np.asarray(quaternion, np.float64).reshape(4)
+    except (TypeError, ValueError):
+        return None
+    size = math.sqrt(w * w + x * x + y * y + z * z)
+    if not (np.all(np.isfinite(p)) and 0.5 <= size <= 2.0):
+        return None
+    pose = np.eye(4)
+    pose[:3, :3] = pin.Quaternion(w / size, x / size, y / size, z / size).matrix()
+    pose[:3, 3] = p
+    return pose
+
+
 def wxyz(R: Array) -> Array:
     """Unit quaternion (w, x, y, z) of a rotation matrix (3, 3)."""
     x, y, z, w = pin.Quaternion(R).coeffs()
@@ -56,6 +76,7 @@ class Scene:
 
     Attributes:
         arm: Length [m] of an angular-velocity arrow per rad/s.
+        refused: Gizmo poses from a page that were not poses (NaN, a zero quaternion).
     """
 
     def __init__(self, server: Any, robot: Robot, visuals: Visuals,
@@ -68,8 +89,13 @@ class Scene:
         self.arm = 0.4 * reach
         scene = server.scene
         scene.set_up_direction("+z")
+        # Plain lights, no image-based lighting and no shadows: a frame renders several times
+        # faster where the page has no GPU (a software renderer, as in the tests' chromium).
+        scene.configure_environment_map(None)
+        scene.configure_default_lights(enabled=True, cast_shadow=False)
+        scene.add_light_ambient("/light/ambient", intensity=1.2)
         scene.add_grid("/ground", width=4 * reach, height=4 * reach, cell_size=0.1 * reach,
-                       section_size=0.5 * reach)  # fmt: skip
+                       section_size=0.5 * reach, shadow_opacity=0.0)  # fmt: skip
         server.initial_camera.position = (1.3 * reach, -1.1 * reach, 0.9 * reach)
         server.initial_camera.look_at = (0.15 * reach, 0.0, 0.35 * reach)
         self.robot_root = scene.add_frame("/robot", show_axes=False)
@@ -98,6 +124,7 @@ class Scene:
         self.gizmo = scene.add_transform_controls("/target", scale=0.25 * reach)
         self._following = True
         self._dragged = -math.inf
+        self.refused = 0
         self._obstacles: list[Any] = []
         self._pairs: Any = None
         if on_target is not None:
@@ -105,8 +132,10 @@ class Scene:
 
             def dragged(event: Any) -> None:
                 self._dragged = time.perf_counter()
-                pose = pin.XYZQUATToSE3(np.r_[self.gizmo.position, self.gizmo.wxyz[1:],
-                                              self.gizmo.wxyz[0]]).homogeneous  # fmt: skip
+                pose = pose_of(self.gizmo.position, self.gizmo.wxyz)
+                if pose is None:  # a page sent a position or rotation that is not one
+                    self.refused += 1
+                    return
                 callback(pose)
 
             self.gizmo.on_update(dragged)

@@ -30,9 +30,9 @@ from rrc_pin.robot import Robot
 from rrc_pin.urdf_export import to_urdf
 
 Array = npt.NDArray[np.float64]
-PAPER_COLOR = (25, 70, 160)
+PAPER_COLOR = (45, 105, 215)
 """RGB of the paper arms' links (their URDFs give no material)."""
-SKELETON_COLOR = (90, 95, 110)
+SKELETON_COLOR = (120, 125, 140)
 """RGB of a skeleton's links."""
 PACKAGE = "package://example-robot-data/"
 
