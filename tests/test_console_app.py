@@ -106,7 +106,9 @@ def test_the_page_shows_the_arm(console, page, tmp_path):
     Image.fromarray(shot.astype(np.uint8)).save(path)
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     kept = shutil.copy(path, ARTIFACTS / "console.png")
-    print(f"\nscreenshot of the console: {kept} ({arm} arm pixels, {changed:.2%} changed when hidden)")
+    print(
+        f"\nscreenshot of the console: {kept} ({arm} arm pixels, {changed:.2%} changed when hidden)"
+    )
     assert canvas.std() > 10  # not a blank canvas
     gone = (bluish(canvas) & ~bluish(hidden)).sum()  # blue pixels of the arm: gone when hidden
     assert gone > 1000 and gone > 0.7 * arm  # (the rest: the gizmo's blue ring and arrow)
@@ -242,8 +244,10 @@ def test_bad_input_from_pages_never_stops_or_corrupts_the_loop(console, page, br
     wait_for(lambda: gone(console, ws), timeout=30.0, what="the flooding page gone")
     wait_for(lambda: len(console.server.get_clients()) == 1, what="one page left")
     time.sleep(0.5)
-    print(f"\nrefused: {panel.errors - errors} page values, {console.scene.refused} gizmo poses; "
-          f"mailbox: {loop.mailbox.dropped} commands dropped of {loop.mailbox.posted}")
+    print(
+        f"\nrefused: {panel.errors - errors} page values, {console.scene.refused} gizmo poses; "
+        f"mailbox: {loop.mailbox.dropped} commands dropped of {loop.mailbox.posted}"
+    )
     assert loop.alive and loop.errors == 0
     assert loop.clock.ticks > ticks + 50  # still ticking
     q = loop.snapshot.q
@@ -263,7 +267,9 @@ def test_the_last_page_closing_releases_the_deadman(console, page):
     loop = console.loop
     assert loop.operator.latched
     page.close()
-    wait_for(lambda: not loop.operator.latched,
-             what=f"the released deadman ({len(console.server.get_clients())} pages)")
+    wait_for(
+        lambda: not loop.operator.latched,
+        what=f"the released deadman ({len(console.server.get_clients())} pages)",
+    )
     assert "no page connected" in loop.notices[-1].text
     assert loop.alive
