@@ -117,6 +117,11 @@ def parser() -> argparse.ArgumentParser:
     )
     console.add_argument("--rate", type=float, default=100.0, help="control loop rate [Hz]")
     console.add_argument(
+        "--realtime",
+        action="store_true",
+        help="run the control loop under real-time scheduling (Linux, root or CAP_SYS_NICE)",
+    )
+    console.add_argument(
         "--out", type=Path, default=Path("."), metavar="DIR", help="folder for saved records"
     )
     urdf = sub.add_parser("urdf", help="compare or rewrite the committed URDFs")
@@ -176,7 +181,8 @@ def console_command(args: argparse.Namespace) -> int:
     from rrc_pin.console import Console, console_robot
 
     robot = console_robot(args.arm, args.cell)
-    console = Console(robot, host=args.host, port=args.port, rate=args.rate, out=args.out)
+    console = Console(robot, host=args.host, port=args.port, rate=args.rate, out=args.out,
+                      realtime=args.realtime)  # fmt: skip
     console.serve_forever()
     return 0
 

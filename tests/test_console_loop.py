@@ -254,3 +254,13 @@ def test_start_pose_is_inside_the_limits(name):
     assert np.all(q >= robot.lower) and np.all(q <= robot.upper)
     J = robot.jacobian(q)[: 6 if robot.nq >= 6 else 3]
     assert np.linalg.svd(J, compute_uv=False)[-1] > 0.02  # away from singularities
+
+
+def test_a_realtime_loop_runs_under_fifo_or_says_why_not(barker6):
+    loop = ControlLoop(barker6, rate=500.0, realtime=True)
+    loop.start()
+    time.sleep(0.2)
+    loop.stop()
+    refused = [n for n in loop.notices if "real-time scheduling refused" in n.text]
+    assert loop.scheduling == "SCHED_FIFO 10" or (refused and loop.scheduling != "not started")
+    assert loop.clock.ticks > 50

@@ -51,3 +51,20 @@ def test_bad_rates_and_windows_are_refused():
         Rate(0.0)
     with pytest.raises(InvalidInput, match="window"):
         TickClock(1)
+
+
+def test_tick_clock_work_times():
+    clock = TickClock(window=8)
+    for start in (0.0, 1.0, 2.0):
+        clock.tick(start)
+        clock.done(start + 0.25)
+    np.testing.assert_array_equal(clock.work(), [0.25, 0.25, 0.25])
+    assert clock.stats(work=True).median == 0.25
+
+
+def test_a_late_tick_still_sleeps_its_minimum():
+    rate = Rate(1000.0, min_sleep=0.002)
+    time.sleep(0.005)  # late
+    start = time.perf_counter()
+    rate.sleep()
+    assert time.perf_counter() - start >= 0.0019

@@ -33,12 +33,16 @@ def two_arms():
     )
 
 
-@pytest.mark.parametrize("make", [lambda: rrc_pin.load("barker6"), two_arms])
+@pytest.mark.parametrize(
+    "make", [lambda: rrc_pin.load("barker6"), two_arms, lambda: rrc_pin.load("kinova")]
+)
 def test_nested_joint_nodes_put_every_hand_where_the_kinematics_does(server, make):
     robot = make()
     scene = Scene(server, robot, visuals_of(robot))
-    q = robot.random_q(np.random.default_rng(3))
-    pose = scene.update(q)
+    rng = np.random.default_rng(3)
+    scene.update(robot.random_q(rng))
+    q = robot.random_q(rng)
+    pose = scene.update(q)  # the second: only what a joint's motion changes is sent
     model = robot.model
     for tool, handle in scene.hands.items():
         frame = model.frames[model.getFrameId(tool)]

@@ -46,13 +46,15 @@ class Console:
         host: Interface to serve on (default loopback only).
         port: Port; 0 takes a free one (see :attr:`url`).
         rate: Control loop rate [1/s].
-        view_rate: Scene updates per second (the readouts at most 10 per second).
+        view_rate: Scene updates per second (the readouts 5 per second).
         out: Folder for saved records.
         q0: Start configuration (nq,) [rad or m]; default
             :func:`~rrc_pin.console.loop.start_pose`.
         strategy: Initial singularity strategy's name.
         backend: Initial QP backend's name.
         settings: Limits of the operator's controls.
+        realtime: Run the control loop under real-time scheduling where permitted
+            (:class:`~rrc_pin.console.loop.ControlLoop`).
 
     Raises:
         InvalidInput: A bad argument, named.
@@ -66,12 +68,13 @@ class Console:
         host: str = "127.0.0.1",
         port: int = 8080,
         rate: float = 100.0,
-        view_rate: float = 30.0,
+        view_rate: float = 20.0,
         out: str | Path = ".",
         q0: npt.ArrayLike | None = None,
         strategy: str = "resolver",
         backend: str = "daqp",
         settings: OperatorSettings | None = None,
+        realtime: bool = False,
     ) -> None:
         self.robot = load(robot) if isinstance(robot, str) else robot
         if not isinstance(self.robot, Robot):
@@ -81,7 +84,8 @@ class Console:
         self.host, self.port, self.view_rate = host, port, view_rate
         self.out = Path(out)
         self.loop = ControlLoop(self.robot, rate=rate, q0=q0, mailbox=Mailbox(),
-                                settings=settings, strategy=strategy, backend=backend)  # fmt: skip
+                                settings=settings, strategy=strategy, backend=backend,
+                                realtime=realtime)  # fmt: skip
         self.server: Any = None
         self.scene: Scene | None = None
         self.panel: Panel | None = None

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import collections
 import math
+import os
 import threading
 import time
 from collections.abc import Callable
@@ -41,6 +42,10 @@ from solvers.resolution import Resolution
 from solvers.validation import finite_number
 
 Array = npt.NDArray[np.float64]
+LOOP_NICE = -10
+"""The nice value the loop's thread asks for: ahead of the view, the page's callbacks and other
+processes where the OS allows it (the GIL is still shared: see the switch interval of
+:mod:`rrc_pin.console.app`)."""
 
 
 class Notice(NamedTuple):
@@ -92,6 +97,19 @@ class ControlLoop:
         backend: QP backend's name (``installed_backends()``).
         record_limit: Longest record [s], > 0: a full record holds the arm until saved or
             dropped.
+        priority: Nice value asked for the loop's thread (Linux: per thread; a negative one
+            needs root or CAP_SYS_NICE, else the thread keeps its priority), or None.
+        realtime: Run the loop's thread under real-time scheduling (``SCHED_FIFO`` at
+            :data:`REALTIME_PRIORITY`, Linux, root or CAP_SYS_NICE), sleeping at least
+            :data:`MIN_SLEEP` per tick; where it is not permitted, ``priority`` instead (and
+            a notice says so).
+
+    Attributes:
+        scheduling: How the loop's thread is scheduled once it runs (``"SCHED_FIFO 10"``,
+            ``"nice -10"``...).
+        clock: The ticks' periods and work times (:class:`~rrc_pin.console.rate.TickClock`).
+        skipped: Deadlines given up after a stall of more than a period.
+        errors: Ticks that raised (each reported as a notice; the arm stopped).
 
     Raises:
         InvalidInput: A bad argument, named (a strategy the arm cannot take included).
@@ -108,8 +126,13 @@ class ControlLoop:
         strategy: str = "resolver",
         backend: str = "daqp",
         record_limit: float = 120.0,
+        priority: int | None = LOOP_NICE,
+        realtime: bool = False,
     ) -> None:
         self.robot = robot
+        self.priority = priority
+        self.realtime = bool(realtime)
+        self.scheduling = "not started"
         self.rate = finite_number(rate, "rate", 0.0, inclusive=False, error=InvalidInput)
         self.dt = 1.0 / self.rate
         self.mailbox = Mailbox() if mailbox is None else mailbox
@@ -128,6 +151,7 @@ class ControlLoop:
         self.recording = False
         self.notices: collections.deque[Notice] = collections.deque(maxlen=50)
         self.errors = 0
+        self.skipped = 0
         self._notice_id = 0
         self._job: _Job | None = None
         self._held_q: Array = self.ctl.q
@@ -166,7 +190,8 @@ class ControlLoop:
         return self._snapshot
 
     def _run(self) -> None:
-        rate = Rate(self.rate)
+        self.scheduling = self._schedule()
+        rate = Rate(self.rate, min_sleep=MIN_SLEEP if self.realtime else 0.0)
         while not self._stop.is_set():
             now = self.clock.tick()
             try:
@@ -176,7 +201,20 @@ class ControlLoop:
                 self.operator.stop()
                 self._stop_now = True
                 self.notice("error", f"tick failed ({type(exc).__name__}: {exc}); arm stopped")
+            self.clock.done()
+            self.skipped = rate.skipped
             rate.sleep(self._stop)
+
+    def _schedule(self) -> str:
+        """Ask the OS to schedule this (the loop's) thread as configured; say how it is."""
+        if self.realtime:
+            try:
+                os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(REALTIME_PRIORITY))
+                return f"SCHED_FIFO {REALTIME_PRIORITY}"
+            except (OSError, AttributeError) as exc:
+                self.notice("error", f"real-time scheduling refused ({exc}): a nice loop instead")
+        nice = set_nice(self.priority) if self.priority is not None else None
+        return "normal" if nice is None else f"nice {nice}"
 
     # -- one tick -----------------------------------------------------------------------------
 
@@ -435,6 +473,30 @@ class ControlLoop:
                           spec=robot.spec)  # fmt: skip
         return Controller(robot, self.dt, q, strategy=self._strategy, limits=JointLimits(),
                           qp=QPOptions(backend=self._backend), speed=speed)  # fmt: skip
+
+
+REALTIME_PRIORITY = 10
+"""``SCHED_FIFO`` priority of a real-time loop (1 to 99; kernel threads sit at 50)."""
+MIN_SLEEP = 5e-5
+"""Shortest sleep [s] of a real-time loop's tick: an overrunning loop still yields its core."""
+
+
+def set_nice(value: int) -> int | None:
+    """Set the calling thread's nice value (Linux); returns the value it has, or None.
+
+    A value the process may not take (a negative one without the rights) leaves it as it was.
+    """
+    if not hasattr(os, "setpriority") or not hasattr(threading, "get_native_id"):
+        return None
+    thread = threading.get_native_id()
+    try:
+        os.setpriority(os.PRIO_PROCESS, thread, value)
+    except OSError:
+        pass
+    try:
+        return os.getpriority(os.PRIO_PROCESS, thread)
+    except OSError:
+        return None
 
 
 def _takes(robot: Robot, name: str) -> bool:

@@ -151,7 +151,7 @@ def active_names(snapshot: Snapshot) -> list[str]:
 
 
 def status_html(snapshot: Snapshot, readings: Readings, stats: PeriodStats, rate: float,
-                note: str = "") -> str:  # fmt: skip
+                note: str = "", scheduling: str = "") -> str:  # fmt: skip
     """The status block: deadman, mode, resolver, singularity, loop rate, last notice.
 
     Values carry ``data-field`` attributes, for tests.
@@ -172,7 +172,7 @@ def status_html(snapshot: Snapshot, readings: Readings, stats: PeriodStats, rate
         ("backend", snapshot.backend),
         ("record", f"{snapshot.recorded:.1f} s" if snapshot.recording else "off"),
         ("loop", f"{rate:g} Hz: period median {1e3 * stats.median:.2f} ms, "
-                 f"p99 {1e3 * stats.p99:.2f} ms"),
+                 f"p99 {1e3 * stats.p99:.2f} ms{f', {scheduling}' if scheduling else ''}"),
         ("t", f"{snapshot.t:.2f} s, tick {snapshot.tick}"),
         ("notice", note or "-"),
     ]  # fmt: skip

@@ -2,8 +2,9 @@
 
 The robot is a tree of frame nodes, one per Pinocchio joint, nested as the joints are; its
 shapes (:mod:`rrc_pin.console.visuals`) hang under their joint's node. Moving the robot sets
-each joint node's pose relative to its parent (``data.liMi`` after one forward-kinematics
-pass): one message per joint and pose field, however many meshes the links have.
+the pose of each joint node whose angle changed by more than :data:`SHOWN` since it was last
+sent, relative to its parent (``data.liMi`` after one forward-kinematics pass): at most one
+message per joint and pose field, however many meshes the links have, none for a still arm.
 
 - Hand axes ("painting the hand", Barker): x red, y green, z blue at every tool frame, the
   commanded hand's drawn larger; they hang under the joint nodes and cost nothing to move.
@@ -35,6 +36,8 @@ ARROW_TIME = 2.0
 """Length of a linear-velocity arrow: the distance [m] covered in this many seconds."""
 COMMANDED = ((255, 140, 0), (230, 200, 0))
 ACHIEVED = ((30, 90, 230), (0, 190, 210))
+SHOWN = 1e-4
+"""A joint node is moved when its angle [rad] (or position [m]) changed by more than this."""
 DRAG_QUIET = 0.5
 """The gizmo follows the hand again only this long [s] after it was last dragged."""
 
@@ -100,6 +103,14 @@ class Scene:
         server.initial_camera.look_at = (0.15 * reach, 0.0, 0.35 * reach)
         self.robot_root = scene.add_frame("/robot", show_axes=False)
         self._nodes = self._joint_tree(scene)
+        self._coordinate = [int(self.model.joints[j].idx_v) for j in range(self.model.njoints)]
+        self._shown = [math.nan] * robot.nq  # the joint coordinates the nodes show
+        # What a joint's motion changes of its node's pose: a revolute joint turns about an
+        # axis through the joint's origin (only the rotation changes), a prismatic one slides
+        # (only the translation); half the messages of setting both.
+        kinds = [joint.shortname()[len("JointModel"):] for joint in self.model.joints]
+        self._turns = [k in ("RX", "RY", "RZ") or k.startswith(("RUB", "Revolute")) for k in kinds]
+        self._slides = [k in ("PX", "PY", "PZ") or k.startswith("Prismatic") for k in kinds]
         for k, shape in enumerate(visuals.shapes):
             name = f"{self._paths[shape.joint]}/shape{k}"
             if shape.color is None:
@@ -163,11 +174,19 @@ class Scene:
         """Move the robot to ``q`` (nq,); returns the commanded hand's pose (4, 4) [m]."""
         model, data = self.model, self.data
         pin.forwardKinematics(model, data, self.robot.to_pinocchio(q))
+        values, shown = q.tolist(), self._shown
         for j in range(1, model.njoints):
-            placement = data.liMi[j]
+            k = self._coordinate[j]
+            if abs(values[k] - shown[k]) <= SHOWN:  # (False for the first: nan)
+                continue
+            first = math.isnan(shown[k])
+            shown[k] = values[k]
+            placement = data.liMi[j]  # this joint's motion only: its children are unchanged
             node = self._nodes[j]
-            node.wxyz = wxyz(placement.rotation)
-            node.position = placement.translation
+            if first or not self._slides[j]:
+                node.wxyz = wxyz(placement.rotation)
+            if first or not self._turns[j]:
+                node.position = placement.translation
         frame = model.getFrameId(self.hand)
         pose: Array = pin.updateFramePlacement(model, data, frame).homogeneous
         if self._following and time.perf_counter() - self._dragged > DRAG_QUIET:

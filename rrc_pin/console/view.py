@@ -3,9 +3,10 @@
 It reads the latest :class:`~rrc_pin.console.snapshot.Snapshot` (never waits for the loop),
 moves the robot and the arrows at ``rate`` and rewrites the readouts at ``readout_rate``,
 inside ``server.atomic()`` so that a page receives each update whole. It adapts: an update
-that took longer than a quarter of its period stretches the period, so the view never takes
-more than about a quarter of a core from the loop. An error in an update is counted and the
-view goes on.
+that took longer than a fifth of its period stretches the period, so the view never takes
+more than about a fifth of a core from the loop. (Its thread keeps its priority: a thread of
+lower priority holding the GIL when the OS sets it aside would hold the loop up with it.) An
+error in an update is counted and the view goes on.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from rrc_pin.console.scene import Scene
 from rrc_pin.errors import InvalidInput
 from solvers.validation import finite_number
 
-DUTY = 0.25
+DUTY = 0.2
 """Largest fraction of the time the view spends updating."""
 
 
@@ -43,7 +44,7 @@ class View:
     """
 
     def __init__(self, server: Any, loop: ControlLoop, scene: Scene, panel: Panel,
-                 rate: float = 30.0, readout_rate: float = 10.0) -> None:  # fmt: skip
+                 rate: float = 20.0, readout_rate: float = 5.0) -> None:  # fmt: skip
         self.server = server
         self.loop = loop
         self.scene = scene
@@ -110,8 +111,9 @@ class View:
             self._notify()
             self.panel.sync(snap)
             self.panel.joints.content = joints_html(self.loop.robot, snap.q, readings.qdot)
-            self.panel.status.content = status_html(snap, readings, self.loop.clock.stats(),
-                                              self.loop.rate, self._note)  # fmt: skip
+            stats = self.loop.clock.stats()
+            self.panel.status.content = status_html(snap, readings, stats, self.loop.rate,
+                                                    self._note, self.loop.scheduling)  # fmt: skip
 
     def _notify(self) -> None:
         """Show the loop's new notices on every page (and the last in the status)."""
