@@ -18,6 +18,7 @@ from pathlib import Path
 
 import msgspec
 import numpy as np
+import pinocchio as pin
 import pytest
 
 from rrc_pin.console import Console
@@ -93,25 +94,33 @@ def bluish(rgb: np.ndarray) -> np.ndarray:
 
 
 def test_the_page_shows_the_arm(console, page, tmp_path):
-    time.sleep(2.0)  # the first frames of a software renderer
-    shot = screenshot(page)
-    canvas = shot[:, :590]  # the panel sits on the right from x = 600
+    shots = []  # a software renderer's first frames come slowly: look until the arm is there
+
+    def drawn() -> bool:
+        shots.append(screenshot(page)[:, :590])  # the panel sits on the right from x = 600
+        return bluish(shots[-1]).sum() > 1000
+
+    wait_for(drawn, timeout=30.0, what="the arm drawn")
+    canvas = shots[-1]
     arm = int(bluish(canvas).sum())
     console.scene.robot_root.visible = False
-    time.sleep(1.5)
-    hidden = screenshot(page)[:, :590]
+    hidden = []
+
+    def gone() -> bool:
+        hidden.append(screenshot(page)[:, :590])
+        return bluish(hidden[-1]).sum() < 0.3 * arm
+
+    wait_for(gone, timeout=30.0, what="the arm hidden")
     console.scene.robot_root.visible = True
-    changed = (np.abs(canvas - hidden).sum(axis=2) > 60).mean()
+    changed = (np.abs(canvas - hidden[-1]).sum(axis=2) > 60).mean()
     path = tmp_path / "console.png"
-    Image.fromarray(shot.astype(np.uint8)).save(path)
+    Image.fromarray(screenshot(page).astype(np.uint8)).save(path)
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     kept = shutil.copy(path, ARTIFACTS / "console.png")
-    print(
-        f"\nscreenshot of the console: {kept} ({arm} arm pixels, {changed:.2%} changed when hidden)"
-    )
+    print(f"\nscreenshot of the console: {kept} ({arm} arm pixels, {changed:.2%} changed hidden)")
     assert canvas.std() > 10  # not a blank canvas
-    gone = (bluish(canvas) & ~bluish(hidden)).sum()  # blue pixels of the arm: gone when hidden
-    assert gone > 1000 and gone > 0.7 * arm  # (the rest: the gizmo's blue ring and arrow)
+    gone_pixels = (bluish(canvas) & ~bluish(hidden[-1])).sum()  # the arm's: gone when hidden
+    assert gone_pixels > 1000 and gone_pixels > 0.7 * arm  # (the rest: the gizmo's blue)
     assert changed > 0.002
 
 
@@ -129,6 +138,8 @@ def test_a_slider_moved_by_the_keyboard_moves_the_hand_along_its_axis(console, p
     page.keyboard.press(" ")
     wait_for(lambda: loop.snapshot.enabled, what="the latched deadman")
     time.sleep(1.0)
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    page.screenshot(path=ARTIFACTS / "console_moving.png")  # the twist arrows at the hand
     d = loop.robot_pose()[:3, 3] - start[:3, 3]
     assert np.linalg.norm(d) > 0.01  # 20 mm/s for about a second
     assert d @ start[:3, 0] / np.linalg.norm(d) > 0.99  # along the hand's x axis (hand frame)
@@ -150,12 +161,19 @@ def test_keyboard_jogs_and_stop(console, page):
     page.evaluate("document.activeElement.blur()")
     start = loop.robot_pose()
     for _ in range(12):
-        page.keyboard.press("r")  # +vz, half the slider's range, while repeated
+        page.keyboard.press("u")  # +vz, half the slider's range, while repeated
         time.sleep(0.05)
     time.sleep(0.4)  # the jog's timeout, then the controller's deadman
     d = loop.robot_pose()[:3, 3] - start[:3, 3]
     assert np.linalg.norm(d) > 0.01
     assert d @ start[:3, 2] / np.linalg.norm(d) > 0.99  # along the hand's z axis
+    R = loop.robot_pose()[:3, :3]
+    for _ in range(12):
+        page.keyboard.press("Shift+U")  # +wz: the hand turns about its z axis
+        time.sleep(0.05)
+    time.sleep(0.4)
+    turn = pin.log3(R.T @ loop.robot_pose()[:3, :3])
+    assert np.linalg.norm(turn) > 0.05 and turn[2] / np.linalg.norm(turn) > 0.99
 
 
 def test_readouts_show_the_joints_against_their_limits(console, page):
@@ -172,12 +190,12 @@ def test_the_loop_keeps_its_rate_with_a_browser_connected(console, page):
     loop = console.loop
     loop.mailbox.post(Latch(True))
     loop.clock.reset()
-    time.sleep(3.0)
+    time.sleep(2.0)
     stats = loop.clock.stats()
     print(f"\n100 Hz with a browser: median {1e3 * stats.median:.2f} ms, "
           f"p99 {1e3 * stats.p99:.2f} ms, max {1e3 * stats.max:.1f} ms over {stats.n} periods, "
           f"view update {1e3 * console.view.cost:.1f} ms")  # fmt: skip
-    assert stats.n > 200
+    assert stats.n > 150
     assert stats.median == pytest.approx(0.01, rel=0.1)
     assert console.view.errors == 0
 

@@ -14,9 +14,10 @@ Controls (folder by folder):
 - **Trajectory**: record, reverse (seconds), save CSV / NPZ (written on the console's machine
   and offered to the page as a download), load (upload a record: it is replayed from its
   start), home.
-- **Keyboard** (commands with hotkeys; the page must have focus outside a text field): W/S
-  +-x, A/D +-y, R/F +-z, I/K +-wx, J/L +-wy, U/O +-wz (a jog at half the slider's range while
-  a key is held), space STOP.
+- **Keyboard** (commands with hotkeys; the page must have focus outside a text field): I/K
+  +-x, J/L +-y, U/O +-z, and with Shift the rotations about the same axes (a jog at half the
+  slider's range while a key is held), space STOP. (viser moves the camera with W, A, S, D,
+  Q, E and the arrow keys: the jogs keep clear of them.)
 """
 
 from __future__ import annotations
@@ -34,10 +35,9 @@ from rrc_pin.console.snapshot import Snapshot
 from rrc_pin.errors import RrcPinError
 
 KEYS: dict[str, tuple[int, int]] = {
-    "W": (0, 1), "S": (0, -1), "A": (1, 1), "D": (1, -1), "R": (2, 1), "F": (2, -1),
-    "I": (3, 1), "K": (3, -1), "J": (4, 1), "L": (4, -1), "U": (5, 1), "O": (5, -1),
+    "I": (0, 1), "K": (0, -1), "J": (1, 1), "L": (1, -1), "U": (2, 1), "O": (2, -1),
 }  # fmt: skip
-"""Hotkey -> (axis, sign) of its jog."""
+"""Hotkey -> (linear axis, sign) of its jog; with Shift, the rotation about that axis."""
 HOLD_HZ = 20.0
 """Heartbeats per second of the hold-to-move button."""
 
@@ -128,8 +128,12 @@ class Panel:
             home = gui.add_button("home")
             home.on_click(self._guard(lambda e: cmd.Home()))
         for key, (axis, sign) in KEYS.items():
-            command = gui.add_command(f"jog {'+' if sign > 0 else '-'}{AXES[axis]}", hotkey=key)
-            command.on_trigger(self._guard(_jog(axis, sign)))
+            for shift in (False, True):
+                which = axis + 3 if shift else axis
+                label = f"jog {'+' if sign > 0 else '-'}{AXES[which]}"
+                command = gui.add_command(label, hotkey=key,
+                                          modifier="shift" if shift else None)  # fmt: skip
+                command.on_trigger(self._guard(_jog(which, sign)))
         space = gui.add_command("STOP", hotkey="space")
         space.on_trigger(lambda e: self.stop())
 
