@@ -32,7 +32,7 @@ from rrc_pin.console import commands as cmd
 from rrc_pin.console.commands import AXES, FRAMES
 from rrc_pin.console.loop import ControlLoop
 from rrc_pin.console.snapshot import Snapshot
-from rrc_pin.errors import RrcPinError
+from rrc_pin.errors import InvalidInput, RrcPinError
 
 KEYS: dict[str, tuple[int, int]] = {
     "I": (0, 1), "K": (0, -1), "J": (1, 1), "L": (1, -1), "U": (2, 1), "O": (2, -1),
@@ -210,7 +210,7 @@ class Panel:
         upload = self.upload.value
         name = Path(str(upload.name)).name
         if not name.endswith((".csv", ".npz")):
-            raise RrcPinError(f"load: expected a .csv or .npz record, got {name!r}")
+            raise InvalidInput("load", f"expected a .csv or .npz record, got {name!r}")
         folder = Path(tempfile.mkdtemp(prefix="rrc-pin-console-"))
         path = folder / name
         path.write_bytes(upload.content)
