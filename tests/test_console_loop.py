@@ -181,6 +181,12 @@ def test_strategies_and_backends_switch_or_are_refused_with_a_notice(barker6, pa
     assert "freezing" in barker.strategies and barker.ctl.strategy.name == "freezing"
     with pytest.raises(InvalidInput, match="strategy"):
         ControlLoop(panda, strategy="freezing_nope")
+    with pytest.raises(InvalidInput, match="robot"):
+        ControlLoop("panda")
+    with pytest.raises(InvalidInput, match="priority"):
+        ControlLoop(panda, priority=1.5)
+    with pytest.raises(InvalidInput, match="rate"):
+        ControlLoop(panda, rate=float("nan"))
 
 
 def test_a_robot_with_two_hands_commands_the_chosen_one():

@@ -129,6 +129,10 @@ class ControlLoop:
         priority: int | None = LOOP_NICE,
         realtime: bool = False,
     ) -> None:
+        if not isinstance(robot, Robot):
+            raise InvalidInput("robot", f"expected a rrc_pin.Robot, got {robot!r}")
+        if priority is not None and (isinstance(priority, bool) or not isinstance(priority, int)):
+            raise InvalidInput("priority", f"expected a nice value (int) or None, got {priority!r}")
         self.robot = robot
         self.priority = priority
         self.realtime = bool(realtime)

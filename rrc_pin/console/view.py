@@ -117,7 +117,7 @@ class View:
 
     def _notify(self) -> None:
         """Show the loop's new notices on every page (and the last in the status)."""
-        for notice in list(self.loop.notices):
+        for notice in tuple(self.loop.notices):  # (a copy: the loop appends to it)
             if notice.id <= self._notice:
                 continue
             self._notice = notice.id
