@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 import pinocchio as pin
 from machine import machine_info, source_state
-from script import arguments, make_parser, pyplot, write
+from script import arguments, make_parser, mark_quick, pyplot, write
 
 import rrc_pin
 from rrc_pin.robot import frame_id
@@ -297,13 +297,16 @@ def plot(results: dict[str, Any], path: Path) -> bool:
             ax.text(x[i], y, f"{r[part]['speedup']:.1f}x", ha="center", va="bottom")
         if part == "batch":
             ax.set_yscale("log")
-            ax.set_ylim(top=top * 15)
+            # bars from a power of ten below the lowest, not from an autoscaled edge
+            low = 10.0 ** np.floor(np.log10(min(min(a), min(b))))
+            ax.set_ylim(bottom=low, top=top * 15)
         else:
             ax.set_ylim(top=top * 1.35)
         ax.set_xticks(x, arms)
         ax.set_ylabel(ylabel)
         ax.set_title(title)
         ax.legend(loc="upper left", fontsize=8)
+    mark_quick(fig, results)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -40,7 +40,7 @@ from typing import Any  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from script import arguments, make_parser, measure, write  # noqa: E402
+from script import QUICK_NOTE, arguments, make_parser, measure, write  # noqa: E402
 from timing import (  # noqa: E402
     add_ratios,
     one_core,
@@ -269,7 +269,9 @@ def plot(results: dict[str, Any], path: Path) -> bool:
         ({"interleaved": a["contenders"]}, f"{a['arm']}: one tick of the operator's loop")
         for a in results["arms"]
     ]
-    return timing_chart(panels, path, (6.5 * len(panels), 3.4))
+    return timing_chart(panels, path, (6.5 * len(panels), 3.4),
+                        {"interleaved": "interleaved, the same q and command"},
+                        QUICK_NOTE if results.get("quick") else None)  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> int:

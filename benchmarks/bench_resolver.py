@@ -66,7 +66,7 @@ import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
 from scipy.linalg.lapack import dgesvd  # noqa: E402
-from script import make_parser, write  # noqa: E402
+from script import QUICK_NOTE, is_quick, make_parser, write  # noqa: E402
 from stage_profile import profile_steps, profile_table  # noqa: E402
 from timing import (  # noqa: E402
     MODE_TITLES,
@@ -91,7 +91,7 @@ from timing import (  # noqa: E402
 import rrc_pin  # noqa: E402
 from rrc_pin.control.drift import advance  # noqa: E402
 from rrc_pin.robot import frame_id  # noqa: E402
-from solvers.direction import line_scale, uniform_scale  # noqa: E402
+from solvers.kernels import joint_box, line_scale, uniform_scale  # noqa: E402
 from solvers.qp_backends import installed_backends  # noqa: E402
 
 ARMS = ("rrc_k1607", "panda")
@@ -213,9 +213,9 @@ def floor_contenders(arm: Any) -> list[Contender]:
 
 def limits_floor(arm: Any) -> Contender:
     """The least work of a direction-preserving step within the limits, in Python: the
-    Jacobian, rrc-pin's step bounds (``JointLimits().bounds(arm).step``), the SVD's exact
+    Jacobian, rrc-pin's step bounds (:func:`solvers.kernels.joint_box`), the SVD's exact
     rates, and where they leave the bounds the largest scale along them, exactly, with one
-    null direction (:func:`solvers.direction.line_scale`) or none (the uniform scale).
+    null direction (:func:`solvers.kernels.line_scale`) or none (the uniform scale).
     rrc-pin's default answers the same wherever it does not damp; what it does beyond this
     (input checks, the damping near singularities, the fallbacks, the Resolution) is its
     gap to this floor."""
@@ -223,11 +223,11 @@ def limits_floor(arm: Any) -> Contender:
     fid = frame_id(model, arm.tool_frame)
     lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
     data = model.createData()
-    bounds = rrc_pin.JointLimits().bounds(arm)
+    b = step_box(arm)
 
     def step(q: Array, x: Array) -> Array:
         J = pin.computeFrameJacobian(model, data, q, fid, lwa)
-        b = bounds.step(q, DT)
+        b.at(q)
         U, s, Vt, _ = dgesvd(J, full_matrices=1)
         m = s.size  # six rows: the rest of Vt spans the null space
         w = (x @ U / s) @ Vt[:m]
@@ -239,6 +239,22 @@ def limits_floor(arm: Any) -> Contender:
         return uniform_scale(w, b.lb, b.ub) * w
 
     return Contender(LIMITS_FLOOR, step)
+
+
+class step_box:
+    """The step's joint box of ``arm`` (rrc-pin's kernel), its ``lb`` and ``ub`` refreshed by
+    :meth:`at`."""
+
+    def __init__(self, arm: Any) -> None:
+        n = arm.nq
+        self.arm, self.lb, self.ub = arm, np.empty(n), np.empty(n)
+        self.kind = np.empty((2, n), np.int8)
+        self.none, self.zero = np.array([np.inf]), np.zeros(n)
+
+    def at(self, q: Array) -> None:
+        arm = self.arm
+        joint_box(q, arm.lower, arm.upper, arm.velocity_limit, 0.0, 1.0, DT, self.zero, self.none,
+                  self.lb, self.ub, self.kind)  # fmt: skip
 
 
 def floor_agreement(default: Any, floor: Any) -> dict[str, Any]:
@@ -635,7 +651,8 @@ def plot(results: dict[str, Any], path: Path) -> bool:
          f"{arm['arm']}: one resolved-rate step")
         for arm in arms
     ]  # fmt: skip
-    return timing_chart(panels, path, (7.5 * len(arms), 6))
+    note = QUICK_NOTE if is_quick(results) else None
+    return timing_chart(panels, path, (7.5 * len(arms), 6), note=note)
 
 
 if __name__ == "__main__":

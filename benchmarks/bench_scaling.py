@@ -45,7 +45,7 @@ from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
-from script import arguments, make_parser, measure, pyplot, write  # noqa: E402
+from script import arguments, make_parser, mark_quick, measure, pyplot, write  # noqa: E402
 from timing import (  # noqa: E402
     REPEATS,
     combine_rounds,
@@ -373,12 +373,15 @@ def plot(results: dict[str, Any], path: Path) -> bool:
     )  # fmt: skip
     if all("controller" in r for r in rows):
         right.plot(
-            x - 0.2, [r["controller"]["median_us"] for r in rows], "kD", label="Controller.step"
-        )
-    right.bar(x + 0.2, [r["floor_median_us"] for r in rows], 0.4, label="floor (J + solve)")
+            x - 0.2, [r["controller"]["median_us"] for r in rows], "kD",
+            label="Controller.step (median)",
+        )  # fmt: skip
+    right.bar(x + 0.2, [r["floor_median_us"] for r in rows], 0.4,
+              label="floor: J + solve (median)")  # fmt: skip
     right.set_xticks(x, [f"{r['arm']}\n{r['nq']} DOF" for r in rows], fontsize=8)
     right.set(ylabel="time per step [us]", title="step time against DOF (p10-p90 bars)")
     right.legend()
+    mark_quick(fig, results)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

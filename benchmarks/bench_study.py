@@ -20,7 +20,7 @@ from typing import Any
 import numpy as np
 import sampling_study as st
 from machine import machine_info, source_state
-from script import arguments, make_parser, pyplot, write
+from script import arguments, make_parser, mark_quick, pyplot, write
 
 FULL_DTS = (0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1)
 REPORT_VX = {0.01: 0.5, 0.1: 6.0}
@@ -305,6 +305,7 @@ def plot(results: dict[str, Any], runs: dict[float, st.Sampled], path: Path) -> 
     )
     ax.set(title="x velocity error against dt and path speed", xlabel="dt [s]", ylabel="[in/s]")
     ax.legend(fontsize=7)
+    mark_quick(fig, results)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)

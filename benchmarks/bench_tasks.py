@@ -65,7 +65,7 @@ from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 import pinocchio as pin  # noqa: E402
-from bench_resolver import BACKEND_MODULES, rrc_statistics  # noqa: E402
+from bench_resolver import BACKEND_MODULES, rrc_statistics, step_box  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
 from placo_peer import PlacoPeer, Worker, placo_checks, placo_python, placo_urdf  # noqa: E402
 from render_tasks import FLOOR, MODES, PLACO, STRICT, WEIGHTED, plot, readme_table  # noqa: E402
@@ -159,7 +159,7 @@ def floor(robot: Any) -> Contender:
     model, data = robot.model, robot.model.createData()
     frames = [model.getFrameId(f) for f in robot.tool_frames]
     lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-    bounds = rrc_pin.JointLimits().bounds(robot)
+    s = step_box(robot)
     n, target = robot.nq, robot.neutral()
     A = np.zeros((12 + n, n))
     A[12:] = np.eye(n) * POSTURE_COST
@@ -174,7 +174,7 @@ def floor(robot: Any) -> Contender:
         b = np.concatenate([x, POSTURE_COST * POSTURE_GAIN * (target - q)])
         P, c = A.T @ A, b @ A
         w = np.linalg.solve(P, c)
-        s = bounds.step(q, DT)
+        s.at(q)
         if ((s.lb <= w) & (w <= s.ub)).all():
             return w
         return daqp.solve(P, -c, np.zeros((0, n)), s.ub, s.lb, sense)[0]

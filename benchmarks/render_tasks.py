@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from script import QUICK_NOTE, is_quick
 from stage_profile import profile_table
 from timing import MODE_TITLES, mode_table, rounds_note, timing_chart, us
 
@@ -230,4 +231,5 @@ def plot(results: dict[str, Any], path: Path) -> bool:
     """Median step time per contender and mode (bars), p99 as a tick; False without matplotlib."""
     rows = {mode: results["modes"][mode]["contenders"] for mode in MODES}
     title = f"{results['robot']}: two frame tasks and a posture, one step"
-    return timing_chart([(rows, title)], path, (8, 0.5 * len(rows[MODES[0]]) + 1.5))
+    note = QUICK_NOTE if is_quick(results) else None
+    return timing_chart([(rows, title)], path, (8, 0.5 * len(rows[MODES[0]]) + 1.5), note=note)

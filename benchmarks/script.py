@@ -76,6 +76,22 @@ def write(
     return out
 
 
+QUICK_NOTE = "quick run (a smoke test, not a result)"
+"""What a figure of a ``--quick`` run says above its panels."""
+
+
+def is_quick(results: dict[str, Any]) -> bool:
+    """Whether ``results`` come from a quick run (the flag at the top, or in the settings)."""
+    settings = results.get("settings")
+    return bool(results.get("quick") or (isinstance(settings, dict) and settings.get("quick")))
+
+
+def mark_quick(fig: Any, results: dict[str, Any]) -> None:
+    """Title ``fig`` with :data:`QUICK_NOTE` when ``results`` come from a quick run."""
+    if is_quick(results):
+        fig.suptitle(QUICK_NOTE, color="firebrick")
+
+
 def pyplot() -> Any:
     """``matplotlib.pyplot`` on the Agg backend (files only), or None without matplotlib."""
     try:

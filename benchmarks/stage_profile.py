@@ -9,18 +9,18 @@ benchmark:
 
 - ``step``: the contender's whole call (the total): ``Resolver.solve(q, twist)``, or for
   tasks the FrameTasks built in the call and ``Resolver.solve(q, tasks)`` (``solve``);
-- ``q check``: ``Robot.check_q``; ``task checks``: the tasks and levels checked against the
-  robot (``Resolver._levels``, tasks only);
-- ``kinematics``: ``rrc_pin.kinematics.Kinematics`` (one ``computeJointJacobians`` and
-  ``updateFramePlacements`` per tick, tasks only);
-- ``task rows``: the one-twist rows (twist check and Jacobian, of which ``jacobian`` is
-  ``pinocchio.computeFrameJacobian``), or every task's ``rows`` (tasks);
-- ``bounds``: the step's bounds (``JointBounds.step``);
-- ``resolve``: ``solvers.resolve.resolve``, of which ``top level`` (the stacked rows'
-  factorisation, exact rates, fit check and damping; of which ``svd`` is ``JacobianSVD``),
-  ``QP build`` (``direction_qp`` and the least-squares QP), ``backend`` (the backend's
-  ``solve``, its data conversion included), ``lower levels`` (strict priorities) and
-  ``report`` (building the ``Resolution``).
+- ``q check``: ``Robot.configuration``; ``task checks``: the tasks and levels checked
+  against the robot (``Resolver._levels``, tasks only);
+- ``kinematics``: every joint's Jacobian and every frame's pose (``Kinematics``, when a tick
+  needs more than one frame), of which ``jacobian`` is one frame's (``Kinematics.jacobian``);
+- ``task rows``: the tasks' rows (``FrameTask.rows_at`` and every task's ``rows``);
+- ``limits``: the limits' constraints (``JointLimits.constraints``: the step's box);
+- ``problem``: the problem built (``solvers.problem.build``);
+- ``numerics``: ``solvers.pipeline.solve``'s own code, of which ``factorization`` (the QR
+  and the SVD on demand), ``direction`` (the direction problem: the exact kernels and the
+  QP's build), ``backend`` (the backend's ``solve``, its data conversion included) and
+  ``lower levels`` (``solvers.least_squares.least_squares``);
+- ``report``: building the ``Resolution``.
 
 Times are exclusive (self time): a stage's time is what its function spent outside the
 other wrapped functions it called, so the stages add up to the step. ``step``'s own time is
@@ -42,28 +42,31 @@ from typing import Any
 
 import numpy as np
 import numpy.typing as npt
-import pinocchio as pin
 
-import solvers.resolve as resolve_module
+import solvers.pipeline as pipeline_module
+from rrc_pin import kinematics as kinematics_module
 from rrc_pin import tasks as tasks_module
+from rrc_pin.limits import JointLimits
+from solvers.factorization import Factorization
+from solvers.resolution import Resolution
 
 Array = npt.NDArray[np.float64]
 
 STAGES = {
     "step": "the call's own code: building the tasks (none for one twist)",
     "solve": "Resolver.solve's own code",
-    "q check": "Robot.check_q",
+    "q check": "Robot.configuration",
     "task checks": "tasks and levels checked against the robot",
-    "kinematics": "Kinematics: computeJointJacobians + updateFramePlacements",
-    "task rows": "the tasks' rows (one twist: the twist check and row selection)",
-    "jacobian": "pinocchio.computeFrameJacobian",
-    "bounds": "JointBounds.step",
-    "resolve": "solvers.resolve.resolve's own code (clipping, null space, checks)",
-    "top level": "stacking, exact rates, fit check, damping",
-    "svd": "JacobianSVD (every level)",
-    "QP build": "direction_qp, the least-squares QP",
+    "kinematics": "every joint's Jacobian and frame's pose (several frames)",
+    "jacobian": "one frame's Jacobian (Kinematics.jacobian)",
+    "task rows": "the tasks' rows",
+    "limits": "the limits' constraints (the step's box)",
+    "problem": "solvers.problem.build",
+    "numerics": "solvers.pipeline.solve's own code (status, clip, checks)",
+    "factorization": "QR, least-norm rates, SVD on demand",
+    "direction": "the direction problem: exact kernels, QP build",
     "backend": "the backend's solve (its data conversion included)",
-    "lower levels": "strict levels' own code",
+    "lower levels": "strict levels (least squares in null spaces)",
     "report": "building the Resolution",
 }
 """Every stage (exclusive time) and what it holds, in the order of the profile table."""
@@ -131,27 +134,27 @@ def _patched(targets: list[tuple[Any, str, str]], stages: _Stages) -> Iterator[l
 
 def _targets(resolver: Any, tasks: bool) -> list[tuple[Any, str, str]]:
     """What to wrap: (owner, attribute, stage)."""
-    module = sys.modules[type(resolver).__module__]
+    resolver_module = sys.modules[type(resolver).__module__]
     out: list[tuple[Any, str, str]] = [
         (resolver, "solve", "solve"),
-        (resolver.robot, "check_q", "q check"),
-        (resolver._bounds, "step", "bounds"),
+        (resolver.robot, "configuration", "q check"),
         (resolver.backend, "solve", "backend"),
-        (module, "resolve", "resolve"),
-        (resolve_module, "_top_level", "top level"),
-        (resolve_module, "JacobianSVD", "svd"),
-        (resolve_module, "direction_qp", "QP build"),
-        (resolve_module, "_least_squares_qp", "QP build"),
-        (resolve_module, "_lower_level", "lower levels"),
-        (resolve_module, "_report", "report"),
+        (kinematics_module.Kinematics, "_compute_whole", "kinematics"),
+        (kinematics_module.Kinematics, "jacobian", "jacobian"),
+        (JointLimits, "constraints", "limits"),
+        (resolver_module, "build", "problem"),
+        (resolver_module, "solve", "numerics"),
+        (Factorization, "__init__", "factorization"),
+        (Factorization, "least_norm", "factorization"),
+        (Factorization, "rates", "factorization"),
+        (pipeline_module, "along", "direction"),
+        (pipeline_module, "direction_qp", "direction"),
+        (pipeline_module, "least_squares", "lower levels"),
+        (Resolution, "of", "report"),
     ]
     if not tasks:
-        return [
-            *out,
-            (resolver, "_twist_rows", "task rows"),
-            (pin, "computeFrameJacobian", "jacobian"),
-        ]
-    out += [(resolver, "_levels", "task checks"), (module, "Kinematics", "kinematics")]
+        return [*out, (tasks_module.FrameTask, "rows_at", "task rows")]
+    out.append((resolver, "_levels", "task checks"))
     for name in sorted(getattr(tasks_module, "__all__", ())):
         kind = getattr(tasks_module, name)
         if isinstance(kind, type) and "rows" in kind.__dict__ and name != "Task":

@@ -19,15 +19,26 @@ from rrc_pin.errors import (
     UnknownBackend,
     URDFError,
 )
-from rrc_pin.limits import JointLimits
+from rrc_pin.limits import JointLimits, Limit
 from rrc_pin.loading import arms, load
 from rrc_pin.resolver import Damping, QPOptions, Resolver
 from rrc_pin.robot import Robot
-from rrc_pin.tasks import DampingTask, FrameTask, JointTask, PostureTask, RelativeFrameTask, Task
-from solvers.resolution import ActiveLimit, Resolution, TaskReport
+from rrc_pin.tasks import (
+    DampingTask,
+    FrameTask,
+    JointTask,
+    PostureTask,
+    RelativeFrameTask,
+    Task,
+    TaskRows,
+)
+from solvers.problem import Constraints
+from solvers.resolution import ActiveLimit, ActiveRow, Resolution, TaskReport
 
 __all__ = [
     "ActiveLimit",
+    "ActiveRow",
+    "Constraints",
     "Controller",
     "Damping",
     "DampingTask",
@@ -38,6 +49,7 @@ __all__ = [
     "InvalidInput",
     "JointLimits",
     "JointTask",
+    "Limit",
     "PostureTask",
     "QPOptions",
     "RelativeFrameTask",
@@ -47,6 +59,7 @@ __all__ = [
     "RrcPinError",
     "Task",
     "TaskReport",
+    "TaskRows",
     "ToolFrameRequired",
     "TrajectoryLog",
     "URDFError",

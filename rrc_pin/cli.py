@@ -15,6 +15,8 @@ from rrc_pin import models, urdf_export
 from rrc_pin.errors import RrcPinError
 from rrc_pin.loading import INSTALLED, arms, load
 
+ILLUSTRATIONS = (1, 2, 4, 5, 6, 7)
+"""The Appendix II illustrations ``rrc-pin guidance`` reproduces."""
 EXIT_BROKEN_PIPE = 141
 """Exit code when the reader of stdout went away (128 + SIGPIPE, as a killed process gives)."""
 
@@ -43,9 +45,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     return code
 
 
+DESCRIPTION = """\
+Resolved-rate control of robot arms on Pinocchio: the robots it knows, a scripted
+teleoperation demo, cross-checks of the paper arms, the benchmarks of a checkout, the
+committed URDFs and Nadkarni's guidance illustrations. 'rrc-pin COMMAND --help' says more."""
+
+
 def parser() -> argparse.ArgumentParser:
     """The argument parser of ``rrc-pin``."""
-    out = argparse.ArgumentParser(prog="rrc-pin", description=__doc__)
+    out = argparse.ArgumentParser(
+        prog="rrc-pin",
+        description=DESCRIPTION,
+        formatter_class=argparse.RawDescriptionHelpFormatter,  # DESCRIPTION's own lines
+    )
     sub = out.add_subparsers(dest="command", required=True)
     sub.add_parser("arms", help="table of the robots rrc_pin.load accepts, with their tool frames")
     demo = sub.add_parser(
@@ -57,15 +69,16 @@ def parser() -> argparse.ArgumentParser:
         "--arm",
         default=None,
         metavar="NAME",
-        help="print only the kinematics row of this arm (DOF, tool position, cond(J) at a "
-        "named pose) instead of the tour",
+        help="print only the kinematics row of this arm, a name or a URDF path (DOF, tool "
+        "position, cond(J) at its ready pose) instead of the tour",
     )
     demo.add_argument(
         "--out",
         type=Path,
         default=None,
         metavar="DIR",
-        help="folder for the outputs (default: a new ./rrc-pin-demo-<timestamp>)",
+        help="folder for the outputs (default: a new rrc-pin-demo-<timestamp>-* folder in the "
+        "system's temporary directory, printed)",
     )
     demo.add_argument("--quick", action="store_true", help="shorter scripts (a smoke test)")
     check = sub.add_parser("check", help="cross-check every catalogue arm: DH, Pinocchio, yourdfpy")
@@ -98,10 +111,18 @@ def parser() -> argparse.ArgumentParser:
         "of the checkout, if any; placo pins its own Pinocchio)",
     )
     guidance = sub.add_parser(
-        "guidance", help="Nadkarni's Appendix II: the thesis's numbers beside the computed ones"
+        "guidance",
+        help="Nadkarni's Appendix II: the thesis's numbers beside the computed ones, the "
+        "known errata marked",
     )
     guidance.add_argument(
-        "--illustration", type=int, required=True, choices=(1, 2, 4, 5, 6, 7), metavar="N"
+        "--illustration",
+        type=int,
+        required=True,
+        choices=ILLUSTRATIONS,
+        metavar="N",
+        help="the illustration: " + ", ".join(map(str, ILLUSTRATIONS[:-1]))
+        + f" or {ILLUSTRATIONS[-1]} (3 is 1 and 2 in one run)",
     )
     console = sub.add_parser(
         "console",
@@ -197,8 +218,11 @@ def _discard_stdout() -> None:
 
 
 def arms_table() -> str:
-    """Name, DOF, joint types, tool frames, source, and assumed values or locked joints."""
-    rows = [("name", "dof", "joints", "tool frames", "source", "assumed / locked")]
+    """The robots: name, DOF, joint types, tool frames, source, assumptions or locked joints.
+
+    The last column also says where each robot's ready pose comes from.
+    """
+    rows = [("name", "dof", "joints", "tool frames", "source", "assumed / locked, ready pose")]
     for name in arms():
         robot = load(name)
         kinds = "".join(
@@ -211,7 +235,10 @@ def arms_table() -> str:
         else:
             installed = INSTALLED[name]
             source = f"example-robot-data: {installed.path}"
-            notes = f"locked: {installed.locked}" if installed.locked else "-"
+            notes = f"locked: {installed.locked}; " if installed.locked else ""
+            notes += f"ready pose: {installed.ready.reason}"
+            if installed.ready.srdf:
+                notes += f" ({installed.ready.srdf})"
         tools = ", ".join(robot.tool_frames)
         rows.append((name, str(robot.nq), kinds, tools, source, notes))
     widths = [max(len(r[i]) for r in rows) for i in range(5)]

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
+import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
@@ -37,7 +38,8 @@ def combine(arms: Mapping[str, tuple[Robot, npt.ArrayLike]], name: str | None = 
         name: Name of the result; default: the keys joined by ``+``.
 
     Returns:
-        A :class:`Robot` with ``tool_frames`` the prefixed tool frames of every arm.
+        A :class:`Robot` with ``tool_frames`` the prefixed tool frames of every arm, and as
+        its ready configuration the arms' (:meth:`Robot.ready`) side by side.
 
     Raises:
         InvalidInput: ``arms`` is empty or not a mapping, a key is not a non-empty name
@@ -57,16 +59,19 @@ def combine(arms: Mapping[str, tuple[Robot, npt.ArrayLike]], name: str | None = 
     model = pin.Model()
     tools: list[str] = []
     parts: list[str] = []
+    ready = []
     for key, value in arms.items():
         robot, placement = _entry(key, value)
         model = pin.appendModel(model, _prefixed(robot.model, f"{key}/"), 0, placement)
         tools += [f"{key}/{frame}" for frame in robot.tool_frames]
         parts.append(f"{key}: {robot.name}")
+        ready.append(robot.ready())
     return Robot(
         model,
         tools,
         name=name if name is not None else "+".join(arms),
         source=f"combine({', '.join(parts)})",
+        poses={"ready": np.concatenate(ready)},
     )
 
 

@@ -7,24 +7,28 @@ arms: reach, then cross), roll the hand against a joint limit, let go (the deadm
 command), and reverse the last two seconds (Barker's evacuation). The script runs once per
 applicable singularity strategy; a summary table is printed, the trajectories are written
 as CSV, the table as ``summary.csv`` and a figure as ``session.png`` (needs matplotlib, the
-``plot`` extra) into the output folder.
+``plot`` extra) into the output folder: ``--out``, or a new folder under the system's
+temporary directory (never the working directory), printed.
+
+rrc_k1607 and kr5_3r start at their ready pose (:meth:`rrc_pin.Robot.ready`); barker6 starts
+next to its wrist singularity, which its script turns through first.
 """
 
 from __future__ import annotations
 
 import csv
+import tempfile
 import time
 from collections import Counter
-from collections.abc import Callable
-from datetime import datetime
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin import models
 from rrc_pin.control import Controller, TrajectoryLog
+from rrc_pin.control.strategies import make_strategy
 from rrc_pin.limits import JointLimits
 from rrc_pin.loading import load
 from rrc_pin.robot import Robot
@@ -46,10 +50,10 @@ class Segment(NamedTuple):
 
 
 class Session(NamedTuple):
-    """An arm's script and the strategies it runs under."""
+    """An arm's script, its start (None: the arm's ready pose) and its strategies."""
 
     arm: str
-    q0: tuple[float, ...]
+    q0: tuple[float, ...] | None
     segments: tuple[Segment, ...]
     strategies: tuple[str, ...]
 
@@ -60,7 +64,7 @@ class Row(NamedTuple):
     arm: str
     strategy: str
     steps: int
-    drift_mm: float
+    drift_mm: float | None  # None: not measured (the strategy chooses the rates)
     margin_rad: float
     rate: float
     statuses: str
@@ -130,11 +134,11 @@ SESSIONS = (
              LET_GO),
             ("resolver", "slowdown", "generalized_inverse", "freezing", "auxiliary_hand",
              "wrist_choice", "uncoupled")),
-    Session("rrc_k1607", (0.0, 0.5, 0.0, 1.2, 0.0, 0.6, 0.0),
+    Session("rrc_k1607", None,
             (*REACH, ACROSS,
              Segment("roll against joint 7's limit", fixed([0, 0, 0, 0, 0, 2.0]), 3.0), LET_GO),
             ("resolver", "slowdown")),
-    Session("kr5_3r", (0.0, 0.785, -0.785),
+    Session("kr5_3r", None,
             (*REACH, ACROSS, Segment("sideways against joint 1's limit", sideways(0.5), 6.0),
              LET_GO),
             ("resolver", "slowdown")),
@@ -156,15 +160,16 @@ def run_session(session: Session, strategy: str, quick: bool) -> TrajectoryLog:
 
 
 def summarise(arm: str, strategy: str, log: TrajectoryLog, robot: Robot) -> Row:
-    """The summary row of one session's log."""
+    """The summary row of one session's log (no drift where the strategy chooses the rates)."""
     q = np.asarray(log.column("q"), dtype=np.float64)
     qdot = np.asarray(log.column("qdot"), dtype=np.float64)
     drift = np.asarray(log.column("drift_position"), dtype=np.float64)
     margin = float(np.min(np.minimum(q - robot.lower, robot.upper - q)))
     statuses = Counter(str(s) for s in log.column("status"))
     met = sorted({name for s in log.column("singularity") if s for name in str(s).split("+")})
+    measured = not make_strategy(strategy).chooses_rates
     return Row(
-        arm, strategy, len(log), 1e3 * float(np.max(drift)), margin,
+        arm, strategy, len(log), 1e3 * float(np.max(drift)) if measured else None, margin,
         float(np.max(np.abs(qdot) / robot.velocity_limit)),
         " ".join(f"{k} {n}" for k, n in statuses.most_common()),
         "; ".join(met[:3]) + (f"; +{len(met) - 3} more" if len(met) > 3 else ""),
@@ -175,28 +180,39 @@ HEADER = ("arm", "strategy", "steps", "max drift [mm]", "min margin [rad]", "max
           "statuses", "singularities met")  # fmt: skip
 
 
+NOT_MEASURED = "-"
+"""What the table prints for a drift that is not measured (summary.csv: an empty cell)."""
+
+
+def drift_text(row: Row) -> str:
+    """The drift as printed: four decimals [mm], or :data:`NOT_MEASURED`."""
+    return NOT_MEASURED if row.drift_mm is None else f"{row.drift_mm:.4f}"
+
+
 def print_table(rows: list[Row]) -> None:
     """The summary table."""
     print(f"{HEADER[0]:10s} {HEADER[1]:20s} {HEADER[2]:>6s} {HEADER[3]:>14s} {HEADER[4]:>16s} "
           f"{HEADER[5]:>16s}  {HEADER[6]} | {HEADER[7]}")  # fmt: skip
     for r in rows:
-        print(f"{r.arm:10s} {r.strategy:20s} {r.steps:6d} {r.drift_mm:14.4f} {r.margin_rad:16.6f} "
-              f"{r.rate:16.4f}  {r.statuses} | {r.singularities or '-'}")  # fmt: skip
+        print(f"{r.arm:10s} {r.strategy:20s} {r.steps:6d} {drift_text(r):>14s} "
+              f"{r.margin_rad:16.6f} {r.rate:16.4f}  {r.statuses} | "
+              f"{r.singularities or '-'}")  # fmt: skip
 
 
 def write_summary(rows: list[Row], path: Path) -> None:
-    """The table as CSV, numbers as printed."""
+    """The table as CSV, numbers as printed; a drift not measured is an empty cell."""
     with path.open("w", newline="") as f:
         writer = csv.writer(f)
         writer.writerow(HEADER)
         for r in rows:
-            writer.writerow([r.arm, r.strategy, r.steps, f"{r.drift_mm:.4f}", f"{r.margin_rad:.6f}",
+            drift = "" if r.drift_mm is None else f"{r.drift_mm:.4f}"
+            writer.writerow([r.arm, r.strategy, r.steps, drift, f"{r.margin_rad:.6f}",
                              f"{r.rate:.4f}", r.statuses, r.singularities])  # fmt: skip
 
 
 def default_out() -> Path:
-    """A new folder under the working directory."""
-    return Path.cwd() / f"rrc-pin-demo-{datetime.now().strftime('%Y%m%d-%H%M%S')}"
+    """A new folder ``rrc-pin-demo-*`` under the system's temporary directory (created)."""
+    return Path(tempfile.mkdtemp(prefix=f"rrc-pin-demo-{time.strftime('%Y%m%d-%H%M%S')}-"))
 
 
 def teleoperation(out: Path | None = None, quick: bool = False) -> int:
@@ -226,27 +242,39 @@ def teleoperation(out: Path | None = None, quick: bool = False) -> int:
     for session in SESSIONS:
         labels = ", ".join(s.label for s in session.segments)
         print(f"\n{session.arm}: {labels}, then reverse {REVERSE:g} s.", end="")
-    print("\n\ndrift: distance from the commanded pose (corrected at every tick; Barker's "
-          "strategies choose\nthe rates themselves and leave that pose, so none is measured); "
-          "margin: closest approach to a\njoint limit; statuses: how the resolver answered.")
-    print(f"\nwritten: {len(runs)} trajectories (CSV), summary.csv"
+    print("\n\ndrift: distance from the commanded pose (corrected at every tick); '-': not "
+          "measured: Barker's\nstrategies choose the rates themselves and leave that pose "
+          "(summary.csv leaves the cell empty);\nmargin: closest approach to a joint limit; "
+          "statuses: how the resolver answered.")
+    print(f"\nwritten to {out}: {len(runs)} trajectories (CSV), summary.csv"
           + (", session.png" if figure else "; session.png skipped: matplotlib is not "
              "installed (pip install -e '.[plot]')"))  # fmt: skip
     return 0
 
 
-def kinematics_tour(names: list[str]) -> None:
-    """Print, per arm and tool frame, its position and Jacobian conditioning at a named pose."""
-    print(f"{'arm':12s} {'dof':>3s} {'pose':12s} {'tool frame':16s} {'position [m]':>28s} "
-          f"{'cond(J)':>9s}")  # fmt: skip
-    for name in names:
-        arm = load(name)
-        spec = models.CATALOGUE.get(name)
-        pose_name, q = next(iter(spec.named_poses.items())) if spec else ("neutral", arm.neutral())
+def kinematics_tour(names: Sequence[str]) -> None:
+    """Print, per arm and tool frame, its position and Jacobian conditioning at its ready pose.
+
+    Every arm is loaded before anything is printed (a name that does not load prints
+    nothing); the arm column holds the robot's name (a URDF's robot, not its path), and the
+    columns are as wide as their widest cell.
+
+    Raises:
+        RrcPinError: A name that :func:`rrc_pin.load` refuses.
+    """
+    robots = [load(name) for name in names]
+    rows = [("arm", "dof", "pose", "tool frame", "position [m]", "cond(J)")]
+    for arm in robots:
+        q = arm.ready()
         for frame in arm.tool_frames:
             position = np.array2string(arm.fk(q, frame)[:3, 3], precision=4, suppress_small=True)
             cond = np.linalg.cond(arm.jacobian(q, frame=frame))
-            print(f"{name:12s} {arm.nq:3d} {pose_name:12s} {frame:16s} {position:>28s} {cond:9.2e}")
+            rows.append((arm.name, str(arm.nq), "ready", frame, position, f"{cond:.2e}"))
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]))]
+    right = (False, True, False, False, True, True)
+    for r in rows:
+        cells = [c.rjust(w) if k else c.ljust(w) for c, w, k in zip(r, widths, right, strict=True)]
+        print("  ".join(cells).rstrip())
 
 
 def run_demo(arm: str | None = None, out: Path | None = None, quick: bool = False) -> int:

@@ -1,51 +1,90 @@
-"""The kinematics of one control tick: frame Jacobians and poses, computed once for all tasks.
+"""The kinematics of one control tick, computed once for every task and limit that reads it.
 
-:class:`Kinematics` runs ``pinocchio.computeJointJacobians`` (which includes the forward
-kinematics) and ``updateFramePlacements`` once at a configuration, in a ``pinocchio.Data``
-that belongs to its caller (a resolver's own: never a Data shared between threads); the tasks
-then read frame Jacobians (``getFrameJacobian``, no recomputation) and poses from it.
-:class:`Layout` is what the tasks may name on a robot, prepared once.
+:class:`Kinematics` answers frame Jacobians and poses at one configuration from a
+``pinocchio.Data`` that belongs to its caller (a resolver's own: never a Data shared between
+threads). It computes lazily: the first Jacobian asked for comes from one
+``computeFrameJacobian`` call (what a one-frame tick needs); a second frame, or a pose, runs
+``computeJointJacobians`` and ``updateFramePlacements`` once, and every later request reads
+them. :class:`Layout` is what tasks and limits may name on a robot, prepared once.
 """
 
 from __future__ import annotations
 
-from typing import NamedTuple
+import math
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from rrc_pin.robot import PIN_REFERENCE, frame_index
+from rrc_pin.robot import PIN_REFERENCE, Robot, frame_index
 from solvers.spatial import Reference
 
 Array = npt.NDArray[np.float64]
 
+MIN_REACH = 0.01
+"""[m] The smallest reach a frame's linear rows are normalised by (a frame at the base)."""
+
 
 class Layout(NamedTuple):
-    """The names a task may use on one robot, and its continuous joints.
+    """The names a task or limit may use on one robot, and its joints' limits.
 
     Attributes:
         nv: Number of joints (one rate each).
         frames: Frame name to Pinocchio frame index.
         joints: Joint name to index in q.
         continuous: Mask (nv,) of the continuous (unbounded revolute) joints.
+        lower: Lower position limits (nv,) [rad or m].
+        upper: Upper position limits (nv,).
+        velocity: Velocity limits (nv,) [rad/s or m/s].
+        reach: Frame name to its reach [m] (:func:`reach`), the unit of its linear rows.
+        closed_form: A closed form answering the tool frame's world_aligned Jacobian, or None.
+        tool_frame: The frame the closed form answers for, or None.
     """
 
     nv: int
     frames: dict[str, int]
     joints: dict[str, int]
     continuous: npt.NDArray[np.bool_]
+    lower: Array
+    upper: Array
+    velocity: Array
+    reach: dict[str, float]
+    closed_form: Any = None
+    tool_frame: str | None = None
 
     @classmethod
-    def of(cls, model: pin.Model, joint_names: list[str]) -> Layout:
-        """The layout of ``model`` whose joints (in q's order) are ``joint_names``."""
-        continuous = np.array([model.joints[j].nq == 2 for j in range(1, model.njoints)])
-        joints = {n: i for i, n in enumerate(joint_names)}
-        return cls(model.nv, frame_index(model), joints, continuous)
+    def of(cls, robot: Robot, closed_form: Any = None) -> Layout:
+        """The layout of ``robot`` (with ``closed_form`` for its tool frame, if given)."""
+        model = robot.model
+        continuous = robot.continuous
+        joints = {n: i for i, n in enumerate(robot.joint_names)}
+        frames = frame_index(model)
+        reaches = {name: reach(model, fid) for name, fid in frames.items()}
+        return cls(
+            model.nv, frames, joints, continuous, robot.lower, robot.upper,
+            robot.velocity_limit, reaches, closed_form,
+            robot.tool_frame if closed_form is not None else None,
+        )  # fmt: skip
+
+
+def reach(model: pin.Model, frame: int) -> float:
+    """The length [m] of the chain from the base to ``frame``: the sum of its links' offsets.
+
+    An upper bound of how far the frame can be from the base (for revolute chains): the
+    scale at which a frame's linear velocity compares with an angular one (1 m/s at this
+    distance is 1 rad/s), so that the resolver's metric does not mix metres and radians. At
+    least :data:`MIN_REACH`.
+    """
+    f = model.frames[frame]
+    length = float(np.linalg.norm(f.placement.translation))
+    for j in model.supports[f.parentJoint][1:]:
+        length += float(np.linalg.norm(model.jointPlacements[j].translation))
+    return max(length, MIN_REACH) if math.isfinite(length) else 1.0
 
 
 class Kinematics:
-    """Frame Jacobians (6, nv) and poses of one configuration.
+    """Frame Jacobians (6, nv) and poses of one configuration (module docstring).
 
     Args:
         model: The ``pinocchio.Model``.
@@ -57,27 +96,58 @@ class Kinematics:
     Attributes:
         q: Joint positions (nv,).
         q_pin: Pinocchio configuration (model.nq,).
-        continuous: Mask (nv,) of the continuous joints.
+        layout: The robot's layout.
     """
+
+    __slots__ = ("_data", "_first", "_model", "_whole", "layout", "q", "q_pin")
 
     def __init__(
         self, model: pin.Model, data: pin.Data, layout: Layout, q: Array, q_pin: Array
     ) -> None:
-        self.q, self.q_pin, self.continuous = q, q_pin, layout.continuous
-        self._model, self._data, self._layout = model, data, layout
-        pin.computeJointJacobians(model, data, q_pin)
-        pin.updateFramePlacements(model, data)
+        self.q, self.q_pin, self.layout = q, q_pin, layout
+        self._model, self._data = model, data
+        self._first: str | None = None  # the one frame whose Jacobian computeFrameJacobian gave
+        self._whole = False  # every joint's Jacobian and every frame's pose computed
+
+    @property
+    def model(self) -> pin.Model:
+        """The Pinocchio model."""
+        return self._model
+
+    @property
+    def data(self) -> pin.Data:
+        """The Data with every joint's placement and Jacobian at q (computed on first use)."""
+        self._compute_whole()
+        return self._data
 
     def jacobian(self, frame: str, ref: Reference = "world_aligned") -> Array:
         """Geometric Jacobian (6, nv) of ``frame``, rows [v; w], in frame ``ref``."""
-        fid = self._layout.frames[frame]
-        J: Array = pin.getFrameJacobian(self._model, self._data, fid, PIN_REFERENCE[ref])
-        return J
+        layout = self.layout
+        if frame == layout.tool_frame and ref == "world_aligned":
+            return np.asarray(layout.closed_form.jacobian(self.q), dtype=np.float64)
+        fid = layout.frames[frame]
+        J: Array
+        if not self._whole and (self._first is None or self._first == frame):
+            self._first = frame
+            J = pin.computeFrameJacobian(
+                self._model, self._data, self.q_pin, fid, PIN_REFERENCE[ref]
+            )
+        else:
+            self._compute_whole()
+            J = pin.getFrameJacobian(self._model, self._data, fid, PIN_REFERENCE[ref])
+        return J if J.ndim == 2 else J.reshape(6, 1)  # one joint: Pinocchio gives (6,)
 
     def joint_index(self, joint: str) -> int:
         """Index in q of the joint named ``joint``."""
-        return self._layout.joints[joint]
+        return self.layout.joints[joint]
 
     def pose(self, frame: str) -> Array:
         """Pose (4, 4) of ``frame`` in the base frame [m] (a copy)."""
-        return np.array(self._data.oMf[self._layout.frames[frame]].homogeneous)
+        self._compute_whole()
+        return np.array(self._data.oMf[self.layout.frames[frame]].homogeneous)
+
+    def _compute_whole(self) -> None:
+        if not self._whole:
+            pin.computeJointJacobians(self._model, self._data, self.q_pin)
+            pin.updateFramePlacements(self._model, self._data)
+            self._whole = True

@@ -1,44 +1,50 @@
-"""The resolver users run at every control tick: a twist or a stack of tasks in, joint rates out.
+"""The resolver users run at every control tick: a twist or tasks in, joint rates out.
 
-One pipeline, down the layers once: the tasks give rows (:mod:`rrc_pin.tasks`; kinematics
-computed once per tick, :mod:`rrc_pin.kinematics`), the limits give the step's bounds
-(:mod:`rrc_pin.limits`, :mod:`solvers.joint_bounds`), :func:`solvers.resolve.resolve` builds
-and solves the QPs and falls back when they fail, and the
-:class:`~solvers.resolution.Resolution` is the immutable record of the answer.
+One pipeline, each stage a module, entered once per tick (docs/api.md, "The resolver"):
 
-``Resolver.solve(q, twist)`` is that pipeline with one :class:`~rrc_pin.tasks.FrameTask` for
-the robot's tool frame (its Jacobian in one Pinocchio call); ``solve(q, tasks)`` takes any
-tasks, weighted (one QP) or by strict priority levels.
+1. **tasks** give rows ``A qdot ~= b`` (:mod:`rrc_pin.tasks`), from one :class:`Kinematics`
+   of the tick; ``solve(q, twist)`` is its :class:`~rrc_pin.tasks.FrameTask` with this tick's
+   twist;
+2. **limits** give a box and named constraint rows (:mod:`rrc_pin.limits`);
+3. **the problem** is built apart from solving it (:func:`solvers.problem.build`);
+4. **the numerics** solve it: compiled kernels, the QP backend where rows need it, the
+   fallbacks (:func:`solvers.pipeline.solve`);
+5. **the report**, decided once (:class:`~solvers.resolution.Resolution`).
 
-Bad input raises :class:`~rrc_pin.errors.InvalidInput` (or another
-:class:`~rrc_pin.errors.RrcPinError`) naming the argument before any state changes;
-numerical trouble never raises: the resolution says which method answered and why.
+Every argument is checked here, at the public boundary, before any state changes: bad input
+raises :class:`~rrc_pin.errors.InvalidInput` (or another
+:class:`~rrc_pin.errors.RrcPinError`) naming the argument. Numerical trouble never raises: the
+resolution says which method answered and why.
 
-Threads: a Resolver holds its own ``pinocchio.Data`` and warm starts, so one Resolver must
-not be used by two threads at once; several Resolvers on one shared Robot may.
+Threads: a Resolver may be shared; its ticks run one at a time (a lock), each on its own
+arguments. Its state across ticks (the backend's warm starts, the previous rates for the
+acceleration limits) is then shared too: give each thread its own Resolver for independent
+sequences, or pass ``qdot_prev`` explicitly.
 """
 
 from __future__ import annotations
 
+import threading
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal, cast
 
 import numpy as np
 import numpy.typing as npt
-import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput, UnknownBackend
 from rrc_pin.kinematics import Kinematics, Layout
-from rrc_pin.limits import JointLimits
+from rrc_pin.limits import JointLimits, Limit
 from rrc_pin.loading import load
-from rrc_pin.robot import PIN_REFERENCE, Robot
+from rrc_pin.robot import Robot
 from rrc_pin.tasks import FrameTask, Task
-from solvers import jacobian_svd
+from solvers import damping as solver_damping
 from solvers.errors import BackendNotFound, InputError
+from solvers.pipeline import DEFAULT_FALLBACKS, Method, Options, solve
+from solvers.problem import TaskRows, build
 from solvers.qp_backends import make_backend
-from solvers.resolution import Method, Resolution, TaskRows
-from solvers.resolve import DEFAULT_FALLBACKS, ResolveOptions, resolve
+from solvers.resolution import Resolution
 from solvers.spatial import Reference
 from solvers.validation import positive
 
@@ -49,16 +55,19 @@ TaskCommand = Task | Sequence[Task | Sequence[Task]]
 
 Priority = Literal["weighted", "strict"]
 
+DEFAULT_TIME_LIMIT = 0.05
+"""[s] The backend's time cap per QP by default (:class:`QPOptions`): five periods at 100 Hz."""
 
-class Damping(jacobian_svd.Damping):
-    """Damping near singularities (:class:`solvers.jacobian_svd.Damping`), for the resolver.
+
+class Damping(solver_damping.Damping):
+    """Damping near singularities (:class:`solvers.damping.Damping`), for the resolver.
 
     Attributes:
-        ratio: A singular direction is weak when, at full joint rate, it delivers less than
-            1/ratio of the task speed of the strongest direction; > 1.
+        threshold: The condition number of the top level's normalised rows beyond which a
+            command that cannot be met is damped (>= 10; default 100).
 
     Raises:
-        InvalidInput: ``ratio`` not a finite number > 1.
+        InvalidInput: ``threshold`` not a finite number >= 10.
     """
 
     def __post_init__(self) -> None:
@@ -70,26 +79,41 @@ class Damping(jacobian_svd.Damping):
 
 @dataclass(frozen=True)
 class QPOptions:
-    """The QP backend and the fallbacks of a resolver.
+    """The QP backend, its time cap and the fallbacks of a resolver.
 
     Attributes:
         backend: A name of :func:`solvers.qp_backends.installed_backends`: ``"daqp"``
-            (default: exact active-set answers, the fastest median and tail of rrc-pin's
-            backends in docs/benchmarks.md), ``"osqp"``, or a qpsolvers solver (``proxqp``,
-            ``quadprog``, ``clarabel``...).
-        options: The backend's own settings, checked at construction.
-        fallbacks: Methods tried after the QP fails, in order: ``"scipy"`` (the same problem
-            solved exactly by scipy.optimize), ``"dls"``, ``"scaling"``; ``"hold"`` always ends
+            (default: exact active-set answers), ``"osqp"``, or a qpsolvers solver
+            (``proxqp``, ``quadprog``, ``clarabel``...).
+        options: The backend's own settings (a mapping), checked at construction.
+        fallbacks: Methods tried after the pipeline fails, in order: ``"scipy"`` (the same
+            problem solved exactly by scipy.optimize), ``"scaling"``; ``"hold"`` always ends
             the chain.
+        time_limit: [s] > 0, the backend's time per QP: past it the answer is refused and the
+            fallbacks answer (reported in ``attempts``).
+
+    Raises:
+        InvalidInput: ``options`` not a mapping, ``time_limit`` not a finite number > 0.
     """
 
     backend: str = "daqp"
     options: Mapping[str, Any] = field(default_factory=dict)
     fallbacks: Sequence[Method] = DEFAULT_FALLBACKS
+    time_limit: float = DEFAULT_TIME_LIMIT
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.options, Mapping):
+            raise InvalidInput(
+                "qp.options", f"expected a mapping of settings, got {self.options!r}"
+            )
+        if not isinstance(self.backend, str):
+            raise InvalidInput("qp.backend", f"expected a backend name, got {self.backend!r}")
+        object.__setattr__(self, "time_limit", positive(self.time_limit, "qp.time_limit",
+                                                        InvalidInput))  # fmt: skip
 
 
 class Resolver:
-    """Joint rates for commanded twists or tasks, inside the joint limits, at every tick.
+    """Joint rates for commanded twists or tasks, inside the limits, at every tick.
 
     Args:
         robot: A :class:`rrc_pin.Robot`, or a name or path that :func:`rrc_pin.load` takes.
@@ -98,14 +122,14 @@ class Resolver:
             frame, rows, ref and weights are used (its twist is the call's); default the
             robot's tool frame, full twist (position only below six joints), world_aligned.
             A robot with several tool frames has no default: solve it with tasks.
-        limits: Joint limits (default :class:`~rrc_pin.limits.JointLimits()`).
-        qp: Backend and fallbacks (default :class:`QPOptions()`: daqp, then the exact LP).
+        limits: A :class:`~rrc_pin.limits.Limit` or a sequence of them (default
+            ``JointLimits()``); include ``JointLimits`` to keep the joint limits.
+        qp: Backend, time cap and fallbacks (default :class:`QPOptions()`: daqp).
         damping: Damping near singularities (default :class:`Damping()`), or None.
-        direction_preserving: When a command cannot be met, slow down along it instead of
-            distorting it (the top level as Drake's scale-maximising QP); False: the
-            least-squares tracking QP.
-        use_closed_form: Take the single-twist Jacobian from ``robot.closed_form`` (the
-            paper's equations; world_aligned only) instead of Pinocchio.
+        direction_preserving: When the top level's command cannot be met, slow down along it
+            instead of distorting it (the direction problem); False: least squares.
+        use_closed_form: Take the tool frame's world_aligned Jacobian from
+            ``robot.closed_form`` (the paper's equations) instead of Pinocchio.
 
     Raises:
         InvalidInput: Any invalid argument, named.
@@ -119,7 +143,7 @@ class Resolver:
         dt: float = 0.01,
         *,
         task: FrameTask | None = None,
-        limits: JointLimits | None = None,
+        limits: Limit | Sequence[Limit] | None = None,
         qp: QPOptions | None = None,
         damping: Damping | None = Damping(),  # noqa: B008 - immutable
         direction_preserving: bool = True,
@@ -129,42 +153,50 @@ class Resolver:
             robot = load(robot)
         if not isinstance(robot, Robot):
             raise InvalidInput("robot", f"expected a rrc_pin.Robot or a name, got {robot!r}")
+        if not isinstance(direction_preserving, bool):
+            raise InvalidInput("direction_preserving", f"expected True or False, got "
+                               f"{direction_preserving!r}")  # fmt: skip
+        if not isinstance(use_closed_form, bool):
+            raise InvalidInput("use_closed_form", f"expected True or False, got "
+                               f"{use_closed_form!r}")  # fmt: skip
         self.robot = robot
         self.dt = _dt(dt)
-        self.limits = JointLimits() if limits is None else _typed(limits, JointLimits, "limits")
-        self._bounds = self.limits.bounds(robot)
         self.qp = QPOptions() if qp is None else _typed(qp, QPOptions, "qp")
         try:
-            self.options = ResolveOptions(direction_preserving, damping, self.qp.fallbacks)
-            self.backend = make_backend(self.qp.backend, **dict(self.qp.options))
+            self.options = Options(damping, self.qp.fallbacks)  # type: ignore[arg-type]
+            self.backend = make_backend(self.qp.backend, self.qp.time_limit,
+                                        **dict(self.qp.options))  # fmt: skip
         except BackendNotFound as exc:
             raise UnknownBackend(exc.backend, exc.available) from exc
         except InputError as exc:
             name = {"backend_options": "qp.options", "fallbacks": "qp.fallbacks"}
             raise InvalidInput(name.get(exc.argument, exc.argument), exc.reason) from exc
-        self._data = robot.model.createData()  # this resolver's own: thread-safe across resolvers
-        self._layout = Layout.of(robot.model, list(robot.joint_names))
+        self.direction_preserving = direction_preserving
         self.task = self._default_task() if task is None else _typed(task, FrameTask, "task")
-        self._frame = -1
+        closed_form = self._closed_form_for(self.task) if use_closed_form else None
+        self._layout = Layout.of(robot, closed_form)
         if self.task is not None:
             self.task.check(self._layout)
-            self._frame = self._layout.frames[self.task.frame]
-        elif use_closed_form:
-            raise InvalidInput("use_closed_form", "the closed form needs a task (one frame)")
-        self._closed_form = self._closed_form_for(self.task) if use_closed_form else None
+        self.limits = _limits(limits)
+        for limit in self.limits:
+            limit.check(self._layout)
+        self._data = robot.model.createData()  # this resolver's own
         self._names = tuple(robot.joint_names)
-        self._last_qdot: Array | None = None
+        self._last_qdot = np.zeros(robot.nq)
+        self._lock = threading.Lock()
 
     def reset(self) -> None:
         """Forget the warm starts and the previous joint rates."""
-        self.backend.reset()
-        self._last_qdot = None
+        with self._lock:
+            self.backend.reset()
+            self._last_qdot = np.zeros(self.robot.nq)
 
     def warm_start_state(self) -> dict[str, Any]:
         """Copies of every value that carries over to the next ``solve``."""
-        state: dict[str, Any] = dict(self.backend.warm_start_state())
-        state["last_qdot"] = None if self._last_qdot is None else self._last_qdot.copy()
-        return state
+        with self._lock:
+            state: dict[str, Any] = dict(self.backend.warm_start_state())
+            state["last_qdot"] = self._last_qdot.copy()
+            return state
 
     def solve(
         self,
@@ -182,9 +214,9 @@ class Resolver:
             q: Joint positions (nq,) [rad or m].
             command: A twist [v; w] (6,) [m/s, rad/s] of the resolver's task (or only its
                 rows), in frame ``ref``; or tasks: one :class:`~rrc_pin.tasks.Task`, a list
-                of them (``priority="weighted"``: one QP, their weights trade them off), or a
-                list of levels, each a task or a list of tasks (``priority="strict"``: each
-                level exactly optimal within the optimal set of those above; the top level
+                of them (``priority="weighted"``: their weights trade them off), or a list of
+                levels, each a task or a list of tasks (``priority="strict"``: each level
+                exactly optimal within the optimal set of those above; the top level
                 direction-preserving with one common scale).
             ref: Frame of a twist: ``world_aligned``, ``local`` or ``world``; default the
                 resolver's task's. Not used with tasks (each task has its own).
@@ -194,7 +226,7 @@ class Resolver:
                 rates this resolver returned last (zero at the first step).
 
         Returns:
-            The :class:`~solvers.resolution.Resolution` (finite, within the bounds).
+            The :class:`~solvers.resolution.Resolution` (finite, within the box).
 
         Raises:
             InvalidInput: A bad q, twist, task, level, ref, priority, dt or qdot_prev, named;
@@ -204,61 +236,34 @@ class Resolver:
         """
         q, q_pin = self.robot.configuration(q)
         step = self.dt if dt is None else _dt(dt)
-        prev = None if qdot_prev is None else self.robot.check_q(qdot_prev, "qdot_prev")
+        previous = None if qdot_prev is None else self.robot.check_q(qdot_prev, "qdot_prev")
         if isinstance(command, Task) or _is_tasks(command):
             if ref is not None:
                 raise InvalidInput("ref", "tasks carry their own ref; pass ref to FrameTask")
             levels, weighted = self._levels(cast(TaskCommand, command), priority)
+            twist = None
+        else:
+            if priority != "weighted":
+                raise InvalidInput("priority", "a twist is one task: priority is for lists of "
+                                   "tasks")  # fmt: skip
+            task = self._twist_task()
+            twist = task.check_twist(cast(npt.ArrayLike, command))
+            levels, weighted = [[task]], False
+            ref = task.ref if ref is None else task.check_ref(ref)
+        with self._lock:
+            start = time.perf_counter()
             kin = Kinematics(self.robot.model, self._data, self._layout, q, q_pin)
-            rows = [[t.rows(kin) for t in level] for level in levels]
-            # the tasks' arrays may be the caller's: the resolution keeps copies
-            return self._resolve(rows, q, step, prev, weighted, copy_rows=True)
-        task = self._twist_task()
-        b = task.check_twist(cast(npt.ArrayLike, command)).copy()  # the resolution keeps it
-        ref = task.ref if ref is None else task.check_ref(ref)
-        return self._resolve([[self._twist_rows(task, q, q_pin, b, ref)]], q, step, prev)
-
-    def _solve_checked_twist(
-        self, q: Array, q_pin: Array, twist: Array, ref: Reference
-    ) -> Resolution:
-        """``solve(q, twist, ref)`` on arguments the caller has checked and owns.
-
-        For :class:`~rrc_pin.control.Controller`, which checks the operator's command at its
-        boundary and holds q itself: one check per tick instead of two (with the read-only q
-        this cut the controller's own work per tick on panda from 79k to 53k instructions,
-        callgrind).
-
-        Args:
-            q: Joint positions (nq,), finite (the controller's own).
-            q_pin: The same as Pinocchio's configuration vector.
-            twist: A finite (6,) twist nobody changes afterwards (the resolution keeps it).
-            ref: ``local`` or ``world_aligned``.
-        """
-        task = self._twist_task()
-        b = task.selected_rates(twist)
-        return self._resolve([[self._twist_rows(task, q, q_pin, b, ref)]], q, self.dt, None)
-
-    def _resolve(
-        self,
-        rows: list[list[TaskRows]],
-        q: Array,
-        step: float,
-        prev: Array | None,
-        weighted: bool = False,
-        copy_rows: bool = False,
-    ) -> Resolution:
-        """The step's bounds and the pipeline (:func:`solvers.resolve.resolve`) on ``rows``."""
-        if self.limits.acceleration is None:
-            prev = None
-        elif prev is None:
-            prev = np.zeros(self.robot.nq) if self._last_qdot is None else self._last_qdot
-        bounds = self._bounds.step(q, step, prev)
-        result = resolve(
-            rows, bounds, self.backend, self.options, weighted=weighted, joint_names=self._names,
-            copy_rows=copy_rows,
-        )  # fmt: skip
-        self._last_qdot = result.qdot
-        return result
+            if twist is None:
+                rows = [[t.rows(kin) for t in level] for level in levels]
+            else:
+                rows = [[cast(FrameTask, levels[0][0]).rows_at(kin, twist, cast(Reference, ref))]]
+            before = self._last_qdot if previous is None else previous
+            constraints = [limit.constraints(kin, step, before) for limit in self.limits]
+            problem = build(rows, constraints, self.robot.nq, step, weighted=weighted,
+                            direction=self.direction_preserving)  # fmt: skip
+            answer = solve(problem, self.backend, self.options)
+            self._last_qdot = answer.qdot
+            return Resolution.of(problem, answer, time.perf_counter() - start, self._names)
 
     def rows_of(self, task: Task, q: npt.ArrayLike) -> TaskRows:
         """The rows ``A qdot ~= b`` that ``task`` gives at ``q`` (what ``solve`` stacks).
@@ -269,7 +274,8 @@ class Resolver:
         """
         q, q_pin = self.robot.configuration(q)
         _typed(task, Task, "task").check(self._layout)
-        return task.rows(Kinematics(self.robot.model, self._data, self._layout, q, q_pin))
+        with self._lock:
+            return task.rows(Kinematics(self.robot.model, self._data, self._layout, q, q_pin))
 
     def _twist_task(self) -> FrameTask:
         """The task of ``solve(q, twist)``; a robot with several tool frames has none."""
@@ -281,27 +287,13 @@ class Resolver:
             )  # fmt: skip
         return self.task
 
-    def _twist_rows(
-        self, task: FrameTask, q: Array, q_pin: Array, b: Array, ref: Reference
-    ) -> TaskRows:
-        """``task`` at ``q``, rates ``b`` of its rows in frame ``ref`` (one Jacobian call)."""
-        if self._closed_form is not None:
-            if ref != "world_aligned":
-                raise InvalidInput("ref", f"the closed form gives world_aligned rows, got {ref!r}")
-            J = np.asarray(self._closed_form.jacobian(q), dtype=np.float64)
-        else:
-            J = pin.computeFrameJacobian(
-                self.robot.model, self._data, q_pin, self._frame, PIN_REFERENCE[ref]
-            )
-        return task.rows_from(J, b)
-
-    def _levels(
-        self, command: TaskCommand, priority: str
-    ) -> tuple[list[list[Task]], bool]:
+    def _levels(self, command: TaskCommand, priority: str) -> tuple[list[list[Task]], bool]:
         """The tasks as priority levels, every task checked against the robot."""
-        if priority not in ("weighted", "strict"):
+        if not isinstance(priority, str) or priority not in ("weighted", "strict"):
             raise InvalidInput("priority", f"expected 'weighted' or 'strict', got {priority!r}")
-        items = [command] if isinstance(command, Task) else list(command)  # never empty
+        items = [command] if isinstance(command, Task) else list(command)
+        if not items:
+            raise InvalidInput("command", "no tasks: pass a twist, a task or a list of tasks")
         if priority == "weighted":
             if not all(isinstance(t, Task) for t in items):
                 raise InvalidInput(
@@ -334,11 +326,15 @@ class Resolver:
 
     def _closed_form_for(self, task: FrameTask | None) -> Any:
         cf = self.robot.closed_form
-        assert task is not None
-        if cf is None or task.frame != cf.frame or task.frame != self.robot.tool_frame:
+        if (
+            task is None
+            or cf is None
+            or task.frame != cf.frame
+            or task.frame != self.robot.tool_frame
+        ):
             raise InvalidInput(
                 "use_closed_form",
-                f"{self.robot.name} has no closed form for frame {task.frame!r} (the papers' "
+                f"{self.robot.name} has no closed form for this task's frame (the papers' "
                 "closed forms answer for the catalogue arms' 'tool' frame)",
             )
         if max(task.selected) >= cf.task_dim:
@@ -358,8 +354,17 @@ def _typed(value: Any, kind: type, name: str) -> Any:
     return value
 
 
+def _limits(limits: Limit | Sequence[Limit] | None) -> tuple[Limit, ...]:
+    if limits is None:
+        return (JointLimits(),)
+    items = (limits,) if isinstance(limits, Limit) else limits
+    if not isinstance(items, (list, tuple)) or not all(isinstance(x, Limit) for x in items):
+        raise InvalidInput("limits", f"expected a Limit or a sequence of them, got {limits!r}")
+    return tuple(items)
+
+
 def _is_tasks(command: Any) -> bool:
     """True when ``command`` is a list of tasks or of levels (lists) of tasks, not a twist."""
     if isinstance(command, np.ndarray) or not isinstance(command, (list, tuple)):
         return False
-    return any(isinstance(t, (Task, list, tuple)) for t in command)
+    return not command or any(isinstance(t, (Task, list, tuple)) for t in command)

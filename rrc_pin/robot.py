@@ -2,8 +2,9 @@
 
 Joints are one coordinate each at this API: revolute, prismatic, and continuous (unbounded)
 revolute joints, which Pinocchio stores as (cos, sin) with nq = 2, nv = 1; the Robot maps
-one angle per joint to Pinocchio's configuration vector. Any other joint (free-flyer,
-spherical, planar) is refused with a message saying why.
+one angle per joint to Pinocchio's configuration vector. Mimic joints (Pinocchio's
+``JointModelMimic``, nq = nv = 0) follow their primary joint and take no coordinate. Any other
+joint (free-flyer, spherical, planar) is refused with a message saying why.
 
 Threads: a Robot may be shared between threads. Its methods never write shared state: each
 thread computes in its own ``pinocchio.Data`` (a ``threading.local``, created on the thread's
@@ -18,7 +19,7 @@ The cost of a Data per thread is its memory: about 0.2 MB for panda, 0.8 MB for 
 from __future__ import annotations
 
 import threading
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -41,6 +42,13 @@ PIN_REFERENCE = {
 Seed = np.random.Generator | int | None
 """What :meth:`Robot.random_q` takes: a numpy Generator, an int seed (>= 0) or None."""
 
+UNBOUNDED = 1e6
+"""A joint limit beyond +-this [rad or m] counts as none (URDFs write 1e16 or 1e308 for none):
+:meth:`Robot.random_q` draws such a joint over a finite window, see there."""
+READY_INSET = 0.1
+"""Fraction of a joint's range that :meth:`Robot.ready` keeps from each limit when the robot
+has no named ready configuration."""
+
 
 class Robot:
     """A Pinocchio model with its tool frames, joint limits and SI units at every method.
@@ -58,6 +66,10 @@ class Robot:
         velocity_limit: Joint speed limits (nq,) [rad/s or m/s]; +inf where the URDF gives none.
         spec: The catalogue :class:`ArmSpec` the robot was built from, or None.
         source: Where the model came from (a path, ``catalogue``, a combination).
+        poses: Named configurations (nq,) [rad or m] (read-only arrays); ``"ready"``, where
+            present, is :meth:`ready`'s.
+        mimic_joints: Joints that follow another (URDF ``<mimic>``): in the model, not in q.
+        continuous: Mask (nq,) of the continuous (unbounded revolute) joints.
     """
 
     def __init__(
@@ -68,30 +80,49 @@ class Robot:
         name: str,
         source: str,
         spec: ArmSpec | None = None,
+        poses: Mapping[str, npt.ArrayLike] | None = None,
     ) -> None:
         """Wrap ``model``; every entry of ``tool_frames`` must name one of its frames.
 
         Args:
-            model: The kinematic model (1-DOF joints only).
+            model: The kinematic model, a ``pinocchio.Model`` (1-DOF joints, and mimic joints
+                that follow one of them).
             tool_frames: One frame name, several, or None: the model's one end link (the
                 unique leaf of its tree that a joint moves, see :func:`end_links`).
             name: Robot name.
             source: Where the model came from, for messages.
             spec: The catalogue arm it was built from, if any.
+            poses: Named configurations (nq,) [rad or m], each within the joint limits;
+                ``"ready"`` is the one :meth:`ready` returns. Default: the ``spec``'s named
+                poses, else none.
 
         Raises:
+            InvalidInput: ``model`` is not a ``pinocchio.Model``, ``name`` or ``source`` not a
+                string, ``spec`` not an ArmSpec, ``tool_frames`` empty, not names or naming a
+                frame twice, or a pose not a finite (nq,) vector within the limits (named).
             URDFError: The model has no moving joint, or a joint that is not one coordinate
                 (free-flyer, spherical...).
             ToolFrameRequired: ``tool_frames`` is None and the tree has several end links
                 (lists them).
-            InvalidInput: ``tool_frames`` is empty or names a frame twice.
             FrameNotFound: A tool frame is not a frame of the model.
         """
+        if not isinstance(model, pin.Model):
+            raise InvalidInput("model", f"expected a pinocchio.Model, got {_brief(model)}")
+        for label, value in (("name", name), ("source", source)):
+            if not isinstance(value, str) or not value:
+                raise InvalidInput(label, f"expected a non-empty string, got {_brief(value)}")
+        if spec is not None and not isinstance(spec, ArmSpec):
+            raise InvalidInput("spec", f"expected an ArmSpec or None, got {_brief(spec)}")
         if model.nv == 0:
             raise URDFError(source, "no moving joint: there is nothing to control")
         scalar_api, scalar_pin, angle_api, angle_pin = [], [], [], []
+        moving: list[tuple[int, str]] = []  # (index in q, joint name)
+        mimic: list[str] = []
         for j in range(1, model.njoints):
             joint = model.joints[j]
+            if joint.shortname() == "JointModelMimic":  # follows its primary: no coordinate
+                mimic.append(str(model.names[j]))
+                continue
             if joint.nv != 1 or joint.nq not in (1, 2):
                 raise URDFError(
                     source,
@@ -99,6 +130,7 @@ class Robot:
                     f"nv={joint.nv}); rrc-pin handles serial arms of 1-DOF joints only "
                     "(lock or remove it, e.g. with pinocchio.buildReducedModel)",
                 )
+            moving.append((joint.idx_v, str(model.names[j])))
             if joint.nq == 1:
                 scalar_api.append(joint.idx_v)
                 scalar_pin.append(joint.idx_q)
@@ -131,9 +163,13 @@ class Robot:
         self.tool_frames: tuple[str, ...] = tools
         self.tool_frame: str | None = tools[0] if len(tools) == 1 else None
         self.nq: int = model.nv
-        self.joint_names = [str(model.names[j]) for j in range(1, model.njoints)]
+        self.joint_names = [joint for _, joint in sorted(moving)]  # = moving_joints(model)
+        self.mimic_joints: tuple[str, ...] = tuple(mimic)
         self._scalar = (np.array(scalar_api, dtype=int), np.array(scalar_pin, dtype=int))
         self._angle = (np.array(angle_api, dtype=int), np.array(angle_pin, dtype=int))
+        self.continuous = np.zeros(self.nq, dtype=bool)
+        self.continuous[self._angle[0]] = True
+        self.continuous.flags.writeable = False
         self._identity_map = not angle_api and model.nq == model.nv
 
         self.lower = np.full(self.nq, -np.inf)
@@ -142,6 +178,8 @@ class Robot:
         self.upper[self._scalar[0]] = model.upperPositionLimit[self._scalar[1]]
         velocity = np.array(model.velocityLimit, dtype=float)
         self.velocity_limit = np.where(velocity > 0.0, velocity, np.inf)
+        named = (spec.named_poses if spec is not None else {}) if poses is None else poses
+        self.poses: dict[str, npt.NDArray[np.float64]] = self._checked_poses(named)
 
         self._local = threading.local()  # this thread's pinocchio.Data, see _scratch
         self._lock = threading.Lock()  # guards the one-time build of the closed form
@@ -228,11 +266,39 @@ class Robot:
         return q, out
 
     def neutral(self) -> npt.NDArray[np.float64]:
-        """The zero configuration clipped into the joint limits, (nq,) [rad or m]."""
+        """The zero configuration clipped into the joint limits, (nq,) [rad or m].
+
+        It may sit on a limit (panda's joint 4) or at a singularity (an arm stretched out):
+        start a session from :meth:`ready` instead.
+        """
         return np.clip(np.zeros(self.nq), self.lower, self.upper)
 
+    def ready(self) -> npt.NDArray[np.float64]:
+        """A configuration (nq,) [rad or m] to start from, away from limits and singularities.
+
+        The robot's named ``"ready"`` pose (:attr:`poses`): every catalogue arm and every
+        robot :func:`rrc_pin.load` knows by name has one (from example-robot-data's SRDF
+        where it gives one, else chosen and stated with the arm's data; ``rrc-pin arms``
+        says which), and a :func:`rrc_pin.combine` cell has its arms'. Any other model: the
+        zero configuration moved at least :data:`READY_INSET` of each joint's range inside
+        its limits (of the window :meth:`random_q` draws from, for unbounded joints), with
+        no promise about singularities (pass ``poses={"ready": q}`` to :class:`Robot` to
+        name one). A new array at every call.
+        """
+        pose = self.poses.get("ready")
+        if pose is not None:
+            named: npt.NDArray[np.float64] = np.array(pose)
+            return named
+        lo, hi = _finite_window(self.lower, self.upper)
+        inset = READY_INSET * (hi - lo)
+        inside: npt.NDArray[np.float64] = np.clip(np.zeros(self.nq), lo + inset, hi - inset)
+        return inside
+
     def random_q(self, rng: Seed = None) -> npt.NDArray[np.float64]:
-        """A configuration (nq,) drawn uniformly within the limits ([-pi, pi] if continuous).
+        """A configuration (nq,) drawn uniformly within the limits.
+
+        Unbounded joints (continuous, or limits beyond +-:data:`UNBOUNDED`) are drawn in
+        [-pi, pi]; a joint bounded on one side only, over 2 pi [rad or m] from that limit.
 
         Args:
             rng: A ``numpy.random.Generator`` (advanced by the draw), an int seed >= 0 (the
@@ -242,8 +308,7 @@ class Robot:
             InvalidInput: ``rng`` is none of these.
         """
         generator = _generator(rng)
-        lo = np.where(np.isfinite(self.lower), self.lower, -np.pi)
-        hi = np.where(np.isfinite(self.upper), self.upper, np.pi)
+        lo, hi = _finite_window(self.lower, self.upper)
         return generator.uniform(lo, hi)
 
     def fk(self, q: npt.ArrayLike, frame: str | None = None) -> npt.NDArray[np.float64]:
@@ -297,6 +362,8 @@ class Robot:
         J: npt.NDArray[np.float64] = pin.computeFrameJacobian(
             self.model, data, q_pin, fid, PIN_REFERENCE[ref]
         )
+        if J.ndim == 1:  # Pinocchio's binding returns a (6, 1) matrix as a (6,) array
+            J = J.reshape(6, 1)
         return J
 
     def _frame(self, frame: str | None, argument: str = "frame") -> int:
@@ -307,10 +374,39 @@ class Robot:
                     argument, f"{self.name} has several tool frames", list(self.tool_frames)
                 )
             frame = self.tool_frame
-        fid = self._frame_ids.get(frame) if isinstance(frame, str) else None
+        if not isinstance(frame, str):
+            raise InvalidInput(argument, f"expected a frame name (str), got {_brief(frame)}")
+        fid = self._frame_ids.get(frame)
         if fid is None:
-            raise FrameNotFound(str(frame), sorted(self._frame_ids), argument)
+            raise FrameNotFound(frame, sorted(self._frame_ids), argument)
         return fid
+
+    def _checked_poses(
+        self, poses: Mapping[str, npt.ArrayLike]
+    ) -> dict[str, npt.NDArray[np.float64]]:
+        """``poses`` as read-only (nq,) arrays, each within the limits.
+
+        Raises:
+            InvalidInput: Not a mapping of names to finite (nq,) vectors within the limits.
+        """
+        if not isinstance(poses, Mapping):
+            raise InvalidInput("poses", f"expected a mapping name -> q, got {_brief(poses)}")
+        out: dict[str, npt.NDArray[np.float64]] = {}
+        for key, value in poses.items():
+            if not isinstance(key, str) or not key:
+                raise InvalidInput("poses", f"expected names (str) as keys, got {_brief(key)}")
+            q = as_vector(value, f"poses[{key!r}]", self.nq, InvalidInput).copy()
+            outside = (q < self.lower) | (q > self.upper)
+            if outside.any():
+                j = int(np.argmax(outside))
+                raise InvalidInput(
+                    f"poses[{key!r}]",
+                    f"joint {self.joint_names[j]!r} at {q[j]:.6g} is outside its limits "
+                    f"[{self.lower[j]:.6g}, {self.upper[j]:.6g}]",
+                )
+            q.flags.writeable = False
+            out[key] = q
+        return out
 
     def _scratch(self) -> pin.Data:
         """The calling thread's ``pinocchio.Data``, created on the thread's first call."""
@@ -319,6 +415,19 @@ class Robot:
         except AttributeError:
             self._local.data = data = self.model.createData()
             return data
+
+
+def moving_joints(model: pin.Model) -> list[str]:
+    """Names of the joints that take a coordinate of q (one rate each), in q's order.
+
+    Mimic joints, which follow their primary joint, are left out.
+    """
+    joints = [
+        (model.joints[j].idx_v, str(model.names[j]))
+        for j in range(1, model.njoints)
+        if model.joints[j].nv > 0 and model.joints[j].shortname() != "JointModelMimic"
+    ]
+    return [name for _, name in sorted(joints)]
 
 
 def frame_index(model: pin.Model) -> dict[str, int]:
@@ -341,17 +450,34 @@ def end_links(model: pin.Model) -> list[str]:
     grippers, fingertips, cameras and sensor links.
     """
     bodies = [i for i, f in enumerate(model.frames) if f.type == pin.FrameType.BODY]
-    parents = set()
-    for i in bodies:
-        parent = model.frames[i].parentFrame
-        while parent and model.frames[parent].type != pin.FrameType.BODY:
-            parent = model.frames[parent].parentFrame
-        parents.add(parent)
+    parents = {parent_link(model, i) for i in bodies}
     return [
         str(model.frames[i].name)
         for i in bodies
         if i not in parents and model.frames[i].parentJoint != 0
     ]
+
+
+def parent_link(model: pin.Model, frame: int) -> int:
+    """Index of the body frame (link) that frame ``frame`` hangs from; 0 for the universe.
+
+    Walks up ``parentFrame`` to the first body frame, on any frame graph: where the walk comes
+    back to a frame it has seen (``pinocchio.buildReducedModel`` in Pinocchio 4.1 makes the
+    frame of a locked joint its own parent), it takes instead the last body frame before
+    ``frame`` moved by the same joint (``parentJoint``), else 0.
+    """
+    frames = model.frames
+    seen = {frame}
+    parent = frames[frame].parentFrame
+    while parent and frames[parent].type != pin.FrameType.BODY:
+        if parent in seen:  # a cycle: the frame graph is broken here
+            joint = frames[frame].parentJoint
+            same = [i for i in range(frame) if frames[i].type == pin.FrameType.BODY
+                    and frames[i].parentJoint == joint]  # fmt: skip
+            return same[-1] if same else 0
+        seen.add(parent)
+        parent = frames[parent].parentFrame
+    return int(parent)
 
 
 def frame_id(model: pin.Model, name: str) -> int:
@@ -364,6 +490,28 @@ def frame_id(model: pin.Model, name: str) -> int:
     if name not in index:
         raise FrameNotFound(name, sorted(index))
     return index[name]
+
+
+def _finite_window(
+    lower: npt.NDArray[np.float64], upper: npt.NDArray[np.float64]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Finite bounds (nq,) to draw from, (lo, hi).
+
+    The limits where they are within +-:data:`UNBOUNDED`; [-pi, pi] where neither is; 2 pi
+    [rad or m] from the one that is, where only one is.
+    """
+    lo_ok, hi_ok = np.abs(lower) <= UNBOUNDED, np.abs(upper) <= UNBOUNDED
+    lo = np.where(lo_ok, lower, np.where(hi_ok, upper - 2.0 * np.pi, -np.pi))
+    hi = np.where(hi_ok, upper, np.where(lo_ok, lower + 2.0 * np.pi, np.pi))
+    return lo, hi
+
+
+def _brief(value: object, limit: int = 60) -> str:
+    """``repr(value)`` cut to ``limit`` characters, with its type (for error messages)."""
+    text = repr(value)
+    if len(text) > limit:
+        text = text[: limit - 3] + "..."
+    return f"{text} ({type(value).__name__})"
 
 
 def _generator(rng: Seed) -> np.random.Generator:

@@ -25,6 +25,16 @@ class ProblemError(SolverError):
     """A QP backend failed in a way that is not a numerical answer (bad setup, crash)."""
 
 
+class NumericalFailure(SolverError):
+    """A method of the numerics found no usable answer.
+
+    No solution, an answer outside the constraints, a backend's fault or time-out.
+
+    Internal: the pipeline records it in the resolution's ``attempts`` and goes on to the
+    next method; it never reaches a caller of the resolver.
+    """
+
+
 class BackendNotFound(SolverError, ValueError):
     """An unknown or uninstalled QP backend was requested.
 

@@ -12,13 +12,26 @@ r"""The QP of one priority level, built apart from solving it.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+import math
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 import qpsolvers
 
+from solvers import kernels
+from solvers.errors import NumericalFailure
+from solvers.problem import Box, Rows
+
+if TYPE_CHECKING:
+    from solvers.qp_backends.base import QPBackend
+
 Array = npt.NDArray[np.float64]
+
+FEASIBILITY_TOL = 1e-6
+"""A backend's answer may leave the box and rows by this much times (1 + the norm of the
+velocity limits) before it counts as a failure (it is clipped back into the box either way)."""
 
 
 class QP(NamedTuple):
@@ -83,3 +96,93 @@ class Decoding(NamedTuple):
         """The joint rates (n,) of ``z`` (nz,)."""
         x = z if self.M is None else self.M @ z
         return x if self.x0 is None else x + self.x0
+
+
+class Solved(NamedTuple):
+    """A backend's answer, checked and decoded.
+
+    Attributes:
+        x: The decoded rates (n,).
+        backend: The backend's name.
+        iterations: Its iterations.
+        solve_time: Time in its solver [s].
+    """
+
+    x: Array
+    backend: str
+    iterations: int
+    solve_time: float
+
+
+def solve_checked(backend: QPBackend, qp: QP, decoding: Decoding) -> Solved:
+    """``qp`` solved by ``backend``, its answer checked (shape, finite) and decoded.
+
+    Anything the backend raises, an answer past its time limit, and an answer of the wrong
+    shape or with a non-finite entry, is a :class:`~solvers.errors.NumericalFailure`: the
+    caller's fallbacks answer.
+
+    Raises:
+        NumericalFailure: No usable answer.
+    """
+    try:
+        sol = backend.solve(qp)
+    except Exception as exc:
+        raise NumericalFailure(f"{backend.name}: {type(exc).__name__}: {exc}") from exc
+    z = sol.x
+    if z is None:
+        raise NumericalFailure(f"{sol.backend}: {sol.status}")
+    limit = backend.time_limit
+    if limit is not None and sol.solve_time > limit:
+        raise NumericalFailure(f"{sol.backend}: took {sol.solve_time:.3g} s, past the time "
+                               f"limit {limit:.3g} s")  # fmt: skip
+    z = np.asarray(z, dtype=np.float64)
+    if z.shape != qp.q.shape or not np.isfinite(z).all():
+        raise NumericalFailure(f"{sol.backend}: answer of shape {z.shape}, finite "
+                               f"{bool(np.isfinite(z).all())}; expected {qp.q.shape}")  # fmt: skip
+    return Solved(decoding.rates(z), sol.backend, sol.iterations, sol.solve_time)
+
+
+@dataclass(slots=True)
+class Work:
+    """What the backends did during one tick, and which methods failed.
+
+    Attributes:
+        backend: The last backend that answered, or "".
+        iterations: Their iterations, summed.
+        solve_time: Time inside their solvers [s].
+        attempts: ``(method or level, reason)`` of every failure.
+    """
+
+    backend: str = ""
+    iterations: int = 0
+    solve_time: float = 0.0
+    attempts: list[tuple[str, str]] = field(default_factory=list)
+
+
+def solve_within(
+    qp: QP, decoding: Decoding, box: Box, rows: Rows | None, backend: QPBackend, work: Work
+) -> Array:
+    """The backend's answer to ``qp``, within the box and rows to :data:`FEASIBILITY_TOL`.
+
+    Args:
+        qp: The problem.
+        decoding: How its solution decodes into rates.
+        box: The step's bounds.
+        rows: Constraint rows, or None.
+        backend: The backend.
+        work: Where its work is counted.
+
+    Raises:
+        NumericalFailure: No usable answer (the backend's fault, time-out or infeasibility, a
+            non-finite answer or one outside the constraints beyond the tolerance).
+    """
+    solved = solve_checked(backend, qp, decoding)
+    work.backend = solved.backend
+    work.iterations += solved.iterations
+    work.solve_time += solved.solve_time
+    x = np.minimum(np.maximum(solved.x, box.lb), box.ub)
+    size = math.hypot(*(x - solved.x).tolist())
+    tol = FEASIBILITY_TOL * (1.0 + math.hypot(*np.minimum(box.velocity, 1e300).tolist()))
+    if not (size <= tol and (rows is None or kernels.rows_hold(rows.G, x, rows.h, tol))):
+        raise NumericalFailure(f"{solved.backend}: answer outside the constraints by {size:.3g}")
+    return x

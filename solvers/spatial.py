@@ -23,7 +23,7 @@ REFERENCES: tuple[str, ...] = ("world_aligned", "local", "world")
 
 def check_reference(ref: str, error: type[InputError] = InputError) -> Reference:
     """Return ``ref`` if it names one of :data:`REFERENCES`, else raise naming ``ref``."""
-    if ref not in REFERENCES:
+    if not isinstance(ref, str) or ref not in REFERENCES:
         raise error("ref", f"expected one of {', '.join(REFERENCES)}, got {ref!r}")
     return ref  # type: ignore[return-value]
 

@@ -79,15 +79,30 @@ def real_array(
     """``x`` as a float array of any shape (infinities and NaN kept), real numbers only.
 
     Raises:
-        InputError: Booleans, complex numbers, strings, objects or ragged sequences.
+        InputError: Booleans (alone, as an array or inside a list: ``[0.1, True]``), complex
+            numbers, strings, objects or ragged sequences.
     """
     try:
         raw = np.asarray(x)
     except (TypeError, ValueError) as exc:  # ragged sequences
         raise error(name, f"{want}, got {x!r}") from exc
-    if raw.dtype.kind not in "fiu":  # booleans, complex numbers, strings and objects
+    if raw.dtype.kind not in "fiu" or (type(x) is not np.ndarray and _holds_bool(x)):
+        # booleans, complex numbers, strings and objects; numpy makes [0.1, True] floats
         raise error(name, f"{want}, got {x!r}")
     return raw.astype(np.float64, copy=False)
+
+
+def _holds_bool(x: object) -> bool:
+    """Whether the nested lists and tuples ``x`` hold a boolean (Python's or numpy's)."""
+    if type(x) is not list and type(x) is not tuple:
+        return isinstance(x, (bool, np.bool_)) or (
+            isinstance(x, np.ndarray) and x.dtype.kind == "b"
+        )
+    kinds = set(map(type, x))
+    if bool in kinds or np.bool_ in kinds:
+        return True
+    nested = kinds & {list, tuple, np.ndarray}
+    return bool(nested) and any(_holds_bool(v) for v in x if type(v) in nested)
 
 
 def _non_finite(arr: npt.NDArray[np.float64], name: str, error: type[InputError]) -> None:

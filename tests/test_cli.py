@@ -29,6 +29,29 @@ def test_arms_table_lists_tool_frames_sources_and_assumptions(capsys):
     assert rows["baxter"].split()[1:5] == ["15", "R" * 15, "left_gripper,", "right_gripper"]
     assert "l_gripper_tool_frame, r_gripper_tool_frame" in rows["pr2"]
     assert "locked: head, laser tilt, grippers" in rows["pr2"]
+    # where each ready pose comes from (issue 33 item 2)
+    assert "ready pose: the SRDF's state 'default' (panda_description/srdf/panda.srdf)" in rows[
+        "panda"]  # fmt: skip
+    assert "ready pose (0, 0, 90, 0, 45, 0) deg" in rows["barker6"]
+    assert all("ready pose" in row for row in rows.values())
+
+
+def test_help_is_plain_text_and_lists_the_illustrations(capsys):
+    """Issue 33 item 8: the top-level help showed the module's reST (double backquotes); the
+    guidance help did not say which illustrations exist."""
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    text = capsys.readouterr().out
+    assert "``" not in text and ":func:" not in text and ":class:" not in text
+    assert "'rrc-pin COMMAND --help' says more" in text
+    with pytest.raises(SystemExit):
+        main(["guidance", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "--illustration N the illustration: 1, 2, 4, 5, 6 or 7" in text
+    for command in ("arms", "demo", "check", "bench", "urdf"):
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+        assert "``" not in capsys.readouterr().out
 
 
 def run_console_script(*args: str, close_stdout: bool = False) -> subprocess.CompletedProcess:
@@ -83,6 +106,7 @@ def test_demo_help_says_what_arm_does(capsys):
     assert info.value.code == 0
     help_text = " ".join(capsys.readouterr().out.split())
     assert "--arm NAME print only the kinematics row of this arm" in help_text
+    assert "at its ready pose" in help_text
     assert "instead of the tour" in help_text
 
 

@@ -135,3 +135,11 @@ def test_bad_arms_are_refused_naming_the_entry(arms, message):
 def test_a_bad_name_is_refused():
     with pytest.raises(InvalidInput, match="^name: expected a string"):
         combine({"a": (rrc_pin.load("kr5_3r"), np.eye(4))}, name=3)
+
+
+def test_the_ready_pose_is_the_arms_side_by_side(cell):
+    """Issue 33 item 2: a cell starts where each of its arms would."""
+    arms, robot = cell
+    want = np.concatenate([arm.ready() for arm, _ in arms.values()])
+    np.testing.assert_array_equal(robot.ready(), want)
+    np.testing.assert_array_equal(robot.poses["ready"], want)

@@ -270,3 +270,11 @@ def test_a_realtime_loop_runs_under_fifo_or_says_why_not(barker6):
     refused = [n for n in loop.notices if "real-time scheduling refused" in n.text]
     assert loop.scheduling == "SCHED_FIFO 10" or (refused and loop.scheduling != "not started")
     assert loop.clock.ticks > 50
+
+
+def test_a_record_is_full_at_the_logs_capacity_too(barker6):
+    loop = ControlLoop(barker6, rate=100.0)  # record_limit 120 s: the log's ring is shorter
+    loop.ctl.log.capacity = 10
+    loop.mailbox.post(cmd.Record(True))
+    moved(loop, 15, cmd.Latch(True), cmd.Velocity(np.array([0.02, 0, 0, 0, 0, 0])))
+    assert loop.snapshot.mode == "held" and "record full (0.1 s)" in loop.notices[-1].text

@@ -167,8 +167,8 @@ def test_joint_limit_margins_are_kept(panda):
         (lambda c: c.step(np.array([np.inf, -np.inf, 0.0, 0.0, 0.0, 0.0])), "twist"),
         (lambda c: c.step(np.zeros((6, 1))), "twist"),
         (lambda c: c.step([0.0, 0.0, 0.1]), "twist"),
-        (lambda c: c.step([0.1, 0, 0, 0, 0, 0], frame="tool"), "frame"),
-        (lambda c: c.step([0.1, 0, 0, 0, 0, 0], frame="world"), "frame"),
+        (lambda c: c.step([0.1, 0, 0, 0, 0, 0], ref="tool"), "ref"),
+        (lambda c: c.step([0.1, 0, 0, 0, 0, 0], ref="world"), "ref"),
         (lambda c: c.reverse(10.0), "seconds"),
         (lambda c: c.reverse(-1.0), "seconds"),
         (lambda c: setattr(c, "speed", 1.5), "speed"),
@@ -276,3 +276,12 @@ def test_records_name_the_singularity_met(barker):
         ctl.step([0.0, 0.0, 0.0, 0.0, -0.5, 0.0])  # theta5 towards and through 0
     labels = set(ctl.log.column("singularity"))
     assert "wrist (S5 = 0)" in labels
+
+
+def test_the_default_start_is_the_ready_pose():
+    """Issue 33 item 2: Controller(panda) started on joint 4's limit, with a recovering tick."""
+    ctl = Controller(rrc_pin.load("panda"))
+    np.testing.assert_array_equal(ctl.q, ctl.robot.ready())
+    for _ in range(3):
+        _, r = ctl.step([0.02, 0.0, 0.0, 0.0, 0.0, 0.0], ref="world_aligned")
+        assert r.status == "exact"

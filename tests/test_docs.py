@@ -36,3 +36,32 @@ def test_documents_stand_alone():
     """A clone has no ../shared: the README and docs never point there."""
     for path in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
         assert "../shared" not in path.read_text(), path
+
+
+def test_readme_runs_a_robot_from_any_pinocchio_model():
+    """Issue 33 item 9: Robot(pinocchio.Model, tool_frames, ...) worked and was not documented."""
+    text = (ROOT / "README.md").read_text()
+    blocks = [b.split("```", 1)[0] for b in text.split("```python")[1:]]
+    snippet = next(b for b in blocks if "rrc_pin.Robot(" in b)
+    namespace: dict = {}
+    exec(compile(snippet, "README.md", "exec"), namespace)
+    assert namespace["r"].status == "exact" and namespace["r"].qdot.shape == (6,)
+    assert namespace["arm5"].nq == 5 and namespace["arm5"].tool_frame == "tool0"
+    assert "pinocchio.buildReducedModel" in text
+
+
+def test_readme_command_table_says_which_extra_each_command_needs():
+    """Issue 33 item 9: `rrc-pin bench` failed after the README's set-up with "pink not
+    installed": the table names the extra of every command."""
+    from rrc_pin.cli import parser
+
+    text = (ROOT / "README.md").read_text()
+    table = text.split("## Command line", 1)[1].split("\n\n", 2)[1]
+    lines = table.splitlines()
+    assert lines[0] == "| command | needs | what it does |"
+    rows = {line.split("|")[1].strip().split()[1].strip("`"): line.split("|")[2].strip()
+            for line in lines[2:]}  # fmt: skip
+    commands = parser()._subparsers._group_actions[0].choices  # every command of the CLI
+    assert set(rows) == set(commands)
+    assert rows["bench"] == "`[bench]`" and "`[plot]`" in rows["demo"]
+    assert all(rows[c] == "-" for c in ("arms", "check", "urdf", "guidance"))

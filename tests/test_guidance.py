@@ -385,3 +385,35 @@ def test_exports_exist_and_are_sorted():
     exec("from rrc_pin.guidance import *", namespace)
     assert set(guidance.__all__) <= set(namespace)
     assert guidance.__all__ == sorted(guidance.__all__)
+
+
+@pytest.mark.parametrize("degrees", [150.0, 170.0, 179.0, 180.0])
+def test_type_iii_turns_gradually_up_to_a_half_turn(degrees):
+    """Issue 33 item 5: panda at its ready pose, the goal 0.1 m along x and y turned about the
+    hand's z, 20 divisions. The points' division turned the largest step by 20.5 deg at 150
+    (uniform: 7.5), 48.8 at 170, 85 at 179 (1.33 rad of joint motion), and raised a foreign
+    'points' error at 180; the divided turn gives 1.00x uniform (within 1.1x here)."""
+    arm = rrc_pin.load("panda")
+    q0 = arm.ready()
+    T0 = arm.fk(q0)
+    goal = T0.copy()
+    goal[:3, 3] += [0.1, 0.1, 0.0]
+    goal[:3, :3] = T0[:3, :3] @ pin.exp3(np.radians(degrees) * np.array([0.0, 0.0, 1.0]))
+    k = 20
+    path = straight_line(arm, q0, goal, k)
+    turns = [pin.log3(path.hand[i + 1][:3, :3] @ path.hand[i][:3, :3].T) for i in range(k)]
+    angles = np.degrees(np.linalg.norm(turns, axis=1))
+    assert angles.max() <= 1.1 * degrees / k and angles.min() >= 0.9 * degrees / k
+    axes = np.array(turns) / np.radians(angles)[:, None]
+    assert np.all(axes @ axes[0] > 0.99)  # one axis, one way: no turn back
+    assert np.all(np.abs(axes @ T0[:3, 2]) > 0.99)  # the hand's z
+    assert np.abs(np.diff(path.q, axis=0)).max() < 0.2  # [rad] a joint in a step (1.34 at 179)
+    assert pose_error(goal, path.hand[-1]) < 1e-3
+    line = np.array([1.0, 1.0, 0.0]) / np.sqrt(2)
+    for T in path.hand:
+        off = T[:3, 3] - T0[:3, 3]
+        assert np.linalg.norm(off - (off @ line) * line) < 1e-3  # [m] on the line
+    if degrees == 180.0:  # the thesis's division of the points cannot pass a half turn
+        points = np.stack([goal[:3, 3], goal[:3, 3] + goal[:3, 2], goal[:3, 3] + goal[:3, 0]])
+        with pytest.raises(InvalidInput, match="^goal_points: division 10 of 20: the divided"):
+            straight_line_points(arm, q0, points, k, spacing=1.0)

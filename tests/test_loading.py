@@ -138,7 +138,9 @@ def test_a_tree_urdf_needs_its_tool_frames(tmp_path):
     assert {"left_gripper", "right_gripper"} <= set(info.value.candidates)
     assert "sonar_ring" not in info.value.candidates
     robot = rrc_pin.load(path, tool_frame=("left_gripper", "right_gripper"))
-    assert robot.nq == 19 and robot.tool_frames == ("left_gripper", "right_gripper")
+    # 15 arm and head joints, 2 fingers; each finger's second joint mimics its first (issue 28)
+    assert robot.nq == 17 and robot.tool_frames == ("left_gripper", "right_gripper")
+    assert robot.mimic_joints == ("l_gripper_r_finger_joint", "r_gripper_r_finger_joint")
     ur5 = robots_directory() / INSTALLED["ur5"].path
     with pytest.raises(ToolFrameRequired) as info:
         rrc_pin.load(ur5)
@@ -237,3 +239,44 @@ def test_every_loading_error_is_an_rrc_pin_error(tmp_path):
     for call in calls:
         with pytest.raises(RrcPinError):
             call()
+
+
+READY_MARGIN = 0.1
+"""[rad or m] The least distance of a ready pose from a joint limit (or 10 % of a shorter
+range)."""
+READY_SIGMA = 0.05
+"""The least smallest singular value of a ready pose's task Jacobian: where the slowdown
+strategy starts and the controller's log starts naming singularities."""
+
+
+@pytest.mark.parametrize("name", rrc_pin.arms())
+def test_every_robot_has_a_ready_pose_away_from_limits_and_singularities(name):
+    """Issue 33 item 2: panda's start pose sat on joint 4's limit, baxter's arms were straight."""
+    robot = rrc_pin.load(name)
+    q = robot.ready()
+    np.testing.assert_array_equal(q, robot.poses["ready"])
+    span = np.minimum(robot.upper - robot.lower, 2 * np.pi)
+    margin = np.minimum(q - robot.lower, robot.upper - q)
+    assert np.all(margin >= np.minimum(READY_MARGIN, 0.1 * span)), (name, margin)
+    rows = 3 if robot.nq < 6 else 6  # the controller's task rows
+    for frame in robot.tool_frames:
+        sigma = np.linalg.svd(robot.jacobian(q, frame=frame)[:rows], compute_uv=False)[-1]
+        assert sigma >= READY_SIGMA, (name, frame, sigma)
+    reason = (
+        "; ".join(CATALOGUE[name].assumed) if name in CATALOGUE else INSTALLED[name].ready.reason
+    )
+    assert "ready" in reason or "SRDF" in reason or "chosen" in reason
+
+
+def test_ready_poses_come_from_the_srdf_where_it_gives_one():
+    panda = rrc_pin.load("panda")  # panda.srdf's "default"
+    np.testing.assert_allclose(panda.ready(), [0, -0.785398, 0, -2.35619, 0, 1.5707, 0.785398])
+    kinova = rrc_pin.load("kinova")  # kinova.srdf's "arm_up", joint 3 turned into its limits
+    np.testing.assert_allclose(kinova.ready(), [1.5707, 2.618, 2 * np.pi - 1.5707, 3.1415,
+                                                2.618, 0.0])  # fmt: skip
+    talos = rrc_pin.load("talos_upper")
+    assert talos.ready()[talos.joint_names.index("arm_left_4_joint")] == -0.525366
+    assert INSTALLED["talos_upper"].ready.srdf == "talos_data/srdf/talos.srdf"
+    barker = rrc_pin.load("barker6")  # a catalogue arm: chosen, stated in its ArmSpec
+    np.testing.assert_allclose(barker.ready(), np.deg2rad([0, 0, 90, 0, 45, 0]))
+    assert barker.poses["paper_start"].tolist() == [0.0] * 6

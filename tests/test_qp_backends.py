@@ -461,11 +461,12 @@ def test_daqp_warm_starts_per_key(daqp_calls: list[dict], rng: np.random.Generat
     state = backend.warm_start_state()
     np.testing.assert_array_equal(state["b"], xb)
     assert daqp_calls[-1]["primal_tol"] == 1e-9  # the default setting
-    # the box first, then the rows, two-sided, infinite sides as they are
+    # the box first, then the rows of unit norm, two-sided, infinite sides as they are
     _, _, A, upper, lower, sense = daqp_calls[-1]["args"]
-    np.testing.assert_array_equal(A, a.C)
-    np.testing.assert_array_equal(upper, np.concatenate([a.ub, a.u]))
-    np.testing.assert_array_equal(lower, np.concatenate([a.lb, a.l]))
+    norms = np.linalg.norm(a.C, axis=1)
+    np.testing.assert_allclose(A, a.C / norms[:, None], rtol=1e-15)
+    np.testing.assert_allclose(upper, np.concatenate([a.ub, a.u / norms]), rtol=1e-15)
+    np.testing.assert_allclose(lower, np.concatenate([a.lb, a.l / norms]), rtol=1e-15)
     assert sense.dtype == np.intc and not sense.any()
 
 

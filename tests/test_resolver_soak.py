@@ -60,13 +60,14 @@ def test_soak_every_arm_every_backend(name: str) -> None:
             assert np.all(step[inside] >= arm.lower[inside])
             assert np.all(step[inside] <= arm.upper[inside])
             assert 0.0 <= r.scale <= 1.0
-            y = J @ r.qdot
-            along = min(1.0, max(0.0, float(y @ b) / float(b @ b)))
+            unit = r.problem.levels[0][0].unit  # the normalised metric: linear rows / reach
+            y, bn = J @ r.qdot / unit, b / unit
+            along = min(1.0, max(0.0, float(y @ bn) / float(bn @ bn)))
             assert r.scale == pytest.approx(along, abs=1e-9 + 1e-9 * along)
             if moving and k not in moving and np.linalg.norm(r.qdot) <= 1e-9:
                 frozen.append((k, r.status, r.attempts))
         exact = np.linalg.pinv(J) @ b
-        bounds = answers["daqp"].bounds
+        bounds = answers["daqp"].box
         if np.all(exact >= bounds.lb) and np.all(exact <= bounds.ub) and np.any(b):
             for r in answers.values():
                 veers.append(veer(J @ r.qdot, b))

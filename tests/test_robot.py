@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import subprocess
 import sys
 import threading
 
@@ -251,3 +252,202 @@ def test_closed_form_is_none_for_non_paper_arms():
     assert rrc_pin.load("ur5").closed_form is None
     assert rrc_pin.load("nadkarni_c1").closed_form is None
     assert rrc_pin.load("barker6", tool_frame=("tool", "flange")).closed_form is None
+
+
+REDUCED = """
+import pinocchio as pin
+import rrc_pin
+for name, joint in (("ur5", 6), ("panda", 7), ("baxter", 3), ("so101", 5), ("z1", 6)):
+    model = rrc_pin.load(name).model
+    reduced = pin.buildReducedModel(model, [joint], pin.neutral(model))
+    try:
+        robot = rrc_pin.Robot(reduced, None, name=name, source="reduced")
+        print(name, robot.nq, robot.tool_frame)
+    except rrc_pin.ToolFrameRequired as exc:
+        print(name, reduced.nv, "ends:", ",".join(sorted(exc.candidates)))
+"""
+
+
+def test_a_reduced_model_with_a_locked_joint_loads():
+    """Issue 28 item 3: with Pinocchio 4.1 a locked joint's frame is its own parent, and the
+    search for end links never ended (a subprocess, so that a hang fails within a minute)."""
+    done = subprocess.run([sys.executable, "-c", REDUCED], capture_output=True, text=True,
+                          timeout=60)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    lines = dict(line.split(" ", 1) for line in done.stdout.splitlines())
+    assert lines["ur5"] == "5 ends: ee_link,tool0"  # as the full ur5_robot.urdf
+    assert lines["z1"] == "5 gripperMover"
+    assert lines["panda"] == "6 ends: panda_hand_tcp,panda_rightfinger"
+    model = rrc_pin.load("ur5").model
+    reduced = pin.buildReducedModel(model, [6], pin.neutral(model))
+    from rrc_pin.robot import parent_link
+
+    assert parent_link(reduced, reduced.getFrameId("wrist_3_link")) == reduced.getFrameId(
+        "wrist_2_link"
+    )
+    robot = Robot(reduced, "tool0", name="ur5_5", source="reduced")
+    q = np.array([0.1, -1.2, 1.3, -1.6, -1.5])
+    np.testing.assert_allclose(robot.fk(q), rrc_pin.load("ur5").fk([*q, 0.0]), atol=1e-12)
+
+
+MIMIC = """<robot name="mimic">
+  <link name="base"/><link name="l0"/><link name="l1"/><link name="l2"/>
+  <joint name="j0" type="{kind}"><parent link="base"/><child link="l0"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" velocity="1" effort="1"/></joint>
+  <joint name="j1" type="revolute"><parent link="l0"/><child link="l1"/><axis xyz="0 0 1"/>
+    <limit lower="-2" upper="2" velocity="1" effort="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0.5 0 0"/>
+    <axis xyz="0 0 1"/><limit lower="-2" upper="2" velocity="1" effort="1"/>
+    <mimic joint="j1" multiplier="0.5" offset="0.1"/></joint>
+</robot>"""
+
+
+def test_a_mimic_joint_follows_its_primary(tmp_path):
+    """Issue 28 item 7: the mimic joint loaded as an independent one (nq 2); honoured now."""
+    path = tmp_path / "mimic.urdf"
+    path.write_text(MIMIC.format(kind="prismatic"))
+    arm = rrc_pin.load(path)
+    assert arm.nq == 2 and arm.joint_names == ["j0", "j1"] and arm.mimic_joints == ("j2",)
+    q = [0.2, 0.4]
+    turn = q[1] + 0.5 * q[1] + 0.1  # j2 = 0.5 j1 + 0.1
+    np.testing.assert_allclose(arm.fk(q)[:3, 3], [0.5 * np.cos(q[1]), 0.5 * np.sin(q[1]), 0.2],
+                               atol=1e-12)  # fmt: skip
+    np.testing.assert_allclose(arm.fk(q)[:2, 0], [np.cos(turn), np.sin(turn)], atol=1e-12)
+    assert arm.jacobian(q).shape == (6, 2)
+    assert arm.jacobian(q)[5, 1] == pytest.approx(1.5)  # the link turns 1.5 rad per rad of j1
+    # two joints: the resolver commands the tool's position (j1 at 0.3 rad/s turns it)
+    v = [-0.15 * np.sin(q[1]), 0.15 * np.cos(q[1]), 0.05, 0.0, 0.0, 0.0]
+    r = rrc_pin.Resolver(arm, dt=0.01).solve(q, v)
+    np.testing.assert_allclose(r.qdot, [0.05, 0.3], atol=1e-9)
+    path.write_text(MIMIC.format(kind="continuous"))  # a continuous joint beside the mimic
+    arm = rrc_pin.load(path)
+    assert arm.nq == 2 and arm.continuous.tolist() == [True, False]
+    posture = rrc_pin.PostureTask([3.0, 0.0], gain=1.0)  # the short way round: -3.28 rad
+    r = rrc_pin.Resolver(arm, dt=0.01).solve([-3.0, 0.0], [posture])
+    assert r.qdot[0] < 0.0 and r.qdot[1] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_without_mimic_support_a_mimic_joint_is_refused_by_name(tmp_path, monkeypatch):
+    """A Pinocchio before 3.4 has no ``mimic=``: the joint is refused, not loaded free."""
+    path = tmp_path / "mimic.urdf"
+    path.write_text(MIMIC.format(kind="prismatic"))
+    build = pin.buildModelFromUrdf
+
+    def old_pinocchio(filename, *args, **kwargs):
+        if "mimic" in kwargs:
+            raise TypeError("unexpected keyword argument 'mimic'")
+        return build(filename, *args)
+
+    monkeypatch.setattr(pin, "buildModelFromUrdf", old_pinocchio)
+    with pytest.raises(URDFError, match="joint 'j2' mimics 'j1': this Pinocchio"):
+        rrc_pin.load(path)
+
+
+def test_random_q_is_finite_where_the_limits_are_huge(tmp_path):
+    """Issue 28 item 7: limits of +-1e308 made random_q raise OverflowError."""
+    path = tmp_path / "huge.urdf"
+    joints = "".join(
+        f'<joint name="j{i}" type="{kind}"><parent link="l{i}"/><child link="l{i + 1}"/>'
+        f'<axis xyz="0 0 1"/><limit lower="{lo}" upper="{hi}" velocity="1" effort="1"/></joint>'
+        for i, (kind, lo, hi) in enumerate(
+            [("revolute", -1e308, 1e308), ("prismatic", 0.0, 1e308), ("revolute", -1.0, 1.0)]
+        )
+    )
+    links = "".join(f'<link name="l{i}"/>' for i in range(4))
+    path.write_text(f'<robot name="huge">{links}{joints}</robot>')
+    arm = rrc_pin.load(path)
+    assert arm.upper[0] == 1e308
+    Q = np.array([arm.random_q(seed) for seed in range(200)])
+    assert np.isfinite(Q).all()
+    assert -np.pi <= Q[:, 0].min() < -2.5 and 2.5 < Q[:, 0].max() <= np.pi
+    assert 0.0 <= Q[:, 1].min() < 0.5 and 5.5 < Q[:, 1].max() <= 2 * np.pi
+    assert -1.0 <= Q[:, 2].min() and Q[:, 2].max() <= 1.0
+    np.testing.assert_allclose(arm.ready(), [0.0, 0.2 * np.pi, 0.0])  # 10 % inside
+
+
+def test_ready_is_a_named_pose_away_from_the_limits():
+    panda = rrc_pin.load("panda")
+    ready = panda.ready()
+    np.testing.assert_array_equal(ready, panda.poses["ready"])
+    ready[0] = 9.0  # a copy: the pose stays
+    assert panda.poses["ready"][0] == 0.0 and not panda.poses["ready"].flags.writeable
+    model = panda.model  # a model without named poses: zero, 10 % of each range inside
+    bare = Robot(model, "panda_hand_tcp", name="bare", source="here")
+    span = panda.upper[3] - panda.lower[3]
+    np.testing.assert_allclose(bare.ready()[3], panda.upper[3] - 0.1 * span)
+    named = Robot(model, "panda_hand_tcp", name="n", source="here", poses=panda.poses)
+    np.testing.assert_array_equal(named.ready(), panda.ready())
+    with pytest.raises(InvalidInput, match=r"^poses\['ready'\]: joint 'panda_joint4' at 0 is "
+                       "outside its limits"):  # fmt: skip
+        Robot(model, "panda_hand_tcp", name="n", source="here", poses={"ready": np.zeros(7)})
+    with pytest.raises(InvalidInput, match=r"^poses\['up'\]: expected shape \(7,\)"):
+        Robot(model, "panda_hand_tcp", name="n", source="here", poses={"up": np.zeros(3)})
+
+
+@pytest.mark.parametrize(
+    ("call", "argument"),
+    [
+        (lambda m: Robot("panda", None, name="x", source="x"), "model"),
+        (lambda m: Robot(None, None, name="x", source="x"), "model"),
+        (lambda m: Robot(m, None, name=object(), source="x"), "name"),
+        (lambda m: Robot(m, None, name="", source="x"), "name"),
+        (lambda m: Robot(m, None, name="x", source=np.array(["a"])), "source"),
+        (lambda m: Robot(m, None, name="x", source="x", spec="barker6"), "spec"),
+        (lambda m: Robot(m, None, name="x", source="x", poses=[1, 2]), "poses"),
+        (lambda m: Robot(m, None, name="x", source="x", poses={3: [0] * 3}), "poses"),
+    ],
+)
+def test_what_is_not_a_model_or_a_name_is_refused_by_name(call, argument):
+    """Issue 28 item 8: a non-model raised AttributeError; any object passed as a name."""
+    model = rrc_pin.load("kr5_3r").model
+    with pytest.raises(InvalidInput) as info:
+        call(model)
+    assert info.value.argument == argument
+
+
+def test_arrays_and_booleans_where_names_and_numbers_go_are_refused():
+    """Issue 28 item 8: an array as ``frame`` or ``ref`` (TypeError: unhashable), a boolean
+    inside q (taken as 1.0)."""
+    arm = rrc_pin.load("panda")
+    q = arm.ready()
+    for frame in (np.array(["panda_hand_tcp"]), ["panda_hand_tcp"], 3):
+        for call in (arm.fk, arm.jacobian):
+            with pytest.raises(InvalidInput, match="^frame: expected a frame name") as info:
+                call(q, frame=frame)
+            assert info.value.argument == "frame"
+    with pytest.raises(InvalidInput, match="^ref: expected one of"):
+        arm.jacobian(q, ref=np.array(["local"]))
+    with pytest.raises(InvalidInput, match="^q: expected a real numeric array"):
+        arm.fk([0.0, True, 0.0, -1.5, 0.0, 1.5, 0.0])
+
+
+BAD = [None, object(), "x", np.array(["a", "b"]), [True, 0.0], 3 + 1j, {"a": 1}, float("nan"),
+       np.zeros((2, 2)), [[0.0] * 7], np.full(7, np.inf), [0.0, True, 0, 0, 0, 0, 0]]  # fmt: skip
+
+
+def test_bad_input_of_every_robot_method_raises_only_the_package_errors():
+    """Issue 28 item 8: every bad-input class, at every Robot call site, raises an RrcPinError
+    naming the argument, and changes nothing."""
+    arm = rrc_pin.load("panda")
+    q = arm.ready()
+    calls = {
+        "q": [lambda v: arm.fk(v), lambda v: arm.jacobian(v), lambda v: arm.check_q(v),
+              lambda v: arm.to_pinocchio(v), lambda v: arm.frame_pose(v, "panda_hand_tcp")],
+        "frame": [lambda v: arm.fk(q, v), lambda v: arm.jacobian(q, frame=v),
+                  lambda v: arm.frame_pose(q, v)],
+        "ref": [lambda v: arm.jacobian(q, ref=v)],
+        "rng": [lambda v: arm.random_q(v)],
+    }  # fmt: skip
+    before = (arm.ready(), arm.fk(q), arm.lower.copy(), dict(arm.poses))
+    for argument, sites in calls.items():
+        for site in sites:
+            for value in BAD:
+                if value is None and argument in ("frame", "rng"):
+                    continue  # None: the tool frame, fresh entropy
+                with pytest.raises(rrc_pin.RrcPinError) as info:
+                    site(value)
+                assert getattr(info.value, "argument", argument) == argument, (argument, value)
+    np.testing.assert_array_equal(before[0], arm.ready())
+    np.testing.assert_array_equal(before[1], arm.fk(q))
+    np.testing.assert_array_equal(before[2], arm.lower)
+    assert before[3].keys() == arm.poses.keys()

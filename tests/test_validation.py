@@ -40,6 +40,9 @@ def test_good_input_comes_back_as_float_arrays(rng: np.random.Generator) -> None
     "value",
     [[True, False, True],
      np.array([True, False, True]),
+     [0.5, True, 0.0],  # issue 28 item 8: numpy makes the boolean a float
+     (1, 2, np.True_),
+     [np.float64(1), False, 2],
      [1j, 0, 0],
      np.array([1, 2, 3], dtype=complex),
      "abc",

@@ -16,7 +16,6 @@ reported the same way, and the loop goes on ticking: a page can neither stop nor
 from __future__ import annotations
 
 import collections
-import math
 import os
 import threading
 import time
@@ -96,7 +95,7 @@ class ControlLoop:
         strategy: Singularity strategy's name (``rrc_pin.control.STRATEGIES``).
         backend: QP backend's name (``installed_backends()``).
         record_limit: Longest record [s], > 0: a full record holds the arm until saved or
-            dropped.
+            dropped (full also at the log's capacity, ``TrajectoryLog.capacity`` ticks).
         priority: Nice value asked for the loop's thread (Linux: per thread; a negative one
             needs root or CAP_SYS_NICE, else the thread keeps its priority), or None.
         realtime: Run the loop's thread under real-time scheduling (``SCHED_FIFO`` at
@@ -266,18 +265,19 @@ class ControlLoop:
         return self._publish(*self._step(*wanted), mode)
 
     def _step(self, twist: Array | None, frame: cmd.Frame) -> tuple[Resolution, Array | None]:
-        """The one call of ``Controller.step`` (its frame keyword is renamed ``ref`` on main)."""
-        step = self.ctl.step(twist, frame=frame)
+        """The one call of ``Controller.step``."""
+        step = self.ctl.step(twist, ref=frame)
         return step.resolution, twist
 
     def _publish(self, resolution: Resolution | None, twist: Array | None, mode: Mode) -> Snapshot:
         log = self.ctl.log
         if not self.recording:
             log.clear()  # nothing kept: the log stays empty between records
-        elif len(log) * self.dt >= self.record_limit and not self._full:
-            self._full = True
+        elif not self._full and (len(log) * self.dt >= self.record_limit
+                                 or len(log) >= log.capacity):  # fmt: skip
+            self._full = True  # (a full log, a ring, would forget the record's start)
             self.operator.stop()
-            self.notice("error", f"record full ({self.record_limit:g} s): the arm holds; save "
+            self.notice("error", f"record full ({len(log) * self.dt:g} s): the arm holds; save "
                                  "it or stop recording")  # fmt: skip
         enabled = twist is not None and mode in ("teleop", "target")
         self._snapshot = self._snap(resolution, twist, mode, enabled)
@@ -515,14 +515,13 @@ def _takes(robot: Robot, name: str) -> bool:
 def start_pose(robot: Robot, near: float = 0.05) -> Array:
     """A start configuration away from limits and singularities, for the console.
 
-    The paper arms start where ``rrc-pin demo`` does (and panda at its ready pose). Any other
-    robot at the middle of its joint ranges (0 for a continuous joint) when the smallest
-    singular value of its task rows is at least ``near`` there; else at the best of 64
-    seeded draws from the middle half of the ranges (the same robot, the same pose).
+    The robot's named ready pose (:meth:`Robot.ready`: every arm and robot loaded by name has
+    one). Any other robot at the middle of its joint ranges (0 for a continuous joint) when the
+    smallest singular value of its task rows is at least ``near`` there; else at the best of
+    64 seeded draws from the middle half of the ranges (the same robot, the same pose).
     """
-    known = START.get(robot.name)
-    if known is not None and len(known) == robot.nq:
-        return np.array(known)
+    if "ready" in robot.poses:
+        return robot.ready()
     bounded = np.isfinite(robot.lower) & np.isfinite(robot.upper)
     lower, upper = np.where(bounded, robot.lower, -np.pi), np.where(bounded, robot.upper, np.pi)
     middle: Array = 0.5 * (lower + upper)
@@ -539,12 +538,3 @@ def start_pose(robot: Robot, near: float = 0.05) -> Array:
     draws = middle + 0.25 * (upper - lower) * rng.uniform(-1.0, 1.0, (64, robot.nq))
     best: Array = max(draws, key=sigma)
     return best
-
-
-START: dict[str, tuple[float, ...]] = {
-    "barker6": (0.35, -0.2, 0.9, 0.17, 0.20, 0.0),
-    "rrc_k1607": (0.0, 0.5, 0.0, 1.2, 0.0, 0.6, 0.0),
-    "kr5_3r": (0.0, 0.785, -0.785),
-    "panda": (0.0, -math.pi / 4, 0.0, -3 * math.pi / 4, 0.0, math.pi / 2, math.pi / 4),
-}
-"""Start configurations [rad] of the arms whose middle of the ranges is a poor start."""

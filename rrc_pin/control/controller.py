@@ -1,7 +1,7 @@
 r"""Controller: Barker's operator loop on the resolver, one tick per call.
 
 Every :meth:`Controller.step` takes the operator's twist in the hand frame (Barker eq. (20),
-``frame="local"``) or in base axes (``"world_aligned"``), weights it by the speed override
+``ref="local"``) or in base axes (``"world_aligned"``), weights it by the speed override
 and the deadman (:class:`~rrc_pin.control.deadman.Deadman`), adds the bounded pull back to
 the commanded pose (:class:`~rrc_pin.control.drift.DriftCorrection`), lets the singularity
 strategy adjust it (:mod:`rrc_pin.control.strategies`), resolves it with the
@@ -43,7 +43,7 @@ Array = npt.NDArray[np.float64]
 Frame = Literal["local", "world_aligned"]
 LINEAR = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
 FRAMES: tuple[str, ...] = ("local", "world_aligned")
-REANCHOR = ("damped", "singular", "least_squares", "recovering", "fallback")
+REANCHOR = ("damped", "singular", "least_squares", "recovering", "fallback", "partial")
 """Statuses whose motion departs from the command's direction: the reference pose is reset to
 the reached pose instead of pulling the hand back to a pose it could not follow."""
 NO_ERROR = (0.0,) * 6
@@ -114,7 +114,7 @@ class Controller:
         robot: A :class:`rrc_pin.Robot` with one tool frame, or a name :func:`rrc_pin.load`
             takes.
         dt: Control period [s], > 0.
-        q0: Initial joint positions (nq,) [rad or m]; default ``robot.neutral()``.
+        q0: Initial joint positions (nq,) [rad or m]; default ``robot.ready()``.
         strategy: A singularity strategy: a :class:`Strategy` or its name
             (:data:`~rrc_pin.control.strategies.STRATEGIES`); default ``"resolver"`` (the
             resolver's own handling).
@@ -166,7 +166,7 @@ class Controller:
         self.dt = self.resolver.dt
         self.strategy = make_strategy(strategy)
         self.strategy.check(robot)
-        self.q = robot.neutral() if q0 is None else robot.check_q(q0, "q0")
+        self.q = robot.ready() if q0 is None else robot.check_q(q0, "q0")
         self.speed = speed
         self.deadman = deadman
         self.drift = drift
@@ -219,27 +219,27 @@ class Controller:
 
     # -- the loop ---------------------------------------------------------------------------
 
-    def step(self, twist: npt.ArrayLike | None = None, frame: Frame = "local") -> Step:
+    def step(self, twist: npt.ArrayLike | None = None, ref: Frame = "local") -> Step:
         """Resolve and integrate one tick of the operator's command.
 
         Args:
-            twist: Commanded twist [v; w] (6,) [m/s, rad/s] of the tool frame in ``frame``,
+            twist: Commanded twist [v; w] (6,) [m/s, rad/s] of the tool frame in ``ref``,
                 or None: no new command this tick (the last one ages, see ``deadman``).
-            frame: ``"local"`` (hand axes, Barker eq. (20)) or ``"world_aligned"`` (base
-                axes).
+            ref: ``"local"`` (hand axes, Barker eq. (20)) or ``"world_aligned"`` (base
+                axes), as tasks name their frames.
 
         Returns:
             The new configuration and the tick's resolution.
 
         Raises:
-            InvalidInput: A bad ``twist`` (shape, NaN, inf) or ``frame``, raised before any
+            InvalidInput: A bad ``twist`` (shape, NaN, inf) or ``ref``, raised before any
                 state changes.
         """
-        if frame not in FRAMES:
-            raise InvalidInput("frame", f"expected one of {', '.join(FRAMES)}, got {frame!r}")
+        if not isinstance(ref, str) or ref not in FRAMES:
+            raise InvalidInput("ref", f"expected one of {', '.join(FRAMES)}, got {ref!r}")
         if twist is not None:
             command = _checked_twist(twist)
-            self._command, self._command_frame, self._command_time = command, frame, self.t
+            self._command, self._command_frame, self._command_time = command, ref, self.t
         age = self.t - self._command_time
         weight = self._speed
         if self.deadman is not None and age > self.deadman.timeout:  # the command fades
@@ -271,10 +271,9 @@ class Controller:
             decision = self.strategy.decide(Situation(self.robot, q, wanted, self.dt, command,
                                                       self._rows, hand))  # fmt: skip
         factor = decision.factor
-        if decision.rates is None:  # q is its own and the command checked: no second check
-            r = self.resolver._solve_checked_twist(
-                q, q_pin, wanted if factor == 1.0 else factor * wanted, self._command_frame
-            )
+        if decision.rates is None:
+            r = self.resolver.solve(q, wanted if factor == 1.0 else factor * wanted,
+                                    self._command_frame)  # fmt: skip
         else:
             r = self.resolver.solve(q, [RatesTask(decision.rates)], priority="strict")
         # q itself, not a copy: read-only, replaced at every tick.
@@ -402,13 +401,6 @@ def _checked_twist(twist: npt.ArrayLike) -> Array:
 def _followed(r: Resolution) -> float | None:
     """Fraction in [0, 1] of a twist's command the resolution achieved along its direction.
 
-    None when the answer departs from the command's direction (:data:`REANCHOR`). The status
-    the pipeline decided (``Resolution.known_status``: ``exact`` for the box-free optimum)
-    is known at once, without computing the achieved twist; otherwise the answer is
-    ``exact``, ``scaled`` or ``least_squares``, read from ``Resolution.status`` and ``scale``.
+    None when the answer departs from the command's direction (:data:`REANCHOR`).
     """
-    if r.known_status == "exact":
-        return 1.0
-    if r.known_status is not None:
-        return None
     return None if r.status in REANCHOR else r.scale

@@ -7,7 +7,7 @@ import numpy.typing as npt
 
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.tasks import Task
-from solvers.resolution import TaskRows
+from solvers.problem import TaskRows
 
 Array = npt.NDArray[np.float64]
 

@@ -1,8 +1,16 @@
-"""TrajectoryLog: what a controller did at every tick, saved to CSV or NPZ and loaded back."""
+"""TrajectoryLog: what a controller did at every tick, saved to CSV or NPZ and loaded back.
+
+The log is a ring: it keeps the last :data:`CAPACITY` ticks (10 minutes at 100 Hz) and
+forgets the oldest beyond, so that its memory is bounded however long a controller runs
+(about 2.9 kB a tick until the records are read, 1.5 kB a record: at most some 175 MB).
+"""
 
 from __future__ import annotations
 
 import csv
+import os
+import zipfile
+from collections import deque
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -61,13 +69,15 @@ class LogRecord(NamedTuple):
     note: str
 
 
+CAPACITY = 60_000
+"""Ticks a log keeps by default: 10 minutes at 100 Hz (:attr:`TrajectoryLog.capacity`)."""
 VECTORS = ("q", "qdot", "commanded", "achieved")
 SCALARS = ("t", "scale", "factor", "sigma_min", "manipulability", "drift_position",
            "drift_rotation")  # fmt: skip
 
 
 class TrajectoryLog:
-    """The records of one controller, in time order, with array views for analysis.
+    """The records of one controller's last ticks, in time order, with array views.
 
     A controller appends its ticks as they are (:meth:`append_tick`) and the log derives
     their records when it is read (``records``, :meth:`column`, :meth:`save`): what a record
@@ -75,36 +85,79 @@ class TrajectoryLog:
     resolution's status, scale and active limits) costs more than the rest of a controller's
     tick, and is paid once, when someone looks.
 
+    The log keeps the last ``capacity`` ticks (a ring): appending to a full log forgets the
+    oldest, so its memory stays flat however long the session (``len`` and ``records`` count
+    the ticks kept; :attr:`dropped` those forgotten). Save it (:meth:`save`) before it fills
+    to keep a whole session; ``Controller.reverse`` retraces within what is kept.
+
     Args:
         joint_names: Names of the joints (the CSV's column names).
         derive: Makes the record of a tick passed to :meth:`append_tick` (the controller's),
             or None for a log of records only.
+        capacity: Ticks kept, >= 1 (default :data:`CAPACITY`: 10 minutes at 100 Hz);
+            settable (a smaller one forgets the oldest ticks at once).
+
+    Raises:
+        InvalidInput: ``joint_names`` not a sequence of names, ``derive`` not callable, or a
+            bad ``capacity``, named.
     """
 
     def __init__(
         self, joint_names: list[str] | tuple[str, ...],
         derive: Callable[[Any], LogRecord] | None = None,
+        capacity: int = CAPACITY,
     ) -> None:  # fmt: skip
+        if isinstance(joint_names, str) or not isinstance(joint_names, (list, tuple)) or not all(
+            isinstance(n, str) for n in joint_names
+        ):
+            raise InvalidInput("joint_names", f"expected a list of names, got {joint_names!r}")
+        if derive is not None and not callable(derive):
+            raise InvalidInput("derive", f"expected a callable or None, got {derive!r}")
         self.joint_names = tuple(joint_names)
-        self._records: list[LogRecord] = []
-        self._ticks: list[tuple[Any, ...]] = []
+        self._capacity = _checked_capacity(capacity)
+        # Records (derived) then pending ticks, oldest first; the pending ones are the newest.
+        self._entries: deque[LogRecord | tuple[Any, ...]] = deque(maxlen=self._capacity)
+        self._pending = 0  # ticks at the end of _entries not yet derived
         self._derive = derive
+        self.dropped = 0
+        """Ticks forgotten because the log was full (the oldest first)."""
 
     def __len__(self) -> int:
-        return len(self._records) + len(self._ticks)
+        return len(self._entries)
+
+    @property
+    def capacity(self) -> int:
+        """Ticks kept (the oldest forgotten beyond), >= 1."""
+        return self._capacity
+
+    @capacity.setter
+    def capacity(self, value: int) -> None:
+        value = _checked_capacity(value)
+        self.dropped += max(0, len(self._entries) - value)
+        self._pending = min(self._pending, value)
+        self._entries = deque(self._entries, maxlen=value)
+        self._capacity = value
 
     @property
     def records(self) -> list[LogRecord]:
-        """Every record, in time order (the ticks appended so far derived now)."""
-        if self._ticks:
+        """The records kept, in time order, as a new list (the ticks pending derived now)."""
+        if self._pending:
             assert self._derive is not None  # append_tick refuses a log without derive
-            self._records.extend(map(self._derive, self._ticks))
-            self._ticks.clear()
-        return self._records
+            ticks = [self._entries.pop() for _ in range(self._pending)][::-1]
+            self._entries.extend(map(self._derive, ticks))
+            self._pending = 0
+        return list(self._entries)  # type: ignore[arg-type]  # every entry derived above
 
     def append(self, record: LogRecord) -> None:
-        """Add one tick's record."""
-        self.records.append(record)
+        """Add one tick's record (forgetting the oldest tick when the log is full).
+
+        Raises:
+            InvalidInput: ``record`` is not a :class:`LogRecord`.
+        """
+        if not isinstance(record, LogRecord):
+            raise InvalidInput("record", f"expected a LogRecord, got {type(record).__name__}")
+        self.records  # noqa: B018 - derive the pending ticks first: they are older
+        self._push(record)
 
     def append_tick(self, tick: tuple[Any, ...]) -> None:
         """Add one tick, its record derived when the log is read (``derive``).
@@ -114,23 +167,34 @@ class TrajectoryLog:
         """
         if self._derive is None:
             raise InvalidInput("tick", "this log has no derive: append records")
-        self._ticks.append(tick)
+        self._push(tick)
+        self._pending = min(self._pending + 1, self._capacity)
+
+    def _push(self, entry: LogRecord | tuple[Any, ...]) -> None:
+        if len(self._entries) == self._capacity:
+            self.dropped += 1
+        self._entries.append(entry)
 
     def positions(self, n: int) -> list[Array]:
-        """Joint positions ``q`` of the last ``n`` ticks, oldest first, no record derived.
+        """Joint positions ``q`` of the last ``n`` ticks kept, oldest first, no record derived.
 
         (What :meth:`Controller.reverse` retraces: reading ``records`` after a long session
         would derive every record first.)
+
+        Raises:
+            InvalidInput: ``n`` is not an integer >= 0.
         """
-        ticks = self._ticks[len(self._ticks) - n:] if n > 0 else []
-        rest = n - len(ticks)
-        records = self._records[len(self._records) - rest:] if rest > 0 else []
-        return [r.q for r in records] + [t[1] for t in ticks]  # a tick's (t, q, ...)
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
+            raise InvalidInput("n", f"expected an integer >= 0, got {n!r}")
+        n = min(int(n), len(self._entries))
+        start = len(self._entries) - n
+        # a record's q, or a tick's (t, q, ...)
+        return [self._entries[i][1] for i in range(start, len(self._entries))]
 
     def clear(self) -> None:
         """Forget every record."""
-        self._records.clear()
-        self._ticks.clear()
+        self._entries.clear()
+        self._pending = 0
 
     def column(self, name: str) -> Array | npt.NDArray[np.str_]:
         """One field over every record: (N,) for scalars and text, (N, k) for vectors.
@@ -138,7 +202,7 @@ class TrajectoryLog:
         Raises:
             InvalidInput: ``name`` is not a field of :class:`LogRecord` (the error lists them).
         """
-        if name not in LogRecord._fields:
+        if not isinstance(name, str) or name not in LogRecord._fields:
             columns = ", ".join(LogRecord._fields)
             raise InvalidInput("name", f"no column {name!r}; columns: {columns}")
         values = [getattr(r, name) for r in self.records]
@@ -158,55 +222,100 @@ class TrajectoryLog:
         out += [f"commanded:{a}" for a in TWIST] + [f"achieved:{a}" for a in TWIST]
         return out + [s for s in SCALARS if s != "t"] + list(TEXT)
 
-    def save(self, path: str | Path) -> Path:
+    def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the log to ``path``: ``.csv`` (one row per tick, a header) or ``.npz``.
 
         Raises:
-            InvalidInput: ``path`` ends neither in ``.csv`` nor in ``.npz``.
-            OSError: The file cannot be written.
+            InvalidInput: Naming ``path``: not a path, ending neither in ``.csv`` nor in
+                ``.npz``, or a file that cannot be written (a missing folder, no permission:
+                the system's reason).
         """
-        path = Path(path)
-        if path.suffix == ".npz":
-            arrays: dict[str, Any] = {name: self.column(name) for name in LogRecord._fields}
-            arrays["joint_names"] = np.array(self.joint_names, dtype=str)
-            np.savez(path, **arrays)
-            return path
-        if path.suffix != ".csv":
-            raise InvalidInput("path", f"expected a .csv or .npz file, got {str(path)!r}")
-        with path.open("w", newline="") as f:
-            writer = csv.writer(f)
-            writer.writerow(self.header())
-            for r in self.records:
-                row = [repr(float(r.t))]
-                row += [repr(float(v)) for v in (*r.q, *r.qdot, *r.commanded, *r.achieved)]
-                row += [repr(float(getattr(r, s))) for s in SCALARS if s != "t"]
-                writer.writerow(row + [getattr(r, s) for s in TEXT])
+        path = _checked_path(path)
+        try:
+            if path.suffix == ".npz":
+                arrays: dict[str, Any] = {name: self.column(name) for name in LogRecord._fields}
+                arrays["joint_names"] = np.array(self.joint_names, dtype=str)
+                with path.open("wb") as f:  # np.savez(path) would add ".npz" to other names
+                    np.savez(f, **arrays)
+                return path
+            with path.open("w", newline="") as f:
+                writer = csv.writer(f)
+                writer.writerow(self.header())
+                for r in self.records:
+                    row = [repr(float(r.t))]
+                    row += [repr(float(v)) for v in (*r.q, *r.qdot, *r.commanded, *r.achieved)]
+                    row += [repr(float(getattr(r, s))) for s in SCALARS if s != "t"]
+                    writer.writerow(row + [getattr(r, s) for s in TEXT])
+        except OSError as exc:
+            raise InvalidInput("path", f"cannot write {str(path)!r}: {_reason(exc)}") from exc
         return path
 
     @classmethod
-    def load(cls, path: str | Path) -> TrajectoryLog:
+    def load(cls, path: str | os.PathLike[str]) -> TrajectoryLog:
         """A log read back from a file written by :meth:`save` (numbers exact: ``repr``).
 
+        Its capacity holds every record of the file (at least :data:`CAPACITY`).
+
         Raises:
-            InvalidInput: ``path`` ends neither in ``.csv`` nor in ``.npz``, or its columns are
-                not a log's.
-            OSError: The file cannot be read.
+            InvalidInput: Naming ``path``: not a path, ending neither in ``.csv`` nor in
+                ``.npz``, a file that cannot be read (missing, a folder, no permission), or
+                whose contents are not a log's (the first thing that is not, said).
         """
-        path = Path(path)
-        if path.suffix == ".npz":
-            with np.load(path, allow_pickle=False) as data:
-                names = [str(n) for n in data["joint_names"]]
-                columns = {name: data[name] for name in LogRecord._fields}
-        elif path.suffix == ".csv":
-            names, columns = _read_csv(path)
-        else:
-            raise InvalidInput("path", f"expected a .csv or .npz file, got {str(path)!r}")
-        log = cls(names)
-        for i in range(len(columns["t"])):
-            fields: dict[str, Any] = {name: _item(columns[name][i], name)
-                                      for name in LogRecord._fields}  # fmt: skip
-            log.append(LogRecord(**fields))
+        path = _checked_path(path)
+        try:
+            if path.suffix == ".npz":
+                with np.load(path, allow_pickle=False) as data:
+                    missing = [k for k in ("joint_names", *LogRecord._fields) if k not in data]
+                    if missing:
+                        raise _NotALog(f"no field {missing[0]!r}")
+                    names = [str(n) for n in data["joint_names"]]
+                    columns = {name: data[name] for name in LogRecord._fields}
+            else:
+                names, columns = _read_csv(path)
+            log = cls(names, capacity=max(CAPACITY, len(columns["t"])))
+            for i in range(len(columns["t"])):
+                fields: dict[str, Any] = {name: _item(columns[name][i], name, len(names))
+                                          for name in LogRecord._fields}  # fmt: skip
+                log.append(LogRecord(**fields))
+        except OSError as exc:
+            raise InvalidInput("path", f"cannot read {str(path)!r}: {_reason(exc)}") from exc
+        except (_NotALog, ValueError, TypeError, KeyError, IndexError, EOFError, csv.Error,
+                zipfile.BadZipFile) as exc:  # fmt: skip
+            raise InvalidInput(
+                "path", f"{str(path)!r} does not hold a trajectory log ({_reason(exc)})"
+            ) from exc
         return log
+
+
+class _NotALog(Exception):
+    """A file's contents are not a trajectory log's (turned into InvalidInput by ``load``)."""
+
+
+def _checked_capacity(value: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InvalidInput("capacity", f"expected an integer >= 1 (ticks), got {value!r}")
+    return int(value)
+
+
+def _checked_path(path: str | os.PathLike[str]) -> Path:
+    """``path`` as a Path ending in ``.csv`` or ``.npz``.
+
+    Raises:
+        InvalidInput: Not a str or os.PathLike, or another suffix (named ``path``).
+    """
+    if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
+        raise InvalidInput("path", f"expected a file name (str or os.PathLike), got {path!r}")
+    out = Path(path)
+    if out.suffix not in (".csv", ".npz"):
+        raise InvalidInput("path", f"expected a .csv or .npz file, got {str(out)!r}")
+    return out
+
+
+def _reason(exc: BaseException) -> str:
+    """An exception's message without the path it repeats."""
+    if isinstance(exc, OSError) and exc.strerror:
+        return exc.strerror
+    return str(exc) or type(exc).__name__
 
 
 def _read_csv(path: Path) -> tuple[list[str], dict[str, Any]]:
@@ -221,11 +330,13 @@ def _read_csv(path: Path) -> tuple[list[str], dict[str, Any]]:
         rows = list(reader)
     names = [h[2:] for h in header if h.startswith("q:")]
     if header != TrajectoryLog(names).header():
-        raise InvalidInput("path", f"{str(path)!r} does not hold a trajectory log")
+        raise _NotALog("its header is not a log's")
     n, k = len(names), len(SCALARS) - 1
-    numbers = np.array([r[: 1 + 2 * n + 12 + k] for r in rows], dtype=np.float64).reshape(
-        len(rows), 1 + 2 * n + 12 + k
-    )
+    width = 1 + 2 * n + 12 + k
+    for i, row in enumerate(rows):
+        if len(row) != width + len(TEXT):
+            raise _NotALog(f"row {i + 2} has {len(row)} fields, the header {width + len(TEXT)}")
+    numbers = np.array([r[:width] for r in rows], dtype=np.float64).reshape(len(rows), width)
     text = [r[1 + 2 * n + 12 + k:] for r in rows]
     widths = {"q": n, "qdot": n, "commanded": 6, "achieved": 6}
     columns: dict[str, Any] = {"t": numbers[:, 0]}
@@ -239,10 +350,18 @@ def _read_csv(path: Path) -> tuple[list[str], dict[str, Any]]:
     return names, columns
 
 
-def _item(value: Any, name: str) -> Any:
-    """One record's field from a column of the NPZ file."""
+def _item(value: Any, name: str, nq: int) -> Any:
+    """One record's field from a column of a file, checked.
+
+    Raises:
+        _NotALog: A vector of the wrong length, or text where numbers go.
+    """
     if name in TEXT:
         return str(value)
     if name in VECTORS:
-        return np.array(value, dtype=np.float64)
+        out = np.array(value, dtype=np.float64)
+        width = nq if name in ("q", "qdot") else 6
+        if out.shape != (width,):
+            raise _NotALog(f"{name} has shape {out.shape}, expected ({width},)")
+        return out
     return float(value)

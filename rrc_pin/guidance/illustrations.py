@@ -24,6 +24,7 @@ Readings that reproduce the printed digits (docs/api.md, "Guidance"):
 
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass
 
 import numpy as np
@@ -111,11 +112,28 @@ ILLUSTRATION_7_HAND = (
 
 @dataclass(frozen=True)
 class Row:
-    """One printed line beside the computed numbers (thesis units, degrees)."""
+    """One printed line beside the computed numbers (thesis units, degrees).
+
+    Attributes:
+        label: What the line is (``step 3``, ``U(2)``...).
+        printed: The thesis's numbers, as printed.
+        computed: Ours, in the same units.
+        note: Why the two differ where that is known (an erratum of docs/errata.md, or a
+            reading), "" where they agree.
+    """
 
     label: str
     printed: tuple[str, ...]
     computed: tuple[float, ...]
+    note: str = ""
+
+    def differs(self) -> tuple[bool, ...]:
+        """Per entry, whether the computed number does not round to the printed digits."""
+        out = []
+        for p, c in zip(self.printed, self.computed, strict=True):
+            digits = len(p.split(".")[1]) if "." in p else 0
+            out.append(abs(c - float(p)) > 0.5 * 10.0**-digits * (1 + 1e-9))
+        return tuple(out)
 
 
 def chain(name: str) -> DHChain:
@@ -194,8 +212,13 @@ def illustration_2() -> list[Row]:
         p, u = star[i][:3, 3] / INCH, star[i][:3, 2]
         computed = {"X*": p, "X": x_frames[i][:3, 3] / INCH, "U": u, "rho_n": p - (p @ u) * u}
         for key, value in computed.items():
-            rows.append(Row(f"{key}({i + 1})", ILLUSTRATION_2[key][i], tuple(map(float, value))))
+            note = RHO_N_3 if (key, i) == ("rho_n", 2) else ""
+            rows.append(Row(f"{key}({i + 1})", ILLUSTRATION_2[key][i], tuple(map(float, value)),
+                            note))  # fmt: skip
     return rows
+
+
+RHO_N_3 = "erratum: 0.65 for 0.065, a dropped zero (X(2), two lines up, has it)"
 
 
 ESCAPE_4 = np.array([-0.05, 0.05, 0.25, 0.25, -0.25, -0.25])
@@ -240,7 +263,8 @@ def illustration_4() -> list[Row]:
     kicked = np.radians([float(v) for v in TABLE_A2_6[0]]) - start("nadkarni_c1")
     rows = [Row("escape [rad]", tuple(f"{x:.2f}" for x in ESCAPE_4), tuple(map(float, kicked)))]
     for i, p in enumerate(printed[:-1], start=1):
-        rows.append(Row(f"step {i}", p, thesis_units(raised[i], 0)))
+        note = "erratum: 8.608 for 8.604" if i == 3 else ""
+        rows.append(Row(f"step {i}", p, thesis_units(raised[i], 0), note))
     rows.append(Row("final (step 17)", printed[-1], thesis_units(raised[-1], 0)))
     for label, point, computed in zip(
         "abc", ILLUSTRATION_4_HAND, hand_points(path.hand[-1]), strict=True
@@ -292,8 +316,10 @@ def illustration_5(correction: Correction = "none") -> tuple[list[Row], Guidance
     )  # fmt: skip
     ends = path.division_ends
     rows = [
-        Row(f"step {i + 1}", p, thesis_units(path.q[ends[i]], 3)) for i, p in enumerate(TABLE_A2_9)
-    ]
+        Row(f"step {i + 1}", p, thesis_units(path.q[ends[i]], 3),
+            "erratum: theta4 10.000 for 10.886 (its r1, r2, r3 are 10.886's)" if i == 0 else "")
+        for i, p in enumerate(TABLE_A2_9)
+    ]  # fmt: skip
     rows.append(Row("final", TABLE_A2_9_FINAL, thesis_units(path.q[-1], 3)))
     return rows, path
 
@@ -311,6 +337,8 @@ def illustration_6(correction: Correction = "none") -> tuple[list[Row], list[Gui
     rows = [Row(f"step {i}", p, thesis_units(q[i], 3)) for i, p in TABLE_A2_11]
     for n, (path, printed) in enumerate(zip(paths, ILLUSTRATION_6_RHO, strict=True)):
         rows.append(Row(f"rho_0 end of stage {n + 1}", printed, hand_points(path.hand[-1])[0]))
+    within = "stage 2: within one unit of the last digit (docs/errata.md)"
+    rows = [Row(r.label, r.printed, r.computed, within) if any(r.differs()) else r for r in rows]
     return rows, paths
 
 
@@ -359,17 +387,47 @@ TITLES = {
     6: "Illustration 6 (Table A2-11): Type IV on configuration #2, k = 9 and 4",
     7: "Illustration 7 (Table A2-13): Type I on configuration #2, k = 35",
 }
+READINGS = {
+    1: "The inputs are printed to two decimals: computed from them as printed, the screws lie "
+    "within what their rounding allows, not on the printed digits (docs/api.md, Appendix II).",
+    2: "",
+    4: "Erratum: the printed theta1 is 0.05 rad (the escape's step) above the run's from the "
+    "escape on; the computed theta1 is shown raised by it. The goal points are the cards' "
+    "within their rounding. Every step within one unit of the last digit (0.001 deg), but "
+    "8.608.",
+    5: "Erratum: the run's goal b_2 is (15.00, -10.00, 20.00), 5 units out on the hand's z "
+    "axis, not the cards' (11.00, -10.00, 20.00) nor the text's (15.00, -24.00, 12.00).",
+    6: "",
+    7: "Erratum: the table's columns are r1 r2 r3 theta4 theta5 theta6 (headed theta1 theta2 "
+    "theta3).",
+}
+"""What a reader must know to compare an illustration's rows: the errata of docs/errata.md
+that concern the whole table, and the readings."""
 
 
 def format_report(number: int) -> str:
     """Illustration ``number`` as text: each printed line, then the computed numbers under it.
 
-    Lengths in the thesis's units (inches), angles in degrees. Raises as :func:`report`.
+    Lengths in the thesis's units (inches), angles in degrees. A computed number that does not
+    round to the printed digits is marked ``*``; where the reason is known (an erratum of
+    docs/errata.md, a reading), it follows the printed line after ``<-``. Raises as
+    :func:`report`.
     """
     rows = report(number)
-    lines = [TITLES[number], ""]
+    lines = [TITLES[number]]
+    if READINGS[number]:
+        lines += textwrap.wrap(READINGS[number], 92)
+    lines.append("")
+    marked = 0
     for row in rows:
-        lines.append(f"{row.label:<30} thesis   " + " ".join(f"{p:>10}" for p in row.printed))
+        printed = " ".join(f"{p:>10} " for p in row.printed)
+        note = f"  <- {row.note}" if row.note else ""
+        lines.append(f"{row.label:<30} thesis   {printed}{note}".rstrip())
         computed = (round(c, 4) + 0.0 for c in row.computed)  # no "-0.0000"
-        lines.append(f"{'':<30} computed " + " ".join(f"{c:10.4f}" for c in computed))
+        cells = [f"{c:10.4f}{'*' if off else ' '}"
+                 for c, off in zip(computed, row.differs(), strict=True)]  # fmt: skip
+        marked += sum(row.differs())
+        lines.append(f"{'':<30} computed " + " ".join(cells).rstrip())
+    lines += ["", f"* does not round to the printed digits ({marked} of "
+              f"{sum(len(r.printed) for r in rows)}); <- the known reason (docs/errata.md)."]
     return "\n".join(lines)

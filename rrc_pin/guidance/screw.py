@@ -139,7 +139,7 @@ def screw_of_displacement(Q: npt.ArrayLike, q: npt.ArrayLike) -> Screw:
     q = real_array(q, "q", InvalidInput, "expected translations of shape (..., 3)")
     if q.shape != Q.shape[:-1] or not np.isfinite(q).all():
         raise InvalidInput("q", f"expected finite translations of shape {Q.shape[:-1]}")
-    u, theta = _axis_angle(Q)
+    u, theta = axis_angle(Q)
     pure = np.abs(theta) < PURE_TRANSLATION
     shift = np.linalg.norm(q, axis=-1)
     moves = pure & (shift > 0.0)
@@ -185,8 +185,14 @@ def screw_twist(screw: Screw) -> Array:
     return out
 
 
-def _axis_angle(Q: Array) -> tuple[Array, Array]:
-    """Unit axis (..., 3) with the thesis's sign and angle (...) in (-pi, pi] of rotations Q."""
+def axis_angle(Q: Array) -> tuple[Array, Array]:
+    """Unit axis (..., 3) with the thesis's sign and angle (...) in (-pi, pi] of rotations Q.
+
+    Well defined up to and including a half turn: there the skew part of ``Q`` vanishes and
+    the axis comes from its symmetric part, ``u u^T = (Q + Q^T - 2 cos(theta) I) / (2 (1 -
+    cos(theta)))``; the thesis's sign (``u3 > 0``, else ``u1 > 0``, else ``u2 > 0``) makes
+    the choice between ``u`` and ``-u`` of a half turn (``theta = pi``) the same every time.
+    """
     vee = np.stack(
         [Q[..., 2, 1] - Q[..., 1, 2], Q[..., 0, 2] - Q[..., 2, 0], Q[..., 1, 0] - Q[..., 0, 1]],
         axis=-1,

@@ -1,5 +1,6 @@
-"""Limits of a resolution: joint limits (velocity, one-step position, acceleration)."""
+"""Limits of a resolution, one per module: each gives a box and named constraint rows a tick."""
 
 from rrc_pin.limits.joint_limits import JointLimits
+from rrc_pin.limits.limit import Limit
 
-__all__ = ["JointLimits"]
+__all__ = ["JointLimits", "Limit"]

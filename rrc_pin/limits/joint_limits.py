@@ -1,4 +1,4 @@
-"""JointLimits: the joint limits a resolver keeps, as options, checked against the robot."""
+"""JointLimits: velocity, one-step position and acceleration limits of every joint, as a box."""
 
 from __future__ import annotations
 
@@ -9,64 +9,116 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from solvers.errors import InputError
-from solvers.joint_bounds import JointBounds
+from rrc_pin.limits.limit import Limit
+from solvers import kernels
+from solvers.problem import Box, Constraints
+from solvers.validation import as_vector, finite_number, real_array
 
 if TYPE_CHECKING:
-    from rrc_pin.robot import Robot
+    from rrc_pin.kinematics import Kinematics, Layout
 
 Array = npt.NDArray[np.float64]
 
 
 @dataclass(frozen=True)
-class JointLimits:
-    """Joint limits of a resolver (:mod:`solvers.joint_bounds` for the bounds of a step).
+class JointLimits(Limit):
+    """The joint limits a resolver keeps: the box of :func:`solvers.kernels.joint_box`.
 
-    Every step keeps the velocity limits and the position limits over the step (exactly, in
-    floating point); a start outside the position limits only moves back.
+    Every step keeps the velocity limits and the position limits over the step exactly (in
+    floating point); a start outside the position limits only moves back (``recovering``).
 
     Attributes:
-        margin: Distance kept from every position limit [rad or m], >= 0.
-        acceleration: Joint acceleration limits [rad/s^2 or m/s^2], a scalar or (nq,), or
-            None for none.
-        velocity: Velocity limits (nq,) [rad/s or m/s] replacing the robot's, or None.
+        margin: Distance kept from every position limit [rad or m], >= 0 and below half of
+            every joint's range (checked against the robot when a Resolver is built).
+        acceleration: Joint acceleration limits [rad/s^2 or m/s^2] > 0, a scalar or (nq,),
+            or None for none.
+        velocity: Velocity limits (nq,) [rad/s or m/s] > 0 replacing the robot's, or None.
         position_gain: Fraction in (0, 1] of the distance to a position limit allowed in one
             step (pink's ``config_limit_gain``).
+        name: Name in the report.
+
+    Raises:
+        InvalidInput: A field that is not a finite number in its range, named.
     """
 
     margin: float = 0.0
     acceleration: float | npt.ArrayLike | None = None
     velocity: npt.ArrayLike | None = None
     position_gain: float = 1.0
+    name: str = "joint limits"
 
-    def bounds(self, robot: Robot) -> JointBounds:
-        """The robot's limits prepared for the per-step bounds.
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        set_(self, "margin", finite_number(self.margin, "margin", 0.0, error=InvalidInput))
+        gain = finite_number(self.position_gain, "position_gain", 0.0, inclusive=False,
+                             error=InvalidInput)  # fmt: skip
+        if gain > 1.0:
+            raise InvalidInput("position_gain", f"expected a number in (0, 1], got {gain}")
+        set_(self, "position_gain", gain)
+        if self.acceleration is not None:
+            a = real_array(self.acceleration, "acceleration", InvalidInput).reshape(-1).copy()
+            if (
+                np.ndim(self.acceleration) > 1
+                or not np.isfinite(a).all()
+                or (a <= 0.0).any()
+                or not a.size
+            ):
+                raise InvalidInput("acceleration", f"expected finite limits > 0, got {a}")
+            a.flags.writeable = False
+            set_(self, "acceleration", a)
+        if self.velocity is not None:
+            v = real_array(self.velocity, "velocity", InvalidInput).copy()
+            if v.ndim != 1 or not np.isfinite(v).all() or (v <= 0.0).any():
+                raise InvalidInput("velocity", f"expected finite limits > 0 (nq,), got {v}")
+            v.flags.writeable = False
+            set_(self, "velocity", v)
+        if not isinstance(self.name, str):
+            raise InvalidInput("name", f"expected a string, got {self.name!r}")
 
-        Args:
-            robot: The robot (its ``lower``, ``upper``, ``velocity_limit``, ``joint_names``).
+    def check(self, layout: Layout) -> None:
+        """Refuse limits that do not fit the robot.
 
         Raises:
-            InvalidInput: An invalid field (named), or a joint without a finite velocity
-                limit (its URDF gives none) while ``velocity`` is not given.
+            InvalidInput: ``velocity`` or ``acceleration`` of the wrong length, a joint
+                without a finite velocity limit while ``velocity`` is not given, or a
+                ``margin`` of at least half a joint's range (no room would be left).
         """
-        velocity = robot.velocity_limit if self.velocity is None else self.velocity
-        if self.velocity is None and not np.isfinite(robot.velocity_limit).all():
-            missing = [n for n, v in zip(robot.joint_names, robot.velocity_limit, strict=True)
-                       if not np.isfinite(v)]  # fmt: skip
+        n = layout.nv
+        if self.velocity is None and not np.isfinite(layout.velocity).all():
+            missing = [name for name, i in layout.joints.items()
+                       if not np.isfinite(layout.velocity[i])]  # fmt: skip
             raise InvalidInput(
                 "velocity",
                 f"the robot gives no velocity limit for joints {missing} (its URDF has "
-                "velocity=\"0\" or none); pass JointLimits(velocity=[...]) in rad/s or m/s",
+                'velocity="0" or none); pass JointLimits(velocity=[...]) in rad/s or m/s',
             )
-        if np.size(velocity) != robot.nq:
+        if self.velocity is not None:
+            as_vector(self.velocity, "velocity", n, InvalidInput)
+        if self.acceleration is not None and np.size(self.acceleration) not in (1, n):
+            raise InvalidInput("acceleration", f"expected a scalar or shape ({n},), got "
+                               f"{np.shape(self.acceleration)}")  # fmt: skip
+        half = 0.5 * (layout.upper - layout.lower)
+        if self.margin > 0.0 and (self.margin >= half).any():
+            narrow = [name for name, i in layout.joints.items() if self.margin >= half[i]]
             raise InvalidInput(
-                "velocity", f"expected shape ({robot.nq},), got {np.shape(velocity)}"
-            )
-        try:
-            return JointBounds(
-                robot.lower, robot.upper, velocity, self.margin, self.acceleration,
-                self.position_gain,
+                "margin", f"{self.margin} leaves no range for joints {narrow} (half their "
+                f"ranges: {np.round(half[[layout.joints[n] for n in narrow]], 4).tolist()})",
             )  # fmt: skip
-        except InputError as exc:
-            name = {"gain": "position_gain"}.get(exc.argument, exc.argument)
-            raise InvalidInput(name, exc.reason) from exc
+
+    def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
+        """The step's box (:func:`solvers.kernels.joint_box`)."""
+        layout = kin.layout
+        n = layout.nv
+        velocity: Array = layout.velocity if self.velocity is None else np.asarray(self.velocity)
+        acceleration = _NO_ACCELERATION if self.acceleration is None else np.asarray(
+            self.acceleration
+        )
+        lb, ub, kind = np.empty(n), np.empty(n), np.empty((2, n), np.int8)
+        zero, recovering = kernels.joint_box(
+            kin.q, layout.lower, layout.upper, velocity, self.margin, self.position_gain, dt,
+            previous, acceleration, lb, ub, kind,
+        )  # fmt: skip
+        return Constraints(Box(lb, ub, kind, zero, recovering, velocity))
+
+
+_NO_ACCELERATION = np.array([np.inf])

@@ -27,6 +27,7 @@ JOINT_LIMITS_DEG = (160.0, 165.0, 135.0, 135.0, 105.0, 270.0)  # Barker's table,
 OFFSETS_DEG = (180.0, 90.0, 90.0, 180.0, 180.0, 0.0)  # theta'_i - theta_i, Barker's table
 VELOCITY_LIMIT = (2.0, 2.0, 2.0, 4.0, 4.0, 4.0)  # [rad/s], assumed (PUMA 560 class)
 EFFORT_LIMIT = (100.0, 180.0, 90.0, 20.0, 20.0, 20.0)  # [N m], assumed
+READY = tuple(float(v) for v in np.deg2rad((0.0, 0.0, 90.0, 0.0, 45.0, 0.0)))  # chosen, see build
 
 PUMA560 = {
     "no": 0.6718,  # neck-to-base [m]
@@ -92,6 +93,9 @@ def build(
         "r6 = 0: tool frame at the wrist centre; HW moved to the `flange` frame",
         "link inertial data: PUMA 560 (Corke & Armstrong-Helouvry 1994), mirrored onto "
         "Barker's frames; link 1 mass and transverse moments, link 3 Izz raised",
+        "ready pose (0, 0, 90, 0, 45, 0) deg: elbow bent 90 deg, wrist 45 deg, away from the "
+        "limits and singularities (q = 0, Barker's initial position, has theta5 = 0: the "
+        "wrist singular)",
     ]
     symbolic = {k: v for k, v in params.items() if not np.isclose(v, PUMA560[k])}
     if len(symbolic) < len(params):
@@ -115,7 +119,7 @@ def build(
         effort_limit=EFFORT_LIMIT,
         source="Barker, NASA TM-85685 (1983), DH table and appendix A",
         assumed=tuple(assumed),
-        named_poses={"paper_start": (0.0,) * 6},
+        named_poses={"paper_start": (0.0,) * 6, "ready": READY},
         closed_form=closed_form,
         parameters=params,
         inertials=barker_inertials(chain),

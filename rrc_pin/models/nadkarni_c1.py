@@ -23,6 +23,7 @@ TABLE_A2_2: tuple[Row, ...] = (
     (0.00, 0.00, 1.00, 0.00, None),  # the hand frame
 )
 FIRST_FRAME_POINTS = ((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))  # Table A2-3, set five
+READY = tuple(float(v) for v in np.deg2rad((0.0, -60.0, 0.0, 90.0, 0.0, 0.0)))  # chosen
 
 
 def build(name: str = NAME) -> ArmSpec:
@@ -39,8 +40,11 @@ def build(name: str = NAME) -> ArmSpec:
         assumed=(
             "length unit of the thesis taken as the inch",
             "joint limits +-180 deg, velocity limits 2 rad/s, efforts",
+            "ready pose (0, -60, 0, 90, 0, 0) deg, away from the limits and singularities "
+            "(the initial configuration of Table A2-2 is singular: Illustration 4 escapes "
+            "from it)",
         ),
-        named_poses={"table_a2_2": q0},
+        named_poses={"table_a2_2": q0, "ready": READY},
     )
 
 

@@ -44,8 +44,9 @@ def build(name: str = NAME) -> ArmSpec:
         assumed=(
             "length unit of the thesis taken as the inch",
             "prismatic travel +-1 m at 0.5 m/s, revolute +-180 deg at 2 rad/s, efforts",
+            "ready pose: the initial configuration of Table A2-7",
         ),
-        named_poses={"table_a2_7": q0},
+        named_poses={"table_a2_7": q0, "ready": q0},
     )
 
 

@@ -36,6 +36,7 @@ VELOCITY_LIMIT = (1.0, 1.0, 1.5, 1.5, 2.0, 2.0, 2.0)  # [rad/s], assumed
 EFFORT_LIMIT = (140.0, 140.0, 70.0, 70.0, 20.0, 20.0, 20.0)  # [N m], assumed
 LINK_MASSES = (8.0, 5.0, 2.0, 3.5, 1.5, 1.0, 0.5)  # [kg], assumed (upper arm: 2, forearm: 4)
 LINK_RADII = (0.08, 0.06, 0.06, 0.05, 0.05, 0.04, 0.04)  # [m], assumed
+READY = tuple(float(v) for v in np.deg2rad((0.0, 30.0, 0.0, 90.0, 0.0, 45.0, 0.0)))  # chosen
 
 
 def cylinder_links(rows: tuple[DHRow, ...]) -> tuple[LinkInertial, ...]:
@@ -76,8 +77,11 @@ def build(name: str = NAME) -> ArmSpec:
             "joint limits +-(170, 120, 170, 135, 170, 120, 170) deg",
             "velocity limits (1, 1, 1.5, 1.5, 2, 2, 2) rad/s and efforts",
             "link inertial data: solid cylinders of masses (8, 5, 2, 3.5, 1.5, 1, 0.5) kg",
+            "ready pose (0, 30, 0, 90, 0, 45, 0) deg: shoulder 30 deg, elbow 90 deg, wrist "
+            "45 deg, away from the limits and singularities (the home q = 0 is stretched out, "
+            "singular)",
         ),
-        named_poses={"home": (0.0,) * 7},
+        named_poses={"home": (0.0,) * 7, "ready": READY},
         closed_form=closed_form,
         inertials=cylinder_links(rows),
     )

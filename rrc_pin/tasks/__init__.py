@@ -6,5 +6,14 @@ from rrc_pin.tasks.joint_task import JointTask
 from rrc_pin.tasks.posture_task import PostureTask
 from rrc_pin.tasks.relative_frame_task import RelativeFrameTask
 from rrc_pin.tasks.task import Task
+from solvers.problem import TaskRows
 
-__all__ = ["DampingTask", "FrameTask", "JointTask", "PostureTask", "RelativeFrameTask", "Task"]
+__all__ = [
+    "DampingTask",
+    "FrameTask",
+    "JointTask",
+    "PostureTask",
+    "RelativeFrameTask",
+    "Task",
+    "TaskRows",
+]

@@ -6,7 +6,7 @@ import numpy as np
 
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.tasks.task import Task, check_weight
-from solvers.resolution import TaskRows
+from solvers.problem import TaskRows
 
 
 class DampingTask(Task):

@@ -10,7 +10,7 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.tasks.task import Task, check_weight
-from solvers.resolution import TaskRows
+from solvers.problem import TaskRows
 from solvers.spatial import Reference, check_reference
 from solvers.validation import as_vector
 
@@ -62,6 +62,7 @@ class FrameTask(Task):
         self.weight = check_weight(weight, len(self.selected))
         self.name = frame if name is None else name
         self.twist = np.zeros(len(self.selected)) if twist is None else self.check_twist(twist)
+        self._units: dict[float, Array] = {}  # row units by reach: one array per robot frame
 
     def set_twist(self, twist: npt.ArrayLike) -> None:
         """Command a new twist (checked as at construction): keep a task across ticks.
@@ -72,7 +73,7 @@ class FrameTask(Task):
         self.twist = self.check_twist(twist)
 
     def check_twist(self, twist: npt.ArrayLike) -> Array:
-        """``twist`` as the selected rows: (6,) or (rows,) finite.
+        """``twist`` as the selected rows: (6,) or (rows,) finite, a new array (the task's own).
 
         Raises:
             InvalidInput: Wrong shape or a non-finite entry.
@@ -84,11 +85,13 @@ class FrameTask(Task):
         if size != (m,):
             want = "(6,)" if m == 6 else f"(6,) or ({m},)"
             raise InvalidInput("twist", f"expected shape {want}, got {size}")
-        return as_vector(twist, "twist", m, InvalidInput)
+        own: Array = as_vector(twist, "twist", m, InvalidInput).copy()
+        return own
 
     def selected_rates(self, twist: Array) -> Array:
-        """The selected rows' rates of a checked twist (6,) (``twist`` itself when all six)."""
-        return twist if len(self.selected) == 6 else twist[list(self.selected)]
+        """The selected rows' rates of a checked twist (6,), a new array."""
+        rates: Array = twist.copy() if len(self.selected) == 6 else twist[list(self.selected)]
+        return rates
 
     def check_ref(self, ref: str) -> Reference:
         """``ref`` if it names a reference frame that this task's rows can use.
@@ -111,13 +114,32 @@ class FrameTask(Task):
 
     def rows(self, kin: Kinematics) -> TaskRows:
         """The frame's Jacobian rows and the commanded twist."""
-        return self.rows_from(kin.jacobian(self.frame, self.ref), self.twist)
+        return self.rows_at(kin, self.twist, self.ref)
 
-    def rows_from(self, J: Array, b: Array) -> TaskRows:
-        """The task's rows from a full (6, nv) Jacobian ``J`` and the selected rates ``b``."""
-        if len(self.selected) != 6:
-            J = J[list(self.selected)]
-        return TaskRows(J, b, self._row_weights(len(self.selected)), self.name)
+    def rows_at(self, kin: Kinematics, b: Array, ref: Reference) -> TaskRows:
+        """The task's rows in frame ``ref`` with the selected rates ``b`` (checked by the caller).
+
+        What :meth:`rows` gives for a twist ``b`` of this tick (``Resolver.solve(q, twist)``).
+        """
+        return self.rows_from(kin.jacobian(self.frame, ref), b, kin.layout.reach[self.frame])
+
+    def rows_from(self, J: Array, b: Array, reach: float) -> TaskRows:
+        """The task's rows from a full (6, nv) Jacobian ``J`` and the selected rates ``b``.
+
+        Args:
+            J: The frame's Jacobian (6, nv).
+            b: The selected rates.
+            reach: The frame's reach [m], the unit of the linear rows.
+        """
+        selected = self.selected
+        if len(selected) != 6:
+            J = J[list(selected)]
+        unit = self._units.get(reach)
+        if unit is None:
+            unit = np.array([reach if r < 3 else 1.0 for r in selected])
+            unit.flags.writeable = False
+            self._units[reach] = unit
+        return TaskRows(J, b, self._row_weights(len(selected)), self.name, unit)
 
 
 def task_rows(rows: str | Sequence[int] | Sequence[bool]) -> tuple[int, ...]:

@@ -7,7 +7,7 @@ import numpy as np
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.tasks.task import Task, check_weight
-from solvers.resolution import TaskRows
+from solvers.problem import TaskRows
 from solvers.validation import finite_number
 
 

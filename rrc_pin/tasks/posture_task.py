@@ -8,7 +8,7 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.tasks.task import Task, check_weight
-from solvers.resolution import TaskRows
+from solvers.problem import TaskRows
 from solvers.validation import as_vector, positive
 
 Array = npt.NDArray[np.float64]
@@ -58,8 +58,8 @@ class PostureTask(Task):
     def rows(self, kin: Kinematics) -> TaskRows:
         """Identity rows and ``gain (q_ref - q)``."""
         error = self.q_ref - kin.q
-        if kin.continuous.any():
+        if kin.layout.continuous.any():
             wrapped = np.remainder(error + np.pi, 2.0 * np.pi) - np.pi
-            error = np.where(kin.continuous, wrapped, error)
+            error = np.where(kin.layout.continuous, wrapped, error)
         n = error.size
         return TaskRows(np.eye(n), self.gain * error, self._row_weights(n), self.name)

@@ -12,7 +12,7 @@ from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.tasks.frame_task import FrameTask
 from rrc_pin.tasks.task import Task
-from solvers.resolution import TaskRows
+from solvers.problem import TaskRows
 from solvers.validation import positive, rigid_transform
 
 Array = npt.NDArray[np.float64]
@@ -115,4 +115,5 @@ class RelativeFrameTask(Task):
                 self.target[:3, 3] - Rt @ d, pin.log3(self.target[:3, :3] @ R_ab.T)
             ])  # fmt: skip
             b = b + self.gain * error[list(self.selected)]
-        return self._spec.rows_from(J, b)
+        reach = max(kin.layout.reach[self.frame_a], kin.layout.reach[self.frame_b])
+        return self._spec.rows_from(J, b, reach)

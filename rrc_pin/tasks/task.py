@@ -9,7 +9,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
-from solvers.resolution import TaskRows
+from solvers.problem import TaskRows
 from solvers.validation import as_vector, finite_number
 
 Array = npt.NDArray[np.float64]

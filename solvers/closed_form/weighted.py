@@ -20,7 +20,7 @@ import numpy.typing as npt
 
 from solvers.closed_form.base import Array
 from solvers.errors import InputError
-from solvers.jacobian_svd import RANK_TOL  # the default rcond
+from solvers.factorization import RANK_TOL  # the default rcond
 from solvers.validation import as_array, as_vector, finite_number
 
 

@@ -34,11 +34,15 @@ def installed_backends() -> list[str]:
     return native + others
 
 
-def make_backend(name: str, **options: Any) -> QPBackend:
+def make_backend(name: str, time_limit: float | None = None, **options: Any) -> QPBackend:
     """A fresh backend (with its own warm starts) by name, its options checked.
 
     Args:
         name: One of :func:`installed_backends`.
+        time_limit: [s] The most time one solve may take: an answer that took longer is
+            refused (:func:`solvers.qp.solve_checked`), or None for no limit. The backends'
+            own time limits are not used: they make the answers depend on the machine's load;
+            their iteration limits (each backend's defaults) bound the time instead.
         **options: Backend settings (e.g. DAQP's ``iter_limit``, OSQP's ``eps_abs``).
 
     Raises:
@@ -48,15 +52,16 @@ def make_backend(name: str, **options: Any) -> QPBackend:
     installed = installed_backends()
     if not isinstance(name, str) or name not in installed:
         raise BackendNotFound(str(name), installed)
-    backend = NATIVE[name](**options) if name in NATIVE else QpsolversBackend(name, **options)
-    try:  # a two-variable QP with a bound and a row: every setting is read at the first solve
-        probe = backend.solve(_PROBE)
+    try:
+        backend = NATIVE[name](**options) if name in NATIVE else QpsolversBackend(name, **options)
+        probe = backend.solve(_PROBE)  # every setting is read at the first solve
     except ProblemError as exc:
         reason = str(exc).splitlines()[0][:300]
         raise InputError("backend_options", f"{name} refused {options}: {reason}") from exc
     if probe.x is None or not np.allclose(probe.x, [0.5, 0.5], atol=1e-3):
         raise InputError("backend_options", f"{name} with {options} fails a 2-variable QP")
     backend.reset()
+    backend.time_limit = time_limit
     return backend
 
 

@@ -41,9 +41,11 @@ class QPBackend(ABC):
     Attributes:
         name: Backend name, as :func:`solvers.qp_backends.make_backend` takes it.
         options: The settings passed to the solver at every solve.
+        time_limit: [s] The most time a solve may take, or None (set by ``make_backend``).
     """
 
     name: str
+    time_limit: float | None = None
 
     def __init__(self, **options: Any) -> None:
         self.options = dict(options)

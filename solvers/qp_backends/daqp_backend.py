@@ -60,10 +60,14 @@ class DaqpBackend(QPBackend):
         A: Array
         if qp.C is None or qp.l is None or qp.u is None:
             A, upper, lower = np.zeros((0, nz)), qp.ub, qp.lb
-        else:  # the box first, then the rows (DAQP takes infinite bounds as they are)
-            A = qp.C
-            upper = np.concatenate([qp.ub, qp.u])
-            lower = np.concatenate([qp.lb, qp.l])
+        else:  # the box first, then the rows (DAQP takes infinite bounds as they are), each
+            # row of unit norm: DAQP's tolerances are absolute, and a row of norm 8e-7 (a
+            # joint barely in a null space, on its bound) was left broken by 4e-6 at 1e-9
+            norms = np.linalg.norm(qp.C, axis=1)
+            norms[norms == 0.0] = 1.0
+            A = qp.C / norms[:, None]
+            upper = np.concatenate([qp.ub, qp.u / norms])
+            lower = np.concatenate([qp.lb, qp.l / norms])
         sense = np.zeros(upper.size, dtype=np.intc)  # C ints: all inequalities
         t0 = time.perf_counter()
         try:

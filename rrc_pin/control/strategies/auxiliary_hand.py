@@ -64,6 +64,7 @@ class AuxiliaryHand(Strategy):
     """
 
     name = "auxiliary_hand"
+    chooses_rates = True
 
     def __init__(self, k3: float = 20.0, k2: float = 1.0, region: float = 0.05) -> None:
         self.k3 = -finite_number(k3, "k3", 0.0, False, error=InvalidInput)

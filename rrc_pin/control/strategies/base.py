@@ -104,6 +104,9 @@ class Strategy(ABC):
     passive: bool = False
     """Whether :meth:`decide` always keeps the command (:data:`KEEP`): the controller then
     builds no :class:`Situation` for it."""
+    chooses_rates: bool = False
+    """Whether :meth:`decide` always gives joint rates (Barker's strategies): the controller
+    then has no commanded pose to hold, and the log's drift is not measured (it reads 0)."""
 
     def check(self, robot: Robot) -> None:  # noqa: B027 - a hook: most strategies take any arm
         """Refuse a robot this strategy cannot work on.

@@ -35,6 +35,7 @@ class Freezing(Strategy):
     """
 
     name = "freezing"
+    chooses_rates = True
 
     def __init__(self, region: float = 0.02) -> None:
         self.region = finite_number(region, "region", 0.0, False, 0.5, InvalidInput)

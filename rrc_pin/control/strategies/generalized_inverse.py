@@ -24,6 +24,7 @@ class GeneralizedInverse(Strategy):
     """
 
     name = "generalized_inverse"
+    chooses_rates = True
 
     def __init__(self, exact: bool = False) -> None:
         self.exact = bool(exact)

@@ -22,6 +22,7 @@ class Uncoupled(Strategy):
     """Arm by eq. (23), wrist joints commanded one by one (module docstring)."""
 
     name = "uncoupled"
+    chooses_rates = True
 
     def __init__(self) -> None:
         self.closed_form: BarkerClosedForm | None = None

@@ -33,6 +33,7 @@ class WristChoice(Strategy):
     """
 
     name = "wrist_choice"
+    chooses_rates = True
 
     def __init__(self, region: float = 0.05, margin: float = 0.0) -> None:
         self.region = finite_number(region, "region", 0.0, False, 0.5, InvalidInput)

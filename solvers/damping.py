@@ -1,0 +1,94 @@
+r"""Damping near singularities, and only there.
+
+Near a singularity the exact rates of a command grow without bound, so the limits stop the
+arm along a direction it can barely move. Damping trades the command's direction for speed;
+it is therefore applied only where both hold:
+
+1. the command cannot be met (the largest scale along it within the limits, the LP
+   maximum :math:`u^*`, is below 1): a command the arm can follow is followed exactly,
+   however close the singularity;
+2. the level's rows are ill-conditioned: their condition number :math:`\sigma_1/\sigma_r`,
+   in the level's metric (each row divided by its unit, the arm's reach for linear rows, so
+   that metres and radians compare; and times the square root of its weight) exceeds
+   :attr:`Damping.threshold` :math:`\kappa`. Below it a too-fast command is scaled along
+   itself to :math:`u^*`, never damped.
+
+A direction i whose singular value is below the onset :math:`\sigma_{on} = \sigma_1/\kappa`
+gets the squared damping (Maciejewski & Klein 1988's smooth onset, with a floor for the
+step)
+
+.. math::
+
+    \lambda_i^2 = \Big(1 - \big(\sigma_i/\sigma_{on}\big)^2\Big)\,
+        \max\big(\sigma_{on}^2,\ \sigma_1 |u_i^T b|\,\Delta t\big)\,(1 - u^*),
+
+zero at the threshold and for a command that can just be met (:math:`u^* = 1`), so the
+answer is continuous in the configuration and in the command. The floor is for the step
+:math:`\Delta t`: near a singularity :math:`\sigma_i` changes by about :math:`\sigma_1` per
+radian along :math:`v_i`, so the singularity is :math:`\sigma_i/\sigma_1` away, and a step of
+:math:`\Delta t\,\sigma_i |u_i^T b|/(\sigma_i^2 + \lambda_i^2)` along :math:`v_i` stays short
+of it when :math:`\sigma_i^2 + \lambda_i^2 \ge \sigma_1 |u_i^T b| \Delta t`; a step that crosses
+it is undone by the next (a stretched elbow pushed outward: the joints flipped between
+opposite rate limits at most ticks). The damped rates
+:math:`\sum_i \sigma_i/(\sigma_i^2 + \lambda_i^2)\,(u_i^T b)\,v_i` are then scaled along
+themselves within the limits; the resolution reports the angle by which the motion veers
+from the command.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from solvers.validation import finite_number
+
+Array = npt.NDArray[np.float64]
+
+MIN_THRESHOLD = 10.0
+"""The smallest threshold accepted: rows this well conditioned are never damped."""
+
+
+@dataclass(frozen=True)
+class Damping:
+    r"""Damping near singularities (module docstring).
+
+    Attributes:
+        threshold: :math:`\kappa` >= 10, the condition number of a level's normalised rows
+            beyond which a command that cannot be met is damped. The default, 100, leaves
+            every configuration of the catalogue arms that is further than about 2 deg from
+            a singular one undamped (docs/api.md, "Damping").
+
+    Raises:
+        InvalidInput: ``threshold`` not a finite number >= 10.
+    """
+
+    threshold: float = 100.0
+
+    def __post_init__(self) -> None:
+        finite_number(self.threshold, "threshold", MIN_THRESHOLD)
+
+    def lambda_sq(
+        self, sigma: Array, rank: int, scale: float, along: Array, dt: float
+    ) -> Array | None:
+        """Squared damping per singular direction (k,), or None where none applies.
+
+        Args:
+            sigma: Singular values (k,) of the level's normalised rows, descending.
+            rank: How many of them count (the others are zero).
+            scale: The LP maximum :math:`u^*` in [0, 1] of the exact command.
+            along: :math:`|u_i^T b|` (k,), the command's size along each direction.
+            dt: The step [s].
+        """
+        if rank == 0 or scale >= 1.0:
+            return None
+        onset = float(sigma[0]) / self.threshold
+        s = sigma[:rank]
+        if float(s[-1]) >= onset:
+            return None
+        lam = np.zeros(sigma.size)
+        weak = s < onset
+        floor = np.maximum(onset * onset, float(sigma[0]) * along[:rank][weak] * dt)
+        lam[:rank][weak] = (1.0 - (s[weak] / onset) ** 2) * floor * (1.0 - scale)
+        return lam

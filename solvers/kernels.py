@@ -1,0 +1,476 @@
+r"""The compiled kernels of a control tick: small functions, each one equation or one step.
+
+Every function here is compiled by numba (``@njit(cache=True)``, through :func:`kernel`, which
+only keeps the signature visible to mypy) and written as the textbook writes the math, in loops
+where those read clearer than vector tricks. Arrays come in, arrays go out (preallocated by the
+caller where a tick calls the kernel); nothing here allocates Python objects. The same source
+runs as plain Python under ``NUMBA_DISABLE_JIT=1`` (one CI stage does), and tests/test_kernels.py
+compares each kernel with a plain numpy reference.
+
+The first call of a kernel in a fresh checkout compiles it (about 5 s for all of them, once:
+numba caches the machine code in ``__pycache__``); later processes load it in milliseconds.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any, TypeVar, cast
+
+import numpy as np
+import numpy.typing as npt
+from numba import njit
+
+Array = npt.NDArray[np.float64]
+F = TypeVar("F", bound=Callable[..., Any])
+
+ON_LIMIT = 1e-12
+"""[rad or m] A start at most this far outside the range counts as on its limit."""
+
+SHRINK = 1.0 - 8.0 * float(np.finfo(np.float64).eps)
+"""Factor on the one-step position bounds that makes them exact in floating point (eight
+ulps against the six roundings of ``(high - q) * gain / dt * dt``)."""
+
+VELOCITY, POSITION, ACCELERATION = 0, 1, 2
+"""Codes of what sets a joint-rate bound (:func:`joint_box`'s ``kind``)."""
+
+SWEEPS = 60
+"""Most sweeps of the one-sided Jacobi SVD (:func:`jacobi_svd`); it converges quadratically and
+takes five to eight on a 6 x 6 factor, so this cap is only a guard."""
+
+
+def kernel(function: F) -> F:
+    """``numba.njit(cache=True)`` with the function's own signature kept for the type checker."""
+    return cast(F, njit(cache=True)(function))
+
+
+# -- the step's joint box ---------------------------------------------------------------------
+
+
+@kernel
+def joint_box(
+    q: Array,
+    lower: Array,
+    upper: Array,
+    velocity: Array,
+    margin: float,
+    gain: float,
+    dt: float,
+    previous: Array,
+    acceleration: Array,
+    lb: Array,
+    ub: Array,
+    kind: npt.NDArray[np.int8],
+) -> tuple[bool, bool]:
+    r"""Joint-rate bounds of one step: velocity, position over the step, acceleration.
+
+    Three intervals intersected by priority (where two are disjoint the higher one wins):
+
+    1. velocity :math:`|\dot q| \le v_{max}`, never violated;
+    2. position over one step inside the range shrunk by the margin m (at most half of it):
+       :math:`g\,(q_{min} + m - q)/dt \le \dot q \le g\,(q_{max} - m - q)/dt`, shrunk by
+       :data:`SHRINK` so that ``q + qdot * dt`` in doubles (either order, fused or not) never
+       leaves the range. A start outside the range makes the interval exclude zero: the joint
+       moves back (at most at :math:`v_{max}`); one outside by at most :data:`ON_LIMIT` is on
+       its limit (bound zero);
+    3. acceleration :math:`|\dot q - \dot q_{prev}| \le a_{max}\,dt` (``inf`` for none), which
+       yields to the two above.
+
+    Args:
+        q: Joint positions (n,) [rad or m].
+        lower: Lower position limits (n,); -inf allowed.
+        upper: Upper position limits (n,); +inf allowed.
+        velocity: Velocity limits (n,) > 0 [rad/s or m/s].
+        margin: Distance kept from each position limit [rad or m], >= 0.
+        gain: Fraction in (0, 1] of the distance to a position bound allowed in one step.
+        dt: Step [s] > 0.
+        previous: Previous joint rates (n,) (for the acceleration bounds).
+        acceleration: Acceleration limits (n,), or one for all (1,) [rad/s^2 or m/s^2];
+            ``inf`` for none.
+        lb: Out: lower bounds (n,).
+        ub: Out: upper bounds (n,).
+        kind: Out (2, n): what sets each bound, :data:`VELOCITY`, :data:`POSITION` or
+            :data:`ACCELERATION` (row 0 the lower bounds, row 1 the upper).
+
+    Returns:
+        (contains_zero, recovering): whether standing still is allowed, and whether a joint
+        is outside its range and must move back.
+    """
+    n = q.size
+    k = gain / dt * SHRINK
+    recovering = False
+    for i in range(n):
+        half = 0.5 * (upper[i] - lower[i])
+        cut = min(margin, half)
+        low = lower[i] + cut
+        high = max(upper[i] - cut, low) if margin < half else low
+        lo = (low - q[i]) * k
+        hi = (high - q[i]) * k
+        if (lo > 0.0 or hi < 0.0) and low - ON_LIMIT <= q[i] <= high + ON_LIMIT:
+            lo, hi = min(lo, 0.0), max(hi, 0.0)  # on the limit: standing still allowed
+        if lo > 0.0 or hi < 0.0:
+            recovering = True
+        v = velocity[i]
+        kind[0, i] = POSITION if lo > -v else VELOCITY
+        kind[1, i] = POSITION if hi < v else VELOCITY
+        lb[i] = min(max(lo, -v), v)
+        ub[i] = min(max(hi, -v), v)
+        a = acceleration[i if acceleration.size > 1 else 0] * dt
+        if a < math.inf:
+            want_lo, want_hi = previous[i] - a, previous[i] + a
+            if lb[i] < want_lo <= ub[i]:
+                lb[i], kind[0, i] = want_lo, ACCELERATION
+            elif want_lo > ub[i]:  # clipped across: the upper bound's constraint sets both
+                lb[i], kind[0, i] = ub[i], kind[1, i]
+            if lb[i] <= want_hi < ub[i]:
+                ub[i], kind[1, i] = want_hi, ACCELERATION
+            elif want_hi < lb[i]:
+                ub[i], kind[1, i] = lb[i], kind[0, i]
+    contains_zero = True
+    for i in range(n):
+        if lb[i] > 0.0 or ub[i] < 0.0:
+            contains_zero = False
+    return contains_zero, recovering
+
+
+# -- least-norm rates -------------------------------------------------------------------------
+
+
+@kernel
+def householder_qr(At: Array, Q: Array, R: Array) -> None:
+    """Householder QR of ``At`` (n, m): ``At = Q R`` (Golub & Van Loan, Algorithm 5.2.1).
+
+    Args:
+        At: The transposed task rows (n, m).
+        Q: Out: orthogonal (n, n).
+        R: Out: upper triangular (n, m).
+    """
+    n, m = At.shape
+    R[:, :] = At
+    Q[:, :] = 0.0
+    for i in range(n):
+        Q[i, i] = 1.0
+    v = np.empty(n)
+    for j in range(min(n - 1, m)):
+        sigma = 0.0  # the Householder vector of R[j:, j] (Golub & Van Loan, Algorithm 5.1.1)
+        for i in range(j + 1, n):
+            sigma += R[i, j] * R[i, j]
+        if sigma == 0.0:
+            continue
+        x0 = R[j, j]
+        mu = math.sqrt(x0 * x0 + sigma)
+        v0 = x0 - mu if x0 <= 0.0 else -sigma / (x0 + mu)
+        beta = 2.0 * v0 * v0 / (sigma + v0 * v0)
+        v[j] = 1.0
+        for i in range(j + 1, n):
+            v[i] = R[i, j] / v0
+        for c in range(j, m):  # R = (I - beta v v^T) R
+            s = 0.0
+            for i in range(j, n):
+                s += v[i] * R[i, c]
+            s *= beta
+            for i in range(j, n):
+                R[i, c] -= s * v[i]
+        for r in range(n):  # Q = Q (I - beta v v^T)
+            s = 0.0
+            for i in range(j, n):
+                s += Q[r, i] * v[i]
+            s *= beta
+            for i in range(j, n):
+                Q[r, i] -= s * v[i]
+        for i in range(j + 1, n):
+            R[i, j] = 0.0
+
+
+@kernel
+def least_norm_rates(Q: Array, R: Array, b: Array, x: Array) -> bool:
+    r"""The least-norm solution of ``J x = b`` from the QR of :math:`J^T = QR` (m <= n).
+
+    :math:`J = R_1^T Q_1^T`, so :math:`x = Q_1 y` with :math:`R_1^T y = b` by forward
+    substitution (Golub & Van Loan, 5.7.2: the minimum-norm solution of an underdetermined
+    system).
+
+    Args:
+        Q: Orthogonal factor (n, n).
+        R: Triangular factor (n, m), m <= n.
+        b: Right-hand side (m,).
+        x: Out: the rates (n,).
+
+    Returns:
+        False where a pivot of :math:`R_1` is not above ``1e-12`` times the largest (the rows
+        are numerically dependent, or all zero: the SVD answers instead); ``x`` is then not
+        set.
+    """
+    n, m = R.shape
+    largest = 0.0
+    for i in range(m):
+        largest = max(largest, abs(R[i, i]))
+    for i in range(m):
+        if abs(R[i, i]) <= 1e-12 * largest:
+            return False
+    y = np.empty(m)
+    for i in range(m):
+        s = b[i]
+        for k in range(i):
+            s -= R[k, i] * y[k]
+        y[i] = s / R[i, i]
+    for r in range(n):
+        s = 0.0
+        for i in range(m):
+            s += Q[r, i] * y[i]
+        x[r] = s
+    return True
+
+
+@kernel
+def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
+    r"""One-sided Jacobi SVD of a small ``A`` (m, k): ``A V = U diag(sigma)`` (Hestenes 1958).
+
+    Plane rotations of pairs of columns until all are orthogonal (Demmel & Veselic 1992,
+    Algorithm 4.1: the rotation that zeroes :math:`a_p^T a_q`), accumulated in V; the column
+    norms are then the singular values. Columns are sorted by decreasing norm at the end.
+
+    Args:
+        A: The matrix (m, k); out: its columns rotated, ``U diag(sigma)``.
+        V: Out: orthogonal (k, k), the right singular vectors (columns).
+        sigma: Out: the singular values (k,), descending.
+    """
+    m, k = A.shape
+    V[:, :] = 0.0
+    for i in range(k):
+        V[i, i] = 1.0
+    for _ in range(SWEEPS):
+        rotated = False
+        for p in range(k - 1):
+            for q in range(p + 1, k):
+                alpha = beta = gamma = 0.0
+                for i in range(m):
+                    alpha += A[i, p] * A[i, p]
+                    beta += A[i, q] * A[i, q]
+                    gamma += A[i, p] * A[i, q]
+                if gamma == 0.0 or abs(gamma) <= 1e-15 * math.sqrt(alpha * beta):
+                    continue
+                rotated = True
+                zeta = (beta - alpha) / (2.0 * gamma)
+                t = math.copysign(1.0, zeta) / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
+                c = 1.0 / math.sqrt(1.0 + t * t)
+                s = c * t
+                for i in range(m):
+                    ap, aq = A[i, p], A[i, q]
+                    A[i, p], A[i, q] = c * ap - s * aq, s * ap + c * aq
+                for i in range(k):
+                    vp, vq = V[i, p], V[i, q]
+                    V[i, p], V[i, q] = c * vp - s * vq, s * vp + c * vq
+        if not rotated:
+            break
+    for j in range(k):
+        s = 0.0
+        for i in range(m):
+            s += A[i, j] * A[i, j]
+        sigma[j] = math.sqrt(s)
+    for j in range(k):  # selection sort, descending, columns of A and V alike
+        best = j
+        for i in range(j + 1, k):
+            if sigma[i] > sigma[best]:
+                best = i
+        if best != j:
+            sigma[j], sigma[best] = sigma[best], sigma[j]
+            for i in range(m):
+                A[i, j], A[i, best] = A[i, best], A[i, j]
+            for i in range(k):
+                V[i, j], V[i, best] = V[i, best], V[i, j]
+
+
+@kernel
+def svd_rates(
+    US: Array, sigma: Array, right: Array, b: Array, lambda_sq: Array, rank: int, x: Array
+) -> None:
+    r"""Damped least-squares rates :math:`\sum_{i<r}\sigma_i/(\sigma_i^2+\lambda_i^2)(u_i^Tb)v_i`.
+
+    With ``US`` the columns :math:`\sigma_i u_i`, the coefficient is
+    :math:`(\sigma_i u_i)^T b/(\sigma_i^2 + \lambda_i^2)` (Wampler 1986; exact least-norm
+    rates for :math:`\lambda = 0`).
+
+    Args:
+        US: Left singular vectors times their singular values (m, k).
+        sigma: Singular values (k,), descending.
+        right: Right singular vectors (n, k) (columns).
+        b: Task rates (m,).
+        lambda_sq: Squared damping per singular direction (k,).
+        rank: Number of directions used (those of nonzero singular value).
+        x: Out: rates (n,).
+    """
+    n = right.shape[0]
+    m = US.shape[0]
+    x[:] = 0.0
+    for i in range(rank):
+        c = 0.0
+        for r in range(m):
+            c += US[r, i] * b[r]
+        c /= sigma[i] * sigma[i] + lambda_sq[i]
+        for r in range(n):
+            x[r] += c * right[r, i]
+
+
+# -- feasibility and scales -------------------------------------------------------------------
+
+
+@kernel
+def inside(x: Array, lb: Array, ub: Array) -> bool:
+    """Whether ``lb <= x <= ub`` holds exactly (False for NaN)."""
+    for i in range(x.size):
+        if not lb[i] <= x[i] <= ub[i]:
+            return False
+    return True
+
+
+@kernel
+def rows_hold(G: Array, x: Array, h: Array, tol: float) -> bool:
+    """Whether ``G x <= h + tol`` holds (False for NaN)."""
+    p, n = G.shape
+    for i in range(p):
+        s = 0.0
+        for j in range(n):
+            s += G[i, j] * x[j]
+        if not s <= h[i] + tol:
+            return False
+    return True
+
+
+@kernel
+def uniform_scale(x: Array, lb: Array, ub: Array) -> float:
+    """Largest s in [0, 1] with ``lb <= s x <= ub``, for bounds with ``lb <= 0 <= ub``."""
+    s = 1.0
+    for i in range(x.size):
+        if x[i] > 0.0:
+            s = min(s, ub[i] / x[i])
+        elif x[i] < 0.0:
+            s = min(s, lb[i] / x[i])
+    return max(s, 0.0)
+
+
+@kernel
+def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
+    r"""The largest u in [0, 1] with ``lb <= u w + y v <= ub`` for some y, and that y nearest 0.
+
+    Each row gives two half-planes :math:`\alpha u + \beta y \le \gamma` (:math:`\gamma \ge
+    0`); eliminating y between each pair bounding it from opposite sides (Fourier-Motzkin
+    elimination, Dantzig & Eaves 1973) leaves bounds on u alone. The direction problem of
+    one null direction v, exactly.
+
+    Args:
+        w: Rates of the command (n,).
+        v: Null-space direction (n,).
+        lb: Lower bounds (n,) <= 0.
+        ub: Upper bounds (n,) >= 0.
+
+    Returns:
+        u and y: the rates are ``u w + y v``.
+    """
+    n = w.size
+    u = 1.0
+    for i in range(n):  # rows without y bound u alone
+        if v[i] == 0.0:
+            if w[i] > 0.0:
+                u = min(u, ub[i] / w[i])
+            elif w[i] < 0.0:
+                u = min(u, lb[i] / w[i])
+    # half-plane (a, b, g) of row i bounding y from above: b > 0 (the row's side where v > 0)
+    for i in range(n):
+        if v[i] == 0.0:
+            continue
+        a1, b1, g1 = (w[i], v[i], ub[i]) if v[i] > 0.0 else (-w[i], -v[i], -lb[i])
+        for j in range(n):
+            if v[j] == 0.0:
+                continue
+            a2, b2, g2 = (-w[j], -v[j], -lb[j]) if v[j] > 0.0 else (w[j], v[j], ub[j])
+            coefficient = b1 * a2 - b2 * a1  # -b2 (plane 1) + b1 (plane 2): y eliminated
+            if coefficient > 0.0 and b1 * g2 - b2 * g1 < u * coefficient:
+                u = (b1 * g2 - b2 * g1) / coefficient
+    u = max(u, 0.0)
+    y_hi, v_hi, y_lo, v_lo = math.inf, 1.0, -math.inf, 1.0
+    for i in range(n):
+        if v[i] == 0.0:
+            continue
+        a1, b1, g1 = (w[i], v[i], ub[i]) if v[i] > 0.0 else (-w[i], -v[i], -lb[i])
+        if (g1 - a1 * u) / b1 < y_hi:
+            y_hi, v_hi = (g1 - a1 * u) / b1, b1
+        a2, b2, g2 = (-w[i], -v[i], -lb[i]) if v[i] > 0.0 else (w[i], v[i], ub[i])
+        if (g2 - a2 * u) / b2 > y_lo:
+            y_lo, v_lo = (g2 - a2 * u) / b2, -b2
+    if y_lo <= y_hi:
+        return u, min(max(0.0, y_lo), y_hi)
+    # rounding at a vertex: the y that leaves both rows by the same rate (a row with a
+    # null component of rounding size, 1e-15, pins u; its y bound is off by up to 0.1)
+    return u, (v_lo * y_lo + v_hi * y_hi) / (v_lo + v_hi)
+
+
+# -- least squares of a stack -----------------------------------------------------------------
+
+
+@kernel
+def normal_equations(A: Array, b: Array, weight: Array, H: Array, g: Array) -> None:
+    r"""The normal equations of weighted rows: :math:`H = A^T W A`, :math:`g = A^T W b`.
+
+    Args:
+        A: Rows (m, n).
+        b: Their rates (m,).
+        weight: Row weights W (m,) > 0.
+        H: Out (n, n).
+        g: Out (n,).
+    """
+    m, n = A.shape
+    for i in range(n):
+        s = 0.0
+        for r in range(m):
+            s += A[r, i] * weight[r] * b[r]
+        g[i] = s
+        for j in range(i, n):
+            s = 0.0
+            for r in range(m):
+                s += A[r, i] * weight[r] * A[r, j]
+            H[i, j] = s
+            H[j, i] = s
+
+
+@kernel
+def cholesky_solve(H: Array, g: Array, x: Array) -> bool:
+    r"""``x`` solving :math:`Hx = g` for a symmetric positive definite H (Cholesky, :math:`LL^T`).
+
+    Golub & Van Loan, Algorithm 4.2.1, then two triangular solves.
+
+    Returns:
+        False where H is not numerically definite (a pivot below ``1e-12`` times the largest
+        diagonal entry); ``x`` is then not set.
+    """
+    n = g.size
+    L = np.zeros((n, n))
+    largest = 0.0
+    for i in range(n):
+        largest = max(largest, H[i, i])
+    if largest <= 0.0:
+        return False
+    for j in range(n):
+        s = H[j, j]
+        for k in range(j):
+            s -= L[j, k] * L[j, k]
+        if s <= 1e-12 * largest:
+            return False
+        L[j, j] = math.sqrt(s)
+        for i in range(j + 1, n):
+            s = H[i, j]
+            for k in range(j):
+                s -= L[i, k] * L[j, k]
+            L[i, j] = s / L[j, j]
+    y = np.empty(n)
+    for i in range(n):
+        s = g[i]
+        for k in range(i):
+            s -= L[i, k] * y[k]
+        y[i] = s / L[i, i]
+    for i in range(n - 1, -1, -1):
+        s = y[i]
+        for k in range(i + 1, n):
+            s -= L[k, i] * x[k]
+        x[i] = s / L[i, i]
+    return True

@@ -1,0 +1,155 @@
+r"""A least-squares level: :math:`\min \|A\dot q - b\|^2` within the constraints and levels above.
+
+The rates are :math:`\dot q = x + N^T z` (a :class:`Subspace`: the answer of
+the levels above and their null space; all rates for the first level), so the level solves
+
+.. math::
+
+    \min_z \|Bz - c\|^2,\quad B = AN^T,\ c = b - Ax
+    \quad \text{s.t.} \quad lb \le x + N^Tz \le ub,\quad G(x + N^Tz) \le h.
+
+Its unconstrained optimum of least norm is the answer when it satisfies the constraints:
+by the normal equations :math:`B^TBz = B^Tc` (:func:`~solvers.kernels.cholesky_solve`) for
+more rows than unknowns, by the QR of :math:`B^T` (:class:`~solvers.factorization.Factorization`)
+otherwise, and by the SVD where either is rank deficient. Else the backend solves the QP
+with :math:`P = B^TB`: exactly the stated costs where P is definite (their optimum is one
+point). Where it is not (fewer independent rows than unknowns: one frame task on a
+redundant arm, a lower level in a null space) the optimal rates form a set, and the term
+:math:`\epsilon\|z\|^2`, :math:`\epsilon` = :data:`TIE_BREAK` times the trace of P, picks
+the least-norm ones among them; it moves the optimum of the stated costs by at most
+:math:`\epsilon/\lambda` relative along an eigenvector of P of eigenvalue :math:`\lambda`,
+as Levenberg-Marquardt damping would. (Measured on 2,000 random three-level problems: at
+1e-10, DAQP declared 154 feasible lower levels infeasible, at 1e-8 33, at 1e-6 2; DAQP's
+exact proximal iterations instead took up to 0.3 s and hit their iteration limit on 2-5 of
+200 tracking steps of rrc_k1607 and panda.)
+
+The next level moves in the null space of B (the optimal set of a convex least squares has one
+value of Bz).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from solvers import kernels
+from solvers.direction import constraint_rows
+from solvers.factorization import Factorization
+from solvers.problem import Box, Rows
+from solvers.qp import QP, Decoding, Work, solve_within
+
+if TYPE_CHECKING:
+    from solvers.qp_backends.base import QPBackend
+
+Array = npt.NDArray[np.float64]
+
+TIE_BREAK = 1e-6
+"""Weight of the least-norm tie-break of a semidefinite least-squares QP, relative to the
+trace of its P (module docstring)."""
+
+ROUNDING = 1e-12
+"""[rad/s] Slack given to the constraint rows of a lower level's QP, whose start z = 0 sits on
+them wherever a joint is at a bound."""
+
+
+class Subspace(NamedTuple):
+    """Where a level may move: rates ``x + N^T z``.
+
+    Attributes:
+        x: The rates so far (n,).
+        N: Orthonormal rows (d, n) spanning the free directions, or None for all of them.
+    """
+
+    x: Array
+    N: Array | None
+
+
+def optimum(B: Array, c: Array) -> tuple[Array, Factorization | None, bool]:
+    """The least-squares solution of least norm of ``B z ~= c``.
+
+    Args:
+        B: Rows (m, d).
+        c: Rates (m,).
+
+    Returns:
+        z (d,), the :class:`Factorization` of B when it was computed (else None: the normal
+        equations answered), and whether :math:`B^TB` is definite (the optimum one point).
+    """
+    m, d = B.shape
+    if m > d:
+        H, g, z = np.empty((d, d)), np.empty(d), np.empty(d)
+        kernels.normal_equations(B, c, np.ones(m), H, g)
+        if kernels.cholesky_solve(H, g, z):
+            return z, None, True
+    factor = Factorization(B)
+    return factor.least_norm(c), factor, False
+
+
+def least_squares(
+    A: Array,
+    b: Array,
+    space: Subspace,
+    box: Box,
+    rows: Rows | None,
+    backend: QPBackend,
+    work: Work,
+    key: str,
+    need_null: bool,
+) -> tuple[Array, Array | None]:
+    """One least-squares level within ``space`` and the constraints (module docstring).
+
+    Args:
+        A: The level's stacked, row-weighted rows (m, n).
+        b: Their rates (m,).
+        space: Where the level may move.
+        box: The step's bounds.
+        rows: Constraint rows, or None.
+        backend: The QP backend.
+        work: Where the backend's work and failures are counted.
+        key: Warm-start key prefix of the QP.
+        need_null: Whether the next level needs this level's null space.
+
+    Returns:
+        The rates (n,), and the null space (d', n) left for the next level (None when not
+        needed).
+
+    Raises:
+        NumericalFailure: The backend found no usable answer.
+    """
+    x, N = space
+    B = A if N is None else A @ N.T
+    c = b if N is None else b - A @ x
+    z, factor, definite = optimum(B, c)
+    candidate = z if N is None else x + z @ N
+    feasible = kernels.inside(candidate, box.lb, box.ub) and (
+        rows is None or kernels.rows_hold(rows.G, candidate, rows.h, 0.0)
+    )
+    if not feasible:
+        P = B.T @ B
+        q = -(c @ B)
+        d = B.shape[1]
+        if not definite:
+            P.flat[:: d + 1] += TIE_BREAK * max(float(P.trace()), 1.0)
+        if N is None:
+            C, lo, hi = (None, None, None) if rows is None else (
+                rows.G, np.full(rows.h.size, -np.inf), rows.h)  # fmt: skip
+            qp = QP(P, q, C, lo, hi, box.lb, box.ub, f"{key}:{d}")
+            decoding = Decoding(None, None)
+        else:
+            C, lo, hi = constraint_rows(N.T, box, rows, x)
+            # z = 0 (the answer so far) is feasible: keep it so for the backend's tolerance
+            # where joints sit exactly on their bounds
+            lo, hi = np.minimum(lo, 0.0) - ROUNDING, np.maximum(hi, 0.0) + ROUNDING
+            free = np.full(d, np.inf)
+            qp = QP(P, q, C, lo, hi, -free, free, f"{key}:{d}:{hi.size}")
+            decoding = Decoding(x, N.T)
+        candidate = solve_within(qp, decoding, box, rows, backend, work)
+    if not need_null:
+        return candidate, None
+    if factor is None:
+        factor = Factorization(B)
+        factor.least_norm(c)  # records whether B has full row rank, for its null basis
+    null = factor.null_basis()
+    return candidate, null if N is None else null @ N

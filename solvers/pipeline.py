@@ -1,0 +1,431 @@
+r"""The numerics of one tick: a :class:`~solvers.problem.Problem` in, an :class:`Answer` out.
+
+The levels are solved in priority order, each exactly within the optimal set of those above
+(Kanoun, Lamiraux & Wieber 2011; Escande, Mansard & Wieber 2014): a level's answer fixes its
+task rates, and the next level moves only in the null space of its rows (a
+:class:`Subspace`), so it cannot change them. Equality rows come first of all: every level
+moves in their null space.
+
+The top level of the ``direction`` mode (:mod:`solvers.direction`, :mod:`solvers.damping`):
+
+1. the exact rates (least-squares of least norm, :class:`~solvers.factorization.Factorization`)
+   are the answer when they satisfy the constraints (``exact``; ``singular`` where part of
+   the command is outside the rows' range);
+2. otherwise the LP maximum :math:`u^*` of the scale along them: ``exact`` at
+   :math:`u^* = 1` (another solution of the same rates), else ``scaled`` while the rows'
+   condition number is below the damping threshold;
+3. beyond it, the damped rates scaled along themselves (``damped``, the veer reported).
+
+A least-squares level (the other modes, and every lower level): its unconstrained optimum
+(:mod:`solvers.least_squares`) when it satisfies the constraints, else the backend's QP.
+
+When the top level finds no usable answer (a backend fault, an infeasible problem, an answer
+outside the constraints beyond :data:`FEASIBILITY_TOL`), the fallbacks answer it
+(:mod:`solvers.fallbacks`); a lower level that fails keeps the answer of the levels above
+(``dropped``). Every answer is finally clipped into the box, the size of the clip reported.
+Nothing here raises for numerical trouble.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+
+from solvers import kernels
+from solvers.damping import Damping
+from solvers.direction import Along, along, direction_qp
+from solvers.errors import InputError, NumericalFailure
+from solvers.factorization import Factorization
+from solvers.least_squares import Subspace, least_squares
+from solvers.problem import Box, Problem, Rows, largest_weight, row_factors
+from solvers.qp import Work, solve_within
+from solvers.qp_backends.base import QPBackend
+
+Array = npt.NDArray[np.float64]
+
+Method = Literal["qp", "scipy", "scaling", "hold"]
+"""How the top level was answered: ``qp`` the pipeline (its exact kernels, or the backend),
+then the fallbacks (:mod:`solvers.fallbacks`)."""
+
+METHODS: tuple[Method, ...] = ("qp", "scipy", "scaling", "hold")
+
+Status = Literal[
+    "exact", "partial", "scaled", "damped", "singular", "least_squares", "recovering", "fallback"
+]
+"""What the answer is (docs/api.md, "Reading a resolution"):
+
+- ``exact``: every level is met;
+- ``partial``: the top level is met, a lower one only in part (see ``levels``);
+- ``scaled``: the top level's direction is kept exactly, its speed reduced (``scale < 1``)
+  to the largest the constraints allow;
+- ``damped``: near a singularity (the rows' condition number beyond the damping threshold)
+  the command could not be met and its damped rates were scaled instead: the motion veers
+  from the command by ``veer``;
+- ``singular``: part of the top level's command is outside its rows' range (a singularity,
+  or more rows than joints); the rest is met or scaled;
+- ``least_squares``: the top level's least-squares optimum within the constraints, not its
+  command (the tracking and weighted modes);
+- ``recovering``: a joint outside its range, or a constraint row broken at the start, must
+  be restored: the least-squares optimum within the constraints;
+- ``fallback``: the pipeline found no usable answer for the top level; a fallback did
+  (``attempts`` says why).
+"""
+
+LevelStatus = Literal["met", "scaled", "traded", "dropped"]
+"""How one priority level was served: ``met`` (its command, to :data:`EXACT_TOL`), ``scaled``
+(its command's direction, slower), ``traded`` (a least-squares optimum within the levels above
+and the constraints), ``dropped`` (its solve failed: the answer of the levels above kept)."""
+
+EXACT_TOL = 1e-9
+"""Relative residual under which a command counts as met, and a scale as 1."""
+
+DIRECTION_TOL = 1e-7
+"""[rad] A backend's answer to the direction problem may veer from the command by this much
+(its null basis' rounding times its size) before it is refused."""
+
+DEFAULT_FALLBACKS: tuple[Method, ...] = ("scipy", "scaling")
+"""The fallbacks tried after the pipeline by default; ``hold`` ends every chain."""
+
+
+@dataclass(frozen=True)
+class Options:
+    """How the pipeline solves.
+
+    Attributes:
+        damping: Damping near singularities, or None for none.
+        fallbacks: Methods tried in order after the pipeline fails (names of :data:`METHODS`
+            except ``qp``); ``hold`` always ends the chain.
+
+    Raises:
+        InputError: An unknown or repeated fallback, ``qp`` among them, or ``hold`` before
+            another one.
+    """
+
+    damping: Damping | None = field(default_factory=Damping)
+    fallbacks: tuple[Method, ...] = DEFAULT_FALLBACKS
+
+    def __post_init__(self) -> None:
+        given = self.fallbacks
+        if isinstance(given, str):
+            given = (given,)
+        if not isinstance(given, (tuple, list)) or not all(isinstance(m, str) for m in given):
+            raise InputError("fallbacks", f"expected a sequence of method names, got {given!r}")
+        for name in given:
+            if name not in METHODS or name == "qp":
+                choices = ", ".join(m for m in METHODS if m != "qp")
+                raise InputError("fallbacks", f"unknown method {name!r}; expected {choices}")
+        if len(set(given)) != len(given):
+            raise InputError("fallbacks", f"repeated method in {tuple(given)}")
+        if "hold" in given[:-1]:
+            raise InputError("fallbacks", f"'hold' always answers, so it comes last: {given}")
+        if self.damping is not None and not isinstance(self.damping, Damping):
+            raise InputError("damping", f"expected a Damping or None, got {self.damping!r}")
+        chain = tuple(given) if given[-1:] == ("hold",) else (*given, "hold")
+        object.__setattr__(self, "fallbacks", chain)
+
+
+class Answer(NamedTuple):
+    """What the numerics produced for one problem.
+
+    Attributes:
+        qdot: Joint rates (n,), finite, within the box (read-only).
+        method: How the top level was answered.
+        status: What the answer is (:data:`Status`).
+        levels: How each priority level was served (:data:`LevelStatus`).
+        scale: The top level's fraction of its command achieved along it, in [0, 1].
+        veer: Angle [rad] between the top level's achieved and commanded rates (its metric).
+        lambda_sq: The largest squared damping applied (0 when undamped).
+        backend: The last backend that answered, or "".
+        iterations: Backend iterations.
+        solve_time: Time inside the backend [s].
+        attempts: ``(method or level, reason)`` of every method that failed.
+        clip: Size of the final clip into the box [rad/s].
+    """
+
+    qdot: Array
+    method: Method
+    status: Status
+    levels: tuple[LevelStatus, ...]
+    scale: float
+    veer: float
+    lambda_sq: float
+    backend: str
+    iterations: int
+    solve_time: float
+    attempts: tuple[tuple[str, str], ...]
+    clip: float
+
+
+class _Top(NamedTuple):
+    """The top level's answer and its report."""
+
+    qdot: Array
+    status: Status
+    scale: float
+    veer: float
+    lambda_sq: float
+    null: Array | None  # the next level's free directions, or None if none are left
+
+
+def solve(problem: Problem, backend: QPBackend, options: Options) -> Answer:
+    """Joint rates serving ``problem``'s levels in priority order (module docstring).
+
+    Args:
+        problem: The tick's problem (:func:`solvers.problem.build`), its arrays finite.
+        backend: The QP backend (warm-started across calls).
+        options: Damping and fallbacks.
+
+    Returns:
+        The :class:`Answer`; never raises for numerical trouble.
+    """
+    work = Work()
+    box, rows = problem.box, problem.rows
+    method: Method = "qp"
+    top: _Top | None = None
+    try:
+        space = _equality_space(problem)
+        top = _top(problem, space, backend, options, work)
+    except (NumericalFailure, np.linalg.LinAlgError) as exc:
+        work.attempts.append(("qp", str(exc)))
+    if top is None:
+        from solvers.fallbacks import fallback
+
+        for name in options.fallbacks:
+            try:
+                qdot = fallback(name, problem, work)
+            except (NumericalFailure, np.linalg.LinAlgError) as exc:
+                work.attempts.append((name, str(exc)))
+                continue
+            method = name
+            top = _Top(qdot, "fallback", *_along_command(problem, qdot), 0.0, None)
+            break
+    assert top is not None  # "hold" always answers
+    qdot, levels = top.qdot, ["met" if top.status == "exact" else _level_status(top.status)]
+    null = top.null
+    for k in range(1, len(problem.levels)):
+        if method != "qp" or null is None or null.shape[0] == 0:
+            levels.append("dropped" if method != "qp" else _served(problem, k, qdot))
+            continue
+        A, b = problem.stacked[k]
+        try:
+            qdot, null = least_squares(A, b, Subspace(qdot, null), box, rows, backend, work,
+                                       f"level{k}", k < len(problem.levels) - 1)  # fmt: skip
+        except (NumericalFailure, np.linalg.LinAlgError) as exc:
+            work.attempts.append((f"level {k}", f"{exc}; the levels above kept"))
+            levels.append("dropped")
+            null = None
+            continue
+        levels.append(_served(problem, k, qdot))
+    qdot, clip = _clipped(qdot, box)
+    qdot, shrink = _within_rows(qdot, box, rows)
+    qdot.flags.writeable = False
+    status = top.status
+    if status == "exact" and any(s != "met" for s in levels[1:]):
+        status = "partial"
+    return Answer(
+        qdot, method, status, tuple(levels), top.scale * shrink, top.veer, top.lambda_sq,
+        work.backend, work.iterations, work.solve_time, tuple(work.attempts), clip,
+    )  # fmt: skip
+
+
+def _top(
+    problem: Problem, space: Subspace, backend: QPBackend, options: Options, work: Work
+) -> _Top:
+    """The top level's answer (module docstring)."""
+    A, b = problem.stacked[0]
+    box, rows = problem.box, problem.rows
+    if problem.mode != "direction":
+        last = len(problem.levels) == 1
+        qdot, null = least_squares(A, b, space, box, rows, backend, work, "least_squares", not last)
+        met = _met(A @ qdot, b)
+        status: Status = "recovering" if box.recovering or _broken(rows) else (
+            "exact" if met else "least_squares")  # fmt: skip
+        return _Top(qdot, status, *_along_command(problem, qdot), 0.0, null)
+    B = A if space.N is None else A @ space.N.T
+    factor = Factorization(B)
+    z = factor.least_norm(b)
+    w = z if space.N is None else z @ space.N
+    null = factor.null_basis() if space.N is None else factor.null_basis() @ space.N
+    outside_range = factor.J.shape[0] > factor.J.shape[1] or not _met(B @ z, b)
+    if _feasible(w, box, rows):
+        if outside_range:
+            return _Top(w, "singular", *_along_command(problem, w), 0.0, null)
+        return _Top(w, "exact", 1.0, 0.0, 0.0, null)
+    u_w = _scaled(A, w, null, box, rows, backend, work)
+    if not outside_range and u_w.u >= 1.0 - EXACT_TOL:
+        return _Top(u_w.qdot, "exact", 1.0, 0.0, 0.0, null)
+    lam, usable = _damping(options.damping, factor, b, w, u_w.u, box, problem.dt, space.N is None)
+    if lam is None and outside_range:
+        return _Top(u_w.qdot, "singular", *_along_command(problem, u_w.qdot), 0.0, null)
+    if lam is None:
+        return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
+    z = usable.rates(b, lam)
+    damped = _scaled(A, z if space.N is None else z @ space.N, null, box, rows, backend, work)
+    return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot), float(lam.max()),
+                null)  # fmt: skip
+
+
+def _damping(
+    damping: Damping | None, factor: Factorization, b: Array, w: Array, scale: float, box: Box,
+    dt: float, clampable: bool,
+) -> tuple[Array | None, Factorization]:  # fmt: skip
+    """The damping a command that cannot be met needs, and the factorisation it applies to.
+
+    The condition number is that of the joints the command can use: a joint that the exact
+    rates ``w`` push against a bound holding it still is taken out of the rows (Baerlocher &
+    Boulic 2004's clamping), as long as the rows keep their rank without it (else the command
+    needs it and the rows' own factorisation serves). Such a joint is lost to the command,
+    and the singularity that matters is that of the others: rolling rrc_k1607's hand with
+    joint 7 on its limit, the full rows' condition number is 7 while the other six joints
+    are near their own singularity; scaled along the exact rates, the joints flipped between
+    opposite rate limits at every tick, the hand at 0.3 % of the command.
+    """
+    if damping is None:
+        return None, factor
+    usable = _clamped(factor, w, box, dt) if clampable else factor
+    if usable.condition() <= damping.threshold:
+        return None, usable
+    US, sigma, _, rank = usable.svd
+    along = np.abs(b @ US) / np.maximum(sigma, 1e-300)  # |u_i^T b|
+    return damping.lambda_sq(sigma, rank, scale, along, dt), usable
+
+
+def _clamped(factor: Factorization, w: Array, box: Box, dt: float) -> Factorization:
+    """The rows without the joints ``w`` pushes against a bound that holds them (``_damping``)."""
+    still = kernels.ON_LIMIT / dt  # a bound within rounding of zero holds the joint
+    pushed = ((w > 0.0) & (box.ub <= still)) | ((w < 0.0) & (box.lb >= -still))
+    if not pushed.any():
+        return factor
+    J = factor.J.copy()
+    J[:, pushed] = 0.0
+    clamped = Factorization(J)
+    return clamped if clamped.svd[3] >= factor.svd[3] else factor
+
+
+def _scaled(
+    A: Array, w: Array, null: Array, box: Box, rows: Rows | None, backend: QPBackend, work: Work
+) -> Along:
+    """The direction problem along ``w``: exactly by the kernels, else by the backend.
+
+    A backend's answer is decoded from the null space and w, so its task rates are a multiple
+    of ``A w`` up to the null basis' rounding times the answer's size; its scale is read from
+    them, and an answer that veers from them by more than :data:`DIRECTION_TOL` is refused.
+
+    Raises:
+        NumericalFailure: The backend found no usable answer.
+    """
+    answer = along(w, null, box, rows)
+    if answer is not None:
+        return answer
+    qp, decoding = direction_qp(w, null, box, rows)
+    qdot = solve_within(qp, decoding, box, rows, backend, work)
+    scale, veer = scale_and_veer(A @ qdot, A @ w)
+    if veer > DIRECTION_TOL:
+        raise NumericalFailure(f"{work.backend}: answer veers by {veer:.3g} rad from the command")
+    return Along(qdot, scale)
+
+
+def _equality_space(problem: Problem) -> Subspace:
+    """The rates that meet the equality rows, ``x0 + N^T z`` (least norm x0), or all rates."""
+    n = problem.n
+    if problem.equalities is None:
+        return Subspace(np.zeros(n), None)
+    C, d = problem.equalities
+    factor = Factorization(C)
+    x0 = factor.least_norm(d)
+    if not _met(C @ x0, d):
+        raise NumericalFailure("the equality rows contradict each other")
+    return Subspace(x0, factor.null_basis())
+
+
+def _feasible(x: Array, box: Box, rows: Rows | None) -> bool:
+    """Whether ``x`` satisfies the box and the rows exactly (False for NaN)."""
+    return kernels.inside(x, box.lb, box.ub) and (
+        rows is None or kernels.rows_hold(rows.G, x, rows.h, 0.0)
+    )
+
+
+def _broken(rows: Rows | None) -> bool:
+    return rows is not None and bool((rows.h < 0.0).any())
+
+
+def _met(y: Array, b: Array) -> bool:
+    return _norm(y - b) <= EXACT_TOL * (1.0 + _norm(b))
+
+
+def _level_status(status: Status) -> LevelStatus:
+    return "scaled" if status == "scaled" else "traded"
+
+
+def _served(problem: Problem, k: int, qdot: Array) -> LevelStatus:
+    """How level ``k`` was served by ``qdot``: met, scaled along its command, or traded."""
+    A, b = problem.stacked[k]
+    y = A @ qdot
+    if _met(y, b):
+        return "met"
+    scale, veer = scale_and_veer(y, b)
+    return "scaled" if veer <= 1e-6 and scale > 0.0 else "traded"
+
+
+def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
+    """The top level's scale and veer for ``qdot`` in its normalised metric."""
+    level = problem.levels[0]
+    top = largest_weight(level)
+    y, b = [], []
+    for t in level:
+        factor = row_factors(t, top, units=True)
+        y.append(t.A @ qdot if factor is None else factor * (t.A @ qdot))
+        b.append(t.b if factor is None else factor * t.b)
+    return scale_and_veer(np.concatenate(y), np.concatenate(b))
+
+
+def scale_and_veer(y: Array, b: Array) -> tuple[float, float]:
+    """Fraction of ``b`` achieved along it by ``y`` (in [0, 1]) and the angle between them [rad].
+
+    Computed on both divided by their largest entries, so that no product overflows.
+    """
+    top_b = float(np.abs(b).max()) if b.size else 0.0
+    if top_b == 0.0:
+        return 1.0, 0.0
+    top_y = float(np.abs(y).max())
+    if top_y == 0.0:
+        return 0.0, 0.0
+    bn, yn = b / top_b, y / top_y
+    cosine = float(yn @ bn) / (_norm(yn) * _norm(bn))
+    veer = math.acos(min(max(cosine, -1.0), 1.0))
+    with np.errstate(over="ignore"):
+        ratio = float(np.float64(top_y) / top_b) * float(yn @ bn) / float(bn @ bn)
+    return min(max(ratio, 0.0), 1.0), veer
+
+
+def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:
+    """``x`` shrunk toward zero until the rows hold exactly, and the factor (zero feasible).
+
+    A backend leaves the rows by up to its tolerance (1e-9); the shrink keeps the direction.
+    """
+    if rows is None or not box.contains_zero or bool((rows.h < 0.0).any()):
+        return x, 1.0
+    values = rows.G @ x
+    over = values > rows.h
+    if not over.any():
+        return x, 1.0
+    factor = float((rows.h[over] / values[over]).min()) * (1.0 - 4.0 * _EPS)
+    return x * factor, factor
+
+
+_EPS = float(np.finfo(np.float64).eps)
+
+
+def _clipped(x: Array, box: Box) -> tuple[Array, float]:
+    """``x`` clipped into the box, and the Euclidean size of the clip."""
+    y = np.minimum(np.maximum(x, box.lb), box.ub)
+    return y, _norm(y - x)
+
+
+def _norm(x: Array) -> float:
+    """Euclidean norm without overflow or underflow."""
+    return math.hypot(*x.tolist())

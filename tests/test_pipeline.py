@@ -1,0 +1,380 @@
+"""solvers.pipeline on random problems against independent references: strict levels
+(Clarabel on the lexicographic definition), the weighted optimum (BVLS), the direction scale
+(HiGHS on the whole LP), constraint rows and equality rows, and the fallback chain."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import qpsolvers
+from scipy.optimize import linprog, lsq_linear
+
+import solvers.pipeline as pipeline_module
+from solvers import kernels
+from solvers.damping import Damping
+from solvers.errors import InputError, ProblemError
+from solvers.pipeline import Answer, Options, solve
+from solvers.problem import Box, Constraints, Problem, TaskRows, build
+from solvers.qp_backends import QPBackend, QPSolution, make_backend
+
+N = 10
+DT = 0.01
+
+
+def box_at(
+    rng: np.random.Generator, n: int = N, tight: float = 1.0, q: np.ndarray | None = None
+) -> Box:
+    """The joint box of a random start in [-3, 3] (velocity limits 0.5-2 rad/s)."""
+    v = rng.uniform(0.5, 2.0, n) * tight
+    q = rng.uniform(-2.5, 2.5, n) if q is None else q
+    lb, ub, kind = np.empty(n), np.empty(n), np.empty((2, n), np.int8)
+    zero, recovering = kernels.joint_box(
+        q,
+        np.full(n, -3.0),
+        np.full(n, 3.0),
+        v,
+        0.0,
+        1.0,
+        DT,
+        np.zeros(n),
+        np.array([np.inf]),
+        lb,
+        ub,
+        kind,
+    )
+    return Box(lb, ub, kind, zero, recovering, v)
+
+
+def levels_at(
+    rng: np.random.Generator, sizes: tuple[int, ...], scale: float
+) -> list[list[TaskRows]]:
+    return [
+        [TaskRows(rng.normal(size=(m, N)), rng.normal(size=m) * scale, None, f"t{k}")]
+        for k, m in enumerate(sizes)
+    ]
+
+
+def run(
+    levels: list[list[TaskRows]],
+    box: Box,
+    backend: QPBackend | None = None,
+    options: Options | None = None,
+    *,
+    weighted: bool = False,
+    direction: bool = True,
+    G: np.ndarray | None = None,
+    h: np.ndarray | None = None,
+    C: np.ndarray | None = None,
+    d: np.ndarray | None = None,
+) -> tuple[Problem, Answer]:
+    names = tuple(f"row{i}" for i in range(0 if h is None else h.size))
+    names += tuple(f"eq{i}" for i in range(0 if d is None else d.size))
+    problem = build(
+        levels, [Constraints(box, G, h, C, d, names)], N, DT, weighted=weighted, direction=direction
+    )
+    answer = solve(problem, backend or make_backend("daqp"), options or Options())
+    return problem, answer
+
+
+def stacked(level: list[TaskRows]) -> tuple[np.ndarray, np.ndarray]:
+    return np.vstack([t.A for t in level]), np.concatenate([t.b for t in level])
+
+
+def level_optimum(levels: list[list[TaskRows]], k: int, x: np.ndarray, box: Box) -> float:
+    """The least value of level k's squared residual subject to the achieved rates of the
+    levels above (those of ``x``) as equality constraints and the box (Kanoun et al. 2011's
+    lexicographic definition), by an interior-point solver (Clarabel), not by the null-space
+    parametrisation of the pipeline."""
+    A, y = stacked(levels[k])
+    above = [t.A for level in levels[:k] for t in level]
+    A_eq = np.vstack(above) if above else None
+    ref = qpsolvers.solve_qp(
+        A.T @ A + 1e-10 * np.eye(N),
+        -A.T @ y,
+        A=A_eq,
+        b=None if A_eq is None else A_eq @ x,
+        lb=box.lb,
+        ub=box.ub,
+        solver="clarabel",
+    )
+    assert ref is not None
+    return float(np.sum((A @ ref - y) ** 2))
+
+
+def lp_maximum(
+    A: np.ndarray, b: np.ndarray, box: Box, G: np.ndarray | None = None, h: np.ndarray | None = None
+) -> float:
+    """max s in [0, 1] with A qdot = s b within the box and rows: HiGHS on (qdot, s)."""
+    m, n = A.shape
+    rows = np.zeros((0, n + 1)) if G is None else np.c_[G, np.zeros(len(G))]
+    result = linprog(
+        np.r_[np.zeros(n), -1.0],
+        A_ub=rows if G is not None else None,
+        b_ub=h,
+        A_eq=np.c_[A, -b],
+        b_eq=np.zeros(m),
+        bounds=[*zip(box.lb, box.ub, strict=True), (0.0, 1.0)],
+        method="highs",
+    )
+    assert result.status == 0, result.message
+    return float(result.x[-1])
+
+
+@pytest.mark.filterwarnings("ignore:Converted matrix")  # qpsolvers hands Clarabel CSC matrices
+def test_strict_levels_are_lexicographically_optimal(rng: np.random.Generator) -> None:
+    """Each level of the answer is optimal within the optimal set of the levels above."""
+    for _ in range(150):
+        sizes = tuple(int(m) for m in rng.integers(1, 4, size=3))
+        levels = levels_at(rng, sizes, float(rng.choice([0.1, 1.0, 5.0])))
+        box = box_at(rng)
+        _, answer = run(levels, box, direction=False, options=Options(damping=None))
+        assert answer.method == "qp" and not answer.attempts, answer.attempts
+        for k in range(3):
+            A, y = stacked(levels[k])
+            mine = float(np.sum((A @ answer.qdot - y) ** 2))
+            assert mine <= level_optimum(levels, k, answer.qdot, box) * (1 + 1e-6) + 1e-7
+
+
+def test_lower_levels_are_rarely_dropped() -> None:
+    """A lower level whose answer leaves the box beyond rounding is dropped (the levels above
+    kept, the attempt recorded): over 2,000 random three-level problems, a handful."""
+    rng = np.random.default_rng(5)
+    backend = make_backend("daqp")
+    dropped = 0
+    for _ in range(2000):
+        sizes = tuple(int(m) for m in rng.integers(1, 4, size=3))
+        levels = levels_at(rng, sizes, float(rng.choice([0.1, 1.0, 5.0])))
+        _, answer = run(levels, box_at(rng), backend, Options(damping=None), direction=False)
+        dropped += "dropped" in answer.levels
+    assert dropped <= 6
+
+
+def test_a_lower_level_never_changes_a_higher_one(rng: np.random.Generator) -> None:
+    backend = make_backend("daqp")
+    for direction in (True, False):
+        for _ in range(200):
+            levels = levels_at(rng, (3, 3, 2), float(rng.choice([0.1, 1.0, 5.0])))
+            box = box_at(rng)
+            for k in range(1, 3):
+                upper = run(levels[:k], box, backend, direction=direction)[1].qdot
+                full = run(levels[: k + 1], box, backend, direction=direction)[1].qdot
+                for level in levels[:k]:
+                    A = level[0].A
+                    np.testing.assert_allclose(A @ full, A @ upper, atol=1e-9)
+
+
+def test_the_top_level_keeps_one_common_scale_the_lp_maximum(rng: np.random.Generator) -> None:
+    """Two tasks on one level commanded beyond the limits slow down together, to the largest
+    scale any rates within the box allow (HiGHS on the whole LP)."""
+    scaled = 0
+    for _ in range(150):
+        levels = levels_at(rng, (3, 3), 20.0)
+        top = [levels[0][0], levels[1][0]]
+        box = box_at(rng)
+        _, answer = run([top], box, options=Options(damping=None))
+        A, b = stacked(top)
+        best = lp_maximum(A, b, box)
+        assert answer.scale == pytest.approx(best, abs=1e-9)
+        assert answer.status in ("scaled", "exact") and answer.veer <= 1e-9
+        np.testing.assert_allclose(A @ answer.qdot, answer.scale * b, atol=1e-9 * np.abs(b).max())
+        scaled += answer.status == "scaled"
+    assert scaled > 100
+
+
+def test_where_the_lp_maximum_is_one_the_command_is_met_exactly(rng: np.random.Generator) -> None:
+    """The exact least-norm rates leave the box, yet another solution fits: met, zero veer."""
+    met = 0
+    for _ in range(300):
+        levels = levels_at(rng, (6,), float(rng.uniform(0.5, 3.0)))
+        box = box_at(rng)
+        A, b = stacked(levels[0])
+        if lp_maximum(A, b, box) < 1.0 - 1e-12:
+            continue
+        _, answer = run(levels, box)
+        assert answer.status == "exact" and answer.scale == 1.0 and answer.veer == 0.0
+        np.testing.assert_allclose(A @ answer.qdot, b, atol=1e-9 * (1.0 + np.abs(b).max()))
+        exact = np.linalg.pinv(A) @ b
+        met += not kernels.inside(exact, box.lb, box.ub)
+    assert met > 20  # the exact rates did not fit: the null space answered
+
+
+@pytest.mark.filterwarnings("ignore:Converted matrix")
+def test_weighted_is_the_exact_optimum_of_its_costs(rng: np.random.Generator) -> None:
+    """Within 1e-6 rad/s of scipy's BVLS on the same costs and box, limits active."""
+    active = 0
+    for _ in range(200):
+        tasks = [
+            TaskRows(rng.normal(size=(6, N)), rng.normal(size=6) * 3.0, None, "a"),
+            TaskRows(rng.normal(size=(6, N)), rng.normal(size=6), np.full(6, 0.1), "b"),
+            TaskRows(np.eye(N), rng.normal(size=N), np.full(N, 1e-2), "posture"),
+        ]
+        box = box_at(rng)
+        _, answer = run([tasks], box, weighted=True)
+        root = [np.ones(6), np.sqrt(np.full(6, 0.1)), np.sqrt(np.full(N, 1e-2))]
+        A = np.vstack([r[:, None] * t.A for r, t in zip(root, tasks, strict=True)])
+        y = np.concatenate([r * t.b for r, t in zip(root, tasks, strict=True)])
+        ref = lsq_linear(A, y, bounds=(box.lb, box.ub), method="bvls", tol=1e-14).x
+        np.testing.assert_allclose(answer.qdot, ref, atol=1e-6)
+        active += not kernels.inside(np.linalg.lstsq(A, y, rcond=None)[0], box.lb, box.ub)
+    assert active > 150
+
+
+def test_constraint_rows_are_kept_and_the_scale_is_the_lp_maximum(rng: np.random.Generator) -> None:
+    """A random G qdot <= h (a few rows) beside the box: never broken beyond 1e-12, the
+    direction scale the LP maximum of the whole problem, in either mode."""
+    for direction in (True, False):
+        for _ in range(150):
+            levels = levels_at(rng, (4,), 3.0)
+            box = box_at(rng)
+            G = rng.normal(size=(3, N))
+            h = rng.uniform(0.0, 0.5, 3)
+            _, answer = run(levels, box, direction=direction, G=G, h=h)
+            assert np.all(G @ answer.qdot <= h + 1e-12), G @ answer.qdot - h
+            assert np.all(answer.qdot >= box.lb) and np.all(answer.qdot <= box.ub)
+            if direction:
+                A, b = stacked(levels[0])
+                assert answer.scale == pytest.approx(lp_maximum(A, b, box, G, h), abs=1e-9)
+
+
+def test_a_row_broken_at_the_start_is_restored(rng: np.random.Generator) -> None:
+    """h < 0 (a wall already crossed): the answer moves back across it where the box allows,
+    reported as recovering."""
+    for _ in range(100):
+        levels = levels_at(rng, (4,), 1.0)
+        box = box_at(rng)
+        g = rng.normal(size=(1, N))
+        lowest = float(np.minimum(g[0] * box.lb, g[0] * box.ub).sum())  # g qdot's least value
+        h = np.array([0.5 * lowest])  # broken at zero rates, restorable within the box
+        _, answer = run(levels, box, G=g, h=h)
+        assert answer.status == "recovering"
+        assert float((g @ answer.qdot)[0]) <= h[0] + 1e-9
+
+
+def test_equality_rows_hold_and_the_command_scales_within_them(rng: np.random.Generator) -> None:
+    """C qdot = 0 (a foot in support): met to rounding, the top level the LP maximum within
+    them."""
+    for _ in range(100):
+        levels = levels_at(rng, (3,), 5.0)
+        box = box_at(rng)
+        C = rng.normal(size=(3, N))
+        _, answer = run(levels, box, C=C, d=np.zeros(3))
+        np.testing.assert_allclose(C @ answer.qdot, 0.0, atol=1e-9)
+        A, b = stacked(levels[0])
+        with_contacts = np.vstack([A, C])
+        assert answer.scale == pytest.approx(
+            lp_maximum(with_contacts, np.r_[b, np.zeros(3)], box), abs=1e-7
+        )
+
+
+class Broken(QPBackend):
+    """A backend that raises (its own error or a foreign one), finds nothing, or answers
+    with the wrong shape or NaN."""
+
+    name = "broken"
+
+    def __init__(self, mode: str) -> None:
+        super().__init__()
+        self.mode = mode
+
+    def solve(self, qp: object) -> QPSolution:
+        if self.mode == "raise":
+            raise ProblemError("broken: crashed")
+        if self.mode == "foreign":
+            raise KeyError("something inside the backend")
+        if self.mode == "shape":
+            return QPSolution(np.zeros(2), "solved", 1, 0.0, self.name)
+        if self.mode == "nan":
+            return QPSolution(np.full(qp.q.size, np.nan), "solved", 1, 0.0, self.name)  # type: ignore[attr-defined]
+        return QPSolution(None, "maximum iterations reached", 4000, 0.0, self.name)
+
+
+@pytest.mark.parametrize("mode", ["raise", "foreign", "shape", "nan", "not found"])
+def test_every_backend_fault_falls_back(mode: str, rng: np.random.Generator) -> None:
+    """Issue 28 item 4: a backend's exception (its own or foreign), an answer of the wrong
+    shape or a non-finite one always goes to the fallback chain."""
+    levels = levels_at(rng, (3,), 50.0)  # seven null directions: the backend's QP
+    box = box_at(rng)
+    _, answer = run(levels, box, Broken(mode))
+    assert answer.method == "scipy" and answer.status == "fallback"
+    assert answer.attempts[0][0] == "qp" and "broken" in answer.attempts[0][1]
+    assert np.all(answer.qdot >= box.lb) and np.all(answer.qdot <= box.ub)
+    exact = run(levels, box)[1]
+    assert answer.scale == pytest.approx(exact.scale, rel=1e-6)  # the exact LP
+
+
+def test_fallback_chain_order_and_hold(rng: np.random.Generator) -> None:
+    levels = levels_at(rng, (3,), 50.0)
+    box = box_at(rng)
+    for fallbacks, method in ((("scaling",), "scaling"), ((), "hold")):
+        _, answer = run(levels, box, Broken("raise"), Options(fallbacks=fallbacks))
+        assert answer.method == method and 0.0 <= answer.scale <= 1.0
+    recovering = box_at(rng, q=np.full(N, 3.5))
+    assert not recovering.contains_zero
+    _, answer = run(levels, recovering, Broken("raise"), Options(fallbacks=("scaling",)))
+    assert answer.method == "hold" and [a[0] for a in answer.attempts] == ["qp", "scaling"]
+    np.testing.assert_array_equal(answer.qdot, np.clip(0.0, recovering.lb, recovering.ub))
+    _, answer = run(levels, recovering, Broken("raise"))
+    assert answer.method == "scipy"  # bounded least squares (BVLS)
+
+
+def test_one_null_direction_is_solved_without_the_backend(rng: np.random.Generator) -> None:
+    """Nine rows on ten joints: the exact kernel answers, no backend runs."""
+    levels = levels_at(rng, (N - 1,), 50.0)
+    _, answer = run(levels, box_at(rng), Broken("raise"), Options(damping=None))
+    assert answer.method == "qp" and answer.backend == "" and not answer.attempts
+    assert answer.status == "scaled"
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+def test_numerical_trouble_never_raises(rng: np.random.Generator) -> None:
+    box = box_at(rng)
+    for A in (rng.normal(size=(6, N)) * 1e300, np.zeros((6, N)), rng.normal(size=(6, N)) * 1e-300):
+        for b in (np.ones(6) * 1e6, np.full(6, 1.7e308), np.zeros(6)):
+            for direction in (True, False):
+                _, answer = run([[TaskRows(A, b, None, "t")]], box, direction=direction)
+                assert np.all(np.isfinite(answer.qdot))
+                assert np.all(answer.qdot >= box.lb) and np.all(answer.qdot <= box.ub)
+                assert 0.0 <= answer.scale <= 1.0 and np.isfinite(answer.veer)
+
+
+def test_options_are_checked() -> None:
+    with pytest.raises(InputError) as info:
+        Options(fallbacks=("qp",))
+    assert info.value.argument == "fallbacks"
+    with pytest.raises(InputError):
+        Options(fallbacks=("scaling", "scaling"))
+    with pytest.raises(InputError) as info:
+        Options(damping=0.1)  # type: ignore[arg-type]
+    assert info.value.argument == "damping"
+    with pytest.raises(InputError, match="fallbacks: 'hold' always answers"):
+        Options(fallbacks=("hold", "scipy"))
+    with pytest.raises(InputError) as info:
+        Options(fallbacks=np.array([["scipy"]]))  # type: ignore[arg-type]
+    assert info.value.argument == "fallbacks"
+    assert Options(fallbacks="scaling").fallbacks == ("scaling", "hold")  # type: ignore[arg-type]
+
+
+def test_fallbacks_keep_the_constraint_rows_or_give_way(rng: np.random.Generator) -> None:
+    """A scaling answer that breaks a row counts as failed: the next method answers."""
+    levels = levels_at(rng, (3,), 50.0)
+    box = box_at(rng)
+    exact = np.linalg.pinv(levels[0][0].A) @ levels[0][0].b
+    scaled = kernels.uniform_scale(exact, box.lb, box.ub) * exact
+    g = rng.normal(size=(1, N))
+    h = np.array([g[0] @ scaled - 0.1])  # just broken by the uniform scale
+    _, answer = run(levels, box, Broken("raise"), Options(fallbacks=("scaling",)), G=g, h=h)
+    assert [a[0] for a in answer.attempts] == ["qp", "scaling"], answer.attempts
+    assert "breaks a constraint row" in answer.attempts[1][1] and answer.method == "hold"
+
+
+def test_damping_only_past_the_threshold(rng: np.random.Generator, monkeypatch) -> None:
+    """Below the condition-number threshold a command that cannot be met is scaled, never
+    damped; the damping module is not consulted at all."""
+    calls = []
+    monkeypatch.setattr(Damping, "lambda_sq", lambda *a: calls.append(a) or None)
+    for _ in range(100):
+        levels = levels_at(rng, (6,), 20.0)
+        _, answer = run(levels, box_at(rng), options=Options(Damping(threshold=1e12)))
+        assert answer.status == "scaled" and answer.veer <= 1e-9
+    assert calls == []
+    assert pipeline_module.EXACT_TOL == 1e-9
