@@ -281,6 +281,27 @@ def test_bad_input_from_pages_never_stops_or_corrupts_the_loop(console, page, br
     assert page.locator(".rrc-joint").count() == 6  # and it still shows the console
 
 
+def test_dragging_the_gizmo_servoes_the_hand_to_it(console, page):
+    loop = console.loop
+    loop.mailbox.post(Latch(True))  # (as the page's checkbox does)
+    start = loop.robot_pose()
+    target = start.copy()
+    target[:3, 3] += 0.03 * start[:3, 1]  # 3 cm along the hand's y axis
+    x, y, z, w = pin.Quaternion(target[:3, :3]).coeffs().tolist()
+    ws = raw_socket(console)  # the page's gizmo, by its message
+    ws.send(message("TransformControlsUpdateMessage", name="/target", wxyz=[w, x, y, z],
+                    position=target[:3, 3].tolist()))  # fmt: skip
+    wait_for(lambda: loop.snapshot.mode == "target", what="the servo to the target")
+    wait_for(lambda: np.linalg.norm(loop.robot_pose()[:3, 3] - target[:3, 3]) < 2e-3,
+             what="the hand at the target")  # fmt: skip
+    d = loop.robot_pose()[:3, 3] - start[:3, 3]
+    assert d @ start[:3, 1] / np.linalg.norm(d) > 0.99
+    ws.socket.close()
+    wait_for(lambda: gone(console, ws), what="the gizmo's page gone")
+    page.get_by_role("button", name="drop the target").click()
+    wait_for(lambda: loop.operator.target is None, what="the target dropped")
+
+
 def test_the_last_page_closing_releases_the_deadman(console, page):
     loop = console.loop
     assert loop.operator.latched
