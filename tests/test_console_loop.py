@@ -269,7 +269,7 @@ def test_a_realtime_loop_runs_under_fifo_or_says_why_not(barker6):
     loop.stop()
     refused = [n for n in loop.notices if "real-time scheduling refused" in n.text]
     assert loop.scheduling == "SCHED_FIFO 10" or (refused and loop.scheduling != "not started")
-    assert loop.clock.ticks > 50
+    assert loop.clock.ticks > 20
 
 
 def test_a_record_is_full_at_the_logs_capacity_too(barker6):
