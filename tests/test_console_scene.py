@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 
 import rrc_pin
-from rrc_pin.console.scene import ARROW_TIME, Scene, pose_of, wxyz
+from rrc_pin.console.scene import ARROW, Scene, pose_of, wxyz
 from rrc_pin.console.visuals import visuals_of
 
 viser = pytest.importorskip("viser")
@@ -63,11 +63,11 @@ def test_arrows_start_at_the_hand_and_scale_with_the_twist(server):
     robot = rrc_pin.load("kr5_3r")
     scene = Scene(server, robot, visuals_of(robot))
     origin = np.array([0.5, 0.1, 0.3])
-    scene.set_arrows(origin, np.array([0.1, 0, 0, 0, 0, 1.0]), None)
+    scene.set_arrows(origin, np.array([0.1, 0, 0, 0, 0, 0.25]), None)  # full, half full
     points = np.asarray(scene.arrows.points)
     np.testing.assert_allclose(points[:, 0], np.tile(origin, (4, 1)), atol=1e-6)
-    np.testing.assert_allclose(points[0, 1] - origin, [0.1 * ARROW_TIME, 0, 0], atol=1e-6)
-    np.testing.assert_allclose(points[1, 1] - origin, [0, 0, scene.arm], atol=1e-6)
+    np.testing.assert_allclose(points[0, 1] - origin, [ARROW * scene.reach, 0, 0], atol=1e-6)
+    np.testing.assert_allclose(points[1, 1] - origin, [0, 0, ARROW * scene.reach / 2], atol=1e-6)
     np.testing.assert_allclose(points[2:, 1], points[2:, 0])  # nothing achieved
 
 

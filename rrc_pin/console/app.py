@@ -101,8 +101,10 @@ class Console:
         server = self.server
         server.gui.set_panel_label(f"rrc-pin console: {self.robot.name}")
         mailbox = self.loop.mailbox
+        limits = self.loop.operator.settings
         self.scene = Scene(server, self.robot, visuals,
-                           on_target=lambda pose: mailbox.post(Target(pose)))  # fmt: skip
+                           on_target=lambda pose: mailbox.post(Target(pose)),
+                           full=(limits.max_linear, limits.max_angular))  # fmt: skip
         self.panel = Panel(server, self.loop, self.out)
         self.view = View(server, self.loop, self.scene, self.panel, rate=self.view_rate)
 

@@ -10,7 +10,7 @@ message per joint and pose field, however many meshes the links have, none for a
   commanded hand's drawn larger; they hang under the joint nodes and cost nothing to move.
 - Twist arrows from the commanded hand: the commanded linear velocity (orange) and angular
   velocity (yellow), and what the joint rates achieved (``J qdot``: blue and cyan), in base
-  axes, :data:`ARROW_TIME` seconds of motion long (angular: radians times :attr:`Scene.arm`).
+  axes, a slider's full value (``full``) :data:`ARROW` of the robot's reach long.
 - The target gizmo: dragging it asks the hand to servo there (``on_target``); while no target
   is set it follows the commanded hand.
 - Obstacles and active collision pairs: drawn by :meth:`Scene.set_obstacles` and
@@ -32,8 +32,8 @@ from rrc_pin.console.visuals import Visuals
 from rrc_pin.robot import Robot
 
 Array = npt.NDArray[np.float64]
-ARROW_TIME = 2.0
-"""Length of a linear-velocity arrow: the distance [m] covered in this many seconds."""
+ARROW = 0.4
+"""Length of the arrow of a slider's full value (linear or angular), in the robot's reach."""
 COMMANDED = ((255, 140, 0), (230, 200, 0))
 ACHIEVED = ((30, 90, 230), (0, 190, 210))
 SHOWN = 1e-4
@@ -76,20 +76,23 @@ class Scene:
         robot: The robot.
         visuals: Its shapes.
         on_target: Called with the gizmo's pose (4, 4) when the operator drags it.
+        full: The sliders' full values [m/s, rad/s], drawn :data:`ARROW` of the reach long.
 
     Attributes:
-        arm: Length [m] of an angular-velocity arrow per rad/s.
+        scale: Arrow lengths [m] per m/s and per rad/s.
         refused: Gizmo poses from a page that were not poses (NaN, a zero quaternion).
     """
 
     def __init__(self, server: Any, robot: Robot, visuals: Visuals,
-                 on_target: Callable[[Array], None] | None = None) -> None:  # fmt: skip
+                 on_target: Callable[[Array], None] | None = None,
+                 full: tuple[float, float] = (0.1, 0.5)) -> None:  # fmt: skip
         self.server = server
         self.robot = robot
         self.model = robot.model
         self.data = robot.model.createData()  # the view's own: the Robot's is per thread
         reach = visuals.reach
-        self.arm = 0.4 * reach
+        self.reach = reach
+        self.scale = (ARROW * reach / full[0], ARROW * reach / full[1])
         scene = server.scene
         scene.set_up_direction("+z")
         # Plain lights, no image-based lighting and no shadows: a frame renders several times
@@ -132,7 +135,7 @@ class Scene:
                                        shaft_radius=0.006 * reach, head_radius=0.015 * reach,
                                        head_length=0.04 * reach)  # fmt: skip
         self._points = np.zeros((4, 2, 3), np.float32)
-        self.gizmo = scene.add_transform_controls("/target", scale=0.25 * reach)
+        self.gizmo = scene.add_transform_controls("/target", scale=0.18 * reach)
         self._following = True
         self._dragged = -math.inf
         self.refused = 0
@@ -168,7 +171,7 @@ class Scene:
         """Draw ``tool``'s axes as the commanded hand (larger) and the others smaller."""
         self.hand = tool
         for name, handle in self.hands.items():
-            handle.axes_length = (0.15 if name == tool else 0.08) * self.arm / 0.4
+            handle.axes_length = (0.15 if name == tool else 0.08) * self.reach
 
     def update(self, q: Array) -> Array:
         """Move the robot to ``q`` (nq,); returns the commanded hand's pose (4, 4) [m]."""
@@ -201,8 +204,8 @@ class Scene:
         for k, twist in enumerate((zero if commanded is None else commanded,
                                    zero if achieved is None else achieved)):  # fmt: skip
             points[2 * k, 0] = points[2 * k + 1, 0] = origin
-            points[2 * k, 1] = origin + ARROW_TIME * twist[:3]
-            points[2 * k + 1, 1] = origin + self.arm * twist[3:]
+            points[2 * k, 1] = origin + self.scale[0] * twist[:3]
+            points[2 * k + 1, 1] = origin + self.scale[1] * twist[3:]
         if not np.array_equal(points.astype(np.float32), self._points):  # unchanged: not re-sent
             self._points = points.astype(np.float32)
             self.arrows.points = self._points
