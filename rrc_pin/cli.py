@@ -1,4 +1,4 @@
-"""Command line: ``rrc-pin arms | demo | check | bench | urdf --check|--write | guidance | map``."""
+"""Command line: ``rrc-pin arms | demo | check | bench | urdf | guidance | map | console``."""
 
 from __future__ import annotations
 
@@ -162,6 +162,27 @@ def parser() -> argparse.ArgumentParser:
         metavar="K",
         help="confirm K random reached voxels by resolved-rate IK through the resolver",
     )
+    console = sub.add_parser(
+        "console",
+        help="the operator's console in the browser (needs the console extra): the arm in 3-D, "
+        "hand-frame commands, joint limits and singularities live",
+    )
+    robot = console.add_mutually_exclusive_group()
+    robot.add_argument("--arm", default=None, metavar="NAME", help="arm to drive (default barker6)")
+    robot.add_argument("--cell", default=None, metavar="NAME", help="a cell of several arms")
+    console.add_argument("--port", type=int, default=8080, help="port (the next free one if taken)")
+    console.add_argument(
+        "--host", default="127.0.0.1", help="interface to serve on (default: this machine only)"
+    )
+    console.add_argument("--rate", type=float, default=100.0, help="control loop rate [Hz]")
+    console.add_argument(
+        "--realtime",
+        action="store_true",
+        help="run the control loop under real-time scheduling (Linux, root or CAP_SYS_NICE)",
+    )
+    console.add_argument(
+        "--out", type=Path, default=Path("."), metavar="DIR", help="folder for saved records"
+    )
     urdf = sub.add_parser("urdf", help="compare or rewrite the committed URDFs")
     mode = urdf.add_mutually_exclusive_group(required=True)
     mode.add_argument("--check", action="store_true", help="fail if a committed file differs")
@@ -196,6 +217,8 @@ def run(args: argparse.Namespace) -> int:
 
         print(format_report(args.illustration))
         return 0
+    if args.command == "console":
+        return console_command(args)
     if args.command == "check":
         from rrc_pin.cross_check import run_cross_check
 
@@ -205,6 +228,24 @@ def run(args: argparse.Namespace) -> int:
     from rrc_pin.demo import run_demo
 
     return run_demo(args.arm, out=args.out, quick=args.quick)
+
+
+def console_command(args: argparse.Namespace) -> int:
+    """Serve the console until interrupted; 2 (one line on stderr) without the console extra.
+
+    Raises:
+        RrcPinError: An arm or cell that does not load, a bad rate or port.
+    """
+    if not _installed("viser"):
+        print('rrc-pin console: viser not installed: pip install -e ".[console]"', file=sys.stderr)
+        return 2
+    from rrc_pin.console import Console, console_robot
+
+    robot = console_robot(args.arm, args.cell)
+    console = Console(robot, host=args.host, port=args.port, rate=args.rate, out=args.out,
+                      realtime=args.realtime)  # fmt: skip
+    console.serve_forever()
+    return 0
 
 
 def _discard_stdout() -> None:

@@ -15,8 +15,10 @@ import rrc_pin
 import solvers
 
 ROOT = Path(__file__).resolve().parents[1]
-UPPER = {"resolver", "control", "controller", "guidance", "cell", "cli", "demo", "dynamics", "maps",
-         "console"}
+UPPER = {"resolver", "control", "controller", "guidance", "cell", "cli", "demo", "dynamics",
+         "maps", "console"}  # fmt: skip
+TOP = {"console", "cli"}
+"""The entry points: nothing else in rrc_pin imports them."""
 LOWER = {"dh", "models", "urdf_export", "urdf_compare", "robot", "loading", "errors", "cross_check"}
 
 
@@ -54,7 +56,7 @@ def test_lower_layers_never_import_upper_ones():
                 )
 
 
-def _imports(path: Path) -> list[str]:
+def imported_names(path: Path) -> list[str]:
     names = []
     for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.ImportFrom) and node.module:
@@ -70,13 +72,27 @@ def test_only_the_entry_points_import_the_maps():
     the maps import no entry point."""
     for path in (ROOT / "rrc_pin").rglob("*.py"):
         rel = path.relative_to(ROOT / "rrc_pin").with_suffix("")
-        names = _imports(path)
+        names = imported_names(path)
         if rel.parts[0] in ("maps", "cli", "console"):
             if rel.parts[0] == "maps":
                 assert not any(n.split(".")[:2] in (["rrc_pin", "cli"], ["rrc_pin", "console"])
                                for n in names), rel  # fmt: skip
             continue
         assert not any(n.startswith("rrc_pin.maps") for n in names), (rel, names)
+
+
+def test_only_the_entry_points_import_the_console():
+    """The console is the top layer beside the command line (DESIGN.md's layering)."""
+    for path in (ROOT / "rrc_pin").rglob("*.py"):
+        rel = path.relative_to(ROOT / "rrc_pin").with_suffix("")
+        if rel.parts[0] in TOP:
+            continue
+        for name in imported_names(path):
+            parts = name.split(".")
+            assert not (parts[0] == "rrc_pin" and len(parts) > 1 and parts[1] == "console"), (
+                rel,
+                name,
+            )
 
 
 @pytest.mark.parametrize("package", [rrc_pin, solvers])

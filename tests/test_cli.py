@@ -73,6 +73,11 @@ def run_console_script(*args: str, close_stdout: bool = False) -> subprocess.Com
         (["demo", "--arm", "ur55"], "rrc-pin demo: name_or_path: unknown arm 'ur55'"),
         (["check", "--samples", "0"], "rrc-pin check: samples: expected an integer >= 1, got 0"),
         (["check", "--samples", "-3"], "rrc-pin check: samples: expected an integer >= 1"),
+        (["console", "--arm", "ur55"], "rrc-pin console: name_or_path: unknown arm 'ur55'"),
+        (["console", "--cell", "no_such_cell"],
+         "rrc-pin console: --cell: 'no_such_cell' does not load as a cell"),
+        (["console", "--rate", "0"], "rrc-pin console: rate: expected a finite number > 0"),
+        (["console", "--port", "70000"], "rrc-pin console: port: expected a port number"),
     ],
 )
 def test_errors_are_one_line_and_exit_code_2(args, message, capsys):
@@ -337,3 +342,10 @@ def test_map_errors_are_one_line_and_change_nothing(extra, message, tmp_path, ca
     assert len(err) == 1 and err[0].startswith(message), err
     after = sorted(p for p in out.rglob("*") if p.is_file()) if out.exists() else []
     assert after == files and snapshot(after) == before
+
+
+def test_console_without_its_extra_says_what_to_install(monkeypatch, capsys):
+    monkeypatch.setattr(rrc_pin.cli, "_installed", lambda module: module != "viser")
+    assert main(["console"]) == 2
+    err = capsys.readouterr().err
+    assert err == 'rrc-pin console: viser not installed: pip install -e ".[console]"\n'
