@@ -11,17 +11,20 @@ equations are compiled kernels of :mod:`solvers.closed_form.rrc_k1607_equations`
   ``J_i = [z_i x (p - o_i); z_i]``. Rows ``[v; w]``: velocity of frame 7's origin and
   angular velocity, base axes (``world_aligned``, Pinocchio's LOCAL_WORLD_ALIGNED).
 - Joint rates: the weighted pseudo-inverse with null-space term, Nguyen eqs. (21)-(22),
-  evaluated as ``qdot = L (J L)^+ (xdot - J z) + z`` with ``W = L L^T`` (the same vector,
-  one solve): the least-norm solution by a Householder QR of ``(J L)^T``, accurate to about
-  ``eps kappa(J L)``. With ``W = I`` and ``z = 0`` it is the minimum-norm solution of
-  eq. (23).
+  evaluated as ``qdot = J_W^+ (xdot - J z) + z`` (the same vector, one solve). With
+  ``W = L L^T`` and ``B = J L``: ``B B^T y = xdot - J z`` by Cholesky's method, then
+  ``qdot = L B^T y + z`` (eq. (22) as printed). With ``W = I`` and ``z = 0`` it is the
+  minimum-norm solution of eq. (23). Forming ``B B^T`` squares the condition number: the
+  rates are accurate to about ``eps kappa(B)^2`` (1e-13 at kappa = 40, 1e-8 at kappa = 1e4).
 
-Singularities: where the QR shows ``sigma_min(J L) < rcond ||J L||_F`` (a pivot of R below
-1e-12 times the largest, or ``|xdot - J z| < rcond ||J L||_F |qdot - z|``), the rates come
-from the truncated pseudo-inverse instead (``L (J L)^+ (xdot - J z) + z``, singular values
-below ``rcond sigma_max`` dropped: the least-squares rates of least ``(qdot - z)^T W^-1
-(qdot - z)``, finite for any finite input, never NaN). Damping is the QP resolver's
-business, not this module's. Elsewhere the exact rates are returned, however large.
+Singularities: with ``tau = rcond^2 trace(B B^T)``, the rates come from the truncated
+pseudo-inverse (``L B^+ (xdot - J z) + z``, singular values below ``rcond sigma_max``
+dropped: the least-squares rates of least ``(qdot - z)^T W^-1 (qdot - z)``, finite for any
+finite input, never NaN) where the solve proves ``lambda_min(B B^T) < tau``: a Cholesky
+pivot not above 1e-12 times the largest diagonal entry, or ``|b| < tau |y|`` for the
+solution ``y`` of ``B B^T y = b`` (``|b| >= lambda_min |y|`` always). Damping is the QP
+resolver's business, not this module's. Elsewhere the exact rates are returned, however
+large.
 """
 
 from __future__ import annotations
@@ -39,8 +42,6 @@ ALPHA_DEG = (0.0, -90.0, 90.0, -90.0, 90.0, -90.0, 90.0)
 """Nguyen Table 1 twists alpha_{i-1} [deg]; the closed form is derived for these."""
 DEFAULT_RCOND = 1e-6
 """Relative singular-value threshold of ``J W^1/2`` below which the SVD form answers."""
-_IDENTITY = np.eye(NQ)
-_ZERO = np.zeros(NQ)
 
 
 class RrcK1607ClosedForm(ClosedForm):
@@ -65,10 +66,9 @@ class RrcK1607ClosedForm(ClosedForm):
     def __init__(
         self, *, a: npt.ArrayLike, d: npt.ArrayLike, rcond: float = DEFAULT_RCOND
     ) -> None:
-        self._a = as_vector(a, "a", NQ).copy()
-        self._d = as_vector(d, "d", NQ).copy()
-        self.a = tuple(self._a.tolist())
-        self.d = tuple(self._d.tolist())
+        self.a = tuple(as_vector(a, "a", NQ).tolist())
+        self.d = tuple(as_vector(d, "d", NQ).tolist())
+        self._p = np.array(self.a + self.d)  # the kernels' parameters
         self.rcond = finite_number(rcond, "rcond", 0.0, inclusive=False, upper=1.0)
 
     def __repr__(self) -> str:
@@ -93,7 +93,7 @@ class RrcK1607ClosedForm(ClosedForm):
         """
         Q = as_array(Q, "Q", (None, NQ))
         out = np.empty((Q.shape[0], 4, 4))
-        eqs.pose_batch(self._a, self._d, Q, out)
+        eqs.pose_batch(self._p, Q, out)
         return out
 
     def jacobian(self, q: npt.ArrayLike) -> Array:
@@ -106,7 +106,7 @@ class RrcK1607ClosedForm(ClosedForm):
         """
         qv = vector(q, "q", NQ)
         J = np.empty((TASK_DIM, NQ))
-        if not eqs.jacobian_at(self._a, self._d, qv, J):
+        if not eqs.jacobian_at(self._p, qv, J):
             as_vector(q, "q", NQ)  # raises, naming the entry
         return J
 
@@ -118,7 +118,7 @@ class RrcK1607ClosedForm(ClosedForm):
         """
         Q = as_array(Q, "Q", (None, NQ))
         out = np.empty((Q.shape[0], TASK_DIM, NQ))
-        eqs.jacobian_batch(self._a, self._d, Q, out)
+        eqs.jacobian_batch(self._p, Q, out)
         return out
 
     def joint_rates(
@@ -153,10 +153,10 @@ class RrcK1607ClosedForm(ClosedForm):
                 not symmetric positive definite.
         """
         qv, xv = vector(q, "q", NQ), vector(xdot, "xdot", TASK_DIM)
-        L = _factor(W)
-        zv = _ZERO if z is None else as_vector(z, "z", NQ)
+        L = weight_factor(W, NQ)
+        zv = None if z is None else as_vector(z, "z", NQ)
         out = np.empty(NQ)
-        if not eqs.joint_rates_at(self._a, self._d, qv, xv, L, zv, self.rcond, out):
+        if not eqs.joint_rates_at(self._p, qv, xv, L, zv, self.rcond, out):
             as_vector(q, "q", NQ)  # one of the two raises, naming the entry
             as_vector(xdot, "xdot", TASK_DIM)
         return out
@@ -171,14 +171,9 @@ class RrcK1607ClosedForm(ClosedForm):
         (N, 7) [rad/s] or None. Raises as :meth:`joint_rates`.
         """
         Q, X = self._check_batch(Q, X)
-        L = _factor(W)
-        Zm = _ZERO[None] if Z is None else as_array(Z, "Z", (Q.shape[0], NQ))
+        L = weight_factor(W, NQ)
+        Zm = None if Z is None else as_array(Z, "Z", (Q.shape[0], NQ))
         out = np.empty((Q.shape[0], NQ))
-        eqs.joint_rates_batch(self._a, self._d, Q, X, L, Zm, self.rcond, out)
+        eqs.joint_rates_batch(self._p, Q, X, L, Zm, self.rcond, out)
         return out
 
-
-def _factor(W: npt.ArrayLike | None) -> Array:
-    """The factor L of ``W = L L^T`` (:func:`weight_factor`); the identity for None."""
-    L = weight_factor(W, NQ)
-    return _IDENTITY if L is None else L
