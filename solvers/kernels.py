@@ -281,7 +281,7 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
                     continue
                 rotated = True
                 zeta = (beta - alpha) / (2.0 * gamma)
-                t = math.copysign(1.0, zeta) / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
+                t = math.copysign(1.0, zeta) / (abs(zeta) + math.hypot(1.0, zeta))
                 c = 1.0 / math.sqrt(1.0 + t * t)
                 s = c * t
                 for i in range(m):

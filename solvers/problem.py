@@ -220,8 +220,11 @@ def _stack(tasks: Sequence[TaskRows], normalised: bool, box: Box) -> tuple[Array
 def _weighted(
     tasks: Sequence[TaskRows], top: float, normalised: bool, scale: float, A: Array, b: Array
 ) -> float:
-    """Fill ``A``, ``b`` with the tasks' rows in the level's metric, the rates times ``scale``;
-    return the rates' largest magnitude."""
+    """Fill ``A``, ``b`` with the tasks' rows in the level's metric, the rates times ``scale``.
+
+    Returns:
+        The rates' largest magnitude.
+    """
     peak, r = 0.0, 0
     for t in tasks:
         k = t.b.size
