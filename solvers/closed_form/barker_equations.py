@@ -633,17 +633,3 @@ def hand_to_base_batch(p: Array, Q: Array, out: Array) -> None:
     g = geometry(p)
     for k in range(Q.shape[0]):
         hand_to_base(g, joint_trig(Q[k]), out[k])
-
-
-# -- for Python callers (the control strategies) --------------------------------------------
-
-
-def trig(q: npt.ArrayLike) -> Trig:
-    """:func:`joint_trig` of six angles [rad] given as any sequence (a list, an array)."""
-    return joint_trig(np.asarray(q, dtype=np.float64))
-
-
-def wrist_terms(g: BarkerGeometry, t: Trig, rt: npt.ArrayLike) -> tuple[float, float, float]:
-    """:func:`wrist_equations` of RVEL~ ``rt`` (3,) [rad/s] given as any sequence."""
-    r1, r2, r3 = np.asarray(rt, dtype=np.float64).tolist()
-    return wrist_equations(g, t, r1, r2, r3)

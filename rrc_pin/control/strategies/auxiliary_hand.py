@@ -43,7 +43,7 @@ from rrc_pin.control.strategies.base import Decision, Situation, Strategy
 from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
 from solvers.closed_form.barker import BarkerClosedForm
-from solvers.closed_form.barker_equations import f_terms, trig, turn1
+from solvers.closed_form.barker_equations import f_terms, joint_trig, turn1
 from solvers.validation import finite_number
 
 AT_SINGULAR = 1e-9
@@ -102,7 +102,7 @@ class AuxiliaryHand(Strategy):
         else:  # outward with the elbow bent: straighten, stopping at the singular point
             th3 = -math.copysign(min(abs(self.k3 * tx2), abs(offset) / situation.dt), offset)
         th2 = (-g.we * th3 + self.k2 * ty2) / (g.we + g.es)  # eq. (46)
-        t = trig(q.tolist())
+        t = joint_trig(q)
         F = f_terms(g, t)
         lateral = turn1(t, twist[0], twist[1])[1]  # -F1 thetadot_1: only theta1 moves it
         th1 = -lateral / F.f1 if abs(F.f1) > AT_SINGULAR else 0.0

@@ -17,7 +17,7 @@ from rrc_pin.control.strategies.base import Decision, Situation, Strategy
 from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
 from solvers.closed_form.barker import BarkerClosedForm
-from solvers.closed_form.barker_equations import trig, wrist_terms
+from solvers.closed_form.barker_equations import joint_trig, wrist_equations
 from solvers.validation import finite_number
 
 
@@ -48,12 +48,12 @@ class WristChoice(Strategy):
         """The closed form's rates, with the roll on theta6 (or theta4) in the wrist region."""
         cf = self.closed_form or barker_closed_form(situation.robot, self.name)
         q, twist = situation.q, situation.twist
-        t = trig(q.tolist())
+        t = joint_trig(q)
         if abs(t.s5) >= self.region:
             return Decision(rates=cf.joint_rates(q, twist))
         arm = cf.arm_rates(q, twist[:3])
         rvel = cf.rvel_tilde(q, arm, twist[3:])
-        th5, _, roll = wrist_terms(cf.geometry, t, rvel.tolist())  # eqs (49), (61)
+        th5, _, roll = wrist_equations(cf.geometry, t, *rvel.tolist())  # eqs (49), (61)
         robot = situation.robot
         next6 = q[5] + roll * situation.dt
         at_limit = not (robot.lower[5] + self.margin <= next6 <= robot.upper[5] - self.margin)
