@@ -16,7 +16,7 @@ import pytest
 import rrc_pin
 from rrc_pin.models import barker6
 from solvers.closed_form.barker import BarkerClosedForm, BarkerSingularity
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 
 TOL = 1e-9
 MODEL_TOL = 1e-13  # Pinocchio (URDF at 15 significant digits) against exact formulas
@@ -523,7 +523,7 @@ def test_bad_q_raises_input_error(bad) -> None:
         lambda: cf.tvel_frame2(bad, np.zeros(3)), lambda: cf.m_matrix(bad),
     ]  # fmt: skip
     for call in calls:
-        with pytest.raises(InputError) as info:
+        with pytest.raises(InvalidInput) as info:
             call()
         assert info.value.argument == "q"
         assert isinstance(info.value, ValueError)
@@ -550,7 +550,7 @@ def test_bad_velocities_and_batches_raise_input_error() -> None:
         (lambda: cf.hand_twist_to_base(q, np.zeros(3)), "twist"),
     ]
     for call, name in cases:
-        with pytest.raises(InputError) as info:
+        with pytest.raises(InvalidInput) as info:
             call()
         assert info.value.argument == name
 
@@ -560,7 +560,7 @@ def test_bad_velocities_and_batches_raise_input_error() -> None:
 def test_constructor_validates_parameters(name: str, value) -> None:
     params = dict(no=0.6718, es=0.4318, sn=0.15, we=0.4318, a3=0.0203, r3=0.0, alpha3=np.pi / 2)
     params[name] = value
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InvalidInput) as info:
         BarkerClosedForm(**params)
     assert info.value.argument == name
 
@@ -569,10 +569,10 @@ def test_constructor_is_keyword_only_and_checks_rcond() -> None:
     with pytest.raises(TypeError):
         BarkerClosedForm(0.6718, 0.4318, 0.15, 0.4318, 0.0203, 0.0, np.pi / 2)  # type: ignore[misc]
     params = dict(no=0.6718, es=0.4318, sn=0.15, we=0.4318, a3=0.0203, r3=0.0, alpha3=np.pi / 2)
-    with pytest.raises(InputError, match="rcond"):
+    with pytest.raises(InvalidInput, match="rcond"):
         BarkerClosedForm(**params, rcond=0.7)
     no_f2 = BarkerClosedForm(**{**params, "sn": 0.0})
-    with pytest.raises(InputError, match="F2"):  # SN + R3 + CAL3 WE = 0: no reduced path
+    with pytest.raises(InvalidInput, match="F2"):  # SN + R3 + CAL3 WE = 0: no reduced path
         no_f2.joint_rates(np.ones(6), np.ones(6), "reduced")
     # the wrist never divides by F2: its rates are the last three of the full path's
     full = no_f2.joint_rates(np.ones(6), np.ones(6))

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from solvers.closed_form.base import finite, vector
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 
 
 def test_vector_passes_float_vectors_and_converts_the_rest() -> None:
@@ -16,7 +16,7 @@ def test_vector_passes_float_vectors_and_converts_the_rest() -> None:
     np.testing.assert_array_equal(vector([1, 2, 3], "q", 3), [1.0, 2.0, 3.0])
     assert vector(np.arange(3), "q", 3).dtype == np.float64
     for bad in (np.zeros((3, 1)), [1.0, 2.0], "abc", [True, 0.0, 0.0]):
-        with pytest.raises(InputError) as info:
+        with pytest.raises(InvalidInput) as info:
             vector(bad, "q", 3)
         assert info.value.argument == "q"
 

@@ -44,7 +44,7 @@ import numpy.typing as npt
 from solvers.closed_form import barker_equations as eqs
 from solvers.closed_form.barker_equations import BarkerGeometry, FTerms
 from solvers.closed_form.base import Array, ClosedForm, first, row, vector
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 from solvers.validation import as_array, as_vector, finite_number
 
 Method = Literal["full", "reduced"]
@@ -98,7 +98,7 @@ class BarkerClosedForm(ClosedForm):
         band: Relative width of the damped singular neighbourhoods, in [1e-4, 0.5).
 
     Raises:
-        InputError: A parameter is not a finite number, or ``rcond``, ``band`` out of range,
+        InvalidInput: A parameter is not a finite number, or ``rcond``, ``band`` out of range,
             naming it.
     """
 
@@ -129,7 +129,7 @@ class BarkerClosedForm(ClosedForm):
         """Wrist-centre Jacobian (6, 6) at ``q`` (6,) [rad], rows [v; w], base axes (eq. (22)).
 
         Raises:
-            InputError: ``q`` is not a finite (6,) vector.
+            InvalidInput: ``q`` is not a finite (6,) vector.
         """
         qv = vector(q, "q", 6)
         J = np.empty((6, 6))
@@ -141,7 +141,7 @@ class BarkerClosedForm(ClosedForm):
         """Wrist-centre Jacobians (N, 6, 6) at ``Q`` (N, 6) [rad], rows [v; w], base axes.
 
         Raises:
-            InputError: ``Q`` is not a finite (N, 6) array.
+            InvalidInput: ``Q`` is not a finite (N, 6) array.
         """
         Q = as_array(Q, "Q", (None, 6))
         out = np.empty((Q.shape[0], 6, 6))
@@ -156,7 +156,7 @@ class BarkerClosedForm(ClosedForm):
         """The wrist centres (N, 3) [m] at ``Q`` (N, 6): ``(F7, F6, NO + F3)``.
 
         Raises:
-            InputError: ``Q`` is not a finite (N, 6) array.
+            InvalidInput: ``Q`` is not a finite (N, 6) array.
         """
         Q = as_array(Q, "Q", (None, 6))
         out = np.empty((Q.shape[0], 3))
@@ -219,7 +219,7 @@ class BarkerClosedForm(ClosedForm):
         base axes. In the arm's band: damped, or M* / M1* with ``exact`` (module docstring).
 
         Raises:
-            InputError: Bad ``q``, ``tvel`` or ``method``.
+            InvalidInput: Bad ``q``, ``tvel`` or ``method``.
         """
         return first(self.arm_rates_batch(row(q, "q", 6), row(tvel, "tvel", 3), method, exact))
 
@@ -260,7 +260,7 @@ class BarkerClosedForm(ClosedForm):
         damped, or M2* (eq. (60)) with ``exact`` (``pinv(W, rcond) @ rvel_tilde``).
 
         Raises:
-            InputError: Bad ``q`` or ``rvel_tilde``.
+            InvalidInput: Bad ``q`` or ``rvel_tilde``.
         """
         return first(self.wrist_rates_batch(row(q, "q", 6), row(rvel_tilde, "rvel_tilde", 3),
                                             exact))  # fmt: skip
@@ -294,7 +294,7 @@ class BarkerClosedForm(ClosedForm):
             ``1 / band`` times the command inside them (``exact``: finite, never NaN).
 
         Raises:
-            InputError: Bad ``q``, ``xdot`` or ``method``.
+            InvalidInput: Bad ``q``, ``xdot`` or ``method``.
         """
         reduced = self._reduced(method)
         qv, xv = vector(q, "q", 6), vector(xdot, "xdot", 6)
@@ -310,7 +310,7 @@ class BarkerClosedForm(ClosedForm):
         """Batch :meth:`joint_rates`: ``Q`` (N, 6), ``X`` (N, 6) -> (N, 6) [rad/s].
 
         Raises:
-            InputError: Bad ``Q``, ``X`` or ``method``.
+            InvalidInput: Bad ``Q``, ``X`` or ``method``.
         """
         reduced = self._reduced(method)
         Q, X = self._check_batch(Q, X)
@@ -356,9 +356,9 @@ class BarkerClosedForm(ClosedForm):
         if method == "full":
             return False
         if method != "reduced":
-            raise InputError("method", f"expected one of {', '.join(METHODS)}, got {method!r}")
+            raise InvalidInput("method", f"expected one of {', '.join(METHODS)}, got {method!r}")
         if not self._has_reduced:
-            raise InputError(
+            raise InvalidInput(
                 "method", "the reduced path divides by F2 = SN + R3 + cos(alpha3) WE = 0"
             )
         return True

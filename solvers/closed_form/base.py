@@ -41,7 +41,7 @@ class ClosedForm(ABC):
         """Jacobians (N, task_dim, nq) at N configurations ``Q`` (N, nq) [rad] or [m].
 
         Raises:
-            InputError: Wrong shape or non-finite entries.
+            InvalidInput: Wrong shape or non-finite entries.
         """
 
     @abstractmethod
@@ -52,7 +52,7 @@ class ClosedForm(ABC):
         regular, the minimum-norm one where the arm is redundant.
 
         Raises:
-            InputError: Wrong shapes or non-finite entries.
+            InvalidInput: Wrong shapes or non-finite entries.
         """
 
     @abstractmethod
@@ -60,7 +60,7 @@ class ClosedForm(ABC):
         """Jacobian at one configuration ``q`` (nq,): shape (task_dim, nq).
 
         Raises:
-            InputError: ``q`` is not a finite (nq,) vector.
+            InvalidInput: ``q`` is not a finite (nq,) vector.
         """
 
     @abstractmethod
@@ -68,7 +68,7 @@ class ClosedForm(ABC):
         """Joint rates (nq,) realising the task velocity ``xdot`` (task_dim,) at ``q`` (nq,).
 
         Raises:
-            InputError: Wrong shapes or non-finite entries.
+            InvalidInput: Wrong shapes or non-finite entries.
         """
 
     def _check_batch(self, Q: npt.ArrayLike, X: npt.ArrayLike) -> tuple[Array, Array]:
@@ -92,7 +92,7 @@ def vector(x: npt.ArrayLike, name: str, size: int) -> Array:
     """``x`` as a float64 vector for a kernel that checks its size and entries (:func:`finite`).
 
     A float64 vector passes as it is, anything else through
-    :func:`~solvers.validation.as_vector` (which raises :class:`InputError` naming ``name``).
+    :func:`~solvers.validation.as_vector` (which raises :class:`InvalidInput` naming ``name``).
     Where the kernel refuses it, the caller calls ``as_vector`` again to raise. The checks of
     the common case are one pass inside the kernel: ``BarkerClosedForm.jacobian`` takes about
     half the time it takes with ``as_vector`` first (2.0 against 3.8 us, measured).

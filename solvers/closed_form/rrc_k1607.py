@@ -57,7 +57,7 @@ class RrcK1607ClosedForm(ClosedForm):
             (module docstring).
 
     Raises:
-        InputError: ``a`` or ``d`` not seven finite numbers, or ``rcond`` not in (0, 1).
+        InvalidInput: ``a`` or ``d`` not seven finite numbers, or ``rcond`` not in (0, 1).
     """
 
     nq = NQ
@@ -80,7 +80,7 @@ class RrcK1607ClosedForm(ClosedForm):
         ``q``: joint angles theta_1..theta_7 (7,) [rad].
 
         Raises:
-            InputError: ``q`` is not a finite (7,) vector.
+            InvalidInput: ``q`` is not a finite (7,) vector.
         """
         T: Array = self.fk_batch(as_vector(q, "q", NQ)[None])[0]
         return T
@@ -89,7 +89,7 @@ class RrcK1607ClosedForm(ClosedForm):
         """Poses of frame 7 at N configurations ``Q`` (N, 7) [rad]: (N, 4, 4).
 
         Raises:
-            InputError: ``Q`` is not a finite (N, 7) array.
+            InvalidInput: ``Q`` is not a finite (N, 7) array.
         """
         Q = as_array(Q, "Q", (None, NQ))
         out = np.empty((Q.shape[0], 4, 4))
@@ -102,7 +102,7 @@ class RrcK1607ClosedForm(ClosedForm):
         Rows [v; w], ``world_aligned`` ([m/rad] then [1]).
 
         Raises:
-            InputError: ``q`` is not a finite (7,) vector.
+            InvalidInput: ``q`` is not a finite (7,) vector.
         """
         qv = vector(q, "q", NQ)
         J = np.empty((TASK_DIM, NQ))
@@ -114,7 +114,7 @@ class RrcK1607ClosedForm(ClosedForm):
         """Jacobians of frame 7 at ``Q`` (N, 7) [rad]: (N, 6, 7), rows [v; w], ``world_aligned``.
 
         Raises:
-            InputError: ``Q`` is not a finite (N, 7) array.
+            InvalidInput: ``Q`` is not a finite (N, 7) array.
         """
         Q = as_array(Q, "Q", (None, NQ))
         out = np.empty((Q.shape[0], TASK_DIM, NQ))
@@ -149,7 +149,7 @@ class RrcK1607ClosedForm(ClosedForm):
             Joint rates (7,) [rad/s].
 
         Raises:
-            InputError: Wrong shape or non-finite entries in any argument (named), or ``W``
+            InvalidInput: Wrong shape or non-finite entries in any argument (named), or ``W``
                 not symmetric positive definite.
         """
         qv, xv = vector(q, "q", NQ), vector(xdot, "xdot", TASK_DIM)

@@ -40,7 +40,7 @@ import numpy.typing as npt
 
 from solvers.closed_form import three_r_equations as eqs
 from solvers.closed_form.base import Array, ClosedForm, first, vector
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 from solvers.validation import as_array, as_vector, finite_number
 
 DEFAULT_RCOND = 1e-9
@@ -80,7 +80,7 @@ class ThreeRClosedForm(ClosedForm):
         rcond: Relative singularity threshold in (0, 1) (module docstring).
 
     Raises:
-        InputError: A length not finite, ``a1 < 0``, ``a2 <= 0``, ``a3 <= 0``, or ``rcond``
+        InvalidInput: A length not finite, ``a1 < 0``, ``a2 <= 0``, ``a3 <= 0``, or ``rcond``
             outside (0, 1), naming it.
     """
 
@@ -103,7 +103,7 @@ class ThreeRClosedForm(ClosedForm):
         ``world_aligned``: the first three rows of Pinocchio's Jacobian.
 
         Raises:
-            InputError: ``q`` is not a finite (3,) vector.
+            InvalidInput: ``q`` is not a finite (3,) vector.
         """
         qv = vector(q, "q", 3)
         J = np.empty((3, 3))
@@ -115,7 +115,7 @@ class ThreeRClosedForm(ClosedForm):
         """Angular Jacobian ``J_A = (z0 z1 z2)`` (exam eq. (1)), (3, 3), base axes.
 
         Raises:
-            InputError: ``q`` is not a finite (3,) vector.
+            InvalidInput: ``q`` is not a finite (3,) vector.
         """
         return first(self.angular_jacobian_batch(as_vector(q, "q", 3)[None]))
 
@@ -123,7 +123,7 @@ class ThreeRClosedForm(ClosedForm):
         """``[J_L; J_A]``, (6, 3), rows [v; w], ``world_aligned`` (Pinocchio's full Jacobian).
 
         Raises:
-            InputError: ``q`` is not a finite (3,) vector.
+            InvalidInput: ``q`` is not a finite (3,) vector.
         """
         return np.vstack([self.jacobian(q), self.angular_jacobian(q)])
 
@@ -134,7 +134,7 @@ class ThreeRClosedForm(ClosedForm):
         answer of the module docstring.
 
         Raises:
-            InputError: ``q`` or ``xdot`` not a finite (3,) vector.
+            InvalidInput: ``q`` or ``xdot`` not a finite (3,) vector.
         """
         qv, xv = vector(q, "q", 3), vector(xdot, "xdot", 3)
         out = np.empty(3)
@@ -149,7 +149,7 @@ class ThreeRClosedForm(ClosedForm):
         ``q`` (3,) [rad], ``qdot`` (3,) [rad/s] (exam eq. (1), step 4).
 
         Raises:
-            InputError: ``q`` or ``qdot`` not a finite (3,) vector.
+            InvalidInput: ``q`` or ``qdot`` not a finite (3,) vector.
         """
         return self.angular_jacobian(q) @ as_vector(qdot, "qdot", 3)
 
@@ -157,7 +157,7 @@ class ThreeRClosedForm(ClosedForm):
         """Unit vector (3,) spanning N(J_A): ``(0, 1, -1) / sqrt(2)`` at every ``q`` (step 5).
 
         Raises:
-            InputError: ``q`` is not a finite (3,) vector.
+            InvalidInput: ``q`` is not a finite (3,) vector.
         """
         as_vector(q, "q", 3)
         return np.array(_NULL)
@@ -172,7 +172,7 @@ class ThreeRClosedForm(ClosedForm):
         ``q`` (3,) [rad]; ``omega`` (3,) [rad/s], base axes.
 
         Raises:
-            InputError: ``q`` or ``omega`` not a finite (3,) vector.
+            InvalidInput: ``q`` or ``omega`` not a finite (3,) vector.
         """
         qv, w = as_vector(q, "q", 3), as_vector(omega, "omega", 3)
         beta, residual = eqs.angular_split(qv[0], w[0], w[1])
@@ -187,7 +187,7 @@ class ThreeRClosedForm(ClosedForm):
         """``J_L`` at N configurations: ``Q`` (N, 3) -> (N, 3, 3); see :meth:`jacobian`.
 
         Raises:
-            InputError: ``Q`` is not a finite (N, 3) array.
+            InvalidInput: ``Q`` is not a finite (N, 3) array.
         """
         Q = as_array(Q, "Q", (None, 3))
         out = np.empty((Q.shape[0], 3, 3))
@@ -198,7 +198,7 @@ class ThreeRClosedForm(ClosedForm):
         """``J_A`` at N configurations: ``Q`` (N, 3) -> (N, 3, 3).
 
         Raises:
-            InputError: ``Q`` is not a finite (N, 3) array.
+            InvalidInput: ``Q`` is not a finite (N, 3) array.
         """
         Q = as_array(Q, "Q", (None, 3))
         out = np.empty((Q.shape[0], 3, 3))
@@ -209,7 +209,7 @@ class ThreeRClosedForm(ClosedForm):
         """``J_L^-1 v`` at N configurations: ``Q``, ``X`` (N, 3) -> (N, 3) [rad/s].
 
         Raises:
-            InputError: ``Q`` or ``X`` not a finite (N, 3) array.
+            InvalidInput: ``Q`` or ``X`` not a finite (N, 3) array.
         """
         Q, X = self._check_batch(Q, X)
         out = np.empty((Q.shape[0], 3))
@@ -226,12 +226,12 @@ def minimum_norm_shift(qdot: npt.ArrayLike, direction: npt.ArrayLike) -> float:
     ``qdot`` per unit of ``direction``.
 
     Raises:
-        InputError: Non-finite or mismatched vectors, or a zero ``direction``.
+        InvalidInput: Non-finite or mismatched vectors, or a zero ``direction``.
     """
     d = as_array(direction, "direction", (None,))
     v = as_vector(qdot, "qdot", d.shape[0])
     dd = float(d @ d)
     if dd == 0.0:
-        raise InputError("direction", "expected a nonzero vector")
+        raise InvalidInput("direction", "expected a nonzero vector")
     return -float(v @ d) / dd
 

@@ -14,7 +14,6 @@ import numpy as np
 
 from rrc_pin.control.strategies.barker_arm import barker_closed_form
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
-from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
 from solvers.closed_form.barker import BarkerClosedForm
 from solvers.closed_form.barker_equations import joint_trig, wrist_equations
@@ -36,8 +35,8 @@ class WristChoice(Strategy):
     chooses_rates = True
 
     def __init__(self, region: float = 0.05, margin: float = 0.0) -> None:
-        self.region = finite_number(region, "region", 0.0, False, 0.5, InvalidInput)
-        self.margin = finite_number(margin, "margin", 0.0, error=InvalidInput)
+        self.region = finite_number(region, "region", 0.0, False, 0.5)
+        self.margin = finite_number(margin, "margin", 0.0)
         self.closed_form: BarkerClosedForm | None = None
 
     def check(self, robot: Robot) -> None:
