@@ -35,6 +35,7 @@ from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
+from scipy.optimize import linprog
 
 from solvers import kernels
 from solvers.errors import NumericalFailure
@@ -119,8 +120,6 @@ def direction_lp(w: Array, null: Array, box: Box, rows: Rows | None) -> Array:
     Raises:
         NumericalFailure: HiGHS found no solution.
     """
-    from scipy.optimize import linprog
-
     d, n = null.shape
     M = np.empty((n, d + 1))
     M[:, :d] = null.T

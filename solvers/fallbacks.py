@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 import numpy.typing as npt
+from scipy.optimize import lsq_linear
 
 from solvers import kernels
 from solvers.direction import direction_lp
@@ -60,8 +61,6 @@ def _bvls(A: Array, b: Array, problem: Problem) -> Array:
     """The top level's bounded least squares solved exactly by scipy's BVLS."""
     if problem.rows is not None:
         raise NumericalFailure("scipy: bounded least squares takes no constraint rows")
-    from scipy.optimize import lsq_linear
-
     box = problem.box
     x = np.minimum(np.maximum(0.0, box.lb), box.ub)  # joints with lb == ub are fixed there
     free = box.lb < box.ub

@@ -132,6 +132,11 @@ def least_squares(
         d = B.shape[1]
         if not definite:
             P.flat[:: d + 1] += TIE_BREAK * max(float(P.trace()), 1.0)
+        # Divided by their largest entry, the costs have the same minimiser and the backends'
+        # absolute tolerances read as relative ones (a command saturating the box gave
+        # gradients 1e7 times P, and proxqp iterated for 10 s).
+        size = max(float(np.abs(P).max()), float(np.abs(q).max()), np.finfo(float).tiny)
+        P, q = P / size, q / size
         if N is None:
             C, lo, hi = (None, None, None) if rows is None else (
                 rows.G, np.full(rows.h.size, -np.inf), rows.h)  # fmt: skip
