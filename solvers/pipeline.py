@@ -378,7 +378,9 @@ def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
     """The top level's scale and veer for ``qdot`` in its normalised metric."""
     level = problem.levels[0]
     top = largest_weight(level)
-    peak = max(float(np.abs(t.b).max(initial=0.0)) for t in level) or 1.0  # no overflow below
+    # A command near the float range is divided down so that its units cannot overflow it; a
+    # subnormal one is not divided up (the achieved rates divided by it overflowed: NaN scale)
+    peak = max(1.0, *(float(np.abs(t.b).max(initial=0.0)) for t in level))
     y, b = [], []
     for t in level:
         factor = row_factors(t, top, units=True)

@@ -205,6 +205,20 @@ def test_commands_near_the_float_range_never_raise(ref: str, arms: dict) -> None
         check_step(arm, q, tracked.qdot, 0.01)
 
 
+def test_a_subnormal_command_from_outside_the_limits_has_a_finite_report(arms: dict) -> None:
+    """The soak's kr5_3r step: a command of 1e-310 while a joint moves back into range. The
+    achieved rates divided by the command's size overflowed: scale and veer were NaN."""
+    arm = arms["kr5_3r"]
+    q = np.array([-3.010136227911727, -0.47952047206079684, 2.6930186934432983])
+    twist = [5e-324, -1e-310, 5e-324, -9.2e-3, 1e308, 0.1]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = Resolver(arm).solve(q, twist)
+    assert r.status == "recovering"
+    assert 0.0 <= r.scale <= 1.0 and np.isfinite(r.veer)
+    check_step(arm, q, r.qdot, 0.01)
+
+
 def test_start_outside_the_limits_moves_back(arms: dict) -> None:
     arm = arms["rrc_k1607"]
     q = arm.neutral() + 0.3
