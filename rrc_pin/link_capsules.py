@@ -70,7 +70,8 @@ def link_paths(spec: ArmSpec) -> list[list[Matrix4]]:
         if spec.chain.convention == "modified":
             factors = _modified_pre(rows[i + 1]) if i + 1 < len(rows) else []
         else:
-            factors = [rot_z(row.theta), translation(z=row.d), translation(x=row.a), rot_x(row.alpha)]
+            factors = [rot_z(row.theta), translation(z=row.d), translation(x=row.a),
+                       rot_x(row.alpha)]  # fmt: skip
         paths.append(factors)
     paths[-1].append(np.asarray(spec.chain.tool, dtype=float))
     return paths

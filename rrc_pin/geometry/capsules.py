@@ -39,11 +39,13 @@ def merge_capsules(geometry: pin.GeometryModel) -> pin.GeometryModel:
         if not isinstance(shape, coal.Cylinder):
             continue
         ends = [obj.placement.act(np.array([0.0, 0.0, s * shape.halfLength])) for s in (-1, 1)]
-        found = [_sphere_at(objects, used, obj.parentFrame, end, shape.radius) for end in ends]
-        if found[0] is None or found[1] is None or found[0] == found[1]:
+        low = _sphere_at(objects, used, obj.parentFrame, ends[0], shape.radius)
+        high = _sphere_at(objects, used | {low} if low is not None else used, obj.parentFrame,
+                          ends[1], shape.radius)  # fmt: skip
+        if low is None or high is None:
             continue
-        used.update((found[0], found[1]))
-        a, b = (objects[k].placement.translation for k in found)
+        used.update((low, high))
+        a, b = objects[low].placement.translation, objects[high].placement.translation
         capsules[i] = (coal.Capsule(shape.radius, float(np.linalg.norm(b - a))), _axis(a, b))
     out = pin.GeometryModel()
     for i, obj in enumerate(objects):

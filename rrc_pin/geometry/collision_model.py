@@ -108,8 +108,10 @@ class CollisionModel:
 
     @property
     def pairs(self) -> tuple[tuple[str, str], ...]:
-        """The active pairs, ``(name_a, name_b)`` by body name; A is a robot body or held
-        object, B a robot body, held object or obstacle."""
+        """The active pairs, ``(name_a, name_b)`` by body name.
+
+        A is a robot body or a held object; B a robot body, a held object or an obstacle.
+        """
         return self._scene.pair_names
 
     @property
@@ -155,15 +157,19 @@ class CollisionModel:
 
     def add_capsule(self, T: npt.ArrayLike, radius: float, length: float,
                     name: str | None = None) -> str:  # fmt: skip
-        """A capsule about the z axis of pose ``T`` (axis ``length`` between the sphere
-        centres, ``radius`` [m]); its name."""
+        """A capsule about the z axis of pose ``T`` (4, 4) in the world; its name.
+
+        ``length`` [m] is its axis (between the centres of its end spheres), ``radius`` [m].
+        """
         pose = _pose(T, "T")
         return self._add_world("capsule", shapes.capsule(radius, length), pose, name)
 
     def add_cylinder(self, T: npt.ArrayLike, radius: float, length: float,
                      name: str | None = None) -> str:  # fmt: skip
-        """A cylinder of ``radius`` and height ``length`` [m] along the z axis of pose ``T``,
-        centred on its origin; its name."""
+        """A cylinder of ``radius`` and height ``length`` [m] about the z axis of pose ``T``.
+
+        Centred on the origin of ``T`` (4, 4, world frame). Returns its name.
+        """
         pose = _pose(T, "T")
         return self._add_world("cylinder", shapes.cylinder(radius, length), pose, name)
 
@@ -173,8 +179,10 @@ class CollisionModel:
         return self._add_world("convex", shapes.convex(points), pose, name)
 
     def add_halfspace(self, normal: npt.ArrayLike, offset: float, name: str | None = None) -> str:
-        """The solid half-space ``normal . x <= offset`` (world frame, [m]): the obstacle is on
-        the side ``normal`` points away from (a floor at height h: ``(0, 0, 1), h``); its name.
+        """The solid half-space ``normal . x <= offset`` (world frame, [m]); its name.
+
+        The obstacle is on the side ``normal`` points away from: a floor at height h is
+        ``(0, 0, 1), h``. ``normal`` need not be unit (both are divided by its norm).
         """
         shape, unit, d = shapes.halfspace(normal, offset)
         label = self._new_name("halfspace", name)
@@ -195,14 +203,13 @@ class CollisionModel:
         length: float | None = None,
         points: npt.ArrayLike | None = None,
     ) -> str:
-        """A shape held by ``link`` (it moves with the link), at pose ``T_link_shape`` (4, 4)
-        in the link's frame; its name.
+        """A shape held by ``link`` (it moves with the link); its name.
 
         Args:
             link: A link (frame) of the robot.
             kind: ``box`` (``size``), ``sphere`` (``radius``), ``capsule`` or ``cylinder``
                 (``radius``, ``length``), ``convex`` (``points`` (N, 3) in the shape's frame).
-            T_link_shape: The shape's pose in the link's frame [m].
+            T_link_shape: The shape's pose (4, 4) in the link's frame [m].
             name: Its name (default: the kind and a number).
             size: Box sides (3,) [m].
             radius: Radius [m].
@@ -214,7 +221,9 @@ class CollisionModel:
         """
         fid = self._link(link, "link")
         if kind not in shapes.ATTACHABLE:
-            raise InvalidInput("kind", f"expected one of {', '.join(shapes.ATTACHABLE)}, got {kind!r}")
+            raise InvalidInput(
+                "kind", f"expected one of {', '.join(shapes.ATTACHABLE)}, got {kind!r}"
+            )
         given = {"size": size, "radius": radius, "length": length, "points": points}
         wanted = shapes.DIMENSIONS[kind]
         for key, value in given.items():
@@ -251,18 +260,21 @@ class CollisionModel:
                 self._walls = {k: v for k, v in self._walls.items() if k != name}
             else:
                 known = [*self._extras, *self._walls]
-                raise InvalidInput("name", f"nothing named {name!r}; added: {', '.join(known) or 'none'}")
+                raise InvalidInput(
+                    "name", f"nothing named {name!r}; added: {', '.join(known) or 'none'}"
+                )
 
     # -- virtual walls ----------------------------------------------------------------------
 
     def add_workspace(self, T: npt.ArrayLike, size: npt.ArrayLike, frame: str | None = None,
                       name: str | None = None) -> str:  # fmt: skip
-        """Six walls keeping ``frame``'s origin inside a box of sides ``size`` (3,) [m] at pose
-        ``T`` (4, 4) (world frame); the group's name (walls ``<name>/+x`` ... ``<name>/-z``).
+        """Six walls keeping ``frame``'s origin inside a box; the group's name.
+
+        The walls are named ``<name>/+x`` ... ``<name>/-z`` (:class:`Wall`).
 
         Args:
-            T: The box's pose.
-            size: Its sides, each > 0.
+            T: The box's pose (4, 4), world frame [m].
+            size: Its sides (3,) [m], each > 0.
             frame: The frame held inside (default: the robot's tool frame).
             name: The group's name (default: ``workspace`` and a number).
         """
@@ -278,8 +290,10 @@ class CollisionModel:
 
     def add_wall(self, normal: npt.ArrayLike, offset: float, frame: str | None = None,
                  name: str | None = None) -> str:  # fmt: skip
-        """One wall keeping ``frame``'s origin where ``normal . p <= offset`` (world frame, [m]);
-        its name. ``normal`` need not be unit (both are divided by its norm)."""
+        """One wall keeping ``frame``'s origin where ``normal . p <= offset``; its name.
+
+        World frame, [m]. ``normal`` need not be unit (both are divided by its norm).
+        """
         n = as_array(normal, "normal", (3,), InvalidInput)
         if float(np.linalg.norm(n)) < 1e-12:
             raise InvalidInput("normal", f"expected a non-zero vector, got {n.tolist()}")
@@ -319,9 +333,11 @@ class CollisionModel:
 
     def proximity_at(self, q: npt.ArrayLike, detection: float,
                      data: CollisionData | None = None) -> Proximity:  # fmt: skip
-        """:meth:`proximity` at joint positions ``q`` (nq,) [rad or m], forward kinematics
-        computed here (in the calling thread's ``robot.data``); ``data`` defaults to one kept
-        per thread."""
+        """:meth:`proximity` at joint positions ``q`` (nq,) [rad or m].
+
+        Forward kinematics computed here (in the calling thread's ``robot.data``); ``data``
+        defaults to one kept per thread.
+        """
         q_api, q_pin = self.robot.configuration(q)
         pdata = self.robot.data
         pin.forwardKinematics(self.robot.model, pdata, q_pin)

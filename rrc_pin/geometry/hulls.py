@@ -21,24 +21,28 @@ from typing import NamedTuple
 import coal
 import pinocchio as pin
 
+from rrc_pin.errors import URDFError
+
 _LOCK = threading.Lock()
 _HULLS: dict[tuple[str, tuple[float, ...]], coal.ConvexBase] = {}
 _SECONDS = [0.0]
 _BUILT = [0]
 
-QHULL_OPTIONS = "Qt"
-"""qhull options: triangulated output (coal's default)."""
+QHULL_OPTIONS = ("Qt", "QJ")
+"""qhull options tried in turn: triangulated output (coal's default), then joggled input (a
+hull of the vertices moved by about 1e-11 of the mesh's size: centauro's pelvis mesh, whose
+triangulated hull gives a vertex more neighbours than coal stores)."""
 
 
 class HullStatistics(NamedTuple):
     """The hulls built in this process so far.
 
     Attributes:
-        count: Number of hulls built (and cached).
+        built: Number of hulls built (and cached).
         seconds: Their total build time [s] (qhull; the meshes were already loaded).
     """
 
-    count: int
+    built: int
     seconds: float
 
 
@@ -53,19 +57,39 @@ def convex_hull(obj: pin.GeometryObject) -> coal.ConvexBase:
 
     A mesh read from no file (built in code) gets its hull built at every call.
     """
-    mesh = obj.geometry
     key = (str(obj.meshPath), tuple(float(s) for s in obj.meshScale))
     with _LOCK:
         hull = _HULLS.get(key) if obj.meshPath else None
         if hull is None:
             start = time.perf_counter()
-            mesh.buildConvexHull(True, QHULL_OPTIONS)
-            hull = mesh.convex
+            hull = _build(obj)
             _SECONDS[0] += time.perf_counter() - start
             _BUILT[0] += 1
             if obj.meshPath:
                 _HULLS[key] = hull
     return hull
+
+
+def _build(obj: pin.GeometryObject) -> coal.ConvexBase:
+    """Build the hull of ``obj``'s mesh with the first of :data:`QHULL_OPTIONS` that works.
+
+    Raises:
+        URDFError: qhull failed with every option (naming the mesh file).
+    """
+    failures = []
+    for options in QHULL_OPTIONS:
+        try:
+            obj.geometry.buildConvexHull(True, options)
+        except RuntimeError as exc:
+            failures.append(f"{options}: {str(exc).strip().splitlines()[-1]}")
+            continue
+        hull: coal.ConvexBase = obj.geometry.convex
+        return hull
+    raise URDFError(
+        str(obj.meshPath) or str(obj.name),
+        "qhull could not build its convex hull (" + "; ".join(failures) + "); use "
+        "geometry='urdf' to keep the mesh",
+    )
 
 
 def is_mesh(geometry: coal.CollisionGeometry) -> bool:

@@ -9,9 +9,10 @@ A pair is left out (with its reason) when:
 - ``srdf``: the robot's SRDF disables the two links (``pinocchio.removeCollisionPairs``);
 - ``always``: a paper arm's links whose capsules overlap at every configuration
   (:func:`rrc_pin.link_capsules.always_touching`: a spherical wrist);
-- ``ready``: for a robot with neither an SRDF nor DH capsules, the pairs already in contact at
-  its ready configuration (MoveIt's "default" rule: bodies that touch in the robot's own
-  design pose are parts that overlap by construction, e.g. a cover over a joint).
+- ``ready``: of the pairs left, those already in contact at the robot's ready configuration
+  (MoveIt's "default" rule: bodies that touch in the robot's own start pose overlap by
+  construction: a cover over a joint, the K-1607's wrist, whose offsets a5 = -a6 bring link 7
+  back onto the forearm's axis).
 
 Every other pair of the robot's bodies is active.
 """

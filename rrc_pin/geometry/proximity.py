@@ -98,7 +98,7 @@ def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Dat
     tree = scene.tree
     if tree is not None:
         joint_poses(q, tree.parent, tree.rotation, tree.translation, tree.kind, tree.axis,
-                    tree.index, poses)  # fmt: skip
+                    tree.coordinate, poses)  # fmt: skip
     else:
         poses[:] = [M.homogeneous for M in placed().oMi.tolist()]
     world_centres(poses, scene.joint, scene.centre, cdata.world)
@@ -163,11 +163,11 @@ def _unit(normal: Array, distance: Array, point_a: Array, point_b: Array,
 
 
 def _empty() -> Proximity:
-    arrays = [np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
-              np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)]  # fmt: skip
-    for a in arrays:
-        a.flags.writeable = False
-    return Proximity((), *arrays)
+    empty = Proximity((), np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
+                      np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))  # fmt: skip
+    for array in empty[1:]:
+        array.flags.writeable = False
+    return empty
 
 
 EMPTY = _empty()

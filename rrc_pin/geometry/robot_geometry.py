@@ -164,8 +164,7 @@ def filtered_pairs(
 def _filtered(
     robot: Robot, objects: pin.GeometryModel, source: _Source, variant: str
 ) -> RobotGeometry:
-    use_ready = not source.srdf_removed and not source.always and robot.spec is None
-    pairs, excluded = _split(robot, objects, source.srdf_removed, source.always, use_ready)
+    pairs, excluded = _split(robot, objects, source.srdf_removed, source.always, True)
     return RobotGeometry(objects, pairs, excluded, variant)
 
 

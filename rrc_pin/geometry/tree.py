@@ -39,7 +39,7 @@ class KinematicTree(NamedTuple):
         translation: Joint placement translations (nj, 3) [m].
         kind: :data:`~solvers.broad_phase.REVOLUTE` or :data:`~solvers.broad_phase.PRISMATIC`.
         axis: Unit axes (nj, 3) in the joint's frame.
-        index: The coordinate of q (one per joint, the API's) that moves the joint.
+        coordinate: The coordinate of q (one per joint, the API's) that moves the joint.
     """
 
     parent: Index
@@ -47,7 +47,7 @@ class KinematicTree(NamedTuple):
     translation: Array
     kind: Index
     axis: Array
-    index: Index
+    coordinate: Index
 
 
 def tree_of(model: pin.Model, q_check: Array) -> KinematicTree | None:
@@ -99,6 +99,6 @@ def _agrees(model: pin.Model, tree: KinematicTree, q: Array) -> bool:
     pin.forwardKinematics(model, data, q_pin)
     poses = np.zeros((model.njoints, 4, 4))
     joint_poses(q, tree.parent, tree.rotation, tree.translation, tree.kind, tree.axis,
-                tree.index, poses)  # fmt: skip
+                tree.coordinate, poses)  # fmt: skip
     expected = np.array([M.homogeneous for M in data.oMi.tolist()])
     return bool(np.abs(poses - expected).max() <= CHECK_TOL)

@@ -1,8 +1,8 @@
-"""Virtual walls: half-spaces a tool frame's origin stays inside.
+r"""Virtual walls: half-spaces a tool frame's origin stays inside.
 
 A wall is a plane the tool may not cross: the tool's origin p (world frame, [m]) stays where
 
-.. math:: n \\cdot p \\le o
+.. math:: n \cdot p \le o
 
 with n the wall's unit normal pointing out of the allowed region and o its offset. A
 workspace box gives six walls (its faces, normals outward); a single half-space is one wall.
@@ -19,7 +19,7 @@ Array = npt.NDArray[np.float64]
 
 
 class Wall(NamedTuple):
-    """One virtual wall of a tool frame: the origin of ``frame`` stays where ``normal . p <= offset``.
+    """One virtual wall: the origin of ``frame`` stays where ``normal . p <= offset``.
 
     Attributes:
         name: The wall's name (a box's faces: ``<name>/+x``, ``<name>/-x``, ...).
