@@ -1,6 +1,6 @@
 """rrc_pin.geometry.tree: the joints as arrays, or None where the kernel cannot follow them.
 
-The kernel itself against Pinocchio: tests/test_broad_phase.py. Here: a model with a mimic
+The kernel itself against Pinocchio: tests/test_proximity_kernels.py. Here: a model with a mimic
 joint gets no tree, and its queries, which then read Pinocchio's placements, stay exact.
 """
 

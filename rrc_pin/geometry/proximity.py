@@ -5,7 +5,7 @@ The steps, in the order data flows:
 1. the joint placements of the tick, from q by the compiled forward kinematics of
    :mod:`~rrc_pin.geometry.tree` (or read from Pinocchio's ``data.oMi`` for a model it does
    not cover);
-2. the broad phase (:mod:`solvers.broad_phase`, compiled): bounding-sphere centres in the world,
+2. the broad phase (:mod:`solvers.proximity_kernels`, compiled): bounding-sphere centres in the world,
    and the pairs whose distance bound is below the detection distance;
 3. the narrow phase for those candidates only: ``pinocchio.updateGeometryPlacements``, then
    ``pinocchio.computeDistance`` per candidate (coal: signed distance, EPA in penetration),
@@ -27,7 +27,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.geometry.scene import Scene
-from solvers.broad_phase import joint_poses, near_pairs, world_centres
+from solvers.proximity_kernels import joint_poses, near_pairs, world_centres
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
