@@ -9,8 +9,10 @@ For every paper arm with a closed form (barker6, rrc_k1607, kr5_3r):
 - scalar: median per-call time of ``cf.joint_rates(q, xdot)`` against
   ``pin.computeFrameJacobian(..., LOCAL_WORLD_ALIGNED)`` followed by ``numpy.linalg.solve``
   (square arms; the first three rows for kr5_3r) or ``numpy.linalg.lstsq`` (minimum norm, for
-  the redundant rrc_k1607; pinv is slower still and is recorded too), both timed with
-  ``timeit`` at the same configurations, interleaved;
+  the redundant rrc_k1607; pinv is slower still and is recorded too), and of
+  ``cf.jacobian(q)`` against ``computeFrameJacobian`` alone, all timed with ``timeit`` at the
+  same configurations, interleaved (the compiled kernels are called once before, so that no
+  sample holds their compilation);
 - batch: ``cf.joint_rates_batch`` on N = 10^5 configurations against a Python loop of the
   same Pinocchio + numpy calls, timed on a subset and scaled to N.
 
@@ -102,7 +104,10 @@ def bench_arm(
     cf_us: list[float] = []
     pin_us: list[float] = []
     pinv_us: list[float] = []
+    jac_us: list[float] = []
+    pin_jac_us: list[float] = []
     worst = 0.0
+    cf.jacobian(Qs[0])  # compiled (or loaded from numba's cache) before any timing
     for q, x, exact in zip(Qs, Xs, exact_rows(cf, Qs), strict=True):
         ours, ref = cf.joint_rates(q, x), pin_rates(q, x)
         if exact:
@@ -111,6 +116,10 @@ def bench_arm(
         pin_us += per_call_us(lambda q=q, x=x: pin_rates(q, x), number, 3)
         if m < nq:
             pinv_us += per_call_us(lambda q=q, x=x: pin_pinv(q, x), number, 1)
+        jac_us += per_call_us(lambda q=q: cf.jacobian(q), number, 3)
+        pin_jac_us += per_call_us(
+            lambda q=q: pin.computeFrameJacobian(model, data, q, fid, lwa), number, 3
+        )
     scalar = {
         "closed_form_us": statistics.median(cf_us),
         "pinocchio_us": statistics.median(pin_us),
@@ -119,6 +128,9 @@ def bench_arm(
         "max_relative_difference": worst,
         "samples": len(cf_us),
         "calls_per_sample": number,
+        "jacobian_us": statistics.median(jac_us),
+        "pinocchio_jacobian_us": statistics.median(pin_jac_us),
+        "jacobian_speedup": statistics.median(pin_jac_us) / statistics.median(jac_us),
     }
     if pinv_us:
         scalar["pinocchio_pinv_us"] = statistics.median(pinv_us)
@@ -180,22 +192,29 @@ def markdown_table(results: dict[str, Any]) -> str:
     """The results as a Markdown table, one row per arm, then a note on how they were taken.
 
     Columns: the scalar closed form and Pinocchio + numpy per call [us] (medians) and their
-    ratio; the batch closed form and the Python loop over Pinocchio + numpy [configurations
-    per second] at N = 10^5, and their ratio. Every cell is a plain number.
+    ratio; the closed-form Jacobian and Pinocchio's per call [us] (medians; in recordings
+    that hold them); the batch closed form and the Python loop over Pinocchio + numpy
+    [configurations per second] at N = 10^5, and their ratio. Every cell is a plain number.
     """
     n = results["sizes"]["n_batch"]
+    jacobians = all("jacobian_us" in r["scalar"] for r in results["arms"])
+    head = "| arm | scalar closed form [us] | Pinocchio + numpy [us] | speed-up | "
+    if jacobians:
+        head += "Jacobian: closed form [us] | Pinocchio [us] | "
     lines = [
-        "| arm | scalar closed form [us] | Pinocchio + numpy [us] | speed-up | "
-        "batch [configs/s] | loop [configs/s] | speed-up |",
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+        head + "batch [configs/s] | loop [configs/s] | speed-up |",
+        "| --- |" + " ---: |" * (8 if jacobians else 6),
     ]
     solvers = []
     for r in results["arms"]:
         s, b = r["scalar"], r["batch"]
+        jacobian = (
+            f"{s['jacobian_us']:.2f} | {s['pinocchio_jacobian_us']:.2f} | " if jacobians else ""
+        )
         lines.append(
             f"| {r['arm']} | {s['closed_form_us']:.1f} | {s['pinocchio_us']:.1f} | "
-            f"{s['speedup']:.1f}x | {b['closed_form_per_s']:,.0f} | {b['loop_per_s']:,.0f} | "
-            f"{b['speedup']:.0f}x |"
+            f"{s['speedup']:.1f}x | {jacobian}{b['closed_form_per_s']:,.0f} | "
+            f"{b['loop_per_s']:,.0f} | {b['speedup']:.0f}x |"
         )
         solvers.append(f"{s['pinocchio_solver']} ({r['arm']})")
     info = results["machine"]
@@ -203,8 +222,9 @@ def markdown_table(results: dict[str, Any]) -> str:
     lines += [
         "",
         "Pinocchio + numpy: `computeFrameJacobian` (LOCAL_WORLD_ALIGNED) then "
-        f"{', '.join(solvers)}. Scalar: median time per call of `joint_rates` (timeit). "
-        f"Batch: `joint_rates_batch` on N = {n:,} configurations against a Python loop of the "
+        f"{', '.join(solvers)}. Scalar: median time per call of `joint_rates` (timeit)"
+        + ("; Jacobian: `jacobian` against `computeFrameJacobian` alone. " if jacobians else ". ")
+        + f"Batch: `joint_rates_batch` on N = {n:,} configurations against a Python loop of the "
         f"Pinocchio + numpy calls, interleaved in one run (medians of {BATCH_RUNS}). Measured on "
         f"{info['cpu']} ({info['cores']} cores), Python {info['python']}, numpy "
         f"{info['numpy']}, Pinocchio {info['pinocchio']}"

@@ -119,7 +119,7 @@ def _entry(key: object, value: object) -> tuple[Robot, pin.SE3]:
     label = f"arms[{key!r}]"
     if not (isinstance(value, tuple) and len(value) == 2 and isinstance(value[0], Robot)):
         raise InvalidInput(label, f"expected (Robot, T_base (4, 4)), got {value!r}")
-    T = rigid_transform(value[1], label, InvalidInput)
+    T = rigid_transform(value[1], label)
     return value[0], pin.SE3(T[:3, :3], T[:3, 3])
 
 

@@ -187,7 +187,7 @@ class DHChain:
         Raises:
             InvalidInput: ``q`` is not a finite (nq,) vector.
         """
-        q = as_vector(q, "q", self.nq, InvalidInput)
+        q = as_vector(q, "q", self.nq)
         out = np.empty((self.nq + 1, 4, 4))
         out[0] = np.asarray(self.base)
         for i, row in enumerate(self.rows):
@@ -223,7 +223,7 @@ class DHChain:
         Returns:
             (6, nq) array, rows [v; w].
         """
-        ref = check_reference(ref, InvalidInput)
+        ref = check_reference(ref)
         axes, points = self.joint_axes(q)
         T = self.fk(q)
         p = T[:3, 3]

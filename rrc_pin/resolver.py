@@ -93,8 +93,7 @@ class QPOptions:
             )
         if not isinstance(self.backend, str):
             raise InvalidInput("qp.backend", f"expected a backend name, got {self.backend!r}")
-        object.__setattr__(self, "time_limit", positive(self.time_limit, "qp.time_limit",
-                                                        InvalidInput))  # fmt: skip
+        object.__setattr__(self, "time_limit", positive(self.time_limit, "qp.time_limit"))
 
 
 class Resolver:
@@ -140,20 +139,20 @@ class Resolver:
             raise InvalidInput("robot", f"expected a rrc_pin.Robot or a name, got {robot!r}")
         if not isinstance(direction_preserving, bool):
             raise InvalidInput("direction_preserving", f"expected True or False, got "
-                               f"{direction_preserving!r}")  # fmt: skip
+                               f"{direction_preserving!r}")
         if not isinstance(use_closed_form, bool):
             raise InvalidInput("use_closed_form", f"expected True or False, got "
-                               f"{use_closed_form!r}")  # fmt: skip
+                               f"{use_closed_form!r}")
         self.robot = robot
         self.dt = _dt(dt)
         self.qp = QPOptions() if qp is None else _typed(qp, QPOptions, "qp")
         try:
             self.options = Options(damping, self.qp.fallbacks)  # type: ignore[arg-type]
             self.backend = make_backend(self.qp.backend, self.qp.time_limit,
-                                        **dict(self.qp.options))  # fmt: skip
-        except UnknownBackend:
-            raise
-        except InvalidInput as exc:  # the options' names as the caller spells them
+                                        **dict(self.qp.options))
+        except UnknownBackend as exc:  # the names as the caller spells them: qp.backend
+            raise UnknownBackend(exc.backend, exc.available, "qp.backend") from exc
+        except InvalidInput as exc:
             name = {"backend_options": "qp.options", "fallbacks": "qp.fallbacks"}
             raise InvalidInput(name.get(exc.argument, exc.argument), exc.reason) from exc
         self.direction_preserving = direction_preserving
@@ -230,7 +229,7 @@ class Resolver:
         else:
             if not isinstance(priority, str) or priority != "weighted":
                 raise InvalidInput("priority", "a twist is one task: priority is for lists of "
-                                   f"tasks, got {priority!r}")  # fmt: skip
+                                   f"tasks, got {priority!r}")
             task = self._twist_task()
             twist = task.check_twist(cast(npt.ArrayLike, command))
             levels, weighted = [[task]], False
@@ -245,7 +244,7 @@ class Resolver:
             before = self._last_qdot if previous is None else previous
             constraints = [limit.constraints(kin, step, before) for limit in self.limits]
             problem = build(rows, constraints, self.robot.nq, step, weighted=weighted,
-                            direction=self.direction_preserving)  # fmt: skip
+                            direction=self.direction_preserving)
             answer = solve(problem, self.backend, self.options)
             self._last_qdot = answer.qdot
             return Resolution.of(problem, answer, time.perf_counter() - start, self._names)
@@ -269,7 +268,7 @@ class Resolver:
                 "command", f"{self.robot.name} has several tool frames "
                 f"({', '.join(self.robot.tool_frames)}): pass tasks, e.g. [FrameTask(frame, "
                 "twist)], or Resolver(robot, task=FrameTask(frame))",
-            )  # fmt: skip
+            )
         return self.task
 
     def _levels(self, command: TaskCommand, priority: str) -> tuple[list[list[Task]], bool]:
@@ -284,7 +283,7 @@ class Resolver:
                 raise InvalidInput(
                     "command", "a weighted resolution takes a flat list of tasks (levels are "
                     "for priority='strict')",
-                )  # fmt: skip
+                )
             levels = [items]
         else:
             levels = [[t] if isinstance(t, Task) else list(t) for t in items]
@@ -331,7 +330,7 @@ class Resolver:
 
 def _dt(dt: float) -> float:
     """A control period: finite, at least :data:`MIN_DT` [s]."""
-    return finite_number(dt, "dt", MIN_DT, error=InvalidInput)
+    return finite_number(dt, "dt", MIN_DT)
 
 
 def _typed(value: Any, kind: type, name: str) -> Any:

@@ -231,7 +231,7 @@ class Robot:
         Raises:
             InvalidInput: Wrong length, non-numeric, NaN or inf, naming ``name``.
         """
-        return as_vector(q, name, self.nq, InvalidInput)
+        return as_vector(q, name, self.nq)
 
     def to_pinocchio(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
         """Pinocchio configuration vector (model.nq,) of joint positions ``q`` (nq,).
@@ -354,7 +354,7 @@ class Robot:
             ToolFrameRequired: No ``frame`` on a robot with several tool frames (lists them).
             FrameNotFound: ``frame`` is not a frame of the model (lists them).
         """
-        ref = check_reference(ref, InvalidInput)
+        ref = check_reference(ref)
         fid = self._frame(frame)
         q_pin = self.to_pinocchio(q)
         data = self._scratch()
@@ -394,7 +394,7 @@ class Robot:
         for key, value in poses.items():
             if not isinstance(key, str) or not key:
                 raise InvalidInput("poses", f"expected names (str) as keys, got {_brief(key)}")
-            q = as_vector(value, f"poses[{key!r}]", self.nq, InvalidInput).copy()
+            q = as_vector(value, f"poses[{key!r}]", self.nq).copy()
             outside = (q < self.lower) | (q > self.upper)
             if outside.any():
                 j = int(np.argmax(outside))

@@ -36,11 +36,11 @@ class UnknownBackend(InvalidInput):
         available: Names of the installed backends.
     """
 
-    def __init__(self, backend: str, available: list[str]) -> None:
+    def __init__(self, backend: str, available: list[str], argument: str = "backend") -> None:
         self.backend = backend
         self.available = available
         super().__init__(
-            "backend", f"unknown or not installed {backend!r}; installed: {', '.join(available)} "
+            argument, f"unknown or not installed {backend!r}; installed: {', '.join(available)} "
             "(install more with `pip install rrc-pin[bench]`)",
         )  # fmt: skip
 
@@ -60,7 +60,3 @@ class NumericalFailure(RrcPinError):
     Internal: the pipeline records it in the resolution's ``attempts`` and goes on to the
     next method; it never reaches a caller of the resolver.
     """
-
-
-SolverError = RrcPinError  # the closed forms' modules still say these names:
-InputError = InvalidInput  # removed once they are rewritten as kernels

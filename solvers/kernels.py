@@ -281,7 +281,7 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
                     continue
                 rotated = True
                 zeta = (beta - alpha) / (2.0 * gamma)
-                t = math.copysign(1.0, zeta) / (abs(zeta) + math.sqrt(1.0 + zeta * zeta))
+                t = math.copysign(1.0, zeta) / (abs(zeta) + math.hypot(1.0, zeta))
                 c = 1.0 / math.sqrt(1.0 + t * t)
                 s = c * t
                 for i in range(m):
@@ -459,7 +459,14 @@ def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
 
 @kernel
 def weighted_rows(
-    A: Array, b: Array, weight: Array, top: float, unit: Array, A_out: Array, b_out: Array
+    A: Array,
+    b: Array,
+    weight: Array,
+    top: float,
+    unit: Array,
+    scale: float,
+    A_out: Array,
+    b_out: Array,
 ) -> float:
     r"""Rows and rates in a level's metric: each row times :math:`\sqrt{w_i/w_{top}}/u_i`.
 
@@ -469,6 +476,8 @@ def weighted_rows(
         weight: Row weights (m,) > 0.
         top: The level's largest weight.
         unit: Each row's unit (m,) (the arm's reach for linear rows, else 1).
+        scale: A factor on the rates, applied first (a command near the float range is
+            divided by its largest entry before the rows' factors).
         A_out: Out (m, n).
         b_out: Out (m,).
 
@@ -481,7 +490,7 @@ def weighted_rows(
         f = math.sqrt(weight[i] / top) / unit[i]
         for j in range(n):
             A_out[i, j] = A[i, j] * f
-        b_out[i] = b[i] * f
+        b_out[i] = (b[i] * scale) * f
         peak = max(peak, abs(b_out[i]))
     return peak
 

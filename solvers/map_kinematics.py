@@ -21,9 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from solvers import map_batch
-from solvers.closed_form import barker_equations as eqs
 from solvers.closed_form.barker import BarkerClosedForm
-from solvers.closed_form.base import stack_entries
 from solvers.map_batch import Chain, GridArrays, Rows
 
 Array = npt.NDArray[np.float64]
@@ -121,13 +119,11 @@ class BarkerKinematics(ArmKinematics):
         self, Q: Array, grid: GridArrays, dexterity: bool, quanta: Array, first: int, out: Rows
     ) -> None:
         """See :meth:`ArmKinematics.block_rows`."""
-        g, n = self.closed_form.geometry, Q.shape[0]
-        t = eqs.trig_batch(Q)
-        F = eqs.f_terms(g, t)
-        P = np.stack(np.broadcast_arrays(*eqs.wrist_centre(g, t, F)), axis=1)
-        _, _, z5 = eqs.wrist_axes(g, t)  # R0_6's third column (eq. C13): the tool's z axis
-        Z = np.stack(np.broadcast_arrays(*z5), axis=1)
-        J = stack_entries(eqs.jacobian_rows(g, t), n) if dexterity else np.empty((n, 6, 6))
-        values = np.stack([np.abs(F.f1), np.abs(eqs.eq33(g, t)), np.abs(t.s5)], axis=1)
+        cf, n = self.closed_form, Q.shape[0]
+        P = cf.wrist_centre_batch(Q)
+        Z = np.ascontiguousarray(cf.hand_to_base_batch(Q)[:, :, 2])  # R0_6's z (eq. C13)
+        J = cf.jacobian_batch(Q) if dexterity else np.empty((n, 6, 6))
+        s = cf.singularity_batch(Q)
+        values = np.abs(np.stack([s.eq32, s.eq33, s.s5], axis=1))
         flags = values <= np.asarray(self.tolerances)
         map_batch.batch_rows(P, Z, J, flags, Q, self.chain, grid, dexterity, quanta, first, out)

@@ -378,11 +378,13 @@ def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
     """The top level's scale and veer for ``qdot`` in its normalised metric."""
     level = problem.levels[0]
     top = largest_weight(level)
+    peak = max(float(np.abs(t.b).max(initial=0.0)) for t in level) or 1.0  # no overflow below
     y, b = [], []
     for t in level:
         factor = row_factors(t, top, units=True)
-        y.append(t.A @ qdot if factor is None else factor * (t.A @ qdot))
-        b.append(t.b if factor is None else factor * t.b)
+        achieved, commanded = (t.A @ qdot) / peak, t.b / peak
+        y.append(achieved if factor is None else factor * achieved)
+        b.append(commanded if factor is None else factor * commanded)
     return scale_and_veer(np.concatenate(y), np.concatenate(b))
 
 

@@ -14,12 +14,14 @@ how the levels are solved (:data:`Mode`):
   command is feasible: a joint outside its range, a row with h < 0);
 - ``weighted``: one level, its tasks traded by their weights.
 
-Every level's stacked rows are made safe for the numerics here, once: in the least-squares
-modes each level's weights are divided by their largest (the optimum does not change), and a
-level whose weighted rates exceed :data:`LARGE` is divided down to it along its direction
-(the limits set the answer long before: it stays the optimum to rounding); the direction
-problem depends on the command's direction only, so a command is divided by its largest
-entry where it exceeds :data:`LARGE`.
+Every level's stacked rows are made safe for the numerics here, once. Each level's weights are
+divided by their largest (the optimum does not change). The direction problem depends on the
+command's direction only, so a command is divided by its largest entry where it exceeds
+:data:`LARGE`. A least-squares level whose rates exceed :data:`SATURATION` times what its
+rows can reach within the box (``1 + max|A| sum_j max(|lb_j|, |ub_j|)``) is divided down to
+that along its direction: its optimum is then saturated against the box, and a longer
+command no longer changes it (capped at 1e100 instead, a tracking QP of panda hung proxqp
+for minutes: gradient 1e99 against a box of 2 rad/s).
 """
 
 from __future__ import annotations
@@ -38,8 +40,12 @@ Array = npt.NDArray[np.float64]
 Mode = Literal["direction", "least_squares", "weighted"]
 
 LARGE = 1e100
-"""[task units] Weighted rates beyond this are divided down to it (module docstring): their
-squares stay far from overflow (1e308)."""
+"""[task units] A direction level's rates beyond this are divided by their largest entry
+(module docstring): their squares stay far from overflow (1e308)."""
+
+SATURATION = 1e6
+"""A least-squares level's rates beyond this many times its reach within the box are divided
+down to it (module docstring)."""
 
 
 class TaskRows(NamedTuple):
@@ -179,7 +185,7 @@ def build(
         mode = "least_squares"
     stacked, rate_factor = [], 1.0
     for k, level in enumerate(levels):
-        A, b, factor = _stack(level, normalised=(k == 0 and mode == "direction"))
+        A, b, factor = _stack(level, k == 0 and mode == "direction", box)
         stacked.append((A, b))
         rate_factor = factor if k == 0 else rate_factor
     kept = tuple(tuple(level) for level in levels)
@@ -187,39 +193,60 @@ def build(
                    mode, dt)  # fmt: skip
 
 
-def _stack(tasks: Sequence[TaskRows], normalised: bool) -> tuple[Array, Array, float]:
+def _stack(tasks: Sequence[TaskRows], normalised: bool, box: Box) -> tuple[Array, Array, float]:
     """Rows and rates of ``tasks`` stacked in the level's metric, and the rates' factor.
 
     Each row times the square root of its weight over the level's largest (and in the
-    normalised metric divided by its unit, :func:`solvers.kernels.weighted_rows`); the
-    direction level's rates divided by their largest entry beyond :data:`LARGE`, a
-    least-squares level's divided down to :data:`LARGE`.
+    normalised metric divided by its unit, :func:`solvers.kernels.weighted_rows`); the rates
+    capped as the module docstring says (:func:`_capped`).
     """
     top = largest_weight(tasks)
     if len(tasks) == 1 and top == 1.0 and tasks[0].weight is None:
         if not normalised or tasks[0].unit is None:  # the rows as they are
             A, b = tasks[0].A, tasks[0].b
             peak = float(np.abs(b).max()) if b.size else 0.0
-            return _capped(A, b, peak, normalised)
+            return _capped(A, b, peak, normalised, box)
     m = sum(t.b.size for t in tasks)
     A, b = np.empty((m, tasks[0].A.shape[1])), np.empty(m)
+    peak = _weighted(tasks, top, normalised, 1.0, A, b)
+    if normalised and peak > LARGE:  # the direction alone: b / its largest, before the
+        # rows' factors (up to 1 / MIN_REACH) could overflow
+        scale = 1.0 / max(float(np.abs(t.b).max(initial=0.0)) for t in tasks)
+        _weighted(tasks, top, normalised, scale, A, b)
+        return A, b, scale
+    return _capped(A, b, peak, normalised, box)
+
+
+def _weighted(
+    tasks: Sequence[TaskRows], top: float, normalised: bool, scale: float, A: Array, b: Array
+) -> float:
+    """Fill ``A``, ``b`` with the tasks' rows in the level's metric, the rates times ``scale``.
+
+    Returns:
+        The rates' largest magnitude.
+    """
     peak, r = 0.0, 0
     for t in tasks:
         k = t.b.size
         weight = _ones(k) if t.weight is None else t.weight
         unit = t.unit if normalised and t.unit is not None else _ones(k)
-        peak = max(peak, kernels.weighted_rows(t.A, t.b, weight, top, unit, A[r : r + k],
-                                               b[r : r + k]))  # fmt: skip
-        r += k
-    return _capped(A, b, peak, normalised)
+        rows = kernels.weighted_rows(t.A, t.b, weight, top, unit, scale, A[r : r + k], b[r : r + k])
+        peak, r = max(peak, rows), r + k
+    return peak
 
 
-def _capped(A: Array, b: Array, peak: float, normalised: bool) -> tuple[Array, Array, float]:
-    """``(A, b)`` with b divided as :func:`_stack` says where it exceeds :data:`LARGE`."""
-    if peak <= LARGE:
+def _capped(
+    A: Array, b: Array, peak: float, normalised: bool, box: Box
+) -> tuple[Array, Array, float]:
+    """``(A, b, factor)``: b times the factor that :func:`_stack` gives it (1 mostly)."""
+    if normalised:
+        return (A, b, 1.0) if peak <= LARGE else (A, b / peak, 1.0 / peak)
+    if peak <= SATURATION:  # within any reach of 1 or more: no need to look further
         return A, b, 1.0
-    rate_factor = 1.0 / peak if normalised else LARGE / peak
-    return A, b * rate_factor, rate_factor
+    sides = np.maximum(-box.lb, box.ub)
+    reach = 1.0 + float(np.abs(A).max(initial=0.0)) * float(sides[np.isfinite(sides)].sum())
+    cap = SATURATION * reach
+    return (A, b, 1.0) if peak <= cap else (A, b * (cap / peak), cap / peak)
 
 
 _ONES: dict[int, Array] = {}

@@ -183,8 +183,9 @@ class Resolution(_Record):
                     moved = (t.A != 0.0).any(axis=0).tolist()
                     bound_by = tuple(a for a in active if moved[a.joint])
                 factor = row_factors(t, largest_weight((t,)), units=True)
+                peak = float(np.abs(t.b).max(initial=0.0)) or 1.0  # no overflow in the metric
                 scale = scale_and_veer(y, t.b)[0] if factor is None else scale_and_veer(
-                    factor * y, factor * t.b)[0]  # fmt: skip
+                    factor * (y / peak), factor * (t.b / peak))[0]  # fmt: skip
                 out.append(TaskReport(t.name, k, t.b, y, _norm(y - t.b), scale, bound_by))
         return tuple(out)
 

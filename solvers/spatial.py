@@ -21,10 +21,10 @@ Reference = Literal["world_aligned", "local", "world"]
 REFERENCES: tuple[str, ...] = ("world_aligned", "local", "world")
 
 
-def check_reference(ref: str, error: type[InvalidInput] = InvalidInput) -> Reference:
+def check_reference(ref: str) -> Reference:
     """Return ``ref`` if it names one of :data:`REFERENCES`, else raise naming ``ref``."""
     if not isinstance(ref, str) or ref not in REFERENCES:
-        raise error("ref", f"expected one of {', '.join(REFERENCES)}, got {ref!r}")
+        raise InvalidInput("ref", f"expected one of {', '.join(REFERENCES)}, got {ref!r}")
     return ref  # type: ignore[return-value]
 
 

@@ -14,7 +14,7 @@ _F64 = np.dtype(np.float64)
 
 
 def as_vector(
-    x: npt.ArrayLike, name: str, size: int, error: type[InvalidInput] = InvalidInput
+    x: npt.ArrayLike, name: str, size: int
 ) -> npt.NDArray[np.float64]:
     """Return ``x`` as a finite float vector of shape ``(size,)``.
 
@@ -22,19 +22,17 @@ def as_vector(
         x: Value to check.
         name: Argument name used in the error message.
         size: Expected length.
-        error: Exception class to raise (a subclass of :class:`InvalidInput`).
 
     Raises:
         InvalidInput: Wrong shape, non-numeric, NaN or inf.
     """
-    return as_array(x, name, (size,), error)
+    return as_array(x, name, (size,))
 
 
 def as_array(
     x: npt.ArrayLike,
     name: str,
     shape: tuple[int | None, ...],
-    error: type[InvalidInput] = InvalidInput,
 ) -> npt.NDArray[np.float64]:
     """Return ``x`` as a finite float array of the given shape (``None`` matches any size).
 
@@ -44,15 +42,15 @@ def as_array(
     """
     if type(x) is np.ndarray and x.dtype == _F64 and x.shape == shape:  # the common case
         if not all_finite(x):
-            _non_finite(x, name, error)
+            _non_finite(x, name)
         return x
-    arr = real_array(x, name, error, f"expected a real numeric array of shape {_fmt(shape)}")
+    arr = real_array(x, name, f"expected a real numeric array of shape {_fmt(shape)}")
     if arr.ndim != len(shape) or any(
         want is not None and got != want for got, want in zip(arr.shape, shape, strict=True)
     ):
-        raise error(name, f"expected shape {_fmt(shape)}, got {arr.shape}")
+        raise InvalidInput(name, f"expected shape {_fmt(shape)}, got {arr.shape}")
     if not all_finite(arr):
-        _non_finite(arr, name, error)
+        _non_finite(arr, name)
     return arr
 
 
@@ -64,7 +62,6 @@ def all_finite(x: npt.NDArray[np.float64]) -> bool:
 def real_array(
     x: npt.ArrayLike,
     name: str,
-    error: type[InvalidInput] = InvalidInput,
     want: str = "expected real numbers",
 ) -> npt.NDArray[np.float64]:
     """``x`` as a float array of any shape (infinities and NaN kept), real numbers only.
@@ -76,10 +73,10 @@ def real_array(
     try:
         raw = np.asarray(x)
     except (TypeError, ValueError) as exc:  # ragged sequences
-        raise error(name, f"{want}, got {x!r}") from exc
+        raise InvalidInput(name, f"{want}, got {x!r}") from exc
     if raw.dtype.kind not in "fiu" or (type(x) is not np.ndarray and _holds_bool(x)):
         # booleans, complex numbers, strings and objects; numpy makes [0.1, True] floats
-        raise error(name, f"{want}, got {x!r}")
+        raise InvalidInput(name, f"{want}, got {x!r}")
     return raw.astype(np.float64, copy=False)
 
 
@@ -96,9 +93,10 @@ def _holds_bool(x: object) -> bool:
     return bool(nested) and any(_holds_bool(v) for v in x if type(v) in nested)
 
 
-def _non_finite(arr: npt.NDArray[np.float64], name: str, error: type[InvalidInput]) -> None:
+def _non_finite(arr: npt.NDArray[np.float64], name: str) -> None:
     bad = np.argwhere(~np.isfinite(arr))[0]
-    raise error(name, f"non-finite entry {arr[tuple(bad)]} at index {tuple(int(i) for i in bad)}")
+    where = tuple(int(i) for i in bad)
+    raise InvalidInput(name, f"non-finite entry {arr[tuple(bad)]} at index {where}")
 
 
 def finite_number(
@@ -107,7 +105,6 @@ def finite_number(
     lower: float | None = None,
     inclusive: bool = True,
     upper: float | None = None,
-    error: type[InvalidInput] = InvalidInput,
 ) -> float:
     """Return ``value`` as a finite float, optionally bounded.
 
@@ -117,7 +114,6 @@ def finite_number(
         lower: Lower bound, or None for none.
         inclusive: Whether ``value == lower`` is accepted.
         upper: Exclusive upper bound, or None for none.
-        error: Exception class to raise (a subclass of :class:`InvalidInput`).
 
     Raises:
         InvalidInput: ``value`` is not a real number (a bool or a string is refused), not
@@ -126,18 +122,19 @@ def finite_number(
     """
     real = (int, float, np.integer, np.floating)  # not complex numbers (np.number)
     if isinstance(value, (bool, np.bool_, np.timedelta64)) or not isinstance(value, real):
-        raise error(name, f"expected {_wanted(lower, inclusive, upper)}, got {value!r}")
+        raise InvalidInput(name, f"expected {_wanted(lower, inclusive, upper)}, got {value!r}")
     try:
         out = float(value)
     except OverflowError:  # an int beyond the float range
         got = f"an int of {len(str(value))} digits"
-        raise error(name, f"expected {_wanted(lower, inclusive, upper)}, got {got}") from None
+        wanted = _wanted(lower, inclusive, upper)
+        raise InvalidInput(name, f"expected {wanted}, got {got}") from None
     if (
         not isfinite(out)
         or (lower is not None and (out < lower or (out == lower and not inclusive)))
         or (upper is not None and out >= upper)
     ):
-        raise error(name, f"expected {_wanted(lower, inclusive, upper)}, got {out}")
+        raise InvalidInput(name, f"expected {_wanted(lower, inclusive, upper)}, got {out}")
     return out
 
 
@@ -152,13 +149,13 @@ def _wanted(lower: float | None, inclusive: bool, upper: float | None) -> str:
     return f"a finite number in {'[' if inclusive else '('}{lower:g}, {upper:g})"
 
 
-def positive(x: float, name: str, error: type[InvalidInput] = InvalidInput) -> float:
+def positive(x: float, name: str) -> float:
     """Return ``x`` as a float if it is finite and > 0.
 
     Raises:
         InvalidInput: ``x`` is not a finite positive number.
     """
-    return finite_number(x, name, 0.0, inclusive=False, error=error)
+    return finite_number(x, name, 0.0, inclusive=False)
 
 
 def _fmt(shape: tuple[int | None, ...]) -> str:
@@ -175,14 +172,14 @@ RIGID_TOL = 1e-9
 
 
 def rigid_transform(
-    x: npt.ArrayLike, name: str, error: type[InvalidInput] = InvalidInput
+    x: npt.ArrayLike, name: str
 ) -> npt.NDArray[np.float64]:
     """``x`` as a (4, 4) rigid transform (a rotation and a translation, within :data:`RIGID_TOL`).
 
     Raises:
         InvalidInput: Wrong shape, a non-finite entry, or not a rigid transform.
     """
-    T = as_array(x, name, (4, 4), error)
+    T = as_array(x, name, (4, 4))
     R = T[:3, :3]
     rigid = (
         np.abs(R.T @ R - np.eye(3)).max() <= RIGID_TOL
@@ -190,5 +187,5 @@ def rigid_transform(
         and np.abs(T[3] - (0.0, 0.0, 0.0, 1.0)).max() <= RIGID_TOL
     )
     if not rigid:
-        raise error(name, f"not a rigid transform: {T.tolist()}")
+        raise InvalidInput(name, f"not a rigid transform: {T.tolist()}")
     return T

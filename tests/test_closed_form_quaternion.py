@@ -14,7 +14,7 @@ from solvers.closed_form.quaternion import (
     rotation_vector,
     small_rotation,
 )
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 
 
 def random_rotations(rng: np.random.Generator, n: int) -> np.ndarray:
@@ -223,6 +223,6 @@ def test_batch_equals_single_for_1000():
     ],
 )
 def test_bad_input_raises_input_error_naming_the_argument(call, argument):
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InvalidInput) as info:
         call()
     assert info.value.argument == argument

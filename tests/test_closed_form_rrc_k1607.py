@@ -8,7 +8,7 @@ import pytest
 import rrc_pin
 from solvers.closed_form import null_space_projector, weighted_pseudo_inverse, weighted_rates
 from solvers.closed_form.rrc_k1607 import RrcK1607ClosedForm
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 
 ARM = rrc_pin.load("rrc_k1607")  # Pinocchio, from the generated URDF
 CF = ARM.closed_form
@@ -346,7 +346,7 @@ def test_nguyen_functions_reject_bad_input() -> None:
         (lambda: null_space_projector(np.full((6, 7), np.nan)), "J"),
     ]
     for call, argument in cases:
-        with pytest.raises(InputError) as info:
+        with pytest.raises(InvalidInput) as info:
             call()
         assert info.value.argument == argument
 
@@ -380,7 +380,7 @@ def test_nguyen_functions_reject_bad_input() -> None:
     ],
 )
 def test_bad_input_raises_input_error_naming_the_argument(call, argument):
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InvalidInput) as info:
         call()
     assert info.value.argument == argument
 

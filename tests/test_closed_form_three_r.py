@@ -7,7 +7,7 @@ import pytest
 
 import rrc_pin
 from solvers.closed_form.three_r import AngularRates, ThreeRClosedForm, minimum_norm_shift
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 
 ARM = rrc_pin.load("kr5_3r")  # Pinocchio, from the generated URDF
 CF = ARM.closed_form
@@ -219,6 +219,6 @@ def test_batch_equals_scalar_for_1000(regular):
     ],
 )
 def test_bad_input_raises_input_error_naming_the_argument(call, argument):
-    with pytest.raises(InputError) as info:
+    with pytest.raises(InvalidInput) as info:
         call()
     assert info.value.argument == argument

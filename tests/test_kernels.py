@@ -126,7 +126,7 @@ def test_weighted_rows_and_clip_into(rng: np.random.Generator) -> None:
     A, b = rng.normal(size=(6, 7)), rng.normal(size=6)
     w, unit = rng.uniform(0.1, 10.0, 6), rng.uniform(0.5, 2.0, 6)
     A_out, b_out = np.empty((6, 7)), np.empty(6)
-    peak = kernels.weighted_rows(A, b, w, 10.0, unit, A_out, b_out)
+    peak = kernels.weighted_rows(A, b, w, 10.0, unit, 1.0, A_out, b_out)
     f = np.sqrt(w / 10.0) / unit
     np.testing.assert_allclose(A_out, A * f[:, None], rtol=1e-15)
     np.testing.assert_allclose(b_out, b * f, rtol=1e-15)

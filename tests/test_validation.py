@@ -11,10 +11,6 @@ from solvers.errors import InvalidInput
 from solvers.validation import as_array, as_vector, finite_number, positive
 
 
-class _MyError(InvalidInput):
-    """A caller's own subclass, as rrc_pin passes one."""
-
-
 def test_good_input_comes_back_as_float_arrays(rng: np.random.Generator) -> None:
     x = rng.standard_normal(6)
     for value, want in (
@@ -66,8 +62,6 @@ def test_what_is_not_real_numbers_is_refused(value: object) -> None:
     assert info.value.argument == "q"
     assert info.value.reason.startswith("expected a real numeric array")
     assert isinstance(info.value, ValueError)
-    with pytest.raises(_MyError):
-        as_vector(value, "q", 3, _MyError)  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize(
@@ -84,8 +78,6 @@ def test_bad_shapes_and_non_finite_entries_name_the_argument(value: object, mess
     with pytest.raises(InvalidInput, match=message) as info:
         as_vector(value, "q", 3)  # type: ignore[arg-type]
     assert info.value.argument == "q"
-    with pytest.raises(_MyError, match=message):
-        as_vector(value, "q", 3, _MyError)  # type: ignore[arg-type]
 
 
 def test_batch_shapes() -> None:
@@ -125,8 +117,6 @@ def test_finite_number_refuses_what_is_not_a_real_number(value: object) -> None:
         with pytest.raises(InvalidInput, match=r"^dt: expected a finite number") as info:
             finite_number(value, "dt")  # type: ignore[arg-type]
     assert info.value.argument == "dt"
-    with pytest.raises(_MyError):
-        finite_number(value, "dt", error=_MyError)  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize(
@@ -147,8 +137,6 @@ def test_finite_number_states_the_expected_range(value: object, bounds: dict, me
     with pytest.raises(InvalidInput, match=message) as info:
         finite_number(value, "x", **bounds)  # type: ignore[arg-type]
     assert info.value.argument == "x"
-    with pytest.raises(_MyError):
-        finite_number(value, "x", **bounds, error=_MyError)  # type: ignore[arg-type]
 
 
 @pytest.mark.parametrize("dt", [True, "0.01", 0.0, -0.01, np.nan, np.inf, None])
@@ -162,5 +150,3 @@ def test_positive() -> None:
     assert positive(0.01, "dt") == 0.01
     assert positive(np.float32(2.0), "dt") == 2.0
     assert positive(1, "dt") == 1.0
-    with pytest.raises(_MyError, match="^dt:"):
-        positive(-1.0, "dt", _MyError)

@@ -69,7 +69,7 @@ class Velocity:
     frame: Frame = "local"
 
     def __post_init__(self) -> None:
-        twist = as_vector(self.twist, "twist", 6, InvalidInput).copy()
+        twist = as_vector(self.twist, "twist", 6).copy()
         twist.flags.writeable = False
         object.__setattr__(self, "twist", twist)
         one_of(self.frame, "frame", FRAMES)
@@ -191,7 +191,7 @@ class Target:
     def __post_init__(self) -> None:
         if self.pose is None:
             return
-        pose = as_array(self.pose, "pose", (4, 4), InvalidInput).copy()
+        pose = as_array(self.pose, "pose", (4, 4)).copy()
         R = pose[:3, :3]
         if not (np.allclose(R @ R.T, np.eye(3), atol=1e-6) and np.allclose(pose[3], [0, 0, 0, 1])
                 and np.linalg.det(R) > 0.0):  # fmt: skip

@@ -136,12 +136,11 @@ class ControlLoop:
         self.priority = priority
         self.realtime = bool(realtime)
         self.scheduling = "not started"
-        self.rate = finite_number(rate, "rate", 0.0, inclusive=False, error=InvalidInput)
+        self.rate = finite_number(rate, "rate", 0.0, inclusive=False)
         self.dt = 1.0 / self.rate
         self.mailbox = Mailbox() if mailbox is None else mailbox
         self.operator = Operator(settings)
-        self.record_limit = finite_number(record_limit, "record_limit", 0.0, inclusive=False,
-                                          error=InvalidInput)  # fmt: skip
+        self.record_limit = finite_number(record_limit, "record_limit", 0.0, inclusive=False)
         self.hands: tuple[str, ...] = robot.tool_frames
         self.start_q = start_pose(robot) if q0 is None else robot.check_q(q0, "q0").copy()
         self.clock = TickClock()
@@ -172,8 +171,7 @@ class ControlLoop:
         """Start ticking in a new thread (once)."""
         if self._thread is not None:
             return
-        self._thread = threading.Thread(target=self._run, name="rrc-pin control loop",
-                                        daemon=True)  # fmt: skip
+        self._thread = threading.Thread(target=self._run, name="rrc-pin control loop", daemon=True)
         self._thread.start()
 
     def stop(self, timeout: float = 2.0) -> None:
@@ -277,8 +275,10 @@ class ControlLoop:
                                  or len(log) >= log.capacity):  # fmt: skip
             self._full = True  # (a full log, a ring, would forget the record's start)
             self.operator.stop()
-            self.notice("error", f"record full ({len(log) * self.dt:g} s): the arm holds; save "
-                                 "it or stop recording")  # fmt: skip
+            self.notice(
+                "error",
+                f"record full ({len(log) * self.dt:g} s): the arm holds; save it or stop recording",
+            )
         enabled = twist is not None and mode in ("teleop", "target")
         self._snapshot = self._snap(resolution, twist, mode, enabled)
         return self._snapshot
@@ -287,13 +287,24 @@ class ControlLoop:
               q: Array | None = None) -> Snapshot:  # fmt: skip
         ctl = self.ctl
         return Snapshot(
-            tick=self.clock.ticks, t=ctl.t, q=ctl.q if q is None else q,
-            resolution=resolution, twist=twist, frame=self.operator.frame, hand=self._hand,
-            enabled=enabled, mode=mode, recording=self.recording,
-            recorded=len(ctl.log) * self.dt if self.recording else 0.0, speed=ctl.speed,
-            strategy=self._strategy, backend=self._backend, target=self.operator.target,
-            latched=self.operator.latched, stops=self.operator.stops,
-        )  # fmt: skip
+            tick=self.clock.ticks,
+            t=ctl.t,
+            q=ctl.q if q is None else q,
+            resolution=resolution,
+            twist=twist,
+            frame=self.operator.frame,
+            hand=self._hand,
+            enabled=enabled,
+            mode=mode,
+            recording=self.recording,
+            recorded=len(ctl.log) * self.dt if self.recording else 0.0,
+            speed=ctl.speed,
+            strategy=self._strategy,
+            backend=self._backend,
+            target=self.operator.target,
+            latched=self.operator.latched,
+            stops=self.operator.stops,
+        )
 
     def robot_pose(self) -> Array:
         """The commanded hand's pose (4, 4) at the controller's q (base frame) [m]."""
@@ -349,8 +360,9 @@ class ControlLoop:
 
     def _set_strategy(self, name: str) -> None:
         if name not in self.strategies:
-            raise InvalidInput("strategy", f"{self.robot.name} takes {', '.join(self.strategies)}; "
-                                           f"got {name!r}")  # fmt: skip
+            raise InvalidInput(
+                "strategy", f"{self.robot.name} takes {', '.join(self.strategies)}; got {name!r}"
+            )
         strategy = make_strategy(name)
         strategy.check(self.ctl.robot)
         self.ctl.strategy = strategy
@@ -360,8 +372,9 @@ class ControlLoop:
         cmd.one_of(name, "backend", self.backends)
         # A resolver of the same robot, period and limits (its default task: the controller's
         # task rows are unchanged); the controller keeps its q, log and reference pose.
-        self.ctl.resolver = Resolver(self.ctl.robot, self.dt, limits=self.ctl.resolver.limits,
-                                     qp=QPOptions(backend=name))  # fmt: skip
+        self.ctl.resolver = Resolver(
+            self.ctl.robot, self.dt, limits=self.ctl.resolver.limits, qp=QPOptions(backend=name)
+        )
         self._backend = name
 
     def _set_hand(self, frame: str) -> None:
@@ -387,8 +400,10 @@ class ControlLoop:
             raise InvalidInput("seconds", "nothing recorded: start recording first")
         n = max(1, round(seconds / self.dt))
         if n > len(self.ctl.log):
-            raise InvalidInput("seconds", f"asked for {seconds:g} s; the record holds "
-                                          f"{len(self.ctl.log) * self.dt:.3g} s")  # fmt: skip
+            raise InvalidInput(
+                "seconds",
+                f"asked for {seconds:g} s; the record holds {len(self.ctl.log) * self.dt:.3g} s",
+            )
         self.operator.stop()
         ctl = self.ctl
 
@@ -425,8 +440,11 @@ class ControlLoop:
         def work() -> tuple[Array, Array]:
             log = TrajectoryLog.load(path)
             if log.joint_names != names:
-                raise InvalidInput("path", f"{path} records joints {', '.join(log.joint_names)}; "
-                                           f"this arm has {', '.join(names)}")  # fmt: skip
+                raise InvalidInput(
+                    "path",
+                    f"{path} records joints {', '.join(log.joint_names)}; "
+                    f"this arm has {', '.join(names)}",
+                )
             teleop = log.column("mode") == "teleop"
             if not teleop.any():
                 raise InvalidInput("path", f"{path} holds no teleoperation ticks")
@@ -473,10 +491,16 @@ class ControlLoop:
         """
         robot = self.robot
         if len(self.hands) > 1:  # a Controller commands one tool frame: this hand's
-            robot = Robot(robot.model, hand, name=robot.name, source=robot.source,
-                          spec=robot.spec)  # fmt: skip
-        return Controller(robot, self.dt, q, strategy=self._strategy, limits=JointLimits(),
-                          qp=QPOptions(backend=self._backend), speed=speed)  # fmt: skip
+            robot = Robot(robot.model, hand, name=robot.name, source=robot.source, spec=robot.spec)
+        return Controller(
+            robot,
+            self.dt,
+            q,
+            strategy=self._strategy,
+            limits=JointLimits(),
+            qp=QPOptions(backend=self._backend),
+            speed=speed,
+        )
 
 
 REALTIME_PRIORITY = 10

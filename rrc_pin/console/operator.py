@@ -61,9 +61,8 @@ class OperatorSettings:
 
     def __post_init__(self) -> None:
         for name in ("max_linear", "max_angular", "jog_timeout", "hold_timeout", "target_gain"):
-            finite_number(getattr(self, name), name, 0.0, inclusive=False, error=InvalidInput)
-        fraction = finite_number(self.jog_fraction, "jog_fraction", 0.0, inclusive=False,
-                                 error=InvalidInput)  # fmt: skip
+            finite_number(getattr(self, name), name, 0.0, inclusive=False)
+        fraction = finite_number(self.jog_fraction, "jog_fraction", 0.0, inclusive=False)
         if fraction > 1.0:
             raise InvalidInput("jog_fraction", f"expected a number in (0, 1], got {fraction}")
 

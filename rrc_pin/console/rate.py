@@ -30,8 +30,8 @@ class Rate:
     """
 
     def __init__(self, hz: float, min_sleep: float = 0.0) -> None:
-        self.period = 1.0 / finite_number(hz, "rate", 0.0, inclusive=False, error=InvalidInput)
-        self.min_sleep = finite_number(min_sleep, "min_sleep", 0.0, error=InvalidInput)
+        self.period = 1.0 / finite_number(hz, "rate", 0.0, inclusive=False)
+        self.min_sleep = finite_number(min_sleep, "min_sleep", 0.0)
         self.skipped = 0
         self._next = time.perf_counter() + self.period
 

@@ -19,7 +19,6 @@ from rrc_pin.console.loop import ControlLoop
 from rrc_pin.console.panel import Panel
 from rrc_pin.console.readouts import Reader, joints_html, status_html
 from rrc_pin.console.scene import Scene
-from rrc_pin.errors import InvalidInput
 from solvers.validation import finite_number
 
 DUTY = 0.2
@@ -49,10 +48,9 @@ class View:
         self.loop = loop
         self.scene = scene
         self.panel = panel
-        self.period = 1.0 / finite_number(rate, "view_rate", 0.0, inclusive=False,
-                                          error=InvalidInput)  # fmt: skip
+        self.period = 1.0 / finite_number(rate, "view_rate", 0.0, inclusive=False)  # fmt: skip
         self.readout_period = 1.0 / finite_number(readout_rate, "readout_rate", 0.0,
-                                                  inclusive=False, error=InvalidInput)  # fmt: skip
+                                                  inclusive=False)  # fmt: skip
         self.reader = Reader(loop.robot)
         self.updates = 0
         self.errors = 0

@@ -155,7 +155,7 @@ class Controller:
             raise InvalidInput(
                 "robot", f"{robot.name} has several tool frames ({', '.join(robot.tool_frames)}); "
                 "load it with tool_frame=... for one hand",
-            )  # fmt: skip
+            )
         if deadman is not None and not isinstance(deadman, Deadman):
             raise InvalidInput("deadman", f"expected a Deadman or None, got {deadman!r}")
         if drift is not None and not isinstance(drift, DriftCorrection):
@@ -169,8 +169,7 @@ class Controller:
         self.speed = speed
         self.deadman = deadman
         self.drift = drift
-        self.label = SingularityLabel(robot, finite_number(near, "near", 0.0, inclusive=False,
-                                                           error=InvalidInput))  # fmt: skip
+        self.label = SingularityLabel(robot, finite_number(near, "near", 0.0, inclusive=False))
         self.log = TrajectoryLog(robot.joint_names, self._log_record)
         self.t = 0.0
         assert self.resolver.task is not None  # one tool frame: the resolver has its task
@@ -205,7 +204,7 @@ class Controller:
 
     @speed.setter
     def speed(self, value: float) -> None:
-        value = finite_number(value, "speed", 0.0, error=InvalidInput)
+        value = finite_number(value, "speed", 0.0)
         if value > 1.0:
             raise InvalidInput("speed", f"expected a finite number in [0, 1], got {value}")
         self._speed = value
@@ -265,26 +264,26 @@ class Controller:
             decision = KEEP
         else:
             decision = self.strategy.decide(Situation(self.robot, q, wanted, self.dt, command,
-                                                      self._rows, hand))  # fmt: skip
+                                                      self._rows, hand))
         factor = decision.factor
         if decision.rates is None:
             r = self.resolver.solve(q, wanted if factor == 1.0 else factor * wanted,
-                                    self._command_frame)  # fmt: skip
+                                    self._command_frame)
         else:
             r = self.resolver.solve(q, [RatesTask(decision.rates)], priority="strict")
         # q itself, not a copy: read-only, replaced at every tick.
         self.log.append_tick(Tick(self.t, q, r, command, hand, factor, error, "teleop",
-                                  decision.note))  # fmt: skip
+                                  decision.note))
         fraction = None if decision.rates is not None else _followed(r)
         if fraction is None:
             self._reanchor = True
         elif self._full:  # the command, for the time it was followed
             self._reference = advance(self._reference, command, factor * fraction * self.dt,
-                                      local)  # fmt: skip
+                                      local)
         else:  # the commanded position, at the orientation reached
             moved = to_base_axes(pose.rotation, command) if local else command
             self._reference = advance(self._reference, moved * LINEAR,
-                                      factor * fraction * self.dt, False)  # fmt: skip
+                                      factor * fraction * self.dt, False)
         return self._advance(r)
 
     def reverse(self, seconds: float, extra: float = 1.0) -> Retrace:
@@ -308,14 +307,14 @@ class Controller:
             InvalidInput: ``seconds`` not > 0 or longer than the record, or a bad ``extra``;
                 raised before any state changes.
         """
-        seconds = finite_number(seconds, "seconds", 0.0, inclusive=False, error=InvalidInput)
-        extra = finite_number(extra, "extra", 0.0, upper=1e6, error=InvalidInput)
+        seconds = finite_number(seconds, "seconds", 0.0, inclusive=False)
+        extra = finite_number(extra, "extra", 0.0, upper=1e6)
         ticks = seconds / self.dt
         if ticks > len(self.log) + 0.5:
             raise InvalidInput(
                 "seconds", f"asked to reverse {seconds:.6g} s ({ticks:.6g} ticks); the record "
                 f"holds {len(self.log)} ticks ({len(self.log) * self.dt:.6g} s)",
-            )  # fmt: skip
+            )
         n = max(1, round(ticks))
         targets = self.log.positions(n)[::-1]
         budget = n + math.ceil(extra * n)
@@ -326,7 +325,7 @@ class Controller:
                 rates = (target - q) / self.dt
                 r = self.resolver.solve(q, [RatesTask(rates, "reverse")], priority="strict")
                 self.log.append_tick(Tick(self.t, q, r, np.zeros(6), None, 1.0, NO_ERROR,
-                                          "reverse", ""))  # fmt: skip
+                                          "reverse", ""))
                 self._advance(r)
                 steps += 1
                 if r.status == "exact":  # reached (to rounding): on to the next one
@@ -382,7 +381,7 @@ class Controller:
             drift_rotation=math.hypot(*tick.error[3:]), mode=tick.mode, method=r.method,
             status=r.status, active=active, singularity=self.label(tick.q, J_task, sv),
             note=tick.note,
-        )  # fmt: skip
+        )
 
 
 def _checked_twist(twist: npt.ArrayLike) -> Array:
@@ -391,7 +390,7 @@ def _checked_twist(twist: npt.ArrayLike) -> Array:
     Raises:
         InvalidInput: Naming ``twist``: not a real (6,) vector, or NaN or inf in it.
     """
-    out: Array = as_vector(twist, "twist", 6, InvalidInput).copy()
+    out: Array = as_vector(twist, "twist", 6).copy()
     return out
 
 

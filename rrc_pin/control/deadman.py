@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from rrc_pin.errors import InvalidInput
 from solvers.validation import finite_number
 
 
@@ -29,8 +28,8 @@ class Deadman:
     fade: float = 0.3
 
     def __post_init__(self) -> None:
-        finite_number(self.timeout, "timeout", 0.0, error=InvalidInput)
-        finite_number(self.fade, "fade", 0.0, inclusive=False, error=InvalidInput)
+        finite_number(self.timeout, "timeout", 0.0)
+        finite_number(self.fade, "fade", 0.0, inclusive=False)
 
     def factor(self, age: float) -> float:
         """Weight in [0, 1] of a command ``age`` seconds old."""

@@ -25,7 +25,6 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from rrc_pin.errors import InvalidInput
 from solvers.validation import finite_number
 
 Array = npt.NDArray[np.float64]
@@ -54,7 +53,7 @@ class DriftCorrection:
 
     def __post_init__(self) -> None:
         for name in ("gain", "max_linear", "max_angular"):
-            finite_number(getattr(self, name), name, 0.0, error=InvalidInput)
+            finite_number(getattr(self, name), name, 0.0)
 
     def twist(self, error: Array) -> Array:
         """Correcting twist (6,) [m/s, rad/s] from the pose error, in the error's axes.

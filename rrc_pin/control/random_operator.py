@@ -26,9 +26,9 @@ def random_commands(
     """
     if not isinstance(rng, np.random.Generator):
         raise InvalidInput("rng", f"expected a numpy Generator, got {rng!r}")
-    seconds = finite_number(seconds, "seconds", 0.0, inclusive=False, error=InvalidInput)
-    dt = finite_number(dt, "dt", 0.0, inclusive=False, error=InvalidInput)
-    hold = finite_number(hold, "hold", 0.0, inclusive=False, error=InvalidInput)
+    seconds = finite_number(seconds, "seconds", 0.0, inclusive=False)
+    dt = finite_number(dt, "dt", 0.0, inclusive=False)
+    hold = finite_number(hold, "hold", 0.0, inclusive=False)
     n, per = round(seconds / dt), max(1, round(hold / dt))
     segments = -(-n // per)
     twists = rng.normal(size=(segments, 6)) * np.array([speed] * 3 + [turn] * 3)

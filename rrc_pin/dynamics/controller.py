@@ -38,9 +38,9 @@ class Controller(ABC):
         self, robot: Robot, dt: float = 1e-3, torque_limit: npt.ArrayLike | None = None
     ) -> None:
         self.robot = robot
-        self.dt = finite_number(dt, "dt", 0.0, inclusive=False, error=InvalidInput)
+        self.dt = finite_number(dt, "dt", 0.0, inclusive=False)
         limit = robot.model.effortLimit if torque_limit is None else torque_limit
-        self.torque_limit = as_vector(limit, "torque_limit", robot.nq, InvalidInput)
+        self.torque_limit = as_vector(limit, "torque_limit", robot.nq)
         if np.any(self.torque_limit <= 0.0):
             raise InvalidInput("torque_limit", "every limit must be > 0")
         self.faults = 0
@@ -82,7 +82,7 @@ def gains(
     Raises:
         InvalidInput: Wrong shape, NaN, inf (unless allowed) or a wrong sign, naming ``name``.
     """
-    arr = real_array(value, name, InvalidInput, f"expected a number or {size} numbers")
+    arr = real_array(value, name, f"expected a number or {size} numbers")
     if arr.ndim == 0:
         arr = np.full(size, float(arr))
     if arr.shape != (size,):

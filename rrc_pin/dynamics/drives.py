@@ -50,7 +50,7 @@ class Drives:
     def __post_init__(self) -> None:
         size: int | None = None  # the armature's length; the others must match it
         for label in ("armature", "viscous", "coulomb"):
-            values = as_array(getattr(self, label), label, (size,), InvalidInput)
+            values = as_array(getattr(self, label), label, (size,))
             size = values.shape[0]
             if np.any(values < 0.0):
                 raise InvalidInput(label, "every entry must be >= 0")

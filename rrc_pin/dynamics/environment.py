@@ -38,12 +38,12 @@ class ContactPlane:
     damping: float = 0.0
 
     def __post_init__(self) -> None:
-        as_vector(self.point, "point", 3, InvalidInput)
-        n = as_vector(self.normal, "normal", 3, InvalidInput)
+        as_vector(self.point, "point", 3)
+        n = as_vector(self.normal, "normal", 3)
         if abs(np.linalg.norm(n) - 1.0) > 1e-6:
             raise InvalidInput("normal", f"expected a unit vector, got norm {np.linalg.norm(n)}")
-        finite_number(self.stiffness, "stiffness", 0.0, inclusive=False, error=InvalidInput)
-        finite_number(self.damping, "damping", 0.0, error=InvalidInput)
+        finite_number(self.stiffness, "stiffness", 0.0, inclusive=False)
+        finite_number(self.damping, "damping", 0.0)
 
     def force_on_tool(self, p: Array, pdot: Array) -> Array:
         """Force (3,) [N] the plane applies to a tool point at ``p`` moving at ``pdot``."""

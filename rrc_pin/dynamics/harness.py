@@ -88,7 +88,7 @@ def run(
         raise InvalidInput(
             "controller", f"its period {controller.dt} s differs from the simulator's {sim.dt} s"
         )
-    duration = finite_number(duration, "duration", 0.0, inclusive=False, error=InvalidInput)
+    duration = finite_number(duration, "duration", 0.0, inclusive=False)
     steps = round(duration / sim.dt)
     nq = sim.robot.nq
     out = {k: np.zeros((steps, nq)) for k in ("q", "q_ref", "tau")}

@@ -115,7 +115,7 @@ def check_selection(selection: npt.ArrayLike) -> Array:
     Raises:
         InvalidInput: Not three entries, or an entry other than 0 or 1 (names ``selection``).
     """
-    s = real_array(selection, "selection", InvalidInput, "expected three 0/1 entries")
+    s = real_array(selection, "selection", "expected three 0/1 entries")
     if s.shape != (3,) or not np.all((s == 0.0) | (s == 1.0)):
         raise InvalidInput(
             "selection", f"expected three entries, each 0 (position) or 1 (force), got {s}"
@@ -129,7 +129,7 @@ def check_rotation(R: npt.ArrayLike) -> Array:
     Raises:
         InvalidInput: Wrong shape, non-finite, or not a rotation (names ``task_frame``).
     """
-    m = as_array(R, "task_frame", (3, 3), InvalidInput)
+    m = as_array(R, "task_frame", (3, 3))
     if np.abs(m.T @ m - np.eye(3)).max() > 1e-6 or abs(np.linalg.det(m) - 1.0) > 1e-6:
         raise InvalidInput("task_frame", "expected a rotation matrix (orthonormal, det +1)")
     return m

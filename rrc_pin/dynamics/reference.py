@@ -41,11 +41,11 @@ class HandPath:
     segment: float
 
     def __post_init__(self) -> None:
-        as_array(self.start, "start", (4, 4), InvalidInput)
-        offsets = as_array(self.offsets, "offsets", (None, 3), InvalidInput)
+        as_array(self.start, "start", (4, 4))
+        offsets = as_array(self.offsets, "offsets", (None, 3))
         if offsets.shape[0] < 2:
             raise InvalidInput("offsets", "expected at least two waypoints")
-        finite_number(self.segment, "segment", 0.0, inclusive=False, error=InvalidInput)
+        finite_number(self.segment, "segment", 0.0, inclusive=False)
 
     @property
     def duration(self) -> float:
@@ -91,10 +91,10 @@ class JointTrajectory:
         period: float = 0.01,
         pull: float = 10.0,
     ) -> None:
-        q = as_vector(q0, "q0", robot.nq, InvalidInput).copy()
-        duration = finite_number(duration, "duration", 0.0, inclusive=False, error=InvalidInput)
-        period = finite_number(period, "period", 0.0, inclusive=False, error=InvalidInput)
-        pull = finite_number(pull, "pull", 0.0, error=InvalidInput)
+        q = as_vector(q0, "q0", robot.nq).copy()
+        duration = finite_number(duration, "duration", 0.0, inclusive=False)
+        period = finite_number(period, "period", 0.0, inclusive=False)
+        pull = finite_number(pull, "pull", 0.0)
         resolver = Resolver(robot, dt=period)
         times = np.arange(0.0, duration + period, period)
         samples = [q]

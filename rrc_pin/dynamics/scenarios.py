@@ -245,8 +245,8 @@ def tracking(
         InvalidInput: A bad duration or time (named), an unknown controller.
     """
     check_controller(controller_name)
-    duration = finite_number(duration, "duration", 0.0, inclusive=False, error=InvalidInput)
-    change_at = finite_number(change_at, "change_at", 0.0, upper=duration, error=InvalidInput)
+    duration = finite_number(duration, "duration", 0.0, inclusive=False)
+    change_at = finite_number(change_at, "change_at", 0.0, upper=duration)
     q0 = start(robot)
     path = HandPath(robot.fk(q0), np.array(TRACKING_PATH), segment)
     trajectory = JointTrajectory(robot, q0, path, duration)
@@ -278,9 +278,9 @@ def force(
         InvalidInput: A bad stiffness or duration (named), an unknown controller.
     """
     check_controller(controller_name)
-    stiffness = finite_number(stiffness, "stiffness", 0.0, inclusive=False, error=InvalidInput)
-    duration = finite_number(duration, "duration", 0.0, inclusive=False, error=InvalidInput)
-    tilt = finite_number(tilt, "tilt", -np.pi / 2, upper=np.pi / 2, error=InvalidInput)
+    stiffness = finite_number(stiffness, "stiffness", 0.0, inclusive=False)
+    duration = finite_number(duration, "duration", 0.0, inclusive=False)
+    tilt = finite_number(tilt, "tilt", -np.pi / 2, upper=np.pi / 2)
     R = rot_x(tilt)[:3, :3]
     normal = R[:, 2]
     wanted = -FORCE * normal

@@ -84,13 +84,13 @@ class Simulator:
     ) -> None:
         if robot.tool_frame is None or robot.model.nq != robot.model.nv:
             raise InvalidInput("robot", "expected an arm with one tool frame and 1-DOF joints")
-        self.dt = finite_number(dt, "dt", 0.0, inclusive=False, error=InvalidInput)
+        self.dt = finite_number(dt, "dt", 0.0, inclusive=False)
         n = robot.nq
         drives = drives_of(robot.name, n) if drives is None else drives
         if drives.armature.shape != (n,):
             raise InvalidInput("drives", f"expected {n} joints, got {drives.armature.shape[0]}")
         limit = robot.model.effortLimit if torque_limit is None else torque_limit
-        self.torque_limit = as_vector(limit, "torque_limit", n, InvalidInput)
+        self.torque_limit = as_vector(limit, "torque_limit", n)
         if np.any(self.torque_limit <= 0.0):
             raise InvalidInput("torque_limit", "every limit must be > 0")
         self.robot = robot
@@ -112,11 +112,11 @@ class Simulator:
 
     def reset(self, q: npt.ArrayLike, v: npt.ArrayLike | None = None, t: float = 0.0) -> State:
         """Put the arm at ``q`` [rad] with speed ``v`` [rad/s] (default rest) at time ``t``."""
-        position = as_vector(q, "q", self.robot.nq, InvalidInput).copy()
+        position = as_vector(q, "q", self.robot.nq).copy()
         speed: Array = (
-            np.zeros(self.robot.nq) if v is None else as_vector(v, "v", self.robot.nq, InvalidInput)
+            np.zeros(self.robot.nq) if v is None else as_vector(v, "v", self.robot.nq)
         )
-        self.t = finite_number(t, "t", error=InvalidInput)
+        self.t = finite_number(t, "t")
         self.q, self.v = position, speed.copy()
         self.report = StepReport(np.zeros(self.robot.nq), False, np.zeros(3))
         return self.state()
@@ -152,7 +152,7 @@ class Simulator:
         Raises:
             InvalidInput: ``tau`` is not a finite (nq,) vector (the state is unchanged).
         """
-        tau = as_vector(tau, "tau", self.robot.nq, InvalidInput)
+        tau = as_vector(tau, "tau", self.robot.nq)
         applied = np.clip(tau, -self.torque_limit, self.torque_limit)
         total = applied.copy()
         if self.friction:

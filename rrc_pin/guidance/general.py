@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import numpy.typing as npt
 
-from rrc_pin.errors import InvalidInput
 from rrc_pin.guidance.screw import screw_from_poses
 from rrc_pin.guidance.stepping import (
     Array,
@@ -57,7 +56,7 @@ def general(
     Raises:
         InvalidInput: A bad ``goal``, ``q0`` or ``steps``, named.
     """
-    target = rigid_transform(goal, "goal", InvalidInput)
+    target = rigid_transform(goal, "goal")
     k = check_steps(steps)
     start = None if relocate else arm.fk(check_q0(arm, q0))
 
@@ -99,8 +98,8 @@ def general_axes(
     """
     u_w = unit_axis(rotation[0], "rotation")
     u_v = unit_axis(translation[0], "translation")
-    theta = finite_number(rotation[1], "rotation", error=InvalidInput)
-    r = finite_number(translation[1], "translation", error=InvalidInput)
+    theta = finite_number(rotation[1], "rotation")
+    r = finite_number(translation[1], "translation")
     k = check_steps(steps)
 
     def twist(i: int, T: Array) -> Step:

@@ -107,8 +107,8 @@ def _check(c: Command, i: int) -> tuple[Array, float, float, Frame, Array | None
     if not isinstance(c, Command):
         raise InvalidInput(name, f"expected a guidance.Command, got {c!r}")
     axis = unit_axis(c.axis, f"{name}.axis")
-    d = finite_number(c.d, f"{name}.d", error=InvalidInput)
-    theta = finite_number(c.theta, f"{name}.theta", error=InvalidInput)
+    d = finite_number(c.d, f"{name}.d")
+    theta = finite_number(c.theta, f"{name}.theta")
     if c.frame not in ("global", "hand"):
         raise InvalidInput(f"{name}.frame", f"expected 'global' or 'hand', got {c.frame!r}")
     point = None

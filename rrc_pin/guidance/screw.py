@@ -69,7 +69,7 @@ def frames_from_points(points: npt.ArrayLike, name: str = "points") -> Array:
     Raises:
         InvalidInput: Wrong shape, a non-finite coordinate, coincident or collinear points.
     """
-    P = real_array(points, name, InvalidInput, "expected points of shape (..., 3, 3)")
+    P = real_array(points, name, "expected points of shape (..., 3, 3)")
     if P.ndim < 2 or P.shape[-2:] != (3, 3):
         raise InvalidInput(name, f"expected shape (..., 3, 3), got {P.shape}")
     if not np.isfinite(P).all():
@@ -136,7 +136,7 @@ def screw_of_displacement(Q: npt.ArrayLike, q: npt.ArrayLike) -> Screw:
         InvalidInput: Bad shapes, non-finite entries, or ``Q`` not a rotation.
     """
     Q = _rotations(Q, "Q")
-    q = real_array(q, "q", InvalidInput, "expected translations of shape (..., 3)")
+    q = real_array(q, "q", "expected translations of shape (..., 3)")
     if q.shape != Q.shape[:-1] or not np.isfinite(q).all():
         raise InvalidInput("q", f"expected finite translations of shape {Q.shape[:-1]}")
     u, theta = axis_angle(Q)
@@ -236,7 +236,7 @@ def _skew(u: Array) -> Array:
 
 
 def _rotations(Q: npt.ArrayLike, name: str) -> Array:
-    R = real_array(Q, name, InvalidInput, "expected rotations of shape (..., 3, 3)")
+    R = real_array(Q, name, "expected rotations of shape (..., 3, 3)")
     if R.ndim < 2 or R.shape[-2:] != (3, 3):
         raise InvalidInput(name, f"expected shape (..., 3, 3), got {R.shape}")
     if not np.isfinite(R).all():
@@ -248,7 +248,7 @@ def _rotations(Q: npt.ArrayLike, name: str) -> Array:
 
 
 def _poses(T: npt.ArrayLike, name: str) -> Array:
-    A = real_array(T, name, InvalidInput, "expected poses of shape (..., 4, 4)")
+    A = real_array(T, name, "expected poses of shape (..., 4, 4)")
     if A.ndim < 2 or A.shape[-2:] != (4, 4):
         raise InvalidInput(name, f"expected shape (..., 4, 4), got {A.shape}")
     if not np.isfinite(A).all():

@@ -139,7 +139,7 @@ def screw_motion(
     Raises:
         InvalidInput: A bad ``goal``, ``q0``, ``steps``, ``b_form`` or ``closing``, named.
     """
-    target = rigid_transform(goal, "goal", InvalidInput)
+    target = rigid_transform(goal, "goal")
     k = check_steps(steps)
     extra = check_closing(closing)
     check_b_form(b_form)

@@ -60,8 +60,7 @@ class ThesisSolver:
     escape: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
-        finite_number(self.singular_cond, "singular_cond", lower=1.0, inclusive=False,
-                      error=InvalidInput)  # fmt: skip
+        finite_number(self.singular_cond, "singular_cond", lower=1.0, inclusive=False)  # fmt: skip
         if self.escape is not None:
             kick = np.asarray(self.escape, dtype=float)
             if kick.ndim != 1 or not np.isfinite(kick).all() or not kick.any():
@@ -361,5 +360,5 @@ def check_q0(arm: Kinematics, q0: npt.ArrayLike) -> Array:
     Raises:
         InvalidInput: Wrong shape or non-finite.
     """
-    q: Array = as_vector(q0, "q0", arm.nq, InvalidInput).copy()
+    q: Array = as_vector(q0, "q0", arm.nq).copy()
     return q

@@ -86,7 +86,7 @@ def straight_line(
     Raises:
         InvalidInput: A bad ``goal``, ``q0``, ``steps``, ``solver`` or ``correction``, named.
     """
-    target = rigid_transform(goal, "goal", InvalidInput)
+    target = rigid_transform(goal, "goal")
     k = check_steps(steps)
     q = check_q0(arm, q0)
     return run_divisions(arm, q, divided_poses(arm.fk(q), target, k), 1, "twist", solver,
@@ -158,7 +158,7 @@ def straight_line_points(
             ``substeps``, ``b_form`` or ``closing``, named.
     """
     k = check_steps(steps)
-    gap = finite_number(spacing, "spacing", lower=0.0, inclusive=False, error=InvalidInput)
+    gap = finite_number(spacing, "spacing", lower=0.0, inclusive=False)
     goal = frames_from_points(goal_points, "goal_points")
     extra = check_closing(closing)
     if not callable(substeps):

@@ -33,10 +33,10 @@ def joint_rates(increments: npt.ArrayLike, hand_step: float, hand_speed: float) 
     Raises:
         InvalidInput: Non-finite input, or ``hand_step`` zero.
     """
-    D = as_array(increments, "increments", (None,) * np.ndim(increments), InvalidInput)
-    step = finite_number(hand_step, "hand_step", error=InvalidInput)
+    D = as_array(increments, "increments", (None,) * np.ndim(increments))
+    step = finite_number(hand_step, "hand_step")
     if step == 0.0:
         raise InvalidInput("hand_step", "the hand must move in the step (nonzero)")
-    speed = finite_number(hand_speed, "hand_speed", error=InvalidInput)
+    speed = finite_number(hand_speed, "hand_speed")
     out: Array = D / step * speed
     return out

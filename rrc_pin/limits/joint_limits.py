@@ -49,14 +49,13 @@ class JointLimits(Limit):
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
-        set_(self, "margin", finite_number(self.margin, "margin", 0.0, error=InvalidInput))
-        gain = finite_number(self.position_gain, "position_gain", 0.0, inclusive=False,
-                             error=InvalidInput)  # fmt: skip
+        set_(self, "margin", finite_number(self.margin, "margin", 0.0))
+        gain = finite_number(self.position_gain, "position_gain", 0.0, inclusive=False)  # fmt: skip
         if gain > 1.0:
             raise InvalidInput("position_gain", f"expected a number in (0, 1], got {gain}")
         set_(self, "position_gain", gain)
         if self.acceleration is not None:
-            a = real_array(self.acceleration, "acceleration", InvalidInput).reshape(-1).copy()
+            a = real_array(self.acceleration, "acceleration").reshape(-1).copy()
             if (
                 np.ndim(self.acceleration) > 1
                 or not np.isfinite(a).all()
@@ -67,7 +66,7 @@ class JointLimits(Limit):
             a.flags.writeable = False
             set_(self, "acceleration", a)
         if self.velocity is not None:
-            v = real_array(self.velocity, "velocity", InvalidInput).copy()
+            v = real_array(self.velocity, "velocity").copy()
             if v.ndim != 1 or not np.isfinite(v).all() or (v <= 0.0).any():
                 raise InvalidInput("velocity", f"expected finite limits > 0 (nq,), got {v}")
             v.flags.writeable = False
@@ -93,7 +92,7 @@ class JointLimits(Limit):
                 'velocity="0" or none); pass JointLimits(velocity=[...]) in rad/s or m/s',
             )
         if self.velocity is not None:
-            as_vector(self.velocity, "velocity", n, InvalidInput)
+            as_vector(self.velocity, "velocity", n)
         if self.acceleration is not None and np.size(self.acceleration) not in (1, n):
             raise InvalidInput("acceleration", f"expected a scalar or shape ({n},), got "
                                f"{np.shape(self.acceleration)}")  # fmt: skip

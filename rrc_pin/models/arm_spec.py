@@ -100,4 +100,4 @@ def check_parameters(values: dict[str, float]) -> dict[str, float]:
     Raises:
         InvalidInput: A value is not a finite real number, naming its parameter.
     """
-    return {key: finite_number(value, key, error=InvalidInput) for key, value in values.items()}
+    return {key: finite_number(value, key) for key, value in values.items()}

@@ -40,9 +40,9 @@ class LinkInertial:
     inertia: tuple[tuple[float, float, float], ...]
 
     def __post_init__(self) -> None:
-        finite_number(self.mass, "mass", error=InvalidInput, lower=0.0, inclusive=False)
-        as_array(self.com, "com", (3,), InvalidInput)
-        inertia = as_array(self.inertia, "inertia", (3, 3), InvalidInput)
+        finite_number(self.mass, "mass", lower=0.0, inclusive=False)
+        as_array(self.com, "com", (3,))
+        inertia = as_array(self.inertia, "inertia", (3, 3))
         if not np.allclose(inertia, inertia.T, rtol=0.0, atol=1e-12):
             raise InvalidInput("inertia", "must be symmetric")
         moments = np.linalg.eigvalsh(inertia)
@@ -101,8 +101,8 @@ def cylinder(mass: float, radius: float, end: npt.ArrayLike) -> LinkInertial:
         radius: Radius [m], > 0.
         end: Far end (3,) [m] of the axis, in the reference frame.
     """
-    radius = finite_number(radius, "radius", error=InvalidInput, lower=0.0, inclusive=False)
-    end = as_array(end, "end", (3,), InvalidInput)
+    radius = finite_number(radius, "radius", lower=0.0, inclusive=False)
+    end = as_array(end, "end", (3,))
     length = float(np.linalg.norm(end))
     u: npt.NDArray[np.float64]
     centre: npt.NDArray[np.float64]

@@ -31,7 +31,7 @@ def frame_from_points(points: npt.ArrayLike) -> npt.NDArray[np.float64]:
     Raises:
         InvalidInput: Wrong shape, non-finite, or the three points are (nearly) collinear.
     """
-    P = as_array(points, "points", (3, 3), InvalidInput)
+    P = as_array(points, "points", (3, 3))
     z = P[1] - P[0]
     x = P[2] - P[0]
     if np.linalg.norm(z) < 1e-12 or np.linalg.norm(np.cross(z, x)) < 1e-12 * np.linalg.norm(z):

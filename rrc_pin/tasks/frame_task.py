@@ -81,11 +81,11 @@ class FrameTask(Task):
         m = len(self.selected)
         size = np.shape(twist)
         if size == (6,) and m != 6:
-            return self.selected_rates(as_vector(twist, "twist", 6, InvalidInput))
+            return self.selected_rates(as_vector(twist, "twist", 6))
         if size != (m,):
             want = "(6,)" if m == 6 else f"(6,) or ({m},)"
             raise InvalidInput("twist", f"expected shape {want}, got {size}")
-        own: Array = as_vector(twist, "twist", m, InvalidInput).copy()
+        own: Array = as_vector(twist, "twist", m).copy()
         return own
 
     def selected_rates(self, twist: Array) -> Array:
@@ -99,7 +99,7 @@ class FrameTask(Task):
         Raises:
             InvalidInput: An unknown name, or ``world`` with partial rows.
         """
-        checked = check_reference(ref, InvalidInput)
+        checked = check_reference(ref)
         if checked == "world" and len(self.selected) != 6:
             raise InvalidInput(
                 "ref",

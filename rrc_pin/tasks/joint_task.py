@@ -30,7 +30,7 @@ class JointTask(Task):
         if not isinstance(joint, str):
             raise InvalidInput("joint", f"expected a joint name, got {joint!r}")
         self.joint = joint
-        self.rate = finite_number(rate, "rate", error=InvalidInput)
+        self.rate = finite_number(rate, "rate")
         self.weight = check_weight(weight)
         self.name = f"joint:{joint}" if name is None else task_name(name)
 

@@ -37,8 +37,8 @@ class PostureTask(Task):
         weight: float | npt.ArrayLike = 1.0,
         name: str = "posture",
     ) -> None:
-        self.q_ref = as_vector(q_ref, "q_ref", np.size(q_ref), InvalidInput)
-        self.gain = positive(gain, "gain", InvalidInput)
+        self.q_ref = as_vector(q_ref, "q_ref", np.size(q_ref))
+        self.gain = positive(gain, "gain")
         self.weight = check_weight(weight, self.q_ref.size)
         self.name = task_name(name)
 

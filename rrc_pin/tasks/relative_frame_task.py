@@ -69,8 +69,8 @@ class RelativeFrameTask(Task):
             name=f"{frame_b}/{frame_a}" if name is None else name,
         )  # fmt: skip
         self.frame_a, self.frame_b = frame_a, frame_b
-        self.target = None if target is None else rigid_transform(target, "target", InvalidInput)
-        self.gain = positive(gain, "gain", InvalidInput)
+        self.target = None if target is None else rigid_transform(target, "target")
+        self.gain = positive(gain, "gain")
         self.name = self._spec.name
 
     @property

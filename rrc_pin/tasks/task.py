@@ -60,10 +60,10 @@ def check_weight(weight: float | npt.ArrayLike, size: int | None = None) -> floa
         InvalidInput: Not positive, not finite, or the wrong shape.
     """
     if type(weight) is float or np.ndim(weight) == 0:
-        return finite_number(weight, "weight", 0.0, inclusive=False, error=InvalidInput)  # type: ignore[arg-type]
+        return finite_number(weight, "weight", 0.0, inclusive=False)  # type: ignore[arg-type]
     if size is None:
         raise InvalidInput("weight", f"expected a number > 0, got {weight!r}")
-    w: Array = as_vector(weight, "weight", size, InvalidInput).copy()  # the task's own
+    w: Array = as_vector(weight, "weight", size).copy()  # the task's own
     if (w <= 0.0).any():
         raise InvalidInput("weight", f"expected weights > 0, got {w}")
     return w

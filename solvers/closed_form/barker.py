@@ -36,49 +36,21 @@ values (2.8 % of random configurations within the limits), the wrist where
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
-from typing import Literal, NamedTuple
+from typing import Any, Literal, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form._batch import CHUNK, blocks
-from solvers.closed_form.barker_equations import (
-    BarkerGeometry,
-    FTerms,
-    Trig,
-    arm_from_m1,
-    arm_full,
-    arm_in_band,
-    arm_s2,
-    damped_solve,
-    det_adj2,
-    eq33,
-    f_terms,
-    hand_to_base_rows,
-    jacobian_rows,
-    m1_system,
-    m2_rows,
-    m_rotated,
-    m_rows,
-    rvel_tilde,
-    trig,
-    trig_batch,
-    truncated_solve,
-    tvel_frame2,
-    wrist_centre,
-    wrist_regular,
-    wrist_s2,
-    wrist_terms,
-)
-from solvers.closed_form.base import Array, ClosedForm, Entry, first, row, stack_entries
-from solvers.errors import InputError
+from solvers.closed_form import barker_equations as eqs
+from solvers.closed_form.barker_equations import BarkerGeometry, FTerms
+from solvers.closed_form.base import Array, ClosedForm, first, row, vector
+from solvers.errors import InvalidInput
 from solvers.validation import as_array, as_vector, finite_number
 
 Method = Literal["full", "reduced"]
 METHODS: tuple[str, ...] = ("full", "reduced")
 MIN_BAND = 1e-4
-"""Smallest ``band``: the damped normal equations lose about ``eps / band^2`` relative."""
+"""Smallest ``band``: the damped solves lose about ``eps / band^2`` relative."""
 
 
 class BarkerSingularity(NamedTuple):
@@ -93,51 +65,12 @@ class BarkerSingularity(NamedTuple):
         wrist_singular: Inside the wrist's band: the default path damps M2.
     """
 
-    eq32: Entry
-    eq33: Entry
-    s5: Entry
-    det_m: Entry
-    arm_singular: Entry
-    wrist_singular: Entry
-
-
-def _at(value: Entry, idx: npt.NDArray[np.intp]) -> Entry:
-    """``value[idx]`` for an array, ``value`` for a float (a constant entry)."""
-    return np.take(value, idx) if isinstance(value, np.ndarray) else value
-
-
-_Band = Callable[[], tuple[list[list[Entry]], Sequence[Entry], Entry]]
-"""A block's system in its band, built on demand: ``(A, b, s^2)`` of ``A x = b``."""
-
-
-def _solved(
-    closed: Callable[[], Sequence[Entry]], band: _Band, bad: Entry, eps: float, exact: bool,
-    repair: bool = True,
-) -> Sequence[Entry]:  # fmt: skip
-    """A block's rates: the closed form ``closed()`` outside its band, ``band()`` solved in it.
-
-    In the band by :func:`damped_solve`, or by :func:`truncated_solve` with ``exact``. One
-    configuration (Python floats, ``bad`` a bool): one answer or the other (the closed form
-    divides by zero on the singular set). A batch ((N,) arrays, ``bad`` (N,)): the closed
-    form at every row (inf or NaN in the band), then with ``repair`` the rows in the band
-    solved again.
-    """
-    if not isinstance(bad, np.ndarray):
-        if not bad:
-            return closed()
-        A, b, s2 = band()
-        if not exact:
-            return damped_solve(A, b, s2, eps)
-        return [v.item() for v in truncated_solve(A, b, eps, 1)]
-    out = closed()
-    idx = np.flatnonzero(bad) if repair else None
-    if idx is not None and idx.size:
-        A, b, s2 = band()
-        A, b = [[_at(v, idx) for v in r] for r in A], [_at(v, idx) for v in b]
-        x = truncated_solve(A, b, eps, idx.size) if exact else damped_solve(A, b, s2[idx], eps)
-        for o, xi in zip(out, x, strict=True):
-            o[idx] = xi
-    return out
+    eq32: Any
+    eq33: Any
+    s5: Any
+    det_m: Any
+    arm_singular: Any
+    wrist_singular: Any
 
 
 class BarkerClosedForm(ClosedForm):
@@ -147,6 +80,11 @@ class BarkerClosedForm(ClosedForm):
     axes of frame 6. Twists ``[TVEL^; RVEL^]`` are ``world_aligned`` (wrist-centre velocity
     and angular velocity in base axes); operator commands in hand axes (``local``) go through
     :meth:`hand_twist_to_base` (eq. (20)).
+
+    Every method is one call of a compiled kernel of
+    :mod:`~solvers.closed_form.barker_equations`; a ``_batch`` method loops over its rows
+    inside the kernel, and the other methods of one configuration are a batch of one, except
+    :meth:`jacobian` and :meth:`joint_rates`, which call their kernel directly.
 
     Args:
         no: Neck-to-base length NO = r1 [m].
@@ -160,7 +98,7 @@ class BarkerClosedForm(ClosedForm):
         band: Relative width of the damped singular neighbourhoods, in [1e-4, 0.5).
 
     Raises:
-        InputError: A parameter is not a finite number, or ``rcond``, ``band`` out of range,
+        InvalidInput: A parameter is not a finite number, or ``rcond``, ``band`` out of range,
             naming it.
     """
 
@@ -176,6 +114,7 @@ class BarkerClosedForm(ClosedForm):
         self.rcond = finite_number(rcond, "rcond", 0.0, upper=0.5)
         self.band = finite_number(band, "band", MIN_BAND, upper=0.5)
         self.geometry = BarkerGeometry.from_parameters(**checked)
+        self._p = eqs.parameters(self.geometry, self.band, self.rcond)
         scale = sum(abs(v) for k, v in checked.items() if k != "alpha3")
         self._has_reduced = abs(self.geometry.f2) > 1e-12 * scale  # eq. (39) divides by F2
 
@@ -186,37 +125,58 @@ class BarkerClosedForm(ClosedForm):
             f"r3={g.r3}, alpha3={g.alpha3}, rcond={self.rcond}, band={self.band})"
         )
 
-    def _eps(self, exact: bool) -> tuple[float, float]:
-        """Band of the arm [m] and of the wrist [1] (``rcond`` scaled for ``exact``)."""
-        width = self.rcond if exact else self.band
-        return width * self.geometry.reach, width
-
     def jacobian(self, q: npt.ArrayLike) -> Array:
         """Wrist-centre Jacobian (6, 6) at ``q`` (6,) [rad], rows [v; w], base axes (eq. (22)).
 
         Raises:
-            InputError: ``q`` is not a finite (6,) vector.
+            InvalidInput: ``q`` is not a finite (6,) vector.
         """
-        return np.array(jacobian_rows(self.geometry, trig(as_vector(q, "q", 6).tolist())))
+        qv = vector(q, "q", 6)
+        J = np.empty((6, 6))
+        if not eqs.jacobian_at(self._p, qv, J):
+            as_vector(q, "q", 6)  # raises, naming the entry
+        return J
 
     def jacobian_batch(self, Q: npt.ArrayLike) -> Array:
         """Wrist-centre Jacobians (N, 6, 6) at ``Q`` (N, 6) [rad], rows [v; w], base axes.
 
         Raises:
-            InputError: ``Q`` is not a finite (N, 6) array.
+            InvalidInput: ``Q`` is not a finite (N, 6) array.
         """
         Q = as_array(Q, "Q", (None, 6))
-        return stack_entries(jacobian_rows(self.geometry, trig_batch(Q)), Q.shape[0])
+        out = np.empty((Q.shape[0], 6, 6))
+        eqs.jacobian_batch(self._p, Q, out)
+        return out
+
+    def wrist_centre(self, q: npt.ArrayLike) -> Array:
+        """The wrist centre p06 (3,) [m] in base coordinates at ``q`` (6,) [rad]."""
+        return first(self.wrist_centre_batch(row(q, "q", 6)))
+
+    def wrist_centre_batch(self, Q: npt.ArrayLike) -> Array:
+        """The wrist centres (N, 3) [m] at ``Q`` (N, 6): ``(F7, F6, NO + F3)``.
+
+        Raises:
+            InvalidInput: ``Q`` is not a finite (N, 6) array.
+        """
+        Q = as_array(Q, "Q", (None, 6))
+        out = np.empty((Q.shape[0], 3))
+        eqs.wrist_centre_batch(self._p, Q, out)
+        return out
 
     def f_terms(self, q: npt.ArrayLike) -> FTerms:
         """F1..F7 (eqs (27)-(31), (41), (37)) [m] at ``q`` (6,), as floats."""
-        return FTerms(*(float(v[0]) for v in self.f_terms_batch(row(q, "q", 6))))
+        return FTerms(*self._f_terms(row(q, "q", 6))[0].tolist())
 
     def f_terms_batch(self, Q: npt.ArrayLike) -> FTerms:
         """F1..F7 [m] at ``Q`` (N, 6), each (N,)."""
+        return FTerms(*np.ascontiguousarray(self._f_terms(Q).T))
+
+    def _f_terms(self, Q: npt.ArrayLike) -> Array:
+        """F1..F7 [m] at ``Q`` (N, 6) as the columns of an (N, 7) array."""
         Q = as_array(Q, "Q", (None, 6))
-        F = f_terms(self.geometry, trig_batch(Q))
-        return F._replace(f2=np.full(Q.shape[0], F.f2))
+        out = np.empty((Q.shape[0], 7))
+        eqs.f_terms_batch(self._p, Q, out)
+        return out
 
     def m_matrix(self, q: npt.ArrayLike) -> Array:
         """Barker's M (3, 3) [m], eq. (26): ``TVEL^ = M thetadot_123``."""
@@ -225,8 +185,9 @@ class BarkerClosedForm(ClosedForm):
     def m_matrix_batch(self, Q: npt.ArrayLike) -> Array:
         """Barker's M at ``Q`` (N, 6): (N, 3, 3) [m]."""
         Q = as_array(Q, "Q", (None, 6))
-        t = trig_batch(Q)
-        return stack_entries(m_rows(t, f_terms(self.geometry, t)), Q.shape[0])
+        out = np.empty((Q.shape[0], 3, 3))
+        eqs.m_matrix_batch(self._p, Q, out)
+        return out
 
     def det_m(self, q: npt.ArrayLike) -> float:
         """Determinant of M [m^3] in the factored form of eq. (D9)."""
@@ -239,71 +200,15 @@ class BarkerClosedForm(ClosedForm):
     def singularity(self, q: npt.ArrayLike) -> BarkerSingularity:
         """Values of conditions (32), (33) and S5 at ``q`` (6,), as Python scalars."""
         s = self.singularity_batch(row(q, "q", 6))
-        return BarkerSingularity(*(v[0].item() for v in s))
+        return BarkerSingularity(*(np.asarray(v)[0].item() for v in s))
 
     def singularity_batch(self, Q: npt.ArrayLike) -> BarkerSingularity:
         """Values of conditions (32), (33) and S5 at ``Q`` (N, 6), each (N,); band flags."""
         Q = as_array(Q, "Q", (None, 6))
-        g, t = self.geometry, trig_batch(Q)
-        F = f_terms(g, t)
-        det, adj2 = det_adj2(g, t, F)
-        eps_arm, eps_wrist = self._eps(exact=False)
-        return BarkerSingularity(
-            eq32=F.f1, eq33=eq33(g, t), s5=t.s5, det_m=det,
-            arm_singular=arm_in_band(det, adj2, eps_arm),
-            wrist_singular=wrist_s2(t) <= eps_wrist * eps_wrist,
-        )  # fmt: skip
-
-    def _arm(
-        self, t: Trig, tvel: Sequence[Entry], reduced: bool, exact: bool, repair: bool = True
-    ) -> tuple[Sequence[Entry], Entry]:
-        """thetadot_1..3 by the closed form, and whether in the arm's band (floats or (N,) each).
-
-        In the band (:func:`_solved`): eq. (38) or eq. (44), by :func:`damped_solve` or
-        :func:`truncated_solve`; for a batch without ``repair`` those rows are meaningless
-        (inf or NaN).
-        """
-        g = self.geometry
-        F = f_terms(g, t)
-        eps = self._eps(exact)[0]
-        if reduced:  # eqs (39), (44)
-            A, b, ta = m1_system(t, F, tvel)
-            det = A[0][0] * A[1][1] - A[0][1] * A[1][0]
-            fro2 = sum(v * v for r in A for v in r)  # ||adj M1||_F^2 of the 2x2 M1
-            bad = arm_in_band(det, fro2, eps)
-            th23 = _solved(lambda: ((A[1][1] * b[0] - A[0][1] * b[1]) / det,
-                                    (A[0][0] * b[1] - A[1][0] * b[0]) / det),
-                           lambda: (A, b, arm_s2(det, fro2)), bad, eps, exact, repair)  # fmt: skip
-            return arm_from_m1(F, th23[0], th23[1], ta), bad
-        det, adj2 = det_adj2(g, t, F)
-        bad = arm_in_band(det, adj2, eps)
-        out = _solved(lambda: arm_full(t, F, det, tvel),
-                      lambda: (*m_rotated(t, F, tvel), arm_s2(det, adj2)),  # eq. (38)
-                      bad, eps, exact, repair)  # fmt: skip
-        return out, bad
-
-    def _wrist(
-        self, t: Trig, rt: Sequence[Entry], exact: bool, repair: bool = True
-    ) -> tuple[Sequence[Entry], Entry]:
-        """thetadot_4..6 from RVEL~ by eqs (49)-(51), and whether in the wrist's band.
-
-        In the band (:func:`_solved`): M2 (eq. (60)).
-        """
-        th5, ga, gb = wrist_terms(self.geometry, t, rt)
-        eps = self._eps(exact)[1]
-        s2 = wrist_s2(t)
-        bad = s2 <= eps * eps
-        th46 = _solved(lambda: wrist_regular(t, ga, gb), lambda: (m2_rows(t), (ga, gb), s2), bad,
-                       eps, exact, repair)  # fmt: skip
-        return [th46[0], th5, th46[1]], bad
-
-    def _rates(
-        self, t: Trig, x: Sequence[Entry], reduced: bool, exact: bool, repair: bool
-    ) -> tuple[list[Entry], Entry]:
-        """Rates at ``t`` for ``x`` (6 floats or (N,) arrays): arm, eq. (48), wrist; bad rows."""
-        arm, arm_bad = self._arm(t, x[:3], reduced, exact, repair)
-        wrist, wrist_bad = self._wrist(t, rvel_tilde(t, arm, x[3:]), exact, repair)
-        return [*arm, *wrist], arm_bad | wrist_bad
+        values = np.empty((4, Q.shape[0])).T  # columns stored apart: each field contiguous
+        flags = np.empty((2, Q.shape[0]), dtype=np.bool_).T
+        eqs.singularity_batch(self._p, Q, values, flags)
+        return BarkerSingularity(*values.T, *flags.T)
 
     def arm_rates(
         self, q: npt.ArrayLike, tvel: npt.ArrayLike, method: Method = "full", exact: bool = False
@@ -314,7 +219,7 @@ class BarkerClosedForm(ClosedForm):
         base axes. In the arm's band: damped, or M* / M1* with ``exact`` (module docstring).
 
         Raises:
-            InputError: Bad ``q``, ``tvel`` or ``method``.
+            InvalidInput: Bad ``q``, ``tvel`` or ``method``.
         """
         return first(self.arm_rates_batch(row(q, "q", 6), row(tvel, "tvel", 3), method, exact))
 
@@ -325,8 +230,9 @@ class BarkerClosedForm(ClosedForm):
         reduced = self._reduced(method)
         Q = as_array(Q, "Q", (None, 6))
         T = as_array(TVEL, "TVEL", (Q.shape[0], 3))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.stack(self._arm(trig_batch(Q), list(T.T), reduced, exact)[0], axis=1)
+        out = np.empty((Q.shape[0], 3))
+        eqs.arm_rates_batch(self._p, Q, T, reduced, bool(exact), out)
+        return out
 
     def rvel_tilde(self, q: npt.ArrayLike, arm_rates: npt.ArrayLike, rvel: npt.ArrayLike) -> Array:
         """RVEL~ = RVEL^ - z0 thetadot_1 - z1 thetadot_2 - z2 thetadot_3 (eq. (48)), (3,)."""
@@ -341,7 +247,9 @@ class BarkerClosedForm(ClosedForm):
         Q = as_array(Q, "Q", (None, 6))
         A = as_array(ARM, "ARM", (Q.shape[0], 3))
         R = as_array(RVEL, "RVEL", (Q.shape[0], 3))
-        return np.stack(rvel_tilde(trig_batch(Q), list(A.T), list(R.T)), axis=1)
+        out = np.empty((Q.shape[0], 3))
+        eqs.rvel_tilde_batch(Q, A, R, out)
+        return out
 
     def wrist_rates(
         self, q: npt.ArrayLike, rvel_tilde: npt.ArrayLike, exact: bool = False
@@ -352,7 +260,7 @@ class BarkerClosedForm(ClosedForm):
         damped, or M2* (eq. (60)) with ``exact`` (``pinv(W, rcond) @ rvel_tilde``).
 
         Raises:
-            InputError: Bad ``q`` or ``rvel_tilde``.
+            InvalidInput: Bad ``q`` or ``rvel_tilde``.
         """
         return first(self.wrist_rates_batch(row(q, "q", 6), row(rvel_tilde, "rvel_tilde", 3),
                                             exact))  # fmt: skip
@@ -363,8 +271,9 @@ class BarkerClosedForm(ClosedForm):
         """Batch :meth:`wrist_rates`: ``Q`` (N, 6), ``RVEL_TILDE`` (N, 3) -> (N, 3) [rad/s]."""
         Q = as_array(Q, "Q", (None, 6))
         R = as_array(RVEL_TILDE, "RVEL_TILDE", (Q.shape[0], 3))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return np.stack(self._wrist(trig_batch(Q), list(R.T), exact)[0], axis=1)
+        out = np.empty((Q.shape[0], 3))
+        eqs.wrist_rates_batch(self._p, Q, R, bool(exact), out)
+        return out
 
     def joint_rates(
         self, q: npt.ArrayLike, xdot: npt.ArrayLike, method: Method = "full", exact: bool = False
@@ -385,13 +294,15 @@ class BarkerClosedForm(ClosedForm):
             ``1 / band`` times the command inside them (``exact``: finite, never NaN).
 
         Raises:
-            InputError: Bad ``q``, ``xdot`` or ``method``.
+            InvalidInput: Bad ``q``, ``xdot`` or ``method``.
         """
         reduced = self._reduced(method)
-        qv, xv = as_vector(q, "q", 6), as_vector(xdot, "xdot", 6)
-        # One configuration on Python floats: 9 us (16 us in a band) against 64 us for the
-        # batch path on one row (measured; 5 of the 9 us are the two argument checks).
-        return np.array(self._rates(trig(qv.tolist()), xv.tolist(), reduced, exact, True)[0])
+        qv, xv = vector(q, "q", 6), vector(xdot, "xdot", 6)
+        out = np.empty(6)
+        if not eqs.joint_rates_at(self._p, qv, xv, reduced, bool(exact), out):
+            as_vector(q, "q", 6)  # one of the two raises, naming the entry
+            as_vector(xdot, "xdot", 6)
+        return out
 
     def joint_rates_batch(
         self, Q: npt.ArrayLike, X: npt.ArrayLike, method: Method = "full", exact: bool = False
@@ -399,47 +310,12 @@ class BarkerClosedForm(ClosedForm):
         """Batch :meth:`joint_rates`: ``Q`` (N, 6), ``X`` (N, 6) -> (N, 6) [rad/s].
 
         Raises:
-            InputError: Bad ``Q``, ``X`` or ``method``.
+            InvalidInput: Bad ``Q``, ``X`` or ``method``.
         """
         reduced = self._reduced(method)
         Q, X = self._check_batch(Q, X)
         out = np.empty((Q.shape[0], 6))
-        bad = np.empty(Q.shape[0], dtype=bool)
-        # Cosines and sines in buffers reused by every block: 20 % of the batch time saved
-        # (measured), the page faults of fresh 320 kB arrays.
-        buffers = (np.empty(5 * CHUNK), np.empty(5 * CHUNK))
-
-        def rates(Qr: Array, Xr: Array, repair: bool) -> tuple[list[Entry], Entry]:
-            t, x = trig_batch(Qr, out=buffers), list(np.ascontiguousarray(Xr.T))
-            return self._rates(t, x, reduced, exact, repair)
-
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            for rows in blocks(Q.shape[0]):
-                values, bad[rows] = rates(Q[rows], X[rows], False)
-                for j, v in enumerate(values):
-                    out[rows, j] = v
-            idx = np.flatnonzero(bad)  # in a band: solved again, in blocks of their own
-            for part in blocks(idx.size):
-                i = idx[part]  # np.take: a third of the time of Q[i] (measured)
-                out[i] = np.stack(rates(np.take(Q, i, 0), np.take(X, i, 0), True)[0], axis=1)
-        return out
-
-    def wrist_centre(self, q: npt.ArrayLike) -> Array:
-        """The wrist centre p06 (3,) [m] in base coordinates at ``q`` (6,) [rad]."""
-        return first(self.wrist_centre_batch(row(q, "q", 6)))
-
-    def wrist_centre_batch(self, Q: npt.ArrayLike) -> Array:
-        """The wrist centres (N, 3) [m] at ``Q`` (N, 6): ``(F7, F6, NO + F3)``.
-
-        Raises:
-            InputError: ``Q`` is not a finite (N, 6) array.
-        """
-        Q = as_array(Q, "Q", (None, 6))
-        t = trig_batch(Q)
-        out: Array = np.stack(
-            np.broadcast_arrays(*wrist_centre(self.geometry, t, f_terms(self.geometry, t))),
-            axis=1,
-        )
+        eqs.joint_rates_batch(self._p, Q, X, reduced, bool(exact), out)
         return out
 
     def hand_to_base(self, q: npt.ArrayLike) -> Array:
@@ -449,7 +325,9 @@ class BarkerClosedForm(ClosedForm):
     def hand_to_base_batch(self, Q: npt.ArrayLike) -> Array:
         """R0_6 at ``Q`` (N, 6): (N, 3, 3)."""
         Q = as_array(Q, "Q", (None, 6))
-        return stack_entries(hand_to_base_rows(self.geometry, trig_batch(Q, six=True)), len(Q))
+        out = np.empty((Q.shape[0], 3, 3))
+        eqs.hand_to_base_batch(self._p, Q, out)
+        return out
 
     def hand_twist_to_base(self, q: npt.ArrayLike, twist: npt.ArrayLike) -> Array:
         """Operator command ``[TVEL; RVEL]`` (6,) in hand axes -> base axes, eq. (20)."""
@@ -470,15 +348,17 @@ class BarkerClosedForm(ClosedForm):
         """Batch :meth:`tvel_frame2`: ``Q`` (N, 6), ``TVEL`` (N, 3) -> (N, 3) [m/s]."""
         Q = as_array(Q, "Q", (None, 6))
         T = as_array(TVEL, "TVEL", (Q.shape[0], 3))
-        return np.stack(tvel_frame2(trig_batch(Q), list(T.T)), axis=1)
+        out = np.empty((Q.shape[0], 3))
+        eqs.tvel_frame2_batch(Q, T, out)
+        return out
 
     def _reduced(self, method: str) -> bool:
         if method == "full":
             return False
         if method != "reduced":
-            raise InputError("method", f"expected one of {', '.join(METHODS)}, got {method!r}")
+            raise InvalidInput("method", f"expected one of {', '.join(METHODS)}, got {method!r}")
         if not self._has_reduced:
-            raise InputError(
+            raise InvalidInput(
                 "method", "the reduced path divides by F2 = SN + R3 + cos(alpha3) WE = 0"
             )
         return True

@@ -32,7 +32,7 @@ import numpy as np
 import numpy.typing as npt
 
 from solvers.closed_form.base import first
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 from solvers.validation import as_array
 
 Array = npt.NDArray[np.float64]
@@ -47,7 +47,7 @@ def quaternion_from_matrix(R: npt.ArrayLike) -> Array:
     (N, 4), ``eta >= 0``.
 
     Raises:
-        InputError: ``R`` has the wrong shape, a non-finite entry, or is not a rotation
+        InvalidInput: ``R`` has the wrong shape, a non-finite entry, or is not a rotation
             (tolerance :data:`ORTHONORMAL_TOL`).
     """
     Rs, single = _stack(R, "R", (3, 3))
@@ -56,7 +56,7 @@ def quaternion_from_matrix(R: npt.ArrayLike) -> Array:
     bad = (np.abs(gram).max(axis=(1, 2)) > ORTHONORMAL_TOL) | (np.abs(det - 1.0) > ORTHONORMAL_TOL)
     if np.any(bad):
         i = int(np.argmax(bad))
-        raise InputError(
+        raise InvalidInput(
             "R", f"expected a rotation matrix (orthonormal, det +1); item {i} has det {det[i]:.6g}"
         )
     r11, r12, r13 = Rs[:, 0, 0], Rs[:, 0, 1], Rs[:, 0, 2]
@@ -101,12 +101,12 @@ def matrix_from_quaternion(q: npt.ArrayLike) -> Array:
     ``[eta, beta, gamma, xi]`` (4,) or (N, 4), nonzero -> rotation matrix (3, 3) or (N, 3, 3).
 
     Raises:
-        InputError: Wrong shape, non-finite entries, or a zero quaternion.
+        InvalidInput: Wrong shape, non-finite entries, or a zero quaternion.
     """
     qs, single = _stack(q, "q", (4,))
     norm2 = np.einsum("ni,ni->n", qs, qs)
     if np.any(norm2 == 0.0):
-        raise InputError("q", "expected a nonzero quaternion")
+        raise InvalidInput("q", "expected a nonzero quaternion")
     eta, s = qs[:, 0], qs[:, 1:]
     R = (eta * eta - np.einsum("ni,ni->n", s, s))[:, None, None] * np.eye(3)
     R += 2.0 * s[:, :, None] * s[:, None, :]
@@ -126,7 +126,7 @@ def quaternion_difference(q1: npt.ArrayLike, q2: npt.ArrayLike) -> Array:
     sign-normalised: ``delta eta`` may be < 0).
 
     Raises:
-        InputError: Wrong or mismatched shapes, non-finite entries.
+        InvalidInput: Wrong or mismatched shapes, non-finite entries.
     """
     a, single = _stack(q1, "q1", (4,))
     b = as_array(q2, "q2", np.shape(q1))
@@ -148,7 +148,7 @@ def differential_rotation(dq: npt.ArrayLike) -> Array:
     quaternion of the orientation difference, (4,) or (N, 4); returns (3,) or (N, 3) [rad].
 
     Raises:
-        InputError: Wrong shape or non-finite entries.
+        InvalidInput: Wrong shape or non-finite entries.
     """
     qs, single = _stack(dq, "dq", (4,))
     sign = np.where(qs[:, :1] < 0.0, -1.0, 1.0)
@@ -162,12 +162,12 @@ def rotation_vector(dq: npt.ArrayLike) -> Array:
     ``theta`` in [0, pi]; ``dq`` (4,) or (N, 4), nonzero (normalised here).
 
     Raises:
-        InputError: Wrong shape, non-finite entries, or a zero quaternion.
+        InvalidInput: Wrong shape, non-finite entries, or a zero quaternion.
     """
     qs, single = _stack(dq, "dq", (4,))
     norm = np.linalg.norm(qs, axis=1)
     if np.any(norm == 0.0):
-        raise InputError("dq", "expected a nonzero quaternion")
+        raise InvalidInput("dq", "expected a nonzero quaternion")
     qs = qs * (np.where(qs[:, :1] < 0.0, -1.0, 1.0) / norm[:, None])
     sin_half = np.linalg.norm(qs[:, 1:], axis=1)
     theta = 2.0 * np.arctan2(sin_half, qs[:, 0])
@@ -191,7 +191,7 @@ def small_rotation(delta: npt.ArrayLike) -> Array:
     (N, 3, 3).
 
     Raises:
-        InputError: Wrong shape or non-finite entries.
+        InvalidInput: Wrong shape or non-finite entries.
     """
     d, single = _stack(delta, "delta", (3,))
     out = np.eye(3) + _skew(d)
@@ -211,7 +211,7 @@ def _stack(x: npt.ArrayLike, name: str, item: tuple[int, ...]) -> tuple[Array, b
     """``x`` as a stack (N, *item) and whether it was a single item.
 
     Raises:
-        InputError: Neither shape ``item`` nor (N, *item), or non-finite entries.
+        InvalidInput: Neither shape ``item`` nor (N, *item), or non-finite entries.
     """
     try:
         ndim = np.ndim(x)

@@ -25,34 +25,27 @@ the rank-one ``M`` there: the rates are then the minimum-norm least-squares ones
 O(rcond)), finite, never NaN.
 
 ``J_A`` has constant rank 2, null space ``span{(0, 1, -1)}`` (exam, step 5).
+
+The equations are compiled kernels of :mod:`solvers.closed_form.three_r_equations`; a batch
+method loops over its rows inside the kernel.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form._batch import blocks, cos_sin
-from solvers.closed_form.base import Array, ClosedForm, Entry, first, stack_entries
-from solvers.errors import InputError
+from solvers.closed_form import three_r_equations as eqs
+from solvers.closed_form.base import Array, ClosedForm, first, vector
+from solvers.errors import InvalidInput
 from solvers.validation import as_array, as_vector, finite_number
 
 DEFAULT_RCOND = 1e-9
 """Relative threshold below which ``r`` or ``det M`` counts as singular (module docstring)."""
 _NULL = (0.0, math.sqrt(0.5), -math.sqrt(0.5))
-Terms = tuple[Entry, Entry, Entry, Entry, Entry, Entry, Entry]
-"""``(c1, s1, r, h, c23, s23, s3)`` of one configuration (floats) or N ((N,) arrays)."""
-
-
-def _select(condition: Entry, a: Entry, b: Entry) -> Entry:
-    """``a`` where ``condition`` holds, else ``b`` (floats or arrays)."""
-    if isinstance(condition, np.ndarray):
-        return np.where(condition, a, b)
-    return a if condition else b
 
 
 class AngularRates(NamedTuple):
@@ -87,7 +80,7 @@ class ThreeRClosedForm(ClosedForm):
         rcond: Relative singularity threshold in (0, 1) (module docstring).
 
     Raises:
-        InputError: A length not finite, ``a1 < 0``, ``a2 <= 0``, ``a3 <= 0``, or ``rcond``
+        InvalidInput: A length not finite, ``a1 < 0``, ``a2 <= 0``, ``a3 <= 0``, or ``rcond``
             outside (0, 1), naming it.
     """
 
@@ -99,51 +92,10 @@ class ThreeRClosedForm(ClosedForm):
         self.a2 = finite_number(a2, "a2", 0.0, inclusive=False)
         self.a3 = finite_number(a3, "a3", 0.0, inclusive=False)
         self.rcond = finite_number(rcond, "rcond", 0.0, inclusive=False, upper=1.0)
-        self._reach = self.a1 + self.a2 + self.a3
+        self._p = np.array([self.a1, self.a2, self.a3, self.a1 + self.a2 + self.a3])
 
     def __repr__(self) -> str:
         return f"ThreeRClosedForm(a1={self.a1}, a2={self.a2}, a3={self.a3})"
-
-    def _terms(self, c: Sequence[Entry], s: Sequence[Entry]) -> Terms:
-        """``(c1, s1, r, h, c23, s23, s3)`` from the cosines ``c`` and sines ``s`` of q."""
-        c23 = c[1] * c[2] - s[1] * s[2]
-        s23 = s[1] * c[2] + c[1] * s[2]
-        r = self.a1 + self.a2 * c[1] + self.a3 * c23
-        return c[0], s[0], r, self.a2 * s[1] + self.a3 * s23, c23, s23, s[2]
-
-    def _jacobian_rows(self, t: Terms) -> list[list[Entry]]:
-        """Rows of ``J_L`` (exam, above eq. (1)) [m/rad]."""
-        c1, s1, r, h, c23, s23, _ = t
-        a3s23 = self.a3 * s23
-        return [[-r * s1, -h * c1, -a3s23 * c1], [r * c1, -h * s1, -a3s23 * s1],
-                [0.0, r - self.a1, self.a3 * c23]]  # fmt: skip
-
-    def _rates(self, t: Terms, v: Sequence[Entry]) -> tuple[Entry, Entry, Entry]:
-        """``J_L^-1 v`` [rad/s], the pseudo-inverse answer at singularities (module docstring)."""
-        c1, s1, r, h, c23, s23, s3 = t
-        vt = c1 * v[1] - s1 * v[0]  # tangential
-        vu = c1 * v[0] + s1 * v[1]  # radial
-        m00, m01, m10, m11 = -h, -self.a3 * s23, r - self.a1, self.a3 * c23
-        det = self.a2 * self.a3 * s3
-        frob = m00 * m00 + m01 * m01 + m10 * m10 + m11 * m11
-        on_axis = abs(r) <= self.rcond * self._reach
-        rank_one = abs(det) <= self.rcond * frob  # then M^+ = M^T / ||M||_F^2
-        d = _select(rank_one, frob, det)
-        return (
-            _select(on_axis, 0.0, vt / _select(on_axis, 1.0, r)),
-            _select(rank_one, m00 * vu + m10 * v[2], m11 * vu - m01 * v[2]) / d,
-            _select(rank_one, m01 * vu + m11 * v[2], m00 * v[2] - m10 * vu) / d,
-        )
-
-    def _scalar_terms(self, q: npt.ArrayLike) -> Terms:
-        """:meth:`_terms` of one configuration ``q`` (3,), validated, on Python floats."""
-        qs = as_vector(q, "q", 3).tolist()
-        return self._terms([math.cos(v) for v in qs], [math.sin(v) for v in qs])
-
-    def _batch_terms(self, Q: Array) -> Terms:
-        """:meth:`_terms` of ``Q`` (N, 3), (N,) arrays."""
-        C, S = cos_sin(np.ascontiguousarray(Q.T))
-        return self._terms(list(C), list(S))
 
     def jacobian(self, q: npt.ArrayLike) -> Array:
         """Linear Jacobian ``J_L`` (3, 3) [m/rad] of O3 at ``q`` (3,) [rad] (exam, above eq. (1)).
@@ -151,15 +103,19 @@ class ThreeRClosedForm(ClosedForm):
         ``world_aligned``: the first three rows of Pinocchio's Jacobian.
 
         Raises:
-            InputError: ``q`` is not a finite (3,) vector.
+            InvalidInput: ``q`` is not a finite (3,) vector.
         """
-        return np.array(self._jacobian_rows(self._scalar_terms(q)))
+        qv = vector(q, "q", 3)
+        J = np.empty((3, 3))
+        if not eqs.jacobian_at(self._p, qv, J):
+            as_vector(q, "q", 3)  # raises, naming the entry
+        return J
 
     def angular_jacobian(self, q: npt.ArrayLike) -> Array:
         """Angular Jacobian ``J_A = (z0 z1 z2)`` (exam eq. (1)), (3, 3), base axes.
 
         Raises:
-            InputError: ``q`` is not a finite (3,) vector.
+            InvalidInput: ``q`` is not a finite (3,) vector.
         """
         return first(self.angular_jacobian_batch(as_vector(q, "q", 3)[None]))
 
@@ -167,7 +123,7 @@ class ThreeRClosedForm(ClosedForm):
         """``[J_L; J_A]``, (6, 3), rows [v; w], ``world_aligned`` (Pinocchio's full Jacobian).
 
         Raises:
-            InputError: ``q`` is not a finite (3,) vector.
+            InvalidInput: ``q`` is not a finite (3,) vector.
         """
         return np.vstack([self.jacobian(q), self.angular_jacobian(q)])
 
@@ -178,12 +134,14 @@ class ThreeRClosedForm(ClosedForm):
         answer of the module docstring.
 
         Raises:
-            InputError: ``q`` or ``xdot`` not a finite (3,) vector.
+            InvalidInput: ``q`` or ``xdot`` not a finite (3,) vector.
         """
-        t = self._scalar_terms(q)
-        # One configuration on Python floats: 7 us against 46 us for the batch path on one row
-        # (measured; 5 us are the two argument checks).
-        return np.array(self._rates(t, as_vector(xdot, "xdot", 3).tolist()))
+        qv, xv = vector(q, "q", 3), vector(xdot, "xdot", 3)
+        out = np.empty(3)
+        if not eqs.joint_rates_at(self._p, self.rcond, qv, xv, out):
+            as_vector(q, "q", 3)  # one of the two raises, naming the entry
+            as_vector(xdot, "xdot", 3)
+        return out
 
     def angular_velocity(self, q: npt.ArrayLike, qdot: npt.ArrayLike) -> Array:
         """Angular velocity ``omega = J_A thetadot`` (3,) [rad/s] of frame 3, base axes.
@@ -191,7 +149,7 @@ class ThreeRClosedForm(ClosedForm):
         ``q`` (3,) [rad], ``qdot`` (3,) [rad/s] (exam eq. (1), step 4).
 
         Raises:
-            InputError: ``q`` or ``qdot`` not a finite (3,) vector.
+            InvalidInput: ``q`` or ``qdot`` not a finite (3,) vector.
         """
         return self.angular_jacobian(q) @ as_vector(qdot, "qdot", 3)
 
@@ -199,7 +157,7 @@ class ThreeRClosedForm(ClosedForm):
         """Unit vector (3,) spanning N(J_A): ``(0, 1, -1) / sqrt(2)`` at every ``q`` (step 5).
 
         Raises:
-            InputError: ``q`` is not a finite (3,) vector.
+            InvalidInput: ``q`` is not a finite (3,) vector.
         """
         as_vector(q, "q", 3)
         return np.array(_NULL)
@@ -214,54 +172,48 @@ class ThreeRClosedForm(ClosedForm):
         ``q`` (3,) [rad]; ``omega`` (3,) [rad/s], base axes.
 
         Raises:
-            InputError: ``q`` or ``omega`` not a finite (3,) vector.
+            InvalidInput: ``q`` or ``omega`` not a finite (3,) vector.
         """
-        q0 = float(as_vector(q, "q", 3)[0])
-        wx, wy, wz = as_vector(omega, "omega", 3).tolist()
-        c1, s1 = math.cos(q0), math.sin(q0)
-        beta = s1 * wx - c1 * wy
+        qv, w = as_vector(q, "q", 3), as_vector(omega, "omega", 3)
+        beta, residual = eqs.angular_split(qv[0], w[0], w[1])
         return AngularRates(
-            particular=np.array([wz, beta, 0.0]),
+            particular=np.array([w[2], beta, 0.0]),
             null_direction=np.array(_NULL),
-            minimum_norm=np.array([wz, 0.5 * beta, 0.5 * beta]),
-            residual=abs(c1 * wx + s1 * wy),
+            minimum_norm=np.array([w[2], 0.5 * beta, 0.5 * beta]),
+            residual=float(residual),
         )
 
     def jacobian_batch(self, Q: npt.ArrayLike) -> Array:
         """``J_L`` at N configurations: ``Q`` (N, 3) -> (N, 3, 3); see :meth:`jacobian`.
 
         Raises:
-            InputError: ``Q`` is not a finite (N, 3) array.
+            InvalidInput: ``Q`` is not a finite (N, 3) array.
         """
         Q = as_array(Q, "Q", (None, 3))
-        return stack_entries(self._jacobian_rows(self._batch_terms(Q)), Q.shape[0])
+        out = np.empty((Q.shape[0], 3, 3))
+        eqs.jacobian_batch(self._p, Q, out)
+        return out
 
     def angular_jacobian_batch(self, Q: npt.ArrayLike) -> Array:
         """``J_A`` at N configurations: ``Q`` (N, 3) -> (N, 3, 3).
 
         Raises:
-            InputError: ``Q`` is not a finite (N, 3) array.
+            InvalidInput: ``Q`` is not a finite (N, 3) array.
         """
         Q = as_array(Q, "Q", (None, 3))
-        c1, s1 = np.cos(Q[:, 0]), np.sin(Q[:, 0])
-        return stack_entries([[0.0, s1, s1], [0.0, -c1, -c1], [1.0, 0.0, 0.0]], Q.shape[0])
+        out = np.empty((Q.shape[0], 3, 3))
+        eqs.angular_jacobian_batch(self._p, Q, out)
+        return out
 
     def joint_rates_batch(self, Q: npt.ArrayLike, X: npt.ArrayLike) -> Array:
         """``J_L^-1 v`` at N configurations: ``Q``, ``X`` (N, 3) -> (N, 3) [rad/s].
 
-        The arithmetic of :meth:`joint_rates`, in blocks of :data:`~_batch.CHUNK` rows.
-
         Raises:
-            InputError: ``Q`` or ``X`` not a finite (N, 3) array.
+            InvalidInput: ``Q`` or ``X`` not a finite (N, 3) array.
         """
         Q, X = self._check_batch(Q, X)
         out = np.empty((Q.shape[0], 3))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            for rows in blocks(Q.shape[0]):
-                x = list(np.ascontiguousarray(X[rows].T))
-                rates = self._rates(self._batch_terms(Q[rows]), x)
-                for j, v in enumerate(rates):
-                    out[rows, j] = v
+        eqs.joint_rates_batch(self._p, self.rcond, Q, X, out)
         return out
 
 
@@ -274,12 +226,12 @@ def minimum_norm_shift(qdot: npt.ArrayLike, direction: npt.ArrayLike) -> float:
     ``qdot`` per unit of ``direction``.
 
     Raises:
-        InputError: Non-finite or mismatched vectors, or a zero ``direction``.
+        InvalidInput: Non-finite or mismatched vectors, or a zero ``direction``.
     """
     d = as_array(direction, "direction", (None,))
     v = as_vector(qdot, "qdot", d.shape[0])
     dd = float(d @ d)
     if dd == 0.0:
-        raise InputError("direction", "expected a nonzero vector")
+        raise InvalidInput("direction", "expected a nonzero vector")
     return -float(v @ d) / dd
 

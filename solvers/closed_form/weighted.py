@@ -19,7 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from solvers.closed_form.base import Array
-from solvers.errors import InputError
+from solvers.errors import InvalidInput
 from solvers.factorization import RANK_TOL  # the default rcond
 from solvers.validation import as_array, as_vector, finite_number
 
@@ -36,7 +36,7 @@ def weight_factor(W: npt.ArrayLike | None, n: int, name: str = "W") -> Array | N
         None for the identity, else the lower-triangular factor (n, n).
 
     Raises:
-        InputError: Wrong shape, non-finite, non-positive diagonal, or not symmetric
+        InvalidInput: Wrong shape, non-finite, non-positive diagonal, or not symmetric
             positive definite, naming ``name``.
     """
     if W is None:
@@ -44,15 +44,15 @@ def weight_factor(W: npt.ArrayLike | None, n: int, name: str = "W") -> Array | N
     if np.ndim(W) == 1:
         w = as_vector(W, name, n)
         if np.any(w <= 0.0):
-            raise InputError(name, f"expected weights > 0, got {w}")
+            raise InvalidInput(name, f"expected weights > 0, got {w}")
         return np.diag(np.sqrt(w)).astype(np.float64)
     Wm = as_array(W, name, (n, n))
     if not np.allclose(Wm, Wm.T, rtol=1e-12, atol=1e-12 * np.abs(Wm).max()):
-        raise InputError(name, "expected a symmetric matrix")
+        raise InvalidInput(name, "expected a symmetric matrix")
     try:
         L = np.asarray(np.linalg.cholesky(Wm), dtype=np.float64)
     except np.linalg.LinAlgError as exc:
-        raise InputError(name, "expected a positive definite matrix") from exc
+        raise InvalidInput(name, "expected a positive definite matrix") from exc
     return L
 
 
@@ -77,7 +77,7 @@ def weighted_pseudo_inverse(
         :math:`J_W^+`, shape (n, m).
 
     Raises:
-        InputError: Wrong shapes, non-finite entries, invalid ``W`` or ``rcond``, naming it.
+        InvalidInput: Wrong shapes, non-finite entries, invalid ``W`` or ``rcond``, naming it.
     """
     J = as_array(J, "J", (None, None))
     rcond = finite_number(rcond, "rcond", 0.0, upper=1.0)
@@ -105,7 +105,7 @@ def weighted_rates(
         Joint rates (n,).
 
     Raises:
-        InputError: Wrong shapes, non-finite entries, invalid ``W`` or ``rcond``, naming it.
+        InvalidInput: Wrong shapes, non-finite entries, invalid ``W`` or ``rcond``, naming it.
     """
     J = as_array(J, "J", (None, None))
     b = as_vector(xdot, "xdot", J.shape[0])
@@ -125,7 +125,7 @@ def null_space_projector(
     row rank, and for a rank-deficient J it removes the components :math:`J_W^+` reaches.
 
     Raises:
-        InputError: Wrong shapes, non-finite entries, invalid ``W`` or ``rcond``, naming it.
+        InvalidInput: Wrong shapes, non-finite entries, invalid ``W`` or ``rcond``, naming it.
     """
     J = as_array(J, "J", (None, None))
     return np.eye(J.shape[1]) - weighted_pseudo_inverse(J, W, rcond) @ J

@@ -40,10 +40,9 @@ from rrc_pin.control.strategies.barker_arm import (
     nearness,
 )
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
-from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
 from solvers.closed_form.barker import BarkerClosedForm
-from solvers.closed_form.barker_equations import f_terms, trig, turn1
+from solvers.closed_form.barker_equations import f_terms, joint_trig, turn1
 from solvers.validation import finite_number
 
 AT_SINGULAR = 1e-9
@@ -67,9 +66,9 @@ class AuxiliaryHand(Strategy):
     chooses_rates = True
 
     def __init__(self, k3: float = 20.0, k2: float = 1.0, region: float = 0.05) -> None:
-        self.k3 = -finite_number(k3, "k3", 0.0, False, error=InvalidInput)
-        self.k2 = finite_number(k2, "k2", 0.0, error=InvalidInput)
-        self.region = finite_number(region, "region", 0.0, False, 0.5, InvalidInput)
+        self.k3 = -finite_number(k3, "k3", 0.0, False)
+        self.k2 = finite_number(k2, "k2", 0.0)
+        self.region = finite_number(region, "region", 0.0, False, 0.5)
         self.inside = False
         self.entries = 0
         self.closed_form: BarkerClosedForm | None = None
@@ -102,7 +101,7 @@ class AuxiliaryHand(Strategy):
         else:  # outward with the elbow bent: straighten, stopping at the singular point
             th3 = -math.copysign(min(abs(self.k3 * tx2), abs(offset) / situation.dt), offset)
         th2 = (-g.we * th3 + self.k2 * ty2) / (g.we + g.es)  # eq. (46)
-        t = trig(q.tolist())
+        t = joint_trig(q)
         F = f_terms(g, t)
         lateral = turn1(t, twist[0], twist[1])[1]  # -F1 thetadot_1: only theta1 moves it
         th1 = -lateral / F.f1 if abs(F.f1) > AT_SINGULAR else 0.0

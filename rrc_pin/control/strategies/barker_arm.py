@@ -11,7 +11,7 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
 from solvers.closed_form.barker import BarkerClosedForm
-from solvers.closed_form.barker_equations import eq33, f_terms, trig
+from solvers.closed_form.barker_equations import eq33, f_terms, joint_trig
 
 Array = npt.NDArray[np.float64]
 
@@ -52,7 +52,7 @@ def nearness(cf: BarkerClosedForm, q: Array) -> Nearness:
     path on one row; measured), for every tick of a controller.
     """
     g = cf.geometry
-    t = trig(q.tolist())
+    t = joint_trig(q)
     return Nearness(abs(f_terms(g, t).f1) / g.reach, abs(eq33(g, t)) / g.reach, abs(t.s5))
 
 

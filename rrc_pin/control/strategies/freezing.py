@@ -13,7 +13,6 @@ from __future__ import annotations
 
 from rrc_pin.control.strategies.barker_arm import barker_closed_form, nearness
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
-from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
 from solvers.closed_form.barker import BarkerClosedForm
 from solvers.validation import finite_number
@@ -38,7 +37,7 @@ class Freezing(Strategy):
     chooses_rates = True
 
     def __init__(self, region: float = 0.02) -> None:
-        self.region = finite_number(region, "region", 0.0, False, 0.5, InvalidInput)
+        self.region = finite_number(region, "region", 0.0, False, 0.5)
         self.closed_form: BarkerClosedForm | None = None
 
     def check(self, robot: Robot) -> None:

@@ -58,10 +58,10 @@ class Slowdown(Strategy):
                 "measure", f"expected 'sigma_min' or 'manipulability', got {measure!r}"
             )
         self.measure: Measure = measure
-        self.stop = finite_number(stop, "stop", 0.0, error=InvalidInput)
-        self.start = finite_number(start, "start", self.stop, inclusive=False, error=InvalidInput)
-        self.rate = finite_number(rate, "rate", 0.0, inclusive=False, error=InvalidInput)
-        self.release = finite_number(release, "release", 1.0, error=InvalidInput)
+        self.stop = finite_number(stop, "stop", 0.0)
+        self.start = finite_number(start, "start", self.stop, inclusive=False)
+        self.rate = finite_number(rate, "rate", 0.0, inclusive=False)
+        self.release = finite_number(release, "release", 1.0)
         self.engaged = False
 
     def reset(self) -> None:

@@ -14,10 +14,9 @@ import numpy as np
 
 from rrc_pin.control.strategies.barker_arm import barker_closed_form
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
-from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
 from solvers.closed_form.barker import BarkerClosedForm
-from solvers.closed_form.barker_equations import trig, wrist_terms
+from solvers.closed_form.barker_equations import joint_trig, wrist_equations
 from solvers.validation import finite_number
 
 
@@ -36,8 +35,8 @@ class WristChoice(Strategy):
     chooses_rates = True
 
     def __init__(self, region: float = 0.05, margin: float = 0.0) -> None:
-        self.region = finite_number(region, "region", 0.0, False, 0.5, InvalidInput)
-        self.margin = finite_number(margin, "margin", 0.0, error=InvalidInput)
+        self.region = finite_number(region, "region", 0.0, False, 0.5)
+        self.margin = finite_number(margin, "margin", 0.0)
         self.closed_form: BarkerClosedForm | None = None
 
     def check(self, robot: Robot) -> None:
@@ -48,12 +47,12 @@ class WristChoice(Strategy):
         """The closed form's rates, with the roll on theta6 (or theta4) in the wrist region."""
         cf = self.closed_form or barker_closed_form(situation.robot, self.name)
         q, twist = situation.q, situation.twist
-        t = trig(q.tolist())
+        t = joint_trig(q)
         if abs(t.s5) >= self.region:
             return Decision(rates=cf.joint_rates(q, twist))
         arm = cf.arm_rates(q, twist[:3])
         rvel = cf.rvel_tilde(q, arm, twist[3:])
-        th5, _, roll = wrist_terms(cf.geometry, t, rvel.tolist())  # eqs (49), (61)
+        th5, _, roll = wrist_equations(cf.geometry, t, *rvel.tolist())  # eqs (49), (61)
         robot = situation.robot
         next6 = q[5] + roll * situation.dt
         at_limit = not (robot.lower[5] + self.margin <= next6 <= robot.upper[5] - self.margin)
