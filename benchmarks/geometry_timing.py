@@ -1,6 +1,7 @@
 """Proximity per tick (rrc_pin.geometry) against computing every pair, and the hull build cost.
 
-Run from a checkout: ``PYTHONPATH=. python benchmarks/geometry_timing.py`` (``--ticks N``, default 2000).
+Run from a checkout: ``PYTHONPATH=. python benchmarks/geometry_timing.py`` (``--ticks N``,
+default 2000).
 Prints a Markdown table (the one docs/api.md records) and the conditions: CPU, load, versions.
 
 Scenes (detection distance 0.10 m):
@@ -41,12 +42,12 @@ from pathlib import Path
 
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import numpy as np  # noqa: E402
-import pinocchio as pin  # noqa: E402
+import numpy as np
+import pinocchio as pin
 
-import rrc_pin  # noqa: E402
-from rrc_pin.geometry import CollisionModel  # noqa: E402
-from rrc_pin.kinematics import Kinematics, Layout  # noqa: E402
+import rrc_pin
+from rrc_pin.geometry import CollisionModel
+from rrc_pin.kinematics import Kinematics, Layout
 
 DETECTION = 0.10
 SPREAD = 0.6
@@ -105,7 +106,7 @@ def run(ticks: int) -> list[str]:
         for q in configurations(robot, ticks):
             q_pin = robot.to_pinocchio(q)
             kin = Kinematics(model, pdata, layout, q, q_pin)
-            kin.data  # the resolver's tasks have computed it
+            _ = kin.data  # the resolver's tasks have computed it
             start = time.perf_counter()
             prox = cm.proximity(kin, data, DETECTION)
             times["prox"].append(time.perf_counter() - start)

@@ -1,5 +1,5 @@
-"""solvers.proximity_kernels: the compiled forward kinematics and bounding-sphere test, against numpy
-references (1e-12) and Pinocchio."""
+"""solvers.proximity_kernels: the compiled forward kinematics and bounding-sphere test, against
+numpy references (1e-12) and Pinocchio."""
 
 from __future__ import annotations
 

@@ -150,7 +150,7 @@ class CollisionModel:
         """A sphere of ``radius`` [m] at a centre (3,) or pose (4, 4) in the world; its name."""
         arr = np.asarray(center_or_T) if not isinstance(center_or_T, np.ndarray) else center_or_T
         if arr.shape == (3,):
-            pose = pin.SE3(np.eye(3), as_array(arr, "center_or_T", (3,), InvalidInput).copy())
+            pose = pin.SE3(np.eye(3), as_array(arr, "center_or_T", (3,)).copy())
         else:
             pose = _pose(center_or_T, "center_or_T")
         return self._add_world("sphere", shapes.sphere(radius), pose, name)
@@ -278,8 +278,8 @@ class CollisionModel:
             frame: The frame held inside (default: the robot's tool frame).
             name: The group's name (default: ``workspace`` and a number).
         """
-        pose = rigid_transform(T, "T", InvalidInput)
-        sides = as_array(size, "size", (3,), InvalidInput)
+        pose = rigid_transform(T, "T")
+        sides = as_array(size, "size", (3,))
         if np.any(sides <= 0.0):
             raise InvalidInput("size", f"expected three sides > 0 [m], got {sides.tolist()}")
         held = self._wall_frame(frame)
@@ -294,10 +294,10 @@ class CollisionModel:
 
         World frame, [m]. ``normal`` need not be unit (both are divided by its norm).
         """
-        n = as_array(normal, "normal", (3,), InvalidInput)
+        n = as_array(normal, "normal", (3,))
         if float(np.linalg.norm(n)) < 1e-12:
             raise InvalidInput("normal", f"expected a non-zero vector, got {n.tolist()}")
-        d = finite_number(offset, "offset", error=InvalidInput)
+        d = finite_number(offset, "offset")
         held = self._wall_frame(frame)
         with self._lock:
             label = self._new_name("wall", name)
@@ -352,7 +352,7 @@ class CollisionModel:
         if not isinstance(data, CollisionData):
             raise InvalidInput("data", f"expected cm.create_data()'s, got {type(data).__name__}")
         if not (type(detection) is float and 0.0 <= detection < np.inf):  # 1 us saved a tick
-            detection = finite_number(detection, "detection", 0.0, error=InvalidInput)
+            detection = finite_number(detection, "detection", 0.0)
         return query(self._scene, self.robot.model, q, placed, data, detection)
 
     # -- internals --------------------------------------------------------------------------
@@ -411,5 +411,5 @@ class CollisionModel:
 
 def _pose(T: npt.ArrayLike, name: str) -> pin.SE3:
     """``T`` checked as a (4, 4) rigid transform, as a ``pinocchio.SE3``."""
-    M = rigid_transform(T, name, InvalidInput)
+    M = rigid_transform(T, name)
     return pin.SE3(M[:3, :3].copy(), M[:3, 3].copy())

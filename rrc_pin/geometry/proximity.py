@@ -5,8 +5,8 @@ The steps, in the order data flows:
 1. the joint placements of the tick, from q by the compiled forward kinematics of
    :mod:`~rrc_pin.geometry.tree` (or read from Pinocchio's ``data.oMi`` for a model it does
    not cover);
-2. the broad phase (:mod:`solvers.proximity_kernels`, compiled): bounding-sphere centres in the world,
-   and the pairs whose distance bound is below the detection distance;
+2. the broad phase (:mod:`solvers.proximity_kernels`, compiled): bounding-sphere centres in
+   the world, and the pairs whose distance bound is below the detection distance;
 3. the narrow phase for those candidates only: ``pinocchio.updateGeometryPlacements``, then
    ``pinocchio.computeDistance`` per candidate (coal: signed distance, EPA in penetration),
    keeping those below the detection distance.

@@ -37,7 +37,8 @@ class KinematicTree(NamedTuple):
         parent: Parent joint (nj,).
         rotation: Joint placement rotations (nj, 3, 3) in the parent joint's frame.
         translation: Joint placement translations (nj, 3) [m].
-        kind: :data:`~solvers.proximity_kernels.REVOLUTE` or :data:`~solvers.proximity_kernels.PRISMATIC`.
+        kind: :data:`~solvers.proximity_kernels.REVOLUTE` or
+            :data:`~solvers.proximity_kernels.PRISMATIC`.
         axis: Unit axes (nj, 3) in the joint's frame.
         coordinate: The coordinate of q (one per joint, the API's) that moves the joint.
     """
