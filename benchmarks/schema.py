@@ -21,6 +21,7 @@ from typing import Any
 
 KNOWN = (
     "closed_form", "resolver", "tasks", "study", "scaling", "controller", "control_schemes", "maps",
+    "collision",
 )
 MACHINE = ("cpu", "cores", "python", "numpy", "pinocchio")
 STATS = ("median_us", "p10_us", "p90_us", "p99_us")
@@ -49,6 +50,7 @@ def problems(results: dict[str, Any]) -> list[str]:
         "controller": _controller,
         "control_schemes": _control_schemes,
         "maps": _maps,
+        "collision": _collision,
     }[name]
     out += list(check(results))
     return out
@@ -240,6 +242,19 @@ def _maps(results: dict[str, Any]) -> Iterator[str]:
     confirmed = (results.get("audit") or {}).get("confirmed")
     if not (_finite(confirmed) and 0.0 <= confirmed <= 1.0):
         yield "audit.confirmed: expected a share in [0, 1]"
+
+
+def _collision(results: dict[str, Any]) -> Iterator[str]:
+    rows = results.get("rows") or []
+    if not rows:
+        yield "rows: empty"
+    for r in rows:
+        where = f"rows.{r.get('contender')}.{r.get('pairs')}"
+        for key in ("median_us", "p99_us", "pairs"):
+            if not _positive(r.get(key)):
+                yield f"{where}.{key}: expected a positive number"
+        if not isinstance(r.get("min_distance_m"), (int, float)):
+            yield f"{where}.min_distance_m: expected a number"
 
 
 def _finite(value: Any) -> bool:

@@ -1,7 +1,8 @@
 """rrc-pin: Pinocchio-backed resolved-rate control of robot arms.
 
 Entry points: :func:`arms`, :func:`load`, :class:`Robot`; :class:`Resolver` with its options
-(:class:`JointLimits`, :class:`QPOptions`, :class:`Damping`), tasks (:class:`FrameTask`,
+(:class:`JointLimits`, :class:`CollisionLimit` on a :class:`CollisionModel`,
+:class:`QPOptions`, :class:`Damping`), tasks (:class:`FrameTask`,
 :class:`RelativeFrameTask`, :class:`PostureTask`, :class:`JointTask`, :class:`DampingTask`)
 and its answer, :class:`Resolution`; the teleoperation loop :class:`Controller` (with
 :class:`Deadman`, :class:`DriftCorrection`, :class:`TrajectoryLog`; strategies in
@@ -19,7 +20,8 @@ from rrc_pin.errors import (
     UnknownBackend,
     URDFError,
 )
-from rrc_pin.limits import JointLimits, Limit
+from rrc_pin.geometry import CollisionModel
+from rrc_pin.limits import CollisionLimit, JointLimits, Limit
 from rrc_pin.loading import arms, load
 from rrc_pin.resolver import QPOptions, Resolver
 from rrc_pin.robot import Robot
@@ -39,6 +41,8 @@ from solvers.resolution import ActiveLimit, ActiveRow, Resolution, TaskReport
 __all__ = [
     "ActiveLimit",
     "ActiveRow",
+    "CollisionLimit",
+    "CollisionModel",
     "Constraints",
     "Controller",
     "Damping",

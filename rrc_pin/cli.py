@@ -320,6 +320,7 @@ BENCHMARKS = (
     "controller",
     "control_schemes",
     "maps",
+    "collision",
 )
 BENCH_MODULES = {
     "closed_form": ("matplotlib",),
@@ -330,6 +331,7 @@ BENCH_MODULES = {
     "controller": ("matplotlib",),
     "control_schemes": ("matplotlib",),
     "maps": ("distributed", "zarr", "matplotlib"),
+    "collision": ("pink", "mink", "mujoco", "matplotlib"),
 }
 """What each benchmark needs from the bench extra (placo and mink are optional: their rows are
 skipped when they are absent)."""

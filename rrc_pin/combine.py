@@ -13,11 +13,15 @@ resolver's tasks and limits apply to it unchanged (a frame task per tool frame, 
 - Tool frames: the prefixed tool frames of every arm, in order.
 - Sparsity: arms share no joint, so the Jacobian of one arm's frame has zero columns for
   every other arm's joints (block-sparse).
+- Parts: the result is a :class:`Combined` robot that keeps its arms and their placements
+  (:attr:`Combined.parts`), so that :class:`rrc_pin.geometry.CollisionModel` carries the
+  collision geometry of every arm at its base (names prefixed like the frames).
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -28,7 +32,36 @@ from rrc_pin.robot import Robot
 from solvers.validation import rigid_transform
 
 
-def combine(arms: Mapping[str, tuple[Robot, npt.ArrayLike]], name: str | None = None) -> Robot:
+class Part(NamedTuple):
+    """One arm of a :class:`Combined` robot.
+
+    Attributes:
+        key: Its key: the prefix of its names (``left`` gives ``left/...``).
+        robot: The arm as it was given.
+        T_base: Pose (4, 4) of its base in the cell's base frame [m].
+    """
+
+    key: str
+    robot: Robot
+    T_base: npt.NDArray[np.float64]
+
+
+class Combined(Robot):
+    """A :class:`Robot` made by :func:`combine`, that remembers its arms.
+
+    Attributes:
+        parts: The arms, in the order of q, each with its key and base placement.
+    """
+
+    def __init__(self, model: pin.Model, tool_frames: Sequence[str], *, name: str, source: str,
+                 poses: Mapping[str, npt.ArrayLike], parts: Sequence[Part]) -> None:  # fmt: skip
+        super().__init__(model, tool_frames, name=name, source=source, poses=poses)
+        self.parts: tuple[Part, ...] = tuple(parts)
+
+
+def combine(
+    arms: Mapping[str, tuple[Robot, npt.ArrayLike]], name: str | None = None
+) -> Combined:
     """One robot made of ``arms``, each at its base placement.
 
     Args:
@@ -38,8 +71,9 @@ def combine(arms: Mapping[str, tuple[Robot, npt.ArrayLike]], name: str | None = 
         name: Name of the result; default: the keys joined by ``+``.
 
     Returns:
-        A :class:`Robot` with ``tool_frames`` the prefixed tool frames of every arm, and as
-        its ready configuration the arms' (:meth:`Robot.ready`) side by side.
+        A :class:`Combined` robot with ``tool_frames`` the prefixed tool frames of every arm,
+        as its ready configuration the arms' (:meth:`Robot.ready`) side by side, and its
+        arms in :attr:`Combined.parts`.
 
     Raises:
         InvalidInput: ``arms`` is empty or not a mapping, a key is not a non-empty name
@@ -60,18 +94,21 @@ def combine(arms: Mapping[str, tuple[Robot, npt.ArrayLike]], name: str | None = 
     tools: list[str] = []
     parts: list[str] = []
     ready = []
+    kept: list[Part] = []
     for key, value in arms.items():
         robot, placement = _entry(key, value)
         model = pin.appendModel(model, _prefixed(robot.model, f"{key}/"), 0, placement)
         tools += [f"{key}/{frame}" for frame in robot.tool_frames]
         parts.append(f"{key}: {robot.name}")
         ready.append(robot.ready())
-    return Robot(
+        kept.append(Part(key, robot, placement.homogeneous))
+    return Combined(
         model,
         tools,
         name=name if name is not None else "+".join(arms),
         source=f"combine({', '.join(parts)})",
         poses={"ready": np.concatenate(ready)},
+        parts=kept,
     )
 
 

@@ -16,6 +16,13 @@ The top level of the ``direction`` mode (:mod:`solvers.direction`, :mod:`solvers
    condition number is below the damping threshold;
 3. beyond it, the damped rates scaled along themselves (``damped``, the veer reported).
 
+Before 2, where the exact rates cross a constraint row marked ``slide`` (a collision pair, which
+the command should slide along rather than stop at), the command is first projected onto what
+the slide rows and the box allow, :math:`b' = A\dot q^*` with :math:`\dot q^*` the least
+squares of :math:`A\dot q \approx b` within them (:mod:`solvers.least_squares`), and 1-2 run on
+:math:`b'` (``sliding``, the veer from :math:`b` reported). Without a crossed slide row nothing
+changes: exact answers stay exact (0 veer).
+
 A least-squares level (the other modes, and every lower level): its unconstrained optimum
 (:mod:`solvers.least_squares`) when it satisfies the constraints, else the backend's QP.
 
@@ -54,7 +61,8 @@ then the fallbacks (:mod:`solvers.fallbacks`)."""
 METHODS: tuple[Method, ...] = ("qp", "scipy", "scaling", "hold")
 
 Status = Literal[
-    "exact", "partial", "scaled", "damped", "singular", "least_squares", "recovering", "fallback"
+    "exact", "partial", "scaled", "sliding", "damped", "singular", "least_squares", "recovering",
+    "fallback",
 ]
 """What the answer is (docs/api.md, "Reading a resolution"):
 
@@ -62,6 +70,10 @@ Status = Literal[
 - ``partial``: the top level is met, a lower one only in part (see ``levels``);
 - ``scaled``: the top level's direction is kept exactly, its speed reduced (``scale < 1``)
   to the largest the constraints allow;
+- ``sliding``: the exact rates crossed a row the command may slide along (a collision pair):
+  the command was replaced by what those rows and the box let it keep (its least squares
+  within them), whose direction is then kept (met, or scaled); ``veer`` is the angle turned
+  from the command, ``scale`` the fraction of the command achieved along it;
 - ``damped``: near a singularity (the rows' condition number beyond the damping threshold)
   the command could not be met and its damped rates were scaled instead: the motion veers
   from the command by ``veer``;
@@ -253,14 +265,32 @@ def _top(
         z = factor.least_norm(b)
         w = z @ space.N
         fits = kernels.inside(w, box.lb, box.ub)
+    slid = False
+    slide = None if rows is None else rows.sliding
+    if slide is not None and not kernels.rows_hold(slide.G, w, slide.h, 0.0):
+        # the exact rates cross a row the command may slide along: the command becomes what
+        # the slide rows and the box let it keep (the rest of the pipeline is unchanged)
+        try:
+            kept, _ = least_squares(A, b, space, box, slide, backend, work, "slide", False)
+        except (NumericalFailure, np.linalg.LinAlgError) as exc:
+            work.attempts.append(("slide", f"{exc}; the command kept as given"))
+        else:
+            b, slid = A @ kept, True
+            z = factor.least_norm(b)
+            w = z if space.N is None else z @ space.N
+            fits = kernels.inside(w, box.lb, box.ub)
     outside_range = not factor.regular and not _met(factor.J @ z, b)
     if fits and (rows is None or kernels.rows_hold(rows.G, w, rows.h, 0.0)):
         null = _null(factor, space) if len(problem.levels) > 1 else None
+        if slid:
+            return _Top(w, "sliding", *_along_command(problem, w), 0.0, null)
         if outside_range:
             return _Top(w, "singular", *_along_command(problem, w), 0.0, null)
         return _Top(w, "exact", 1.0, 0.0, 0.0, null)
     null = _null(factor, space)
     u_w = _scaled(A, w, null, box, rows, backend, work)
+    if slid:
+        return _Top(u_w.qdot, "sliding", *_along_command(problem, u_w.qdot), 0.0, null)
     if not outside_range and u_w.u >= 1.0 - EXACT_TOL:
         return _Top(u_w.qdot, "exact", 1.0, 0.0, 0.0, null)
     lam, usable = _damping(options.damping, factor, b, w, u_w.u, box, problem.dt, space.N is None)

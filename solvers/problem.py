@@ -99,6 +99,11 @@ class Constraints(NamedTuple):
         C: Equality rows (r, n), ``C qdot = d``, or None.
         d: Their rates (r,).
         names: One name per row of G, then of C, for the report.
+        slide: Per row of G (p,), whether the top level's command may slide along it (a
+            collision pair: the command loses its component into the row, not its speed along
+            the rest; :mod:`solvers.pipeline`), or None for none.
+        distance: Per row of G (p,), the distance [m] the row keeps (a collision pair's signed
+            distance, reported with the active rows), NaN where none, or None.
     """
 
     box: Box | None = None
@@ -107,14 +112,35 @@ class Constraints(NamedTuple):
     C: Array | None = None
     d: Array | None = None
     names: tuple[str, ...] = ()
+    slide: npt.NDArray[np.bool_] | None = None
+    distance: Array | None = None
 
 
 class Rows(NamedTuple):
-    """Constraint rows ``G qdot <= h`` of a problem, named."""
+    """Constraint rows ``G qdot <= h`` of a problem, named.
+
+    Attributes:
+        G: Rows (p, n).
+        h: Bounds (p,).
+        names: One name per row.
+        slide: Mask (p,) of the rows the top level's command may slide along, or None (none).
+        distance: The distance [m] each row keeps (NaN where none), or None.
+    """
 
     G: Array
     h: Array
     names: tuple[str, ...]
+    slide: npt.NDArray[np.bool_] | None = None
+    distance: Array | None = None
+
+    @property
+    def sliding(self) -> Rows | None:
+        """The rows the command may slide along, or None."""
+        if self.slide is None or not self.slide.any():
+            return None
+        keep = self.slide
+        names = tuple(n for n, k in zip(self.names, keep.tolist(), strict=True) if k)
+        return Rows(self.G[keep], self.h[keep], names)
 
 
 class Problem(NamedTuple):
@@ -304,14 +330,25 @@ def _rows(constraints: Sequence[Constraints]) -> Rows | None:
     Gs: list[Array] = []
     hs: list[Array] = []
     names: list[str] = []
+    slides: list[npt.NDArray[np.bool_]] = []
+    distances: list[Array] = []
     for c in constraints:
         if c.G is not None and c.h is not None and c.h.size:
             Gs.append(c.G)
             hs.append(c.h)
             names += c.names[: c.h.size]
+            slides.append(np.zeros(c.h.size, bool) if c.slide is None else c.slide)
+            distances.append(np.full(c.h.size, np.nan) if c.distance is None else c.distance)
     if not hs:
         return None
-    return Rows(np.vstack(Gs), np.concatenate(hs), tuple(names))
+    if len(hs) == 1:
+        c = next(c for c in constraints if c.h is not None and c.h.size)
+        return Rows(Gs[0], hs[0], tuple(names), c.slide, c.distance)
+    slide = np.concatenate(slides)
+    distance = np.concatenate(distances)
+    return Rows(np.vstack(Gs), np.concatenate(hs), tuple(names),
+                slide if slide.any() else None,
+                None if np.isnan(distance).all() else distance)  # fmt: skip
 
 
 def _equalities(

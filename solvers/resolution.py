@@ -60,12 +60,14 @@ class ActiveRow(NamedTuple):
         row: Its index among the problem's rows.
         value: ``g qdot`` [the row's units].
         bound: ``h``.
+        distance: The distance [m] the row keeps (a collision pair's signed distance), or NaN.
     """
 
     name: str
     row: int
     value: float
     bound: float
+    distance: float = math.nan
 
 
 class TaskReport(NamedTuple):
@@ -165,10 +167,12 @@ class Resolution(_Record):
         if rows is None:
             return ()
         values = rows.G @ self.qdot
+        distance = rows.distance
         return tuple(
-            ActiveRow(rows.names[i], i, float(values[i]), float(rows.h[i]))
+            ActiveRow(rows.names[i], i, float(values[i]), float(rows.h[i]),
+                      math.nan if distance is None else float(distance[i]))
             for i in np.flatnonzero(values >= rows.h - ACTIVE_TOL).tolist()
-        )
+        )  # fmt: skip
 
     @cached_property
     def tasks(self) -> tuple[TaskReport, ...]:

@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 
 import rrc_pin
-from rrc_pin.combine import combine
+from rrc_pin.combine import Combined, combine
 from rrc_pin.cross_check import finite_difference_jacobians
 from rrc_pin.errors import InvalidInput, ToolFrameRequired
 
@@ -143,3 +143,12 @@ def test_the_ready_pose_is_the_arms_side_by_side(cell):
     want = np.concatenate([arm.ready() for arm, _ in arms.values()])
     np.testing.assert_array_equal(robot.ready(), want)
     np.testing.assert_array_equal(robot.poses["ready"], want)
+
+
+def test_the_result_keeps_its_arms_and_their_placements(cell):
+    arms, robot = cell
+    assert isinstance(robot, Combined)
+    assert [p.key for p in robot.parts] == list(arms)
+    for part, (arm, T) in zip(robot.parts, arms.values(), strict=True):
+        assert part.robot is arm
+        np.testing.assert_allclose(part.T_base, T, atol=1e-15)

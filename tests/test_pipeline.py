@@ -383,3 +383,60 @@ def test_damping_only_past_the_threshold(rng: np.random.Generator, monkeypatch) 
         assert answer.status == "scaled" and answer.veer <= 1e-9
     assert calls == []
     assert pipeline_module.EXACT_TOL == 1e-9
+
+
+# -- slide rows (collision pairs): the command loses its component into them, not its speed --
+
+
+def plane_problem(slide: bool | None, b: tuple[float, float, float]) -> Problem:
+    """Three joints moving a point (A = I); a floor row -qdot_z <= 0 (no approach)."""
+    n = 3
+    free = np.full(n, 2.0)
+    box = Box(-free, free.copy(), np.zeros((2, n), np.int8), True, False, free.copy())
+    rows = Constraints(
+        G=np.array([[0.0, 0.0, -1.0]]), h=np.array([0.0]), names=("hand|floor",),
+        slide=None if slide is None else np.array([slide]), distance=np.array([0.02]),
+    )  # fmt: skip
+    task = TaskRows(np.eye(n), np.array(b), None, "hand")
+    return build([[task]], [Constraints(box), rows], n, DT)
+
+
+def test_a_slide_row_keeps_the_tangential_component_of_a_command_into_it() -> None:
+    answer = solve(plane_problem(True, (0.1, 0.05, -0.1)), make_backend("daqp"), Options())
+    assert answer.status == "sliding"
+    # to the least-squares QP's tie-break (solvers.least_squares.TIE_BREAK times 3, relative)
+    assert np.allclose(answer.qdot, (0.1, 0.05, 0.0), rtol=1e-5, atol=1e-12)
+    tangential = np.hypot(0.1, 0.05)
+    assert answer.veer == pytest.approx(np.arctan2(0.1, tangential), abs=1e-9)
+    assert answer.scale == pytest.approx(tangential**2 / (tangential**2 + 0.01), rel=1e-5)
+
+
+def test_a_row_without_the_slide_flag_still_scales_the_command_to_a_stop() -> None:
+    for flag in (None, False):
+        answer = solve(plane_problem(flag, (0.1, 0.05, -0.1)), make_backend("daqp"), Options())
+        assert answer.status == "scaled"
+        assert np.allclose(answer.qdot, 0.0, atol=1e-12)
+
+
+def test_a_slide_row_not_crossed_changes_nothing() -> None:
+    for b in ((0.1, 0.05, 0.1), (0.1, 0.0, 0.0), (3.0, 0.0, 1.0)):
+        plain = solve(plane_problem(None, b), make_backend("daqp"), Options())
+        slid = solve(plane_problem(True, b), make_backend("daqp"), Options())
+        assert slid.status == plain.status and slid.veer == plain.veer == 0.0
+        assert np.array_equal(slid.qdot, plain.qdot)
+
+
+def test_sliding_keeps_the_box_by_scaling_the_kept_command() -> None:
+    answer = solve(plane_problem(True, (4.0, 0.0, -1.0)), make_backend("daqp"), Options())
+    assert answer.status == "sliding"
+    assert np.allclose(answer.qdot, (2.0, 0.0, 0.0), rtol=1e-5, atol=1e-12)  # the box's 2 along x
+    assert answer.qdot[2] >= -1e-12
+
+
+def test_sliding_reports_the_pair_and_its_distance() -> None:
+    from solvers.resolution import Resolution
+
+    problem = plane_problem(True, (0.1, 0.0, -0.1))
+    answer = solve(problem, make_backend("daqp"), Options())
+    (row,) = Resolution.of(problem, answer, 0.0, None).active_rows
+    assert row.name == "hand|floor" and row.distance == 0.02 and row.bound == 0.0

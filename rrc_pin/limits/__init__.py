@@ -1,6 +1,7 @@
 """Limits of a resolution, one per module: each gives a box and named constraint rows a tick."""
 
+from rrc_pin.limits.collision import CollisionLimit
 from rrc_pin.limits.joint_limits import JointLimits
 from rrc_pin.limits.limit import Limit
 
-__all__ = ["JointLimits", "Limit"]
+__all__ = ["CollisionLimit", "JointLimits", "Limit"]

@@ -39,6 +39,9 @@ class ArmSpec:
         inertials: One :class:`LinkInertial` per link, each in the DH frame i attached to link
             i (standard: at its far joint; modified: at its own joint), or empty for the
             placeholder inertia of :mod:`rrc_pin.urdf_export`.
+        collision_radii: Radius of each link's collision capsules (nq,) [m], > 0, or empty for
+            none; the capsules follow the DH offsets (:mod:`rrc_pin.link_capsules`). The
+            papers give no link widths: every arm records its radii as assumed.
     """
 
     name: str
@@ -53,11 +56,17 @@ class ArmSpec:
     closed_form: Callable[[], ClosedForm] | None = None
     parameters: dict[str, float] = field(default_factory=dict)
     inertials: tuple[LinkInertial, ...] = ()
+    collision_radii: tuple[float, ...] = ()
 
     def __post_init__(self) -> None:
         n = self.chain.nq
         if self.inertials and len(self.inertials) != n:
             raise InvalidInput("inertials", f"expected {n} links, got {len(self.inertials)}")
+        radii = np.asarray(self.collision_radii, dtype=float)
+        if radii.size and (radii.shape != (n,) or not np.all(np.isfinite(radii) & (radii > 0))):
+            raise InvalidInput(
+                "collision_radii", f"expected {n} finite radii > 0 [m], got {self.collision_radii}"
+            )
         for label in ("lower", "upper", "velocity_limit", "effort_limit"):
             values = np.asarray(getattr(self, label), dtype=float)
             if values.shape != (n,):

@@ -27,6 +27,7 @@ JOINT_LIMITS_DEG = (160.0, 165.0, 135.0, 135.0, 105.0, 270.0)  # Barker's table,
 OFFSETS_DEG = (180.0, 90.0, 90.0, 180.0, 180.0, 0.0)  # theta'_i - theta_i, Barker's table
 VELOCITY_LIMIT = (2.0, 2.0, 2.0, 4.0, 4.0, 4.0)  # [rad/s], assumed (PUMA 560 class)
 EFFORT_LIMIT = (100.0, 180.0, 90.0, 20.0, 20.0, 20.0)  # [N m], assumed
+COLLISION_RADII = (0.10, 0.08, 0.06, 0.05, 0.04, 0.04)  # [m], assumed (PUMA 560 class)
 READY = tuple(float(v) for v in np.deg2rad((0.0, 0.0, 90.0, 0.0, 45.0, 0.0)))  # chosen, see build
 
 PUMA560 = {
@@ -93,6 +94,8 @@ def build(
         "r6 = 0: tool frame at the wrist centre; HW moved to the `flange` frame",
         "link inertial data: PUMA 560 (Corke & Armstrong-Helouvry 1994), mirrored onto "
         "Barker's frames; link 1 mass and transverse moments, link 3 Izz raised",
+        "collision capsule radii (0.10, 0.08, 0.06, 0.05, 0.04, 0.04) m along the DH offsets: "
+        "PUMA 560 class link widths (the report gives none)",
         "ready pose (0, 0, 90, 0, 45, 0) deg: elbow bent 90 deg, wrist 45 deg, away from the "
         "limits and singularities (q = 0, Barker's initial position, has theta5 = 0: the "
         "wrist singular)",
@@ -123,6 +126,7 @@ def build(
         closed_form=closed_form,
         parameters=params,
         inertials=barker_inertials(chain),
+        collision_radii=COLLISION_RADII,
     )
 
 

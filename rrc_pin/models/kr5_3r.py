@@ -49,11 +49,14 @@ def build(a1: float = 0.2, a2: float = 0.5, a3: float = 0.5, name: str = NAME) -
         assumed=(
             "joint limits +-170, +-135, +-150 deg",
             "velocity limits (6.5, 5.2, 6.5) rad/s and efforts (KR5 class)",
+            "collision capsule radii (0.08, 0.06, 0.05) m along the DH offsets, KR5 class "
+            "(the exam gives no widths)",
             "ready pose: the exam's configuration (0, 45, -45) deg",
         ),
         named_poses={"exam": (0.0, np.pi / 4, -np.pi / 4), "ready": (0.0, np.pi / 4, -np.pi / 4)},
         closed_form=closed_form,
         parameters={"a1": a1, "a2": a2, "a3": a3},
+        collision_radii=(0.08, 0.06, 0.05),
     )
 
 

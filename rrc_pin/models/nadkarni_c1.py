@@ -40,11 +40,14 @@ def build(name: str = NAME) -> ArmSpec:
         assumed=(
             "length unit of the thesis taken as the inch",
             "joint limits +-180 deg, velocity limits 2 rad/s, efforts",
+            "collision capsule radii (0.04, 0.04, 0.03, 0.03, 0.025, 0.02) m along the DH "
+            "offsets (the thesis gives no widths)",
             "ready pose (0, -60, 0, 90, 0, 0) deg, away from the limits and singularities "
             "(the initial configuration of Table A2-2 is singular: Illustration 4 escapes "
             "from it)",
         ),
         named_poses={"table_a2_2": q0, "ready": READY},
+        collision_radii=(0.04, 0.04, 0.03, 0.03, 0.025, 0.02),
     )
 
 

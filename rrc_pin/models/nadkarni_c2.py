@@ -44,9 +44,12 @@ def build(name: str = NAME) -> ArmSpec:
         assumed=(
             "length unit of the thesis taken as the inch",
             "prismatic travel +-1 m at 0.5 m/s, revolute +-180 deg at 2 rad/s, efforts",
+            "collision radii (0.04, 0.04, 0.04, 0.03, 0.03, 0.02) m: spheres at the prismatic "
+            "links' frames and the wrist, a capsule along r6 (the thesis gives no widths)",
             "ready pose: the initial configuration of Table A2-7",
         ),
         named_poses={"table_a2_7": q0, "ready": q0},
+        collision_radii=(0.04, 0.04, 0.04, 0.03, 0.03, 0.02),
     )
 
 

@@ -77,6 +77,8 @@ def build(name: str = NAME) -> ArmSpec:
             "joint limits +-(170, 120, 170, 135, 170, 120, 170) deg",
             "velocity limits (1, 1, 1.5, 1.5, 2, 2, 2) rad/s and efforts",
             "link inertial data: solid cylinders of masses (8, 5, 2, 3.5, 1.5, 1, 0.5) kg",
+            "link radii (0.08, 0.06, 0.06, 0.05, 0.05, 0.04, 0.04) m, of the inertial cylinders "
+            "and the collision capsules along the DH offsets (the report gives no widths)",
             "ready pose (0, 30, 0, 90, 0, 45, 0) deg: shoulder 30 deg, elbow 90 deg, wrist "
             "45 deg, away from the limits and singularities (the home q = 0 is stretched out, "
             "singular)",
@@ -84,6 +86,7 @@ def build(name: str = NAME) -> ArmSpec:
         named_poses={"home": (0.0,) * 7, "ready": READY},
         closed_form=closed_form,
         inertials=cylinder_links(rows),
+        collision_radii=LINK_RADII,
     )
 
 

@@ -1,0 +1,256 @@
+"""Collision-constrained steps of a two-arm cell: rrc-pin's CollisionLimit, mink's
+CollisionAvoidanceLimit and pink's SelfCollisionBarrier, side by side in one process.
+
+Run with the peers' environment from a checkout:
+``PYTHONPATH=. .venv-peers/bin/python benchmarks/bench_collision.py --out DIR`` (``--record``
+writes ``benchmarks/results/collision.{json,png}``; ``--quick`` a short smoke run).
+
+The cell: two pandas facing each other 1.0 m apart (``rrc_pin.combine``), capsule geometry
+(:class:`rrc_pin.CollisionModel`); for mink the same joint tree and capsules written as MJCF
+(:mod:`collision_peers`; MuJoCo's ``mj_geomDistance`` equals coal's distance to 1e-15 on them).
+Each hand is commanded toward the other (0.3 m/s at most, position rows) plus a tangential
+0.05 m/s along +z, so that the hands meet and then have to slide. Every contender runs its own
+closed loop (its own q, integrated at 100 Hz) on the same commands, interleaved tick by tick
+(each tick steps every contender once, in turn).
+
+Pair sets (the number of pairs each library checks): the inter-arm pairs between links from
+``panda_link<K>`` to the fingers for K = 8 (hand and fingers), 6, 4, then every pair of the
+cell (224, self-collision included).
+
+Per contender and pair set: the step's time (median, p99; one call from q and the command to
+the joint rates, distances included), the minimum distance over every pair of the cell reached
+(coal, the same capsules), the tangential progress while constrained (the hands' mean +z speed
+over the commanded 0.05 m/s, on ticks where a pair is closer than twice the safety distance),
+and the largest joint-rate jump at a tick where a pair enters the detection distance.
+Settings: safety 0.02 m, detection 0.10 m; rrc-pin's gain 0.5 m/s; mink's gain 0.85 (its
+default) with the same distances; pink's barrier gain 1, d_min 0.02, every pair of the set.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np
+import pinocchio as pin
+from collision_peers import mjcf
+from script import arguments, make_parser, mark_quick, measure, pyplot, write
+from timing import progress
+
+import rrc_pin
+from rrc_pin import CollisionLimit, CollisionModel, FrameTask, JointLimits, Resolver
+
+DT = 0.01
+SAFETY, DETECTION = 0.02, 0.10
+SPEED, SLIDE = 0.3, 0.05
+LINKS = (8, 6, 4, None)
+
+
+def cell() -> tuple[rrc_pin.Robot, CollisionModel]:
+    panda = rrc_pin.load("panda")
+    facing = np.eye(4)
+    facing[:3, :3] = np.diag([-1.0, -1.0, 1.0])
+    facing[0, 3] = 1.0
+    robot = rrc_pin.combine({"left": (panda, np.eye(4)), "right": (panda, facing)})
+    return robot, CollisionModel(robot, "capsules")
+
+
+def link_number(body: str) -> int:
+    name = body.split("/")[-1]
+    if name.startswith("panda_link"):
+        return int(name[len("panda_link")].rstrip("_"))
+    return 8  # hand, fingers
+
+
+def pair_set(cm: CollisionModel, k: int | None) -> list[tuple[str, str]]:
+    if k is None:
+        return list(cm.pairs)
+    return [(a, b) for a, b in cm.pairs if a.split("/")[0] != b.split("/")[0]
+            and link_number(a) >= k and link_number(b) >= k]  # fmt: skip
+
+
+def commands(robot: rrc_pin.Robot, q: np.ndarray) -> list[np.ndarray]:
+    hands = [robot.frame_pose(q, f)[:3, 3] for f in robot.tool_frames]
+    out = []
+    for me, other in ((0, 1), (1, 0)):
+        v = 2.0 * (hands[other] - hands[me])
+        v *= min(1.0, SPEED / max(float(np.linalg.norm(v)), 1e-12))
+        out.append(v + np.array([0.0, 0.0, SLIDE]))
+    return out
+
+
+class Rrc:
+    label = "rrc-pin CollisionLimit"
+
+    def __init__(self, robot, cm, pairs):
+        limit = CollisionLimit(cm, SAFETY, DETECTION, 0.5, pairs=pairs)
+        self.resolver = Resolver(robot, DT, limits=[JointLimits(), limit])
+        self.tasks = [FrameTask(f, rows="position") for f in robot.tool_frames]
+
+    def step(self, q, v):
+        for task, twist in zip(self.tasks, v, strict=True):
+            task.set_twist(twist)
+        return np.array(self.resolver.solve(q, [self.tasks], priority="strict").qdot)
+
+
+class Mink:
+    label = "mink CollisionAvoidanceLimit"
+
+    def __init__(self, robot, cm, pairs):
+        import mink
+        import mujoco
+
+        self.mink = mink
+        self.model = mujoco.MjModel.from_xml_string(mjcf(robot, cm.scene.geometry,
+                                                         robot.tool_frames))  # fmt: skip
+        self.conf = mink.Configuration(self.model)
+        self.tasks = [mink.FrameTask(f, "site", position_cost=1.0, orientation_cost=0.0)
+                      for f in robot.tool_frames]  # fmt: skip
+        velocity = {robot.model.names[j]: float(robot.velocity_limit[j - 1])
+                    for j in range(1, robot.model.njoints)}  # fmt: skip
+        self.limits = [
+            mink.ConfigurationLimit(self.model), mink.VelocityLimit(self.model, velocity),
+            mink.CollisionAvoidanceLimit(self.model, [([a], [b]) for a, b in pairs], 0.85,
+                                         SAFETY, DETECTION),
+        ]  # fmt: skip
+
+    def step(self, q, v):
+        self.conf.update(q)
+        for task, twist in zip(self.tasks, v, strict=True):
+            T = self.conf.get_transform_frame_to_world(task.frame_name, "site")
+            target = self.mink.SE3.from_rotation_and_translation(
+                T.rotation(), T.translation() + twist * DT)
+            task.set_target(target)
+        return self.mink.solve_ik(self.conf, self.tasks, DT, "daqp", 1e-3, limits=self.limits)
+
+
+class Pink:
+    label = "pink SelfCollisionBarrier"
+
+    def __init__(self, robot, cm, pairs):
+        import pink
+        from pink.barriers import SelfCollisionBarrier
+
+        self.pink, self.robot = pink, robot
+        geometry = pin.GeometryModel()
+        for obj in cm.scene.geometry.geometryObjects:
+            geometry.addGeometryObject(obj)
+        for a, b in pairs:
+            geometry.addCollisionPair(pin.CollisionPair(geometry.getGeometryId(a),
+                                                        geometry.getGeometryId(b)))  # fmt: skip
+        self.geometry = geometry
+        self.data = robot.model.createData()
+        self.gdata = pin.GeometryData(geometry)
+        self.tasks = [pink.tasks.FrameTask(f, position_cost=1.0, orientation_cost=0.0)
+                      for f in robot.tool_frames]  # fmt: skip
+        self.barriers = [SelfCollisionBarrier(len(pairs), gain=1.0, d_min=SAFETY)]
+
+    def step(self, q, v):
+        conf = self.pink.Configuration(self.robot.model, self.data, q, copy_data=False,
+                                       collision_model=self.geometry,
+                                       collision_data=self.gdata)  # fmt: skip
+        for task, twist in zip(self.tasks, v, strict=True):
+            T = conf.get_transform_frame_to_world(task.frame).copy()
+            T.translation = T.translation + twist * DT
+            task.set_target(T)
+        return self.pink.solve_ik(conf, self.tasks, DT, "daqp", barriers=self.barriers,
+                                  safety_break=False)  # fmt: skip
+
+
+def run(ticks: int) -> dict[str, Any]:
+    robot, cm = cell()
+    rows = []
+    for k in LINKS:
+        pairs = pair_set(cm, k)
+        contenders = [kind(robot, cm, pairs) for kind in (Rrc, Mink, Pink)]
+        state = {c.label: robot.ready().copy() for c in contenders}
+        times: dict[str, list[float]] = {c.label: [] for c in contenders}
+        minimum = dict.fromkeys(state, np.inf)
+        progress_z: dict[str, list[float]] = {c.label: [] for c in contenders}
+        jump = dict.fromkeys(state, 0.0)
+        last: dict[str, Any] = {c.label: (None, 0) for c in contenders}
+        for tick in range(ticks):
+            for c in contenders:
+                q = state[c.label]
+                v = commands(robot, q)
+                start = time.perf_counter()
+                qdot = c.step(q, v)
+                times[c.label].append(time.perf_counter() - start)
+                qdot = np.nan_to_num(np.asarray(qdot, dtype=float))
+                hands_before = [robot.frame_pose(q, f)[2, 3] for f in robot.tool_frames]
+                q = np.clip(q + DT * qdot, robot.lower, robot.upper)
+                state[c.label] = q
+                prox = cm.proximity_at(q, DETECTION)
+                near = len(prox.names)
+                if near:
+                    d = float(prox.distance.min())
+                    minimum[c.label] = min(minimum[c.label], d)
+                    if d < 2 * SAFETY:
+                        hands = [robot.frame_pose(q, f)[2, 3] for f in robot.tool_frames]
+                        rise = np.mean(np.subtract(hands, hands_before)) / DT
+                        progress_z[c.label].append(rise / SLIDE)
+                previous, count = last[c.label]
+                if previous is not None and near > count:
+                    jump[c.label] = max(jump[c.label], float(np.abs(qdot - previous).max()))
+                last[c.label] = (qdot, near)
+            if tick % 200 == 0:
+                progress(f"{len(pairs)} pairs: tick {tick}")
+        for c in contenders:
+            t = np.array(times[c.label][10:]) * 1e6
+            rows.append({
+                "contender": c.label, "pairs": len(pairs), "median_us": float(np.median(t)),
+                "p99_us": float(np.percentile(t, 99)),
+                "min_distance_m": float(minimum[c.label]),
+                "tangential_progress": float(np.mean(progress_z[c.label]))
+                if progress_z[c.label] else None,
+                "constrained_ticks": len(progress_z[c.label]),
+                "largest_activation_jump": jump[c.label],
+            })  # fmt: skip
+            progress(str(rows[-1]))
+    return {"settings": {"ticks": ticks, "dt": DT, "safety": SAFETY, "detection": DETECTION,
+                         "speed": SPEED, "slide": SLIDE}, "rows": rows}  # fmt: skip
+
+
+def plot(results: dict[str, Any], path: Path) -> bool:
+    plt = pyplot()
+    if plt is None:
+        return False
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    labels = sorted({r["contender"] for r in results["rows"]})
+    for label in labels:
+        rows = sorted((r for r in results["rows"] if r["contender"] == label),
+                      key=lambda r: r["pairs"])  # fmt: skip
+        x = [r["pairs"] for r in rows]
+        ax[0].plot(x, [r["median_us"] for r in rows], "o-", label=label)
+        ax[1].plot(x, [r["min_distance_m"] * 1e3 for r in rows], "o-", label=label)
+    ax[0].set(xscale="log", yscale="log", xlabel="pairs", ylabel="step median [us]")
+    ax[1].axhline(SAFETY * 1e3, color="gray", ls="--")
+    ax[1].set(xscale="log", xlabel="pairs", ylabel="minimum distance [mm]")
+    ax[0].legend(fontsize=8)
+    mark_quick(fig, results)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = make_parser(__doc__, "collision")
+    parser.add_argument("--ticks", type=int, default=None, help="ticks per pair set")
+    args = arguments(parser, argv)
+    ticks = args.ticks or (60 if args.quick else 1000)
+    results = measure("collision", args.quick, lambda: run(ticks), "mink", "mujoco", "pink",
+                      "coal")  # fmt: skip
+    for r in results["rows"]:
+        print(r)
+    write(args, "collision", results, lambda p: plot(results, p))
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    main()

@@ -1,0 +1,236 @@
+r"""CollisionLimit: every pair of bodies kept apart, and tool frames inside their walls.
+
+One velocity-damper row per pair closer than the detection distance (Kanehiro et al. 2008,
+:mod:`solvers.damper_kernels`):
+
+.. math:: -n^T (J_b - J_a)\,\dot q \le \xi \frac{d - d_s}{d_i - d_s}
+
+``d`` the pair's signed distance (negative in penetration, where the normal still points
+from A to B: the row then asks the pair to separate, never to stay: mink's PR 105), ``n`` the
+unit normal from A to B, ``J_a``, ``J_b`` the witness points' linear Jacobians, ``d_s`` the
+safety distance, ``d_i`` the detection distance and :math:`\xi` [m/s] the approach speed
+allowed at ``d_i`` (the row is not felt there by a slower approach: activation is smooth).
+Below ``d_s`` the pair separates, restoring :data:`RECOVERY` of the shortfall a step (at most
+at :math:`\xi`).
+Linearised over one step of ``dt``, the distance after the step is at least
+:math:`d_s + (d - d_s)(1 - \xi\,dt / (d_i - d_s))`, so :math:`\xi` is capped at
+:math:`(d_i - d_s)/dt` (never crossing :math:`d_s` in one step). The true distance differs
+from the linearised one by second-order terms (the witness points' accelerations over a step,
+and their motion along curved surfaces): docs/api.md states the tolerance measured.
+
+A virtual wall (:meth:`~rrc_pin.geometry.CollisionModel.add_workspace`, ``add_wall``) gives
+the same row for its frame's origin :math:`p` at distance :math:`o - n^T p` from the wall,
+with the wall itself as the safety distance (``d_s = 0``): :math:`n^T J_p \dot q \le
+\xi (o - n^T p) / d_i`.
+
+Every row is marked ``slide`` (:class:`~solvers.problem.Constraints`): the resolver's
+direction-preserving top level loses only the command's component into a pair, and slides
+along it (:mod:`solvers.pipeline`, ``sliding``). Rows are named ``"body_a|body_b"`` (walls
+``"frame|wall"``) and carry their distance, so ``Resolution.active_rows`` names the pairs
+that bound the answer and how close they are.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.errors import InvalidInput
+from rrc_pin.geometry import CollisionModel, Wall
+from rrc_pin.limits.limit import Limit
+from solvers.damper_kernels import damper_rows
+from solvers.problem import Constraints
+from solvers.validation import finite_number
+
+if TYPE_CHECKING:
+    from rrc_pin.geometry.proximity import Proximity
+    from rrc_pin.kinematics import Kinematics, Layout
+
+Array = npt.NDArray[np.float64]
+
+SAFETY = 0.02
+"""[m] Default safety distance d_s."""
+
+DETECTION = 0.10
+"""[m] Default detection distance d_i."""
+
+GAIN = 0.5
+"""[m/s] Default approach speed xi allowed at the detection distance."""
+
+RECOVERY = 0.5
+"""Fraction of a shortfall below the safety distance restored per step (at most at the gain):
+:mod:`solvers.damper_kernels`."""
+
+STILL = 1e-9
+"""[m/s per rad/s] A row whose every entry is below this is dropped: no joint changes the
+pair's distance (a base link turning about its own axis over the floor), so the row cannot
+be met if it asks for separation, and constrains nothing otherwise."""
+
+
+class CollisionLimit(Limit):
+    """Keeps the pairs of a :class:`~rrc_pin.geometry.CollisionModel` apart (module docstring).
+
+    Args:
+        model: The collision model (the resolver's robot's; obstacles may be added later).
+        safety: Safety distance d_s [m], >= 0 and below ``detection``.
+        detection: Detection distance d_i [m]: pairs closer than it get a row.
+        gain: xi [m/s] > 0, the approach speed allowed at ``detection`` (capped at
+            ``(detection - safety) / dt`` each tick).
+        pairs: Only these pairs ``(body_a, body_b)`` (names of ``model.bodies``, either
+            order), or None for every pair of the model.
+        name: Name in the report.
+
+    Attributes:
+        last: The :class:`~rrc_pin.geometry.Proximity` of the last tick (the rows' pairs).
+
+    Raises:
+        InvalidInput: ``model`` not a CollisionModel, a distance or gain out of range, a pair
+            naming a body the model does not have or that is not one of its pairs; nothing is
+            kept.
+
+    One limit holds one query state (a resolver's ticks run one at a time): give each
+    resolver its own.
+    """
+
+    def __init__(
+        self,
+        model: CollisionModel,
+        safety: float = SAFETY,
+        detection: float = DETECTION,
+        gain: float = GAIN,
+        *,
+        pairs: Sequence[tuple[str, str]] | None = None,
+        name: str = "collision",
+    ) -> None:
+        if not isinstance(model, CollisionModel):
+            raise InvalidInput("model", f"expected a CollisionModel, got {type(model).__name__}")
+        d_s = finite_number(safety, "safety", 0.0)
+        d_i = finite_number(detection, "detection", 0.0, inclusive=False)
+        if d_s >= d_i:
+            raise InvalidInput("safety", f"expected below the detection distance {d_i} m, got "
+                               f"{d_s} m")  # fmt: skip
+        xi = finite_number(gain, "gain", 0.0, inclusive=False)
+        if not isinstance(name, str):
+            raise InvalidInput("name", f"expected a string, got {name!r}")
+        chosen = None if pairs is None else _pairs(model, pairs)
+        self.model, self.safety, self.detection, self.gain, self.name = model, d_s, d_i, xi, name
+        self.pairs = chosen
+        self.last: Proximity | None = None
+        self._data = model.create_data()
+        robot = model.robot.model
+        support = np.zeros((robot.njoints, robot.nv), dtype=np.bool_)
+        for j in range(1, robot.njoints):
+            for i in robot.supports[j].tolist()[1:]:
+                start = robot.joints[i].idx_v
+                support[j, start : start + robot.joints[i].nv] = True
+        self._support = support
+        self._names: dict[tuple[str, str], str] = {}
+
+    def check(self, layout: Layout) -> None:
+        """Refuse a resolver whose robot is not the model's.
+
+        Raises:
+            InvalidInput: ``model`` of a robot with other joints or frames.
+        """
+        robot = self.model.robot
+        if layout.nv != robot.model.nv or list(layout.joints) != list(robot.joint_names):
+            raise InvalidInput("model", f"a collision model of {robot.name} (joints "
+                               f"{list(robot.joint_names)}), not of this robot's joints "
+                               f"{list(layout.joints)}")  # fmt: skip
+
+    def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
+        """The damper rows of the pairs within the detection distance, and of the walls."""
+        prox = self.model.proximity(kin, self._data, self.detection)
+        if self.pairs is not None and prox.names:
+            keep = [k for k, names in enumerate(prox.names) if names in self.pairs]
+            prox = _subset(prox, keep)
+        self.last = prox
+        walls = self.model.walls()
+        k = len(prox.names)
+        if not k and not walls:
+            return _NONE
+        xi = min(self.gain, (self.detection - self.safety) / dt)
+        nv = kin.model.nv
+        G, h = np.empty((k, nv)), np.empty(k)
+        names = [self._name(pair) for pair in prox.names]
+        distance = prox.distance
+        if k:
+            J = kin.data.J
+            damper_rows(J, self._support, prox.joint_a, prox.joint_b, prox.point_a,
+                        prox.point_b, prox.normal, prox.distance, self.safety, self.detection,
+                        xi, RECOVERY / dt, G, h)  # fmt: skip
+        if walls:
+            G, h, distance = self._walls(kin, walls, G, h, names, distance, dt)
+        if h.size:  # a pair no joint can move apart or together has no row (module docstring)
+            moved = np.abs(G).max(axis=1) > STILL
+            if not moved.all():
+                G, h, distance = G[moved], h[moved], distance[moved]
+                names = [n for n, m in zip(names, moved.tolist(), strict=True) if m]
+        if not h.size:
+            return _NONE
+        return Constraints(G=G, h=h, names=tuple(names), slide=np.ones(h.size, dtype=np.bool_),
+                           distance=distance)  # fmt: skip
+
+    def _walls(
+        self, kin: Kinematics, walls: Sequence[Wall], G: Array, h: Array, names: list[str],
+        distance: Array, dt: float,
+    ) -> tuple[Array, Array, Array]:  # fmt: skip
+        """The rows of the walls whose frame is within the detection distance of them."""
+        xi = min(self.gain, self.detection / dt)
+        rows, bounds, gaps = [G], [h], [distance]
+        for wall in walls:
+            p = kin.pose(wall.frame)[:3, 3]
+            gap = wall.offset - float(wall.normal @ p)
+            if gap >= self.detection:
+                continue
+            J = kin.jacobian(wall.frame, "world_aligned")[:3]
+            rows.append((wall.normal @ J)[None, :])
+            bounds.append(np.array([xi * gap / self.detection]))
+            gaps.append(np.array([gap]))
+            names.append(f"{wall.frame}|{wall.name}")
+        return np.vstack(rows), np.concatenate(bounds), np.concatenate(gaps)
+
+    def _name(self, pair: tuple[str, str]) -> str:
+        label = self._names.get(pair)
+        if label is None:
+            label = self._names[pair] = f"{pair[0]}|{pair[1]}"
+        return label
+
+
+_NONE = Constraints()
+
+
+def _pairs(model: CollisionModel, pairs: Sequence[tuple[str, str]]) -> frozenset[tuple[str, str]]:
+    """``pairs`` as the model orders them, each checked."""
+    bodies = set(model.bodies)
+    known = set(model.pairs)
+    out = set()
+    if isinstance(pairs, (str, bytes)) or not isinstance(pairs, Sequence):
+        raise InvalidInput("pairs", f"expected a sequence of (body_a, body_b), got {pairs!r}")
+    for pair in pairs:
+        if not (isinstance(pair, (tuple, list)) and len(pair) == 2
+                and all(isinstance(x, str) for x in pair)):  # fmt: skip
+            raise InvalidInput("pairs", f"expected (body_a, body_b) names, got {pair!r}")
+        for body in pair:
+            if body not in bodies:
+                raise InvalidInput("pairs", f"no body {body!r} in the collision model; bodies: "
+                                   f"{', '.join(model.bodies)}")  # fmt: skip
+        a, b = pair
+        if (a, b) in known:
+            out.add((a, b))
+        elif (b, a) in known:
+            out.add((b, a))
+        else:
+            raise InvalidInput("pairs", f"({a!r}, {b!r}) is not a pair of the model (left out: "
+                               f"{model.excluded.get((a, b), model.excluded.get((b, a)))})")
+    return frozenset(out)
+
+
+def _subset(prox: Proximity, keep: list[int]) -> Proximity:
+    index = np.array(keep, dtype=np.int64)
+    return type(prox)(tuple(prox.names[k] for k in keep), prox.distance[index],
+                      prox.point_a[index], prox.point_b[index], prox.normal[index],
+                      prox.joint_a[index], prox.joint_b[index])  # fmt: skip

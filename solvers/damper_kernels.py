@@ -1,0 +1,114 @@
+r"""The velocity-damper rows of collision pairs, one compiled pass over every pair.
+
+The damper is Kanehiro, Lamiraux, Kanoun, Yoshida & Laumond 2008.
+
+A pair at signed distance :math:`d` (negative in penetration) with witness points
+:math:`p_a` on body A, :math:`p_b` on body B and unit normal :math:`n` from A to B
+(:math:`p_b - p_a = d\,n`) changes its distance at :math:`\dot d = n^T (v_b - v_a)`, the
+witness points' velocities :math:`v = J_p \dot q`. The damper keeps
+
+.. math:: \dot d \ge -\xi \frac{d - d_s}{d_i - d_s}
+   \iff -n^T (J_b - J_a)\,\dot q \le \xi \frac{d - d_s}{d_i - d_s}
+
+with :math:`d_s` the safety distance, :math:`d_i` the detection distance and :math:`\xi`
+[m/s] the approach speed allowed at :math:`d_i`. Below :math:`d_s` (and in penetration) the
+bound is negative: the pair must separate, at
+
+.. math:: \dot d \ge \min\left(\rho \frac{d_s - d}{\Delta t}, \xi\right)
+
+restoring the fraction :math:`\rho` of the shortfall per step (at most at :math:`\xi`). The
+damper's own rate there, :math:`\xi/(d_i - d_s)` (6 %/step at its defaults), would let a
+second-order loss of a fraction of a millimetre a step (two capsules near parallel, whose
+witness points jump from end to end as they turn) settle millimetres below :math:`d_s`; at
+:math:`\rho` it settles at about that loss divided by :math:`\rho`.
+
+A point's linear Jacobian from its joint's Jacobian in Pinocchio's WORLD convention (the
+spatial velocity at the world origin, :math:`[v_O; \omega]`, what
+``pinocchio.getJointJacobian(model, data, j, WORLD)`` returns): :math:`v_p = v_O + \omega
+\times p`, so
+
+.. math:: n^T J_p = n^T J_v + (p \times n)^T J_\omega
+
+over the joint's supporting columns (every other column zero). The WORLD Jacobians of all
+joints are one (6, nv) matrix (``data.J``), masked per joint by its support.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+
+from solvers.kernels import kernel
+
+Array = npt.NDArray[np.float64]
+Index = npt.NDArray[np.int64]
+
+HELD = 1e-6
+"""[m] A pair less than this below d_s is held (h = 0), not recovered: the damper brings pairs
+to d_s exponentially, and rounding leaves them a hair below it (h of -1e-18 would turn every
+such tick into a recovery, the whole problem a least-squares one)."""
+
+
+@kernel
+def damper_rows(
+    J: Array,
+    support: npt.NDArray[np.bool_],
+    joint_a: Index,
+    joint_b: Index,
+    point_a: Array,
+    point_b: Array,
+    normal: Array,
+    distance: Array,
+    safety: float,
+    detection: float,
+    xi: float,
+    recovery: float,
+    G: Array,
+    h: Array,
+) -> None:
+    """Fill the damper rows ``G qdot <= h`` of k pairs (module docstring).
+
+    Args:
+        J: Every joint's Jacobian in the WORLD convention (6, nv), rows [v_O; w].
+        support: (njoints, nv) whether column c moves joint j (row 0, the world: none).
+        joint_a: The joint of body A per pair (k,).
+        joint_b: The joint of body B per pair (k,).
+        point_a: Witness points on A (k, 3), world frame [m].
+        point_b: Witness points on B (k, 3) [m].
+        normal: Unit normals from A to B (k, 3).
+        distance: Signed distances (k,) [m].
+        safety: d_s [m].
+        detection: d_i [m], > d_s.
+        xi: Approach speed allowed at d_i [m/s].
+        recovery: rho / dt [1/s], the rate restoring a shortfall below d_s.
+        G: Out (k, nv).
+        h: Out (k,) [m/s].
+    """
+    k = distance.size
+    nv = J.shape[1]
+    span = detection - safety
+    for r in range(k):
+        n0, n1, n2 = normal[r, 0], normal[r, 1], normal[r, 2]
+        # p x n for each witness point
+        a0 = point_a[r, 1] * n2 - point_a[r, 2] * n1
+        a1 = point_a[r, 2] * n0 - point_a[r, 0] * n2
+        a2 = point_a[r, 0] * n1 - point_a[r, 1] * n0
+        b0 = point_b[r, 1] * n2 - point_b[r, 2] * n1
+        b1 = point_b[r, 2] * n0 - point_b[r, 0] * n2
+        b2 = point_b[r, 0] * n1 - point_b[r, 1] * n0
+        ja, jb = joint_a[r], joint_b[r]
+        for c in range(nv):
+            linear = n0 * J[0, c] + n1 * J[1, c] + n2 * J[2, c]
+            value = 0.0
+            if support[jb, c]:
+                value -= linear + b0 * J[3, c] + b1 * J[4, c] + b2 * J[5, c]
+            if support[ja, c]:
+                value += linear + a0 * J[3, c] + a1 * J[4, c] + a2 * J[5, c]
+            G[r, c] = value
+        gap = distance[r] - safety
+        if gap >= 0.0:
+            h[r] = xi * gap / span
+        elif gap > -HELD:
+            h[r] = 0.0
+        else:
+            h[r] = max(recovery * gap, -xi)
