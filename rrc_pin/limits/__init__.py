@@ -1,6 +1,8 @@
 """Limits of a resolution, one per module: each gives a box and named constraint rows a tick."""
 
+from rrc_pin.limits.contact_limit import ContactLimit
+from rrc_pin.limits.grip_limit import GripLimit
 from rrc_pin.limits.joint_limits import JointLimits
 from rrc_pin.limits.limit import Limit
 
-__all__ = ["JointLimits", "Limit"]
+__all__ = ["ContactLimit", "GripLimit", "JointLimits", "Limit"]
