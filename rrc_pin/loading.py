@@ -407,7 +407,8 @@ def load(
     if key in models.CELLS:
         _refuse_parameters(parameters, f"the cell {key!r}")
         if tool_frame is not None:
-            raise InvalidInput("tool_frame", f"a cell's tool frames are its hands; got {tool_frame!r}")
+            raise InvalidInput("tool_frame",
+                               f"a cell's tool frames are its hands; got {tool_frame!r}")
         spec = models.CELLS[key]
         return from_spec(spec, {m.key: _from_spec(models.CATALOGUE[m.arm], m.tool)
                                 for m in spec.mounts})  # fmt: skip

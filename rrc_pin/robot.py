@@ -412,7 +412,8 @@ class Robot:
         """A configuration (nq,) drawn uniformly within the limits.
 
         A floating base is left where :meth:`ready` puts it (its pose is not a joint's: a
-        cell's ready pose stands the body on its feet). Unbounded joints (continuous, or limits beyond +-:data:`UNBOUNDED`) are drawn in
+        cell's ready pose stands the body on its feet). Unbounded joints (continuous, or
+        limits beyond +-:data:`UNBOUNDED`) are drawn in
         [-pi, pi]; a joint bounded on one side only, over 2 pi [rad or m] from that limit.
 
         Args:

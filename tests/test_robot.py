@@ -225,7 +225,8 @@ def _floating_ur5() -> Robot:
 def test_a_free_flyer_root_is_a_floating_base_with_nq_one_more_than_nv():
     arm = _floating_ur5()
     assert (arm.nq, arm.nv, arm.floating) == (13, 12, True)
-    assert arm.dof_names[:6] == tuple(f"root_joint:{a}" for a in ("vx", "vy", "vz", "wx", "wy", "wz"))
+    axes = ("vx", "vy", "vz", "wx", "wy", "wz")
+    assert arm.dof_names[:6] == tuple(f"root_joint:{a}" for a in axes)
     assert list(arm.actuated) == [False] * 6 + [True] * 6
     assert np.isinf(arm.dof_lower[:6]).all() and arm.dof_lower.shape == (12,)
     np.testing.assert_array_equal(arm.neutral()[:7], [0, 0, 0, 0, 0, 0, 1])

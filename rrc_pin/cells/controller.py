@@ -213,7 +213,8 @@ class CellController:
             InvalidInput: Not a name :meth:`commandable` lists.
         """
         self._check_name(name, "name")
-        return self._targets[name].copy()
+        out: Array = self._targets[name].copy()
+        return out
 
     def frame_of(self, name: str) -> str:
         """The frame command ``name`` moves (the object's, the body's or the hand's)."""
@@ -298,11 +299,12 @@ class CellController:
         self.contact.set_frames(self.support)
         self.grip.set_pairs([] if not self.coupled else
                             [g.hands for g in cell.objects.values()])  # fmt: skip
+        levels: list[list[Task]]
         if hands:
             r = self.resolver.solve(self._q, [*top, *hands, self.posture])
         else:
-            r = self.resolver.solve(self._q, [top, [self.posture]] if top else [[self.posture]],
-                                    priority="strict")  # fmt: skip
+            levels = [top, [self.posture]] if top else [[self.posture]]
+            r = self.resolver.solve(self._q, levels, priority="strict")
         self._record(r, poses, "teleop")
         follow = r.scale if hands == [] else 1.0
         if r.status in REANCHOR:
@@ -389,7 +391,7 @@ class CellController:
             if ref not in REFS or (ref == "base" and name not in self.cell.arms):
                 raise InvalidInput(label, f"ref {ref!r}: expected world, local, or base (for a "
                                    "hand)")  # fmt: skip
-            twist = as_vector(value, label, 6)  # type: ignore[arg-type]
+            twist = as_vector(value, label, 6)
             out[name] = np.concatenate([twist, [REFS.index(ref)]])
         return out
 
@@ -480,15 +482,17 @@ def _inverse(T: Array) -> Array:
 
 
 def _transport(twist: Array, frm: Array, to: Array) -> Array:
-    """A world-axes twist of frame ``frm``'s origin as that of ``to``'s origin on the same
-    rigid body: :math:`v_b = v_a + \\omega \\times (p_b - p_a)`."""
+    r"""A world-axes twist of ``frm``'s origin moved to ``to``'s origin on one rigid body.
+
+    :math:`v_b = v_a + \omega \times (p_b - p_a)`.
+    """
     v, w = twist[:3], twist[3:]
     return np.concatenate([v + np.cross(w, to[:3, 3] - frm[:3, 3]), w])
 
 
 def _moved(T: Array, delta: Array) -> Array:
     """Pose ``T`` moved by the world-axes displacement ``delta`` (6,) [m, rad] of its origin."""
-    out = T.copy()
+    out: Array = T.copy()
     out[:3, 3] += delta[:3]
     out[:3, :3] = pin.exp3(delta[3:]) @ T[:3, :3]
     return out

@@ -14,6 +14,9 @@ SPACING = 0.9
 INWARD = 0.25
 """[rad] Joint 1 of each arm turned toward the other in the ready pose (assumed)."""
 
+UPRIGHT = (0.0, 0.0, 0.0)
+"""Both bases upright, facing +x (roll, pitch, yaw [rad]; assumed)."""
+
 _ARM_READY = (0.0, 0.5235987755982988, 0.0, 1.5707963267948966, 0.0, 0.7853981633974483, 0.0)
 
 
@@ -24,11 +27,9 @@ def _ready(yaw: float) -> tuple[float, ...]:
 SPEC = CellSpec(
     name="gsfc_dual",
     mounts=(
-        Mount("left", "rrc_k1607", (0.0, SPACING / 2, 0.0), (0.0, 0.0, 0.0), "tool",
-              _ready(-INWARD)),
-        Mount("right", "rrc_k1607", (0.0, -SPACING / 2, 0.0), (0.0, 0.0, 0.0), "tool",
-              _ready(INWARD)),
-    ),  # fmt: skip
+        Mount("left", "rrc_k1607", (0.0, SPACING / 2, 0.0), UPRIGHT, "tool", _ready(-INWARD)),
+        Mount("right", "rrc_k1607", (0.0, -SPACING / 2, 0.0), UPRIGHT, "tool", _ready(INWARD)),
+    ),
     source="Nguyen & Zhou, NASA grant NAG 5-1124 report (1990), section 2: the GSFC dual-arm "
     "telerobot testbed (two RRC K-1607 slave arms, two 6-DOF Kraft mini-master hand controllers)",
     assumed=(

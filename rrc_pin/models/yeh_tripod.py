@@ -34,7 +34,8 @@ SPEC = CellSpec(
     "arms as the legs of a robot walking over structural beams",
     assumed=(
         f"hips at the corners of an equilateral triangle, {HIP_RADIUS} m from the body's "
-        "centre: the reports give no body size; with the legs' ready reach the feet stand 1.45 m apart, "
+        "centre: the reports give no body size; with the legs' ready reach the feet stand "
+        "1.45 m apart, "
         "inside each leg's reach of the others' footholds",
         "each leg mounted upside down (roll pi) and yawed so that its ready reach points "
         "away from the body",

@@ -98,8 +98,10 @@ class FrameTask(Task):
         self.target = None if target is None else rigid_transform(target, "target")
 
     def error(self, pose: Array) -> Array:
-        """The pose error (6,) ``[p* - p; log(R* R^T)]`` [m, rad] in base axes, zero without
-        a target; ``pose`` (4, 4) is the frame's."""
+        """The pose error (6,) ``[p* - p; log(R* R^T)]`` [m, rad] in base axes.
+
+        Zero without a target; ``pose`` (4, 4) is the frame's.
+        """
         if self.target is None:
             return np.zeros(6)
         return np.concatenate([
