@@ -8,6 +8,7 @@ and its answer, :class:`Resolution`; the teleoperation loop :class:`Controller` 
 :mod:`rrc_pin.control.strategies`).
 """
 
+from rrc_pin.cells import Cell, CellController, MasterSlave, make_cell
 from rrc_pin.combine import combine
 from rrc_pin.control import Controller, Deadman, DriftCorrection, TrajectoryLog
 from rrc_pin.errors import (
@@ -19,7 +20,7 @@ from rrc_pin.errors import (
     UnknownBackend,
     URDFError,
 )
-from rrc_pin.limits import JointLimits, Limit
+from rrc_pin.limits import ContactLimit, GripLimit, JointLimits, Limit
 from rrc_pin.loading import arms, load
 from rrc_pin.resolver import QPOptions, Resolver
 from rrc_pin.robot import Robot
@@ -39,7 +40,10 @@ from solvers.resolution import ActiveLimit, ActiveRow, Resolution, TaskReport
 __all__ = [
     "ActiveLimit",
     "ActiveRow",
+    "Cell",
+    "CellController",
     "Constraints",
+    "ContactLimit",
     "Controller",
     "Damping",
     "DampingTask",
@@ -47,10 +51,12 @@ __all__ = [
     "DriftCorrection",
     "FrameNotFound",
     "FrameTask",
+    "GripLimit",
     "InvalidInput",
     "JointLimits",
     "JointTask",
     "Limit",
+    "MasterSlave",
     "PostureTask",
     "QPOptions",
     "RelativeFrameTask",
@@ -69,4 +75,5 @@ __all__ = [
     "arms",
     "combine",
     "load",
+    "make_cell",
 ]

@@ -23,7 +23,6 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin import models
-from rrc_pin.cells.cell import from_spec
 from rrc_pin.errors import InvalidInput, UnknownArm, URDFError
 from rrc_pin.models.arm_spec import ArmSpec
 from rrc_pin.robot import Robot, moving_joints
@@ -409,6 +408,8 @@ def load(
         if tool_frame is not None:
             raise InvalidInput("tool_frame",
                                f"a cell's tool frames are its hands; got {tool_frame!r}")
+        from rrc_pin.cells.cell import from_spec  # here: the cells package imports load
+
         spec = models.CELLS[key]
         return from_spec(spec, {m.key: _from_spec(models.CATALOGUE[m.arm], m.tool)
                                 for m in spec.mounts})  # fmt: skip
