@@ -4,7 +4,9 @@ The tripod (``rrc_pin.load("yeh_tripod")``) stands on three feet clamped to the 
 cycle lifts each leg in turn (up, forward by the stride, down) while the two others carry the
 body, then moves the body forward by the stride on all three feet: Yeh's gait in its
 simplest form. The feet in support never slip (fixed contacts); the body advances by the
-planned distance.
+planned distance. Prints the advance and the largest slip. Needs only ``pip install -e .``.
+
+Run: ``python examples/tripod_walk.py``
 """
 
 from __future__ import annotations
@@ -34,6 +36,7 @@ def move(ctl: CellController, name: str, displacement: np.ndarray) -> None:
 
 
 def main() -> None:
+    """Walk the tripod CYCLES cycles along x and print what was reached."""
     cell = rrc_pin.load("yeh_tripod")
     ctl = CellController(cell, dt=0.01)
     body0 = cell.fk(ctl.q, "body")[:3, 3]
@@ -53,6 +56,8 @@ def main() -> None:
         slip = max(slip, *(np.linalg.norm(cell.fk(ctl.q, f)[:3, 3] - p)
                            for f, p in support.items()))  # fmt: skip
     advance = cell.fk(ctl.q, "body")[:3, 3] - body0
+    print(f"feet in support: {', '.join(ctl.support)}")
+    print(f"stride {STRIDE} m, clearance {LIFT} m, foot and body speed {SPEED} m/s")
     print(f"{CYCLES} cycles, {ctl.t:.2f} s: body advanced {advance[0]:.6f} m along the beam "
           f"(planned {CYCLES * STRIDE:.3f} m), sideways {abs(advance[1]):.2e} m; "
           f"largest slip of a foot in support {slip:.2e} m")
