@@ -12,8 +12,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from rrc_pin import models, urdf_export
-from rrc_pin.errors import RrcPinError
 from rrc_pin.cells import Cell
+from rrc_pin.errors import RrcPinError
 from rrc_pin.loading import INSTALLED, arms, cells, load
 
 ILLUSTRATIONS = (1, 2, 4, 5, 6, 7)
