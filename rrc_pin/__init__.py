@@ -9,6 +9,7 @@ and its answer, :class:`Resolution`; the teleoperation loop :class:`Controller` 
 :mod:`rrc_pin.control.strategies`).
 """
 
+from rrc_pin.cells import Cell, CellController, MasterSlave, make_cell
 from rrc_pin.combine import combine
 from rrc_pin.control import Controller, Deadman, DriftCorrection, TrajectoryLog
 from rrc_pin.errors import (
@@ -21,7 +22,7 @@ from rrc_pin.errors import (
     URDFError,
 )
 from rrc_pin.geometry import CollisionModel
-from rrc_pin.limits import CollisionLimit, JointLimits, Limit
+from rrc_pin.limits import CollisionLimit, ContactLimit, GripLimit, JointLimits, Limit
 from rrc_pin.loading import arms, load
 from rrc_pin.resolver import QPOptions, Resolver
 from rrc_pin.robot import Robot
@@ -41,9 +42,12 @@ from solvers.resolution import ActiveLimit, ActiveRow, Resolution, TaskReport
 __all__ = [
     "ActiveLimit",
     "ActiveRow",
+    "Cell",
+    "CellController",
     "CollisionLimit",
     "CollisionModel",
     "Constraints",
+    "ContactLimit",
     "Controller",
     "Damping",
     "DampingTask",
@@ -51,10 +55,12 @@ __all__ = [
     "DriftCorrection",
     "FrameNotFound",
     "FrameTask",
+    "GripLimit",
     "InvalidInput",
     "JointLimits",
     "JointTask",
     "Limit",
+    "MasterSlave",
     "PostureTask",
     "QPOptions",
     "RelativeFrameTask",
@@ -73,4 +79,5 @@ __all__ = [
     "arms",
     "combine",
     "load",
+    "make_cell",
 ]

@@ -12,8 +12,9 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from rrc_pin import models, urdf_export
+from rrc_pin.cells import Cell
 from rrc_pin.errors import RrcPinError
-from rrc_pin.loading import INSTALLED, arms, load
+from rrc_pin.loading import INSTALLED, arms, cells, load
 
 ILLUSTRATIONS = (1, 2, 4, 5, 6, 7)
 """The Appendix II illustrations ``rrc-pin guidance`` reproduces."""
@@ -281,6 +282,13 @@ def arms_table() -> str:
                 notes += f" ({installed.ready.srdf})"
         tools = ", ".join(robot.tool_frames)
         rows.append((name, str(robot.nq), kinds, tools, source, notes))
+    for name in cells():
+        cell = load(name)
+        assert isinstance(cell, Cell)  # load gives a Cell for a cell's name
+        layout = models.CELLS[name]
+        dof = f"{cell.nv}" + (" (6 floating)" if cell.floating else "")
+        rows.append((name, dof, "cell", ", ".join(cell.tool_frames), layout.source,
+                     f"{cell.describe()}; " + "; ".join(layout.assumed)))  # fmt: skip
     widths = [max(len(r[i]) for r in rows) for i in range(5)]
     return "\n".join(
         "  ".join(cell.ljust(w) for cell, w in zip(r[:5], widths, strict=True)) + "  " + r[5]

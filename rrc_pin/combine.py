@@ -97,7 +97,7 @@ def combine(
     kept: list[Part] = []
     for key, value in arms.items():
         robot, placement = _entry(key, value)
-        model = pin.appendModel(model, _prefixed(robot.model, f"{key}/"), 0, placement)
+        model = pin.appendModel(model, prefixed(robot.model, f"{key}/"), 0, placement)
         tools += [f"{key}/{frame}" for frame in robot.tool_frames]
         parts.append(f"{key}: {robot.name}")
         ready.append(robot.ready())
@@ -123,7 +123,7 @@ def _entry(key: object, value: object) -> tuple[Robot, pin.SE3]:
     return value[0], pin.SE3(T[:3, :3], T[:3, 3])
 
 
-def _prefixed(model: pin.Model, prefix: str) -> pin.Model:
+def prefixed(model: pin.Model, prefix: str) -> pin.Model:
     """A copy of ``model`` with every joint and frame name but the universe's prefixed."""
     out = pin.Model(model)
     for j in range(1, out.njoints):

@@ -30,9 +30,10 @@ class Layout(NamedTuple):
     """The names a task or limit may use on one robot, and its joints' limits.
 
     Attributes:
-        nv: Number of joints (one rate each).
+        nv: Number of joint rates (a floating base's six, then one per joint).
         frames: Frame name to Pinocchio frame index.
-        joints: Joint name to index in q.
+        joints: Joint name to index in qdot (a floating base's rates are named
+            ``base:vx`` ... ``base:wz``, :attr:`Robot.dof_names`).
         continuous: Mask (nv,) of the continuous (unbounded revolute) joints.
         lower: Lower position limits (nv,) [rad or m].
         upper: Upper position limits (nv,).
@@ -40,6 +41,8 @@ class Layout(NamedTuple):
         reach: Frame name to its reach [m] (:func:`reach`), the unit of its linear rows.
         closed_form: A closed form answering the tool frame's world_aligned Jacobian, or None.
         tool_frame: The frame the closed form answers for, or None.
+        actuated: Mask (nv,) of the rates a joint drives (False for a floating base's), or
+            None when every rate is.
     """
 
     nv: int
@@ -52,19 +55,23 @@ class Layout(NamedTuple):
     reach: dict[str, float]
     closed_form: Any = None
     tool_frame: str | None = None
+    actuated: npt.NDArray[np.bool_] | None = None
 
     @classmethod
     def of(cls, robot: Robot, closed_form: Any = None) -> Layout:
         """The layout of ``robot`` (with ``closed_form`` for its tool frame, if given)."""
         model = robot.model
         continuous = robot.continuous
-        joints = {n: i for i, n in enumerate(robot.joint_names)}
+        if robot.floating:  # per rate: the base's six are not continuous joints
+            continuous = np.concatenate([np.zeros(6, dtype=bool), continuous[7:]])
+        joints = {n: i for i, n in enumerate(robot.dof_names)}
         frames = frame_index(model)
         reaches = {name: reach(model, fid) for name, fid in frames.items()}
         return cls(
-            model.nv, frames, joints, continuous, robot.lower, robot.upper,
+            model.nv, frames, joints, continuous, robot.dof_lower, robot.dof_upper,
             robot.velocity_limit, reaches, closed_form,
             robot.tool_frame if closed_form is not None else None,
+            robot.actuated if robot.floating else None,
         )  # fmt: skip
 
 
@@ -90,11 +97,12 @@ class Kinematics:
         model: The ``pinocchio.Model``.
         data: A ``pinocchio.Data`` of ``model`` owned by the caller (overwritten).
         layout: The robot's :class:`Layout`.
-        q: Joint positions at the API (nv,) [rad or m], one coordinate per joint.
-        q_pin: The same configuration as Pinocchio's vector (model.nq,).
+        q: Each rate's position (nv,) [rad or m] (:meth:`Robot.dof_positions`: the joints'
+            coordinates, 0 for a floating base's six rates).
+        q_pin: The configuration as Pinocchio's vector (model.nq,).
 
     Attributes:
-        q: Joint positions (nv,).
+        q: Each rate's position (nv,).
         q_pin: Pinocchio configuration (model.nq,).
         layout: The robot's layout.
     """

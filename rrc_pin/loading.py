@@ -345,6 +345,11 @@ def arms() -> list[str]:
     return list(models.CATALOGUE) + installed
 
 
+def cells() -> list[str]:
+    """Names of the ready-made cells :func:`load` accepts (``gsfc_dual``, ``yeh_tripod``)."""
+    return list(models.CELLS)
+
+
 def parameters_of(name: str) -> list[str]:
     """Geometry parameters that :func:`load` passes to the builder of catalogue arm ``name``.
 
@@ -366,7 +371,9 @@ def load(
     """Load an arm, or a robot with several arms, as a :class:`Robot`.
 
     Args:
-        name_or_path: A catalogue name (``"barker6"``, ...), an example-robot-data robot
+        name_or_path: A catalogue name (``"barker6"``, ...), a ready-made cell
+            (``"gsfc_dual"``, ``"yeh_tripod"``: a :class:`~rrc_pin.cells.Cell`), an
+            example-robot-data robot
             (``"panda"``, ``"ur5"``, ``"baxter"``, ...), an :class:`ArmSpec` (e.g. a variant
             from ``rrc_pin.models.barker6.build(alpha3=...)``), or the path of any URDF. A
             committed catalogue URDF (its robot name is a catalogue name and its content
@@ -396,6 +403,16 @@ def load(
             "name_or_path", f"expected a name, a path or an ArmSpec, got {name_or_path!r}"
         )
     key = os.fspath(name_or_path)
+    if key in models.CELLS:
+        _refuse_parameters(parameters, f"the cell {key!r}")
+        if tool_frame is not None:
+            raise InvalidInput("tool_frame",
+                               f"a cell's tool frames are its hands; got {tool_frame!r}")
+        from rrc_pin.cells.cell import from_spec  # here: the cells package imports load
+
+        spec = models.CELLS[key]
+        return from_spec(spec, {m.key: _from_spec(models.CATALOGUE[m.arm], m.tool)
+                                for m in spec.mounts})  # fmt: skip
     if key in BUILDERS:
         return _from_spec(_build(key, parameters), tool_frame)
     _refuse_parameters(parameters, f"{key!r}, which is not a catalogue arm")
@@ -404,7 +421,7 @@ def load(
     path = Path(key)
     if path.suffix.lower() in (".urdf", ".xml") or path.exists():
         return _from_file(path, tool_frame)
-    raise UnknownArm(key, arms())
+    raise UnknownArm(key, arms() + cells())
 
 
 def _refuse_parameters(parameters: dict[str, float], what: str) -> None:

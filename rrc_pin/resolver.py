@@ -45,7 +45,7 @@ from solvers.problem import TaskRows, build
 from solvers.qp_backends import make_backend
 from solvers.resolution import Resolution
 from solvers.spatial import Reference
-from solvers.validation import finite_number, positive
+from solvers.validation import as_vector, finite_number, positive
 
 Array = npt.NDArray[np.float64]
 
@@ -165,15 +165,15 @@ class Resolver:
         for limit in self.limits:
             limit.check(self._layout)
         self._data = robot.model.createData()  # this resolver's own
-        self._names = tuple(robot.joint_names)
-        self._last_qdot = np.zeros(robot.nq)
+        self._names = robot.dof_names
+        self._last_qdot = np.zeros(robot.nv)
         self._lock = threading.Lock()
 
     def reset(self) -> None:
         """Forget the warm starts and the previous joint rates."""
         with self._lock:
             self.backend.reset()
-            self._last_qdot = np.zeros(self.robot.nq)
+            self._last_qdot = np.zeros(self.robot.nv)
 
     def warm_start_state(self) -> dict[str, Any]:
         """Copies of every value that carries over to the next ``solve``."""
@@ -206,7 +206,7 @@ class Resolver:
                 resolver's task's. Not used with tasks (each task has its own).
             priority: ``"weighted"`` or ``"strict"``, for a list of tasks.
             dt: Step [s] for this call; default the constructor's.
-            qdot_prev: Previous joint rates (nq,) for the acceleration limits; default the
+            qdot_prev: Previous joint rates (nv,) for the acceleration limits; default the
                 rates this resolver returned last (zero at the first step).
 
         Returns:
@@ -220,7 +220,7 @@ class Resolver:
         """
         q, q_pin = self.robot.configuration(q)
         step = self.dt if dt is None else _dt(dt)
-        previous = None if qdot_prev is None else self.robot.check_q(qdot_prev, "qdot_prev")
+        previous = None if qdot_prev is None else as_vector(qdot_prev, "qdot_prev", self.robot.nv)
         if isinstance(command, Task) or _is_tasks(command):
             if ref is not None:
                 raise InvalidInput("ref", "tasks carry their own ref; pass ref to FrameTask")
@@ -236,14 +236,15 @@ class Resolver:
             ref = task.ref if ref is None else task.check_ref(ref)
         with self._lock:
             start = time.perf_counter()
-            kin = Kinematics(self.robot.model, self._data, self._layout, q, q_pin)
+            kin = Kinematics(self.robot.model, self._data, self._layout,
+                             self.robot.dof_positions(q), q_pin)  # fmt: skip
             if twist is None:
                 rows = [[t.rows(kin) for t in level] for level in levels]
             else:
                 rows = [[cast(FrameTask, levels[0][0]).rows_at(kin, twist, cast(Reference, ref))]]
             before = self._last_qdot if previous is None else previous
             constraints = [limit.constraints(kin, step, before) for limit in self.limits]
-            problem = build(rows, constraints, self.robot.nq, step, weighted=weighted,
+            problem = build(rows, constraints, self.robot.nv, step, weighted=weighted,
                             direction=self.direction_preserving)
             answer = solve(problem, self.backend, self.options)
             self._last_qdot = answer.qdot
@@ -259,7 +260,9 @@ class Resolver:
         q, q_pin = self.robot.configuration(q)
         _typed(task, Task, "task").check(self._layout)
         with self._lock:
-            return task.rows(Kinematics(self.robot.model, self._data, self._layout, q, q_pin))
+            kin = Kinematics(self.robot.model, self._data, self._layout,
+                             self.robot.dof_positions(q), q_pin)  # fmt: skip
+            return task.rows(kin)
 
     def _twist_task(self) -> FrameTask:
         """The task of ``solve(q, twist)``; a robot with several tool frames has none."""
@@ -306,7 +309,7 @@ class Resolver:
         frame = self.robot.tool_frame
         if frame is None:
             return None
-        return FrameTask(frame, rows="full" if self.robot.nq >= 6 else "position")
+        return FrameTask(frame, rows="full" if self.robot.nv >= 6 else "position")
 
     def _closed_form_for(self, task: FrameTask | None) -> Any:
         cf = self.robot.closed_form

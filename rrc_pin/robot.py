@@ -3,8 +3,19 @@
 Joints are one coordinate each at this API: revolute, prismatic, and continuous (unbounded)
 revolute joints, which Pinocchio stores as (cos, sin) with nq = 2, nv = 1; the Robot maps
 one angle per joint to Pinocchio's configuration vector. Mimic joints (Pinocchio's
-``JointModelMimic``, nq = nv = 0) follow their primary joint and take no coordinate. Any other
-joint (free-flyer, spherical, planar) is refused with a message saying why.
+``JointModelMimic``, nq = nv = 0) follow their primary joint and take no coordinate.
+
+A floating base is a free-flyer root joint (Pinocchio's ``JointModelFreeFlyer`` as the first
+joint, hanging from the universe: a legged cell's body). Its coordinates are Pinocchio's own,
+``[x, y, z, qx, qy, qz, qw]`` (position [m], unit quaternion), at the start of q; its six
+rates ``[v; w]`` (in the body's axes, Pinocchio's convention) start qdot. Then
+``nq = nv + 1``: configurations are moved by :meth:`Robot.integrate` (``pinocchio.integrate``),
+never by ``q + qdot dt``, and the arrays indexed by joint rate (``velocity_limit``,
+``dof_lower``, ``dof_upper``) have ``nv`` entries, those indexed by coordinate (``lower``,
+``upper``) ``nq``. The base is not actuated: it has no position limits, and its rates move
+only as far as the rows (contacts) and its velocity limits (set in the model) allow. Any
+other joint (a free-flyer below the root, spherical, planar) is refused with a message
+saying why.
 
 Threads: a Robot may be shared between threads. Its methods never write shared state: each
 thread computes in its own ``pinocchio.Data`` (a ``threading.local``, created on the thread's
@@ -18,6 +29,7 @@ The cost of a Data per thread is its memory: about 0.2 MB for panda, 0.8 MB for 
 
 from __future__ import annotations
 
+import math
 import threading
 from collections.abc import Mapping, Sequence
 
@@ -29,7 +41,7 @@ from rrc_pin.errors import FrameNotFound, InvalidInput, ToolFrameRequired, URDFE
 from rrc_pin.models.arm_spec import ArmSpec
 from solvers.closed_form.base import ClosedForm
 from solvers.spatial import Reference, check_reference
-from solvers.validation import as_vector
+from solvers.validation import as_vector, finite_number
 
 PIN_REFERENCE = {
     "world_aligned": pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
@@ -41,9 +53,15 @@ PIN_REFERENCE = {
 Seed = np.random.Generator | int | None
 """What :meth:`Robot.random_q` takes: a numpy Generator, an int seed (>= 0) or None."""
 
+BASE_AXES = ("vx", "vy", "vz", "wx", "wy", "wz")
+"""Names of a floating base's six rates (body axes), in :attr:`Robot.dof_names`."""
+
 UNBOUNDED = 1e6
 """A joint limit beyond +-this [rad or m] counts as none (URDFs write 1e16 or 1e308 for none):
 :meth:`Robot.random_q` draws such a joint over a finite window, see there."""
+QUATERNION_TOL = 1e-6
+"""A base quaternion shorter than this is refused (it has no direction); any longer one is
+normalised."""
 READY_INSET = 0.1
 """Fraction of a joint's range that :meth:`Robot.ready` keeps from each limit when the robot
 has no named ready configuration."""
@@ -58,11 +76,18 @@ class Robot:
         tool_frames: Names of the end-effector frames, one for an arm, several for a robot
             with several arms (baxter, pr2, a :func:`rrc_pin.combine` cell).
         tool_frame: The tool frame of an arm, or None when there are several.
-        nq: Number of joints (one coordinate each at this API).
-        joint_names: Joint names, in the order of q.
-        lower: Joint lower limits (nq,) [rad or m]; -inf for continuous joints.
-        upper: Joint upper limits (nq,) [rad or m]; +inf for continuous joints.
-        velocity_limit: Joint speed limits (nq,) [rad/s or m/s]; +inf where the URDF gives none.
+        nq: Number of coordinates of q: one per joint, plus 7 for a floating base.
+        nv: Number of joint rates (qdot): one per joint, plus 6 for a floating base; nq
+            without one.
+        floating: Whether the root joint is a free-flyer (module docstring).
+        base_joint: The free-flyer's name, or None.
+        joint_names: Names of the actuated joints, in the order of q (after the base's 7).
+        dof_names: Names of the nv rates: ``base:vx`` ... ``base:wz``, then the joints.
+        actuated: Mask (nv,) of the rates a joint drives (False for the base's six).
+        lower: Lower limits (nq,) of q's coordinates [rad or m]; -inf for continuous joints
+            and the base.
+        upper: Upper limits (nq,) [rad or m]; +inf for continuous joints and the base.
+        velocity_limit: Speed limits (nv,) [rad/s or m/s]; +inf where the model gives none.
         spec: The catalogue :class:`ArmSpec` the robot was built from, or None.
         source: Where the model came from (a path, ``catalogue``, a combination).
         poses: Named configurations (nq,) [rad or m] (read-only arrays); ``"ready"``, where
@@ -115,9 +140,11 @@ class Robot:
         if model.nv == 0:
             raise URDFError(source, "no moving joint: there is nothing to control")
         scalar_api, scalar_pin, angle_api, angle_pin = [], [], [], []
-        moving: list[tuple[int, str]] = []  # (index in q, joint name)
+        moving: list[tuple[int, str]] = []  # (index in qdot, joint name)
         mimic: list[str] = []
-        for j in range(1, model.njoints):
+        floating = model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer"
+        offset = 1 if floating else 0  # API coordinates before a joint's: idx_v + offset
+        for j in range(2 if floating else 1, model.njoints):
             joint = model.joints[j]
             if joint.shortname() == "JointModelMimic":  # follows its primary: no coordinate
                 mimic.append(str(model.names[j]))
@@ -127,14 +154,15 @@ class Robot:
                     source,
                     f"joint {model.names[j]!r} is a {joint.shortname()} (nq={joint.nq}, "
                     f"nv={joint.nv}); rrc-pin handles serial arms of 1-DOF joints only "
-                    "(lock or remove it, e.g. with pinocchio.buildReducedModel)",
+                    "(lock or remove it, e.g. with pinocchio.buildReducedModel); a floating "
+                    "base is a free-flyer as the first joint, from the universe",
                 )
             moving.append((joint.idx_v, str(model.names[j])))
             if joint.nq == 1:
-                scalar_api.append(joint.idx_v)
+                scalar_api.append(joint.idx_v + offset)
                 scalar_pin.append(joint.idx_q)
             else:
-                angle_api.append(joint.idx_v)
+                angle_api.append(joint.idx_v + offset)
                 angle_pin.append(joint.idx_q)
         self._frame_ids = frame_index(model)
         if tool_frames is None:
@@ -161,11 +189,17 @@ class Robot:
         self.model = model
         self.tool_frames: tuple[str, ...] = tools
         self.tool_frame: str | None = tools[0] if len(tools) == 1 else None
-        self.nq: int = model.nv
+        self.floating: bool = floating
+        self.nv: int = model.nv
+        self.nq: int = model.nv + offset
+        self.base_joint: str | None = str(model.names[1]) if floating else None
         self.joint_names = [joint for _, joint in sorted(moving)]  # = moving_joints(model)
+        base_dofs = [f"{self.base_joint}:{axis}" for axis in BASE_AXES] if floating else []
+        self.dof_names: tuple[str, ...] = (*base_dofs, *self.joint_names)
         self.mimic_joints: tuple[str, ...] = tuple(mimic)
         self._scalar = (np.array(scalar_api, dtype=int), np.array(scalar_pin, dtype=int))
         self._angle = (np.array(angle_api, dtype=int), np.array(angle_pin, dtype=int))
+        self._offset = offset
         self.continuous = np.zeros(self.nq, dtype=bool)
         self.continuous[self._angle[0]] = True
         self.continuous.flags.writeable = False
@@ -176,7 +210,10 @@ class Robot:
         self.lower[self._scalar[0]] = model.lowerPositionLimit[self._scalar[1]]
         self.upper[self._scalar[0]] = model.upperPositionLimit[self._scalar[1]]
         velocity = np.array(model.velocityLimit, dtype=float)
-        self.velocity_limit = np.where(velocity > 0.0, velocity, np.inf)
+        self.velocity_limit = np.where((velocity > 0.0) & (velocity < UNBOUNDED), velocity, np.inf)
+        self.actuated = np.ones(self.nv, dtype=bool)
+        self.actuated[: 6 * offset] = False
+        self.actuated.flags.writeable = False
         named = (spec.named_poses if spec is not None else {}) if poses is None else poses
         self.poses: dict[str, npt.NDArray[np.float64]] = self._checked_poses(named)
 
@@ -245,6 +282,72 @@ class Robot:
         """
         return self.configuration(q)[1]
 
+    def dof_positions(self, q: npt.ArrayLike) -> npt.NDArray[np.float64]:
+        """Each rate's position (nv,) [rad or m]: the joints' coordinates, 0 for the base's six.
+
+        What position limits and posture tasks compare with, indexed like qdot; ``q``
+        itself (checked) without a floating base.
+
+        Raises:
+            InvalidInput: ``q`` is not a finite (nq,) vector.
+        """
+        q = self.check_q(q)
+        return self._dof(q)
+
+    def _dof(self, q: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        if not self.floating:
+            return q
+        out: npt.NDArray[np.float64] = np.concatenate([np.zeros(6), q[7:]])
+        return out
+
+    @property
+    def dof_lower(self) -> npt.NDArray[np.float64]:
+        """Lower position limits (nv,) per rate [rad or m]; -inf for the base's six."""
+        return self._dof_limits(self.lower, -np.inf)
+
+    @property
+    def dof_upper(self) -> npt.NDArray[np.float64]:
+        """Upper position limits (nv,) per rate [rad or m]; +inf for the base's six."""
+        return self._dof_limits(self.upper, np.inf)
+
+    def _dof_limits(
+        self, limits: npt.NDArray[np.float64], base: float
+    ) -> npt.NDArray[np.float64]:
+        if not self.floating:
+            return limits
+        out: npt.NDArray[np.float64] = np.concatenate([np.full(6, base), limits[7:]])
+        return out
+
+    def integrate(
+        self, q: npt.ArrayLike, qdot: npt.ArrayLike, dt: float
+    ) -> npt.NDArray[np.float64]:
+        r"""The configuration (nq,) reached from ``q`` at rates ``qdot`` (nv,) after ``dt`` [s].
+
+        .. math:: q_{k+1} = q_k \oplus \dot q\, \Delta t \quad (\texttt{pinocchio.integrate})
+
+        ``q + qdot dt`` exactly (the same floats) without a floating base or a continuous
+        joint; a floating base moves on SE(3) (its twist in body axes), its quaternion
+        normalised; a continuous joint's angle advances by ``qdot dt``.
+
+        Raises:
+            InvalidInput: Bad ``q``, ``qdot`` (not finite (nv,)) or ``dt``.
+        """
+        q, q_pin = self.configuration(q)
+        v = as_vector(qdot, "qdot", self.nv)
+        step = finite_number(dt, "dt")
+        if self._identity_map:
+            out: npt.NDArray[np.float64] = q + v * step
+            return out
+        moved = pin.integrate(self.model, q_pin, v * step)
+        if not self.floating:  # continuous joints: back to angles by the difference
+            angles: npt.NDArray[np.float64] = q + pin.difference(self.model, q_pin, moved)
+            return angles
+        out = q.copy()
+        out[:7] = moved[:7]
+        delta = pin.difference(self.model, q_pin, moved)
+        out[7:] = q[7:] + delta[6:]
+        return out
+
     def configuration(
         self, q: npt.ArrayLike
     ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
@@ -257,6 +360,12 @@ class Robot:
         if self._identity_map:
             return q, q
         out = np.empty(self.model.nq)
+        if self.floating:
+            out[:7] = q[:7]
+            norm = math.hypot(*q[3:7].tolist())
+            if not norm > QUATERNION_TOL:
+                raise InvalidInput("q", f"the base quaternion q[3:7] = {q[3:7]} has no direction")
+            out[3:7] /= norm
         api, pin_idx = self._scalar
         out[pin_idx] = q[api]
         api, pin_idx = self._angle
@@ -270,7 +379,13 @@ class Robot:
         It may sit on a limit (panda's joint 4) or at a singularity (an arm stretched out):
         start a session from :meth:`ready` instead.
         """
-        return np.clip(np.zeros(self.nq), self.lower, self.upper)
+        return self._identity_base(np.clip(np.zeros(self.nq), self.lower, self.upper))
+
+    def _identity_base(self, q: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """``q`` with a floating base at the origin, unrotated (in place; ``q`` returned)."""
+        if self.floating:
+            q[:7] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0)
+        return q
 
     def ready(self) -> npt.NDArray[np.float64]:
         """A configuration (nq,) [rad or m] to start from, away from limits and singularities.
@@ -291,12 +406,14 @@ class Robot:
         lo, hi = _finite_window(self.lower, self.upper)
         inset = READY_INSET * (hi - lo)
         inside: npt.NDArray[np.float64] = np.clip(np.zeros(self.nq), lo + inset, hi - inset)
-        return inside
+        return self._identity_base(inside)
 
     def random_q(self, rng: Seed = None) -> npt.NDArray[np.float64]:
         """A configuration (nq,) drawn uniformly within the limits.
 
-        Unbounded joints (continuous, or limits beyond +-:data:`UNBOUNDED`) are drawn in
+        A floating base is left where :meth:`ready` puts it (its pose is not a joint's: a
+        cell's ready pose stands the body on its feet). Unbounded joints (continuous, or
+        limits beyond +-:data:`UNBOUNDED`) are drawn in
         [-pi, pi]; a joint bounded on one side only, over 2 pi [rad or m] from that limit.
 
         Args:
@@ -308,7 +425,10 @@ class Robot:
         """
         generator = _generator(rng)
         lo, hi = _finite_window(self.lower, self.upper)
-        return generator.uniform(lo, hi)
+        q: npt.NDArray[np.float64] = generator.uniform(lo, hi)
+        if self.floating:
+            q[:7] = self.ready()[:7]
+        return q
 
     def fk(self, q: npt.ArrayLike, frame: str | None = None) -> npt.NDArray[np.float64]:
         """Pose (4, 4) of a frame in the base frame, translation in [m].
@@ -341,7 +461,7 @@ class Robot:
     def jacobian(
         self, q: npt.ArrayLike, ref: Reference = "world_aligned", frame: str | None = None
     ) -> npt.NDArray[np.float64]:
-        """Geometric Jacobian of a frame, (6, nq), rows [v; w] ([m/s], [rad/s] per unit rate).
+        """Geometric Jacobian of a frame, (6, nv), rows [v; w] ([m/s], [rad/s] per unit rate).
 
         Args:
             q: Joint positions (nq,).

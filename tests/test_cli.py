@@ -21,7 +21,7 @@ def test_arms_table_lists_tool_frames_sources_and_assumptions(capsys):
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].split()[:5] == ["name", "dof", "joints", "tool", "frames"]
     rows = {line.split()[0]: line for line in lines[1:]}
-    assert list(rows) == rrc_pin.arms()
+    assert list(rows) == rrc_pin.arms() + rrc_pin.loading.cells()
     assert rows["barker6"].split()[1:4] == ["6", "RRRRRR", "tool"]
     assert "PUMA 560 values" in rows["barker6"]
     assert rows["nadkarni_c2"].split()[1:3] == ["6", "PPPRRR"]
@@ -34,6 +34,9 @@ def test_arms_table_lists_tool_frames_sources_and_assumptions(capsys):
         "panda"]  # fmt: skip
     assert "ready pose (0, 0, 90, 0, 45, 0) deg" in rows["barker6"]
     assert all("ready pose" in row for row in rows.values())
+    assert rows["gsfc_dual"].split()[1:3] == ["14", "cell"] and "shoulder spacing" in rows[
+        "gsfc_dual"]  # fmt: skip
+    assert "24 (6 floating)" in rows["yeh_tripod"] and "leg1/flange" in rows["yeh_tripod"]
 
 
 def test_help_is_plain_text_and_lists_the_illustrations(capsys):

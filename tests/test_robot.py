@@ -215,11 +215,58 @@ def test_continuous_joints_take_one_angle_each(rng):
     np.testing.assert_allclose(arm.fk(q_wrapped), T, atol=1e-12)
 
 
-def test_free_flyer_is_refused_with_the_reason():
+def _floating_ur5() -> Robot:
     path = robots_directory() / INSTALLED["ur5"].path
     model = pin.buildModelFromUrdf(str(path), pin.JointModelFreeFlyer())
+    model.velocityLimit[:6] = 1.0
+    return Robot(model, "tool0", name="ur5_floating", source=str(path))
+
+
+def test_a_free_flyer_root_is_a_floating_base_with_nq_one_more_than_nv():
+    arm = _floating_ur5()
+    assert (arm.nq, arm.nv, arm.floating) == (13, 12, True)
+    axes = ("vx", "vy", "vz", "wx", "wy", "wz")
+    assert arm.dof_names[:6] == tuple(f"root_joint:{a}" for a in axes)
+    assert list(arm.actuated) == [False] * 6 + [True] * 6
+    assert np.isinf(arm.dof_lower[:6]).all() and arm.dof_lower.shape == (12,)
+    np.testing.assert_array_equal(arm.neutral()[:7], [0, 0, 0, 0, 0, 0, 1])
+    rng = np.random.default_rng(3)
+    q = arm.random_q(rng)
+    assert arm.jacobian(q).shape == (6, 12)
+    np.testing.assert_array_equal(arm.dof_positions(q)[6:], q[7:])
+
+
+def test_integrate_moves_a_floating_base_on_se3_and_matches_pinocchio():
+    arm = _floating_ur5()
+    rng = np.random.default_rng(4)
+    q = arm.random_q(rng)
+    q[:3] = rng.normal(size=3)
+    q[3:7] = rng.normal(size=4)
+    q[3:7] /= np.linalg.norm(q[3:7])
+    v = rng.normal(size=12)
+    moved = arm.integrate(q, v, 0.01)
+    np.testing.assert_allclose(moved, pin.integrate(arm.model, q, v * 0.01), atol=1e-15)
+    # The tool moves by the Jacobian's twist to first order (finite difference over dt)
+    dt = 1e-6
+    J = arm.jacobian(q, "world_aligned")
+    p0, p1 = arm.fk(q)[:3, 3], arm.fk(arm.integrate(q, v, dt))[:3, 3]
+    np.testing.assert_allclose((p1 - p0) / dt, J[:3] @ v, atol=1e-4)
+
+
+def test_a_base_quaternion_of_zero_length_is_refused_naming_q():
+    arm = _floating_ur5()
+    q = arm.neutral()
+    q[3:7] = 0.0
+    with pytest.raises(InvalidInput, match="^q:.*quaternion"):
+        arm.fk(q)
+
+
+def test_a_free_flyer_below_the_root_is_refused_with_the_reason():
+    arm = rrc_pin.load("barker6")
+    model = pin.Model(arm.model)
+    model.addJoint(1, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "loose")
     with pytest.raises(URDFError, match="JointModelFreeFlyer.*1-DOF joints only"):
-        Robot(model, "tool0", name="ur5_floating", source=str(path))
+        Robot(model, "tool", name="loose", source="test")
 
 
 @pytest.mark.parametrize(

@@ -32,7 +32,7 @@ class JointLimits(Limit):
             every joint's range (checked against the robot when a Resolver is built).
         acceleration: Joint acceleration limits [rad/s^2 or m/s^2] > 0, a scalar or (nq,),
             or None for none.
-        velocity: Velocity limits (nq,) [rad/s or m/s] > 0 replacing the robot's, or None.
+        velocity: Velocity limits (nv,) [rad/s or m/s] > 0 replacing the robot's, or None.
         position_gain: Fraction in (0, 1] of the distance to a position limit allowed in one
             step (pink's ``config_limit_gain``).
         name: Name in the report.
@@ -86,6 +86,14 @@ class JointLimits(Limit):
         if self.velocity is None and not np.isfinite(layout.velocity).all():
             missing = [name for name, i in layout.joints.items()
                        if not np.isfinite(layout.velocity[i])]  # fmt: skip
+            if layout.actuated is not None and not all(layout.actuated[layout.joints[n]]
+                                                       for n in missing):  # fmt: skip
+                raise InvalidInput(
+                    "velocity",
+                    f"the floating base's rates {missing} have no velocity limit: give the "
+                    "free-flyer's model.velocityLimit (a body speed cap) or JointLimits("
+                    "velocity=[...]) (nv,)",
+                )
             raise InvalidInput(
                 "velocity",
                 f"the robot gives no velocity limit for joints {missing} (its URDF has "

@@ -1,4 +1,4 @@
-"""FrameTask: a commanded twist of one frame of the robot."""
+"""FrameTask: a commanded twist of one frame of the robot, optionally toward a target pose."""
 
 from __future__ import annotations
 
@@ -6,13 +6,14 @@ from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
+import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.tasks.task import Task, check_weight, task_name
 from solvers.problem import TaskRows
 from solvers.spatial import Reference, check_reference
-from solvers.validation import as_vector
+from solvers.validation import as_vector, positive, rigid_transform
 
 Array = npt.NDArray[np.float64]
 
@@ -25,7 +26,16 @@ ROWS: dict[str, tuple[int, ...]] = {
 
 
 class FrameTask(Task):
-    """The twist ``[v; w]`` of frame ``frame``, in the reference frame ``ref``.
+    r"""The twist ``[v; w]`` of frame ``frame``, in the reference frame ``ref``.
+
+    With a ``target`` pose :math:`T^* = (R^*, p^*)` (pink's and mink's ``set_target``) the
+    commanded twist is a feed-forward, and the pose error is fed back:
+
+    .. math:: b = \nu_{ff} + k\,[p^* - p;\ \log(R^* R^T)]
+
+    (the error in base axes at the frame's origin, expressed in ``ref`` like the twist), so
+    that a commanded frame follows its target without drift. Advance the target with the
+    feed-forward each tick (:meth:`set_target`), or hold it still with a zero twist.
 
     Args:
         frame: Name of a frame of the robot (e.g. its tool frame).
@@ -39,9 +49,12 @@ class FrameTask(Task):
             mask (6,) or row indices.
         weight: Cost > 0 of the squared residual, scalar or one per selected row.
         name: Name in the report (default the frame's).
+        target: Pose (4, 4) of the frame in the base frame to hold [m], or None.
+        gain: k > 0 [1/s], the fraction of the pose error corrected per second.
 
     Raises:
-        InvalidInput: A bad twist, ref, rows or weight, or ``world`` with partial rows.
+        InvalidInput: A bad twist, ref, rows, weight, target or gain, or ``world`` with
+            partial rows.
     """
 
     def __init__(
@@ -53,9 +66,13 @@ class FrameTask(Task):
         rows: str | Sequence[int] | Sequence[bool] = "full",
         weight: float | npt.ArrayLike = 1.0,
         name: str | None = None,
+        target: npt.ArrayLike | None = None,
+        gain: float = 10.0,
     ) -> None:
         if not isinstance(frame, str):
             raise InvalidInput("frame", f"expected a frame name, got {frame!r}")
+        self.target: Array | None = None if target is None else rigid_transform(target, "target")
+        self.gain = positive(gain, "gain")
         self.frame = frame
         self.selected = task_rows(rows)
         self.ref = self.check_ref(ref)
@@ -71,6 +88,25 @@ class FrameTask(Task):
             InvalidInput: Wrong shape or a non-finite entry; the task is then unchanged.
         """
         self.twist = self.check_twist(twist)
+
+    def set_target(self, target: npt.ArrayLike | None) -> None:
+        """Hold the frame at pose ``target`` (4, 4) in the base frame [m], or None for none.
+
+        Raises:
+            InvalidInput: Not a rigid transform; the task is then unchanged.
+        """
+        self.target = None if target is None else rigid_transform(target, "target")
+
+    def error(self, pose: Array) -> Array:
+        """The pose error (6,) ``[p* - p; log(R* R^T)]`` [m, rad] in base axes.
+
+        Zero without a target; ``pose`` (4, 4) is the frame's.
+        """
+        if self.target is None:
+            return np.zeros(6)
+        return np.concatenate([
+            self.target[:3, 3] - pose[:3, 3], pin.log3(self.target[:3, :3] @ pose[:3, :3].T)
+        ])  # fmt: skip
 
     def check_twist(self, twist: npt.ArrayLike) -> Array:
         """``twist`` as the selected rows: (6,) or (rows,) finite, a new array (the task's own).
@@ -119,8 +155,18 @@ class FrameTask(Task):
     def rows_at(self, kin: Kinematics, b: Array, ref: Reference) -> TaskRows:
         """The task's rows in frame ``ref`` with the selected rates ``b`` (checked by the caller).
 
-        What :meth:`rows` gives for a twist ``b`` of this tick (``Resolver.solve(q, twist)``).
+        What :meth:`rows` gives for a twist ``b`` of this tick (``Resolver.solve(q, twist)``),
+        plus the target's feedback (class docstring) when the task holds one.
         """
+        if self.target is not None:
+            pose = kin.pose(self.frame)
+            error = self.error(pose)  # base axes, at the frame's origin
+            if ref == "local":
+                R = pose[:3, :3]
+                error = np.concatenate([R.T @ error[:3], R.T @ error[3:]])
+            elif ref == "world":  # spatial velocity at the base origin
+                error[:3] += np.cross(pose[:3, 3], error[3:])
+            b = b + self.gain * self.selected_rates(error)
         return self.rows_from(kin.jacobian(self.frame, ref), b, kin.layout.reach[self.frame])
 
     def rows_from(self, J: Array, b: Array, reach: float) -> TaskRows:

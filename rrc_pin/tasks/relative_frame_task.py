@@ -96,6 +96,14 @@ class RelativeFrameTask(Task):
         """
         self._spec.set_twist(twist)
 
+    def set_target(self, target: npt.ArrayLike | None) -> None:
+        """Hold frame b at pose ``target`` (4, 4) in frame a [m], or None for none.
+
+        Raises:
+            InvalidInput: Not a rigid transform; the task is then unchanged.
+        """
+        self.target = None if target is None else rigid_transform(target, "target")
+
     def frames(self) -> tuple[str, ...]:
         """Both frames."""
         return (self.frame_a, self.frame_b)

@@ -1,0 +1,84 @@
+"""GripLimit: two frames held rigidly together (two hands on one object), as equality rows."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.errors import FrameNotFound, InvalidInput
+from rrc_pin.limits.contact_limit import AXES
+from rrc_pin.limits.limit import Limit
+from rrc_pin.tasks.relative_frame_task import RelativeFrameTask
+from solvers.problem import Constraints
+
+if TYPE_CHECKING:
+    from rrc_pin.kinematics import Kinematics, Layout
+
+Array = npt.NDArray[np.float64]
+
+
+class GripLimit(Limit):
+    """Grips: for each pair ``(a, b)``, b's twist relative to a is zero (six equality rows).
+
+    The rows are :class:`~rrc_pin.tasks.RelativeFrameTask`'s (its class docstring), held
+    exactly at every answer, whatever the levels do (scaled, damped, traded): two hands on
+    one object keep their grip to first order; the controller of a cell removes the
+    integration's second-order remainder by a projection
+    (:class:`~rrc_pin.cells.controller.CellController`).
+
+    Args:
+        pairs: ``(frame_a, frame_b)`` pairs.
+        name: Name in the report; rows are named ``name:frame_b/frame_a:axis``.
+
+    Raises:
+        InvalidInput: Not pairs of two different frame names.
+    """
+
+    def __init__(self, pairs: Sequence[tuple[str, str]] = (), name: str = "grip") -> None:
+        if not isinstance(name, str):
+            raise InvalidInput("name", f"expected a string, got {name!r}")
+        self.name = name
+        self._layout: Layout | None = None
+        self.set_pairs(pairs)
+
+    def set_pairs(self, pairs: Sequence[tuple[str, str]]) -> None:
+        """The pairs held from now on (an object grasped or released); checked.
+
+        Raises:
+            InvalidInput: Not pairs of two different frame names; the limit is unchanged.
+            FrameNotFound: A frame the robot (of the resolver holding it) does not have.
+        """
+        items = tuple(tuple(p) for p in pairs)
+        for p in items:
+            if len(p) != 2 or not all(isinstance(f, str) for f in p) or p[0] == p[1]:
+                raise InvalidInput("pairs", f"expected (frame_a, frame_b) pairs, got {pairs!r}")
+            if self._layout is not None:
+                for frame in p:
+                    if frame not in self._layout.frames:
+                        raise FrameNotFound(frame, sorted(self._layout.frames), "pairs")
+        self.pairs: tuple[tuple[str, str], ...] = items  # type: ignore[assignment]
+        self._tasks = tuple(RelativeFrameTask(a, b) for a, b in self.pairs)
+        self._names = tuple(f"{self.name}:{b}/{a}:{x}" for a, b in self.pairs for x in AXES)
+        self._zero = np.zeros(6 * len(items))
+
+    def check(self, layout: Layout) -> None:
+        """Refuse frames the robot does not have.
+
+        Raises:
+            FrameNotFound: Naming ``pairs`` and listing the robot's frames.
+        """
+        for pair in self.pairs:
+            for frame in pair:
+                if frame not in layout.frames:
+                    raise FrameNotFound(frame, sorted(layout.frames), "pairs")
+        self._layout = layout
+
+    def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
+        """The grip rows ``C qdot = 0`` (C: (6 k, nv))."""
+        if not self.pairs:
+            return Constraints()
+        C = np.vstack([t.rows(kin).A for t in self._tasks])
+        return Constraints(C=C, d=self._zero, names=self._names)
