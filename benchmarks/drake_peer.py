@@ -19,7 +19,7 @@ Two frames and a posture (:func:`two_frames`): Drake's Jacobians of both frames 
 (12 rows), the J-and-V overload, the posture as Drake's joint centering (K = gain, the
 nominal the posture's reference): a strict priority of the hands over the posture, the
 hands with one common scale, as rrc-pin's ``priority="strict"``. Drake has no weighted mode.
-A step fails (raises) where Drake finds no solution (``kNoSolution``); ``kStuck`` (a scale
+A step fails (raises) where Drake finds no solution (``kNoSolutionFound``); ``kStuck`` (a scale
 below 0.01) still answers, and its rates are used, as Drake's own controllers do.
 """
 
@@ -158,7 +158,7 @@ def one_frame(arm: Any, drake: DrakeArm, dt: float) -> Any:
     params = drake.parameters(arm, dt)
     frame = drake.frame(arm.tool_frame)
     plant, context, v_index = drake.plant, drake.context, drake.v_index
-    failed = DifferentialInverseKinematicsStatus.kNoSolution
+    failed = DifferentialInverseKinematicsStatus.kNoSolutionFound
 
     def step(q: Array, x: Array) -> Array:
         drake.set(q)
@@ -188,7 +188,7 @@ def two_frames(arm: Any, drake: DrakeArm, dt: float, gain: float, nominal: Array
     params.set_joint_centering_gain(gain * np.eye(n))
     frames = [drake.frame(f) for f in arm.tool_frames]
     zero = np.zeros(n)
-    failed = DifferentialInverseKinematicsStatus.kNoSolution
+    failed = DifferentialInverseKinematicsStatus.kNoSolutionFound
     q_index, v_index = drake.q_index, drake.v_index
 
     def step(q: Array, x: Array) -> Array:
