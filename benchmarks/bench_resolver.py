@@ -287,16 +287,17 @@ def _quality_lines(results: dict[str, Any]) -> list[str]:
             if q is None:
                 continue
             fast = (
-                f", too fast {q['direction_error_median_deg']:.2g} deg median, "
-                f"{100 * q['at_lp_best']:.0f}% at the LP's best speed"
+                f"; of {q['too_fast_steps']} too-fast steps, {100 * q['at_lp_best']:.0f}% at the "
+                f"LP's best speed, {q['stopped_steps']} standing still, direction error "
+                f"{q['direction_error_median_deg']:.2g} deg median"
                 if q.get("too_fast_steps")
                 else ""
             )
             parts.append(
-                f"{label} veers at {q['veer_steps']} of {q['reachable_steps']} reachable steps "
-                f"(max {q['veer_max_deg']:.2g} deg){fast}"
+                f"{label}: veers at {q['veer_steps']} of {q['reachable_steps']} fully reachable "
+                f"steps (max {q['veer_max_deg']:.2g} deg){fast}"
             )
-        out.append(f"Answers, {arm['arm']}: " + "; ".join(parts) + ".")
+        out.append(f"Answers, {arm['arm']}: " + ". ".join(parts) + ".")
     return out
 
 

@@ -149,9 +149,9 @@ def quality_table(quality: dict[str, Any], order: list[str]) -> list[str]:
     speed along the command."""
     lines = [
         "| contender | fully reachable steps | veer there: steps | largest [deg] | too-fast "
-        "steps (LP scale < 1) | direction error median / p90 / max [deg] | at the LP's best | "
-        "speed along the command / LP best (median) |",
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+        "steps (0 < LP scale < 1) | standing still there | direction error median / p90 / max "
+        "[deg] | at the LP's best | speed along the command / LP best (median) |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     for label in order:
         q = quality.get(label)
@@ -166,7 +166,8 @@ def quality_table(quality: dict[str, Any], order: list[str]) -> list[str]:
         )
         lines.append(
             f"| {label} | {q['reachable_steps']} | {q['veer_steps']} | "
-            f"{q['veer_max_deg']:.2g} | {q['too_fast_steps']} | {fast} |"
+            f"{q['veer_max_deg']:.2g} | {q['too_fast_steps']} | {q.get('stopped_steps', 0)} | "
+            f"{fast} |"
         )
     return lines
 

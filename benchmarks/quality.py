@@ -12,9 +12,13 @@ contender's own report:
   both in the normalised metric (linear rows divided by the frame's reach, rrc-pin's
   documented metric, so that metres and radians weigh alike). Where the LP maximum is 1:
   the steps that veer by more than :data:`VEER_TOL` and the largest angle. On the too-fast
-  segments where the LP maximum is below 1: the veer's median, p90 and largest (the
-  direction error), and the share of steps that reach the LP's best speed along the command
-  (scale within :data:`SPEED_TOL` of it, veer within :data:`VEER_TOL`);
+  segments where the LP maximum is below 1 but above :data:`BLOCKED` (the arm can move along
+  the command, slower): the veer's median, p90 and largest (the direction error) over the
+  answers that move, the answers that stand still (``stopped``: achieved rates below
+  :data:`BLOCKED` of the command, no direction), and the share of steps that reach the LP's
+  best speed along the command (scale within :data:`SPEED_TOL` of it, veer within
+  :data:`VEER_TOL`). Where the LP maximum is :data:`BLOCKED` or less, a limit stops every
+  motion along the command (``blocked_steps``): standing still is the best answer there;
 - the **weighted optimum** (baxter, weighted): the distance [rad/s] of the rates from the
   exact optimum of rrc-pin's stated costs in the box (scipy's BVLS);
 - the **limit excess**: the largest velocity and position excess (:mod:`timing`).
@@ -36,6 +40,9 @@ VEER_TOL = 1e-6
 """[rad] A veer above this counts (rrc-pin's exact answers veer by 1e-12 or less)."""
 SPEED_TOL = 1e-6
 """Relative tolerance of "at the LP's best speed along the command"."""
+BLOCKED = 1e-6
+"""An LP maximum scale at most this: no motion along the command is possible (a limit
+blocks it); achieved rates below this fraction of the command: the answer stands still."""
 
 
 def step_box(robot: Any, q: Array, dt: float) -> tuple[Array, Array]:
@@ -103,7 +110,10 @@ def direction(
     best = ref["lp_scale"]
     ok = ~failed
     reachable = ok & (best >= 1.0 - REACHABLE_TOL)
-    fast = ok & (best < 1.0 - REACHABLE_TOL) & np.array([k == "too_fast" for k in kinds])
+    too_fast = np.array([k == "too_fast" for k in kinds])
+    fast = ok & (best < 1.0 - REACHABLE_TOL) & (best > BLOCKED) & too_fast
+    stopped = np.linalg.norm(y, axis=1) <= BLOCKED * np.sqrt(bb)
+    moving = fast & ~stopped
     at_best = (np.abs(scale - best) <= SPEED_TOL * np.maximum(best, 1e-12)) & (veer <= VEER_TOL)
     deg = np.degrees
     out: dict[str, Any] = {
@@ -111,16 +121,18 @@ def direction(
         "veer_steps": int((reachable & (veer > VEER_TOL)).sum()),
         "veer_max_deg": float(deg(veer[reachable].max())) if reachable.any() else 0.0,
         "too_fast_steps": int(fast.sum()),
+        "stopped_steps": int((fast & stopped).sum()),
+        "blocked_steps": int((ok & (best <= BLOCKED)).sum()),
         "failed_steps": int(failed.sum()),
     }
     if fast.any():
-        e = deg(veer[fast])
+        e = deg(veer[moving]) if moving.any() else np.zeros(1)
         out.update(
             direction_error_median_deg=float(np.median(e)),
             direction_error_p90_deg=float(np.percentile(e, 90)),
             direction_error_max_deg=float(e.max()),
             at_lp_best=float(at_best[fast].mean()),
-            speed_median=float(np.median(scale[fast] / np.maximum(best[fast], 1e-12))),
+            speed_median=float(np.median(scale[fast] / best[fast])),
         )
     return out
 

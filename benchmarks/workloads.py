@@ -8,8 +8,11 @@ kind drawn at random:
 
 - ``smooth``: the command blends linearly from one random twist to the next (linear parts
   N(0, 0.1) m/s, angular N(0, 0.15) rad/s per axis): reachable, far from the limits mostly;
-- ``too_fast``: a constant twist of random direction, 1.5 m/s and 3 rad/s: beyond what the
-  joints' velocity limits allow, so the answer can only be slower than the command (or veer);
+- ``too_fast``: twists of random direction, 1.5 m/s and 3 rad/s, a new direction every
+  :data:`FAST_EVERY` steps: beyond what the joints' velocity limits allow, so the answer can
+  only be slower than the command (or veer). The directions change within the segment
+  because a constant one soon drives a joint onto its limit, where no motion along it is
+  left (the LP maximum scale is then 0: standing still is the answer);
 - ``near_limit``: at the segment's start, three joints are moved to within 0.02 rad inside a
   position limit (upper or lower at random), then a moderate random twist (N(0, 0.23) m/s,
   N(0, 0.35) rad/s) drives on: the one-step position bounds are active.
@@ -34,6 +37,8 @@ NEAR = 0.02
 """[rad] How far inside its limit a near-limit segment starts a joint (at most)."""
 NEAR_JOINTS = 3
 """Joints put near a limit at the start of a near-limit segment."""
+FAST_EVERY = 10
+"""Steps between two directions of a too-fast segment."""
 
 
 def fresh_seed() -> int:
@@ -88,6 +93,8 @@ def record(
                 for i in rng.choice(finite, size=min(NEAR_JOINTS, finite.size), replace=False):
                     inside = rng.uniform(0.0, NEAR)
                     q[i] = upper[i] - inside if rng.random() < 0.5 else lower[i] + inside
+        if kind == "too_fast" and j and j % FAST_EVERY == 0:
+            start = end = np.concatenate([_too_fast(rng) for _ in range(frames)])
         x = start + (end - start) * (j / (SEGMENT - 1))
         Q[k], X[k] = q, x
         kinds.append(kind)
