@@ -247,7 +247,9 @@ def readme_table(results: dict[str, Any]) -> str:
                 )
                 cells += f" {us(r['median_us'])} / {us(r['p99_us'])} | {ratio} |"
             lines.append(cells)
-    lines += ["", _setup_line(results), "", *_quality_lines(results)]
+    lines += ["", _setup_line(results)]
+    for line in _quality_lines(results):
+        lines += ["", line]
     return "\n".join(lines)
 
 

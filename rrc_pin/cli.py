@@ -331,8 +331,9 @@ BENCH_MODULES = {
     "control_schemes": ("matplotlib",),
     "maps": ("distributed", "zarr", "matplotlib"),
 }
-"""What each benchmark needs from the bench extra (placo and mink are optional: their rows are
-skipped when they are absent)."""
+"""What each benchmark needs from the bench extra. The resolver and tasks benchmarks also need
+PlaCo, mink and Drake for a full run (they refuse without, naming what is missing); a quick run
+records the absent ones as "not in this environment" (docs/benchmarks.md)."""
 
 
 def bench_command(
