@@ -1,50 +1,34 @@
-"""The resolver against pink's ``solve_ik``: step time as users run it, and limit compliance.
+"""One frame in the limits: rrc-pin, PlaCo, pink, mink and Drake side by side in one process.
 
-Run from a checkout: ``python benchmarks/bench_resolver.py --out DIR`` (``--record`` writes
-``benchmarks/results/`` instead, ``--quick`` a short smoke run, ``--steps N`` the trajectory
-length; with neither ``--out`` nor ``--record`` nothing is written). ``rrc-pin bench`` runs it.
+Run from a checkout, in the peers' environment (docs/benchmarks.md): ``python
+benchmarks/bench_resolver.py --out DIR`` (``--record`` writes ``benchmarks/results/``,
+``--quick`` a short smoke run that runs without the peers that do not import, ``--steps N``
+the trajectory length, ``--seed S`` a given seed instead of a fresh one). ``rrc-pin bench``
+runs it. Issue 27's comparison.
 
-One arm at a time (rrc_k1607, panda), one trajectory of joint configurations is recorded
-first: from a seeded random start, piecewise-constant random twists (new every 50 steps,
-about 0.4 m/s and 0.6 rad/s) are resolved by rrc-pin in tracking mode
-(``Resolver(arm, dt, direction_preserving=False)``, DAQP) and integrated with dt = 10 ms, so
-that position and velocity limits become active along the way. Then every contender
-computes joint rates at every recorded configuration q_k with its twist. A step's time is
-the whole call, as its users make it:
+Workloads: panda and rrc_k1607, the tool frame's full twist, the joint limits (velocity, and
+position over one step). A trajectory per arm (:mod:`workloads`: smooth, too-fast and
+near-limit segments, from a fresh seed, printed and recorded) is recorded by rrc-pin's
+default; then every contender answers the same command at every recorded configuration, the
+whole call timed, as its users call it:
 
-- rrc-pin: ``Resolver.solve(q, twist)`` (Pinocchio Jacobian, bounds, one SVD, the QP when
-  the box-free optimum leaves the bounds, the Resolution): the default (DAQP,
-  direction-preserving), tracking (DAQP, ``direction_preserving=False``), OSQP and every
-  other installed backend (direction-preserving);
-- pink (``pink.solve_ik``): ``configuration.update(q)``, the FrameTask target set to the
-  pose moved by ``twist * dt``, ``solve_ik(..., limits=[ConfigurationLimit(gain=1),
-  VelocityLimit])`` with every qpsolvers backend pink accepts. pink raises when its QP has
-  no solution (a failure, rates taken as zero);
-- mink (``mink.solve_ik``, :mod:`mink_peer`): the arm's URDF loaded into MuJoCo (meshes
-  stripped; its tool pose and Jacobian checked against Pinocchio's first, the benchmark
-  stops if they differ), the same target pose as pink's, ``ConfigurationLimit`` and
-  ``VelocityLimit``, every qpsolvers backend; absent when mink is not installed;
-- Pinocchio + numpy, the unconstrained step and physical floor (no limits):
-  ``computeFrameJacobian`` then ``numpy.linalg.solve`` on ``J J^T``, ``lstsq``, or damped
-  least squares;
-- the floor within the limits (:data:`LIMITS_FLOOR`): the least a direction-preserving step
-  in the limits does in Python, rrc-pin's default without its damping, checks, fallbacks
-  and report (:func:`limits_floor`), what pure Python can reach on this problem.
+- rrc-pin: ``Resolver(arm, dt).solve(q, twist)``, the default (DAQP, direction-preserving),
+  returning its :class:`~rrc_pin.Resolution` (status, method, scale and veer decided in the
+  call);
+- PlaCo (:mod:`placo_peer`): a soft frame task (weight 1) with the target moved by
+  ``twist * dt``, joint and velocity limits, ``solve``; a weighted least squares of the pose
+  error in the limits (it trades speed and direction when the command cannot be met);
+- pink and mink (quadprog): ``solve_ik`` with a FrameTask whose target is the pose moved by
+  ``twist * dt``, ``ConfigurationLimit`` and ``VelocityLimit``: least squares too;
+- Drake (:mod:`drake_peer`): ``DoDifferentialInverseKinematics`` with the twist as the frame's
+  spatial velocity, position and velocity limits: direction-preserving, as rrc-pin's default.
 
-Each contender is timed in the three modes of :mod:`timing` (tight loop, 1 kHz loop with
-``time.sleep`` to the next tick, interleaved with its peers in an order shuffled at each
-step), each mode from fresh contenders, :data:`timing.REPEATS` rounds of the three modes
-(one with ``--quick``), combined by their medians (:func:`timing.combine_rounds`). Per
-contender and mode: median, p10, p90, p99 and mean [us], the ratio to pink's fastest
-backend of that mode (its median over the contender's, its p99 over the contender's: above
-1, faster than pink), the largest
-velocity and position excess, failures; per rrc-pin contender how its steps were answered
-(status, method, backend share, active bounds). Then where the default's step time goes:
-:mod:`stage_profile` (``time.perf_counter`` wrappers around each stage). BLAS threads are
-pinned to one (set before numpy is imported) for both libraries, so that the tiny matrix
-products do not pay for thread hand-offs; OSQP's C-level prints are sent to /dev/null.
-Results: ``resolver.json`` and ``resolver.png``; :func:`docs_section` and
-:func:`readme_table` render them (``update_readme.py``).
+Each peer's kinematics is checked against Pinocchio's first (poses and Jacobians within
+1e-9). Modes (:mod:`timing`): tight, interleaved, 1 ms of other work between calls; rounds
+and ratios (PlaCo's time over the contender's): :mod:`comparison`. The answers' quality
+(:mod:`quality`), on the first round's tight-loop answers: the veer where the LP maximum scale
+along the command is 1, the direction error and speed on the too-fast segments, the limit
+excess. Then where rrc-pin's step time goes (:mod:`stage_profile`).
 """
 
 from __future__ import annotations
@@ -54,331 +38,143 @@ import os
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
-import logging  # noqa: E402
 import sys  # noqa: E402
 import warnings  # noqa: E402
 from collections import Counter  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
-import mink_peer  # noqa: E402
 import numpy as np  # noqa: E402
-import pinocchio as pin  # noqa: E402
-from machine import load_average, machine_info, source_state  # noqa: E402
-from scipy.linalg.lapack import dgesvd  # noqa: E402
-from script import QUICK_NOTE, is_quick, make_parser, write  # noqa: E402
-from stage_profile import profile_steps, profile_table  # noqa: E402
-from timing import (  # noqa: E402
-    MODE_TITLES,
-    MODES,
-    PERIOD,
-    REPEATS,
-    Contender,
-    add_peer_ratios,
-    combine_rounds,
-    fastest_of,
-    mode_table,
-    progress,
-    quiet_stdout,
-    record_trajectory,
-    rounds_note,
-    run_mode,
-    summarise,
-    timing_chart,
-    us,
+import peers  # noqa: E402
+import quality  # noqa: E402
+import workloads  # noqa: E402
+from comparison import (  # noqa: E402
+    excess_table,
+    peers_lines,
+    quality_table,
+    time_workload,
+    timing_table,
 )
+from comparison import plot as comparison_plot  # noqa: E402
+from machine import load_average, machine_info, source_state  # noqa: E402
+from script import make_parser, write  # noqa: E402
+from stage_profile import profile_steps, profile_table  # noqa: E402
+from timing import MODE_TITLES, MODES, REPEATS, Contender, progress, run_mode, us  # noqa: E402
 
 import rrc_pin  # noqa: E402
-from rrc_pin.control.drift import advance  # noqa: E402
-from rrc_pin.robot import frame_id  # noqa: E402
-from solvers.kernels import joint_box, line_scale, uniform_scale  # noqa: E402
-from solvers.qp_backends import installed_backends  # noqa: E402
 
-ARMS = ("rrc_k1607", "panda")
-SEED = 20261122
+ARMS = ("panda", "rrc_k1607")
 DT = 0.01
-SEGMENT = 50
-STEPS, QUICK_STEPS = 2000, 100
-DEFAULT = "rrc-pin default (daqp, direction)"
-TRACKING = "rrc-pin tracking (daqp)"
-BACKEND_MODULES = ("daqp", "osqp", "proxsuite", "quadprog", "clarabel")
-"""Modules of the QP backends, for the versions recorded."""
-FLOOR_DAMPING = 0.01
-"""Damping ``lambda`` of the Pinocchio + numpy DLS row (``J^T (J J^T + lambda^2 I)^-1 x``)."""
-FLOOR = "Pinocchio + numpy solve (J J^T)"
-"""The physical floor: one Pinocchio Jacobian and one small dense solve, no limits."""
-LIMITS_FLOOR = "Pinocchio + SVD + exact scale in the limits"
-"""The floor within the limits (:func:`limits_floor`)."""
+STEPS, QUICK_STEPS = 6000, 100
+RRC = "rrc-pin"
+PLACO = "PlaCo"
+PINK = f"pink ({peers.QP_SOLVER})"
+MINK = f"mink ({peers.QP_SOLVER})"
+DRAKE = "Drake DiffIK"
+ORDER = [RRC, PLACO, DRAKE, PINK, MINK]
+"""The contenders, in the tables' order."""
+OF_PEER = {PLACO: "PlaCo", PINK: "pink", MINK: "mink", DRAKE: "Drake"}
+VERSIONS = ("placo", "pink", "mink", "mujoco", "pydrake", "qpsolvers", "quadprog", "daqp",
+            "numba", "scipy")  # fmt: skip
+"""Modules whose versions are recorded."""
 
 Array = np.ndarray
 
 
-def rrc_options() -> dict[str, dict[str, Any]]:
-    """The rrc-pin contenders: label to Resolver keyword arguments."""
-    out: dict[str, dict[str, Any]] = {
-        DEFAULT: {},
-        TRACKING: {"direction_preserving": False},
-    }
-    for name in installed_backends():
-        if name != "daqp":
-            out[f"rrc-pin {name} (direction)"] = {"qp": rrc_pin.QPOptions(backend=name)}
+def contenders(arm: Any, models: peers.Models, status: dict[str, str]) -> list[Contender]:
+    """Fresh contenders: rrc-pin's default and every peer that imports."""
+    resolver = rrc_pin.Resolver(arm, dt=DT)
+    out = [Contender(RRC, resolver.solve, rates=lambda r: r.qdot, keep=True)]
+    if status["PlaCo"] == "ran":
+        from placo_peer import PlacoPeer
+
+        placo = PlacoPeer(str(models.placo_urdf()), list(arm.joint_names), [arm.tool_frame], DT)
+        out.append(Contender(PLACO, placo.step))
+    if status["Drake"] == "ran":
+        import drake_peer
+
+        out.append(Contender(DRAKE, drake_peer.one_frame(arm, models.drake(), DT)))
+    if status["pink"] == "ran":
+        out.append(Contender(PINK, peers.pink_step(arm, DT)))
+    if status["mink"] == "ran":
+        import mink_peer
+
+        out.append(Contender(MINK, mink_peer.mink_step(arm, DT, peers.QP_SOLVER)))
     return out
-
-
-def rrc_contenders(arm: Any) -> list[Contender]:
-    """Fresh rrc-pin resolvers, each calling ``solve(q, twist)``, keeping the Resolutions."""
-    out = []
-    for label, kwargs in rrc_options().items():
-        resolver = rrc_pin.Resolver(arm, dt=DT, **kwargs)
-        out.append(Contender(label, resolver.solve, rates=lambda r: r.qdot, keep=True))
-    return out
-
-
-def pink_backends() -> list[str]:
-    """The qpsolvers backends pink is run with (every one installed), or [] without pink."""
-    try:
-        import pink  # noqa: F401
-        import qpsolvers
-    except ImportError:
-        return []
-    return list(qpsolvers.available_solvers)
-
-
-def pink_contenders(arm: Any) -> list[Contender]:
-    """pink.solve_ik with every qpsolvers backend, on the same task and limits."""
-    if not pink_backends():
-        return []
-    import pink
-    from pink.limits import ConfigurationLimit, VelocityLimit
-    from pink.tasks import FrameTask
-
-    logging.getLogger().setLevel(logging.ERROR)  # pink logs every near-limit configuration
-    model, frame = arm.model, arm.tool_frame
-    out = []
-    for solver in pink_backends():
-        configuration = pink.Configuration(model, model.createData(), arm.neutral())
-        task = FrameTask(frame, position_cost=1.0, orientation_cost=1.0)
-        limits = [ConfigurationLimit(model, config_limit_gain=1.0), VelocityLimit(model)]
-
-        def step(
-            q: Array,
-            x: Array,
-            configuration: Any = configuration,
-            task: Any = task,
-            limits: Any = limits,
-            solver: str = solver,
-        ) -> Array:
-            configuration.update(q)
-            T = configuration.get_transform_frame_to_world(frame)
-            task.set_target(advance(T, x, DT, local=False))
-            return pink.solve_ik(
-                configuration, [task], DT, solver=solver, limits=limits, safety_break=False
-            )
-
-        out.append(Contender(f"pink {solver}", step))
-    return out
-
-
-def floor_contenders(arm: Any) -> list[Contender]:
-    """Pinocchio + numpy, the unconstrained step (no limits): ``computeFrameJacobian``
-    (LOCAL_WORLD_ALIGNED) then the minimum-norm rates by ``numpy.linalg.solve`` on
-    ``J J^T`` (6 x 6), by ``numpy.linalg.lstsq``, or damped least squares."""
-    model = arm.model
-    fid = frame_id(model, arm.tool_frame)
-    lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-    eye = np.eye(6) * FLOOR_DAMPING**2
-    d1, d2, d3 = (model.createData() for _ in range(3))  # one workspace per contender
-
-    def jacobian(q: Array, data: Any) -> Array:
-        return pin.computeFrameJacobian(model, data, q, fid, lwa)
-
-    def solve(q: Array, x: Array, data: Any = d1) -> Array:
-        J = jacobian(q, data)
-        return J.T @ np.linalg.solve(J @ J.T, x)
-
-    def lstsq(q: Array, x: Array, data: Any = d2) -> Array:
-        return np.linalg.lstsq(jacobian(q, data), x, rcond=None)[0]
-
-    def dls(q: Array, x: Array, data: Any = d3) -> Array:
-        J = jacobian(q, data)
-        return J.T @ np.linalg.solve(J @ J.T + eye, x)
-
-    return [
-        Contender(FLOOR, solve),
-        Contender("Pinocchio + numpy lstsq", lstsq),
-        Contender(f"Pinocchio + numpy DLS (lambda {FLOOR_DAMPING:g})", dls),
-        limits_floor(arm),
-    ]
-
-
-def limits_floor(arm: Any) -> Contender:
-    """The least work of a direction-preserving step within the limits, in Python: the
-    Jacobian, rrc-pin's step bounds (:func:`solvers.kernels.joint_box`), the SVD's exact
-    rates, and where they leave the bounds the largest scale along them, exactly, with one
-    null direction (:func:`solvers.kernels.line_scale`) or none (the uniform scale).
-    rrc-pin's default answers the same wherever it does not damp; what it does beyond this
-    (input checks, the damping near singularities, the fallbacks, the Resolution) is its
-    gap to this floor."""
-    model = arm.model
-    fid = frame_id(model, arm.tool_frame)
-    lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
-    data = model.createData()
-    b = step_box(arm)
-
-    def step(q: Array, x: Array) -> Array:
-        J = pin.computeFrameJacobian(model, data, q, fid, lwa)
-        b.at(q)
-        U, s, Vt, _ = dgesvd(J, full_matrices=1)
-        m = s.size  # six rows: the rest of Vt spans the null space
-        w = (x @ U / s) @ Vt[:m]
-        if ((b.lb <= w) & (w <= b.ub)).all():
-            return w
-        if Vt.shape[0] == m + 1:
-            u, y = line_scale(w, Vt[m], b.lb, b.ub)
-            return np.minimum(np.maximum(u * w + y * Vt[m], b.lb), b.ub)
-        return uniform_scale(w, b.lb, b.ub) * w
-
-    return Contender(LIMITS_FLOOR, step)
-
-
-class step_box:
-    """The step's joint box of ``arm`` (rrc-pin's kernel), its ``lb`` and ``ub`` refreshed by
-    :meth:`at`."""
-
-    def __init__(self, arm: Any) -> None:
-        n = arm.nq
-        self.arm, self.lb, self.ub = arm, np.empty(n), np.empty(n)
-        self.kind = np.empty((2, n), np.int8)
-        self.none, self.zero = np.array([np.inf]), np.zeros(n)
-
-    def at(self, q: Array) -> None:
-        arm = self.arm
-        joint_box(q, arm.lower, arm.upper, arm.velocity_limit, 0.0, 1.0, DT, self.zero, self.none,
-                  self.lb, self.ub, self.kind)  # fmt: skip
-
-
-def floor_agreement(default: Any, floor: Any) -> dict[str, Any]:
-    """The largest difference [rad/s] between rrc-pin's default and the floor in the limits
-    over the steps the default did not damp (there they solve the same problem)."""
-    undamped = np.array([r.status != "damped" for r in default.kept])
-    diff = np.abs(default.rates - floor.rates)[undamped]
-    return {
-        "steps": int(undamped.sum()),
-        "max_difference": float(diff.max()) if diff.size else None,
-    }
-
-
-def tracking_errors(arm: Any, Q: Array, X: Array, rates: Array) -> dict[str, float]:
-    """Relative twist error ``|J(q_k) qdot_k - x_k| / |x_k|`` (rows [v; w], m/s and rad/s
-    summed as one vector) along the trajectory: median, p99 and largest."""
-    J = np.array([arm.jacobian(q) for q in Q])
-    err = np.linalg.norm(np.einsum("kij,kj->ki", J, rates) - X, axis=1)
-    rel = err / np.maximum(np.linalg.norm(X, axis=1), 1e-12)
-    p50, p99 = np.percentile(rel, [50, 99])
-    return {
-        "tracking_median": float(p50),
-        "tracking_p99": float(p99),
-        "tracking_max": float(rel.max()),
-    }
 
 
 def rrc_statistics(resolutions: list[Any]) -> dict[str, Any]:
-    """How a contender's steps were answered: status, method and backend counts, active bounds,
-    the resolver's own build time (median over every step [us]) and backend solve time
-    (median over the steps that called the backend [us]), the largest clip [rad/s]."""
+    """How rrc-pin's steps were answered: status and method counts, the backend's share, the
+    steps with a failed attempt, the largest clip [rad/s]."""
     n = len(resolutions)
-    backends = Counter(r.backend for r in resolutions if r.backend)
-    solves = [r.solve_time for r in resolutions if r.backend]
     return {
         "steps": n,
         "status": dict(Counter(r.status for r in resolutions).most_common()),
         "method": dict(Counter(r.method for r in resolutions).most_common()),
-        "backend_share": sum(backends.values()) / n if n else 0.0,
-        "backends": dict(backends.most_common()),
-        "active_fraction": sum(bool(r.active) for r in resolutions) / n if n else 0.0,
+        "backend_share": sum(bool(r.backend) for r in resolutions) / n if n else 0.0,
         "with_attempts": sum(bool(r.attempts) for r in resolutions),
-        "build_time_median_us": float(np.median([r.build_time for r in resolutions]) * 1e6),
-        "backend_solve_median_us": float(np.median(solves) * 1e6) if solves else 0.0,
         "max_clip": float(max((r.clip for r in resolutions), default=0.0)),
     }
 
 
-def bench_arm(name: str, steps: int, repeats: int) -> dict[str, Any]:
-    """Every contender in every mode along one trajectory of arm ``name``, ``repeats`` rounds
-    (:func:`timing.combine_rounds`), then the profile."""
+def bench_arm(
+    name: str, steps: int, rounds: int, seed: int, status: dict[str, str]
+) -> dict[str, Any]:
+    """Every contender in every mode along one trajectory of arm ``name``, the answers'
+    quality, rrc-pin's profile."""
     arm = rrc_pin.load(name)
-    progress(f"{name}: recording {steps} steps (rrc-pin tracking)")
-    Q, X = record_trajectory(arm, steps, np.random.default_rng(SEED), DT, SEGMENT)
-    limits = (arm.lower, arm.upper, arm.velocity_limit)
-    shuffle = np.random.default_rng(SEED + 1)
-    modes: dict[str, Any] = {}
-    rrc: dict[str, Any] = {}
-    with_mink = mink_peer.available()
-    gap = mink_peer.kinematics_gap(arm) if with_mink else None
-    if gap is not None and max(gap.values()) > mink_peer.KINEMATICS_TOL:
-        # mink would solve another arm's problem: the comparison would be void.
-        raise SystemExit(f"{name}: MuJoCo's kinematics differ from Pinocchio's: {gap}")
-    rounds: dict[str, list[dict[str, Any]]] = {mode: [] for mode in MODES}
-    for round_ in range(repeats):
-        for mode in MODES:
-            contenders = rrc_contenders(arm) + pink_contenders(arm)
-            if with_mink:
-                contenders += mink_peer.mink_contenders(arm, DT)
-            contenders += floor_contenders(arm)
-            progress(f"{name}: {MODE_TITLES[mode]}, {len(contenders)} contenders, "
-                     f"round {round_ + 1} of {repeats}")  # fmt: skip
-            with quiet_stdout():  # OSQP's C code prints "Polishing not needed"
-                runs = run_mode(mode, contenders, Q, X, shuffle, PERIOD)
-            rows = summarise(runs, Q, limits, DT)
-            for label, run in runs.items():
-                rows[label].update(tracking_errors(arm, Q, X, run.rates))
-            add_peer_ratios(rows, "pink ", "baseline")
-            add_peer_ratios(rows, "mink ", "mink")
-            add_peer_ratios(rows, FLOOR, "floor")
-            rounds[mode].append(rows)
-            if round_ == 0:  # the answers are the same in every round
-                rrc[mode] = {
-                    c.label: rrc_statistics(runs[c.label].kept) for c in contenders if c.keep
-                }
-                agreement = floor_agreement(runs[DEFAULT], runs[LIMITS_FLOOR])
-    for mode in MODES:
-        rows = combine_rounds(rounds[mode])
-        modes[mode] = {
-            "pink_fastest": fastest_of(rows, "pink "),
-            "mink_fastest": fastest_of(rows, "mink "),
-            "floor": FLOOR,
-            "contenders": rows,
-        }
-    progress(f"{name}: profile of the default")
-    profile = profile_default(arm, Q, X)
-    recorded = rrc["tight"].get(TRACKING, {})
+    progress(f"{name}: recording {steps} steps (seed {seed})")
+    recorder = rrc_pin.Resolver(arm, dt=DT)
+    Q, X, kinds = workloads.record(arm, 1, steps, np.random.default_rng(seed), DT,
+                                   lambda q, x: recorder.solve(q, x).qdot)  # fmt: skip
+    models = peers.Models(arm)
+    try:
+        gaps = peers.gaps(arm, models, status)
+        placo_of = {label: PLACO for label in ORDER}
+        modes, first = time_workload(
+            name, lambda: contenders(arm, models, status), Q, X,
+            (arm.lower, arm.upper, arm.velocity_limit), DT, rounds, placo_of, RRC,
+        )  # fmt: skip
+    finally:
+        models.close()
+    progress(f"{name}: the answers' quality (LP per step)")
+    J = quality.jacobians(arm, Q, [arm.tool_frame])
+    ref = quality.reference(arm, Q, X, J, DT)
+    unit = quality.units(arm, [arm.tool_frame])
+    judged = {
+        label: quality.direction(J, X, run.rates, unit, ref, kinds, run.failed)
+        for label, run in first.items()
+    }
+    progress(f"{name}: profile of rrc-pin")
     return {
         "arm": name,
         "nq": arm.nq,
         "tool_frame": arm.tool_frame,
+        "seed": seed,
         "trajectory": {
             "steps": steps,
-            "recorded_by": "rrc_pin.Resolver(arm, dt, direction_preserving=False) (DAQP)",
-            "active_fraction": recorded.get("active_fraction"),
+            "recorded_by": "rrc_pin.Resolver(arm, dt) (the default)",
+            "segments": dict(Counter(kinds[:: workloads.SEGMENT]).most_common()),
+            "lp_scale_below_1": int((ref["lp_scale"] < 1.0 - quality.REACHABLE_TOL).sum()),
         },
-        "mink_kinematics_gap": gap,
-        "floor_agreement": agreement,
+        "kinematics_gaps": gaps,
         "modes": modes,
-        "rrc_pin": rrc,
-        "profile": profile,
+        "quality": judged,
+        "rrc_pin": rrc_statistics(first[RRC].kept),
+        "profile": profile_default(arm, Q, X),
     }
 
 
 def profile_default(arm: Any, Q: Array, X: Array) -> dict[str, Any]:
-    """The default's stage profile (:mod:`stage_profile`), with the plain tight-loop median
-    of the same trajectory and the instrumentation's overhead [us]."""
+    """rrc-pin's stage profile (:mod:`stage_profile`), with the plain tight-loop median of the
+    same trajectory and the instrumentation's overhead [us]."""
     reference = rrc_pin.Resolver(arm, dt=DT)
     rates = np.array([reference.solve(q, x).qdot for q, x in zip(Q, X, strict=True)])
     plain = rrc_pin.Resolver(arm, dt=DT)
-    run = run_mode("tight", [Contender(DEFAULT, plain.solve, lambda r: r.qdot)], Q, X)
+    run = run_mode("tight", [Contender(RRC, plain.solve, lambda r: r.qdot)], Q, X)
     resolver = rrc_pin.Resolver(arm, dt=DT)
     profile = profile_steps(lambda q, x: resolver.solve(q, x), resolver, Q, X, rates)
-    profile["plain_median_us"] = float(np.median(run[DEFAULT].seconds) * 1e6)
+    profile["plain_median_us"] = float(np.median(run[RRC].seconds) * 1e6)
     profile["overhead_us"] = (
         profile["stages"]["all"]["total"]["median_us"] - profile["plain_median_us"]
     )
@@ -387,43 +183,39 @@ def profile_default(arm: Any, Q: Array, X: Array) -> dict[str, Any]:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the benchmark; write JSON and PNG to --out or (--record) benchmarks/results."""
-    parser = make_parser(__doc__, "resolver", f"{QUICK_STEPS} steps per arm")
+    parser = make_parser(__doc__, "resolver", f"{QUICK_STEPS} steps per arm, peers optional")
     parser.add_argument("--steps", type=int, default=None, help=f"trajectory length ({STEPS})")
-    parser.add_argument("--arms", nargs="+", default=list(ARMS), help="arms (rrc_k1607 panda)")
+    parser.add_argument("--arms", nargs="+", default=list(ARMS), help="arms (panda rrc_k1607)")
+    parser.add_argument("--seed", type=int, default=None, help="seed (default: a fresh one)")
     args = parser.parse_args(argv)
     steps = args.steps or (QUICK_STEPS if args.quick else STEPS)
     if steps < 2:
         parser.error("--steps: at least 2")
-    if args.record and (
-        args.quick
-        or steps != STEPS
-        or args.arms != list(ARMS)
-        or not pink_backends()
-        or not mink_peer.available()
-    ):
-        parser.error(
-            f"--record keeps full runs only ({STEPS} steps, every arm, pink and mink installed)"
-        )
+    if args.record and (args.quick or steps != STEPS or args.arms != list(ARMS)):
+        parser.error(f"--record keeps full runs only ({STEPS} steps, every arm)")
     warnings.simplefilter("ignore")
-    repeats = 1 if args.quick else REPEATS
+    status = peers.availability()
+    peers.check(status, args.quick)
+    seed = workloads.fresh_seed() if args.seed is None else args.seed
+    progress(f"seed {seed} (rerun with --seed {seed})")
+    rounds = 1 if args.quick else REPEATS
     start = load_average()
     results: dict[str, Any] = {
         "benchmark": "resolver",
-        "machine": machine_info("qpsolvers", "pink", "mink", "mujoco", *BACKEND_MODULES),
+        "schema": 3,
+        "machine": machine_info(*VERSIONS),
         "source": source_state(),
+        "quick": bool(args.quick),
         "settings": {
             "dt": DT,
             "steps": steps,
-            "segment": SEGMENT,
-            "seed": SEED,
-            "period_s": PERIOD,
-            "khz_wait": "time.sleep to the next tick",
-            "rounds": repeats,
-            "quick": bool(args.quick),
-            "pink_backends": pink_backends(),
+            "segment": workloads.SEGMENT,
+            "seed": seed,
+            "rounds": rounds,
+            "qp_solver_of_pink_and_mink": peers.QP_SOLVER,
         },
-        "notes": [] if pink_backends() else ["pink is not installed: its rows are absent"],
-        "arms": [bench_arm(a, steps, repeats) for a in args.arms],
+        "peers": status,
+        "arms": [bench_arm(a, steps, rounds, seed + k, status) for k, a in enumerate(args.arms)],
     }
     results["load_average"] = {"start": start, "end": load_average()}
     write(args, "resolver", results, lambda path: plot(results, path))
@@ -435,224 +227,141 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def readme_table(results: dict[str, Any]) -> str:
-    """The README's table: for each arm, rrc-pin default and tracking against pink's fastest
-    backend, median and p99 in each mode, and the ratios (pink's time over rrc-pin's)."""
-    head = "| arm | contender |"
-    rule = "| --- | --- |"
-    for mode in MODES:
-        head += f" {MODE_TITLES[mode]}: median / p99 [us] | vs pink |"
-        rule += " ---: | ---: |"
-    lines = [head, rule]
+    """The README's table: per arm and contender, median / p99 in each mode and the ratio to
+    PlaCo; then the answers' quality in one line per arm."""
+    head = "| arm | contender |" + "".join(
+        f" {MODE_TITLES[m]}: median / p99 [us] | vs PlaCo |" for m in MODES
+    )
+    lines = [head, "| --- | --- |" + " ---: | ---: |" * len(MODES)]
     for arm in results["arms"]:
-        modes = arm["modes"]
-        for label in [DEFAULT, TRACKING, "pink fastest", LIMITS_FLOOR]:
+        for label in ORDER:
+            if label not in arm["modes"]["tight"]["contenders"]:
+                continue
             cells = f"| {arm['arm']} | {label} |"
-            if label == "pink fastest":
-                names = [modes[m]["pink_fastest"] or "-" for m in MODES]
-                cells = f"| {arm['arm']} | pink fastest ({', '.join(_short(n) for n in names)}) |"
             for mode in MODES:
-                rows = modes[mode]["contenders"]
-                key = modes[mode]["pink_fastest"] if label == "pink fastest" else label
-                row = rows.get(key) if key else None
-                if row is None:
-                    cells += " - | - |"
-                    continue
+                r = arm["modes"][mode]["contenders"][label]
                 ratio = (
-                    "1"
-                    if label == "pink fastest"
-                    else (
-                        f"{row.get('vs_baseline_median', float('nan')):.1f}x / "
-                        f"{row.get('vs_baseline_p99', float('nan')):.1f}x"
-                    )
+                    f"{r['vs_placo_median']:.2f}x / {r['vs_placo_p99']:.2f}x"
+                    if "vs_placo_median" in r
+                    else "-"
                 )
-                cells += f" {us(row['median_us'])} / {us(row['p99_us'])} | {ratio} |"
+                cells += f" {us(r['median_us'])} / {us(r['p99_us'])} | {ratio} |"
             lines.append(cells)
     lines += ["", _setup_line(results)]
+    for line in _quality_lines(results):
+        lines += ["", line]
     return "\n".join(lines)
-
-
-def _short(label: str) -> str:
-    return label.removeprefix("pink ")
 
 
 def _setup_line(results: dict[str, Any]) -> str:
     s, m = results["settings"], results["machine"]
     load = results.get("load_average", {})
-    arms = ", ".join(
-        f"{a['arm']} ({a['nq']} joints, a bound active at "
-        f"{100 * (a['trajectory']['active_fraction'] or 0):.0f}% of the steps)"
-        for a in results["arms"]
-    )
+    missing = [p for p, why in results["peers"].items() if why != "ran"]
     text = (
-        f"{s['steps']} steps of a seeded random teleoperation ({arms}), dt = {1000 * s['dt']:g} "
-        "ms. rrc-pin default: `Resolver(arm)` (DAQP, direction-preserving); tracking: "
-        "`direction_preserving=False`; pink: `solve_ik` with the same frame task and limits, "
-        "its fastest qpsolvers backend in each mode. The floor in the limits: Pinocchio's "
-        "Jacobian, rrc-pin's step bounds, the SVD's exact rates and, where they leave the "
-        "bounds, their largest scale with the null direction, exactly; no damping, checks, "
-        f"fallbacks or report: what plain Python reaches on this problem{_agreement(results)}. "
-        "Ratios: pink's time over rrc-pin's or the floor's (above 1: faster), median / p99; "
-        f"{rounds_note(s)}. Measured on "
-        f"{m['cpu']} ({m['cores']} cores), Python {m['python']}, Pinocchio {m['pinocchio']}, "
-        f"pink {m.get('pink')}"
+        f"{s['steps']} steps per arm (smooth, too-fast and near-limit segments of "
+        f"{s['segment']} steps; seeds " + ", ".join(str(a["seed"]) for a in results["arms"])
+        + f"), dt = {1000 * s['dt']:g} ms, every contender in one process. rrc-pin: "
+        "`Resolver(arm).solve(q, twist)` (its default, the Resolution built); PlaCo: a soft "
+        "frame task; pink and mink: `solve_ik` (quadprog); Drake: "
+        "`DoDifferentialInverseKinematics`. vs PlaCo: PlaCo's time over the contender's, "
+        f"median / p99 (above 1: faster than PlaCo); median of {s['rounds']} rounds. "
+        f"Measured on {m['cpu']} ({m['cores']} cores, shared), Python {m['python']}, "
+        f"Pinocchio {m['pinocchio']}, placo {m.get('placo')}, pink {m.get('pink')}, mink "
+        f"{m.get('mink')}, Drake {m.get('pydrake')}"
     )
     if load:
         text += (
             f", load average {load['start'][0]:.2f} at the start, {load['end'][0]:.2f} at the end"
         )
+    if missing:
+        text += f"; not in this environment: {', '.join(missing)}"
     return text + "."
 
 
-def _agreement(results: dict[str, Any]) -> str:
-    """The recorded agreement of the default and the floor, for the setup line ("" if none)."""
-    parts = [
-        f"{a['arm']} {a['floor_agreement']['max_difference']:.0e} rad/s over "
-        f"{a['floor_agreement']['steps']} steps"
-        for a in results["arms"]
-        if (a.get("floor_agreement") or {}).get("max_difference") is not None
-    ]
-    return f" (rrc-pin's default where it does not damp: {', '.join(parts)})" if parts else ""
+def _quality_lines(results: dict[str, Any]) -> list[str]:
+    """Per arm, one line: each contender's veer where the LP maximum is 1 and its direction
+    error on the too-fast segments."""
+    out = []
+    for arm in results["arms"]:
+        parts = []
+        for label in ORDER:
+            q = arm["quality"].get(label)
+            if q is None:
+                continue
+            fast = (
+                f"; of {q['too_fast_steps']} too-fast steps, {100 * q['at_lp_best']:.0f}% at the "
+                f"LP's best speed, {q['stopped_steps']} standing still, direction error "
+                f"{q['direction_error_median_deg']:.2g} deg median"
+                if q.get("too_fast_steps")
+                else ""
+            )
+            parts.append(
+                f"{label}: veers at {q['veer_steps']} of {q['reachable_steps']} fully reachable "
+                f"steps (max {q['veer_max_deg']:.2g} deg){fast}"
+            )
+        out.append(f"Answers, {arm['arm']}: " + ". ".join(parts) + ".")
+    return out
 
 
 def docs_section(results: dict[str, Any]) -> str:
-    """Every table of the resolver benchmark, for docs/benchmarks.md."""
+    """Every table of the benchmark, for docs/benchmarks.md."""
     s = results["settings"]
     lines = [
-        f"Trajectories: {s['steps']} steps, dt = {1000 * s['dt']:g} ms, twists new every "
-        f"{s['segment']} steps (seed {s['seed']}), recorded by rrc-pin in tracking mode. The "
-        "1 kHz loop waits with `time.sleep` until the next 1 ms tick. Ratios: pink's fastest "
-        "backend of the same mode (by median) over the contender: its median over the "
-        "contender's median, its p99 over the contender's p99 (above 1: faster than pink); "
-        f"{rounds_note(s)}.",
+        f"Trajectories: {s['steps']} steps per arm, dt = {1000 * s['dt']:g} ms, segments of "
+        f"{s['segment']} steps (`benchmarks/workloads.py`); {s['rounds']} rounds of each mode "
+        "from fresh contenders, every time the median of the rounds' (the median's range "
+        "over the rounds beside it). vs PlaCo: PlaCo's median over the contender's / the same "
+        "for p99, within each round (above 1: faster than PlaCo).",
+        "",
+        *peers_lines(results["peers"]),
         "",
     ]
-    for note in results.get("notes", []):
-        lines += [f"- {note}", ""]
     for arm in results["arms"]:
         t = arm["trajectory"]
+        segments = ", ".join(f"{v} {k}" for k, v in t["segments"].items())
+        gaps = "; ".join(
+            f"{peer} {max(g.values()):.1g}" for peer, g in arm.get("kinematics_gaps", {}).items()
+        )
         lines += [
             f"### {arm['arm']} ({arm['nq']} joints, tool frame `{arm['tool_frame']}`)",
             "",
-            f"A bound is active in rrc-pin tracking's answer at "
-            f"{100 * (t['active_fraction'] or 0):.1f}% of the {t['steps']} steps.",
+            f"Seed {arm['seed']}; segments: {segments}; the LP maximum scale along the command "
+            f"is below 1 at {t['lp_scale_below_1']} of {t['steps']} steps. Peers' kinematics "
+            f"against Pinocchio's (largest difference of poses and Jacobians): {gaps or '-'}.",
             "",
+            *timing_table(arm["modes"], ORDER),
+            "",
+            "Answers (first round, tight loop; `benchmarks/quality.py`): the veer where the LP "
+            "maximum scale along the command is 1 (steps above 1e-6 rad), the direction error "
+            "where it is below 1 on the too-fast segments, the share of those steps at the LP's "
+            "best speed along the command, and the speed reached against it.",
+            "",
+            *quality_table(arm["quality"], ORDER),
+            "",
+            "Limit excess and failures (tight loop, first round):",
+            "",
+            *excess_table(arm["modes"], ORDER),
+            "",
+            _routes(arm["rrc_pin"]),
+            "",
+            *profile_table(arm["profile"], "rrc-pin"),
         ]
-        for mode in MODES:
-            baselines = {"pink": "baseline"}
-            if arm["modes"][mode].get("mink_fastest"):
-                baselines["mink"] = "mink"
-            lines += mode_table(arm["modes"][mode], mode, baselines)
-        lines += _summary(arm) + _floor_table(arm) + _routes_table(arm)
-        lines += profile_table(arm["profile"], "the default")
     return "\n".join(lines)
 
 
-def _summary(arm: dict[str, Any]) -> list[str]:
-    """One sentence per mode: rrc-pin's default and tracking against pink's and mink's
-    fastest backends and the floor (ratios, median / p99), and where rrc-pin is behind."""
-    out = []
-    for mode in MODES:
-        m = arm["modes"][mode]
-        rows = m["contenders"]
-        parts, behind = [], []
-        for label in (DEFAULT, TRACKING):
-            r = rows.get(label)
-            if r is None:
-                continue
-            cells = []
-            for key, who in (("baseline", m.get("pink_fastest")), ("mink", m.get("mink_fastest"))):
-                if who and f"vs_{key}_median" in r:
-                    med, p99 = r[f"vs_{key}_median"], r[f"vs_{key}_p99"]
-                    cells.append(f"{med:.2f}x / {p99:.2f}x {who}'s time")
-                    short = "default" if label == DEFAULT else "tracking"
-                    stats = [n for n, v in (("median", med), ("p99", p99)) if v < 1]
-                    behind += [f"{short} {' and '.join(stats)} vs {who}"] if stats else []
-            if "vs_floor_median" in r:
-                cells.append(f"the floor is {1 / r['vs_floor_median']:.1f}x faster (median)")
-            parts.append(f"{label}: " + ", ".join(cells))
-        if not parts:
-            continue
-        tail = "behind: " + "; ".join(behind) if behind else "ahead of every peer's fastest"
-        out.append(f"- {MODE_TITLES[mode]}: " + "; ".join(parts) + f" ({tail}).")
-    if not out:
-        return []
-    return [
-        "Summary (ratios: the peer's time over rrc-pin's, median / p99; above 1 rrc-pin is "
-        "faster):",
-        "",
-        *out,
-        "",
-    ]
-
-
-def _floor_table(arm: dict[str, Any]) -> list[str]:
-    """Tight loop: each contender's gap to the physical floor and its tracking error."""
-    m = arm["modes"]["tight"]
-    rows = m["contenders"]
-    if m.get("floor") not in rows:
-        return []
-    gap = arm.get("mink_kinematics_gap")
-    lines = [
-        f"Tight loop against the physical floor ({m['floor']}: one Pinocchio Jacobian and one "
-        "6 x 6 solve, no limits): the floor's median over the contender's (below 1: slower "
-        "than the floor), and the tracking error |J qdot - x| / |x| (rows [v; w] as one "
-        "vector; the limits and the direction-preserving scale make it nonzero by design).",
-        "",
-        "| contender | median [us] | floor / contender (median) | floor / contender (p99) | "
-        "tracking error, median | p99 | max |",
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
-    ]
-    for label, r in sorted(rows.items(), key=lambda kv: kv[1]["median_us"]):
-        lines.append(
-            f"| {label} | {us(r['median_us'])} | {r.get('vs_floor_median', float('nan')):.2f}x | "
-            f"{r.get('vs_floor_p99', float('nan')):.2f}x | {r.get('tracking_median', 0):.2g} | "
-            f"{r.get('tracking_p99', 0):.2g} | {r.get('tracking_max', 0):.2g} |"
-        )
-    if gap:
-        lines += [
-            "",
-            "mink runs on the arm's URDF loaded into MuJoCo (meshes stripped); its kinematics "
-            f"against Pinocchio's at 50 random configurations: tool position {gap['position']:.1g} "
-            f"m, rotation {gap['rotation']:.1g} rad, Jacobian entries {gap['jacobian']:.1g}.",
-        ]
-    return [*lines, ""]
-
-
-def _routes_table(arm: dict[str, Any]) -> list[str]:
-    stats = arm["rrc_pin"]["tight"]
-    statuses = sorted({s for r in stats.values() for s in r["status"]})
-    lines = [
-        "How rrc-pin's steps were answered (tight loop; the same in every mode): status counts, "
-        "share answered by the backend (the rest: the box-free optimum, or a closed-form scale), "
-        "steps with a failed attempt (then a fallback answered), the resolver's own times: "
-        "its build time (everything but the backend, median over all steps) and the backend's "
-        "solve time (median over the steps that called it).",
-        "",
-        "| contender | " + " | ".join(statuses) + " | backend share | bound active | "
-        "failed attempts | build [us] | backend solve [us] |",
-        "| --- |" + " ---: |" * (len(statuses) + 5),
-    ]
-    for label, r in stats.items():
-        counts = " | ".join(str(r["status"].get(s, 0)) for s in statuses)
-        lines.append(
-            f"| {label} | {counts} | {100 * r['backend_share']:.1f}% | "
-            f"{100 * r['active_fraction']:.1f}% | {r['with_attempts']} | "
-            f"{r['build_time_median_us']:.1f} | {r.get('backend_solve_median_us', 0.0):.1f} |"
-        )
-    return [*lines, ""]
+def _routes(stats: dict[str, Any]) -> str:
+    status = ", ".join(f"{k} {v}" for k, v in stats["status"].items())
+    return (
+        f"rrc-pin's answers: {status}; the backend called at "
+        f"{100 * stats['backend_share']:.1f}% of the steps; {stats['with_attempts']} steps with a "
+        f"failed attempt; largest clip {stats['max_clip']:.1g} rad/s."
+    )
 
 
 def plot(results: dict[str, Any], path: Path) -> bool:
-    """Median step time per contender, mode and arm (bars), p99 as a tick; False without
-    matplotlib (nothing written)."""
-    arms = results["arms"]
-    panels = [
-        ({mode: arm["modes"][mode]["contenders"] for mode in MODES},
-         f"{arm['arm']}: one resolved-rate step")
-        for arm in arms
-    ]  # fmt: skip
-    note = QUICK_NOTE if is_quick(results) else None
-    return timing_chart(panels, path, (7.5 * len(arms), 6), note=note)
+    """Median step time per contender, mode and arm (bars), p99 as a tick."""
+    panels = [(arm["modes"], f"{arm['arm']}: one frame, joint limits") for arm in results["arms"]]
+    return comparison_plot(panels, path, results)
 
 
 if __name__ == "__main__":

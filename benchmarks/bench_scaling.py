@@ -17,15 +17,17 @@ runs it.
   ``bench_resolver.py`` (seeded random twists, rrc-pin tracking mode), for kr5_3r (3 joints),
   barker6 and ur5 (6), rrc_k1607, panda and xarm7 (7), and a longer chain: baxter's left
   gripper as the one FrameTask over its 15 joints (head, both arms). The baseline, timed
-  interleaved with it at every step, is the physical floor: one Pinocchio Jacobian and one
-  small dense solve (no limits; ``J J^T`` for more than 6 joints, ``J`` for 6, the position
+  interleaved with it at every step, is the unconstrained reference: one Pinocchio Jacobian
+  and one small dense numpy solve (no limits; not a floor: the resolver's numerics are
+  compiled kernels, not numpy's calls; the JSON keeps its ``floor_*`` keys;
+  ``J J^T`` for more than 6 joints, ``J`` for 6, the position
   rows, square, for 3). This pass and the next run :data:`timing.REPEATS` rounds (one with
   ``--quick``), each from a fresh resolver or controller, combined by their medians.
 
 - **Controller tick against DOF**: ``Controller(arm).step(twist, "world_aligned")`` (the
   teleoperation loop's tick: the same resolver plus the controller's kinematics, drift
   check, integration and log) driven by the same twists from the trajectory's start, in a
-  second pass interleaved with the same floor; its ticks per second. There is no cell (a
+  second pass interleaved with the same reference; its ticks per second. There is no cell (a
   loop over several arms) in the library: no cell tick rate.
 """
 
@@ -92,7 +94,8 @@ def uniform_q(arm: Any, n: int, rng: np.random.Generator) -> Array:
 
 
 def floor_step(arm: Any) -> Callable[[Array, Array], Array]:
-    """One Pinocchio Jacobian and one small dense solve (module docstring)."""
+    """The unconstrained reference: one Pinocchio Jacobian and one small dense solve
+    (module docstring)."""
     model, data = arm.model, arm.model.createData()
     fid = frame_id(model, arm.tool_frame)
     lwa = pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
@@ -289,11 +292,12 @@ def docs_section(results: dict[str, Any]) -> str:
         "",
         "Resolver step time against DOF: `Resolver(arm).solve` (default: DAQP, "
         f"direction-preserving), {results['settings']['steps']} steps of a seeded random "
-        "teleoperation in a tight loop, interleaved with the physical floor (one Pinocchio "
-        f"Jacobian and one small dense solve, no limits); {rounds_note(results['settings'])}.",
+        "teleoperation in a tight loop, interleaved with the unconstrained reference (one "
+        "Pinocchio Jacobian and one small dense numpy solve, no limits: not a floor, the "
+        f"resolver's numerics are compiled); {rounds_note(results['settings'])}.",
         "",
-        "| arm | tool frame | joints | median [us] | p10 | p90 | p99 | floor median [us] | "
-        "floor / resolver (median) | (p99) |",
+        "| arm | tool frame | joints | median [us] | p10 | p90 | p99 | reference median [us] | "
+        "reference / resolver (median) | (p99) |",
         "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     for r in results["dof"]:
@@ -312,11 +316,12 @@ def controller_table(results: dict[str, Any]) -> list[str]:
     """Controller tick time against DOF (results recorded since the controller exists)."""
     lines = [
         'Controller tick against DOF: `Controller(arm).step(twist, "world_aligned")` on the '
-        "same twists from the trajectory's start, in a second pass interleaved with the floor. "
+        "same twists from the trajectory's start, in a second pass interleaved with the "
+        "unconstrained reference. "
         "No cell (a loop over several arms) exists in the library: no cell tick rate.",
         "",
         "| arm | joints | tick median [us] | p10 | p90 | p99 | ticks per s (median) | "
-        "floor median [us] | floor / tick (median) | (p99) |",
+        "reference median [us] | reference / tick (median) | (p99) |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     for r in results["dof"]:
@@ -377,7 +382,7 @@ def plot(results: dict[str, Any], path: Path) -> bool:
             label="Controller.step (median)",
         )  # fmt: skip
     right.bar(x + 0.2, [r["floor_median_us"] for r in rows], 0.4,
-              label="floor: J + solve (median)")  # fmt: skip
+              label="reference: J + numpy solve, no limits (median)")  # fmt: skip
     right.set_xticks(x, [f"{r['arm']}\n{r['nq']} DOF" for r in rows], fontsize=8)
     right.set(ylabel="time per step [us]", title="step time against DOF (p10-p90 bars)")
     right.legend()

@@ -50,7 +50,7 @@ def package_version(name: str) -> str | None:
     if version is None:
         from importlib import metadata
 
-        for dist in (name, name.replace("_", "-"), f"pin-{name}"):
+        for dist in (name, name.replace("_", "-"), f"pin-{name}", name.removeprefix("py")):
             try:
                 return metadata.version(dist)
             except metadata.PackageNotFoundError:

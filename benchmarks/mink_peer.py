@@ -1,4 +1,4 @@
-"""mink (MuJoCo differential IK) as a peer of the resolver benchmark: the arm's URDF in MuJoCo.
+"""mink (MuJoCo differential IK) as a peer of the benchmarks: the arm's URDF in MuJoCo.
 
 :func:`mujoco_model` loads the URDF that rrc-pin's arm came from (example-robot-data's for
 installed arms, ``urdf/<name>.urdf`` for catalogue arms) into MuJoCo: visuals and
@@ -11,11 +11,12 @@ so that the tool frame is a body of its own, and bodies without inertia given a 
 Pinocchio's at seeded random configurations; the benchmark refuses mink's rows when they
 differ by more than :data:`KINEMATICS_TOL`.
 
-:func:`mink_contenders` gives mink the commands the other peers get: at ``q``, the tool's
-target is its pose moved by ``twist * dt`` (translation in the base frame, rotation
-``exp(w dt)`` applied in the base frame: the same target as pink's), one ``FrameTask``
-(position and orientation cost 1), ``ConfigurationLimit`` and ``VelocityLimit`` (the arm's
-velocity limits), ``mink.solve_ik`` with every qpsolvers backend installed.
+:func:`mink_step` gives mink the commands the other peers get: at ``q``, each tool frame's
+target is its pose moved by its twist times dt (translation in the base frame, rotation
+``exp(w dt)`` applied in the base frame: the same target as pink's), a ``FrameTask`` per
+frame (position and orientation cost 1), a ``PostureTask`` where the workload has one,
+``ConfigurationLimit`` and ``VelocityLimit`` (the arm's velocity limits), ``mink.solve_ik``
+with the qpsolvers backend given.
 """
 
 from __future__ import annotations
@@ -26,7 +27,6 @@ from typing import Any
 
 import numpy as np
 import pinocchio as pin
-from timing import Contender
 
 from rrc_pin.control.drift import advance
 
@@ -91,28 +91,28 @@ def kinematic_urdf(path: Path, moving: list[str]) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
-def mujoco_model(arm: Any) -> tuple[Any, str, np.ndarray]:
-    """MuJoCo model of ``arm`` from its URDF; the tool body's name and the qpos indices of
-    rrc-pin's joints (rrc-pin's order)."""
+def mujoco_model(arm: Any) -> tuple[Any, str | None, np.ndarray]:
+    """MuJoCo model of ``arm`` from its URDF; the tool body's name (None with several tool
+    frames) and the qpos indices of rrc-pin's joints (rrc-pin's order)."""
     import mujoco
 
     model = mujoco.MjModel.from_xml_string(kinematic_urdf(urdf_of(arm), list(arm.joint_names)))
     index = np.array([model.jnt_qposadr[model.joint(name).id] for name in arm.joint_names])
     if model.nq != arm.nq:
         raise ValueError(f"{arm.name}: MuJoCo has {model.nq} coordinates, rrc-pin {arm.nq}")
-    model.body(arm.tool_frame)  # raises KeyError when the tool frame is not a body
+    for frame in arm.tool_frames:
+        model.body(frame)  # raises KeyError when a tool frame is not a body
     return model, arm.tool_frame, index
 
 
 def kinematics_gap(arm: Any, samples: int = 50, seed: int = 7) -> dict[str, float]:
-    """Largest differences between MuJoCo and Pinocchio at ``samples`` random configurations:
-    tool position [m], tool rotation (angle of R_mj^T R_pin) [rad], world-aligned Jacobian
-    entries (rows [v; w]) [m/rad, 1]."""
+    """Largest differences between MuJoCo and Pinocchio at ``samples`` random configurations,
+    over the tool frames: position [m], rotation (angle of R_mj^T R_pin) [rad], world-aligned
+    Jacobian entries (rows [v; w]) [m/rad, 1]."""
     import mujoco
 
-    model, body, index = mujoco_model(arm)
+    model, _, index = mujoco_model(arm)
     data = mujoco.MjData(model)
-    bid = model.body(body).id
     rng = np.random.default_rng(seed)
     gaps = {"position": 0.0, "rotation": 0.0, "jacobian": 0.0}
     jacp, jacr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
@@ -121,59 +121,63 @@ def kinematics_gap(arm: Any, samples: int = 50, seed: int = 7) -> dict[str, floa
         data.qpos[index] = q
         mujoco.mj_kinematics(model, data)
         mujoco.mj_comPos(model, data)
-        mujoco.mj_jacBody(model, data, jacp, jacr, bid)
-        T = arm.fk(q)
-        R = data.xmat[bid].reshape(3, 3)
-        J = arm.jacobian(q)
-        gaps["position"] = max(gaps["position"], float(np.abs(data.xpos[bid] - T[:3, 3]).max()))
-        angle = float(np.linalg.norm(pin.log3(R.T @ T[:3, :3])))
-        gaps["rotation"] = max(gaps["rotation"], angle)
-        J_mj = np.vstack([jacp[:, index], jacr[:, index]])
-        gaps["jacobian"] = max(gaps["jacobian"], float(np.abs(J_mj - J).max()))
+        for frame in arm.tool_frames:
+            bid = model.body(frame).id
+            mujoco.mj_jacBody(model, data, jacp, jacr, bid)
+            T = arm.fk(q, frame)
+            R = data.xmat[bid].reshape(3, 3)
+            J = arm.jacobian(q, frame=frame)
+            gap = float(np.abs(data.xpos[bid] - T[:3, 3]).max())
+            gaps["position"] = max(gaps["position"], gap)
+            angle = float(np.linalg.norm(pin.log3(R.T @ T[:3, :3])))
+            gaps["rotation"] = max(gaps["rotation"], angle)
+            J_mj = np.vstack([jacp[:, index], jacr[:, index]])
+            gaps["jacobian"] = max(gaps["jacobian"], float(np.abs(J_mj - J).max()))
     return gaps
 
 
-def mink_backends() -> list[str]:
-    """The qpsolvers backends mink is run with (every one installed), or [] without mink."""
-    if not available():
-        return []
-    import qpsolvers
-
-    return list(qpsolvers.available_solvers)
-
-
-def mink_contenders(arm: Any, dt: float) -> list[Contender]:
-    """mink.solve_ik with every qpsolvers backend on the arm's tool frame (module docstring)."""
-    if not mink_backends():
-        return []
+def mink_step(
+    arm: Any,
+    dt: float,
+    solver: str,
+    frame_cost: float = 1.0,
+    posture: tuple[float, float, np.ndarray] | None = None,
+) -> Any:
+    """``step(q, x) -> rates``: ``mink.solve_ik`` with a FrameTask per tool frame (its target
+    the frame's pose moved by its twist (6 entries of x each) times dt, as pink's),
+    ``ConfigurationLimit`` and ``VelocityLimit``, and with ``posture`` = (cost, gain [1/s],
+    reference) a PostureTask (gain ``k dt``, as pink's)."""
     import mink
 
-    model, body, index = mujoco_model(arm)
+    model, _, index = mujoco_model(arm)
     velocities = {
         name: float(v) for name, v in zip(arm.joint_names, arm.velocity_limit, strict=True)
     }
-    out = []
-    for solver in mink_backends():
-        configuration = mink.Configuration(model)
-        task = mink.FrameTask(body, "body", position_cost=1.0, orientation_cost=1.0)
-        limits = [mink.ConfigurationLimit(model), mink.VelocityLimit(model, velocities)]
-        qpos = configuration.q.copy()
+    configuration = mink.Configuration(model)
+    frames = list(arm.tool_frames)
+    hands = [
+        mink.FrameTask(f, "body", position_cost=frame_cost, orientation_cost=frame_cost)
+        for f in frames
+    ]
+    tasks: list[Any] = list(hands)
+    if posture is not None:
+        cost, gain, reference = posture
+        target = configuration.q.copy()
+        target[index] = reference
+        task = mink.PostureTask(model, cost=cost, gain=gain * dt)
+        task.set_target(target)
+        tasks.append(task)
+    limits = [mink.ConfigurationLimit(model), mink.VelocityLimit(model, velocities)]
+    qpos = configuration.q.copy()
 
-        def step(
-            q: Array,
-            x: Array,
-            configuration: Any = configuration,
-            task: Any = task,
-            limits: Any = limits,
-            solver: str = solver,
-            qpos: Array = qpos,
-        ) -> Array:
-            qpos[index] = q
-            configuration.update(qpos)
-            T = pin.SE3(configuration.get_transform_frame_to_world(body, "body").as_matrix())
-            task.set_target(mink.SE3.from_matrix(advance(T, x, dt, local=False).homogeneous))
-            v = mink.solve_ik(configuration, [task], dt, solver, limits=limits)
-            return v[index]
+    def step(q: Array, x: Array) -> Array:
+        qpos[index] = q
+        configuration.update(qpos)
+        for i, (frame, task) in enumerate(zip(frames, hands, strict=True)):
+            T = pin.SE3(configuration.get_transform_frame_to_world(frame, "body").as_matrix())
+            moved = advance(T, x[6 * i : 6 * i + 6], dt, local=False).homogeneous
+            task.set_target(mink.SE3.from_matrix(moved))
+        v = mink.solve_ik(configuration, tasks, dt, solver, limits=limits)
+        return v[index]
 
-        out.append(Contender(f"mink {solver}", step))
-    return out
+    return step

@@ -18,7 +18,7 @@ RESULTS = HERE / "results"
 MODULES = {
     "closed_form": "bench_closed_form",
     "resolver": "bench_resolver",
-    "tasks": "render_tasks",
+    "tasks": "bench_tasks",
     "scaling": "bench_scaling",
     "controller": "bench_controller",
     "control_schemes": "bench_control_schemes",

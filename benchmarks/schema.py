@@ -10,7 +10,10 @@ an error and a fitted order per quantity; the controller: its tick rows, and per
 tick times, NaN, limit excess and drift; the control schemes: the scenarios' errors and the
 step-time rows. ``schema`` 2 (written by the closed-form benchmark since it records the
 spread of its timings) also requires the closed forms' p10, p90, p99; files without the key
-are version 1.
+are version 1. The resolver and tasks benchmarks (``schema`` 3, the peers side by side in one
+process): each peer's status is ``ran`` (its rows present in every mode) or "not in this
+environment..." (no row of it), every peer ran in a full run, each peer's kinematics within
+:data:`GAP_TOL` of Pinocchio's, and every contender's answers judged (``quality``).
 """
 
 from __future__ import annotations
@@ -25,10 +28,13 @@ KNOWN = (
 )
 MACHINE = ("cpu", "cores", "python", "numpy", "pinocchio")
 STATS = ("median_us", "p10_us", "p90_us", "p99_us")
-MINK_TOL = 1e-9
-"""Largest MuJoCo-Pinocchio difference accepted beside mink's rows (mink_peer.KINEMATICS_TOL)."""
-FLOOR_TOL = 1e-9
-"""[rad/s] Largest difference accepted between rrc-pin and a floor row solving its problem."""
+GAP_TOL = 1e-9
+"""Largest difference of a peer's kinematics from Pinocchio's accepted beside its rows."""
+PEERS = {"PlaCo": "PlaCo", "pink": "pink", "mink": "mink", "Drake": "Drake"}
+"""Peer: the start of its rows' labels."""
+NOT_HERE = "not in this environment"
+QUALITY = ("reachable_steps", "veer_steps", "veer_max_deg", "too_fast_steps")
+"""What every contender's answers report (benchmarks/quality.py)."""
 
 
 def problems(results: dict[str, Any]) -> list[str]:
@@ -70,8 +76,6 @@ def _rows(where: str, mode: dict[str, Any]) -> Iterator[str]:
                 yield f"{where}.{label}.{key}: expected a positive time"
         if not any(k.startswith("vs_") and k.endswith("_median") for k in row):
             yield f"{where}.{label}: no ratio to a baseline (vs_<baseline>_median)"
-        if mode.get("pink_fastest") and not _positive(row.get("vs_baseline_p99")):
-            yield f"{where}.{label}.vs_baseline_p99: missing though pink ran"
 
 
 def _closed_form(results: dict[str, Any]) -> Iterator[str]:
@@ -98,31 +102,45 @@ def _resolver(results: dict[str, Any]) -> Iterator[str]:
     if not arms:
         yield "arms: empty"
     for arm in arms:
-        modes = arm.get("modes") or {}
-        if not modes:
-            yield f"arms.{arm.get('arm')}.modes: empty"
-        for mode, m in modes.items():
-            yield from _rows(f"arms.{arm.get('arm')}.modes.{mode}", m)
-        minks = any(k.startswith("mink ") for m in modes.values() for k in m.get("contenders", {}))
-        gap = arm.get("mink_kinematics_gap")
-        if minks and not (gap and max(gap.values()) <= MINK_TOL):
-            yield f"arms.{arm.get('arm')}.mink_kinematics_gap: missing or above {MINK_TOL}"
-        agreement = arm.get("floor_agreement")
-        if agreement and not _within(agreement.get("max_difference"), FLOOR_TOL):
-            yield f"arms.{arm.get('arm')}.floor_agreement: above {FLOOR_TOL} rad/s"
+        yield from _comparison(f"arms.{arm.get('arm')}", arm, results)
 
 
 def _tasks(results: dict[str, Any]) -> Iterator[str]:
-    modes = results.get("modes") or {}
+    yield from _comparison("tasks", results, results)
+
+
+def _comparison(where: str, part: dict[str, Any], results: dict[str, Any]) -> Iterator[str]:
+    """One workload of the peers comparison: its rows, its peers' status and kinematics, the
+    answers' quality."""
+    modes = part.get("modes") or {}
     if not modes:
-        yield "modes: empty"
+        yield f"{where}.modes: empty"
     for mode, m in modes.items():
-        yield from _rows(f"modes.{mode}", m)
-    peers = (results.get("equivalence") or {}).get("peers") or {}
-    for label, peer in peers.items():  # PlaCo's regularisation makes its problem another
-        if peer.get("same_problem") and label != "PlaCo":
-            if not _within(peer.get("max_difference"), FLOOR_TOL):
-                yield f"equivalence.peers.{label}: above {FLOOR_TOL} rad/s"
+        yield from _rows(f"{where}.modes.{mode}", m)
+    status = results.get("peers")
+    if not isinstance(status, dict) or set(status) != set(PEERS):
+        yield f"peers: expected the status of {', '.join(PEERS)}"
+        return
+    for peer, prefix in PEERS.items():
+        ran = status[peer] == "ran"
+        if not ran and not str(status[peer]).startswith(NOT_HERE):
+            yield f"peers.{peer}: expected 'ran' or '{NOT_HERE}: ...', got {status[peer]!r}"
+        if not ran and not results.get("quick"):
+            yield f"peers.{peer}: a full run needs every peer ({status[peer]})"
+        for mode, m in modes.items():
+            rows = [k for k in m.get("contenders", {}) if k.startswith(prefix)]
+            if ran and not rows:
+                yield f"{where}.modes.{mode}: {peer} ran but has no row"
+            if not ran and rows:
+                yield f"{where}.modes.{mode}: rows of {peer}, which did not run: {rows}"
+        gap = (part.get("kinematics_gaps") or {}).get(peer)
+        if ran and prefix != "pink" and not (gap and max(gap.values()) <= GAP_TOL):
+            yield f"{where}.kinematics_gaps.{peer}: missing or above {GAP_TOL}"
+    judged = part.get("quality") or {}
+    for label in (modes.get("tight") or {}).get("contenders", {}):
+        for key in QUALITY:
+            if not _finite(judged.get(label, {}).get(key)):
+                yield f"{where}.quality.{label}.{key}: expected a number"
 
 
 def _within(value: Any, tol: float) -> bool:

@@ -2,30 +2,27 @@
 
 A contender is one way of computing the joint rates of a step (a library, a backend, a set
 of options), called exactly as its users call it, the whole call timed with
-``time.perf_counter``. Along one recorded trajectory (configurations ``Q`` and commands
-``X``), it is timed in one of three modes (issue 18 item 14: a control loop is not a tight
-loop):
+``time.perf_counter``, every contender in the same process. Along one recorded trajectory
+(configurations ``Q`` and commands ``X``), it is timed in one of three modes:
 
 - ``tight``: one contender at a time, every step back to back (what a micro-benchmark
   measures: caches, branch predictors and the CPU clock stay hot for that contender);
-- ``khz``: one contender at a time, one call per tick of a 1 kHz loop: after each call the
-  loop sleeps (``time.sleep``) until the next 1 ms tick, as a periodic control loop does. A
-  sleep rather than a busy-wait, because a control loop gives the core up between ticks:
-  the process may be descheduled, the core may run something else or idle and lower its
-  clock, and the call finds its caches as a real tick does (a busy-wait would keep the
-  core hot and measure the tight loop again). A call longer than the period starts the next
-  one at once (counted in ``overruns``), never a burst of catch-up calls;
-- ``interleaved``: at every step every contender is called once, in an order shuffled at
-  each step, so that each call finds the caches left by its peers (what one process running
-  several libraries, or a controller doing other work between ticks, sees).
+- ``interleaved``: at every step every contender is called once, in an order rotated by one
+  at each step (each contender in turn first, after each of the others), so that each call
+  finds the caches left by its peers (one process running several libraries);
+- ``busy``: one contender at a time, and between two calls 1 ms of other work
+  (:class:`OtherWork`: numpy products and Pinocchio kinematics of another model, as a
+  controller does between ticks), so that each call finds its caches cooled by a tick's
+  worth of other code, on a core kept busy (a sleep would let the clock drop and the process
+  be descheduled: what the machine's other load does, not the controller).
 
-In the ``tight`` and ``khz`` modes the contenders take turns of :data:`BLOCK` consecutive
-steps (the order shuffled at every round), each going through the trajectory in order, so
-that every contender samples the whole run's machine state: on a shared machine the load
-of other processes drifts within seconds, and one contender timed at once over the whole
-trajectory would meet a different machine than the next (measured: the medians of identical
-code paths differed by up to 1.9x that way). The first call of a turn finds the caches of
-the previous contender; that is 1 call in 250 (0.4%), below the 99th percentile.
+In the ``tight`` and ``busy`` modes the contenders take turns of :data:`BLOCK` consecutive
+steps (the order rotated at every round of turns), each going through the trajectory in
+order, so that every contender samples the whole run's machine state: on a shared machine
+the load of other processes drifts within seconds, and one contender timed at once over the
+whole trajectory would meet a different machine than the next (measured: the medians of
+identical code paths differed by up to 1.9x that way). The first call of a turn finds the
+caches of the previous contender; that is 1 call in 250 (0.4%), below the 99th percentile.
 
 Each mode starts from fresh contenders (warm starts carry from step to step within a mode,
 as in a control loop) and calls each once, untimed, at the first step before timing.
@@ -51,21 +48,52 @@ import numpy.typing as npt
 
 Array = npt.NDArray[np.float64]
 
-MODES = ("tight", "khz", "interleaved")
+MODES = ("tight", "interleaved", "busy")
 MODE_TITLES = {
     "tight": "tight loop",
-    "khz": "1 kHz loop",
-    "interleaved": "interleaved with the peers",
+    "interleaved": "interleaved",
+    "busy": "1 ms of other work between calls",
 }
-PERIOD = 1e-3
-"""[s] Period of the ``khz`` mode."""
+OTHER_WORK = 1e-3
+"""[s] The other work between two calls of the ``busy`` mode."""
 BLOCK = 250
-"""Steps a contender runs in one turn of the ``tight`` and ``khz`` modes."""
-REPEATS = 5
+"""Steps a contender runs in one turn of the ``tight`` and ``busy`` modes."""
+REPEATS = 3
 """Rounds of every mode in a full run (``--quick``: one), each from fresh contenders: one
-round's medians moved by up to 2x between runs on the project's 2-core virtual machine, and
-pink's with them (its median on panda 85 us in one record, 146 us in the next, rrc_k1607's
-ratio 3.0x then 1.4x): :func:`combine_rounds` keeps the median of the rounds."""
+round's medians move by up to 2x between runs on the project's shared 2-core machine:
+:func:`combine_rounds` keeps the median of the rounds, and each round's numbers (the
+spread)."""
+
+
+class OtherWork:
+    """About ``seconds`` of other work per call: numpy products and Pinocchio kinematics.
+
+    What a controller does between two resolver calls (state estimation, logging, another
+    model's kinematics): 40 x 40 matrix products and Pinocchio's forward kinematics and
+    Jacobians of its sample manipulator, repeated until ``seconds`` have passed.
+    """
+
+    def __init__(self, seconds: float = OTHER_WORK) -> None:
+        import pinocchio as pin
+
+        self.seconds = seconds
+        self.model = pin.buildSampleModelManipulator()
+        self.data = self.model.createData()
+        rng = np.random.default_rng(0)
+        self.M = rng.normal(size=(40, 40)) / 40.0
+        self.q = pin.neutral(self.model)
+        self._pin = pin
+        self.sink = 0.0
+
+    def __call__(self) -> None:
+        pin, clock = self._pin, time.perf_counter
+        end = clock() + self.seconds
+        M = self.M
+        while clock() < end:
+            M2 = M @ M
+            self.q[0] += 1e-3
+            pin.computeJointJacobians(self.model, self.data, self.q)
+            self.sink += float(M2[0, 0])
 
 
 @dataclass
@@ -75,21 +103,15 @@ class Contender:
     Attributes:
         label: Name in the tables.
         call: One step ``call(q, x)`` (q (n,) [rad], x the command) returning what the library
-            returns; the whole call is timed. For a ``remote`` contender, it returns
-            ``(rates or None, seconds)`` timed in the other process (None: it failed).
+            returns; the whole call is timed.
         rates: The joint rates (n,) [rad/s] of what ``call`` returned (not timed).
         keep: Keep what ``call`` returned (rrc-pin's Resolutions, for their statistics).
-        remote: ``call`` runs in another process (see ``call``).
-        loop: For a remote contender, its tight loop run in its own process:
-            ``loop(Q, X) -> (rates (steps, n), seconds (steps,), failed (steps,))``.
     """
 
     label: str
     call: Callable[[Array, Array], Any]
     rates: Callable[[Any], Array] = np.asarray
     keep: bool = False
-    remote: bool = False
-    loop: Callable[[Array, Array], tuple[Array, Array, Array]] | None = None
 
 
 @dataclass
@@ -101,7 +123,6 @@ class Run:
         rates: Joint rates of each step (steps, n) [rad/s] (zero where it failed).
         failed: Steps where the call raised (steps,).
         kept: What the calls returned, if the contender keeps it.
-        overruns: ``khz`` mode: calls longer than the period.
         first_error: The first failure's exception (type and message), or "".
     """
 
@@ -109,7 +130,6 @@ class Run:
     rates: Array
     failed: npt.NDArray[np.bool_]
     kept: list[Any] = field(default_factory=list)
-    overruns: int = 0
     first_error: str = ""
 
 
@@ -118,19 +138,16 @@ def run_mode(
     contenders: Sequence[Contender],
     Q: Array,
     X: Array,
-    rng: np.random.Generator | None = None,
-    period: float = PERIOD,
+    other: Callable[[], None] | None = None,
 ) -> dict[str, Run]:
     """Time ``contenders`` along the trajectory ``(Q, X)`` in ``mode`` (module docstring).
 
     Args:
-        mode: ``tight``, ``khz`` or ``interleaved``.
+        mode: ``tight``, ``interleaved`` or ``busy``.
         contenders: Fresh contenders (their warm starts begin here).
         Q: Configurations (steps, n) [rad].
         X: Commands (steps, m).
-        rng: Shuffles the order of the contenders (at every step of the ``interleaved``
-            mode, where it is required; at every round of turns of the others).
-        period: [s] Period of the ``khz`` mode.
+        other: The ``busy`` mode's work between calls (default :class:`OtherWork`).
 
     Returns:
         A :class:`Run` per contender label.
@@ -142,47 +159,30 @@ def run_mode(
     }
     for c in contenders:  # one untimed call: imports, workspaces, first-call set-up
         _step(c, Q[0], X[0])
+    m = len(contenders)
     if mode == "interleaved":
-        if rng is None:
-            raise ValueError("the interleaved mode needs an rng")
-        order = list(contenders)
         for k in range(steps):
-            rng.shuffle(order)  # no contender always runs first, after another one's misses
-            for c in order:
+            for i in range(m):  # rotated: each contender in turn first, after each other
+                c = contenders[(k + i) % m]
                 _record(runs[c.label], c, k, *_step(c, Q[k], X[k]))
         return runs
-    if mode not in ("tight", "khz"):
+    if mode not in ("tight", "busy"):
         raise ValueError(f"unknown mode {mode!r}; expected one of {', '.join(MODES)}")
-    turns = rng if rng is not None else np.random.default_rng(0)
-    for a in range(0, steps, BLOCK):
+    work = (other or OtherWork()) if mode == "busy" else None
+    for turn, a in enumerate(range(0, steps, BLOCK)):
         b = min(a + BLOCK, steps)
-        order = list(contenders)
-        turns.shuffle(order)
-        for c in order:
+        for i in range(m):
+            c = contenders[(turn + i) % m]
             run = runs[c.label]
-            if mode == "tight" and c.loop is not None:  # a remote contender loops in its process
-                run.rates[a:b], run.seconds[a:b], failed = c.loop(Q[a:b], X[a:b])
-                run.failed[a:b] = failed.astype(bool)
-                continue
-            deadline = time.perf_counter()
             for k in range(a, b):
                 _record(run, c, k, *_step(c, Q[k], X[k]))
-                if mode == "khz":
-                    deadline += period
-                    wait = deadline - time.perf_counter()
-                    if wait > 0.0:
-                        time.sleep(wait)
-                    else:  # the call took the whole tick: start the next one now, no catch-up
-                        run.overruns += 1
-                        deadline = time.perf_counter()
+                if work is not None:
+                    work()
     return runs
 
 
 def _step(c: Contender, q: Array, x: Array) -> tuple[Any, float, str]:
     """One call of ``c``: (what it returned, seconds, the error or "" when it answered)."""
-    if c.remote:
-        rates, seconds = c.call(q, x)
-        return rates, seconds, "failed in its process" if rates is None else ""
     clock = time.perf_counter
     t0 = clock()
     try:
@@ -198,7 +198,7 @@ def _record(run: Run, c: Contender, k: int, out: Any, seconds: float, error: str
         run.failed[k] = True
         run.first_error = run.first_error or error
         return
-    run.rates[k] = out if c.remote else c.rates(out)
+    run.rates[k] = c.rates(out)
     if c.keep:
         run.kept.append(out)
 
@@ -260,7 +260,6 @@ def summarise(
         row: dict[str, Any] = statistics(run.seconds)
         row.update(compliance(Q, run.rates, lower, upper, velocity, dt))
         row["failures"] = int(run.failed.sum())
-        row["overruns"] = run.overruns
         if run.first_error:
             row["first_error"] = run.first_error
         out[label] = row
@@ -282,7 +281,7 @@ def combine_rounds(rounds: Sequence[dict[str, dict[str, Any]]]) -> dict[str, dic
         row: dict[str, Any] = {}
         for key, value in first.items():
             values = [r[key] for r in rows]
-            if key.startswith("max") or key in ("failures", "overruns"):
+            if key.startswith("max") or key == "failures":
                 row[key] = max(values)
             elif isinstance(value, float):
                 row[key] = float(np.median(values))

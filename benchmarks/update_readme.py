@@ -28,8 +28,11 @@ RESULTS = HERE / "results"
 START, END = "<!-- performance:start -->", "<!-- performance:end -->"
 BENCHMARKS = {
     "closed_form": ("bench_closed_form.py", "Closed forms against Pinocchio + numpy"),
-    "resolver": ("bench_resolver.py", "Resolver step time against pink, as users run it"),
-    "tasks": ("bench_tasks.py", "Two grippers and a posture on baxter: rrc-pin, pink, PlaCo"),
+    "resolver": (
+        "bench_resolver.py",
+        "One frame in the limits: rrc-pin, PlaCo, Drake, pink and mink in one process",
+    ),
+    "tasks": ("bench_tasks.py", "Two grippers and a posture on baxter: rrc-pin and its peers"),
     "study": (
         "bench_study.py",
         "Sampling time and velocity conversions (Nguyen & Zhou section 5)",
@@ -51,32 +54,66 @@ SCHEMES_START, SCHEMES_END = "<!-- control-schemes:start -->", "<!-- control-sch
 
 MODES_TEXT = """\
 A step's time is the whole call a user makes (a library, a backend, a set of options: a
-*contender*), timed with `time.perf_counter` along a recorded trajectory, in up to three
-modes (`benchmarks/timing.py`), each from fresh contenders (warm starts carry from step to
-step within a mode, as in a control loop; one untimed call at the first step before timing):
+*contender*), timed with `time.perf_counter` along a recorded trajectory, every contender in
+the same process, in up to three modes (`benchmarks/timing.py`), each from fresh contenders
+(warm starts carry from step to step within a mode, as in a control loop; one untimed call at
+the first step before timing):
 
 - **tight loop**: one contender at a time, every step back to back: caches, branch
   predictors and the CPU clock stay hot for that contender (what a micro-benchmark measures);
-- **1 kHz loop** (resolver benchmark): one contender at a time, one call per tick of a 1 kHz
-  loop; after each call the loop sleeps (`time.sleep`) until the next 1 ms tick, as a
-  periodic control loop does. A sleep rather than a busy-wait, because a control loop gives
-  its core up between ticks: the process may be descheduled, the core may run something else
-  or idle and lower its clock, and the call finds its caches as a real tick does (a busy-wait
-  would keep them hot and measure the tight loop again). A call longer than the period
-  starts the next tick at once (counted as an overrun);
-- **interleaved**: at every step every contender is called once, in an order shuffled at
-  each step, so each call finds the caches its peers left (one process running several
-  libraries, or a controller doing other work between ticks).
+- **interleaved**: at every step every contender is called once, in an order rotated by one
+  at each step, so each call finds the caches its peers left (one process running several
+  libraries);
+- **1 ms of other work between calls** (the peers comparison): one contender at a time, and
+  after each call 1 ms of numpy products and Pinocchio kinematics of another model, as a
+  controller does between ticks: each call finds its caches cooled, on a busy core.
 
-Statistics per contender and mode: median, 10th, 90th and 99th percentiles and mean [us];
-ratios to a peer measured in the same run and mode (the peer's time over the contender's:
-above 1, the contender is faster); the largest excess over the velocity limits and over the
-position limits after one Euler step; failures (the library raised; its rates taken as
-zero). BLAS threads are pinned to one for every library (the matrices are tiny). The
-machine is shared: the load average (1 minute) at the start and end of each benchmark is
-recorded. It counts the benchmark's own process too: a benchmark that runs right after
-another one starts at about 1 on its own, and ends near 1 plus what other processes add;
-those inflate the tails more than the medians."""
+In the tight and other-work modes the contenders take turns of 250 steps, in an order
+rotated at every turn, so that the machine's load drifting over the run meets every
+contender alike. Statistics per contender and mode: median, 10th, 90th and 99th percentiles
+and mean [us]; ratios to a peer measured in the same run, mode and round (the peer's time
+over the contender's: above 1, the contender is faster); the largest excess over the
+velocity limits and over the position limits after one Euler step; failures (the library
+raised; its rates taken as zero). BLAS threads are pinned to one for every library (the
+matrices are tiny). The machine is shared: the load average (1 minute) at the start and end
+of each benchmark is recorded. It counts the benchmark's own process too: a benchmark that
+runs right after another one starts at about 1 on its own, and ends near 1 plus what other
+processes add; those inflate the tails more than the medians. On a machine with more
+runnable processes than cores, a call that loses its core waits a scheduler time slice
+(about 4 ms): the p99 then measures the machine, not the library."""
+
+PEERS_TEXT = """\
+PlaCo 0.10 pins `pin==3.8.0`, so the comparison of rrc-pin with PlaCo, pink, mink and Drake
+(`bench_resolver.py`, `bench_tasks.py`) runs in an environment of its own where all of them
+and rrc-pin import together (rrc-pin needs `pin>=3.0`: pip resolves it to PlaCo's 3.8.0).
+From a checkout, with Python 3.11 (the versions recorded below):
+
+```
+python3.11 -m venv .venv-peers
+.venv-peers/bin/pip install -e ".[bench]" "placo==0.10.2" "drake==1.51.1"
+.venv-peers/bin/python -c "import placo, pink, mink, mujoco, pydrake, numba, daqp, rrc_pin"
+.venv-peers/bin/rrc-pin bench --only resolver --out peers-run
+.venv-peers/bin/rrc-pin bench --only tasks --out peers-run
+```
+
+`--record` instead of `--out DIR` rewrites `benchmarks/results/`. Run without `-e` install, the
+scripts take the checkout from `PYTHONPATH=.`: `PYTHONPATH=. .venv-peers/bin/python
+benchmarks/bench_resolver.py --out DIR`. A full run refuses to start where a peer does not
+import, naming it and what to install; `--quick` (the smoke run the CI makes in the bench
+extra, where PlaCo and Drake are absent) runs without them and records each as "not in this
+environment", never as run. Each run prints its seed (fresh unless `--seed S` is given) and
+records it.
+
+How to read the comparison: every ratio is PlaCo's time over the contender's, taken within
+one round and mode on the same trajectory (above 1: faster than PlaCo); the median's range
+over the rounds shows how far the shared machine moved the numbers. Read the medians and
+their ratios first: on a machine with more runnable processes than its 2 cores (the load
+average recorded), a p99 of several milliseconds is a call that lost its core for a
+scheduler time slice, whoever the contender. The answers' tables say what each library
+does with the same command: PlaCo, pink and mink solve a least squares of the pose error (a
+command they cannot meet is traded against the limits: it veers), rrc-pin's default and
+Drake keep its direction and scale its speed; the LP maximum scale along the command
+(`benchmarks/quality.py`) is the best speed any answer could reach in the step's box."""
 
 
 def load_module(name: str) -> ModuleType:
@@ -136,6 +173,7 @@ def render_docs(results: Path, docs: Path) -> str:
         MODES_TEXT,
         "",
     ]
+    lines += ["## The peers' environment", "", PEERS_TEXT, ""]
     if found:
         lines += ["## Machine, versions, load", "", *_machine_table(found), ""]
         lines += ["## Closing note", "", *closing_note(found), ""]
@@ -172,28 +210,22 @@ def closing_note(found: dict[str, dict[str, Any]]) -> list[str]:
             + ", ".join(f"{a['arm']} {a['batch']['speedup']:.0f}x" for a in cf["arms"])
             + "."
         )
-    res = found.get("resolver")
-    if res:
-        for arm in res["arms"]:
-            m = arm["modes"]["tight"]
-            rows = m["contenders"]
+    for name, key in (("resolver", "arms"), ("tasks", None)):
+        res = found.get(name)
+        if not res or res.get("schema", 1) < 3:
+            continue
+        for part in res[key] if key else [res]:
+            rows = part["modes"]
             cells = []
-            for label in ("rrc-pin default (daqp, direction)", "rrc-pin tracking (daqp)"):
-                r = rows.get(label, {})
-                for key, who in (
-                    ("baseline", m.get("pink_fastest")),
-                    ("mink", m.get("mink_fastest")),
-                ):
-                    if who and f"vs_{key}_median" in r:
-                        cells.append(
-                            f"{label.split(' (')[0]} vs {who} {r[f'vs_{key}_median']:.2f}x / "
-                            f"{r[f'vs_{key}_p99']:.2f}x"
-                        )
-            if not m.get("mink_fastest"):
-                cells.append("mink not in this recording")
+            for mode in rows:
+                for label, r in rows[mode]["contenders"].items():
+                    if label.startswith("rrc-pin") and "vs_placo_median" in r:
+                        cells.append(f"{label}, {mode}: {r['vs_placo_median']:.2f}x / "
+                                     f"{r['vs_placo_p99']:.2f}x")  # fmt: skip
+            what = part.get("arm") or part.get("robot")
             out.append(
-                f"- Resolver, {arm['arm']}, tight loop (peer's time over rrc-pin's, median / "
-                "p99): " + "; ".join(cells) + "."
+                f"- {what}, PlaCo's time over rrc-pin's (median / p99; above 1 rrc-pin is "
+                "faster): " + ("; ".join(cells) or "PlaCo not in this recording") + "."
             )
     study = found.get("study")
     if study:
@@ -209,8 +241,9 @@ def closing_note(found: dict[str, dict[str, Any]]) -> list[str]:
     if scaling:
         worst = max(scaling["dof"], key=lambda r: r["median_us"] / r["floor_median_us"])
         out.append(
-            "- Largest gap to the physical floor (one Pinocchio Jacobian and one small dense "
-            f"solve, same run): {worst['arm']} ({worst['nq']} joints), the resolver's "
+            "- Largest ratio to the unconstrained reference (one Pinocchio Jacobian and one "
+            f"numpy solve, no limits, same run): {worst['arm']} ({worst['nq']} joints), the "
+            "resolver's "
             f"{worst['median_us']:.0f} us against {worst['floor_median_us']:.0f} us "
             f"({worst['median_us'] / worst['floor_median_us']:.1f}x); every arm: "
             + ", ".join(
@@ -256,9 +289,11 @@ def _machine_table(found: dict[str, dict[str, Any]]) -> list[str]:
         ("python", "Python"),
         ("numpy", "numpy"),
         ("pinocchio", "Pinocchio"),
+        ("placo", "PlaCo"),
         ("pink", "pink"),
         ("mink", "mink"),
         ("mujoco", "MuJoCo"),
+        ("pydrake", "Drake"),
         ("qpsolvers", "qpsolvers"),
         ("daqp", "daqp"),
         ("osqp", "osqp"),
@@ -297,18 +332,6 @@ def _machine_table(found: dict[str, dict[str, Any]]) -> list[str]:
             text += " + uncommitted: " + ", ".join(s.get("changed_files") or ["some files"])
         code.append(f"{text} (sources {s.get('source_sha256', '-')})" if s else "-")
     lines.append("| code measured (rrc_pin/, solvers/) | " + " | ".join(code) + " |")
-    placo = found.get("tasks", {}).get("placo", {}).get("info")
-    if placo:
-        lines.append(
-            "| PlaCo (own interpreter) | "
-            + " | ".join(
-                f"placo {placo['placo']}, Pinocchio {placo['pinocchio']}, numpy {placo['numpy']}"
-                if n == "tasks"
-                else "-"
-                for n in names
-            )
-            + " |"
-        )
     return lines
 
 

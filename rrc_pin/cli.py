@@ -341,8 +341,9 @@ BENCH_MODULES = {
     "maps": ("distributed", "zarr", "matplotlib"),
     "collision": ("pink", "mink", "mujoco", "matplotlib"),
 }
-"""What each benchmark needs from the bench extra (placo and mink are optional: their rows are
-skipped when they are absent)."""
+"""What each benchmark needs from the bench extra. The resolver and tasks benchmarks also need
+PlaCo, mink and Drake for a full run (they refuse without, naming what is missing); a quick run
+records the absent ones as "not in this environment" (docs/benchmarks.md)."""
 
 
 def bench_command(

@@ -110,12 +110,9 @@ class Factorization:
         if self._svd is None:
             m, n = self.J.shape
             k = min(m, n)
-            US = np.ascontiguousarray(self.R[:k].T)  # R_1^T (m, k)
-            W, sigma = np.empty((k, k)), np.empty(k)
-            kernels.jacobi_svd(US, W, sigma)
-            cut = RANK_TOL * sigma[0] if k else 0.0
-            rank = int(np.count_nonzero(sigma > cut)) if cut > 0.0 else 0
-            self._svd = (US, sigma, self.Q[:, :k] @ W, rank)
+            US, W, sigma, right = np.empty((m, k)), np.empty((k, k)), np.empty(k), np.empty((n, k))
+            rank = kernels.triangle_svd(self.Q, self.R, RANK_TOL, US, W, sigma, right)
+            self._svd = (US, sigma, right, rank)
         return self._svd
 
     def null_basis(self) -> Array:

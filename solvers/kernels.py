@@ -311,6 +311,76 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
 
 
 @kernel
+def triangle_svd(Q: Array, R: Array, tol: float, US: Array, W: Array, sigma: Array,
+                 right: Array) -> int:  # fmt: skip
+    r"""The SVD of J from the QR of its transpose, :math:`J^T = QR` (k = min(m, n)).
+
+    :math:`R_1^T V = U\Sigma` (:func:`jacobi_svd` of the small triangle's transpose, m x k)
+    gives :math:`J = U\Sigma (Q_1 V)^T` (Golub & Van Loan 2013, section 8.6.3: the
+    R-bidiagonalisation route to the SVD of a wide or tall matrix).
+
+    Args:
+        Q: Orthogonal factor (n, n) of :math:`J^T`.
+        R: Triangular factor (n, m).
+        tol: Singular values at most ``tol * sigma_max`` count as zero.
+        US: Out: :math:`U\Sigma` (m, k).
+        W: Out: the triangle's right singular vectors (k, k).
+        sigma: Out: singular values (k,), descending.
+        right: Out: the right singular vectors of J, :math:`Q_1 W` (n, k).
+
+    Returns:
+        The rank (0 when k is 0 or sigma_max is 0).
+    """
+    n, m = R.shape
+    k = min(m, n)
+    for i in range(m):
+        for j in range(k):
+            US[i, j] = R[j, i]
+    jacobi_svd(US, W, sigma)
+    for i in range(n):
+        for j in range(k):
+            s = 0.0
+            for p in range(k):
+                s += Q[i, p] * W[p, j]
+            right[i, j] = s
+    if k == 0 or not sigma[0] > 0.0:
+        return 0
+    rank = 0
+    for j in range(k):
+        if sigma[j] > tol * sigma[0]:
+            rank += 1
+    return rank
+
+
+@kernel
+def clamp_pushed(J: Array, w: Array, lb: Array, ub: Array, still: float, out: Array) -> bool:
+    """J's columns of the joints that ``w`` pushes against a bound holding them still, zeroed.
+
+    A joint is held where its bound on the side ``w`` moves it is within ``still`` of zero
+    (Baerlocher & Boulic 2004's clamping).
+
+    Args:
+        J: The rows (m, n).
+        w: The rates (n,).
+        lb: Lower bounds (n,).
+        ub: Upper bounds (n,).
+        still: A bound within this of zero holds its joint.
+        out: Out: J with those columns zeroed (m, n), set where True is returned.
+
+    Returns:
+        Whether any joint is held.
+    """
+    m, n = J.shape
+    any_held = False
+    for j in range(n):
+        held = (w[j] > 0.0 and ub[j] <= still) or (w[j] < 0.0 and lb[j] >= -still)
+        any_held = any_held or held
+        for i in range(m):
+            out[i, j] = 0.0 if held else J[i, j]
+    return any_held
+
+
+@kernel
 def svd_rates(
     US: Array, sigma: Array, right: Array, b: Array, lambda_sq: Array, rank: int, x: Array
 ) -> None:

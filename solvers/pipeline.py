@@ -331,12 +331,9 @@ def _damping(
 
 def _clamped(factor: Factorization, w: Array, box: Box, dt: float) -> Factorization:
     """The rows without the joints ``w`` pushes against a bound that holds them (``_damping``)."""
-    still = kernels.ON_LIMIT / dt  # a bound within rounding of zero holds the joint
-    pushed = ((w > 0.0) & (box.ub <= still)) | ((w < 0.0) & (box.lb >= -still))
-    if not pushed.any():
+    J = np.empty_like(factor.J)  # a bound within rounding of zero holds the joint
+    if not kernels.clamp_pushed(factor.J, w, box.lb, box.ub, kernels.ON_LIMIT / dt, J):
         return factor
-    J = factor.J.copy()
-    J[:, pushed] = 0.0
     clamped = Factorization(J)
     return clamped if clamped.svd[3] >= factor.svd[3] else factor
 

@@ -70,7 +70,8 @@ def test_the_quick_control_schemes_figure_and_tables_say_what_ran(bench, drawn, 
 
 
 @pytest.mark.parametrize(("name", "module"), [("controller", "bench_controller"),
-                                              ("tasks", "render_tasks")])  # fmt: skip
+                                              ("resolver", "bench_resolver"),
+                                              ("tasks", "bench_tasks")])  # fmt: skip
 def test_the_timing_legends_hide_no_axis_label(bench, drawn, tmp_path, name, module):
     """controller.png's legend sat on its x-axis label; one legend now, below every label
     (resolver.png draws through the same timing_chart)."""

@@ -49,13 +49,6 @@ def test_schema_names_what_is_missing():
     del row["p99_us"]
     found = schema.problems(broken)
     assert any("p99_us" in p for p in found) and any("no ratio" in p for p in found), found
-    with_mink = copy.deepcopy(resolver)
-    with_mink["arms"][0].pop("mink_kinematics_gap", None)  # recorded beside mink's own rows
-    rows = with_mink["arms"][0]["modes"]["tight"]["contenders"]
-    rows["mink daqp"] = copy.deepcopy(next(iter(rows.values())))
-    assert any("mink_kinematics_gap" in p for p in schema.problems(with_mink))
-    with_mink["arms"][0]["mink_kinematics_gap"] = {"position": 1e-15, "jacobian": 2e-15}
-    assert schema.problems(with_mink) == []
     cf = json.loads((ROOT / "benchmarks" / "results" / "closed_form.json").read_text())
     cf = {**cf, "schema": 2}
     cf["arms"][0]["scalar"].pop("closed_form_p99_us", None)
@@ -63,23 +56,40 @@ def test_schema_names_what_is_missing():
     assert schema.problems({"benchmark": "nope"})[0].startswith("benchmark:")
 
 
-def test_schema_refuses_a_floor_that_solves_another_problem():
-    """The floor rows stand for rrc-pin's own problem: the default against the floor in the
-    limits (resolver), a peer that solves the same problem (tasks), above 1e-9 rad/s."""
-    resolver = json.loads((ROOT / "benchmarks" / "results" / "resolver.json").read_text())
-    resolver["arms"][0]["floor_agreement"] = {"steps": 1000, "max_difference": 1e-12}
-    assert schema.problems(resolver) == []
-    resolver["arms"][0]["floor_agreement"]["max_difference"] = 1e-3
-    assert any("floor_agreement" in p for p in schema.problems(resolver))
-    tasks = json.loads((ROOT / "benchmarks" / "results" / "tasks.json").read_text())
-    peers = tasks["equivalence"]["peers"]
-    floor = next(k for k, p in peers.items() if p["same_problem"] and k != "PlaCo")
-    assert schema.problems(tasks) == []
-    peers[floor]["max_difference"] = float("nan")
-    assert any(floor in p for p in schema.problems(tasks))
-    peers["PlaCo"]["max_difference"] = 1e-6  # its regularisation: not rrc-pin's problem
-    peers[floor]["max_difference"] = 1e-14
-    assert schema.problems(tasks) == []
+@pytest.mark.parametrize("name", ["resolver", "tasks"])
+def test_schema_holds_the_peers_comparison_to_what_ran(name):
+    """Issue 27: every peer ran in a full recording, each peer that ran has its rows and its
+    kinematics checked, a peer that did not run has no row and is said "not in this
+    environment" (a quick run only), and every contender's answers are judged."""
+    recorded = json.loads((ROOT / "benchmarks" / "results" / f"{name}.json").read_text())
+    assert schema.problems(recorded) == []
+    assert set(recorded["peers"].values()) == {"ran"}
+    part = recorded["arms"][0] if name == "resolver" else recorded
+
+    missing_gap = copy.deepcopy(recorded)
+    (missing_gap["arms"][0] if name == "resolver" else missing_gap)["kinematics_gaps"].pop("mink")
+    assert any("kinematics_gaps.mink" in p for p in schema.problems(missing_gap))
+
+    quick = copy.deepcopy(recorded)
+    quick["quick"] = True
+    quick["peers"]["PlaCo"] = "not in this environment: ModuleNotFoundError: placo"
+    found = schema.problems(quick)
+    assert found and all("rows of PlaCo, which did not run" in p for p in found), found
+    for part_ in quick["arms"] if name == "resolver" else [quick]:
+        for m in part_["modes"].values():
+            for label in [k for k in m["contenders"] if k.startswith("PlaCo")]:
+                del m["contenders"][label]
+    assert schema.problems(quick) == []
+    quick["quick"] = False  # a full run without PlaCo: refused
+    assert any("a full run needs every peer" in p for p in schema.problems(quick))
+    quick["peers"]["PlaCo"] = "passed"
+    assert any("peers.PlaCo: expected 'ran'" in p for p in schema.problems(quick))
+
+    unjudged = copy.deepcopy(recorded)
+    target = unjudged["arms"][0] if name == "resolver" else unjudged
+    label = next(iter(part["modes"]["tight"]["contenders"]))
+    del target["quality"][label]
+    assert any(f"quality.{label}" in p for p in schema.problems(unjudged))
 
 
 def test_quick_study_through_the_cli_writes_json_that_follows_the_schema(tmp_path, monkeypatch):
