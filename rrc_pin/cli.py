@@ -81,6 +81,13 @@ def parser() -> argparse.ArgumentParser:
         help="folder for the outputs (default: a new rrc-pin-demo-<timestamp>-* folder in the "
         "system's temporary directory, printed)",
     )
+    demo.add_argument(
+        "--cell",
+        default=None,
+        choices=("gsfc_dual", "yeh_tripod"),
+        help="run this cell's scripted session instead (gsfc_dual: master-slave carrying of "
+        "the held object; yeh_tripod: the walk along the beam): table, log (CSV), figure (PNG)",
+    )
     demo.add_argument("--quick", action="store_true", help="shorter scripts (a smoke test)")
     check = sub.add_parser("check", help="cross-check every catalogue arm: DH, Pinocchio, yourdfpy")
     check.add_argument("--samples", type=int, default=200, help="configurations per arm (>= 1)")
@@ -226,6 +233,10 @@ def run(args: argparse.Namespace) -> int:
         return run_cross_check(samples=args.samples)
     if args.command == "map":
         return map_command(args)
+    if args.cell:
+        from rrc_pin.demo_cells import run_cell_demo
+
+        return run_cell_demo(args.cell, out=args.out, quick=args.quick)
     from rrc_pin.demo import run_demo
 
     return run_demo(args.arm, out=args.out, quick=args.quick)

@@ -352,3 +352,32 @@ def test_console_without_its_extra_says_what_to_install(monkeypatch, capsys):
     assert main(["console"]) == 2
     err = capsys.readouterr().err
     assert err == 'rrc-pin console: viser not installed: pip install -e ".[console]"\n'
+
+
+@pytest.mark.parametrize(
+    ("cell", "label", "bound"),
+    [("gsfc_dual", "max grip error [m]", 1e-5), ("yeh_tripod", "max foot slip [m]", 1e-6)],
+)
+def test_demo_cell_writes_the_log_and_figure_and_prints_bounded_numbers(
+    cell, label, bound, tmp_path, capsys
+):
+    """Issue 30 item 7: ``rrc-pin demo --cell NAME`` runs the cell's scripted session."""
+    assert main(["demo", "--cell", cell, "--quick", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert (tmp_path / f"{cell}.csv").is_file()
+    assert (tmp_path / f"{cell}.png").stat().st_size > 5_000
+    with (tmp_path / f"{cell}.csv").open() as f:
+        header = f.readline().strip().split(",")
+        ticks = sum(1 for _ in f)
+    assert header[:3] == ["t", "mode", "status"]
+    assert re.search(rf"^ticks\s+{ticks}\b", out, re.M)
+    value = float(re.search(rf"^{re.escape(label)}\s+(\S+)", out, re.M).group(1))
+    assert 0.0 <= value < bound
+    if cell == "yeh_tripod":
+        advance = float(re.search(r"^body advance \[m\]\s+(\S+)\s+planned (\S+)", out, re.M)[1])
+        planned = float(re.search(r"planned (\S+)", out)[1])
+        assert abs(advance - planned) < 1e-3
+    else:
+        assert "grip:object" in header
+        moved = float(re.search(r"^object moved \[mm\]\s+(\S+)", out, re.M)[1])
+        assert moved > 10.0
