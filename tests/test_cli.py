@@ -205,6 +205,7 @@ def test_bench_without_its_extras_says_what_to_install(tmp_path, monkeypatch, ca
     assert list(tmp_path.iterdir()) == [] and snapshot(CHECKED_IN) == before
 
 
+@pytest.mark.compiled  # batches of 10^5 configurations: minutes as plain Python
 def test_bench_writes_a_new_folder_by_default_and_never_the_checkout(tmp_path, monkeypatch):
     """A quick closed-form run (no pink needed) lands in ./rrc-pin-bench-<timestamp>, with its
     JSON and a benchmarks.md; --out DIR takes another folder; the checkout stays as it was."""
