@@ -310,7 +310,8 @@ class CollisionModel:
         """A new per-caller query state (one per resolver; never shared between threads)."""
         return CollisionData(self._scene)
 
-    def proximity(self, kin: Kinematics, data: CollisionData, detection: float) -> Proximity:
+    def proximity(self, kin: Kinematics, data: CollisionData, detection: float,
+                  ends: bool = False) -> Proximity:  # fmt: skip
         """The pairs whose signed distance is below ``detection`` [m] at ``kin``'s configuration.
 
         Args:
@@ -318,10 +319,13 @@ class CollisionModel:
                 ``data`` holds every joint's placement).
             data: This caller's :meth:`create_data`.
             detection: Detection distance [m], >= 0.
+            ends: Also a row for each capsule end point within ``detection`` of the other
+                body (:mod:`solvers.narrow_kernels`): what :class:`CollisionLimit` constrains.
 
         Returns:
             A :class:`~rrc_pin.geometry.proximity.Proximity`, one row per pair below
-            ``detection`` (in the order of :attr:`pairs`).
+            ``detection`` (in the order of :attr:`pairs`; with ``ends``, a pair's end-point
+            rows follow its own).
 
         Raises:
             InvalidInput: ``kin`` of another robot, ``data`` not a CollisionData, a negative
@@ -329,7 +333,7 @@ class CollisionModel:
         """
         if kin.model is not self.robot.model:
             raise InvalidInput("kin", f"kinematics of another model than {self.robot.name}'s")
-        return self._query(kin.q, lambda: kin.data, data, detection)
+        return self._query(kin.q, lambda: kin.data, data, detection, ends)
 
     def proximity_at(self, q: npt.ArrayLike, detection: float,
                      data: CollisionData | None = None) -> Proximity:  # fmt: skip
@@ -348,12 +352,12 @@ class CollisionModel:
         return self._query(q_api, lambda: pdata, data, detection)
 
     def _query(self, q: Array, placed: Callable[[], pin.Data], data: CollisionData,
-               detection: float) -> Proximity:  # fmt: skip
+               detection: float, ends: bool = False) -> Proximity:  # fmt: skip
         if not isinstance(data, CollisionData):
             raise InvalidInput("data", f"expected cm.create_data()'s, got {type(data).__name__}")
         if not (type(detection) is float and 0.0 <= detection < np.inf):  # 1 us saved a tick
             detection = finite_number(detection, "detection", 0.0)
-        return query(self._scene, self.robot.model, q, placed, data, detection)
+        return query(self._scene, self.robot.model, q, placed, data, detection, ends is True)
 
     # -- internals --------------------------------------------------------------------------
 
