@@ -335,8 +335,8 @@ class CollisionModel:
             raise InvalidInput("kin", f"kinematics of another model than {self.robot.name}'s")
         return self._query(kin.q, lambda: kin.data, data, detection, ends)
 
-    def proximity_at(self, q: npt.ArrayLike, detection: float,
-                     data: CollisionData | None = None) -> Proximity:  # fmt: skip
+    def proximity_at(self, q: npt.ArrayLike, detection: float, data: CollisionData | None = None,
+                     ends: bool = False) -> Proximity:  # fmt: skip
         """:meth:`proximity` at joint positions ``q`` (nq,) [rad or m].
 
         Forward kinematics computed here (in the calling thread's ``robot.data``); ``data``
@@ -349,7 +349,7 @@ class CollisionModel:
             data = getattr(self._local, "data", None)
             if data is None:
                 data = self._local.data = self.create_data()
-        return self._query(q_api, lambda: pdata, data, detection)
+        return self._query(q_api, lambda: pdata, data, detection, ends)
 
     def _query(self, q: Array, placed: Callable[[], pin.Data], data: CollisionData,
                detection: float, ends: bool = False) -> Proximity:  # fmt: skip

@@ -1,7 +1,9 @@
 r"""CollisionLimit: every pair of bodies kept apart, and tool frames inside their walls.
 
 One velocity-damper row per pair closer than the detection distance (Kanehiro et al. 2008,
-:mod:`solvers.damper_kernels`):
+:mod:`solvers.damper_kernels`), and one per capsule end point within it of the other body
+(:mod:`solvers.narrow_kernels`: near-parallel capsules' closest points jump from end to end,
+and the end about to become the closest is then already constrained):
 
 .. math:: -n^T (J_b - J_a)\,\dot q \le \xi \frac{d - d_s}{d_i - d_s}
 
@@ -84,7 +86,8 @@ class CollisionLimit(Limit):
         name: Name in the report.
 
     Attributes:
-        last: The :class:`~rrc_pin.geometry.Proximity` of the last tick (the rows' pairs).
+        last: The :class:`~rrc_pin.geometry.Proximity` of the last tick (the rows' pairs, a
+            pair's end-point rows after its own).
 
     Raises:
         InvalidInput: ``model`` not a CollisionModel, a distance or gain out of range, a pair
@@ -143,7 +146,7 @@ class CollisionLimit(Limit):
 
     def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
         """The damper rows of the pairs within the detection distance, and of the walls."""
-        prox = self.model.proximity(kin, self._data, self.detection)
+        prox = self.model.proximity(kin, self._data, self.detection, ends=True)
         if self.pairs is not None and prox.names:
             keep = [k for k, names in enumerate(prox.names) if names in self.pairs]
             prox = _subset(prox, keep)
