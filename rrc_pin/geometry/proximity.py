@@ -22,7 +22,8 @@ Conventions of a :class:`Proximity` row (coal's): the witness points ``p_a`` on 
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import NamedTuple
+from operator import itemgetter
+from typing import NamedTuple, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -34,6 +35,7 @@ from solvers.proximity_kernels import joint_poses, near_pairs, world_centres
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
+T = TypeVar("T")
 
 ROWS = 5
 """Most rows of one pair: its closest points and four end points."""
@@ -51,6 +53,8 @@ class Proximity(NamedTuple):
         joint_a: The joint (k,) body A moves with (a joint index of ``kin.model``; 0: the
             world).
         joint_b: The joint (k,) body B moves with.
+        pair: The index (k,) of each row's pair in the scene's pairs
+            (:attr:`~rrc_pin.geometry.CollisionModel.pairs` when queried).
     """
 
     names: tuple[tuple[str, str], ...]
@@ -60,6 +64,7 @@ class Proximity(NamedTuple):
     normal: Array
     joint_a: Index
     joint_b: Index
+    pair: Index
 
 
 class CollisionData:
@@ -139,14 +144,23 @@ def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Dat
     taken = slice(0, rows) if order is None else order
     names = scene.pair_names
     return Proximity(
-        names=tuple([names[k] for k in index.tolist()]),
+        names=gather(names, index),
         distance=cdata.distance[taken].copy(),
         point_a=cdata.point_a[taken].copy(),
         point_b=cdata.point_b[taken].copy(),
         normal=cdata.normal[taken].copy(),
         joint_a=scene.joint[scene.first[index]],
         joint_b=scene.joint[scene.second[index]],
+        pair=index,
     )
+
+
+def gather(items: tuple[T, ...], index: Index) -> tuple[T, ...]:
+    """``items[index[r]]`` for every r, in one C-level gather (not a Python loop)."""
+    if index.size > 1:
+        out: tuple[T, ...] = itemgetter(*index.tolist())(items)
+        return out
+    return (items[int(index[0])],) if index.size else ()
 
 
 def _coal(scene: Scene, model: pin.Model, data: pin.Data, cdata: CollisionData,
@@ -198,7 +212,8 @@ def _unit(normal: Array, distance: float, point_a: Array, point_b: Array,
 
 def _empty() -> Proximity:
     empty = Proximity((), np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
-                      np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))  # fmt: skip
+                      np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+                      np.zeros(0, dtype=np.int64))  # fmt: skip
     for array in empty[1:]:
         array.flags.writeable = False
     return empty

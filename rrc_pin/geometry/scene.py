@@ -72,6 +72,7 @@ class Scene:
         first: First body (npairs,) of each active pair.
         second: Second body (npairs,).
         pair_names: ``(name_a, name_b)`` of each active pair.
+        labels: ``"name_a|name_b"`` of each active pair (a constraint row's name).
         excluded: The pairs left out, by names, with their reasons.
         njoints: Number of joints of the model (including the world, 0).
         tree: The model's joints for the compiled forward kinematics, or None (a query reads
@@ -91,6 +92,7 @@ class Scene:
     first: Index
     second: Index
     pair_names: tuple[tuple[str, str], ...]
+    labels: tuple[str, ...]
     excluded: dict[tuple[str, str], Reason]
     njoints: int
     tree: KinematicTree | None
@@ -160,6 +162,7 @@ def build_scene(
         geometry=geometry, names=names, joint=joint, centre=centre, radius=radius,
         normal=normal, offset=offset, shape=shape, segment=segment, size=size, first=first,
         second=second,
-        pair_names=tuple((names[a], names[b]) for a, b in pairs), excluded=excluded,
+        pair_names=tuple((names[a], names[b]) for a, b in pairs),
+        labels=tuple(f"{names[a]}|{names[b]}" for a, b in pairs), excluded=excluded,
         njoints=model.njoints, tree=tree,
     )  # fmt: skip

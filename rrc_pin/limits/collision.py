@@ -42,6 +42,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.geometry import CollisionModel, Wall
+from rrc_pin.geometry.proximity import gather
 from rrc_pin.limits.limit import Limit
 from solvers.damper_kernels import damper_rows
 from solvers.problem import Constraints
@@ -49,6 +50,7 @@ from solvers.validation import finite_number
 
 if TYPE_CHECKING:
     from rrc_pin.geometry.proximity import Proximity
+    from rrc_pin.geometry.scene import Scene
     from rrc_pin.kinematics import Kinematics, Layout
 
 Array = npt.NDArray[np.float64]
@@ -130,7 +132,7 @@ class CollisionLimit(Limit):
                 start = robot.joints[i].idx_v
                 support[j, start : start + robot.joints[i].nv] = True
         self._support = support
-        self._names: dict[tuple[str, str], str] = {}
+        self._kept: tuple[Scene | None, npt.NDArray[np.bool_]] = (None, np.zeros(0, np.bool_))
 
     def check(self, layout: Layout) -> None:
         """Refuse a resolver whose robot is not the model's.
@@ -147,9 +149,11 @@ class CollisionLimit(Limit):
     def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
         """The damper rows of the pairs within the detection distance, and of the walls."""
         prox = self.model.proximity(kin, self._data, self.detection, ends=True)
+        scene = self._data.scene
         if self.pairs is not None and prox.names:
-            keep = [k for k, names in enumerate(prox.names) if names in self.pairs]
-            prox = _subset(prox, keep)
+            keep = self._keep(scene)[prox.pair]
+            if not keep.all():
+                prox = _subset(prox, np.flatnonzero(keep))
         self.last = prox
         walls = self.model.walls()
         k = len(prox.names)
@@ -158,7 +162,7 @@ class CollisionLimit(Limit):
         xi = min(self.gain, (self.detection - self.safety) / dt)
         nv = kin.model.nv
         G, h = np.empty((k, nv)), np.empty(k)
-        names = [self._name(pair) for pair in prox.names]
+        names = list(gather(scene.labels, prox.pair))
         distance = prox.distance
         if k:
             J = kin.data.J
@@ -196,11 +200,12 @@ class CollisionLimit(Limit):
             names.append(f"{wall.frame}|{wall.name}")
         return np.vstack(rows), np.concatenate(bounds), np.concatenate(gaps)
 
-    def _name(self, pair: tuple[str, str]) -> str:
-        label = self._names.get(pair)
-        if label is None:
-            label = self._names[pair] = f"{pair[0]}|{pair[1]}"
-        return label
+    def _keep(self, scene: Scene) -> npt.NDArray[np.bool_]:
+        """Whether each pair of ``scene`` is one of :attr:`pairs` (kept per scene)."""
+        if self._kept[0] is not scene:
+            chosen = self.pairs or frozenset()
+            self._kept = (scene, np.array([p in chosen for p in scene.pair_names], dtype=np.bool_))
+        return self._kept[1]
 
 
 _NONE = Constraints()
@@ -232,8 +237,7 @@ def _pairs(model: CollisionModel, pairs: Sequence[tuple[str, str]]) -> frozenset
     return frozenset(out)
 
 
-def _subset(prox: Proximity, keep: list[int]) -> Proximity:
-    index = np.array(keep, dtype=np.int64)
-    return type(prox)(tuple(prox.names[k] for k in keep), prox.distance[index],
+def _subset(prox: Proximity, index: npt.NDArray[np.int64]) -> Proximity:
+    return type(prox)(gather(prox.names, index), prox.distance[index],
                       prox.point_a[index], prox.point_b[index], prox.normal[index],
-                      prox.joint_a[index], prox.joint_b[index])  # fmt: skip
+                      prox.joint_a[index], prox.joint_b[index], prox.pair[index])  # fmt: skip
