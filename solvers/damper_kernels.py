@@ -61,7 +61,7 @@ def damper_rows(
     distance: Array,
     safety: float,
     detection: float,
-    xi: float,
+    xi: Array,
     recovery: float,
     G: Array,
     h: Array,
@@ -79,7 +79,7 @@ def damper_rows(
         distance: Signed distances (k,) [m].
         safety: d_s [m].
         detection: d_i [m], > d_s.
-        xi: Approach speed allowed at d_i [m/s].
+        xi: Approach speed allowed at d_i (k,) [m/s], per row.
         recovery: rho / dt [1/s], the rate restoring a shortfall below d_s.
         G: Out (k, nv).
         h: Out (k,) [m/s].
@@ -107,8 +107,8 @@ def damper_rows(
             G[r, c] = value
         gap = distance[r] - safety
         if gap >= 0.0:
-            h[r] = xi * gap / span
+            h[r] = xi[r] * gap / span
         elif gap > -HELD:
             h[r] = 0.0
         else:
-            h[r] = max(recovery * gap, -xi)
+            h[r] = max(recovery * gap, -xi[r])

@@ -103,13 +103,14 @@ def test_the_compiled_rows_equal_the_formula_written_in_numpy():
     nrm /= np.linalg.norm(nrm, axis=1)[:, None]
     d = rng.uniform(-0.05, 0.1, k)
     G, h = np.empty((k, nv)), np.empty(k)
-    damper_rows(J, support, ja, jb, pa, pb, nrm, d, 0.02, 0.1, 0.5, 50.0, G, h)
+    xi = rng.choice([0.5, 4.0], k)  # a pair's own row, an end point's
+    damper_rows(J, support, ja, jb, pa, pb, nrm, d, 0.02, 0.1, xi, 50.0, G, h)
     for r in range(k):
         row = [support[j] * (nrm[r] @ J[:3] + np.cross(p, nrm[r]) @ J[3:])
                for j, p in ((ja[r], pa[r]), (jb[r], pb[r]))]  # fmt: skip
         assert np.allclose(G[r], -(row[1] - row[0]), atol=1e-12)
         gap = d[r] - 0.02
-        want = 0.5 * gap / 0.08 if gap >= 0 else max(50.0 * gap, -0.5) if gap < -1e-6 else 0.0
+        want = xi[r] * gap / 0.08 if gap >= 0 else max(50.0 * gap, -xi[r]) if gap < -1e-6 else 0.0
         assert h[r] == pytest.approx(want, abs=1e-15)
 
 

@@ -3,7 +3,8 @@ r"""CollisionLimit: every pair of bodies kept apart, and tool frames inside thei
 One velocity-damper row per pair closer than the detection distance (Kanehiro et al. 2008,
 :mod:`solvers.damper_kernels`), and one per capsule end point within it of the other body
 (:mod:`solvers.narrow_kernels`: near-parallel capsules' closest points jump from end to end,
-and the end about to become the closest is then already constrained):
+and the end about to become the closest is then already constrained; an end-point row
+may lose :data:`END` of its margin a step, a pair's own row the damper's share):
 
 .. math:: -n^T (J_b - J_a)\,\dot q \le \xi \frac{d - d_s}{d_i - d_s}
 
@@ -67,6 +68,12 @@ GAIN = 0.5
 RECOVERY = 0.5
 """Fraction of a shortfall below the safety distance restored per step (at most at the gain):
 :mod:`solvers.damper_kernels`."""
+
+END = 0.5
+"""Fraction of its margin above d_s an end-point row may lose in one step (its xi is
+``END * (d_i - d_s) / dt``): it only has to keep the end from crossing d_s unseen, and the
+pair's own damper would slow a capsule sliding along another as its overhanging end comes in
+(tangential progress 0.75 of the command with the pair's xi on two pandas' hands)."""
 
 STILL = 1e-9
 """[m/s per rad/s] A row whose every entry is below this is dropped: no joint changes the
@@ -165,10 +172,12 @@ class CollisionLimit(Limit):
         names = list(gather(scene.labels, prox.pair))
         distance = prox.distance
         if k:
-            J = kin.data.J
-            damper_rows(J, self._support, prox.joint_a, prox.joint_b, prox.point_a,
+            gains = np.full(k, xi)
+            pair = prox.pair
+            gains[1:][pair[1:] == pair[:-1]] = END * (self.detection - self.safety) / dt
+            damper_rows(kin.data.J, self._support, prox.joint_a, prox.joint_b, prox.point_a,
                         prox.point_b, prox.normal, prox.distance, self.safety, self.detection,
-                        xi, RECOVERY / dt, G, h)  # fmt: skip
+                        gains, RECOVERY / dt, G, h)  # fmt: skip
         if walls:
             G, h, distance = self._walls(kin, walls, G, h, names, distance, dt)
         if h.size:  # a pair no joint can move apart or together has no row (module docstring)
