@@ -107,6 +107,7 @@ def narrow_phase(
     second: Index,
     candidates: Index,
     count: int,
+    keep: npt.NDArray[np.bool_],
     detection: float,
     ends: bool,
     pair: Index,
@@ -131,6 +132,7 @@ def narrow_phase(
         second: Second body (npairs,).
         candidates: Pair indices from the broad phase.
         count: How many of ``candidates`` to read.
+        keep: Whether each pair (npairs,) is asked for (the others are skipped).
         detection: Detection distance [m].
         ends: Add the end-point rows.
         pair: Out (>= 5 count,): the pair index of each row.
@@ -153,6 +155,8 @@ def narrow_phase(
     direction = np.empty((2, 3))
     for i in range(count):
         k = candidates[i]
+        if not keep[k]:
+            continue
         ab = (first[k], second[k])
         if shape[ab[0]] == OTHER or shape[ab[1]] == OTHER or shape[ab[0]] == HALFSPACE:
             other[others] = k

@@ -256,3 +256,33 @@ def test_a_limit_of_another_robot_is_refused_by_the_resolver():
     with pytest.raises(InvalidInput) as err:
         CollisionLimit("panda")  # type: ignore[arg-type]
     assert err.value.argument == "model"
+
+
+def test_a_limit_on_chosen_pairs_gives_exactly_their_rows():
+    """The pairs a limit is given are selected inside the query (the others never measured):
+    the rows are those of every pair's query restricted to them, end points included, and
+    an obstacle added later (a new scene, new pair indices) keeps the selection by name."""
+    panda = rrc_pin.load("panda")
+    facing = np.eye(4)
+    facing[:3, :3] = np.diag([-1.0, -1.0, 1.0])
+    facing[0, 3] = 0.8
+    robot = rrc_pin.combine({"l": (panda, np.eye(4)), "r": (panda, facing)})
+    cm = CollisionModel(robot)
+    chosen = [p for p in cm.pairs if p[0].startswith("l/") != p[1].startswith("l/")][::2]
+    limit = CollisionLimit(cm, 0.02, 0.3, pairs=chosen)
+    everything = CollisionLimit(cm, 0.02, 0.3)
+    rng = np.random.default_rng(8)
+    seen = 0
+    for trial in range(12):
+        if trial == 6:
+            cm.add_sphere((0.4, 0.0, 0.5), 0.05, name="ball")
+        q = np.clip(robot.ready() + rng.uniform(-0.8, 0.8, robot.nq), robot.lower, robot.upper)
+        c = limit.constraints(kinematics(robot, q), DT, np.zeros(robot.nq))
+        full = everything.constraints(kinematics(robot, q), DT, np.zeros(robot.nq))
+        mine = [k for k, n in enumerate(full.names) if tuple(n.split("|")) in chosen]
+        assert list(c.names) == [full.names[k] for k in mine]
+        if mine:
+            np.testing.assert_array_equal(c.G, full.G[mine])
+            np.testing.assert_array_equal(c.h, full.h[mine])
+        seen += len(mine)
+    assert seen > 10

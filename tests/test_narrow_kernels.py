@@ -46,8 +46,9 @@ def solve(shapes, segments, radii, poses, plane=None, ends=False, detection=FAR)
     other = np.zeros(1, dtype=np.int64)
     rows, others = narrow_phase(poses, joint, shape, np.array(segments), np.array(radii),
                                 normal, offset, np.array([0]), np.array([1]), np.array([0]), 1,
-                                detection, ends, out["pair"], out["distance"], out["point_a"],
-                                out["point_b"], out["normal"], other)  # fmt: skip
+                                np.ones(1, dtype=np.bool_), detection, ends, out["pair"],
+                                out["distance"], out["point_a"], out["point_b"], out["normal"],
+                                other)  # fmt: skip
     assert others == 0
     return rows, out
 

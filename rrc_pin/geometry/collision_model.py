@@ -29,7 +29,7 @@ import pinocchio as pin
 from rrc_pin.errors import InvalidInput
 from rrc_pin.geometry import shapes
 from rrc_pin.geometry.pairs import Reason
-from rrc_pin.geometry.proximity import CollisionData, Proximity, query
+from rrc_pin.geometry.proximity import CollisionData, Proximity, Select, query
 from rrc_pin.geometry.robot_geometry import VARIANTS, filtered_pairs, robot_geometry
 from rrc_pin.geometry.scene import Extra, Scene, build_scene
 from rrc_pin.geometry.tree import tree_of
@@ -311,7 +311,7 @@ class CollisionModel:
         return CollisionData(self._scene)
 
     def proximity(self, kin: Kinematics, data: CollisionData, detection: float,
-                  ends: bool = False) -> Proximity:  # fmt: skip
+                  ends: bool = False, select: Select | None = None) -> Proximity:  # fmt: skip
         """The pairs whose signed distance is below ``detection`` [m] at ``kin``'s configuration.
 
         Args:
@@ -321,6 +321,8 @@ class CollisionModel:
             detection: Detection distance [m], >= 0.
             ends: Also a row for each capsule end point within ``detection`` of the other
                 body (:mod:`solvers.narrow_kernels`): what :class:`CollisionLimit` constrains.
+            select: Gives, from the scene the query reads, the pairs to answer for ((npairs,)
+                mask over its pairs); None: every pair.
 
         Returns:
             A :class:`~rrc_pin.geometry.proximity.Proximity`, one row per pair below
@@ -333,7 +335,7 @@ class CollisionModel:
         """
         if kin.model is not self.robot.model:
             raise InvalidInput("kin", f"kinematics of another model than {self.robot.name}'s")
-        return self._query(kin.q, lambda: kin.data, data, detection, ends)
+        return self._query(kin.q, lambda: kin.data, data, detection, ends, select)
 
     def proximity_at(self, q: npt.ArrayLike, detection: float, data: CollisionData | None = None,
                      ends: bool = False) -> Proximity:  # fmt: skip
@@ -352,12 +354,14 @@ class CollisionModel:
         return self._query(q_api, lambda: pdata, data, detection, ends)
 
     def _query(self, q: Array, placed: Callable[[], pin.Data], data: CollisionData,
-               detection: float, ends: bool = False) -> Proximity:  # fmt: skip
+               detection: float, ends: bool = False,
+               select: Select | None = None) -> Proximity:  # fmt: skip
         if not isinstance(data, CollisionData):
             raise InvalidInput("data", f"expected cm.create_data()'s, got {type(data).__name__}")
         if not (type(detection) is float and 0.0 <= detection < np.inf):  # 1 us saved a tick
             detection = finite_number(detection, "detection", 0.0)
-        return query(self._scene, self.robot.model, q, placed, data, detection, ends is True)
+        return query(self._scene, self.robot.model, q, placed, data, detection, ends is True,
+                     select)  # fmt: skip
 
     # -- internals --------------------------------------------------------------------------
 

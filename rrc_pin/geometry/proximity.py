@@ -36,6 +36,8 @@ from solvers.proximity_kernels import joint_poses, near_pairs, world_centres
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
 T = TypeVar("T")
+Select = Callable[[Scene], npt.NDArray[np.bool_]]
+"""Gives the pairs of a scene to answer for, as a mask (npairs,) over its pairs."""
 
 ROWS = 5
 """Most rows of one pair: its closest points and four end points."""
@@ -100,7 +102,8 @@ class CollisionData:
 
 
 def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Data],
-          cdata: CollisionData, detection: float, ends: bool = False) -> Proximity:  # fmt: skip
+          cdata: CollisionData, detection: float, ends: bool = False,
+          select: Select | None = None) -> Proximity:  # fmt: skip
     """The :class:`Proximity` of ``scene`` at joint positions ``q`` (module docstring).
 
     Args:
@@ -113,6 +116,7 @@ def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Dat
         detection: Detection distance [m]: pairs with a signed distance below it are rows.
         ends: Also the rows of the capsules' end points (:mod:`solvers.narrow_kernels`): a
             pair may then have several rows, its first its closest points.
+        select: Gives the pairs of ``scene`` to answer for ((npairs,) mask), or None: all.
     """
     if cdata.scene is not scene:
         cdata.refresh(scene)
@@ -128,9 +132,10 @@ def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Dat
                        scene.offset, detection, cdata.candidates)  # fmt: skip
     if count == 0:
         return EMPTY
+    keep = scene.every if select is None else select(scene)
     rows, others = narrow_phase(poses, scene.joint, scene.shape, scene.segment, scene.size,
                                 scene.normal, scene.offset, scene.first, scene.second,
-                                cdata.candidates, count, detection, ends, cdata.pair,
+                                cdata.candidates, count, keep, detection, ends, cdata.pair,
                                 cdata.distance, cdata.point_a, cdata.point_b, cdata.normal,
                                 cdata.other)  # fmt: skip
     if others:

@@ -73,6 +73,7 @@ class Scene:
         second: Second body (npairs,).
         pair_names: ``(name_a, name_b)`` of each active pair.
         labels: ``"name_a|name_b"`` of each active pair (a constraint row's name).
+        every: True for every pair (npairs,): the query's default selection.
         excluded: The pairs left out, by names, with their reasons.
         njoints: Number of joints of the model (including the world, 0).
         tree: The model's joints for the compiled forward kinematics, or None (a query reads
@@ -93,6 +94,7 @@ class Scene:
     second: Index
     pair_names: tuple[tuple[str, str], ...]
     labels: tuple[str, ...]
+    every: npt.NDArray[np.bool_]
     excluded: dict[tuple[str, str], Reason]
     njoints: int
     tree: KinematicTree | None
@@ -163,6 +165,7 @@ def build_scene(
         normal=normal, offset=offset, shape=shape, segment=segment, size=size, first=first,
         second=second,
         pair_names=tuple((names[a], names[b]) for a, b in pairs),
-        labels=tuple(f"{names[a]}|{names[b]}" for a, b in pairs), excluded=excluded,
+        labels=tuple(f"{names[a]}|{names[b]}" for a, b in pairs),
+        every=np.ones(len(pairs), dtype=np.bool_), excluded=excluded,
         njoints=model.njoints, tree=tree,
     )  # fmt: skip

@@ -155,12 +155,9 @@ class CollisionLimit(Limit):
 
     def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
         """The damper rows of the pairs within the detection distance, and of the walls."""
-        prox = self.model.proximity(kin, self._data, self.detection, ends=True)
+        select = None if self.pairs is None else self._keep
+        prox = self.model.proximity(kin, self._data, self.detection, True, select)
         scene = self._data.scene
-        if self.pairs is not None and prox.names:
-            keep = self._keep(scene)[prox.pair]
-            if not keep.all():
-                prox = _subset(prox, np.flatnonzero(keep))
         self.last = prox
         walls = self.model.walls()
         k = len(prox.names)
@@ -245,8 +242,3 @@ def _pairs(model: CollisionModel, pairs: Sequence[tuple[str, str]]) -> frozenset
                                f"{model.excluded.get((a, b), model.excluded.get((b, a)))})")
     return frozenset(out)
 
-
-def _subset(prox: Proximity, index: npt.NDArray[np.int64]) -> Proximity:
-    return type(prox)(gather(prox.names, index), prox.distance[index],
-                      prox.point_a[index], prox.point_b[index], prox.normal[index],
-                      prox.joint_a[index], prox.joint_b[index], prox.pair[index])  # fmt: skip
