@@ -516,15 +516,16 @@ def test_daqp_retries_a_declared_infeasible_problem_once_at_a_looser_tolerance(
     assert DaqpBackend(primal_tol=1e-6).solve(INFEASIBLE).x is None and len(calls) == 1
 
 
-def test_daqp_retries_a_cycling_problem_cold_at_a_looser_tolerance() -> None:
-    """A direction QP of the 10-minute panda-folding session (tick 1,710; collision rows of
-    near-parallel capsules, cosine 0.9988 between two): DAQP cycles on it at 1e-9 (exit flag
-    -2, warm or cold); the backend's cold retry at RETRY_TOL solves it."""
+@pytest.mark.parametrize("tick", [1710, 21920])
+def test_daqp_retries_a_cycling_problem_cold_at_a_looser_tolerance(tick: int) -> None:
+    """Direction QPs of 10-minute panda-folding sessions (collision rows of near-parallel
+    capsules): DAQP cycles on them at 1e-9 (exit flag -2, warm or cold); the backend's cold
+    retry at CYCLING_TOL solves them."""
     import daqp
 
     data = np.load(Path(__file__).parent / "data" / "daqp_cycling.npz")
-    qp = QP(data["P"], data["q"], data["C"], data["l"], data["u"], data["lb"], data["ub"],
-            "direction:7:4:23")  # fmt: skip
+    P, q, C, lo, hi, lb, ub = (data[f"{k}_{tick}"] for k in ("P", "q", "C", "l", "u", "lb", "ub"))
+    qp = QP(P, q, C, lo, hi, lb, ub, f"direction:{tick}")
     norms = np.linalg.norm(qp.C, axis=1)
     upper = np.concatenate([qp.ub, qp.u / norms])
     lower = np.concatenate([qp.lb, qp.l / norms])
@@ -532,7 +533,7 @@ def test_daqp_retries_a_cycling_problem_cold_at_a_looser_tolerance() -> None:
     assert daqp.solve(qp.P, qp.q, qp.C / norms[:, None], upper, lower, sense,
                       primal_tol=1e-9)[2] == -2  # fmt: skip
     sol = DaqpBackend().solve(qp)
-    assert sol.status == "solved" and feasible(qp, sol.x, daqp_backend.RETRY_TOL)
+    assert sol.status == "solved" and feasible(qp, sol.x, daqp_backend.CYCLING_TOL)
 
 
 def test_daqp_exception_becomes_problem_error() -> None:
