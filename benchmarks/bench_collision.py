@@ -290,7 +290,10 @@ def plot(results: dict[str, Any], path: Path) -> bool:
         rows = sorted((r for r in results["rows"] if r["contender"] == label),
                       key=lambda r: r["pairs"])  # fmt: skip
         x = [r["pairs"] for r in rows]
-        ax[0].plot(x, [r["median_us"] for r in rows], "o-", label=label)
+        line = ax[0].plot(x, [r["median_us"] for r in rows], "o-", label=label)[0]
+        if all("limit_median_us" in r for r in rows):
+            ax[0].plot(x, [r["limit_median_us"] for r in rows], "s--", color=line.get_color(),
+                       label=f"{label}: the limit's share")  # fmt: skip
         ax[1].plot(x, [r["min_distance_m"] * 1e3 for r in rows], "o-", label=label)
     ax[0].set(xscale="log", yscale="log", xlabel="pairs", ylabel="step median [us]")
     ax[1].axhline(SAFETY * 1e3, color="gray", ls="--")

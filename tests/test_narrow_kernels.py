@@ -12,7 +12,7 @@ import pytest
 from solvers.narrow_kernels import CAPSULE, HALFSPACE, SPHERE, narrow_phase
 
 TOL = 1e-9
-TRIALS = 1500
+TRIALS = 1000
 FAR = 10.0
 """[m] A detection distance every trial is below: each pair gives its row."""
 
@@ -190,4 +190,4 @@ def test_end_point_rows_are_each_end_against_the_other_segment():
         got = out["distance"][1:rows]
         np.testing.assert_allclose(np.sort(got), np.sort(expected), atol=TOL)
         assert (got >= out["distance"][0] - TOL).all()
-    assert counts[5] > 10 and counts[1] > 50, counts  # four end rows, and none, both seen
+    assert counts[5] > 5 and counts[1] > 30, counts  # four end rows, and none, both seen
