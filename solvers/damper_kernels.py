@@ -48,6 +48,12 @@ HELD = 1e-6
 to d_s exponentially, and rounding leaves them a hair below it (h of -1e-18 would turn every
 such tick into a recovery, the whole problem a least-squares one)."""
 
+SLACK = 1e-9
+"""[m/s] The least bound of a row not recovering: a pair held at d_s (bound 0) met by rates
+that cross it by rounding (1e-17) had the whole answer shrunk to zero by the pipeline's last
+step (``solvers.pipeline._within_rows`` scales the rates back into every row, and 0 / 1e-17 is
+0): two hands held side by side stopped sliding. 1e-9 m/s is 6e-7 m in ten minutes."""
+
 
 @kernel
 def damper_rows(
@@ -106,9 +112,7 @@ def damper_rows(
                 value += linear + a0 * J[3, c] + a1 * J[4, c] + a2 * J[5, c]
             G[r, c] = value
         gap = distance[r] - safety
-        if gap >= 0.0:
-            h[r] = xi[r] * gap / span
-        elif gap > -HELD:
-            h[r] = 0.0
+        if gap > -HELD:
+            h[r] = max(xi[r] * gap / span, SLACK)
         else:
             h[r] = max(recovery * gap, -xi[r])
