@@ -28,7 +28,11 @@ already: at most four more rows a capsule pair, one more a capsule against a pla
 distance of the pair is the minimum over the segments' points; every point whose distance may
 become the minimum over one step is then constrained (the ends, and the current minimum).
 
-Pairs of other shapes (boxes, cylinders, convex hulls, meshes) are returned for coal.
+A capsule against a box (body B) goes to coal for its closest points; its end-point rows are
+each end against the box: in the box's frame the end point clamped to the box is the nearest
+box point outside it; inside, the nearest face (the signed distance to a convex set).
+
+Pairs of other shapes (cylinders, convex hulls, meshes) are returned for coal.
 Compiled with numba through :func:`solvers.kernels.kernel`; plain arrays in and out.
 """
 
@@ -44,8 +48,9 @@ from solvers.kernels import kernel
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
 
-OTHER, SPHERE, CAPSULE, HALFSPACE = 0, 1, 2, 3
-"""Codes of a body's shape (:func:`narrow_phase`'s ``shape``); OTHER goes to coal."""
+OTHER, SPHERE, CAPSULE, HALFSPACE, BOX = 0, 1, 2, 3, 4
+"""Codes of a body's shape (:func:`narrow_phase`'s ``shape``); OTHER and BOX go to coal (a
+capsule against a box gets its end-point rows here)."""
 
 SAME = 1e-9
 """[m] An end-point row whose two points are both within this of the pair's closest points is
@@ -101,6 +106,8 @@ def narrow_phase(
     shape: Index,
     segment: Array,
     radius: Array,
+    box_frame: Array,
+    half: Array,
     plane: Array,
     offset: Array,
     first: Index,
@@ -115,6 +122,7 @@ def narrow_phase(
     point_a: Array,
     point_b: Array,
     normal: Array,
+    end: npt.NDArray[np.int8],
     other: Index,
 ) -> tuple[int, int]:
     """The rows of the candidate pairs below ``detection`` (module docstring), in one pass.
@@ -126,6 +134,8 @@ def narrow_phase(
         segment: Each sphere's or capsule's segment end points (ng, 2, 3) in its joint's
             frame [m] (a sphere: its centre twice).
         radius: Sphere and capsule radii (ng,) [m].
+        box_frame: Each box's placement (ng, 3, 4) ``[R | t]`` in its joint's frame.
+        half: Each box's half sides (ng, 3) [m].
         plane: Unit outward normals (ng, 3) of the half-spaces, world frame.
         offset: Offsets (ng,) [m] of the half-spaces (the solid ``plane . x <= offset``).
         first: First body (npairs,) of each pair.
@@ -140,6 +150,7 @@ def narrow_phase(
         point_a: Out (>= 5 count, 3): witness points on A, world frame [m].
         point_b: Out (>= 5 count, 3): witness points on B [m].
         normal: Out (>= 5 count, 3): unit normals from A to B.
+        end: Out (>= 5 count,): 1 for an end point's row, 0 for a pair's closest points'.
         other: Out (>= count,): the candidates of other shapes, for coal.
 
     Returns:
@@ -158,18 +169,27 @@ def narrow_phase(
         if not keep[k]:
             continue
         ab = (first[k], second[k])
-        if shape[ab[0]] == OTHER or shape[ab[1]] == OTHER or shape[ab[0]] == HALFSPACE:
+        sa, sb = shape[ab[0]], shape[ab[1]]
+        if sa == OTHER or sb == OTHER or sa == HALFSPACE or sa == BOX:
             other[others] = k
             others += 1
+            continue
+        if sb == BOX:
+            other[others] = k
+            others += 1
+            if ends and sa == CAPSULE:
+                rows = _box_ends(poses, joint, segment, radius, box_frame, half, ab[0], ab[1],
+                                 k, detection, pair, distance, point_a, point_b, normal, end,
+                                 rows)  # fmt: skip
             continue
         for side in range(2):
             g = ab[side]
             M = poses[joint[g]]
-            for end in range(2):
+            for e in range(2):
                 for r in range(3):
-                    seg[side, end, r] = (
-                        M[r, 0] * segment[g, end, 0] + M[r, 1] * segment[g, end, 1]
-                        + M[r, 2] * segment[g, end, 2] + M[r, 3]
+                    seg[side, e, r] = (
+                        M[r, 0] * segment[g, e, 0] + M[r, 1] * segment[g, e, 1]
+                        + M[r, 2] * segment[g, e, 2] + M[r, 3]
                     )  # fmt: skip
             for r in range(3):
                 direction[side, r] = seg[side, 1, r] - seg[side, 0, r]
@@ -183,23 +203,24 @@ def narrow_phase(
                 plane[h, 0] * seg[0, 1, 0] + plane[h, 1] * seg[0, 1, 1] + plane[h, 2] * seg[0, 1, 2]
             )
             lowest = 0 if height0 <= height1 else 1
-            for end in range(2):
-                if end != lowest and not ends:
+            for e in range(2):
+                if e != lowest and not ends:
                     continue
-                height = (height0 if end == 0 else height1) - offset[h]
+                height = (height0 if e == 0 else height1) - offset[h]
                 if height - ra >= detection:
                     continue
                 if (
-                    end != lowest
+                    e != lowest
                     and direction[0, 0] ** 2 + direction[0, 1] ** 2 + direction[0, 2] ** 2 <= 0.0
                 ):
                     continue
                 pair[rows] = k
+                end[rows] = 0 if e == lowest else 1
                 distance[rows] = height - ra
                 for r in range(3):
                     normal[rows, r] = -plane[h, r]
-                    point_a[rows, r] = seg[0, end, r] - ra * plane[h, r]
-                    point_b[rows, r] = seg[0, end, r] - height * plane[h, r]
+                    point_a[rows, r] = seg[0, e, r] - ra * plane[h, r]
+                    point_b[rows, r] = seg[0, e, r] - height * plane[h, r]
                 rows += 1
             continue
         rb = radius[ab[1]]
@@ -208,6 +229,7 @@ def narrow_phase(
                     normal, rows):  # fmt: skip
             continue  # the ends are no nearer than the closest points
         pair[rows] = k
+        end[rows] = 0
         rows += 1
         if not ends:
             continue
@@ -216,8 +238,8 @@ def narrow_phase(
             if direction[side, 0] ** 2 + direction[side, 1] ** 2 + direction[side, 2] ** 2 <= 0.0:
                 continue  # a sphere has no ends of its own
             o = 1 - side
-            for end in range(2):  # the end point against the other body's segment
-                segment_closest(seg[side, end], still, seg[o, 0], direction[o], swap)
+            for e in range(2):  # the end point against the other body's segment
+                segment_closest(seg[side, e], still, seg[o, 0], direction[o], swap)
                 for r in range(3):
                     close[side, r] = swap[0, r]
                     close[o, r] = swap[1, r]
@@ -229,8 +251,94 @@ def narrow_phase(
                 if _row(close, ra, rb, seg, direction, detection, distance, point_a, point_b,
                         normal, rows):  # fmt: skip
                     pair[rows] = k
+                    end[rows] = 1
                     rows += 1
     return rows, others
+
+
+@kernel
+def _box_ends(
+    poses: Array,
+    joint: Index,
+    segment: Array,
+    radius: Array,
+    box_frame: Array,
+    half: Array,
+    a: int,
+    b: int,
+    k: int,
+    detection: float,
+    pair: Index,
+    distance: Array,
+    point_a: Array,
+    point_b: Array,
+    normal: Array,
+    end: npt.NDArray[np.int8],
+    rows: int,
+) -> int:
+    """Append the end-point rows of capsule ``a`` against box ``b`` (module docstring).
+
+    Returns:
+        The number of rows now written.
+    """
+    Ma = poses[joint[a]]
+    Mj = poses[joint[b]]
+    R = np.empty((3, 3))  # the box's rotation and centre in the world
+    t = np.empty(3)
+    for r in range(3):
+        t[r] = Mj[r, 3]
+        for c in range(3):
+            R[r, c] = Mj[r, 0] * box_frame[b, 0, c] + Mj[r, 1] * box_frame[b, 1, c] + (
+                Mj[r, 2] * box_frame[b, 2, c])  # fmt: skip
+            t[r] += Mj[r, c] * box_frame[b, c, 3]
+    p = np.empty(3)
+    local = np.empty(3)
+    near = np.empty(3)
+    ra = radius[a]
+    for e in range(2):
+        if e == 1 and segment[a, 0, 0] == segment[a, 1, 0] and segment[a, 0, 1] == segment[
+                a, 1, 1] and segment[a, 0, 2] == segment[a, 1, 2]:  # fmt: skip
+            break  # a sphere: one point
+        for r in range(3):
+            p[r] = (Ma[r, 0] * segment[a, e, 0] + Ma[r, 1] * segment[a, e, 1]
+                    + Ma[r, 2] * segment[a, e, 2] + Ma[r, 3])  # fmt: skip
+        for c in range(3):  # R^T (p - t)
+            local[c] = R[0, c] * (p[0] - t[0]) + R[1, c] * (p[1] - t[1]) + R[2, c] * (p[2] - t[2])
+            near[c] = min(max(local[c], -half[b, c]), half[b, c])
+        gap = math.sqrt((local[0] - near[0]) ** 2 + (local[1] - near[1]) ** 2
+                        + (local[2] - near[2]) ** 2)  # fmt: skip
+        n0, n1, n2 = 0.0, 0.0, 0.0  # from the end point towards the box, box frame
+        if gap > MET:
+            sd = gap
+            n0, n1, n2 = (near[0] - local[0]) / gap, (near[1] - local[1]) / gap, (
+                near[2] - local[2]) / gap  # fmt: skip
+        else:  # inside (or on the surface): the nearest face
+            axis, depth = 0, half[b, 0] - abs(local[0])
+            for c in range(1, 3):
+                if half[b, c] - abs(local[c]) < depth:
+                    axis, depth = c, half[b, c] - abs(local[c])
+            sd = -depth
+            face = 1.0 if local[axis] >= 0.0 else -1.0
+            near[axis] = face * half[b, axis]
+            if axis == 0:
+                n0 = -face
+            elif axis == 1:
+                n1 = -face
+            else:
+                n2 = -face
+        d = sd - ra
+        if d >= detection:
+            continue
+        pair[rows] = k
+        end[rows] = 1
+        distance[rows] = d
+        for r in range(3):
+            n = R[r, 0] * n0 + R[r, 1] * n1 + R[r, 2] * n2
+            normal[rows, r] = n
+            point_a[rows, r] = p[r] + ra * n
+            point_b[rows, r] = t[r] + R[r, 0] * near[0] + R[r, 1] * near[1] + R[r, 2] * near[2]
+        rows += 1
+    return rows
 
 
 @kernel

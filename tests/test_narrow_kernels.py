@@ -9,7 +9,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from solvers.narrow_kernels import CAPSULE, HALFSPACE, SPHERE, narrow_phase
+from solvers.narrow_kernels import BOX, CAPSULE, HALFSPACE, SPHERE, narrow_phase
 
 TOL = 1e-9
 TRIALS = 1000
@@ -45,10 +45,11 @@ def solve(shapes, segments, radii, poses, plane=None, ends=False, detection=FAR)
     }  # fmt: skip
     other = np.zeros(1, dtype=np.int64)
     rows, others = narrow_phase(poses, joint, shape, np.array(segments), np.array(radii),
-                                normal, offset, np.array([0]), np.array([1]), np.array([0]), 1,
+                                np.zeros((ng, 3, 4)), np.zeros((ng, 3)), normal, offset,
+                                np.array([0]), np.array([1]), np.array([0]), 1,
                                 np.ones(1, dtype=np.bool_), detection, ends, out["pair"],
                                 out["distance"], out["point_a"], out["point_b"], out["normal"],
-                                other)  # fmt: skip
+                                np.zeros(5, dtype=np.int8), other)  # fmt: skip
     assert others == 0
     return rows, out
 
@@ -191,3 +192,44 @@ def test_end_point_rows_are_each_end_against_the_other_segment():
         np.testing.assert_allclose(np.sort(got), np.sort(expected), atol=TOL)
         assert (got >= out["distance"][0] - TOL).all()
     assert counts[5] > 5 and counts[1] > 30, counts  # four end rows, and none, both seen
+
+
+def test_capsule_end_points_against_a_box_match_coal():
+    """A capsule against a box goes to coal for its closest points; with ``ends`` each end
+    point's row is that point as a sphere of the capsule's radius against the box (coal, to
+    1e-9; inside the box too), with the row's conventions."""
+    rng = np.random.default_rng(13)
+    inside = 0
+    for _ in range(TRIALS):
+        a = body("capsule", rng)
+        half = rng.uniform(0.03, 0.3, 3)
+        poses = np.array([np.eye(4), pose(rotation(rng), rng.normal(size=3) * 0.1),
+                          pose(rotation(rng), rng.normal(size=3) * 0.1)])  # fmt: skip
+        placement = pose(rotation(rng), rng.normal(size=3) * 0.05)  # the box in its joint
+        out = {"pair": np.zeros(5, dtype=np.int64), "distance": np.zeros(5),
+               "point_a": np.zeros((5, 3)), "point_b": np.zeros((5, 3)),
+               "normal": np.zeros((5, 3)), "end": np.zeros(5, dtype=np.int8)}  # fmt: skip
+        frames = np.zeros((2, 3, 4))
+        frames[1] = placement[:3]
+        halves = np.zeros((2, 3))
+        halves[1] = half
+        other = np.zeros(1, dtype=np.int64)
+        rows, others = narrow_phase(
+            poses, np.array([1, 2]), np.array([a[0], BOX]), np.array([a[1], np.zeros((2, 3))]),
+            np.array([a[2], 0.0]), frames, halves, np.zeros((2, 3)), np.zeros(2), np.array([0]),
+            np.array([1]), np.array([0]), 1, np.ones(1, dtype=np.bool_), FAR, True,
+            out["pair"], out["distance"], out["point_a"], out["point_b"], out["normal"],
+            out["end"], other)  # fmt: skip
+        assert others == 1 and other[0] == 0  # the closest points: coal's
+        ends = a[1] @ poses[1][:3, :3].T + poses[1][:3, 3]
+        assert rows == (1 if not (a[1][1] - a[1][0]).any() else 2)
+        assert (out["end"][:rows] == 1).all()
+        for r in range(rows):
+            ref = coal_distance(coal.Sphere(a[2]), pose(np.eye(3), ends[r]),
+                                coal.Box(*(2 * half)), poses[2] @ placement)  # fmt: skip
+            d, n = out["distance"][r], out["normal"][r]
+            assert d == pytest.approx(ref.min_distance, abs=TOL)
+            np.testing.assert_allclose(out["point_b"][r] - out["point_a"][r], d * n, atol=TOL)
+            assert np.linalg.norm(n) == pytest.approx(1.0, abs=1e-12)
+            inside += d < -a[2]
+    assert inside >= 20

@@ -42,6 +42,10 @@ Select = Callable[[Scene], npt.NDArray[np.bool_]]
 ROWS = 5
 """Most rows of one pair: its closest points and four end points."""
 
+REPEAT = 1e-6
+"""[m] An end point's row whose witness points are both within this of its pair's own row
+(coal's, found to GJK's tolerance) repeats it and is left out."""
+
 
 class Proximity(NamedTuple):
     """The pairs whose signed distance is below the detection distance, one row each (k rows).
@@ -77,7 +81,7 @@ class CollisionData:
     Create it with :meth:`CollisionModel.create_data`; never share one between threads.
     """
 
-    __slots__ = ("candidates", "distance", "geometry_data", "normal", "other", "pair",
+    __slots__ = ("candidates", "distance", "end", "geometry_data", "normal", "other", "pair",
                  "point_a", "point_b", "poses", "scene", "world")  # fmt: skip
 
     def __init__(self, scene: Scene) -> None:
@@ -99,6 +103,7 @@ class CollisionData:
         self.point_a = np.zeros((rows, 3))
         self.point_b = np.zeros((rows, 3))
         self.normal = np.zeros((rows, 3))
+        self.end = np.zeros(rows, dtype=np.int8)
 
 
 def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Data],
@@ -134,19 +139,20 @@ def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Dat
         return EMPTY
     keep = scene.every if select is None else select(scene)
     rows, others = narrow_phase(poses, scene.joint, scene.shape, scene.segment, scene.size,
-                                scene.normal, scene.offset, scene.first, scene.second,
-                                cdata.candidates, count, keep, detection, ends, cdata.pair,
-                                cdata.distance, cdata.point_a, cdata.point_b, cdata.normal,
-                                cdata.other)  # fmt: skip
+                                scene.box_frame, scene.half, scene.normal, scene.offset,
+                                scene.first, scene.second, cdata.candidates, count, keep,
+                                detection, ends, cdata.pair, cdata.distance, cdata.point_a,
+                                cdata.point_b, cdata.normal, cdata.end, cdata.other)  # fmt: skip
     if others:
         rows = _coal(scene, model, placed(), cdata, detection, rows, others)
     if rows == 0:
         return EMPTY
     index = cdata.pair[:rows].copy()
-    order = np.argsort(index, kind="stable") if others else None
-    if order is not None:
-        index = index[order]
-    taken = slice(0, rows) if order is None else order
+    taken: slice | Index = slice(0, rows)
+    if others:  # coal's rows came last: each pair's own row first, then its end points'
+        order = np.argsort(2 * index + cdata.end[:rows], kind="stable")
+        order = order[_distinct(order, cdata)]
+        index, taken = index[order], order
     names = scene.pair_names
     return Proximity(
         names=gather(names, index),
@@ -183,6 +189,7 @@ def _coal(scene: Scene, model: pin.Model, data: pin.Data, cdata: CollisionData,
         d = result.min_distance
         if d < detection:
             cdata.pair[rows] = k
+            cdata.end[rows] = 0
             cdata.distance[rows] = d
             point_a, point_b = result.getNearestPoint1(), result.getNearestPoint2()
             cdata.point_a[rows] = point_a
@@ -196,6 +203,24 @@ def _coal(scene: Scene, model: pin.Model, data: pin.Data, cdata: CollisionData,
             )
             rows += 1
     return rows
+
+
+def _distinct(order: Index, cdata: CollisionData) -> npt.NDArray[np.bool_]:
+    """Which rows of ``order`` (sorted: a pair's own row, then its end points') to keep.
+
+    An end point's row that repeats its pair's own (coal's closest points at a capsule's end
+    against a box, within :data:`REPEAT`) is left out.
+    """
+    end = cdata.end[order] == 1
+    keep = np.ones(order.size, dtype=np.bool_)
+    if not end.any():
+        return keep
+    first = np.maximum.accumulate(np.where(end, 0, np.arange(order.size)))
+    own = order[first]
+    same = (np.abs(cdata.point_a[order] - cdata.point_a[own]).max(axis=1) <= REPEAT) & (
+        np.abs(cdata.point_b[order] - cdata.point_b[own]).max(axis=1) <= REPEAT)  # fmt: skip
+    keep[end & same & (cdata.pair[order] == cdata.pair[own])] = False
+    return keep
 
 
 def _unit(normal: Array, distance: float, point_a: Array, point_b: Array,

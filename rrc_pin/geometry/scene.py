@@ -23,7 +23,7 @@ import pinocchio as pin
 from rrc_pin.geometry.pairs import Pair, Reason
 from rrc_pin.geometry.shapes import bounding_sphere
 from rrc_pin.geometry.tree import KinematicTree
-from solvers.narrow_kernels import CAPSULE, HALFSPACE, OTHER, SPHERE
+from solvers.narrow_kernels import BOX, CAPSULE, HALFSPACE, OTHER, SPHERE
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
@@ -69,6 +69,9 @@ class Scene:
         segment: Each sphere's or capsule's segment end points (ng, 2, 3) in its joint's
             frame [m] (a sphere: its centre twice; zeros for other bodies).
         size: Sphere and capsule radii (ng,) [m] (zero for other bodies).
+        box_frame: Each box's placement (ng, 3, 4) ``[R | t]`` in its joint's frame (zeros for
+            other bodies).
+        half: Each box's half sides (ng, 3) [m] (zeros for other bodies).
         first: First body (npairs,) of each active pair.
         second: Second body (npairs,).
         pair_names: ``(name_a, name_b)`` of each active pair.
@@ -90,6 +93,8 @@ class Scene:
     shape: Index
     segment: Array
     size: Array
+    box_frame: Array
+    half: Array
     first: Index
     second: Index
     pair_names: tuple[tuple[str, str], ...]
@@ -145,6 +150,8 @@ def build_scene(
     shape = np.full(len(objects), OTHER, dtype=np.int64)
     segment = np.zeros((len(objects), 2, 3))
     size = np.zeros(len(objects))
+    box_frame = np.zeros((len(objects), 3, 4))
+    halves = np.zeros((len(objects), 3))
     planes = {e.name: e.plane for e in extras if e.plane is not None}
     for g, obj in enumerate(objects):
         c, r = bounding_sphere(obj.geometry)
@@ -158,11 +165,16 @@ def build_scene(
             shape[g] = CAPSULE if isinstance(obj.geometry, coal.Capsule) else SPHERE
             segment[g] = [obj.placement.act(np.array([0.0, 0.0, z])) for z in (-half, half)]
             size[g] = obj.geometry.radius
+        elif isinstance(obj.geometry, coal.Box):
+            shape[g] = BOX
+            box_frame[g] = obj.placement.homogeneous[:3]
+            halves[g] = obj.geometry.halfSide
     first = np.array([a for a, _ in pairs], dtype=np.int64)
     second = np.array([b for _, b in pairs], dtype=np.int64)
     return Scene(
         geometry=geometry, names=names, joint=joint, centre=centre, radius=radius,
-        normal=normal, offset=offset, shape=shape, segment=segment, size=size, first=first,
+        normal=normal, offset=offset, shape=shape, segment=segment, size=size,
+        box_frame=box_frame, half=halves, first=first,
         second=second,
         pair_names=tuple((names[a], names[b]) for a, b in pairs),
         labels=tuple(f"{names[a]}|{names[b]}" for a, b in pairs),
