@@ -91,6 +91,18 @@ class Rrc:
         limit = CollisionLimit(cm, SAFETY, DETECTION, 0.5, pairs=pairs)
         self.resolver = Resolver(robot, DT, limits=[JointLimits(), limit])
         self.tasks = [FrameTask(f, rows="position") for f in robot.tool_frames]
+        self.limit_times: list[float] = []  # the limit's own share: distances and rows
+        self.limit_rows: list[int] = []
+        constraints = limit.constraints
+
+        def timed(*args):
+            start = time.perf_counter()
+            out = constraints(*args)
+            self.limit_times.append(time.perf_counter() - start)
+            self.limit_rows.append(0 if out.h is None else out.h.size)
+            return out
+
+        limit.constraints = timed
 
     def step(self, q, v):
         for task, twist in zip(self.tasks, v, strict=True):
@@ -202,6 +214,10 @@ def run(ticks: int) -> dict[str, Any]:
                 progress(f"{len(pairs)} pairs: tick {tick}")
         for c in contenders:
             t = np.array(times[c.label][10:]) * 1e6
+            share = {}
+            if isinstance(c, Rrc):
+                share = {"limit_median_us": float(np.median(c.limit_times[10:]) * 1e6),
+                         "limit_rows_median": float(np.median(c.limit_rows[10:]))}  # fmt: skip
             rows.append({
                 "contender": c.label, "pairs": len(pairs), "median_us": float(np.median(t)),
                 "p99_us": float(np.percentile(t, 99)),
@@ -209,11 +225,59 @@ def run(ticks: int) -> dict[str, Any]:
                 "tangential_progress": float(np.mean(progress_z[c.label]))
                 if progress_z[c.label] else None,
                 "constrained_ticks": len(progress_z[c.label]),
-                "largest_activation_jump": jump[c.label],
+                "largest_activation_jump": jump[c.label], **share,
             })  # fmt: skip
             progress(str(rows[-1]))
     return {"settings": {"ticks": ticks, "dt": DT, "safety": SAFETY, "detection": DETECTION,
                          "speed": SPEED, "slide": SLIDE}, "rows": rows}  # fmt: skip
+
+
+def _table(results: dict[str, Any], full: bool) -> str:
+    """One row per pair set: each contender's median (p99) step and minimum distance."""
+    rows = results["rows"]
+    labels = list(dict.fromkeys(r["contender"] for r in rows))
+    sets = sorted({r["pairs"] for r in rows})
+    head = "| pairs | " + " | ".join(f"{label} median / p99 [us] | min [mm]" for label in labels)
+    lines = [head + (" | rrc-pin limit's share [us] (rows) |" if full else " |"),
+             "| ---: |" + " ---: | ---: |" * len(labels) + (" ---: |" if full else "")]  # fmt: skip
+    for n in sets:
+        by = {r["contender"]: r for r in rows if r["pairs"] == n}
+        cells = [f"{by[lb]['median_us']:,.0f} / {by[lb]['p99_us']:,.0f} | "
+                 f"{by[lb]['min_distance_m'] * 1e3:.1f}" for lb in labels]  # fmt: skip
+        line = f"| {n} | " + " | ".join(cells) + " |"
+        ours = by.get(Rrc.label, {})
+        if full and "limit_median_us" in ours:
+            line += f" {ours['limit_median_us']:,.0f} ({ours['limit_rows_median']:.0f}) |"
+        elif full:
+            line += " - |"
+        lines.append(line)
+    load = results.get("load_average", {})
+    start, end = (load.get(k, [float("nan")])[0] for k in ("start", "end"))
+    s = results["settings"]
+    lines += ["", f"Safety {s['safety'] * 1e3:.0f} mm, {s['ticks']:,} ticks a pair set, "
+              f"interleaved in one process; load average {start:.1f} at the start, {end:.1f} "
+              "at the end (2 cores)."]  # fmt: skip
+    return "\n".join(lines)
+
+
+def readme_table(results: dict[str, Any]) -> str:
+    """The README's collision table: step time and minimum distance per pair set."""
+    return _table(results, full=False)
+
+
+def docs_section(results: dict[str, Any]) -> str:
+    """docs/benchmarks.md: the table with the limit's share, tangential progress and jumps."""
+    lines = [_table(results, full=True), "",
+             "| contender | pairs | tangential progress | constrained ticks | "
+             "largest activation jump [rad/s] |",
+             "| --- | ---: | ---: | ---: | ---: |"]  # fmt: skip
+    for r in results["rows"]:
+        progress = r["tangential_progress"]
+        shown = "-" if progress is None else f"{progress:.2f}"
+        jump = r["largest_activation_jump"]
+        lines.append(f"| {r['contender']} | {r['pairs']} | {shown} | "
+                     f"{r['constrained_ticks']} | {jump:.2f} |")  # fmt: skip
+    return "\n".join(lines)
 
 
 def plot(results: dict[str, Any], path: Path) -> bool:
@@ -226,7 +290,10 @@ def plot(results: dict[str, Any], path: Path) -> bool:
         rows = sorted((r for r in results["rows"] if r["contender"] == label),
                       key=lambda r: r["pairs"])  # fmt: skip
         x = [r["pairs"] for r in rows]
-        ax[0].plot(x, [r["median_us"] for r in rows], "o-", label=label)
+        line = ax[0].plot(x, [r["median_us"] for r in rows], "o-", label=label)[0]
+        if all("limit_median_us" in r for r in rows):
+            ax[0].plot(x, [r["limit_median_us"] for r in rows], "s--", color=line.get_color(),
+                       label=f"{label}: the limit's share")  # fmt: skip
         ax[1].plot(x, [r["min_distance_m"] * 1e3 for r in rows], "o-", label=label)
     ax[0].set(xscale="log", yscale="log", xlabel="pairs", ylabel="step median [us]")
     ax[1].axhline(SAFETY * 1e3, color="gray", ls="--")

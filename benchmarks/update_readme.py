@@ -44,6 +44,10 @@ BENCHMARKS = {
         "Control schemes on Pinocchio dynamics (Nguyen & Zhou section 6)",
     ),
     "maps": ("bench_maps.py", "Capability maps: samples per second per core, workers, queries"),
+    "collision": (
+        "bench_collision.py",
+        "Collision avoidance on two facing pandas: rrc-pin, mink, pink",
+    ),
 }
 """Benchmark name: (script, title), in the order of the documents."""
 DOCS_ONLY = ("study", "scaling", "control_schemes")

@@ -48,6 +48,12 @@ HELD = 1e-6
 to d_s exponentially, and rounding leaves them a hair below it (h of -1e-18 would turn every
 such tick into a recovery, the whole problem a least-squares one)."""
 
+SLACK = 1e-9
+"""[m/s] The least bound of a row not recovering: a pair held at d_s (bound 0) met by rates
+that cross it by rounding (1e-17) had the whole answer shrunk to zero by the pipeline's last
+step (``solvers.pipeline._within_rows`` scales the rates back into every row, and 0 / 1e-17 is
+0): two hands held side by side stopped sliding. 1e-9 m/s is 6e-7 m in ten minutes."""
+
 
 @kernel
 def damper_rows(
@@ -61,7 +67,7 @@ def damper_rows(
     distance: Array,
     safety: float,
     detection: float,
-    xi: float,
+    xi: Array,
     recovery: float,
     G: Array,
     h: Array,
@@ -79,7 +85,7 @@ def damper_rows(
         distance: Signed distances (k,) [m].
         safety: d_s [m].
         detection: d_i [m], > d_s.
-        xi: Approach speed allowed at d_i [m/s].
+        xi: Approach speed allowed at d_i (k,) [m/s], per row.
         recovery: rho / dt [1/s], the rate restoring a shortfall below d_s.
         G: Out (k, nv).
         h: Out (k,) [m/s].
@@ -106,9 +112,7 @@ def damper_rows(
                 value += linear + a0 * J[3, c] + a1 * J[4, c] + a2 * J[5, c]
             G[r, c] = value
         gap = distance[r] - safety
-        if gap >= 0.0:
-            h[r] = xi * gap / span
-        elif gap > -HELD:
-            h[r] = 0.0
+        if gap > -HELD:
+            h[r] = max(xi[r] * gap / span, SLACK)
         else:
-            h[r] = max(recovery * gap, -xi)
+            h[r] = max(recovery * gap, -xi[r])

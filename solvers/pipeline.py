@@ -49,7 +49,7 @@ from solvers.errors import InvalidInput, NumericalFailure
 from solvers.factorization import Factorization
 from solvers.least_squares import Subspace, least_squares
 from solvers.problem import Box, Problem, Rows, largest_weight, row_factors
-from solvers.qp import Work, solve_within
+from solvers.qp import FEASIBILITY_TOL, Work, solve_within
 from solvers.qp_backends.base import QPBackend
 
 Array = npt.NDArray[np.float64]
@@ -275,6 +275,13 @@ def _top(
         except (NumericalFailure, np.linalg.LinAlgError) as exc:
             work.attempts.append(("slide", f"{exc}; the command kept as given"))
         else:
+            if rows is not None and (rows.slide is None or not rows.slide.all()):
+                within = kernels.rows_hold(rows.G, kept, rows.h, _tolerance(box))
+            else:
+                within = True  # every row slides: the least squares kept them all
+            if within:  # the slid command met within every row: its rates as they are
+                null = _null(factor, space) if len(problem.levels) > 1 else None
+                return _Top(kept, "sliding", *_along_command(problem, kept), 0.0, null)
             b, slid = A @ kept, True
             z = factor.least_norm(b)
             w = z if space.N is None else z @ space.N
@@ -434,6 +441,11 @@ def scale_and_veer(y: Array, b: Array) -> tuple[float, float]:
     with np.errstate(over="ignore"):
         ratio = float(np.float64(top_y) / top_b) * float(yn @ bn) / float(bn @ bn)
     return min(max(ratio, 0.0), 1.0), veer
+
+
+def _tolerance(box: Box) -> float:
+    """How far a backend's answer may leave the rows (:func:`solvers.qp.solve_within`'s)."""
+    return FEASIBILITY_TOL * (1.0 + math.hypot(*np.minimum(box.velocity, 1e300).tolist()))
 
 
 def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:

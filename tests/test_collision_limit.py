@@ -56,8 +56,10 @@ def test_rows_match_pinocchio_joint_jacobians_shifted_to_the_witness_points():
                     J = pin.getJointJacobian(robot.model, kin.data, int(j), pin.WORLD)
                     rows.append(prox.normal[i] @ (J[:3] - pin.skew(p) @ J[3:]))
                 g = -(rows[1] - rows[0])
-                k = c.names.index("|".join(prox.names[i]))
-                assert np.allclose(c.G[k], g, atol=1e-12)
+                name = "|".join(prox.names[i])
+                same = [k for k, n in enumerate(c.names) if n == name
+                        and c.distance[k] == prox.distance[i]]  # fmt: skip
+                assert any(np.allclose(c.G[k], g, atol=1e-12) for k in same)
                 checked += 1
     assert checked > 20
 
@@ -78,12 +80,14 @@ def test_rows_predict_the_change_of_distance_to_first_order():
         if c.h is None:
             continue
         v, eps = rng.normal(size=robot.nq), 1e-6
-        plus, minus = cm.proximity_at(q + eps * v, 0.6), cm.proximity_at(q - eps * v, 0.6)
-        dp, dm = (dict(zip(plus.names, plus.distance, strict=True)),
-                  dict(zip(minus.names, minus.distance, strict=True)))
-        for i, name in enumerate(c.names):
-            pair = tuple(name.split("|"))
-            fd = (dp[pair] - dm[pair]) / (2 * eps)
+        # every row, end points' too, in the limit's order (the same rows at q +- eps v)
+        plus = cm.proximity_at(q + eps * v, 0.3, ends=True)
+        minus = cm.proximity_at(q - eps * v, 0.3, ends=True)
+        assert (
+            ["|".join(p) for p in plus.names] == list(c.names) == ["|".join(p) for p in minus.names]
+        )
+        for i in range(len(c.names)):
+            fd = (plus.distance[i] - minus.distance[i]) / (2 * eps)
             worst, n = max(worst, abs(fd + c.G[i] @ v)), n + 1
     assert n > 10 and worst < 1e-5
 
@@ -99,13 +103,14 @@ def test_the_compiled_rows_equal_the_formula_written_in_numpy():
     nrm /= np.linalg.norm(nrm, axis=1)[:, None]
     d = rng.uniform(-0.05, 0.1, k)
     G, h = np.empty((k, nv)), np.empty(k)
-    damper_rows(J, support, ja, jb, pa, pb, nrm, d, 0.02, 0.1, 0.5, 50.0, G, h)
+    xi = rng.choice([0.5, 4.0], k)  # a pair's own row, an end point's
+    damper_rows(J, support, ja, jb, pa, pb, nrm, d, 0.02, 0.1, xi, 50.0, G, h)
     for r in range(k):
         row = [support[j] * (nrm[r] @ J[:3] + np.cross(p, nrm[r]) @ J[3:])
                for j, p in ((ja[r], pa[r]), (jb[r], pb[r]))]  # fmt: skip
         assert np.allclose(G[r], -(row[1] - row[0]), atol=1e-12)
         gap = d[r] - 0.02
-        want = 0.5 * gap / 0.08 if gap >= 0 else max(50.0 * gap, -0.5) if gap < -1e-6 else 0.0
+        want = xi[r] * gap / 0.08 if gap >= 0 else max(50.0 * gap, -xi[r]) if gap < -1e-6 else 0.0
         assert h[r] == pytest.approx(want, abs=1e-15)
 
 
@@ -251,3 +256,33 @@ def test_a_limit_of_another_robot_is_refused_by_the_resolver():
     with pytest.raises(InvalidInput) as err:
         CollisionLimit("panda")  # type: ignore[arg-type]
     assert err.value.argument == "model"
+
+
+def test_a_limit_on_chosen_pairs_gives_exactly_their_rows():
+    """The pairs a limit is given are selected inside the query (the others never measured):
+    the rows are those of every pair's query restricted to them, end points included, and
+    an obstacle added later (a new scene, new pair indices) keeps the selection by name."""
+    panda = rrc_pin.load("panda")
+    facing = np.eye(4)
+    facing[:3, :3] = np.diag([-1.0, -1.0, 1.0])
+    facing[0, 3] = 0.8
+    robot = rrc_pin.combine({"l": (panda, np.eye(4)), "r": (panda, facing)})
+    cm = CollisionModel(robot)
+    chosen = [p for p in cm.pairs if p[0].startswith("l/") != p[1].startswith("l/")][::2]
+    limit = CollisionLimit(cm, 0.02, 0.3, pairs=chosen)
+    everything = CollisionLimit(cm, 0.02, 0.3)
+    rng = np.random.default_rng(8)
+    seen = 0
+    for trial in range(12):
+        if trial == 6:
+            cm.add_sphere((0.4, 0.0, 0.5), 0.05, name="ball")
+        q = np.clip(robot.ready() + rng.uniform(-0.8, 0.8, robot.nq), robot.lower, robot.upper)
+        c = limit.constraints(kinematics(robot, q), DT, np.zeros(robot.nq))
+        full = everything.constraints(kinematics(robot, q), DT, np.zeros(robot.nq))
+        mine = [k for k, n in enumerate(full.names) if tuple(n.split("|")) in chosen]
+        assert list(c.names) == [full.names[k] for k in mine]
+        if mine:
+            np.testing.assert_array_equal(c.G, full.G[mine])
+            np.testing.assert_array_equal(c.h, full.h[mine])
+        seen += len(mine)
+    assert seen > 10

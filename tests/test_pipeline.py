@@ -11,6 +11,7 @@ from scipy.optimize import linprog, lsq_linear
 
 import solvers.pipeline as pipeline_module
 from solvers import kernels
+from solvers.damper_kernels import SLACK
 from solvers.damping import Damping
 from solvers.errors import InvalidInput, ProblemError
 from solvers.pipeline import Answer, Options, solve
@@ -440,3 +441,24 @@ def test_sliding_reports_the_pair_and_its_distance() -> None:
     answer = solve(problem, make_backend("daqp"), Options())
     (row,) = Resolution.of(problem, answer, 0.0, None).active_rows
     assert row.name == "hand|floor" and row.distance == 0.02 and row.bound == 0.0
+
+
+def test_a_slid_command_met_by_other_joints_is_met_not_scaled() -> None:
+    """Four joints moving a point, joint 4 along z like joint 3; a slide row on joint 3 alone
+    (-qdot_3 <= 1e-9, a held pair's bound: solvers.damper_kernels.SLACK). The least-norm
+    rates of a command down share z between joints 3 and 4 and cross the row; the slide's
+    least squares meets the whole command with joint 4 and keeps the row: those rates are the
+    answer (the least-norm rates scaled back to the row would stand still)."""
+    n = 4
+    free = np.full(n, 2.0)
+    box = Box(-free, free.copy(), np.zeros((2, n), np.int8), True, False, free.copy())
+    rows = Constraints(G=np.array([[0.0, 0.0, -1.0, 0.0]]), h=np.array([SLACK]),
+                       names=("link3|floor",), slide=np.array([True]),
+                       distance=np.array([0.02]))  # fmt: skip
+    A = np.array([[1.0, 0, 0, 0], [0, 1.0, 0, 0], [0, 0, 1.0, 1.0]])
+    b = np.array([0.1, 0.05, -0.1])
+    problem = build([[TaskRows(A, b, None, "hand")]], [Constraints(box), rows], n, DT)
+    answer = solve(problem, make_backend("daqp"), Options())
+    assert answer.status == "sliding"
+    np.testing.assert_allclose(A @ answer.qdot, b, rtol=1e-5, atol=1e-12)
+    assert -answer.qdot[2] <= SLACK and answer.scale == pytest.approx(1.0, abs=1e-5)

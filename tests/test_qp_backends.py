@@ -6,6 +6,7 @@ import importlib
 import re
 import types
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -513,6 +514,26 @@ def test_daqp_retries_a_declared_infeasible_problem_once_at_a_looser_tolerance(
     assert len(calls) == 2  # the first call made to fail, then the real retry
     calls.clear()
     assert DaqpBackend(primal_tol=1e-6).solve(INFEASIBLE).x is None and len(calls) == 1
+
+
+@pytest.mark.parametrize("tick", [1710, 21920])
+def test_daqp_retries_a_cycling_problem_cold_at_a_looser_tolerance(tick: int) -> None:
+    """Direction QPs of 10-minute panda-folding sessions (collision rows of near-parallel
+    capsules): DAQP cycles on them at 1e-9 (exit flag -2, warm or cold); the backend's cold
+    retry at CYCLING_TOL solves them."""
+    import daqp
+
+    data = np.load(Path(__file__).parent / "data" / "daqp_cycling.npz")
+    P, q, C, lo, hi, lb, ub = (data[f"{k}_{tick}"] for k in ("P", "q", "C", "l", "u", "lb", "ub"))
+    qp = QP(P, q, C, lo, hi, lb, ub, f"direction:{tick}")
+    norms = np.linalg.norm(qp.C, axis=1)
+    upper = np.concatenate([qp.ub, qp.u / norms])
+    lower = np.concatenate([qp.lb, qp.l / norms])
+    sense = np.zeros(upper.size, dtype=np.intc)
+    assert daqp.solve(qp.P, qp.q, qp.C / norms[:, None], upper, lower, sense,
+                      primal_tol=1e-9)[2] == -2  # fmt: skip
+    sol = DaqpBackend().solve(qp)
+    assert sol.status == "solved" and feasible(qp, sol.x, daqp_backend.CYCLING_TOL)
 
 
 def test_daqp_exception_becomes_problem_error() -> None:

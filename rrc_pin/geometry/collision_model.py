@@ -29,7 +29,7 @@ import pinocchio as pin
 from rrc_pin.errors import InvalidInput
 from rrc_pin.geometry import shapes
 from rrc_pin.geometry.pairs import Reason
-from rrc_pin.geometry.proximity import CollisionData, Proximity, query
+from rrc_pin.geometry.proximity import CollisionData, Proximity, Select, query
 from rrc_pin.geometry.robot_geometry import VARIANTS, filtered_pairs, robot_geometry
 from rrc_pin.geometry.scene import Extra, Scene, build_scene
 from rrc_pin.geometry.tree import tree_of
@@ -310,7 +310,8 @@ class CollisionModel:
         """A new per-caller query state (one per resolver; never shared between threads)."""
         return CollisionData(self._scene)
 
-    def proximity(self, kin: Kinematics, data: CollisionData, detection: float) -> Proximity:
+    def proximity(self, kin: Kinematics, data: CollisionData, detection: float,
+                  ends: bool = False, select: Select | None = None) -> Proximity:  # fmt: skip
         """The pairs whose signed distance is below ``detection`` [m] at ``kin``'s configuration.
 
         Args:
@@ -318,10 +319,15 @@ class CollisionModel:
                 ``data`` holds every joint's placement).
             data: This caller's :meth:`create_data`.
             detection: Detection distance [m], >= 0.
+            ends: Also a row for each capsule end point within ``detection`` of the other
+                body (:mod:`solvers.narrow_kernels`): what :class:`CollisionLimit` constrains.
+            select: Gives, from the scene the query reads, the pairs to answer for ((npairs,)
+                mask over its pairs); None: every pair.
 
         Returns:
             A :class:`~rrc_pin.geometry.proximity.Proximity`, one row per pair below
-            ``detection`` (in the order of :attr:`pairs`).
+            ``detection`` (in the order of :attr:`pairs`; with ``ends``, a pair's end-point
+            rows follow its own).
 
         Raises:
             InvalidInput: ``kin`` of another robot, ``data`` not a CollisionData, a negative
@@ -329,10 +335,10 @@ class CollisionModel:
         """
         if kin.model is not self.robot.model:
             raise InvalidInput("kin", f"kinematics of another model than {self.robot.name}'s")
-        return self._query(kin.q, lambda: kin.data, data, detection)
+        return self._query(kin.q, lambda: kin.data, data, detection, ends, select)
 
-    def proximity_at(self, q: npt.ArrayLike, detection: float,
-                     data: CollisionData | None = None) -> Proximity:  # fmt: skip
+    def proximity_at(self, q: npt.ArrayLike, detection: float, data: CollisionData | None = None,
+                     ends: bool = False) -> Proximity:  # fmt: skip
         """:meth:`proximity` at joint positions ``q`` (nq,) [rad or m].
 
         Forward kinematics computed here (in the calling thread's ``robot.data``); ``data``
@@ -345,15 +351,17 @@ class CollisionModel:
             data = getattr(self._local, "data", None)
             if data is None:
                 data = self._local.data = self.create_data()
-        return self._query(q_api, lambda: pdata, data, detection)
+        return self._query(q_api, lambda: pdata, data, detection, ends)
 
     def _query(self, q: Array, placed: Callable[[], pin.Data], data: CollisionData,
-               detection: float) -> Proximity:  # fmt: skip
+               detection: float, ends: bool = False,
+               select: Select | None = None) -> Proximity:  # fmt: skip
         if not isinstance(data, CollisionData):
             raise InvalidInput("data", f"expected cm.create_data()'s, got {type(data).__name__}")
         if not (type(detection) is float and 0.0 <= detection < np.inf):  # 1 us saved a tick
             detection = finite_number(detection, "detection", 0.0)
-        return query(self._scene, self.robot.model, q, placed, data, detection)
+        return query(self._scene, self.robot.model, q, placed, data, detection, ends is True,
+                     select)  # fmt: skip
 
     # -- internals --------------------------------------------------------------------------
 

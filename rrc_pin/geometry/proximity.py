@@ -7,9 +7,11 @@ The steps, in the order data flows:
    not cover);
 2. the broad phase (:mod:`solvers.proximity_kernels`, compiled): bounding-sphere centres in
    the world, and the pairs whose distance bound is below the detection distance;
-3. the narrow phase for those candidates only: ``pinocchio.updateGeometryPlacements``, then
-   ``pinocchio.computeDistance`` per candidate (coal: signed distance, EPA in penetration),
-   keeping those below the detection distance.
+3. the narrow phase for those candidates only, keeping those below the detection distance:
+   pairs of spheres, capsules and half-spaces in one compiled pass
+   (:mod:`solvers.narrow_kernels`, also the capsules' end-point rows when asked), the others
+   (boxes, cylinders, hulls, meshes) by coal: ``pinocchio.updateGeometryPlacements``, then
+   ``pinocchio.computeDistance`` per pair (signed distance, EPA in penetration).
 
 Conventions of a :class:`Proximity` row (coal's): the witness points ``p_a`` on body A and
 ``p_b`` on body B, world frame; the signed distance ``d`` (negative in penetration); the unit
@@ -20,17 +22,29 @@ Conventions of a :class:`Proximity` row (coal's): the witness points ``p_a`` on 
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import NamedTuple
+from operator import itemgetter
+from typing import NamedTuple, TypeVar
 
 import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.geometry.scene import Scene
+from solvers.narrow_kernels import narrow_phase
 from solvers.proximity_kernels import joint_poses, near_pairs, world_centres
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
+T = TypeVar("T")
+Select = Callable[[Scene], npt.NDArray[np.bool_]]
+"""Gives the pairs of a scene to answer for, as a mask (npairs,) over its pairs."""
+
+ROWS = 5
+"""Most rows of one pair: its closest points and four end points."""
+
+REPEAT = 1e-6
+"""[m] An end point's row whose witness points are both within this of its pair's own row
+(coal's, found to GJK's tolerance) repeats it and is left out."""
 
 
 class Proximity(NamedTuple):
@@ -45,6 +59,8 @@ class Proximity(NamedTuple):
         joint_a: The joint (k,) body A moves with (a joint index of ``kin.model``; 0: the
             world).
         joint_b: The joint (k,) body B moves with.
+        pair: The index (k,) of each row's pair in the scene's pairs
+            (:attr:`~rrc_pin.geometry.CollisionModel.pairs` when queried).
     """
 
     names: tuple[tuple[str, str], ...]
@@ -54,6 +70,7 @@ class Proximity(NamedTuple):
     normal: Array
     joint_a: Index
     joint_b: Index
+    pair: Index
 
 
 class CollisionData:
@@ -64,7 +81,8 @@ class CollisionData:
     Create it with :meth:`CollisionModel.create_data`; never share one between threads.
     """
 
-    __slots__ = ("candidates", "geometry_data", "poses", "scene", "world")
+    __slots__ = ("candidates", "distance", "end", "geometry_data", "normal", "other", "pair",
+                 "point_a", "point_b", "poses", "scene", "world")  # fmt: skip
 
     def __init__(self, scene: Scene) -> None:
         self.refresh(scene)
@@ -76,11 +94,21 @@ class CollisionData:
         self.poses = np.zeros((scene.njoints, 4, 4))
         self.poses[0] = np.eye(4)
         self.world = np.zeros((len(scene.names), 3))
-        self.candidates = np.zeros(len(scene.first), dtype=np.int64)
+        npairs = len(scene.first)
+        self.candidates = np.zeros(npairs, dtype=np.int64)
+        self.other = np.zeros(npairs, dtype=np.int64)
+        rows = ROWS * npairs  # a pair's row and its end points' (solvers.narrow_kernels)
+        self.pair = np.zeros(rows, dtype=np.int64)
+        self.distance = np.zeros(rows)
+        self.point_a = np.zeros((rows, 3))
+        self.point_b = np.zeros((rows, 3))
+        self.normal = np.zeros((rows, 3))
+        self.end = np.zeros(rows, dtype=np.int8)
 
 
 def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Data],
-          cdata: CollisionData, detection: float) -> Proximity:  # fmt: skip
+          cdata: CollisionData, detection: float, ends: bool = False,
+          select: Select | None = None) -> Proximity:  # fmt: skip
     """The :class:`Proximity` of ``scene`` at joint positions ``q`` (module docstring).
 
     Args:
@@ -91,6 +119,9 @@ def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Dat
             (called only when a pair is near: the narrow phase reads it).
         cdata: The caller's :class:`CollisionData` (refreshed if older than ``scene``).
         detection: Detection distance [m]: pairs with a signed distance below it are rows.
+        ends: Also the rows of the capsules' end points (:mod:`solvers.narrow_kernels`): a
+            pair may then have several rows, its first its closest points.
+        select: Gives the pairs of ``scene`` to answer for ((npairs,) mask), or None: all.
     """
     if cdata.scene is not scene:
         cdata.refresh(scene)
@@ -106,65 +137,113 @@ def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Dat
                        scene.offset, detection, cdata.candidates)  # fmt: skip
     if count == 0:
         return EMPTY
-    gdata = cdata.geometry_data
-    geometry = scene.geometry
-    pin.updateGeometryPlacements(model, placed(), geometry, gdata)
-    rows: list[int] = []
-    distance: list[float] = []
-    point_a: list[Array] = []
-    point_b: list[Array] = []
-    normal: list[Array] = []
-    for k in cdata.candidates[:count].tolist():  # the few candidates, not every pair
-        result = pin.computeDistance(geometry, gdata, k)
-        d = result.min_distance
-        if d < detection:
-            rows.append(k)
-            distance.append(d)
-            point_a.append(result.getNearestPoint1())
-            point_b.append(result.getNearestPoint2())
-            normal.append(result.normal)
-    if not rows:
+    keep = scene.every if select is None else select(scene)
+    rows, others = narrow_phase(poses, scene.joint, scene.shape, scene.segment, scene.size,
+                                scene.box_frame, scene.half, scene.normal, scene.offset,
+                                scene.first, scene.second, cdata.candidates, count, keep,
+                                detection, ends, cdata.pair, cdata.distance, cdata.point_a,
+                                cdata.point_b, cdata.normal, cdata.end, cdata.other)  # fmt: skip
+    if others:
+        rows = _coal(scene, model, placed(), cdata, detection, rows, others)
+    if rows == 0:
         return EMPTY
-    index = np.array(rows, dtype=np.int64)
+    index = cdata.pair[:rows].copy()
+    taken: slice | Index = slice(0, rows)
+    if others:  # coal's rows came last: each pair's own row first, then its end points'
+        order = np.argsort(2 * index + cdata.end[:rows], kind="stable")
+        order = order[_distinct(order, cdata)]
+        index, taken = index[order], order
+    names = scene.pair_names
     return Proximity(
-        names=tuple(scene.pair_names[k] for k in rows),
-        distance=np.array(distance),
-        point_a=np.array(point_a),
-        point_b=np.array(point_b),
-        normal=_unit(np.array(normal), np.array(distance), np.array(point_a),
-                     np.array(point_b),
-                     cdata.world[scene.second[index]] - cdata.world[scene.first[index]]),
+        names=gather(names, index),
+        distance=cdata.distance[taken].copy(),
+        point_a=cdata.point_a[taken].copy(),
+        point_b=cdata.point_b[taken].copy(),
+        normal=cdata.normal[taken].copy(),
         joint_a=scene.joint[scene.first[index]],
         joint_b=scene.joint[scene.second[index]],
+        pair=index,
     )
 
 
-def _unit(normal: Array, distance: Array, point_a: Array, point_b: Array,
+def gather(items: tuple[T, ...], index: Index) -> tuple[T, ...]:
+    """``items[index[r]]`` for every r, in one C-level gather (not a Python loop)."""
+    if index.size > 1:
+        out: tuple[T, ...] = itemgetter(*index.tolist())(items)
+        return out
+    return (items[int(index[0])],) if index.size else ()
+
+
+def _coal(scene: Scene, model: pin.Model, data: pin.Data, cdata: CollisionData,
+          detection: float, rows: int, others: int) -> int:  # fmt: skip
+    """Append coal's rows for the ``others`` candidates of other shapes after ``rows``.
+
+    Returns:
+        The number of rows now written.
+    """
+    gdata = cdata.geometry_data
+    geometry = scene.geometry
+    pin.updateGeometryPlacements(model, data, geometry, gdata)
+    for k in cdata.other[:others].tolist():
+        result = pin.computeDistance(geometry, gdata, k)
+        d = result.min_distance
+        if d < detection:
+            cdata.pair[rows] = k
+            cdata.end[rows] = 0
+            cdata.distance[rows] = d
+            point_a, point_b = result.getNearestPoint1(), result.getNearestPoint2()
+            cdata.point_a[rows] = point_a
+            cdata.point_b[rows] = point_b
+            cdata.normal[rows] = _unit(
+                result.normal,
+                d,
+                point_a,
+                point_b,
+                cdata.world[scene.second[k]] - cdata.world[scene.first[k]],
+            )
+            rows += 1
+    return rows
+
+
+def _distinct(order: Index, cdata: CollisionData) -> npt.NDArray[np.bool_]:
+    """Which rows of ``order`` (sorted: a pair's own row, then its end points') to keep.
+
+    An end point's row that repeats its pair's own (coal's closest points at a capsule's end
+    against a box, within :data:`REPEAT`) is left out.
+    """
+    end = cdata.end[order] == 1
+    keep = np.ones(order.size, dtype=np.bool_)
+    if not end.any():
+        return keep
+    first = np.maximum.accumulate(np.where(end, 0, np.arange(order.size)))
+    own = order[first]
+    same = (np.abs(cdata.point_a[order] - cdata.point_a[own]).max(axis=1) <= REPEAT) & (
+        np.abs(cdata.point_b[order] - cdata.point_b[own]).max(axis=1) <= REPEAT)  # fmt: skip
+    keep[end & same & (cdata.pair[order] == cdata.pair[own])] = False
+    return keep
+
+
+def _unit(normal: Array, distance: float, point_a: Array, point_b: Array,
           centres: Array) -> Array:  # fmt: skip
-    """``normal`` rows (k, 3) made unit.
+    """The ``normal`` (3,) of coal made unit.
 
     coal gives a normal for every pair it measures (EPA's in penetration); should one come
     back zero, the row takes ``(p_b - p_a) / d``, else (witnesses that coincide) the direction
     between the two bodies' bounding-sphere centres (``centres``: B's minus A's), so that no
     row is lost.
     """
-    norm = np.linalg.norm(normal, axis=1)
-    bad = norm < 1e-12
-    if bad.any():
-        for k in np.flatnonzero(bad):
-            gap = (point_b[k] - point_a[k]) * np.sign(distance[k])
-            for direction in (gap, centres[k], np.array([0.0, 0.0, 1.0])):
-                size = float(np.linalg.norm(direction))
-                if size > 1e-12:
-                    normal[k], norm[k] = direction, size
-                    break
-    out: Array = normal / norm[:, None]
-    return out
+    for direction in (normal, (point_b - point_a) * np.sign(distance), centres):
+        size = float(np.linalg.norm(direction))
+        if size > 1e-12:
+            out: Array = direction / size
+            return out
+    return np.array([0.0, 0.0, 1.0])
 
 
 def _empty() -> Proximity:
     empty = Proximity((), np.zeros(0), np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
-                      np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64))  # fmt: skip
+                      np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64),
+                      np.zeros(0, dtype=np.int64))  # fmt: skip
     for array in empty[1:]:
         array.flags.writeable = False
     return empty

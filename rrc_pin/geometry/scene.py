@@ -15,6 +15,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import NamedTuple
 
+import coal
 import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
@@ -22,6 +23,7 @@ import pinocchio as pin
 from rrc_pin.geometry.pairs import Pair, Reason
 from rrc_pin.geometry.shapes import bounding_sphere
 from rrc_pin.geometry.tree import KinematicTree
+from solvers.narrow_kernels import BOX, CAPSULE, HALFSPACE, OTHER, SPHERE
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
@@ -62,9 +64,19 @@ class Scene:
         radius: Bounding radii (ng,) [m]; ``inf`` for a half-space.
         normal: Unit normals (ng, 3) of the half-spaces (zero rows for other bodies).
         offset: Offsets (ng,) [m] of the half-spaces.
+        shape: Each body's shape for the compiled narrow phase (ng,): a code of
+            :mod:`solvers.narrow_kernels` (``OTHER``: coal measures its pairs).
+        segment: Each sphere's or capsule's segment end points (ng, 2, 3) in its joint's
+            frame [m] (a sphere: its centre twice; zeros for other bodies).
+        size: Sphere and capsule radii (ng,) [m] (zero for other bodies).
+        box_frame: Each box's placement (ng, 3, 4) ``[R | t]`` in its joint's frame (zeros for
+            other bodies).
+        half: Each box's half sides (ng, 3) [m] (zeros for other bodies).
         first: First body (npairs,) of each active pair.
         second: Second body (npairs,).
         pair_names: ``(name_a, name_b)`` of each active pair.
+        labels: ``"name_a|name_b"`` of each active pair (a constraint row's name).
+        every: True for every pair (npairs,): the query's default selection.
         excluded: The pairs left out, by names, with their reasons.
         njoints: Number of joints of the model (including the world, 0).
         tree: The model's joints for the compiled forward kinematics, or None (a query reads
@@ -78,9 +90,16 @@ class Scene:
     radius: Array
     normal: Array
     offset: Array
+    shape: Index
+    segment: Array
+    size: Array
+    box_frame: Array
+    half: Array
     first: Index
     second: Index
     pair_names: tuple[tuple[str, str], ...]
+    labels: tuple[str, ...]
+    every: npt.NDArray[np.bool_]
     excluded: dict[tuple[str, str], Reason]
     njoints: int
     tree: KinematicTree | None
@@ -128,6 +147,11 @@ def build_scene(
     radius = np.zeros(len(objects))
     normal = np.zeros((len(objects), 3))
     offset = np.zeros(len(objects))
+    shape = np.full(len(objects), OTHER, dtype=np.int64)
+    segment = np.zeros((len(objects), 2, 3))
+    size = np.zeros(len(objects))
+    box_frame = np.zeros((len(objects), 3, 4))
+    halves = np.zeros((len(objects), 3))
     planes = {e.name: e.plane for e in extras if e.plane is not None}
     for g, obj in enumerate(objects):
         c, r = bounding_sphere(obj.geometry)
@@ -135,11 +159,25 @@ def build_scene(
         radius[g] = r
         if names[g] in planes:
             normal[g], offset[g] = planes[names[g]]
+            shape[g] = HALFSPACE
+        elif isinstance(obj.geometry, coal.Sphere | coal.Capsule):
+            half = obj.geometry.halfLength if isinstance(obj.geometry, coal.Capsule) else 0.0
+            shape[g] = CAPSULE if isinstance(obj.geometry, coal.Capsule) else SPHERE
+            segment[g] = [obj.placement.act(np.array([0.0, 0.0, z])) for z in (-half, half)]
+            size[g] = obj.geometry.radius
+        elif isinstance(obj.geometry, coal.Box):
+            shape[g] = BOX
+            box_frame[g] = obj.placement.homogeneous[:3]
+            halves[g] = obj.geometry.halfSide
     first = np.array([a for a, _ in pairs], dtype=np.int64)
     second = np.array([b for _, b in pairs], dtype=np.int64)
     return Scene(
         geometry=geometry, names=names, joint=joint, centre=centre, radius=radius,
-        normal=normal, offset=offset, first=first, second=second,
-        pair_names=tuple((names[a], names[b]) for a, b in pairs), excluded=excluded,
+        normal=normal, offset=offset, shape=shape, segment=segment, size=size,
+        box_frame=box_frame, half=halves, first=first,
+        second=second,
+        pair_names=tuple((names[a], names[b]) for a, b in pairs),
+        labels=tuple(f"{names[a]}|{names[b]}" for a, b in pairs),
+        every=np.ones(len(pairs), dtype=np.bool_), excluded=excluded,
         njoints=model.njoints, tree=tree,
     )  # fmt: skip

@@ -1,7 +1,10 @@
 r"""CollisionLimit: every pair of bodies kept apart, and tool frames inside their walls.
 
 One velocity-damper row per pair closer than the detection distance (Kanehiro et al. 2008,
-:mod:`solvers.damper_kernels`):
+:mod:`solvers.damper_kernels`), and one per capsule end point within it of the other body
+(:mod:`solvers.narrow_kernels`: near-parallel capsules' closest points jump from end to end,
+and the end about to become the closest is then already constrained; an end-point row
+may lose :data:`END` of its margin a step, a pair's own row the damper's share):
 
 .. math:: -n^T (J_b - J_a)\,\dot q \le \xi \frac{d - d_s}{d_i - d_s}
 
@@ -40,6 +43,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.geometry import CollisionModel, Wall
+from rrc_pin.geometry.proximity import gather
 from rrc_pin.limits.limit import Limit
 from solvers.damper_kernels import damper_rows
 from solvers.problem import Constraints
@@ -47,6 +51,7 @@ from solvers.validation import finite_number
 
 if TYPE_CHECKING:
     from rrc_pin.geometry.proximity import Proximity
+    from rrc_pin.geometry.scene import Scene
     from rrc_pin.kinematics import Kinematics, Layout
 
 Array = npt.NDArray[np.float64]
@@ -63,6 +68,12 @@ GAIN = 0.5
 RECOVERY = 0.5
 """Fraction of a shortfall below the safety distance restored per step (at most at the gain):
 :mod:`solvers.damper_kernels`."""
+
+END = 0.5
+"""Fraction of its margin above d_s an end-point row may lose in one step (its xi is
+``END * (d_i - d_s) / dt``): it only has to keep the end from crossing d_s unseen, and the
+pair's own damper would slow a capsule sliding along another as its overhanging end comes in
+(tangential progress 0.75 of the command with the pair's xi on two pandas' hands)."""
 
 STILL = 1e-9
 """[m/s per rad/s] A row whose every entry is below this is dropped: no joint changes the
@@ -84,7 +95,8 @@ class CollisionLimit(Limit):
         name: Name in the report.
 
     Attributes:
-        last: The :class:`~rrc_pin.geometry.Proximity` of the last tick (the rows' pairs).
+        last: The :class:`~rrc_pin.geometry.Proximity` of the last tick (the rows' pairs, a
+            pair's end-point rows after its own).
 
     Raises:
         InvalidInput: ``model`` not a CollisionModel, a distance or gain out of range, a pair
@@ -127,7 +139,7 @@ class CollisionLimit(Limit):
                 start = robot.joints[i].idx_v
                 support[j, start : start + robot.joints[i].nv] = True
         self._support = support
-        self._names: dict[tuple[str, str], str] = {}
+        self._kept: tuple[Scene | None, npt.NDArray[np.bool_]] = (None, np.zeros(0, np.bool_))
 
     def check(self, layout: Layout) -> None:
         """Refuse a resolver whose robot is not the model's.
@@ -143,10 +155,9 @@ class CollisionLimit(Limit):
 
     def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
         """The damper rows of the pairs within the detection distance, and of the walls."""
-        prox = self.model.proximity(kin, self._data, self.detection)
-        if self.pairs is not None and prox.names:
-            keep = [k for k, names in enumerate(prox.names) if names in self.pairs]
-            prox = _subset(prox, keep)
+        select = None if self.pairs is None else self._keep
+        prox = self.model.proximity(kin, self._data, self.detection, True, select)
+        scene = self._data.scene
         self.last = prox
         walls = self.model.walls()
         k = len(prox.names)
@@ -155,13 +166,15 @@ class CollisionLimit(Limit):
         xi = min(self.gain, (self.detection - self.safety) / dt)
         nv = kin.model.nv
         G, h = np.empty((k, nv)), np.empty(k)
-        names = [self._name(pair) for pair in prox.names]
+        names = list(gather(scene.labels, prox.pair))
         distance = prox.distance
         if k:
-            J = kin.data.J
-            damper_rows(J, self._support, prox.joint_a, prox.joint_b, prox.point_a,
+            gains = np.full(k, xi)
+            pair = prox.pair
+            gains[1:][pair[1:] == pair[:-1]] = END * (self.detection - self.safety) / dt
+            damper_rows(kin.data.J, self._support, prox.joint_a, prox.joint_b, prox.point_a,
                         prox.point_b, prox.normal, prox.distance, self.safety, self.detection,
-                        xi, RECOVERY / dt, G, h)  # fmt: skip
+                        gains, RECOVERY / dt, G, h)  # fmt: skip
         if walls:
             G, h, distance = self._walls(kin, walls, G, h, names, distance, dt)
         if h.size:  # a pair no joint can move apart or together has no row (module docstring)
@@ -193,11 +206,12 @@ class CollisionLimit(Limit):
             names.append(f"{wall.frame}|{wall.name}")
         return np.vstack(rows), np.concatenate(bounds), np.concatenate(gaps)
 
-    def _name(self, pair: tuple[str, str]) -> str:
-        label = self._names.get(pair)
-        if label is None:
-            label = self._names[pair] = f"{pair[0]}|{pair[1]}"
-        return label
+    def _keep(self, scene: Scene) -> npt.NDArray[np.bool_]:
+        """Whether each pair of ``scene`` is one of :attr:`pairs` (kept per scene)."""
+        if self._kept[0] is not scene:
+            chosen = self.pairs or frozenset()
+            self._kept = (scene, np.array([p in chosen for p in scene.pair_names], dtype=np.bool_))
+        return self._kept[1]
 
 
 _NONE = Constraints()
@@ -228,9 +242,3 @@ def _pairs(model: CollisionModel, pairs: Sequence[tuple[str, str]]) -> frozenset
                                f"{model.excluded.get((a, b), model.excluded.get((b, a)))})")
     return frozenset(out)
 
-
-def _subset(prox: Proximity, keep: list[int]) -> Proximity:
-    index = np.array(keep, dtype=np.int64)
-    return type(prox)(tuple(prox.names[k] for k in keep), prox.distance[index],
-                      prox.point_a[index], prox.point_b[index], prox.normal[index],
-                      prox.joint_a[index], prox.joint_b[index])  # fmt: skip

@@ -35,6 +35,17 @@ RETRY_TOL = 1e-8
 1e-9 it refused 36 of 4,000 random strict lower levels, all feasible (joints on their bounds
 make a degenerate vertex at z = 0; Clarabel solves each); the retry leaves 4-6."""
 
+CYCLING_TOL = 1e-7
+"""Primal tolerance of one cold retry of a problem DAQP cycled on (exit flag -2). Cycling met
+degenerate vertices of direction QPs (maximise the scale s <= 1, with collision rows of
+near-parallel capsules, cosines 0.994-0.999 between rows, active with s = 1); in 10-minute
+panda-folding sessions 10 and 2 ticks of 60,000 cycled at 1e-9, warm or cold, and went to the
+fallback. Two of them kept: both cycle at 1e-9, one still at 1e-8, both solve cold at 1e-7 in
+3 iterations (within :data:`solvers.qp.FEASIBILITY_TOL`)."""
+
+RETRIES = {-1: RETRY_TOL, -2: CYCLING_TOL}
+"""DAQP's exit flags retried once, cold, and the primal tolerance of the retry."""
+
 
 class DaqpBackend(QPBackend):
     """DAQP, warm-started from the last primal solution per problem key.
@@ -75,8 +86,9 @@ class DaqpBackend(QPBackend):
                 qp.P, qp.q, A, upper, lower, sense, primal_start=self._start(qp), **self.options
             )
             iterations = int(info["iterations"])
-            if exitflag == -1 and self.options.get("primal_tol", 0.0) < RETRY_TOL:
-                retry = {**self.options, "primal_tol": RETRY_TOL, "primal_start": None}
+            loose = RETRIES.get(exitflag, 0.0)
+            if self.options.get("primal_tol", 0.0) < loose:
+                retry = {**self.options, "primal_tol": loose, "primal_start": None}
                 x, _, exitflag, info = daqp.solve(qp.P, qp.q, A, upper, lower, sense, **retry)
                 iterations += int(info["iterations"])
         except Exception as exc:
