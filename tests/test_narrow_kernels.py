@@ -12,7 +12,7 @@ import pytest
 from solvers.narrow_kernels import BOX, CAPSULE, HALFSPACE, SPHERE, narrow_phase
 
 TOL = 1e-9
-TRIALS = 1000
+TRIALS = 500
 FAR = 10.0
 """[m] A detection distance every trial is below: each pair gives its row."""
 
@@ -126,7 +126,7 @@ def test_rows_match_coal(case):
         if not segments_apart and conditioned:  # meeting segments: along u x v
             assert abs(n @ u) + abs(n @ v) < 1e-9
         inside += d < 0
-    assert inside >= 20 and (unique >= TRIALS // 2 or case in ("parallel", "crossing"))
+    assert inside >= 10 and (unique >= TRIALS // 2 or case in ("parallel", "crossing"))
 
 
 def point_segment(p, ends):
