@@ -34,7 +34,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import subprocess
 import sys
 import time
@@ -48,6 +47,9 @@ import pinocchio as pin
 import rrc_pin
 from rrc_pin.geometry import CollisionModel
 from rrc_pin.kinematics import Kinematics, Layout
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from machine import machine_info
 
 DETECTION = 0.10
 SPREAD = 0.6
@@ -152,19 +154,11 @@ def hull_cost() -> str:
 
 
 def conditions() -> str:
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    import coal
-
-    return (f"{cpu}, {os.cpu_count()} cores, load average {os.getloadavg()[0]:.2f}; Python "
-            f"{platform.python_version()}, Pinocchio {pin.__version__}, coal {coal.__version__}, "
-            f"numpy {np.__version__}")  # fmt: skip
+    """The CPU, its load and the versions measured, in one line."""
+    info = machine_info("coal")
+    return (f"{info['cpu']}, {info['cores']} cores, load average {os.getloadavg()[0]:.2f}; "
+            f"Python {info['python']}, Pinocchio {info['pinocchio']}, coal {info['coal']}, "
+            f"numpy {info['numpy']}")  # fmt: skip
 
 
 def main() -> None:
