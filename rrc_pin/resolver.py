@@ -166,7 +166,7 @@ class Resolver:
             limit.check(self._layout)
         self._data = robot.model.createData()  # this resolver's own
         self._names = robot.dof_names
-        self._last_qdot = np.zeros(robot.nv)
+        self._last_qdot: Array = np.zeros(robot.nv)
         self._lock = threading.Lock()
 
     def reset(self) -> None:

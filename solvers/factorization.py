@@ -73,7 +73,8 @@ class Factorization:
         m, n = J.shape
         factor = cls.__new__(cls)
         factor.J, factor._svd = J, None
-        factor.Q, factor.R, x = np.empty((n, n)), np.empty((n, m)), np.empty(n)
+        x: Array = np.empty(n)
+        factor.Q, factor.R = np.empty((n, n)), np.empty((n, m))
         fit = kernels.least_norm_fit(J, b, lb, ub, factor.Q, factor.R, x)
         factor.regular = fit > 0
         if fit:

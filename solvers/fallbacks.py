@@ -34,7 +34,7 @@ def fallback(name: str, problem: Problem, work: Work) -> Array:
     """
     box = problem.box
     if name == "hold":
-        return np.minimum(np.maximum(0.0, box.lb), box.ub)
+        return box.clip(0.0)
     A, b = problem.stacked[0]
     if problem.equalities is not None:
         raise NumericalFailure(f"{name}: does not keep equality rows")
@@ -54,7 +54,7 @@ def fallback(name: str, problem: Problem, work: Work) -> Array:
         raise NumericalFailure(f"{name}: the answer breaks a constraint row")
     if not np.isfinite(qdot).all():
         raise NumericalFailure(f"{name}: non-finite answer")
-    return np.minimum(np.maximum(qdot, box.lb), box.ub)
+    return box.clip(qdot)
 
 
 def _bvls(A: Array, b: Array, problem: Problem) -> Array:
@@ -62,7 +62,7 @@ def _bvls(A: Array, b: Array, problem: Problem) -> Array:
     if problem.rows is not None:
         raise NumericalFailure("scipy: bounded least squares takes no constraint rows")
     box = problem.box
-    x = np.minimum(np.maximum(0.0, box.lb), box.ub)  # joints with lb == ub are fixed there
+    x = box.clip(0.0)  # joints with lb == ub are fixed there
     free = box.lb < box.ub
     if free.any():
         rhs = b - A[:, ~free] @ x[~free]

@@ -137,6 +137,9 @@ def least_squares(
         # gradients 1e7 times P, and proxqp iterated for 10 s).
         size = max(float(np.abs(P).max()), float(np.abs(q).max()), np.finfo(float).tiny)
         P, q = P / size, q / size
+        C: Array | None
+        lo: Array | None
+        hi: Array | None
         if N is None:
             C, lo, hi = (None, None, None) if rows is None else (
                 rows.G, np.full(rows.h.size, -np.inf), rows.h)  # fmt: skip

@@ -86,7 +86,7 @@ def sample_at(chain: Chain, seed: int, plan: Plan, index: int | Sequence[int]) -
     """
     many = not isinstance(index, (int, np.integer))
     indices = np.atleast_1d(np.asarray(index, dtype=np.int64))
-    if indices.size and (indices.min() < 0 or indices.max() >= plan.samples):
+    if indices.size and (np.min(indices) < 0 or np.max(indices) >= plan.samples):
         raise ValueError(f"sample index outside [0, {plan.samples})")
     out = np.empty((indices.size, chain.n))
     blocks, rows = np.divmod(indices, plan.block_size)

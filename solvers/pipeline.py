@@ -307,7 +307,7 @@ def _top(
         return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
     z = usable.rates(b, lam)
     damped = _scaled(A, z if space.N is None else z @ space.N, null, box, rows, backend, work)
-    return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot), float(lam.max()),
+    return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot), float(np.max(lam)),
                 null)  # fmt: skip
 
 
@@ -466,7 +466,7 @@ def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:
     over = values > rows.h
     if not over.any():
         return x, 1.0
-    factor = float((rows.h[over] / values[over]).min()) * (1.0 - 4.0 * _EPS)
+    factor = float(np.min(rows.h[over] / values[over])) * (1.0 - 4.0 * _EPS)
     return x * factor, factor
 
 

@@ -88,6 +88,11 @@ class Box(NamedTuple):
     recovering: bool
     velocity: Array
 
+    def clip(self, qdot: Array | float) -> Array:
+        """The rates (n,) nearest ``qdot`` inside the box (a scalar is every joint's rate)."""
+        clipped: Array = np.minimum(np.maximum(qdot, self.lb), self.ub)
+        return clipped
+
 
 class Constraints(NamedTuple):
     """What one limit contributes to a tick: a box, inequality rows, equality rows.
@@ -291,7 +296,7 @@ def largest_weight(tasks: Sequence[TaskRows]) -> float:
     """The largest row weight of ``tasks`` (1 for a task without weights)."""
     if len(tasks) == 1 and tasks[0].weight is None:
         return 1.0
-    return max(1.0 if t.weight is None else float(t.weight.max()) for t in tasks)
+    return max(1.0 if t.weight is None else float(np.max(t.weight)) for t in tasks)
 
 
 def row_factors(t: TaskRows, top: float, units: bool) -> Array | None:

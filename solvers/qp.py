@@ -180,7 +180,7 @@ def solve_within(
     work.backend = solved.backend
     work.iterations += solved.iterations
     work.solve_time += solved.solve_time
-    x = np.minimum(np.maximum(solved.x, box.lb), box.ub)
+    x = box.clip(solved.x)
     size = math.hypot(*(x - solved.x).tolist())
     tol = FEASIBILITY_TOL * (1.0 + math.hypot(*np.minimum(box.velocity, 1e300).tolist()))
     if not (size <= tol and (rows is None or kernels.rows_hold(rows.G, x, rows.h, tol))):

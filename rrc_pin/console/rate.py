@@ -128,7 +128,7 @@ class TickClock:
         if p.size == 0:
             return PeriodStats(0, 0.0, 0.0, 0.0)
         median, p99 = np.percentile(p, [50.0, 99.0])
-        return PeriodStats(int(p.size), float(median), float(p99), float(p.max()))
+        return PeriodStats(int(p.size), float(median), float(p99), float(np.max(p)))
 
 
 def _window(ring: Array, count: int) -> Array:

@@ -233,11 +233,11 @@ class CollisionModel:
                 raise InvalidInput(key, f"a {kind} takes only {', '.join(wanted)}")
         placement = _pose(T_link_shape, "T_link_shape")
         builders: dict[str, Callable[[], object]] = {
-            "box": lambda: shapes.box(size),  # type: ignore[arg-type]
+            "box": lambda: shapes.box(size),  # type: ignore[arg-type, unused-ignore]
             "sphere": lambda: shapes.sphere(radius),  # type: ignore[arg-type]
             "capsule": lambda: shapes.capsule(radius, length),  # type: ignore[arg-type]
             "cylinder": lambda: shapes.cylinder(radius, length),  # type: ignore[arg-type]
-            "convex": lambda: shapes.convex(points),  # type: ignore[arg-type]
+            "convex": lambda: shapes.convex(points),  # type: ignore[arg-type, unused-ignore]
         }
         shape = builders[kind]()
         frame = self.robot.model.frames[fid]

@@ -104,7 +104,7 @@ def bounding_sphere(geometry: coal.CollisionGeometry) -> tuple[Array, float]:
     (a mesh), the sphere around coal's axis-aligned bounding box. A half-space gets
     :data:`HALFSPACE_RADIUS`.
     """
-    centre = np.zeros(3)
+    centre: Array = np.zeros(3)
     if isinstance(geometry, coal.Halfspace):
         return centre, HALFSPACE_RADIUS
     if isinstance(geometry, coal.Sphere):
@@ -119,5 +119,5 @@ def bounding_sphere(geometry: coal.CollisionGeometry) -> tuple[Array, float]:
     centre = np.array(geometry.aabb_center, dtype=float)
     if isinstance(geometry, coal.ConvexBase):
         points = np.asarray(geometry.points())
-        return centre, float(np.linalg.norm(points - centre, axis=1).max())
+        return centre, float(np.max(np.linalg.norm(points - centre, axis=1)))
     return centre, float(geometry.aabb_radius)

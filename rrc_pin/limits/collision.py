@@ -165,7 +165,8 @@ class CollisionLimit(Limit):
             return _NONE
         xi = min(self.gain, (self.detection - self.safety) / dt)
         nv = kin.model.nv
-        G, h = np.empty((k, nv)), np.empty(k)
+        G: Array = np.empty((k, nv))
+        h: Array = np.empty(k)
         names = list(gather(scene.labels, prox.pair))
         distance = prox.distance
         if k:

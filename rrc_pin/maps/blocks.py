@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from rrc_pin.errors import ForeignMap
 from rrc_pin.maps.voxels import VoxelStats
@@ -140,7 +141,7 @@ class BlockStore:
                 path.unlink(missing_ok=True)
 
 
-def _arrays(part: Sparse) -> dict[str, np.ndarray]:
+def _arrays(part: Sparse) -> dict[str, npt.NDArray[Any]]:
     return {
         "keys": part.keys, "count": part.count, "dirs": part.dirs, "fmax": part.fmax,
         "isum": part.isum, "imin": part.imin, "outside": np.array(part.outside, np.int64),
@@ -159,7 +160,7 @@ def _atomic_write(path: Path, data: bytes) -> None:
     os.replace(tmp, path)
 
 
-def _atomic_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
+def _atomic_npz(path: Path, arrays: dict[str, npt.NDArray[Any]]) -> None:
     tmp = path.with_name(f".{path.stem}.tmp{os.getpid()}.npz")
     np.savez(tmp, **arrays)  # type: ignore[arg-type]
     os.replace(tmp, path)

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.loading import load
@@ -170,7 +171,7 @@ def versions() -> dict[str, str | None]:
 
 def _definition(
     robot: Robot, frame: str | None, kin: ArmKinematics, plan: Plan, seed: int, grid: Grid,
-    dexterity: bool, q: np.ndarray,
+    dexterity: bool, q: npt.NDArray[Any],
 ) -> dict[str, Any]:  # fmt: skip
     """What makes a map this map (the blocks' fingerprint is its hash)."""
     return {

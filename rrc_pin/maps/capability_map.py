@@ -93,7 +93,7 @@ class CapabilityMap:
         out: Array = popcount(self.stats.dirs) / BINS
         return out
 
-    def column(self, name: str) -> np.ndarray:
+    def column(self, name: str) -> npt.NDArray[Any]:
         """A statistic by name (V,): a stored column, ``coverage``, or a ``*_mean``.
 
         Maxima and means are NaN where the voxel was not reached (or not computed).
@@ -119,7 +119,7 @@ class CapabilityMap:
         return out
 
     @cached_property
-    def _query_columns(self) -> dict[str, np.ndarray]:
+    def _query_columns(self) -> dict[str, npt.NDArray[Any]]:
         """The columns :meth:`at` reads, by :class:`MapQuery` field."""
         names = {"samples": "count"}
         return {f: self.column(names.get(f, f)) for f in MapQuery._fields if f != "inside"}

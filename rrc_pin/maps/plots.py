@@ -93,14 +93,14 @@ def _title(m: CapabilityMap) -> str:
     )
 
 
-def slice_values(grid: Grid, values: np.ndarray, axis: int, at: float) -> np.ndarray:
+def slice_values(grid: Grid, values: npt.NDArray[Any], axis: int, at: float) -> npt.NDArray[Any]:
     """The 2-D slice of ``values`` (V,) normal to ``axis`` through the coordinate ``at`` [m].
 
     Indexed by the two other axes, in order.
     """
     cube = values.reshape(grid.shape)
     i = int(np.clip(np.floor(at / grid.voxel) - grid.start[axis], 0, grid.shape[axis] - 1))
-    out: np.ndarray = np.take(cube, i, axis=axis)
+    out: npt.NDArray[Any] = np.take(cube, i, axis=axis)
     return out
 
 
@@ -109,7 +109,7 @@ def slice_figure(
     grid: Grid,
     reached: npt.NDArray[np.bool_],
     centre: npt.ArrayLike,
-    columns: Sequence[tuple[str, np.ndarray, tuple[float, float] | None]],
+    columns: Sequence[tuple[str, npt.NDArray[Any], tuple[float, float] | None]],
     title: str,
     path: Path,
 ) -> None:
@@ -147,7 +147,7 @@ def slice_figure(
 
 
 def view_figure(
-    plt: Any, grid: Grid, shown: npt.NDArray[np.bool_], values: np.ndarray, label: str,
+    plt: Any, grid: Grid, shown: npt.NDArray[np.bool_], values: npt.NDArray[Any], label: str,
     title: str, path: Path,
 ) -> None:  # fmt: skip
     """The ``shown`` voxels (V,) as points coloured by ``values`` (V,)."""
@@ -163,7 +163,7 @@ def view_figure(
         getattr(ax, name)(f"{_AXES[i]} [m]")
     if P.size:
         lo, hi = P.min(axis=0), P.max(axis=0)
-        half = float((hi - lo).max()) / 2 or grid.voxel
+        half = float(np.max(hi - lo)) / 2 or grid.voxel
         mid = (lo + hi) / 2
         ax.set_xlim(mid[0] - half, mid[0] + half)
         ax.set_ylim(mid[1] - half, mid[1] + half)

@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput, MissingExtra
 from rrc_pin.maps.capability_map import CapabilityMap
@@ -38,7 +39,7 @@ def _zarr() -> Any:
     return zarr
 
 
-def write_array(group: Any, name: str, data: np.ndarray, chunks: tuple[int, ...]) -> None:
+def write_array(group: Any, name: str, data: npt.NDArray[Any], chunks: tuple[int, ...]) -> None:
     """Create array ``name`` in ``group`` holding ``data`` (zarr-python 2 or 3)."""
     chunks = tuple(min(c, max(s, 1)) for c, s in zip(chunks, data.shape, strict=True))
     if hasattr(group, "create_array"):  # zarr-python 3

@@ -28,8 +28,9 @@ voxels.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -205,19 +206,19 @@ class VoxelStats:
             self.outside,
         )  # fmt: skip
 
-    def arrays(self) -> dict[str, np.ndarray]:
+    def arrays(self) -> dict[str, npt.NDArray[Any]]:
         """Every column by name, (V,) each."""
-        out: dict[str, np.ndarray] = {"count": self.count, "directions": self.dirs}
+        out: dict[str, npt.NDArray[Any]] = {"count": self.count, "directions": self.dirs}
         for cols, names in ((self.fmax, self.fields.fmax), (self.isum, self.fields.isum),
                             (self.imin, self.fields.imin)):  # fmt: skip
             out.update({name: cols[:, j] for j, name in enumerate(names)})
         return out
 
     @classmethod
-    def from_arrays(cls, arrays: dict[str, np.ndarray], fields: Fields) -> VoxelStats:
+    def from_arrays(cls, arrays: Mapping[str, npt.NDArray[Any]], fields: Fields) -> VoxelStats:
         """Inverse of :meth:`arrays` (copies into the dense layout)."""
 
-        def cols(names: Sequence[str], dtype: type) -> np.ndarray:
+        def cols(names: Sequence[str], dtype: type) -> npt.NDArray[Any]:
             return np.ascontiguousarray(
                 np.stack([np.asarray(arrays[n]).reshape(-1) for n in names], axis=1), dtype=dtype
             )
