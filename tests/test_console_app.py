@@ -156,6 +156,8 @@ def test_keyboard_jogs_and_stop(console, page):
     page.get_by_label("deadman latched").focus()
     page.keyboard.press(" ")
     wait_for(lambda: loop.operator.latched, what="latched again")
+    console.panel.sync(loop.snapshot)  # the loop's count of the page's own STOP: not a second
+    assert console.panel.latch.value  # release (it unlatched an operator who latched at once)
     page.evaluate("document.activeElement.blur()")
     start = loop.robot_pose()
     for client in console.server.get_clients().values():  # the view the arrow keys moved

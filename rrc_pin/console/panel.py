@@ -67,7 +67,7 @@ class Panel:
         self.mailbox = loop.mailbox
         self.out = out
         self.errors = 0
-        self._stops = 0
+        self._stops = loop.operator.stops
         s = loop.operator.settings
         gui = server.gui
         gui.configure_theme(control_width="large", dark_mode=False, show_logo=False)
@@ -177,7 +177,13 @@ class Panel:
                                        self.frame.value))  # fmt: skip
 
     def stop(self) -> None:
-        """STOP: post it, and put the sliders at zero and the latch off."""
+        """STOP: post it, and put the sliders at zero and the latch off.
+
+        The stop is counted as seen here: :meth:`sync` releases the controls again only for
+        stops the page did not ask for (an operator who latches again right after STOP is not
+        unlatched when the loop's count catches up).
+        """
+        self._stops += 1
         self.mailbox.post(cmd.Stop())
         self._release_controls()
 
@@ -230,6 +236,6 @@ class Panel:
 
     def sync(self, snapshot: Snapshot) -> None:
         """Follow the loop's state: after any stop the sliders read zero and the latch off."""
-        if snapshot.stops != self._stops:
+        if snapshot.stops > self._stops:
             self._stops = snapshot.stops
             self._release_controls()
