@@ -3,8 +3,8 @@ and every installed backend, extreme commands included. Every answer finite, ins
 velocity and one-step position limits, a ``scaled`` answer along its command, no exception.
 
 Fresh seeds at every run (printed on failure). ``RRC_PIN_SOAK=N`` sets the steps per arm for
-the default backend (a tenth for each other one); the suite's default is small, ``.ci/run``
-runs a long soak, and docs/api.md ("Reliability") records a run of 10^5 steps per arm.
+the default backend (a tenth for each other one); the suite's default is small, and
+docs/api.md ("Reliability") records a run of 10^5 steps per arm.
 """
 
 from __future__ import annotations
