@@ -288,3 +288,38 @@ def test_data_follows_a_changed_scene():
     cm.add_halfspace((0, 0, 1), 10.0, name="flood")  # everything below z = 10 is inside it
     prox = cm.proximity_at(arm.ready(), 0.0, data)
     assert {b for _, b in prox.names} == {"flood"} and (prox.distance < 0).all()
+
+
+def test_a_capsule_against_a_hull_gets_its_end_points_rows():
+    """coal measures a capsule against a convex hull; with ``ends`` each end point of the capsule
+    also gets a row, its distance the analytic one from that end to the (cubic) hull."""
+    robot = rrc_pin.load("panda")
+    cm = CollisionModel(robot)
+    q = robot.ready()
+    data = robot.model.createData()
+    pin.forwardKinematics(robot.model, data, robot.to_pinocchio(q))
+    geometry = cm.scene.geometry
+    gdata = pin.GeometryData(geometry)
+    pin.updateGeometryPlacements(robot.model, data, geometry, gdata)
+    (link,) = [i for i, o in enumerate(geometry.geometryObjects) if o.name == "panda_link5_0"]
+    capsule = geometry.geometryObjects[link].geometry
+    M = gdata.oMg[link]
+    ends = [M.act(np.array([0.0, 0.0, s * capsule.halfLength])) for s in (-1.0, 1.0)]
+    half = 0.05  # a cube beside the link, nearer one end, its axis skew to the cube's faces
+    centre = ends[0] + M.rotation @ np.array([capsule.radius + half + 0.03, 0.0, 0.02])
+    corners = np.array([[x, y, z] for x in (-half, half) for y in (-half, half)
+                        for z in (-half, half)])  # fmt: skip
+    T = np.eye(4)
+    T[:3, 3] = centre
+    cm.add_convex(T, corners, name="cube")
+
+    def to_cube(p):
+        return float(np.linalg.norm(np.maximum(np.abs(p - centre) - half, 0.0))) - capsule.radius
+
+    prox = cm.proximity_at(q, 0.3, ends=True)
+    rows = [k for k, names in enumerate(prox.names) if names == ("panda_link5_0", "cube")]
+    assert len(rows) == 3  # the closest points, then each end
+    for k, p in zip(rows[1:], ends, strict=True):
+        assert abs(prox.distance[k] - to_cube(p)) < 1e-6  # GJK's tolerance
+    assert prox.distance[rows[0]] <= min(prox.distance[rows[1:]]) + 1e-6
+    assert cm.proximity_at(q, 0.3).names.count(("panda_link5_0", "cube")) == 1  # no ends

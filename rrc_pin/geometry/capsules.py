@@ -10,6 +10,16 @@ the pairs. The capsule's axis joins the two sphere centres (it holds the spheres
 URDF that rounds its angles (``panda_collision.urdf`` writes pi/2 as 1.57) puts the spheres
 off the cylinder's ends by up to :data:`MATCH_TOL`, and the capsule's side then differs from
 the cylinder's by as much.
+
+A cylinder without its end spheres (baxter's links) becomes the capsule that bounds it: the
+same axis, radius and length, with a half-sphere of its radius added at each end; a box
+(baxter's fingers) the capsule along its longest side, of radius the half-diagonal of its
+cross-section. The capsule holds the shape, so distances to it are conservative (shorter by
+at most its radius), and every link gets the compiled capsule formulas and their end-point
+rows (:mod:`solvers.narrow_kernels`) instead of coal's GJK without them: a box's or
+cylinder's closest point jumps across a face in one step where a capsule's end is already
+constrained (baxter's 10-minute session went 3.5 mm below the safety distance on cylinders,
+docs/api.md).
 """
 
 from __future__ import annotations
@@ -24,18 +34,21 @@ MATCH_TOL = 1e-4
 panda_collision.urdf's 1.57 for pi/2 moves its hand's sphere centres 0.06 mm)."""
 
 
-def merge_capsules(geometry: pin.GeometryModel) -> pin.GeometryModel:
-    """A copy of ``geometry`` with every cylinder-and-end-spheres triple made one capsule.
+def to_capsules(geometry: pin.GeometryModel) -> pin.GeometryModel:
+    """A copy of ``geometry`` with every cylinder and box made a capsule (module docstring).
 
     A cylinder merges with two spheres of its radius on the same frame centred on the two
     ends of its axis (each sphere used once); the capsule takes the cylinder's name and
-    placement. Everything else is kept as it is, in order.
+    placement. A cylinder without both spheres, and a box, become their bounding capsules.
+    Everything else is kept as it is, in order.
     """
     objects = list(geometry.geometryObjects)
     used: set[int] = set()
     capsules: dict[int, tuple[coal.Capsule, pin.SE3]] = {}
     for i, obj in enumerate(objects):
         shape = obj.geometry
+        if isinstance(shape, coal.Box):
+            capsules[i] = _bounding(shape, obj.placement)
         if not isinstance(shape, coal.Cylinder):
             continue
         ends = [obj.placement.act(np.array([0.0, 0.0, s * shape.halfLength])) for s in (-1, 1)]
@@ -43,6 +56,7 @@ def merge_capsules(geometry: pin.GeometryModel) -> pin.GeometryModel:
         high = _sphere_at(objects, used | {low} if low is not None else used, obj.parentFrame,
                           ends[1], shape.radius)  # fmt: skip
         if low is None or high is None:
+            capsules[i] = (coal.Capsule(shape.radius, 2.0 * shape.halfLength), obj.placement)
             continue
         used.update((low, high))
         a, b = objects[low].placement.translation, objects[high].placement.translation
@@ -56,6 +70,15 @@ def merge_capsules(geometry: pin.GeometryModel) -> pin.GeometryModel:
             pin.GeometryObject(obj.name, obj.parentJoint, obj.parentFrame, placement, shape)
         )
     return out
+
+
+def _bounding(box: coal.Box, placement: pin.SE3) -> tuple[coal.Capsule, pin.SE3]:
+    """The capsule holding ``box``: along its longest side, through its centre."""
+    half = np.asarray(box.halfSide, dtype=float)
+    i = int(np.argmax(half))
+    radius = float(np.hypot(*np.delete(half, i)))
+    turn = np.roll(np.eye(3), 2 - i, axis=1)  # a rotation whose z axis is the box's axis i
+    return coal.Capsule(radius, 2.0 * float(half[i])), placement * pin.SE3(turn, np.zeros(3))
 
 
 def _axis(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> pin.SE3:

@@ -25,12 +25,13 @@ from collections.abc import Callable
 from operator import itemgetter
 from typing import NamedTuple, TypeVar
 
+import coal
 import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.geometry.scene import Scene
-from solvers.narrow_kernels import narrow_phase
+from solvers.narrow_kernels import BOX, CAPSULE, SPHERE, narrow_phase
 from solvers.proximity_kernels import joint_poses, near_pairs, world_centres
 
 Array = npt.NDArray[np.float64]
@@ -144,7 +145,7 @@ def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Dat
                                 detection, ends, cdata.pair, cdata.distance, cdata.point_a,
                                 cdata.point_b, cdata.normal, cdata.end, cdata.other)  # fmt: skip
     if others:
-        rows = _coal(scene, model, placed(), cdata, detection, rows, others)
+        rows = _coal(scene, model, placed(), cdata, detection, rows, others, ends)
     if rows == 0:
         return EMPTY
     index = cdata.pair[:rows].copy()
@@ -175,8 +176,13 @@ def gather(items: tuple[T, ...], index: Index) -> tuple[T, ...]:
 
 
 def _coal(scene: Scene, model: pin.Model, data: pin.Data, cdata: CollisionData,
-          detection: float, rows: int, others: int) -> int:  # fmt: skip
+          detection: float, rows: int, others: int, ends: bool) -> int:  # fmt: skip
     """Append coal's rows for the ``others`` candidates of other shapes after ``rows``.
+
+    With ``ends``, a capsule against a shape the compiled phase leaves to coal (a hull, a
+    cylinder, a mesh; a box that is the pair's first body) also gets its end points' rows here:
+    each end as a sphere of the capsule's radius against the other body, as the compiled phase
+    does for a capsule against a box.
 
     Returns:
         The number of rows now written.
@@ -186,23 +192,47 @@ def _coal(scene: Scene, model: pin.Model, data: pin.Data, cdata: CollisionData,
     pin.updateGeometryPlacements(model, data, geometry, gdata)
     for k in cdata.other[:others].tolist():
         result = pin.computeDistance(geometry, gdata, k)
-        d = result.min_distance
-        if d < detection:
-            cdata.pair[rows] = k
-            cdata.end[rows] = 0
-            cdata.distance[rows] = d
-            point_a, point_b = result.getNearestPoint1(), result.getNearestPoint2()
-            cdata.point_a[rows] = point_a
-            cdata.point_b[rows] = point_b
-            cdata.normal[rows] = _unit(
-                result.normal,
-                d,
-                point_a,
-                point_b,
-                cdata.world[scene.second[k]] - cdata.world[scene.first[k]],
-            )
-            rows += 1
+        if result.min_distance >= detection:
+            continue
+        a, b = int(scene.first[k]), int(scene.second[k])
+        rows = _coal_row(scene, cdata, k, result, 0, rows)
+        if not ends:
+            continue
+        for side, g, o in ((0, a, b), (1, b, a)):
+            if scene.shape[g] != CAPSULE or scene.shape[o] in (CAPSULE, SPHERE) or (
+                side == 0 and scene.shape[o] == BOX  # the compiled phase wrote these ends
+            ):
+                continue
+            sphere = coal.Sphere(float(scene.size[g]))
+            other = geometry.geometryObjects[o].geometry
+            M = cdata.poses[scene.joint[g]]
+            there = coal.Transform3s(gdata.oMg[o].rotation, gdata.oMg[o].translation)
+            for e in range(2):
+                centre = M[:3, :3] @ scene.segment[g, e] + M[:3, 3]
+                at = coal.Transform3s(np.eye(3), centre)
+                end_result = coal.DistanceResult()
+                if side == 0:
+                    coal.distance(sphere, at, other, there, coal.DistanceRequest(), end_result)
+                else:
+                    coal.distance(other, there, sphere, at, coal.DistanceRequest(), end_result)
+                if end_result.min_distance < detection:
+                    rows = _coal_row(scene, cdata, k, end_result, 1, rows)
     return rows
+
+
+def _coal_row(scene: Scene, cdata: CollisionData, k: int, result: coal.DistanceResult,
+              end: int, rows: int) -> int:  # fmt: skip
+    """Write coal's ``result`` for pair ``k`` as row ``rows`` (``end``: an end point's)."""
+    d = result.min_distance
+    cdata.pair[rows] = k
+    cdata.end[rows] = end
+    cdata.distance[rows] = d
+    point_a, point_b = result.getNearestPoint1(), result.getNearestPoint2()
+    cdata.point_a[rows] = point_a
+    cdata.point_b[rows] = point_b
+    centres = cdata.world[scene.second[k]] - cdata.world[scene.first[k]]
+    cdata.normal[rows] = _unit(result.normal, d, point_a, point_b, centres)
+    return rows + 1
 
 
 def _distinct(order: Index, cdata: CollisionData) -> npt.NDArray[np.bool_]:

@@ -15,7 +15,8 @@ Where the geometry comes from (:func:`robot_geometry`):
   bodies of two different arms is active (but for two bodies fixed to the world).
 
 Variants (``geometry=``): ``"capsules"`` (the cylinder-and-sphere triples of a capsule model
-merged into capsules, :mod:`~rrc_pin.geometry.capsules`; the paper arms and panda), ``"hulls"``
+merged into capsules, other cylinders and boxes bounded by capsules, meshes as hulls,
+:mod:`~rrc_pin.geometry.capsules`; the paper arms, panda and baxter), ``"hulls"``
 (every mesh made its convex hull, :mod:`~rrc_pin.geometry.hulls`), ``"urdf"`` (the URDF's
 geometry as it is: meshes stay triangle meshes, which coal cannot sign in penetration). The
 default is ``"capsules"`` where the robot has them, else ``"hulls"``.
@@ -36,7 +37,7 @@ import pinocchio as pin
 
 from rrc_pin.combine import Combined
 from rrc_pin.errors import InvalidInput, URDFError
-from rrc_pin.geometry.capsules import merge_capsules
+from rrc_pin.geometry.capsules import to_capsules
 from rrc_pin.geometry.hulls import with_hulls
 from rrc_pin.geometry.pairs import Pair, Reason, all_pairs, in_contact, kinematic_reason
 from rrc_pin.link_capsules import always_touching
@@ -49,8 +50,13 @@ VARIANTS: tuple[str, ...] = ("capsules", "hulls", "urdf")
 
 CAPSULE_URDFS: dict[str, str] = {
     "panda": "panda_description/urdf/panda_collision.urdf",
+    "baxter": "baxter_description/urdf/baxter.urdf",
+    "baxter_left": "baxter_description/urdf/baxter.urdf",
+    "baxter_right": "baxter_description/urdf/baxter.urdf",
 }
-"""Capsule variants example-robot-data ships (cylinders between spheres), by robot name."""
+"""The URDFs of the capsule variants, by robot name: panda's capsule model that
+example-robot-data ships (cylinders between spheres), baxter's own URDF (its links are
+cylinders and boxes, bounded by capsules; its torso and pedestal meshes become hulls)."""
 
 COLLISION_SRDFS: dict[str, str] = {
     "panda": "panda_description/srdf/panda.srdf",
@@ -293,7 +299,7 @@ def _source(robot: Robot, variant: str) -> _Source:
     model, objects = _read(text, path, folder)
     srdf_removed = _srdf_pairs(model, objects, srdf) if srdf is not None else frozenset()
     if variant == "capsules":
-        objects = merge_capsules(objects)
+        objects = with_hulls(to_capsules(objects))
     elif variant == "hulls":
         objects = with_hulls(objects)
     source = _Source(model, objects, srdf_removed, always)
