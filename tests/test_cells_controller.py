@@ -266,3 +266,30 @@ def test_the_log_saves_as_csv(dual, tmp_path):
         ctl.save(tmp_path / "cell.npz")
     with pytest.raises(InvalidInput, match="path: cannot write"):
         ctl.save(tmp_path / "missing" / "cell.csv")
+
+
+@pytest.mark.parametrize("collision", [True, False])
+def test_collision_limits_hold_on_a_floating_cell(tripod, collision):
+    """A CollisionLimit on the tripod's capsules (a floating base): the swinging foot, lifted
+    toward a ball 0.15 m above it, stops at the safety distance (0.02 m, to 1e-5 m); without
+    the limit it goes into the ball. The feet in support do not slip either way."""
+    model = rrc_pin.CollisionModel(tripod, "capsules")
+    ball = model.add_sphere(tripod.fk(tripod.ready(), "leg1/flange")[:3, 3] + [0.0, 0.0, 0.15],
+                            0.05)  # fmt: skip
+    limit = rrc_pin.CollisionLimit(model)
+    ctl = CellController(tripod, 0.01, limits=[rrc_pin.JointLimits(), limit] if collision
+                         else None)  # fmt: skip
+    ctl.swing("leg1")
+    feet = {f: tripod.fk(ctl.q, f)[:3, 3] for f in ("leg2/flange", "leg3/flange")}
+    closest = np.inf
+    for _ in range(150):  # 1.5 s at 0.1 m/s: 0.15 m up
+        ctl.step({"leg1": [0.0, 0.0, 0.1, 0.0, 0.0, 0.0]})
+        prox = model.proximity_at(ctl.q, 0.3)
+        closest = min([closest, *[d for n, d in zip(prox.names, prox.distance, strict=True)
+                                  if ball in n]])  # fmt: skip
+    if collision:
+        assert closest == pytest.approx(limit.safety, abs=1e-5), closest
+    else:
+        assert closest < -0.05, closest
+    slip = max(np.linalg.norm(tripod.fk(ctl.q, f)[:3, 3] - p) for f, p in feet.items())
+    assert slip < 1e-9, slip

@@ -36,7 +36,7 @@ from __future__ import annotations
 import csv
 import math
 import os
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Literal, NamedTuple
 
@@ -156,7 +156,10 @@ class CellController(Loop):
         cell: A :class:`~rrc_pin.cells.Cell` or a ready-made cell's name.
         dt: Control period [s].
         q0: Initial configuration (nq,); default the ready pose.
-        limits: Joint limits (default ``JointLimits()``).
+        limits: The resolver's limits: joint limits (default ``JointLimits()``), or a list of
+            limits (joint limits, a :class:`~rrc_pin.limits.CollisionLimit` on the cell's
+            :class:`~rrc_pin.geometry.CollisionModel`, ...); the support's contacts and the
+            grip are added.
         qp: The resolver's QP options.
         damping: The resolver's damping, or None.
         deadman: How a command ages (default ``Deadman()``), or None.
@@ -185,7 +188,7 @@ class CellController(Loop):
         dt: float = 0.01,
         q0: npt.ArrayLike | None = None,
         *,
-        limits: JointLimits | None = None,
+        limits: Limit | Sequence[Limit] | None = None,
         qp: QPOptions | None = None,
         damping: Damping | None = Damping(),  # noqa: B008 - immutable
         deadman: Deadman | None = Deadman(),  # noqa: B008 - immutable
@@ -199,13 +202,17 @@ class CellController(Loop):
             cell = load(cell)  # type: ignore[assignment]
         if not isinstance(cell, Cell):
             raise InvalidInput("cell", f"expected a Cell or a cell's name, got {cell!r}")
-        if limits is not None and not isinstance(limits, JointLimits):
-            raise InvalidInput("limits", f"expected JointLimits or None, got {limits!r}")
+        given: list[Limit]
+        if limits is None:
+            given = [JointLimits()]
+        elif isinstance(limits, Sequence):
+            given = list(limits)
+        else:
+            given = [limits]
         gain = positive(gain, "gain")
         self.contact = ContactLimit((), name="contact")
         self.grip = GripLimit((), name="grip")
-        joint_limits: list[Limit] = [JointLimits() if limits is None else limits]
-        super().__init__(cell, dt, q0, limits=[*joint_limits, self.contact, self.grip], qp=qp,
+        super().__init__(cell, dt, q0, limits=[*given, self.contact, self.grip], qp=qp,
                          damping=damping, deadman=deadman, speed=speed)  # fmt: skip
         self.cell = cell
         self.gain = gain
