@@ -1,5 +1,6 @@
-"""One tick of a multi-arm cell's controller: gsfc_dual and yeh_tripod, with and without
-collision constraints.
+"""One tick of a multi-arm cell's controller, with and without collision constraints.
+
+The cells: gsfc_dual and yeh_tripod.
 
 Run from a checkout: ``python benchmarks/bench_cells.py --out DIR`` (``--record`` writes
 ``benchmarks/results/cells.json`` and ``.png``, ``--quick`` a short smoke run);
