@@ -115,9 +115,6 @@ class CellLog(RecordRing[CellRecord]):
     def __iter__(self) -> Iterator[CellRecord]:
         return iter(self.records)
 
-    def __getitem__(self, index: int) -> CellRecord:
-        return self.records[index]
-
     def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the log as CSV (one row per tick, a header) to ``path``; return the path.
 

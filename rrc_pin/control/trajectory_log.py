@@ -132,12 +132,25 @@ class RecordRing(Generic[R]):
     @property
     def records(self) -> list[R]:
         """The records kept, in time order, as a new list (the ticks pending derived now)."""
+        self._derive_pending()
+        return list(self._entries)  # type: ignore[arg-type]  # every entry derived above
+
+    def __getitem__(self, index: int) -> R:
+        """Record ``index`` (negative from the newest), without copying the others.
+
+        Raises:
+            IndexError: No such record.
+        """
+        self._derive_pending()
+        return self._entries[index]  # type: ignore[return-value]  # derived above
+
+    def _derive_pending(self) -> None:
+        """Turn the ticks not yet derived into their records, in place."""
         if self._pending:
             assert self._derive is not None  # append_tick refuses a log without derive
             ticks = [self._entries.pop() for _ in range(self._pending)][::-1]
             self._entries.extend(map(self._derive, ticks))
             self._pending = 0
-        return list(self._entries)  # type: ignore[arg-type]  # every entry derived above
 
     def append(self, record: R) -> None:
         """Add one tick's record (forgetting the oldest tick when the log is full).
@@ -148,7 +161,7 @@ class RecordRing(Generic[R]):
         if not isinstance(record, self.record_type):
             raise InvalidInput("record", f"expected a {self.record_type.__name__}, got "
                                f"{type(record).__name__}")  # fmt: skip
-        self.records  # noqa: B018 - derive the pending ticks first: they are older
+        self._derive_pending()  # they are older
         self._push(record)
 
     def append_tick(self, tick: tuple[Any, ...]) -> None:
