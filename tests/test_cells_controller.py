@@ -293,3 +293,19 @@ def test_collision_limits_hold_on_a_floating_cell(tripod, collision):
         assert closest < -0.05, closest
     slip = max(np.linalg.norm(tripod.fk(ctl.q, f)[:3, 3] - p) for f, p in feet.items())
     assert slip < 1e-9, slip
+
+
+def test_setting_q_moves_the_targets_and_anchors_there(tripod):
+    """q set from outside (a new start): the feet in support are anchored where they are
+    then, and a tick without command stays there (no pull back to the old pose)."""
+    ctl = CellController(tripod, 0.01)
+    q = ctl.q.copy()
+    q[2] -= 0.02  # the body 2 cm lower, the feet through the floor: anchored there
+    ctl.q = q
+    with pytest.raises(InvalidInput, match="q: "):
+        ctl.q = np.zeros(3)
+    np.testing.assert_array_equal(ctl.q, q)
+    np.testing.assert_allclose(ctl.target("body"), tripod.fk(q, "body"), atol=1e-15)
+    for _ in range(10):
+        ctl.step()
+    np.testing.assert_allclose(ctl.q, q, atol=1e-9)

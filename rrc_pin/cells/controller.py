@@ -355,6 +355,14 @@ class CellController(Loop):
         self._commands = {}
         self._reanchor()
 
+    def _configuration_set(self) -> None:
+        """Targets and the feet's anchors at the configuration set.
+
+        A cell set elsewhere stays there: the targets' feedback and the projection would
+        pull it back to the old poses and anchors.
+        """
+        self._reanchor()
+
     def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the log as CSV to ``path`` (:meth:`CellLog.save`); return the path."""
         return self.log.save(path)

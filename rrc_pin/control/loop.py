@@ -110,7 +110,7 @@ class Loop:
         self.robot = robot
         self.resolver = Resolver(robot, dt, limits=limits, qp=qp, damping=damping)
         self.dt = self.resolver.dt
-        self.q = robot.ready() if q0 is None else robot.check_q(q0, "q0")
+        self._q = self._checked_q(robot.ready() if q0 is None else q0, "q0")
         self.speed = speed
         self.deadman = deadman
         self.t = 0.0
@@ -128,9 +128,18 @@ class Loop:
 
     @q.setter
     def q(self, value: npt.ArrayLike) -> None:
-        q: Array = self.robot.check_q(value, "q").copy()
+        self._q = self._checked_q(value, "q")
+        self._configuration_set()
+
+    def _checked_q(self, value: npt.ArrayLike, name: str) -> Array:
+        """``value`` as a read-only copy of a valid configuration (nq,).
+
+        Raises:
+            InvalidInput: Not a finite (nq,) vector, naming ``name``.
+        """
+        q: Array = self.robot.check_q(value, name).copy()
         q.flags.writeable = False
-        self._q = q
+        return q
 
     @property
     def speed(self) -> float:
@@ -206,6 +215,9 @@ class Loop:
     def _stopped(self) -> None:
         """Forget the commands and reset the reference poses (after :meth:`reverse`)."""
         raise NotImplementedError
+
+    def _configuration_set(self) -> None:
+        """The configuration was set from outside (``q = ...``); nothing by default."""
 
     # -- shared steps -----------------------------------------------------------------------
 
