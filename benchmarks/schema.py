@@ -8,12 +8,14 @@ least one ratio to a baseline measured in the same run (``vs_<baseline>_median``
 ``_p99``); the closed forms: both timings with their spread and the speed-ups; the study:
 an error and a fitted order per quantity; the controller: its tick rows, and per session the
 tick times, NaN, limit excess and drift; the control schemes: the scenarios' errors and the
-step-time rows. ``schema`` 2 (written by the closed-form benchmark since it records the
-spread of its timings) also requires the closed forms' p10, p90, p99; files without the key
-are version 1. The resolver and tasks benchmarks (``schema`` 3, the peers side by side in one
-process): each peer's status is ``ran`` (its rows present in every mode) or "not in this
-environment..." (no row of it), every peer ran in a full run, each peer's kinematics within
-:data:`GAP_TOL` of Pinocchio's, and every contender's answers judged (``quality``).
+step-time rows; the cells: per cell a tick without and with collision constraints (or the
+refusal), each with its statistics and loop rate. ``schema`` 2 (written by the closed-form
+benchmark since it records the spread of its timings) also requires the closed forms' p10,
+p90, p99; files without the key are version 1. The resolver and tasks benchmarks
+(``schema`` 3, the peers side by side in one process): each peer's status is ``ran`` (its
+rows present in every mode) or "not in this environment..." (no row of it), every peer ran
+in a full run, each peer's kinematics within :data:`GAP_TOL` of Pinocchio's, and every
+contender's answers judged (``quality``).
 """
 
 from __future__ import annotations
@@ -24,8 +26,10 @@ from typing import Any
 
 KNOWN = (
     "closed_form", "resolver", "tasks", "study", "scaling", "controller", "control_schemes", "maps",
-    "collision",
+    "collision", "cells",
 )
+CELLS = ("gsfc_dual", "yeh_tripod")
+"""The cells the cell benchmark times (issue 30)."""
 MACHINE = ("cpu", "cores", "python", "numpy", "pinocchio")
 STATS = ("median_us", "p10_us", "p90_us", "p99_us")
 GAP_TOL = 1e-9
@@ -57,6 +61,7 @@ def problems(results: dict[str, Any]) -> list[str]:
         "control_schemes": _control_schemes,
         "maps": _maps,
         "collision": _collision,
+        "cells": _cells,
     }[name]
     out += list(check(results))
     return out
@@ -273,6 +278,41 @@ def _collision(results: dict[str, Any]) -> Iterator[str]:
                 yield f"{where}.{key}: expected a positive number"
         if not isinstance(r.get("min_distance_m"), (int, float)):
             yield f"{where}.min_distance_m: expected a number"
+
+
+def _cells(results: dict[str, Any]) -> Iterator[str]:
+    """Per cell a tick without and with collision constraints (or the refusal, said)."""
+    rows = results.get("rows") or []
+    not_run = results.get("not_run")
+    if not isinstance(not_run, list):
+        yield "not_run: expected a list (empty when every case ran)"
+        not_run = []
+    for n in not_run:
+        if not (isinstance(n.get("reason"), str) and n["reason"]):
+            yield f"not_run.{n.get('cell')}.{n.get('limits')}.reason: expected the refusal"
+    for cell in CELLS:
+        mine = [r for r in rows if r.get("cell") == cell]
+        if not any(r.get("collision") is False for r in mine):
+            yield f"rows.{cell}: no tick without collision constraints"
+        if not any(r.get("collision") is True for r in mine) and not any(
+            n.get("cell") == cell for n in not_run
+        ):
+            yield f"rows.{cell}: no tick with collision constraints, and no reason in not_run"
+    for r in rows:
+        where = f"rows.{r.get('cell')}.{r.get('limits')}"
+        for key in (*STATS, "rate_hz_median", "rate_hz_p99", "ticks"):
+            if not _positive(r.get(key)):
+                yield f"{where}.{key}: expected a positive number"
+        if not isinstance(r.get("collision"), bool):
+            yield f"{where}.collision: expected true or false"
+        if not r.get("statuses"):
+            yield f"{where}.statuses: empty"
+        if r.get("collision") is True:
+            if not (isinstance(r.get("collision_ticks"), int) and r["collision_ticks"] >= 0):
+                yield f"{where}.collision_ticks: expected a count"
+            distance = r.get("min_distance_m")
+            if not (distance is None or _finite(distance)):
+                yield f"{where}.min_distance_m: expected a number or null (no rows)"
 
 
 def _finite(value: Any) -> bool:

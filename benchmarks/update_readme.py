@@ -48,6 +48,7 @@ BENCHMARKS = {
         "bench_collision.py",
         "Collision avoidance on two facing pandas: rrc-pin, mink, pink",
     ),
+    "cells": ("bench_cells.py", "Multi-arm cells: one controller tick on gsfc_dual and yeh_tripod"),
 }
 """Benchmark name: (script, title), in the order of the documents."""
 DOCS_ONLY = ("study", "scaling", "control_schemes")

@@ -17,7 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 import rrc_pin
-from rrc_pin.cells import CellController, MasterSlave
+from rrc_pin.cells import MasterSlave
 
 QUICK = os.environ.get("RRC_PIN_EXAMPLES_QUICK") == "1"
 DT = 0.01
@@ -35,7 +35,7 @@ def master_pose(t: float) -> np.ndarray:
 def main() -> None:
     """Drive the object from the synthetic master and print what the session shows."""
     cell = rrc_pin.load("gsfc_dual")
-    ctl = CellController(cell, dt=DT)
+    ctl = rrc_pin.Controller(cell, dt=DT)  # a cell: the cell's controller (CellController)
     master = MasterSlave(scale=2.0, rotation=np.eye(3), dt=DT)
     ticks = round(SECONDS / DT)
     start = cell.fk(ctl.q, "object")[:3, 3]

@@ -340,6 +340,7 @@ BENCHMARKS = (
     "control_schemes",
     "maps",
     "collision",
+    "cells",
 )
 BENCH_MODULES = {
     "closed_form": ("matplotlib",),
@@ -351,6 +352,7 @@ BENCH_MODULES = {
     "control_schemes": ("matplotlib",),
     "maps": ("distributed", "zarr", "matplotlib"),
     "collision": ("pink", "mink", "mujoco", "matplotlib"),
+    "cells": ("matplotlib",),
 }
 """What each benchmark needs from the bench extra. The resolver and tasks benchmarks also need
 PlaCo, mink and Drake for a full run (they refuse without, naming what is missing); a quick run

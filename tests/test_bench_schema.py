@@ -137,3 +137,21 @@ def test_control_schemes_doc_is_generated_from_the_results():
     text = (ROOT / "docs" / "control_schemes.md").read_text()
     section = text.split(update_readme.SCHEMES_START, 1)[1].split(update_readme.SCHEMES_END)[0]
     assert section == "\n" + update_readme.render_schemes(update_readme.RESULTS)
+
+
+def test_the_cells_schema_wants_each_cell_with_and_without_collision():
+    """Issue 30: each cell's tick without collision constraints, and with them or the
+    refusal said in not_run."""
+    recorded = json.loads((ROOT / "benchmarks" / "results" / "cells.json").read_text())
+    assert schema.problems(recorded) == []
+    assert {r["cell"] for r in recorded["rows"]} == set(schema.CELLS)
+    dropped = copy.deepcopy(recorded)
+    dropped["rows"] = [r for r in dropped["rows"]
+                       if not (r["cell"] == "yeh_tripod" and r["collision"])]  # fmt: skip
+    assert schema.problems(dropped) == [
+        "rows.yeh_tripod: no tick with collision constraints, and no reason in not_run"]
+    dropped["not_run"] = [{"cell": "yeh_tripod", "limits": "collision", "reason": "refused"}]
+    assert schema.problems(dropped) == []
+    slow = copy.deepcopy(recorded)
+    del slow["rows"][0]["rate_hz_p99"]
+    assert any("rate_hz_p99" in p for p in schema.problems(slow))

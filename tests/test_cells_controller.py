@@ -194,13 +194,58 @@ def test_free_hands_take_world_local_and_base_axes(dual):
         np.testing.assert_allclose(achieved, np.r_[R @ twist[:3], R @ twist[3:]], atol=1e-9)
 
 
-def test_reverse_retraces_the_record(dual):
-    ctl = CellController(dual, 0.01)
+@pytest.mark.parametrize(("name", "command"), [("object", [0.05, 0.0, 0.02, 0.0, 0.0, 0.1]),
+                                               ("body", [0.02, 0.0, 0.01, 0.0, 0.0, 0.1])])
+def test_reverse_retraces_the_record(dual, tripod, name, command):
+    """One tick per recorded configuration (the projection's offsets passed, ``passing``),
+    perhaps one more to reach the start to rounding; the feet kept in support."""
+    cell = dual if name == "object" else tripod
+    ctl = CellController(cell, 0.01)
     start = ctl.q.copy()
+    feet = {f: cell.fk(ctl.q, f) for f in ctl.support}
     for _ in range(30):
-        ctl.step({"object": [0.05, 0.0, 0.02, 0.0, 0.0, 0.1]})
-    assert ctl.reverse(0.3) == 30
-    np.testing.assert_allclose(ctl.q, start, atol=1e-6)
+        ctl.step({name: command})
+    done = ctl.reverse(0.3)
+    assert done.steps in (30, 31) and done.reached and done.error < 1e-9, done  # +1: the start
+    np.testing.assert_allclose(ctl.q, start, atol=1e-9)
+    assert all(rec.mode == "reverse" for rec in ctl.log.records[30:])
+    slip = max((np.linalg.norm(cell.fk(ctl.q, f)[:3, 3] - T[:3, 3]) for f, T in feet.items()),
+               default=0.0)  # fmt: skip
+    assert slip < 1e-9, slip
+    with pytest.raises(InvalidInput, match="seconds: asked to reverse"):
+        ctl.reverse(10.0)
+
+
+def test_controller_of_a_cell_is_the_cells_loop(dual):
+    """rrc_pin.Controller(cell) makes the cell's controller, on the same loop as one arm's."""
+    for robot in (dual, "gsfc_dual"):
+        ctl = rrc_pin.Controller(robot, 0.01, gain=5.0)
+        assert type(ctl) is CellController and ctl.gain == 5.0
+        assert isinstance(ctl, rrc_pin.control.Loop)
+        assert isinstance(rrc_pin.Controller("panda"), rrc_pin.control.Loop)
+    ctl.speed = 0.5
+    ctl.step({"object": [0.02, 0.0, 0.0, 0.0, 0.0, 0.0]})
+    assert ctl.log[-1].scale == pytest.approx(1.0)
+    with pytest.raises(TypeError, match="strategy"):  # one arm's keyword
+        rrc_pin.Controller(dual, strategy="slowdown")
+
+
+def test_the_speed_override_scales_every_command(dual):
+    full, half = CellController(dual, 0.01, damping=None), CellController(dual, 0.01, damping=None)
+    half.speed = 0.5
+    twist = [0.02, 0.01, 0.0, 0.0, 0.0, 0.05]
+    a, b = full.step({"object": twist}), half.step({"object": twist})
+    np.testing.assert_allclose(b.resolution.qdot, 0.5 * a.resolution.qdot, atol=1e-9)
+    with pytest.raises(InvalidInput, match="speed"):
+        half.speed = 1.5
+    assert half.speed == 0.5
+
+
+def test_a_robot_with_several_tool_frames_that_is_no_cell_names_tool_frame_and_cells(dual):
+    arm = rrc_pin.load("kr5_3r")
+    both = rrc_pin.combine({"a": (arm, np.eye(4)), "b": (arm, np.eye(4))})
+    with pytest.raises(InvalidInput, match=r"robot: .*tool_frame=.*make_cell"):
+        rrc_pin.Controller(both)
 
 
 def test_the_deadman_stops_a_stale_command(dual):
@@ -217,3 +262,50 @@ def test_the_log_saves_as_csv(dual, tmp_path):
         ctl.step({"object": [0.01, 0, 0, 0, 0, 0]})
     text = ctl.save(tmp_path / "cell.csv").read_text().splitlines()
     assert len(text) == 4 and text[0].startswith("t,mode,status,scale,levels,error:object")
+    with pytest.raises(InvalidInput, match="path: expected a .csv"):
+        ctl.save(tmp_path / "cell.npz")
+    with pytest.raises(InvalidInput, match="path: cannot write"):
+        ctl.save(tmp_path / "missing" / "cell.csv")
+
+
+@pytest.mark.parametrize("collision", [True, False])
+def test_collision_limits_hold_on_a_floating_cell(tripod, collision):
+    """A CollisionLimit on the tripod's capsules (a floating base): the swinging foot, lifted
+    toward a ball 0.15 m above it, stops at the safety distance (0.02 m, to 1e-5 m); without
+    the limit it goes into the ball. The feet in support do not slip either way."""
+    model = rrc_pin.CollisionModel(tripod, "capsules")
+    ball = model.add_sphere(tripod.fk(tripod.ready(), "leg1/flange")[:3, 3] + [0.0, 0.0, 0.15],
+                            0.05)  # fmt: skip
+    limit = rrc_pin.CollisionLimit(model)
+    ctl = CellController(tripod, 0.01, limits=[rrc_pin.JointLimits(), limit] if collision
+                         else None)  # fmt: skip
+    ctl.swing("leg1")
+    feet = {f: tripod.fk(ctl.q, f)[:3, 3] for f in ("leg2/flange", "leg3/flange")}
+    closest = np.inf
+    for _ in range(150):  # 1.5 s at 0.1 m/s: 0.15 m up
+        ctl.step({"leg1": [0.0, 0.0, 0.1, 0.0, 0.0, 0.0]})
+        prox = model.proximity_at(ctl.q, 0.3)
+        closest = min([closest, *[d for n, d in zip(prox.names, prox.distance, strict=True)
+                                  if ball in n]])  # fmt: skip
+    if collision:
+        assert closest == pytest.approx(limit.safety, abs=1e-5), closest
+    else:
+        assert closest < -0.05, closest
+    slip = max(np.linalg.norm(tripod.fk(ctl.q, f)[:3, 3] - p) for f, p in feet.items())
+    assert slip < 1e-9, slip
+
+
+def test_setting_q_moves_the_targets_and_anchors_there(tripod):
+    """q set from outside (a new start): the feet in support are anchored where they are
+    then, and a tick without command stays there (no pull back to the old pose)."""
+    ctl = CellController(tripod, 0.01)
+    q = ctl.q.copy()
+    q[2] -= 0.02  # the body 2 cm lower, the feet through the floor: anchored there
+    ctl.q = q
+    with pytest.raises(InvalidInput, match="q: "):
+        ctl.q = np.zeros(3)
+    np.testing.assert_array_equal(ctl.q, q)
+    np.testing.assert_allclose(ctl.target("body"), tripod.fk(q, "body"), atol=1e-15)
+    for _ in range(10):
+        ctl.step()
+    np.testing.assert_allclose(ctl.q, q, atol=1e-9)

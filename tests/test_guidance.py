@@ -417,3 +417,78 @@ def test_type_iii_turns_gradually_up_to_a_half_turn(degrees):
         points = np.stack([goal[:3, 3], goal[:3, 3] + goal[:3, 2], goal[:3, 3] + goal[:3, 0]])
         with pytest.raises(InvalidInput, match="^goal_points: division 10 of 20: the divided"):
             straight_line_points(arm, q0, points, k, spacing=1.0)
+
+
+# -- frame=: one frame of a robot with several tool frames ------------------------------------
+
+
+@pytest.fixture(scope="module")
+def dual():
+    return rrc_pin.load("gsfc_dual")
+
+
+def _goal_of(cell, q, frame):
+    """A goal 5 cm and 0.2 rad from ``frame``'s pose at ``q``."""
+    T = cell.fk(q, frame)
+    goal = T.copy()
+    goal[:3, 3] += [0.03, -0.02, 0.04]
+    goal[:3, :3] = pin.exp3(np.array([0.0, 0.2, 0.1])) @ T[:3, :3]
+    return goal
+
+
+@pytest.mark.parametrize("solver", ["thesis", "resolver"])
+@pytest.mark.parametrize("kind", ["straight_line", "screw_motion", "general"])
+def test_guidance_takes_frame_on_a_cell(dual, kind, solver):
+    """The frame named reaches its goal; the other arm's joints do not move."""
+    q0 = dual.ready()
+    goal = _goal_of(dual, q0, "left/tool")
+    run = {"straight_line": straight_line, "screw_motion": screw_motion, "general": general}[kind]
+    chosen = rrc_pin.Resolver(dual, dt=1.0) if solver == "resolver" else "thesis"
+    path = run(dual, q0, goal, 10, solver=chosen, correction="newton", frame="left/tool")
+    end = dual.fk(path.q[-1], "left/tool")
+    assert np.linalg.norm(end[:3, 3] - goal[:3, 3]) < 1e-6
+    assert np.abs(pin.log3(end[:3, :3] @ goal[:3, :3].T)).max() < 1e-6
+    np.testing.assert_allclose(path.hand[-1], end, atol=1e-12)  # the path's hand is the frame's
+    right = dual.arms["right"].q
+    np.testing.assert_array_equal(path.q[:, right], np.tile(q0[right], (len(path.q), 1)))
+    if solver == "resolver":
+        assert (path.q >= dual.lower - 1e-12).all() and (path.q <= dual.upper + 1e-12).all()
+
+
+def test_general_axes_and_operator_take_frame(dual):
+    q0 = dual.ready()
+    T0 = dual.fk(q0, "right/tool")
+    path = general_axes(dual, q0, ((0, 0, 1), 0.2), ((1, 0, 0), 0.03), 10, correction="newton",
+                        frame="right/tool")  # fmt: skip
+    end = dual.fk(path.q[-1], "right/tool")
+    assert end[0, 3] - T0[0, 3] == pytest.approx(0.03, abs=1e-6)
+    paths = operator(dual, q0, [Command((0.0, 0.0, 1.0), 0.05, 0.0)], 5, frame="right/tool")
+    moved = dual.fk(paths[-1].q[-1], "right/tool")[:3, 3] - T0[:3, 3]
+    np.testing.assert_allclose(moved, [0.0, 0.0, 0.05], atol=1e-3)
+
+
+def test_without_frame_a_cell_still_asks_for_one(dual):
+    with pytest.raises(rrc_pin.ToolFrameRequired, match="frame: .*left/tool, right/tool"):
+        straight_line(dual, dual.ready(), np.eye(4), 5)
+
+
+@pytest.mark.parametrize(
+    ("frame", "error", "match"),
+    [
+        ("middle", InvalidInput, r"frame: gsfc_dual has no frame 'middle'; its tool frames: "
+                                 r"left/tool, right/tool, object"),
+        (3, InvalidInput, "frame: expected a frame name"),
+    ],
+)
+def test_an_unknown_frame_is_refused_with_the_names(dual, frame, error, match):
+    with pytest.raises(error, match=match):
+        straight_line(dual, dual.ready(), np.eye(4), 5, frame=frame)
+
+
+def test_frame_needs_a_robot_and_no_floating_base():
+    chain = DHChain("standard", [DHRow(a=0.3, alpha=0.0, d=0.0, theta=0.0)] * 6)
+    with pytest.raises(InvalidInput, match="frame: frame= needs a rrc_pin.Robot"):
+        screw_motion(chain, np.zeros(6), np.eye(4), 5, frame="tool")
+    tripod = rrc_pin.load("yeh_tripod")
+    with pytest.raises(InvalidInput, match="arm: yeh_tripod has a floating base"):
+        straight_line(tripod, tripod.ready(), np.eye(4), 5, frame="leg1/flange")

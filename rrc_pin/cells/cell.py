@@ -25,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from rrc_pin.combine import prefixed
+from rrc_pin.combine import Combined, Part, prefixed
 from rrc_pin.errors import InvalidInput
 from rrc_pin.models.cell_spec import CellSpec
 from rrc_pin.robot import Robot, frame_index
@@ -70,8 +70,12 @@ class Grasp(NamedTuple):
     in_hand: Array
 
 
-class Cell(Robot):
+class Cell(Combined):
     """Several arms as one robot, with named parts (module docstring).
+
+    A :class:`~rrc_pin.combine.Combined` robot (its ``parts``: each arm's key, robot and
+    base placement), so that what takes a combined robot takes a cell: the collision model
+    (:class:`~rrc_pin.geometry.CollisionModel`, each arm's geometry at its base).
 
     Build one with :func:`make_cell`, or load a ready-made one by name
     (``rrc_pin.load("gsfc_dual")``, ``"yeh_tripod"``).
@@ -181,7 +185,8 @@ def make_cell(
         q_ready[2] -= _lowest(model, q_ready, [a.hand for a in parts.values()])
     grasps = _grasps(model, parts, objects, q_ready)
     cell = Cell(model, [a.hand for a in parts.values()], name=name, source=source,
-                poses={"ready": q_ready})  # fmt: skip
+                poses={"ready": q_ready},
+                parts=[Part(a.key, a.robot, a.base) for a in parts.values()])  # fmt: skip
     cell.arms, cell.objects, cell.body, cell.cell_spec = parts, grasps, body, spec
     return cell
 

@@ -21,18 +21,22 @@ Every command is a twist [v; w] (6,) [m/s, rad/s] of the commanded frame's origi
 frame named by its ref (``"world"``: the cell's base axes; ``"local"``: the commanded
 frame's own axes; ``"base"``: the arm's base axes, for a hand). The target poses are the
 drift correction: each advances by the command times the achieved scale, and the tasks feed
-their pose error back (gain ``gain``); the speed override and the deadman weight every
-command, as :class:`~rrc_pin.control.Controller` does for one arm. Below the top level a
-posture task pulls toward the ready pose (the redundancy's use). The configuration is
-integrated on its manifold (:meth:`Robot.integrate`).
+their pose error back (gain ``gain``). Below the top level a posture task pulls toward the
+ready pose (the redundancy's use).
+
+The loop itself is :class:`~rrc_pin.control.loop.Loop`, the one
+:class:`~rrc_pin.control.Controller` is built on: the speed override and the deadman weight
+every command, the configuration is integrated on its manifold, the ticks go to a log ring
+(:class:`CellLog`) and :meth:`~rrc_pin.control.loop.Loop.reverse` retraces them.
+``rrc_pin.Controller(cell)`` makes a ``CellController``.
 """
 
 from __future__ import annotations
 
 import csv
 import math
-from collections.abc import Mapping
-from dataclasses import dataclass
+import os
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Literal, NamedTuple
 
@@ -42,15 +46,16 @@ import pinocchio as pin
 
 from rrc_pin.cells.cell import Cell
 from rrc_pin.control.deadman import Deadman
-from rrc_pin.control.rates_task import RatesTask
+from rrc_pin.control.loop import Loop, Step
+from rrc_pin.control.trajectory_log import CAPACITY, RecordRing, checked_path, reason
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import ContactLimit, GripLimit, JointLimits, Limit
 from rrc_pin.loading import load
-from rrc_pin.resolver import QPOptions, Resolver
+from rrc_pin.resolver import QPOptions
 from rrc_pin.tasks import FrameTask, PostureTask, Task
 from solvers.damping import Damping
 from solvers.resolution import Resolution
-from solvers.validation import as_vector, finite_number, positive
+from solvers.validation import as_vector, positive
 
 Array = npt.NDArray[np.float64]
 Ref = Literal["world", "local", "base"]
@@ -62,20 +67,11 @@ REANCHOR = ("damped", "singular", "least_squares", "recovering", "fallback")
 reached poses instead of pulling back toward poses that could not be followed."""
 
 
-class CellStep(NamedTuple):
-    """One tick's outcome.
-
-    Attributes:
-        q: The cell's configuration after the tick (nq,) (read-only).
-        resolution: The resolver's answer.
-    """
-
-    q: Array
-    resolution: Resolution
+CellStep = Step
+"""One tick's outcome: the configuration after it (nq,) and the resolution."""
 
 
-@dataclass
-class CellRecord:
+class CellRecord(NamedTuple):
     """One tick as the log keeps it.
 
     Attributes:
@@ -101,14 +97,66 @@ class CellRecord:
     mode: str
 
 
-class CellController:
+class CellLog(RecordRing[CellRecord]):
+    """A cell's log: the ring of :class:`CellRecord` every loop keeps, and its CSV.
+
+    Args:
+        nq: Length of the cell's q.
+        nv: Length of its qdot.
+        capacity: Ticks kept (:class:`~rrc_pin.control.trajectory_log.RecordRing`).
+    """
+
+    record_type = CellRecord
+
+    def __init__(self, nq: int, nv: int, capacity: int = CAPACITY) -> None:
+        super().__init__(None, capacity)
+        self.nq, self.nv = nq, nv
+
+    def __iter__(self) -> Iterator[CellRecord]:
+        return iter(self.records)
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write the log as CSV (one row per tick, a header) to ``path``; return the path.
+
+        Raises:
+            InvalidInput: Naming ``path``: not a ``.csv`` path, or a file that cannot be
+                written (the system's reason).
+        """
+        out = checked_path(path)
+        if out.suffix != ".csv":
+            raise InvalidInput("path", f"expected a .csv file, got {str(out)!r}")
+        records = self.records
+        names = sorted({k for rec in records for k in rec.errors})
+        grips = sorted({k for rec in records for k in rec.grip})
+        try:
+            with out.open("w", newline="") as f:
+                w = csv.writer(f)
+                w.writerow(["t", "mode", "status", "scale", "levels",
+                            *[f"error:{n}" for n in names], *[f"grip:{n}" for n in grips],
+                            *[f"q{i}" for i in range(self.nq)],
+                            *[f"qdot{i}" for i in range(self.nv)]])  # fmt: skip
+                for rec in records:
+                    w.writerow([f"{rec.t:.6f}", rec.mode, rec.status, f"{rec.scale:.9g}",
+                                rec.levels, *[f"{rec.errors.get(n, math.nan):.9g}" for n in names],
+                                *[f"{rec.grip.get(n, math.nan):.9g}" for n in grips],
+                                *[f"{x:.12g}" for x in rec.q],
+                                *[f"{x:.12g}" for x in rec.qdot]])  # fmt: skip
+        except OSError as exc:
+            raise InvalidInput("path", f"cannot write {str(out)!r}: {reason(exc)}") from exc
+        return out
+
+
+class CellController(Loop):
     """The teleoperation loop of a cell (module docstring).
 
     Args:
         cell: A :class:`~rrc_pin.cells.Cell` or a ready-made cell's name.
         dt: Control period [s].
         q0: Initial configuration (nq,); default the ready pose.
-        limits: Joint limits (default ``JointLimits()``).
+        limits: The resolver's limits: joint limits (default ``JointLimits()``), or a list of
+            limits (joint limits, a :class:`~rrc_pin.limits.CollisionLimit` on the cell's
+            :class:`~rrc_pin.geometry.CollisionModel`, ...); the support's contacts and the
+            grip are added.
         qp: The resolver's QP options.
         damping: The resolver's damping, or None.
         deadman: How a command ages (default ``Deadman()``), or None.
@@ -125,13 +173,19 @@ class CellController:
         InvalidInput: A bad argument, named.
     """
 
+    passing = 1e-5
+    """[rad, m] :meth:`reverse` passes a recorded configuration within this distance: the
+    closed chains' projection moved each one off its rates' integral (by 7.5e-7 rad on
+    gsfc_dual at 0.17 rad/s, 7.5e-10 on yeh_tripod), so that retracing it takes a second,
+    ``exact`` tick otherwise. The segment's start is still reached to rounding."""
+
     def __init__(
         self,
         cell: Cell | str,
         dt: float = 0.01,
         q0: npt.ArrayLike | None = None,
         *,
-        limits: JointLimits | None = None,
+        limits: Limit | Sequence[Limit] | None = None,
         qp: QPOptions | None = None,
         damping: Damping | None = Damping(),  # noqa: B008 - immutable
         deadman: Deadman | None = Deadman(),  # noqa: B008 - immutable
@@ -145,54 +199,33 @@ class CellController:
             cell = load(cell)  # type: ignore[assignment]
         if not isinstance(cell, Cell):
             raise InvalidInput("cell", f"expected a Cell or a cell's name, got {cell!r}")
-        if deadman is not None and not isinstance(deadman, Deadman):
-            raise InvalidInput("deadman", f"expected a Deadman or None, got {deadman!r}")
-        if limits is not None and not isinstance(limits, JointLimits):
-            raise InvalidInput("limits", f"expected JointLimits or None, got {limits!r}")
-        self.cell = cell
+        given: list[Limit]
+        if limits is None:
+            given = [JointLimits()]
+        elif isinstance(limits, Sequence):
+            given = list(limits)
+        else:
+            given = [limits]
+        gain = positive(gain, "gain")
         self.contact = ContactLimit((), name="contact")
         self.grip = GripLimit((), name="grip")
-        joint_limits: list[Limit] = [JointLimits() if limits is None else limits]
-        self.resolver = Resolver(cell, dt, limits=[*joint_limits, self.contact, self.grip],
-                                 qp=qp, damping=damping)  # fmt: skip
-        self.dt = self.resolver.dt
-        self.gain = positive(gain, "gain")
+        super().__init__(cell, dt, q0, limits=[*given, self.contact, self.grip], qp=qp,
+                         damping=damping, deadman=deadman, speed=speed)  # fmt: skip
+        self.cell = cell
+        self.gain = gain
         self.posture = PostureTask(cell.dof_positions(cell.ready()), gain=posture_gain,
                                    weight=1e-3, name="posture")  # fmt: skip
         self.coupled = bool(coupled)
         self.project_contacts = bool(project_contacts)
-        self.deadman = deadman
-        self.speed = speed
-        self._q = cell.ready() if q0 is None else cell.check_q(q0, "q0").copy()
-        self._q.flags.writeable = False
-        self.t = 0.0
-        self.log: list[CellRecord] = []
+        self.log: CellLog = CellLog(cell.nq, cell.nv)
         self.contact_correction = 0.0
         self.support: list[str] = list(cell.tool_frames) if cell.body is not None else []
         self._anchors: dict[str, Array] = {}
         self._commands: dict[str, Array] = {}
-        self._command_time = -math.inf
         self._targets: dict[str, Array] = {}
         self._reanchor()
 
     # -- settings -------------------------------------------------------------------------
-
-    @property
-    def q(self) -> Array:
-        """The configuration (nq,), read-only."""
-        return self._q
-
-    @property
-    def speed(self) -> float:
-        """Speed override in [0, 1]: every command is multiplied by it."""
-        return self._speed
-
-    @speed.setter
-    def speed(self, value: float) -> None:
-        value = finite_number(value, "speed", 0.0)
-        if value > 1.0:
-            raise InvalidInput("speed", f"expected a finite number in [0, 1], got {value}")
-        self._speed = value
 
     def commandable(self) -> list[str]:
         """Names :meth:`step` takes: held objects, the body, free hands and swinging feet."""
@@ -254,7 +287,7 @@ class CellController:
 
     # -- the loop ---------------------------------------------------------------------------
 
-    def step(self, commands: Mapping[str, Command] | None = None) -> CellStep:
+    def step(self, commands: Mapping[str, Command] | None = None) -> Step:
         """Resolve and integrate one tick.
 
         Args:
@@ -272,10 +305,7 @@ class CellController:
         if commands is not None:
             self._commands = self._checked(commands)
             self._command_time = self.t
-        weight = self._speed
-        age = self.t - self._command_time
-        if self.deadman is not None and age > self.deadman.timeout:
-            weight *= self.deadman.factor(age)
+        weight = self._weight()
         cell = self.cell
         poses = {name: cell.fk(self._q, self.frame_of(name)) for name in self._targets}
         twists = {name: weight * self._in_world(name, poses[name], self._commands[name])
@@ -308,58 +338,34 @@ class CellController:
         self._record(r, poses, "teleop")
         follow = r.scale if hands == [] else 1.0
         if r.status in REANCHOR:
-            self._advance(r)
+            out = self._advance(r)
             self._reanchor()
         else:
             for name, twist in twists.items():
                 self._targets[name] = _moved(self._targets[name], twist * (follow * self.dt))
-            self._advance(r)
-        return CellStep(self._q, r)
-
-    def reverse(self, seconds: float) -> int:
-        """Retrace the last ``seconds`` of the record back in time (feet kept in support).
-
-        Returns:
-            The ticks taken.
-
-        Raises:
-            InvalidInput: ``seconds`` not > 0 or longer than the record.
-        """
-        seconds = finite_number(seconds, "seconds", 0.0, inclusive=False)
-        n = round(seconds / self.dt)
-        if n > len(self.log) or n < 1:
-            raise InvalidInput("seconds", f"asked to reverse {seconds:.6g} s; the record holds "
-                               f"{len(self.log) * self.dt:.6g} s")  # fmt: skip
-        model = self.cell.model
-        targets = [rec.q for rec in self.log[-n:]][::-1]
-        self.contact.set_frames(self.support)
-        for target in targets:
-            here = self.cell.to_pinocchio(self._q)
-            rates = pin.difference(model, here, self.cell.to_pinocchio(target)) / self.dt
-            r = self.resolver.solve(self._q, [RatesTask(rates, "reverse")], priority="strict")
-            self._record(r, {}, "reverse")
-            self._advance(r)
-        self._commands, self._command_time = {}, -math.inf
-        self._reanchor()
-        return n
-
-    def save(self, path: str | Path) -> Path:
-        """Write the log as CSV (one row per tick) to ``path``; return the path."""
-        out = Path(path)
-        names = sorted({k for rec in self.log for k in rec.errors})
-        grips = sorted({k for rec in self.log for k in rec.grip})
-        with out.open("w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["t", "mode", "status", "scale", "levels",
-                        *[f"error:{n}" for n in names], *[f"grip:{n}" for n in grips],
-                        *[f"q{i}" for i in range(self.cell.nq)],
-                        *[f"qdot{i}" for i in range(self.cell.nv)]])  # fmt: skip
-            for rec in self.log:
-                w.writerow([f"{rec.t:.6f}", rec.mode, rec.status, f"{rec.scale:.9g}", rec.levels,
-                            *[f"{rec.errors.get(n, math.nan):.9g}" for n in names],
-                            *[f"{rec.grip.get(n, math.nan):.9g}" for n in grips],
-                            *[f"{x:.12g}" for x in rec.q], *[f"{x:.12g}" for x in rec.qdot]])
+            out = self._advance(r)
         return out
+
+    # -- what the loop asks of it ---------------------------------------------------------
+
+    def _log_reverse(self, q: Array, r: Resolution) -> None:
+        self._record(r, {}, "reverse")
+
+    def _stopped(self) -> None:
+        self._commands = {}
+        self._reanchor()
+
+    def _configuration_set(self) -> None:
+        """Targets and the feet's anchors at the configuration set.
+
+        A cell set elsewhere stays there: the targets' feedback and the projection would
+        pull it back to the old poses and anchors.
+        """
+        self._reanchor()
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write the log as CSV to ``path`` (:meth:`CellLog.save`); return the path."""
+        return self.log.save(path)
 
     # -- helpers --------------------------------------------------------------------------
 
@@ -415,13 +421,12 @@ class CellController:
         self._targets = {n: self.cell.fk(q, self.frame_of(n)) for n in self.commandable()}
         self._anchors = {f: self.cell.fk(q, f) for f in self.support}
 
-    def _advance(self, r: Resolution) -> None:
-        q = self.cell.integrate(self._q, r.qdot, self.dt)
+    def _integrate(self, qdot: Array) -> Array:
+        """The loop's integration, then the closed chains closed again (``project_contacts``)."""
+        q = super()._integrate(qdot)
         if self.project_contacts and (self.support or (self.coupled and self.cell.objects)):
             q = self._projected(q)
-        q.flags.writeable = False
-        self._q = q
-        self.t += self.dt
+        return q
 
     def _projected(self, q: Array) -> Array:
         """``q`` with the closed chains closed again by a Newton step on every rate.

@@ -1,12 +1,14 @@
 """The teleoperation loop: :class:`Controller` and what it is made of.
 
-Its log, deadman, drift correction and singularity strategies
+The loop every controller is built on (:class:`Loop`: speed, deadman, integration, log
+ring, reverse), its log, deadman, drift correction and singularity strategies
 (:mod:`rrc_pin.control.strategies`).
 """
 
-from rrc_pin.control.controller import Controller, Retrace, Step
+from rrc_pin.control.controller import Controller
 from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.drift import DriftCorrection
+from rrc_pin.control.loop import Loop, Retrace, Step
 from rrc_pin.control.strategies import (
     STRATEGIES,
     AuxiliaryHand,
@@ -21,7 +23,7 @@ from rrc_pin.control.strategies import (
     WristChoice,
     make_strategy,
 )
-from rrc_pin.control.trajectory_log import LogRecord, TrajectoryLog
+from rrc_pin.control.trajectory_log import LogRecord, RecordRing, TrajectoryLog
 
 __all__ = [
     "STRATEGIES",
@@ -33,6 +35,8 @@ __all__ = [
     "Freezing",
     "GeneralizedInverse",
     "LogRecord",
+    "Loop",
+    "RecordRing",
     "ResolverOnly",
     "Retrace",
     "Situation",

@@ -26,6 +26,7 @@ import pinocchio as pin
 
 from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.drift import DriftCorrection, advance, pose_error
+from rrc_pin.control.loop import Loop, Step
 from rrc_pin.control.rates_task import RatesTask
 from rrc_pin.control.singularity import SingularityLabel
 from rrc_pin.control.strategies import Situation, Strategy, make_strategy
@@ -33,8 +34,8 @@ from rrc_pin.control.strategies.base import KEEP, to_base_axes
 from rrc_pin.control.trajectory_log import LogRecord, TrajectoryLog
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import JointLimits
-from rrc_pin.loading import load
-from rrc_pin.resolver import QPOptions, Resolver
+from rrc_pin.loading import cells, load
+from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import Robot
 from solvers.damping import Damping
 from solvers.resolution import Resolution
@@ -50,33 +51,6 @@ the reached pose instead of pulling the hand back to a pose it could not follow.
 NO_ERROR = np.zeros(6)
 """The pose error of a tick without a reference (``reverse``)."""
 NO_ERROR.flags.writeable = False
-
-
-class Step(NamedTuple):
-    """One tick's outcome.
-
-    Attributes:
-        q: Joint positions after the tick (nq,) [rad or m] (read-only).
-        resolution: The resolver's answer for the tick.
-    """
-
-    q: Array
-    resolution: Resolution
-
-
-class Retrace(NamedTuple):
-    """What :meth:`Controller.reverse` did.
-
-    Attributes:
-        steps: Ticks taken.
-        reached: Whether every recorded configuration was reached (no limit intervened
-            beyond the extra ticks allowed).
-        error: Largest joint distance [rad or m] from the segment's start at the end.
-    """
-
-    steps: int
-    reached: bool
-    error: float
 
 
 class Tick(NamedTuple):
@@ -106,12 +80,17 @@ class Tick(NamedTuple):
     note: str
 
 
-class Controller:
+class Controller(Loop):
     """A resolved-rate teleoperation loop holding the arm's configuration.
+
+    Built on :class:`~rrc_pin.control.loop.Loop` (speed override, deadman, integration,
+    log ring, ``reverse``). ``Controller(cell)`` with a :class:`~rrc_pin.cells.Cell` (or a
+    cell's name) makes a :class:`~rrc_pin.cells.CellController` instead: the same loop with
+    one command per held object, body or free hand (its own keyword arguments).
 
     Args:
         robot: A :class:`rrc_pin.Robot` with one tool frame, or a name :func:`rrc_pin.load`
-            takes.
+            takes; a cell (or a cell's name) makes a ``CellController``.
         dt: Control period [s], >= 1e-6 (:data:`rrc_pin.resolver.MIN_DT`).
         q0: Initial joint positions (nq,) [rad or m]; default ``robot.ready()``.
         strategy: A singularity strategy: a :class:`Strategy` or its name
@@ -128,9 +107,26 @@ class Controller:
             (:class:`~rrc_pin.control.singularity.SingularityLabel`).
 
     Raises:
-        InvalidInput: A bad argument, named (a robot with several tool frames included).
+        InvalidInput: A bad argument, named; a robot with several tool frames that is not a
+            cell names ``tool_frame`` (load one hand) and ``make_cell`` (a cell of them).
         UnknownArm, URDFError: ``robot`` is a name or path that does not load.
     """
+
+    def __new__(cls, robot: Robot | str, *args: Any, **kwargs: Any) -> Controller:
+        """A ``Controller``, or a ``CellController`` for a cell or a cell's name.
+
+        The cell's controller is built here with the same arguments (its own keywords:
+        ``gain``, ``coupled``, ...; ``strategy``, ``drift`` and ``near`` are one arm's).
+        Statically it reads as a ``Controller``: annotate with ``CellController`` (or
+        build one directly) where its own methods are used.
+        """
+        if cls is Controller and ((isinstance(robot, str) and robot in cells())
+                                  or _is_cell(robot)):  # fmt: skip
+            from rrc_pin.cells.controller import CellController  # the cells sit above
+
+            made: Any = CellController(robot, *args, **kwargs)  # type: ignore[arg-type]
+            return made  # type: ignore[no-any-return]
+        return super().__new__(cls)
 
     def __init__(
         self,
@@ -147,67 +143,33 @@ class Controller:
         speed: float = 1.0,
         near: float = 0.05,
     ) -> None:
-        if isinstance(robot, str):
-            robot = load(robot)
-        if not isinstance(robot, Robot):
-            raise InvalidInput("robot", f"expected a rrc_pin.Robot or a name, got {robot!r}")
+        robot = _loaded(robot)
         if robot.tool_frame is None:
             raise InvalidInput(
                 "robot", f"{robot.name} has several tool frames ({', '.join(robot.tool_frames)}); "
-                "load it with tool_frame=... for one hand",
+                "load it with tool_frame=... for one hand, or make a cell of its arms "
+                "(rrc_pin.make_cell) for one command per hand",
             )
-        if deadman is not None and not isinstance(deadman, Deadman):
-            raise InvalidInput("deadman", f"expected a Deadman or None, got {deadman!r}")
         if drift is not None and not isinstance(drift, DriftCorrection):
             raise InvalidInput("drift", f"expected a DriftCorrection or None, got {drift!r}")
-        self.robot = robot
-        self.resolver = Resolver(robot, dt, limits=limits, qp=qp, damping=damping)
-        self.dt = self.resolver.dt
+        super().__init__(robot, dt, q0, limits=limits, qp=qp, damping=damping, deadman=deadman,
+                         speed=speed)  # fmt: skip
         self.strategy = make_strategy(strategy)
         self.strategy.check(robot)
-        self.q = robot.ready() if q0 is None else robot.check_q(q0, "q0")
-        self.speed = speed
-        self.deadman = deadman
         self.drift = drift
         self.label = SingularityLabel(robot, finite_number(near, "near", 0.0, inclusive=False))
-        self.log = TrajectoryLog(robot.joint_names, self._log_record)
-        self.t = 0.0
+        self.log: TrajectoryLog = TrajectoryLog(robot.joint_names, self._log_record)
         assert self.resolver.task is not None  # one tool frame: the resolver has its task
         self._rows = tuple(self.resolver.task.selected)
         self._full = len(self._rows) == 6
         self._data = robot.model.createData()
         self._frame_id = robot.model.getFrameId(robot.tool_frame)
-        self._manifold = robot.model.nq != robot.model.nv  # continuous joints as (cos, sin)
         self._command: Array = np.zeros(6)
         self._command_frame: Frame = "local"
-        self._command_time = -math.inf
         self._reference = self._pose(self._pinocchio_q(self._q))
         self._reanchor = False
 
     # -- settings ---------------------------------------------------------------------------
-
-    @property
-    def q(self) -> Array:
-        """Joint positions (nq,) [rad or m], read-only: set the attribute to move the arm."""
-        return self._q
-
-    @q.setter
-    def q(self, value: npt.ArrayLike) -> None:
-        q: Array = self.robot.check_q(value, "q").copy()
-        q.flags.writeable = False
-        self._q = q
-
-    @property
-    def speed(self) -> float:
-        """Speed override in [0, 1]: every command is multiplied by it."""
-        return self._speed
-
-    @speed.setter
-    def speed(self, value: float) -> None:
-        value = finite_number(value, "speed", 0.0)
-        if value > 1.0:
-            raise InvalidInput("speed", f"expected a finite number in [0, 1], got {value}")
-        self._speed = value
 
     @property
     def reference(self) -> Array:
@@ -238,10 +200,7 @@ class Controller:
         if twist is not None:
             command = _checked_twist(twist)
             self._command, self._command_frame, self._command_time = command, ref, self.t
-        age = self.t - self._command_time
-        weight = self._speed
-        if self.deadman is not None and age > self.deadman.timeout:  # the command fades
-            weight *= self.deadman.factor(age)
+        weight = self._weight()
         command = self._command if weight == 1.0 else weight * self._command
         local = self._command_frame == "local"
 
@@ -286,60 +245,16 @@ class Controller:
                                       factor * fraction * self.dt, False)
         return self._advance(r)
 
-    def reverse(self, seconds: float, extra: float = 1.0) -> Retrace:
-        """Retrace the last ``seconds`` of the record back to where that segment started.
+    # -- what the loop asks of it -----------------------------------------------------------
 
-        Each tick aims at the previous recorded configuration, at the rates that reach it in
-        one period, kept inside the joint limits by the resolver (scaled when they do not
-        fit; then further ticks aim at the same configuration). When no limit intervenes the
-        arm passes through the recorded configurations up to rounding. The command is
-        cleared (the operator must command again) and the reference pose reset.
+    def _log_reverse(self, q: Array, r: Resolution) -> None:
+        self.log.append_tick(Tick(self.t, q, r, np.zeros(6), None, 1.0, NO_ERROR, "reverse", ""))
 
-        Args:
-            seconds: Length of the segment [s], > 0, at most the recorded time.
-            extra: Extra ticks allowed, as a fraction of the segment's, for configurations a
-                limit delays, >= 0.
-
-        Returns:
-            What was done (:class:`Retrace`).
-
-        Raises:
-            InvalidInput: ``seconds`` not > 0 or longer than the record, or a bad ``extra``;
-                raised before any state changes.
-        """
-        seconds = finite_number(seconds, "seconds", 0.0, inclusive=False)
-        extra = finite_number(extra, "extra", 0.0, upper=1e6)
-        ticks = seconds / self.dt
-        if ticks > len(self.log) + 0.5:
-            raise InvalidInput(
-                "seconds", f"asked to reverse {seconds:.6g} s ({ticks:.6g} ticks); the record "
-                f"holds {len(self.log)} ticks ({len(self.log) * self.dt:.6g} s)",
-            )
-        n = max(1, round(ticks))
-        targets = self.log.positions(n)[::-1]
-        budget = n + math.ceil(extra * n)
-        steps = 0
-        for target in targets:
-            while steps < budget:
-                q = self.q
-                rates = (target - q) / self.dt
-                r = self.resolver.solve(q, [RatesTask(rates, "reverse")], priority="strict")
-                self.log.append_tick(Tick(self.t, q, r, np.zeros(6), None, 1.0, NO_ERROR,
-                                          "reverse", ""))
-                self._advance(r)
-                steps += 1
-                if r.status == "exact":  # reached (to rounding): on to the next one
-                    break
-        self._command, self._command_time = np.zeros(6), -math.inf
+    def _stopped(self) -> None:
+        self._command = np.zeros(6)
         self._reanchor = True
-        error = float(np.max(np.abs(self.q - targets[-1])))
-        return Retrace(steps, error <= 1e-9 and steps <= budget, error)
 
     # -- helpers ----------------------------------------------------------------------------
-
-    def _pinocchio_q(self, q: Array) -> Array:
-        """Pinocchio's configuration of the controller's own ``q`` (valid: not checked again)."""
-        return self.robot.to_pinocchio(q) if self._manifold else q
 
     def _pose(self, q_pin: Array) -> pin.SE3:
         """Tool pose at ``q_pin``, Pinocchio's configuration (one FK pass, own data)."""
@@ -347,18 +262,6 @@ class Controller:
         pin.forwardKinematics(model, data, q_pin)
         pose: pin.SE3 = pin.updateFramePlacement(model, data, self._frame_id)
         return pose
-
-    def _advance(self, r: Resolution) -> Step:
-        """Integrate ``r.qdot`` over one period (Barker eq. (21), ``pinocchio.integrate``)."""
-        model, q = self.robot.model, self._q
-        q_pin = self._pinocchio_q(q)
-        moved = pin.integrate(model, q_pin, r.qdot * self.dt)
-        # Continuous joints: back to angles by the manifold's difference (= qdot dt).
-        q = q + pin.difference(model, q_pin, moved) if self._manifold else moved
-        q.flags.writeable = False  # the log and the Step hold it: never changed, replaced
-        self._q = q
-        self.t += self.dt
-        return Step(q, r)
 
     def _log_record(self, values: tuple[Any, ...]) -> LogRecord:
         """The log's record of a tick (:class:`Tick`'s fields), computed now.
@@ -382,6 +285,29 @@ class Controller:
             status=r.status, active=active, singularity=self.label(tick.q, J_task, sv),
             note=tick.note,
         )
+
+
+def _loaded(robot: Robot | str) -> Robot:
+    """``robot``, loaded when it is a name.
+
+    Raises:
+        InvalidInput: Neither a Robot nor a name, naming ``robot``.
+    """
+    if isinstance(robot, str):
+        robot = load(robot)
+    if not isinstance(robot, Robot):
+        raise InvalidInput("robot", f"expected a rrc_pin.Robot or a name, got {robot!r}")
+    return robot
+
+
+def _is_cell(robot: object) -> bool:
+    """Whether ``robot`` is a :class:`~rrc_pin.cells.Cell`.
+
+    Imported here: the cells' package imports their controller, which imports this module.
+    """
+    from rrc_pin.cells.cell import Cell
+
+    return isinstance(robot, Cell)
 
 
 def _checked_twist(twist: npt.ArrayLike) -> Array:

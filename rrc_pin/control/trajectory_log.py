@@ -13,7 +13,7 @@ import zipfile
 from collections import deque
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, Generic, NamedTuple, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -21,6 +21,7 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput
 
 Array = npt.NDArray[np.float64]
+R = TypeVar("R", bound=tuple[Any, ...])
 TWIST = ("vx", "vy", "vz", "wx", "wy", "wz")
 TEXT = ("mode", "method", "status", "active", "singularity", "note")
 """Text columns (the rest are numbers)."""
@@ -76,47 +77,37 @@ SCALARS = ("t", "scale", "factor", "sigma_min", "manipulability", "drift_positio
            "drift_rotation")  # fmt: skip
 
 
-class TrajectoryLog:
-    """The records of one controller's last ticks, in time order, with array views.
+class RecordRing(Generic[R]):
+    """The last ticks of a controller, in time order: a ring of records derived when read.
 
-    A controller appends its ticks as they are (:meth:`append_tick`) and the log derives
-    their records when it is read (``records``, :meth:`column`, :meth:`save`): what a record
-    adds to a tick (the singular values, the singularity's name, the achieved twist, the
-    resolution's status, scale and active limits) costs more than the rest of a controller's
-    tick, and is paid once, when someone looks.
-
-    The log keeps the last ``capacity`` ticks (a ring): appending to a full log forgets the
-    oldest, so its memory stays flat however long the session (``len`` and ``records`` count
-    the ticks kept; :attr:`dropped` those forgotten). Save it (:meth:`save`) before it fills
-    to keep a whole session; ``Controller.reverse`` retraces within what is kept.
+    What every controller's log shares (:class:`TrajectoryLog` for one arm,
+    :class:`~rrc_pin.cells.controller.CellLog` for a cell): a controller appends its ticks as
+    they are (:meth:`append_tick`) and the log derives their records when it is read
+    (``records``); the ring keeps the last ``capacity`` ticks (appending to a full log forgets
+    the oldest, :attr:`dropped` counts them), and :meth:`positions` gives the joint positions
+    ``Controller.reverse`` retraces without deriving a record.
 
     Args:
-        joint_names: Names of the joints (the CSV's column names).
         derive: Makes the record of a tick passed to :meth:`append_tick` (the controller's),
             or None for a log of records only.
         capacity: Ticks kept, >= 1 (default :data:`CAPACITY`: 10 minutes at 100 Hz);
             settable (a smaller one forgets the oldest ticks at once).
 
     Raises:
-        InvalidInput: ``joint_names`` not a sequence of names, ``derive`` not callable, or a
-            bad ``capacity``, named.
+        InvalidInput: ``derive`` not callable, or a bad ``capacity``, named.
     """
 
+    record_type: type[tuple[Any, ...]] = tuple
+    """The records' class (:meth:`append` refuses others); a record's second field is q."""
+
     def __init__(
-        self, joint_names: list[str] | tuple[str, ...],
-        derive: Callable[[Any], LogRecord] | None = None,
-        capacity: int = CAPACITY,
+        self, derive: Callable[[Any], R] | None = None, capacity: int = CAPACITY,
     ) -> None:  # fmt: skip
-        if isinstance(joint_names, str) or not isinstance(joint_names, (list, tuple)) or not all(
-            isinstance(n, str) for n in joint_names
-        ):
-            raise InvalidInput("joint_names", f"expected a list of names, got {joint_names!r}")
         if derive is not None and not callable(derive):
             raise InvalidInput("derive", f"expected a callable or None, got {derive!r}")
-        self.joint_names = tuple(joint_names)
         self._capacity = _checked_capacity(capacity)
         # Records (derived) then pending ticks, oldest first; the pending ones are the newest.
-        self._entries: deque[LogRecord | tuple[Any, ...]] = deque(maxlen=self._capacity)
+        self._entries: deque[R | tuple[Any, ...]] = deque(maxlen=self._capacity)
         self._pending = 0  # ticks at the end of _entries not yet derived
         self._derive = derive
         self.dropped = 0
@@ -139,24 +130,38 @@ class TrajectoryLog:
         self._capacity = value
 
     @property
-    def records(self) -> list[LogRecord]:
+    def records(self) -> list[R]:
         """The records kept, in time order, as a new list (the ticks pending derived now)."""
+        self._derive_pending()
+        return list(self._entries)  # type: ignore[arg-type]  # every entry derived above
+
+    def __getitem__(self, index: int) -> R:
+        """Record ``index`` (negative from the newest), without copying the others.
+
+        Raises:
+            IndexError: No such record.
+        """
+        self._derive_pending()
+        return self._entries[index]  # type: ignore[return-value]  # derived above
+
+    def _derive_pending(self) -> None:
+        """Turn the ticks not yet derived into their records, in place."""
         if self._pending:
             assert self._derive is not None  # append_tick refuses a log without derive
             ticks = [self._entries.pop() for _ in range(self._pending)][::-1]
             self._entries.extend(map(self._derive, ticks))
             self._pending = 0
-        return list(self._entries)  # type: ignore[arg-type]  # every entry derived above
 
-    def append(self, record: LogRecord) -> None:
+    def append(self, record: R) -> None:
         """Add one tick's record (forgetting the oldest tick when the log is full).
 
         Raises:
-            InvalidInput: ``record`` is not a :class:`LogRecord`.
+            InvalidInput: ``record`` is not a :attr:`record_type`.
         """
-        if not isinstance(record, LogRecord):
-            raise InvalidInput("record", f"expected a LogRecord, got {type(record).__name__}")
-        self.records  # noqa: B018 - derive the pending ticks first: they are older
+        if not isinstance(record, self.record_type):
+            raise InvalidInput("record", f"expected a {self.record_type.__name__}, got "
+                               f"{type(record).__name__}")  # fmt: skip
+        self._derive_pending()  # they are older
         self._push(record)
 
     def append_tick(self, tick: tuple[Any, ...]) -> None:
@@ -170,7 +175,7 @@ class TrajectoryLog:
         self._push(tick)
         self._pending = min(self._pending + 1, self._capacity)
 
-    def _push(self, entry: LogRecord | tuple[Any, ...]) -> None:
+    def _push(self, entry: R | tuple[Any, ...]) -> None:
         if len(self._entries) == self._capacity:
             self.dropped += 1
         self._entries.append(entry)
@@ -178,7 +183,7 @@ class TrajectoryLog:
     def positions(self, n: int) -> list[Array]:
         """Joint positions ``q`` of the last ``n`` ticks kept, oldest first, no record derived.
 
-        (What :meth:`Controller.reverse` retraces: reading ``records`` after a long session
+        (What ``Controller.reverse`` retraces: reading ``records`` after a long session
         would derive every record first.)
 
         Raises:
@@ -195,6 +200,41 @@ class TrajectoryLog:
         """Forget every record."""
         self._entries.clear()
         self._pending = 0
+
+
+class TrajectoryLog(RecordRing[LogRecord]):
+    """The records of one arm's controller (:class:`LogRecord`), with array views and files.
+
+    A :class:`RecordRing` (its ring, lazy records and ``positions``): what a record adds to
+    a tick (the singular values, the singularity's name, the achieved twist, the
+    resolution's status, scale and active limits) costs more than the rest of a controller's
+    tick, and is paid once, when someone looks. Save it (:meth:`save`) before it fills to
+    keep a whole session; ``Controller.reverse`` retraces within what is kept.
+
+    Args:
+        joint_names: Names of the joints (the CSV's column names).
+        derive: Makes the record of a tick passed to :meth:`append_tick` (the controller's),
+            or None for a log of records only.
+        capacity: Ticks kept, >= 1 (default :data:`CAPACITY`: 10 minutes at 100 Hz).
+
+    Raises:
+        InvalidInput: ``joint_names`` not a sequence of names, ``derive`` not callable, or a
+            bad ``capacity``, named.
+    """
+
+    record_type = LogRecord
+
+    def __init__(
+        self, joint_names: list[str] | tuple[str, ...],
+        derive: Callable[[Any], LogRecord] | None = None,
+        capacity: int = CAPACITY,
+    ) -> None:  # fmt: skip
+        if isinstance(joint_names, str) or not isinstance(joint_names, (list, tuple)) or not all(
+            isinstance(n, str) for n in joint_names
+        ):
+            raise InvalidInput("joint_names", f"expected a list of names, got {joint_names!r}")
+        super().__init__(derive, capacity)
+        self.joint_names = tuple(joint_names)
 
     def column(self, name: str) -> Array | npt.NDArray[np.str_]:
         """One field over every record: (N,) for scalars and text, (N, k) for vectors.
@@ -230,7 +270,7 @@ class TrajectoryLog:
                 ``.npz``, or a file that cannot be written (a missing folder, no permission:
                 the system's reason).
         """
-        path = _checked_path(path)
+        path = checked_path(path)
         try:
             if path.suffix == ".npz":
                 arrays: dict[str, Any] = {name: self.column(name) for name in LogRecord._fields}
@@ -247,7 +287,7 @@ class TrajectoryLog:
                     row += [repr(float(getattr(r, s))) for s in SCALARS if s != "t"]
                     writer.writerow(row + [getattr(r, s) for s in TEXT])
         except OSError as exc:
-            raise InvalidInput("path", f"cannot write {str(path)!r}: {_reason(exc)}") from exc
+            raise InvalidInput("path", f"cannot write {str(path)!r}: {reason(exc)}") from exc
         return path
 
     @classmethod
@@ -261,7 +301,7 @@ class TrajectoryLog:
                 ``.npz``, a file that cannot be read (missing, a folder, no permission), or
                 whose contents are not a log's (the first thing that is not, said).
         """
-        path = _checked_path(path)
+        path = checked_path(path)
         try:
             if path.suffix == ".npz":
                 with np.load(path, allow_pickle=False) as data:
@@ -278,11 +318,11 @@ class TrajectoryLog:
                                           for name in LogRecord._fields}  # fmt: skip
                 log.append(LogRecord(**fields))
         except OSError as exc:
-            raise InvalidInput("path", f"cannot read {str(path)!r}: {_reason(exc)}") from exc
+            raise InvalidInput("path", f"cannot read {str(path)!r}: {reason(exc)}") from exc
         except (_NotALog, ValueError, TypeError, KeyError, IndexError, EOFError, csv.Error,
                 zipfile.BadZipFile) as exc:  # fmt: skip
             raise InvalidInput(
-                "path", f"{str(path)!r} does not hold a trajectory log ({_reason(exc)})"
+                "path", f"{str(path)!r} does not hold a trajectory log ({reason(exc)})"
             ) from exc
         return log
 
@@ -297,7 +337,7 @@ def _checked_capacity(value: int) -> int:
     return int(value)
 
 
-def _checked_path(path: str | os.PathLike[str]) -> Path:
+def checked_path(path: str | os.PathLike[str]) -> Path:
     """``path`` as a Path ending in ``.csv`` or ``.npz``.
 
     Raises:
@@ -311,7 +351,7 @@ def _checked_path(path: str | os.PathLike[str]) -> Path:
     return out
 
 
-def _reason(exc: BaseException) -> str:
+def reason(exc: BaseException) -> str:
     """An exception's message without the path it repeats."""
     if isinstance(exc, OSError) and exc.strerror:
         return exc.strerror

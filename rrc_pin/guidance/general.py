@@ -15,6 +15,7 @@ from rrc_pin.guidance.stepping import (
     check_q0,
     check_steps,
     hand_step,
+    on_frame,
     run_steps,
     unit_axis,
 )
@@ -30,6 +31,7 @@ def general(
     relocate: bool = True,
     solver: Solver = "thesis",
     correction: Correction = "none",
+    frame: str | None = None,
 ) -> GuidancePath:
     """Type I, Example 4: from the hand's pose at ``q0`` to ``goal`` in ``steps`` steps.
 
@@ -52,10 +54,13 @@ def general(
         solver: ``"thesis"``, a :class:`ThesisSolver` (eq. (4-11b)) or a
             :class:`rrc_pin.Resolver` (joint limits hold).
         correction: ``"newton"`` for the second-order correction (eq. (5-5)).
+        frame: The frame to guide on a robot with several tool frames (a cell, a combined
+            robot), or any frame of a :class:`rrc_pin.Robot`; None: its one tool frame.
 
     Raises:
         InvalidInput: A bad ``goal``, ``q0`` or ``steps``, named.
     """
+    arm = on_frame(arm, frame)
     target = rigid_transform(goal, "goal")
     k = check_steps(steps)
     start = None if relocate else arm.fk(check_q0(arm, q0))
@@ -78,6 +83,7 @@ def general_axes(
     *,
     solver: Solver = "thesis",
     correction: Correction = "none",
+    frame: str | None = None,
 ) -> GuidancePath:
     """Type I, Examples 1-3: a turn and a translation about and along fixed axes, k steps.
 
@@ -92,10 +98,13 @@ def general_axes(
         steps: Number of steps k >= 1.
         solver: ``"thesis"``, a :class:`ThesisSolver` or a :class:`rrc_pin.Resolver`.
         correction: ``"newton"`` for the second-order correction (eq. (5-5)).
+        frame: The frame to guide on a robot with several tool frames (a cell, a combined
+            robot), or any frame of a :class:`rrc_pin.Robot`; None: its one tool frame.
 
     Raises:
         InvalidInput: A zero or non-finite axis, a non-finite angle or distance, bad steps.
     """
+    arm = on_frame(arm, frame)
     u_w = unit_axis(rotation[0], "rotation")
     u_v = unit_axis(translation[0], "translation")
     theta = finite_number(rotation[1], "rotation")

@@ -25,6 +25,7 @@ from rrc_pin.guidance.stepping import (
     check_q0,
     check_steps,
     hand_twist,
+    on_frame,
     run_steps,
     screw_step,
     unit_axis,
@@ -60,6 +61,7 @@ def operator(
     *,
     solver: Solver = "thesis",
     correction: Correction = "none",
+    frame: str | None = None,
 ) -> list[GuidancePath]:
     """Type IV: the commands one after another, each from where the previous one ended.
 
@@ -70,6 +72,8 @@ def operator(
         steps: Steps per command (one k for all, or one per command).
         solver: ``"thesis"``, a :class:`ThesisSolver` or a :class:`rrc_pin.Resolver`.
         correction: ``"newton"`` for the second-order correction (eq. (5-5)).
+        frame: The frame to guide on a robot with several tool frames (a cell, a combined
+            robot), or any frame of a :class:`rrc_pin.Robot`; None: its one tool frame.
 
     Returns:
         One path per command (each starts where the previous one ended).
@@ -77,6 +81,7 @@ def operator(
     Raises:
         InvalidInput: A bad command (named ``commands[i].field``), ``q0`` or ``steps``.
     """
+    arm = on_frame(arm, frame)
     q = check_q0(arm, q0)
     ks = [steps] * len(commands) if not isinstance(steps, list) else steps
     if len(ks) != len(commands):

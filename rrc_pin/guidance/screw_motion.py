@@ -40,6 +40,7 @@ from rrc_pin.guidance.stepping import (
     Step,
     check_q0,
     check_steps,
+    on_frame,
     run_steps,
 )
 from solvers.validation import rigid_transform
@@ -115,6 +116,7 @@ def screw_motion(
     closing: int = 0,
     solver: Solver = "thesis",
     correction: Correction = "none",
+    frame: str | None = None,
 ) -> GuidancePath:
     """Type II: from the hand's pose at ``q0`` to ``goal`` along their screw, in ``steps`` steps.
 
@@ -132,6 +134,8 @@ def screw_motion(
             goal in one step (DISP took one: Illustrations 4 and 5); 0 for none.
         solver: ``"thesis"``, a :class:`ThesisSolver` or a :class:`rrc_pin.Resolver`.
         correction: ``"newton"`` for the second-order correction (eq. (5-5)).
+        frame: The frame to guide on a robot with several tool frames (a cell, a combined
+            robot), or any frame of a :class:`rrc_pin.Robot`; None: its one tool frame.
 
     Returns:
         The path, ``k + closing`` steps.
@@ -139,6 +143,7 @@ def screw_motion(
     Raises:
         InvalidInput: A bad ``goal``, ``q0``, ``steps``, ``b_form`` or ``closing``, named.
     """
+    arm = on_frame(arm, frame)
     target = rigid_transform(goal, "goal")
     k = check_steps(steps)
     extra = check_closing(closing)

@@ -33,6 +33,8 @@ import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.resolver import Resolver
+from rrc_pin.robot import Robot
+from rrc_pin.tasks import FrameTask
 from solvers.validation import as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
@@ -93,6 +95,64 @@ class Kinematics(Protocol):
     def jacobian(  # noqa: D102
         self, q: npt.ArrayLike, ref: Literal["world", "world_aligned"]
     ) -> Array: ...
+
+
+@dataclass(frozen=True)
+class OnFrame:
+    """A robot's kinematics at one named frame: what guidance steers when given ``frame=``.
+
+    On a robot with several tool frames (a cell, a combined robot) ``fk`` and ``jacobian``
+    need a frame; this names it once. Made by :func:`on_frame`.
+
+    Attributes:
+        robot: The robot.
+        frame: The frame guided (a frame of ``robot.model``).
+    """
+
+    robot: Robot
+    frame: str
+
+    @property
+    def nq(self) -> int:
+        """Length of q."""
+        return self.robot.nq
+
+    def fk(self, q: npt.ArrayLike) -> Array:
+        """Pose (4, 4) of :attr:`frame` at ``q`` in the robot's base frame [m]."""
+        return self.robot.fk(q, self.frame)
+
+    def jacobian(self, q: npt.ArrayLike, ref: Literal["world", "world_aligned"]) -> Array:
+        """Jacobian (6, nv) of :attr:`frame` at ``q`` in ``ref``."""
+        return self.robot.jacobian(q, ref, self.frame)
+
+
+def on_frame(arm: Kinematics, frame: str | None) -> Kinematics:
+    """``arm`` as guidance steers it.
+
+    Itself (``frame`` None: its one tool frame) or :class:`OnFrame` at ``frame``.
+
+    Raises:
+        InvalidInput: Naming ``frame``: not a str, ``arm`` not a :class:`rrc_pin.Robot` (a
+            DH chain has its one hand), or no frame of the robot (the error lists its tool
+            frames, and a cell's objects and body); naming ``arm``: a floating base (guidance
+            adds increments to q).
+    """
+    if isinstance(arm, Robot) and arm.nq != arm.nv:
+        raise InvalidInput("arm", f"{arm.name} has a floating base: guidance steps q + dq "
+                           "on joints only (drive a legged cell with its controller)")  # fmt: skip
+    if frame is None:
+        return arm
+    if not isinstance(frame, str):
+        raise InvalidInput("frame", f"expected a frame name (str) or None, got {frame!r}")
+    if not isinstance(arm, Robot):
+        raise InvalidInput("frame", f"frame= needs a rrc_pin.Robot, got {type(arm).__name__} "
+                           "(its one hand is guided)")  # fmt: skip
+    if not arm.model.existFrame(frame):
+        names = [*arm.tool_frames, *getattr(arm, "objects", {}), *[
+            b for b in [getattr(arm, "body", None)] if b is not None]]  # fmt: skip
+        raise InvalidInput("frame", f"{arm.name} has no frame {frame!r}; its tool frames: "
+                           f"{', '.join(names)} (or any frame of its model)")  # fmt: skip
+    return OnFrame(arm, frame)
 
 
 @dataclass(frozen=True)
@@ -168,6 +228,7 @@ def run_steps(
     *,
     solver: Solver = "thesis",
     correction: Correction = "none",
+    frame: str | None = None,
 ) -> GuidancePath:
     """Take ``steps`` steps, step ``i`` realising ``twist(i, hand pose)``.
 
@@ -181,10 +242,13 @@ def run_steps(
             :class:`ThesisSolver`, or a :class:`rrc_pin.Resolver` of ``arm`` (joint limits).
         correction: ``"none"`` (first order, eq. (4-11)), ``"eq5_5"`` (the thesis's
             eq. (5-5)) or ``"newton"`` (the exact pose of each step).
+        frame: The frame to guide on a robot with several tool frames (a cell, a combined
+            robot), or any frame of a :class:`rrc_pin.Robot`; None: its one tool frame.
 
     Raises:
         InvalidInput: A bad ``q0``, ``steps``, ``solver`` or ``correction``, named.
     """
+    arm = on_frame(arm, frame)
     steps = check_steps(steps)
     q = check_q0(arm, q0)
     if correction not in ("none", "eq5_5", "newton"):
@@ -248,7 +312,10 @@ def first_order(
 ) -> tuple[Array, float]:
     """Joint increments (nq,) of eq. (4-11b), ``J_world D = B``, and the fraction achieved."""
     if isinstance(solver, Resolver):
-        r = solver.solve(q, B / solver.dt, ref="world")
+        if isinstance(arm, OnFrame):  # one of several frames: its task
+            r = solver.solve(q, [FrameTask(arm.frame, B / solver.dt, ref="world")])
+        else:
+            r = solver.solve(q, B / solver.dt, ref="world")
         return np.asarray(r.qdot) * solver.dt, float(r.scale)
     J = arm.jacobian(q, ref="world")
     if J.shape[0] == J.shape[1]:

@@ -42,6 +42,7 @@ from rrc_pin.guidance.stepping import (
     Step,
     check_q0,
     check_steps,
+    on_frame,
     run_steps,
 )
 from solvers.validation import finite_number, rigid_transform
@@ -64,6 +65,7 @@ def straight_line(
     *,
     solver: Solver = "thesis",
     correction: Correction = "none",
+    frame: str | None = None,
 ) -> GuidancePath:
     """Type III: the hand origin on the straight line to the goal's, in ``steps`` steps.
 
@@ -79,6 +81,8 @@ def straight_line(
         steps: Number of divisions k >= 1.
         solver: ``"thesis"``, a :class:`ThesisSolver` or a :class:`rrc_pin.Resolver`.
         correction: ``"eq5_5"`` or ``"newton"`` for the second-order correction.
+        frame: The frame to guide on a robot with several tool frames (a cell, a combined
+            robot), or any frame of a :class:`rrc_pin.Robot`; None: its one tool frame.
 
     Returns:
         The path, one row per step; ``division_ends`` marks the rows that end the divisions.
@@ -86,6 +90,7 @@ def straight_line(
     Raises:
         InvalidInput: A bad ``goal``, ``q0``, ``steps``, ``solver`` or ``correction``, named.
     """
+    arm = on_frame(arm, frame)
     target = rigid_transform(goal, "goal")
     k = check_steps(steps)
     q = check_q0(arm, q0)
@@ -123,6 +128,7 @@ def straight_line_points(
     closing: int = 0,
     solver: Solver = "thesis",
     correction: Correction = "none",
+    frame: str | None = None,
 ) -> GuidancePath:
     """Type III as the thesis states it: the goal given by three points of the hand.
 
@@ -147,6 +153,8 @@ def straight_line_points(
             goal triangle's frame in one step (DISP took one).
         solver: ``"thesis"``, a :class:`ThesisSolver` or a :class:`rrc_pin.Resolver`.
         correction: ``"eq5_5"`` or ``"newton"`` for the second-order correction.
+        frame: The frame to guide on a robot with several tool frames (a cell, a combined
+            robot), or any frame of a :class:`rrc_pin.Robot`; None: its one tool frame.
 
     Returns:
         The path, one row per step; ``division_ends`` marks the rows that end the divisions
@@ -157,6 +165,7 @@ def straight_line_points(
             points fall on a line: about 180 deg), ``q0``, ``steps``, ``spacing``,
             ``substeps``, ``b_form`` or ``closing``, named.
     """
+    arm = on_frame(arm, frame)
     k = check_steps(steps)
     gap = finite_number(spacing, "spacing", lower=0.0, inclusive=False)
     goal = frames_from_points(goal_points, "goal_points")

@@ -148,9 +148,9 @@ class CollisionLimit(Limit):
             InvalidInput: ``model`` of a robot with other joints or frames.
         """
         robot = self.model.robot
-        if layout.nv != robot.model.nv or list(layout.joints) != list(robot.joint_names):
-            raise InvalidInput("model", f"a collision model of {robot.name} (joints "
-                               f"{list(robot.joint_names)}), not of this robot's joints "
+        if layout.nv != robot.model.nv or list(layout.joints) != list(robot.dof_names):
+            raise InvalidInput("model", f"a collision model of {robot.name} (rates "
+                               f"{list(robot.dof_names)}), not of this robot's rates "
                                f"{list(layout.joints)}")  # fmt: skip
 
     def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:

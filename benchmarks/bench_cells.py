@@ -1,0 +1,293 @@
+"""One tick of a multi-arm cell's controller, with and without collision constraints.
+
+The cells: gsfc_dual and yeh_tripod.
+
+Run from a checkout: ``python benchmarks/bench_cells.py --out DIR`` (``--record`` writes
+``benchmarks/results/cells.json`` and ``.png``, ``--quick`` a short smoke run);
+``rrc-pin bench --only cells`` runs it.
+
+- **gsfc_dual** (issue 30): the held object commanded by random world-axes twists (0.15 m/s
+  and 0.4 rad/s per axis, normal, each held 0.5 s), a default ``CellController`` (deadman,
+  targets fed back, the grip's equality rows, the closed chain's projection, the log), at
+  100 Hz. The controllers take the same commands: joint limits only, and joint limits plus
+  a ``CollisionLimit`` on the cell's capsules (every pair between the two arms and the
+  kinematic rules' pairs within each; default safety and detection distances). At every
+  tick each steps, in an order shuffled per tick (interleaved).
+- **yeh_tripod**: the body commanded by random twists (0.03 m/s, 0.1 rad/s per axis, held
+  0.5 s) over its three feet in support (the contacts' equality rows and projection), the
+  same controllers (the collision model: the three legs' capsules, rows over all 24 rates,
+  the floating base's included).
+- A third controller of each cell adds a ball to its collision model (:data:`BALLS`), in the
+  way of the commanded motion, so that the collision rows bind on most ticks (the arms'
+  own pairs come within the detection distance on some ticks of the dual cell's session, on
+  none of the tripod's: there the collision case times the distance queries alone).
+
+A case whose collision model cannot be built or whose limit refuses the cell is recorded in
+``not_run`` with the refusal, never timed without its limit.
+
+Per case the tick's median, p10, p90, p99 [us] (``time.perf_counter`` around ``step``; the
+first ticks left out), the loop rate they give (1 / tick [Hz]), the statuses, the largest
+grip error or foot slip, and with collision the ticks that had collision rows and the
+smallest distance seen. One core, BLAS threads pinned to 1.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+import collections  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import Any  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from script import arguments, make_parser, mark_quick, measure, pyplot, write  # noqa: E402
+from timing import one_core, progress, statistics, us  # noqa: E402
+
+import rrc_pin  # noqa: E402
+from rrc_pin.cells import CellController  # noqa: E402
+from rrc_pin.errors import RrcPinError  # noqa: E402
+
+DT = 0.01
+TICKS, QUICK_TICKS = 3000, 100
+"""Ticks per cell (30 s at 100 Hz; a quick run 1 s)."""
+HOLD = 50
+WARM_UP = 10
+"""First ticks left out of the statistics (caches, the first factorisations)."""
+"""Ticks each random command is held (0.5 s)."""
+SEED = 2030
+SPEEDS = {
+    "gsfc_dual": ("object", np.array([0.15, 0.15, 0.15, 0.4, 0.4, 0.4])),
+    "yeh_tripod": ("body", np.array([0.03, 0.03, 0.03, 0.1, 0.1, 0.1])),
+}
+"""Cell: (the command's name, the standard deviation of each twist entry [m/s, rad/s])."""
+WITHOUT, WITH, BALL = "joint limits", "joint limits + collision", "+ collision, a ball"
+BALLS = {
+    "gsfc_dual": ("object", [0.0, 0.0, -0.25], 0.08),
+    "yeh_tripod": ("body", [0.0, 0.0, -0.6], 0.1),
+}
+"""Cell: the obstacle of the third case, a ball: the frame its centre is placed from at the
+ready pose, the offset [m] (world axes) and its radius [m]: in the way of the commanded
+motion, so that the collision rows bind on most ticks."""
+
+
+def _controllers(cell: rrc_pin.Cell) -> tuple[dict[str, CellController], dict[str, Any]]:
+    """The case's controllers by label, and what could not run (label: reason)."""
+    out = {WITHOUT: CellController(cell, DT)}
+    refused: dict[str, Any] = {}
+    frame, offset, radius = BALLS[cell.name]
+    for label in (WITH, BALL):
+        try:
+            model = rrc_pin.CollisionModel(cell, "capsules")
+            if label == BALL:
+                model.add_sphere(cell.fk(cell.ready(), frame)[:3, 3] + offset, radius, "ball")
+            limit = rrc_pin.CollisionLimit(model)
+            out[label] = CellController(cell, DT, limits=[rrc_pin.JointLimits(), limit])
+        except RrcPinError as exc:
+            message = str(exc).split(" (rates")[0]  # not the lists of names
+            refused[label] = f"{type(exc).__name__}: {message}"
+    return out, refused
+
+
+def run_cell(name: str, ticks: int) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Every controller of cell ``name`` over ``ticks`` ticks, interleaved (module docstring)."""
+    cell = rrc_pin.load(name)
+    controllers, refused = _controllers(cell)
+    command, speed = SPEEDS[name]
+    rng = np.random.default_rng(SEED)
+    order = np.random.default_rng(SEED + 1)
+    twists = [rng.normal(size=6) * speed for _ in range(ticks // HOLD + 1)]
+    times: dict[str, list[float]] = {label: [] for label in controllers}
+    statuses: dict[str, collections.Counter[str]] = {k: collections.Counter() for k in controllers}
+    near = dict.fromkeys(controllers, 0)
+    closest = dict.fromkeys(controllers, np.inf)
+    limits = {label: lim for label, ctl in controllers.items() for lim in ctl.resolver.limits
+              if isinstance(lim, rrc_pin.CollisionLimit)}  # fmt: skip
+    feet = {f: cell.fk(cell.ready(), f)[:3, 3] for f in cell.tool_frames} if cell.body else {}
+    for k in range(ticks):
+        commands = {command: twists[k // HOLD]}
+        for label in order.permutation(list(controllers)):
+            ctl = controllers[str(label)]
+            start = time.perf_counter()
+            r = ctl.step(commands).resolution
+            times[str(label)].append(time.perf_counter() - start)
+            statuses[str(label)][r.status] += 1
+            last = limits[str(label)].last if str(label) in limits else None
+            if last is not None and len(last.names):
+                near[str(label)] += 1
+                closest[str(label)] = min(closest[str(label)], float(last.distance.min()))
+        if k % 1000 == 0:
+            progress(f"cells: {name}, tick {k}")
+    rows = []
+    for label, ctl in controllers.items():
+        stats = statistics(np.array(times[label][WARM_UP:]))
+        row: dict[str, Any] = {
+            "cell": name, "limits": label, "collision": label != WITHOUT, "ticks": ticks,
+            "nv": cell.nv, **stats, "rate_hz_median": 1e6 / stats["median_us"],
+            "rate_hz_p99": 1e6 / stats["p99_us"], "statuses": dict(statuses[label]),
+        }  # fmt: skip
+        if cell.objects:
+            row["grip_max_m"] = max(max(rec.grip.values()) for rec in ctl.log)
+        if feet:
+            row["slip_max_m"] = max(float(np.linalg.norm(cell.fk(ctl.q, f)[:3, 3] - p))
+                                    for f, p in feet.items())  # fmt: skip
+        if label != WITHOUT:
+            row["collision_ticks"] = near[label]
+            row["min_distance_m"] = None if near[label] == 0 else closest[label]
+        rows.append(row)
+        progress(f"cells: {name}, {label}: median {stats['median_us']:.0f} us, "
+                 f"p99 {stats['p99_us']:.0f} us")  # fmt: skip
+    not_run = [{"cell": name, "limits": label, "reason": why} for label, why in refused.items()]
+    return rows, not_run
+
+
+def run(quick: bool) -> dict[str, Any]:
+    """Both cells (module docstring)."""
+    ticks = QUICK_TICKS if quick else TICKS
+    rows: list[dict[str, Any]] = []
+    not_run: list[dict[str, Any]] = []
+    with one_core([]):
+        for name in SPEEDS:
+            r, n = run_cell(name, ticks)
+            rows += r
+            not_run += n
+    settings = {"ticks": ticks, "dt": DT, "hold_ticks": HOLD, "seed": SEED,
+                "speeds": {k: v[1].tolist() for k, v in SPEEDS.items()}}  # fmt: skip
+    return {"settings": settings, "rows": rows, "not_run": not_run}
+
+
+def _rate(hz: float) -> str:
+    return f"{hz / 1000:.1f} kHz" if hz >= 1000 else f"{hz:.0f} Hz"
+
+
+def readme_table(results: dict[str, Any]) -> str:
+    """One row per case: tick median / p99 and the loop rate; the cases that did not run."""
+    lines = [
+        "| cell | limits | tick median / p99 [us] | loop rate (median / p99) |",
+        "| --- | --- | ---: | ---: |",
+    ]
+    for r in results["rows"]:
+        lines.append(f"| {r['cell']} | {r['limits']} | {us(r['median_us'])} / {us(r['p99_us'])} "
+                     f"| {_rate(r['rate_hz_median'])} / {_rate(r['rate_hz_p99'])} |")  # fmt: skip
+    for n in results["not_run"]:
+        lines.append(f"| {n['cell']} | {n['limits']} | not run: {_reason(n)} | |")
+    s, load = results["settings"], results.get("load_average") or {}
+    start, end = (load.get(k, [float("nan")])[0] for k in ("start", "end"))
+    def binding(label: str) -> str:
+        return ", ".join(f"{r['cell']} {r['collision_ticks']:,}" for r in results["rows"]
+                         if r["limits"] == label)  # fmt: skip
+
+    lines += [
+        "",
+        f"`CellController.step` at {1 / s['dt']:.0f} Hz, {s['ticks']:,} ticks a cell of random "
+        f"commands held {s['hold_ticks'] * s['dt']:g} s (the held object's twist on gsfc_dual, "
+        "the body's on yeh_tripod), the controllers of a cell interleaved on one core. "
+        f"Collision: the arms' capsules (ticks with collision rows: {binding(WITH)}), and a "
+        f"ball in the way ({binding(BALL)}). Load average {start:.2f} at the start, {end:.2f} "
+        "at the end (2 cores, shared).",
+    ]
+    return "\n".join(lines)
+
+
+def _reason(n: dict[str, Any]) -> str:
+    """A refusal in a few words (the floating base's, else the message)."""
+    return "a floating base: CollisionLimit refuses it" if "floating" in n["reason"] else (
+        n["reason"])  # fmt: skip
+
+
+def docs_section(results: dict[str, Any]) -> str:
+    """The docs/benchmarks.md section: every statistic, the statuses and the checks."""
+    s = results["settings"]
+    lines = [
+        f"One tick of `CellController.step` at {1 / s['dt']:.0f} Hz, {s['ticks']:,} ticks per "
+        f"cell, random commands held {s['hold_ticks'] * s['dt']:g} s (the object's on "
+        "gsfc_dual, the body's on yeh_tripod), the controllers of a cell interleaved at every "
+        "tick on one core.",
+        "",
+        "| cell | rates | limits | median [us] | p10 | p90 | p99 | max | loop rate (median) | "
+        "(p99) | grip max [m] | foot slip [m] | ticks with collision rows | closest [m] | "
+        "statuses |",
+        "| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | "
+        "---: | ---: | --- |",
+    ]
+    for r in results["rows"]:
+        statuses = ", ".join(f"{k} {v:,}" for k, v in sorted(r["statuses"].items()))
+        grip = f"{r['grip_max_m']:.2g}" if "grip_max_m" in r else "-"
+        slip = f"{r['slip_max_m']:.2g}" if "slip_max_m" in r else "-"
+        rows_ = str(r["collision_ticks"]) if "collision_ticks" in r else "-"
+        closest = "-" if r.get("min_distance_m") is None else f"{r['min_distance_m']:.3f}"
+        lines.append(
+            f"| {r['cell']} | {r['nv']} | {r['limits']} | {us(r['median_us'])} | "
+            f"{us(r['p10_us'])} | {us(r['p90_us'])} | {us(r['p99_us'])} | {us(r['max_us'])} | "
+            f"{_rate(r['rate_hz_median'])} | {_rate(r['rate_hz_p99'])} | {grip} | {slip} | "
+            f"{rows_} | {closest} | {statuses} |"
+        )
+    for n in results["not_run"]:
+        lines += ["", f"Not run: {n['cell']} with {n['limits']}: {n['reason']}"]
+    lines += [
+        "",
+        "The tick is the whole Python step: the commands checked and weighted (speed, deadman), "
+        "the frames' kinematics, the tasks with their targets, the resolver (with the grip's "
+        "or the contacts' equality rows and, with collision, the pairs' distances and rows), "
+        "the integration and the closed chains' projection, the log's record. A loop at the "
+        "rate in the p99 column misses no deadline on this machine 99 % of the time.",
+    ]
+    return "\n".join(lines)
+
+
+def plot(results: dict[str, Any], path: Path) -> bool:
+    """Median bars with p10-p90 whiskers and the p99 marked per case, on a log axis, with the
+    100 Hz period; the loop rate at the median above each bar. False without matplotlib."""
+    plt = pyplot()
+    if plt is None:
+        return False
+    rows = results["rows"]
+    fig, ax = plt.subplots(figsize=(9.0, 4.2))
+    x = np.arange(len(rows))
+    med = np.array([r["median_us"] for r in rows])
+    low = med - np.array([r["p10_us"] for r in rows])
+    high = np.array([r["p90_us"] for r in rows]) - med
+    colors = [{WITHOUT: "tab:blue", WITH: "tab:orange", BALL: "tab:red"}[r["limits"]]
+              for r in rows]  # fmt: skip
+    ax.bar(x, med, color=colors, yerr=[low, high], capsize=4, label="median, p10-p90")
+    ax.plot(x, [r["p99_us"] for r in rows], "k_", markersize=18, mew=2, label="p99")
+    period = 1e6 * results["settings"]["dt"]
+    ax.axhline(period, color="gray", ls="--", lw=1)
+    ax.text(len(rows) - 0.5, period * 1.05, f"the period at {1e6 / period:.0f} Hz", ha="right",
+            va="bottom", fontsize=8, color="gray")  # fmt: skip
+    for i, r in enumerate(rows):
+        ax.text(i, r["p90_us"] * 1.08, _rate(r["rate_hz_median"]), ha="center", va="bottom",
+                fontsize=8)  # fmt: skip
+    ax.set_xticks(x, [f"{r['cell']}\n{r['limits']}" for r in rows], fontsize=8)
+    ax.set_yscale("log")
+    ax.set_ylim(min(r["p10_us"] for r in rows) * 0.5, period * 2.5)
+    ax.set_ylabel("one tick [us]")
+    ax.legend(fontsize=8, loc="upper left")
+    title = "CellController.step on one core; the loop rate at the median above each bar"
+    if results["not_run"]:
+        title += "\nnot run: " + "; ".join(f"{n['cell']} with {n['limits']} ({_reason(n)})"
+                                           for n in results["not_run"])  # fmt: skip
+    ax.set_title(title, fontsize=9)
+    mark_quick(fig, results)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = arguments(make_parser(__doc__, "cells", f"{QUICK_TICKS} ticks per cell"), argv)
+    results = measure("cells", args.quick, lambda: run(args.quick))
+    write(args, "cells", results, lambda path: plot(results, path))
+    print(docs_section(results))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

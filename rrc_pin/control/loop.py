@@ -1,0 +1,270 @@
+r"""Loop: what every teleoperation loop shares, for one arm or a cell of several.
+
+:class:`~rrc_pin.control.Controller` (one tool frame, Barker's loop) and
+:class:`~rrc_pin.cells.CellController` (one command per held object, body or free hand) are
+both built on it; ``rrc_pin.Controller(cell)`` makes the second. A loop holds the
+configuration, the resolver and the clock, and owns:
+
+- the **speed override** and the **deadman** (:meth:`Loop._weight`: every command is
+  multiplied by the speed, and by the deadman's fade once it is older than its timeout);
+- the **integration** of one period on the configuration manifold (Barker eq. (21)):
+
+  .. math:: q_{k+1} = q_k \oplus \dot q_k\, \Delta t \quad (\texttt{pinocchio.integrate});
+
+- the **log** (a :class:`~rrc_pin.control.trajectory_log.RecordRing`) and **reverse**, which
+  retraces the recorded configurations back in time.
+
+What a subclass adds: how a tick's command becomes tasks (its ``step``), how a tick and a
+reverse tick are logged (:meth:`Loop._log_reverse`), and what reverse resets
+(:meth:`Loop._stopped`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any, NamedTuple
+
+import numpy as np
+import numpy.typing as npt
+import pinocchio as pin
+
+from rrc_pin.control.deadman import Deadman
+from rrc_pin.control.rates_task import RatesTask
+from rrc_pin.control.trajectory_log import RecordRing
+from rrc_pin.errors import InvalidInput
+from rrc_pin.limits import Limit
+from rrc_pin.resolver import QPOptions, Resolver
+from rrc_pin.robot import Robot
+from solvers.damping import Damping
+from solvers.resolution import Resolution
+from solvers.validation import finite_number
+
+Array = npt.NDArray[np.float64]
+
+
+class Step(NamedTuple):
+    """One tick's outcome.
+
+    Attributes:
+        q: Joint positions after the tick (nq,) [rad or m] (read-only).
+        resolution: The resolver's answer for the tick.
+    """
+
+    q: Array
+    resolution: Resolution
+
+
+class Retrace(NamedTuple):
+    """What :meth:`Loop.reverse` did.
+
+    Attributes:
+        steps: Ticks taken.
+        reached: Whether every recorded configuration was reached (no limit intervened
+            beyond the extra ticks allowed).
+        error: Largest joint distance [rad or m] from the segment's start at the end.
+    """
+
+    steps: int
+    reached: bool
+    error: float
+
+
+class Loop:
+    """The shared state and steps of a teleoperation loop (module docstring).
+
+    Args:
+        robot: The robot (a :class:`rrc_pin.Robot`, a cell included), already checked.
+        dt: Control period [s], >= 1e-6 (:data:`rrc_pin.resolver.MIN_DT`).
+        q0: Initial configuration (nq,) [rad or m]; default ``robot.ready()``.
+        limits: The resolver's limits (None: ``JointLimits()``).
+        qp: The resolver's QP backend and fallbacks.
+        damping: The resolver's damping near singularities, or None.
+        deadman: How a command ages, or None: a command stays in force until the next.
+        speed: Speed override in [0, 1], settable.
+
+    Raises:
+        InvalidInput: A bad argument, named; nothing is built.
+    """
+
+    log: RecordRing[Any]
+    """The ticks recorded (a subclass makes it before its first tick)."""
+    passing: float = 0.0
+    """Distance [rad or m] within which :meth:`reverse` passes a recorded configuration
+    other than the last without its tick being ``exact`` (0: exact ticks only)."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        dt: float,
+        q0: npt.ArrayLike | None,
+        *,
+        limits: Limit | Sequence[Limit] | None,
+        qp: QPOptions | None,
+        damping: Damping | None,
+        deadman: Deadman | None,
+        speed: float,
+    ) -> None:
+        if deadman is not None and not isinstance(deadman, Deadman):
+            raise InvalidInput("deadman", f"expected a Deadman or None, got {deadman!r}")
+        self.robot = robot
+        self.resolver = Resolver(robot, dt, limits=limits, qp=qp, damping=damping)
+        self.dt = self.resolver.dt
+        self._q = self._checked_q(robot.ready() if q0 is None else q0, "q0")
+        self.speed = speed
+        self.deadman = deadman
+        self.t = 0.0
+        self._command_time = -math.inf
+        # Continuous joints as (cos, sin) or a floating base: q is not Pinocchio's q.
+        self._manifold = robot.model.nq != robot.model.nv
+        self._floating = robot.nq != robot.nv
+
+    # -- settings ---------------------------------------------------------------------------
+
+    @property
+    def q(self) -> Array:
+        """Joint positions (nq,) [rad or m], read-only: set the attribute to move the robot."""
+        return self._q
+
+    @q.setter
+    def q(self, value: npt.ArrayLike) -> None:
+        self._q = self._checked_q(value, "q")
+        self._configuration_set()
+
+    def _checked_q(self, value: npt.ArrayLike, name: str) -> Array:
+        """``value`` as a read-only copy of a valid configuration (nq,).
+
+        Raises:
+            InvalidInput: Not a finite (nq,) vector, naming ``name``.
+        """
+        q: Array = self.robot.check_q(value, name).copy()
+        q.flags.writeable = False
+        return q
+
+    @property
+    def speed(self) -> float:
+        """Speed override in [0, 1]: every command is multiplied by it."""
+        return self._speed
+
+    @speed.setter
+    def speed(self, value: float) -> None:
+        value = finite_number(value, "speed", 0.0)
+        if value > 1.0:
+            raise InvalidInput("speed", f"expected a finite number in [0, 1], got {value}")
+        self._speed = value
+
+    # -- reverse ----------------------------------------------------------------------------
+
+    def reverse(self, seconds: float, extra: float = 1.0) -> Retrace:
+        """Retrace the last ``seconds`` of the record back to where that segment started.
+
+        Each tick aims at the previous recorded configuration, at the rates that reach it in
+        one period, kept inside the limits by the resolver (scaled when they do not fit;
+        then further ticks aim at the same configuration). When no limit intervenes the
+        robot passes through the recorded configurations up to rounding. The commands are
+        cleared (the operator must command again) and the reference poses reset.
+
+        Args:
+            seconds: Length of the segment [s], > 0, at most the recorded time.
+            extra: Extra ticks allowed, as a fraction of the segment's, for configurations a
+                limit delays, >= 0.
+
+        Returns:
+            What was done (:class:`Retrace`).
+
+        Raises:
+            InvalidInput: ``seconds`` not > 0 or longer than the record, or a bad ``extra``;
+                raised before any state changes.
+        """
+        seconds = finite_number(seconds, "seconds", 0.0, inclusive=False)
+        extra = finite_number(extra, "extra", 0.0, upper=1e6)
+        ticks = seconds / self.dt
+        if ticks > len(self.log) + 0.5:
+            raise InvalidInput(
+                "seconds", f"asked to reverse {seconds:.6g} s ({ticks:.6g} ticks); the record "
+                f"holds {len(self.log)} ticks ({len(self.log) * self.dt:.6g} s)",
+            )
+        n = max(1, round(ticks))
+        targets = self.log.positions(n)[::-1]
+        budget = n + math.ceil(extra * n)
+        steps = 0
+        for i, target in enumerate(targets):
+            passing = self.passing if i < n - 1 else 0.0
+            while steps < budget:
+                q = self.q
+                rates = self._difference(q, target) / self.dt
+                r = self.resolver.solve(q, [RatesTask(rates, "reverse")], priority="strict")
+                self._log_reverse(q, r)
+                self._advance(r)
+                steps += 1
+                if r.status == "exact":  # reached (to rounding): on to the next one
+                    break
+                if passing > 0.0 and np.abs(self._difference(self.q, target)).max() <= passing:
+                    break
+        self._command_time = -math.inf
+        self._stopped()
+        error = float(np.max(np.abs(self._difference(self.q, targets[-1]))))
+        return Retrace(steps, error <= 1e-9 and steps <= budget, error)
+
+    # -- what subclasses provide ---------------------------------------------------------
+
+    def _log_reverse(self, q: Array, r: Resolution) -> None:
+        """Record one reverse tick from ``q`` (before it is integrated)."""
+        raise NotImplementedError
+
+    def _stopped(self) -> None:
+        """Forget the commands and reset the reference poses (after :meth:`reverse`)."""
+        raise NotImplementedError
+
+    def _configuration_set(self) -> None:
+        """The configuration was set from outside (``q = ...``); nothing by default."""
+
+    # -- shared steps -----------------------------------------------------------------------
+
+    def _weight(self) -> float:
+        """The factor in [0, 1] of this tick's command.
+
+        The speed override times the deadman's fade of a command older than its timeout (the
+        time since the last one).
+        """
+        weight = self._speed
+        age = self.t - self._command_time
+        if self.deadman is not None and age > self.deadman.timeout:  # the command fades
+            weight *= self.deadman.factor(age)
+        return weight
+
+    def _pinocchio_q(self, q: Array) -> Array:
+        """Pinocchio's configuration of the loop's own ``q`` (valid: not checked again)."""
+        return self.robot.to_pinocchio(q) if self._manifold else q
+
+    def _difference(self, q: Array, target: Array) -> Array:
+        """The displacement (nv,) [rad or m] from ``q`` to ``target`` on the manifold.
+
+        ``target - q`` without a floating base (continuous joints as angles), else
+        ``pinocchio.difference`` (the base's in body axes).
+        """
+        if not self._floating:
+            out: Array = target - q
+            return out
+        model = self.robot.model
+        moved: Array = pin.difference(model, self._pinocchio_q(q), self._pinocchio_q(target))
+        return moved
+
+    def _integrate(self, qdot: Array) -> Array:
+        """The configuration (nq,) one period on from ``q`` at rates ``qdot`` (nv,).
+
+        A new array (Barker eq. (21), ``pinocchio.integrate``).
+        """
+        q = self._q
+        if not self._manifold:
+            out: Array = pin.integrate(self.robot.model, q, qdot * self.dt)
+            return out
+        return self.robot.integrate(q, qdot, self.dt)
+
+    def _advance(self, r: Resolution) -> Step:
+        """Integrate ``r.qdot`` over one period and move the clock on."""
+        q = self._integrate(r.qdot)
+        q.flags.writeable = False  # the log and the Step hold it: never changed, replaced
+        self._q = q
+        self.t += self.dt
+        return Step(q, r)
