@@ -47,6 +47,7 @@ from solvers.damping import Damping
 from solvers.direction import Along, along, direction_qp
 from solvers.errors import InvalidInput, NumericalFailure
 from solvers.factorization import Factorization
+from solvers.kernels import scale_and_veer
 from solvers.least_squares import Subspace, least_squares
 from solvers.problem import Box, Problem, Rows, largest_weight, row_factors
 from solvers.qp import FEASIBILITY_TOL, Work, solve_within
@@ -257,8 +258,10 @@ def _top(
         status: Status = "recovering" if box.recovering or _broken(rows) else (
             "exact" if met else "least_squares")  # fmt: skip
         return _Top(qdot, status, *_along_command(problem, qdot), 0.0, null)
+    boxed: Along | None = None  # the direction problem along w, where the box is all
     if space.N is None:
-        factor, w, fits = Factorization.fitted(A, b, box.lb, box.ub)
+        factor, w, fits, boxed = Factorization.fitted(A, b, box.lb, box.ub)
+        boxed = boxed if rows is None else None
         z = w
     else:
         factor = Factorization(A @ space.N.T)
@@ -295,7 +298,7 @@ def _top(
             return _Top(w, "singular", *_along_command(problem, w), 0.0, null)
         return _Top(w, "exact", 1.0, 0.0, 0.0, null)
     null = _null(factor, space)
-    u_w = _scaled(A, w, null, box, rows, backend, work)
+    u_w = boxed if boxed is not None else _scaled(A, w, null, box, rows, backend, work)
     if slid:
         return _Top(u_w.qdot, "sliding", *_along_command(problem, u_w.qdot), 0.0, null)
     if not outside_range and u_w.u >= 1.0 - EXACT_TOL:
@@ -429,25 +432,6 @@ def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
         y.append(achieved if factor is None else factor * achieved)
         b.append(commanded if factor is None else factor * commanded)
     return scale_and_veer(np.concatenate(y), np.concatenate(b))
-
-
-def scale_and_veer(y: Array, b: Array) -> tuple[float, float]:
-    """Fraction of ``b`` achieved along it by ``y`` (in [0, 1]) and the angle between them [rad].
-
-    Computed on both divided by their largest entries, so that no product overflows.
-    """
-    top_b = float(np.abs(b).max()) if b.size else 0.0
-    if top_b == 0.0:
-        return 1.0, 0.0
-    top_y = float(np.abs(y).max())
-    if top_y == 0.0:
-        return 0.0, 0.0
-    bn, yn = b / top_b, y / top_y
-    cosine = float(yn @ bn) / (_norm(yn) * _norm(bn))
-    veer = math.acos(min(max(cosine, -1.0), 1.0))
-    with np.errstate(over="ignore"):
-        ratio = float(np.float64(top_y) / top_b) * float(yn @ bn) / float(bn @ bn)
-    return min(max(ratio, 0.0), 1.0), veer
 
 
 def _tolerance(box: Box) -> float:
