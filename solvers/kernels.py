@@ -382,6 +382,44 @@ def svd_rates(
             x[r] += c * right[r, i]
 
 
+@kernel
+def damping_lambda_sq(
+    sigma: Array, rank: int, scale: float, along: Array, dt: float, threshold: float, lam: Array
+) -> bool:
+    r"""Squared damping per singular direction (:mod:`solvers.damping`'s schedule).
+
+    With the onset :math:`\sigma_{on} = \sigma_1/\kappa`, every direction i < rank whose
+    singular value is below it gets :math:`\lambda_i^2 = (1 - (\sigma_i/\sigma_{on})^2)\,
+    \max(\sigma_{on}^2, \sigma_1 |u_i^T b|\,\Delta t)\,(1 - u^*)` (Maciejewski & Klein 1988's
+    smooth onset, with a floor for the step), the others zero.
+
+    Args:
+        sigma: Singular values (k,), descending.
+        rank: How many of them count.
+        scale: The LP maximum :math:`u^*` in [0, 1].
+        along: :math:`|u_i^T b|` (k,).
+        dt: The step [s].
+        threshold: :math:`\kappa`.
+        lam: Out: the squared damping (k,), set where True is returned.
+
+    Returns:
+        False where none applies (no rank, :math:`u^* \ge 1`, or every counted singular value
+        at or above the onset).
+    """
+    if rank == 0 or scale >= 1.0:
+        return False
+    onset = sigma[0] / threshold
+    if sigma[rank - 1] >= onset:
+        return False
+    for i in range(sigma.size):
+        lam[i] = 0.0
+        if i < rank and sigma[i] < onset:
+            floor = max(onset * onset, sigma[0] * along[i] * dt)
+            ratio = sigma[i] / onset
+            lam[i] = (1.0 - ratio * ratio) * floor * (1.0 - scale)
+    return True
+
+
 # -- feasibility and scales -------------------------------------------------------------------
 
 
@@ -543,7 +581,7 @@ def direction_step(
 
 
 @kernel
-def scale_and_veer(y: Array, b: Array) -> tuple[float, float]:
+def scale_and_veer(y: Array, b: Array, factor: Array | None = None) -> tuple[float, float]:
     r"""Fraction of ``b`` achieved along it by ``y`` (in [0, 1]) and the angle between them [rad].
 
     The scale is :math:`y^Tb/b^Tb` and the angle :math:`\arccos(y^Tb/(|y||b|))`, computed on
@@ -553,22 +591,38 @@ def scale_and_veer(y: Array, b: Array) -> tuple[float, float]:
     Args:
         y: Achieved rates (m,).
         b: Commanded rates (m,).
+        factor: Row factors (m,) of a level's metric, or None: the scale and angle of
+            ``factor * y`` and ``factor * b``, both first divided by b's largest entry where
+            it exceeds 1 (so that the factors cannot overflow a command near the float range;
+            a subnormal one is not divided up: the achieved rates would overflow).
 
     Returns:
         (scale, veer): (1, 0) for a zero command, (0, 0) for zero rates.
     """
+    m = b.size
+    ys, bs = np.empty(m), np.empty(m)
+    if factor is None:
+        ys[:] = y
+        bs[:] = b
+    else:
+        peak = 1.0
+        for i in range(m):
+            peak = max(peak, abs(b[i]))
+        for i in range(m):
+            ys[i] = factor[i] * (y[i] / peak)
+            bs[i] = factor[i] * (b[i] / peak)
     top_b = 0.0
     top_y = 0.0
-    for i in range(b.size):
-        top_b = max(top_b, abs(b[i]))
-        top_y = max(top_y, abs(y[i]))
+    for i in range(m):
+        top_b = max(top_b, abs(bs[i]))
+        top_y = max(top_y, abs(ys[i]))
     if top_b == 0.0:
         return 1.0, 0.0
     if top_y == 0.0:
         return 0.0, 0.0
     yb = yy = bb = 0.0
-    for i in range(b.size):
-        yn, bn = y[i] / top_y, b[i] / top_b
+    for i in range(m):
+        yn, bn = ys[i] / top_y, bs[i] / top_b
         yb += yn * bn
         yy += yn * yn
         bb += bn * bn

@@ -345,7 +345,8 @@ def _clamped(factor: Factorization, w: Array, box: Box, dt: float) -> Factorizat
     if not kernels.clamp_pushed(factor.J, w, box.lb, box.ub, kernels.ON_LIMIT / dt, J):
         return factor
     clamped = Factorization(J)
-    return clamped if clamped.svd[3] >= factor.svd[3] else factor
+    rank = clamped.svd[3]  # at most the rows' own: where full, theirs is not needed (one SVD)
+    return clamped if rank == min(J.shape) or rank >= factor.svd[3] else factor
 
 
 STILL_SCALE = 1e-9
@@ -419,19 +420,19 @@ def _served(problem: Problem, k: int, qdot: Array) -> LevelStatus:
 
 
 def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
-    """The top level's scale and veer for ``qdot`` in its normalised metric."""
+    """The top level's scale and veer for ``qdot`` in its normalised metric.
+
+    Each row times its factor (:func:`~solvers.problem.row_factors`); the kernel first divides
+    a command near the float range down, so that its units cannot overflow it.
+    """
     level = problem.levels[0]
     top = largest_weight(level)
-    # A command near the float range is divided down so that its units cannot overflow it; a
-    # subnormal one is not divided up (the achieved rates divided by it overflowed: NaN scale)
-    peak = max(1.0, *(float(np.abs(t.b).max(initial=0.0)) for t in level))
-    y, b = [], []
-    for t in level:
-        factor = row_factors(t, top, units=True)
-        achieved, commanded = (t.A @ qdot) / peak, t.b / peak
-        y.append(achieved if factor is None else factor * achieved)
-        b.append(commanded if factor is None else factor * commanded)
-    return scale_and_veer(np.concatenate(y), np.concatenate(b))
+    factors = [row_factors(t, top, units=True) for t in level]
+    factor = [np.ones(t.b.size) if f is None else f for t, f in zip(level, factors, strict=True)]
+    if len(level) == 1:
+        return scale_and_veer(level[0].A @ qdot, level[0].b, factor[0])
+    y = np.concatenate([t.A @ qdot for t in level])
+    return scale_and_veer(y, np.concatenate([t.b for t in level]), np.concatenate(factor))
 
 
 def _tolerance(box: Box) -> float:
