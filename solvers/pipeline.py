@@ -27,7 +27,7 @@ A least-squares level (the other modes, and every lower level): its unconstraine
 (:mod:`solvers.least_squares`) when it satisfies the constraints, else the backend's QP.
 
 When the top level finds no usable answer (a backend fault, an infeasible problem, an answer
-outside the constraints beyond :data:`FEASIBILITY_TOL`), the fallbacks answer it
+outside the constraints beyond :func:`~solvers.qp.tolerance`), the fallbacks answer it
 (:mod:`solvers.fallbacks`); a lower level that fails keeps the answer of the levels above
 (``dropped``). Every answer is finally clipped into the box, the size of the clip reported.
 Nothing here raises for numerical trouble.
@@ -50,7 +50,7 @@ from solvers.factorization import Factorization
 from solvers.kernels import scale_and_veer
 from solvers.least_squares import Subspace, least_squares
 from solvers.problem import Box, Problem, Rows, largest_weight, row_factors
-from solvers.qp import FEASIBILITY_TOL, Work, solve_within
+from solvers.qp import Work, solve_within, tolerance
 from solvers.qp_backends.base import QPBackend
 
 Array = npt.NDArray[np.float64]
@@ -279,7 +279,7 @@ def _top(
             work.attempts.append(("slide", f"{exc}; the command kept as given"))
         else:
             if rows is not None and (rows.slide is None or not rows.slide.all()):
-                within = kernels.rows_hold(rows.G, kept, rows.h, _tolerance(box))
+                within = kernels.rows_hold(rows.G, kept, rows.h, tolerance(box))
             else:
                 within = True  # every row slides: the least squares kept them all
             if within:  # the slid command met within every row: its rates as they are
@@ -433,11 +433,6 @@ def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
         return scale_and_veer(level[0].A @ qdot, level[0].b, factor[0])
     y = np.concatenate([t.A @ qdot for t in level])
     return scale_and_veer(y, np.concatenate([t.b for t in level]), np.concatenate(factor))
-
-
-def _tolerance(box: Box) -> float:
-    """How far a backend's answer may leave the rows (:func:`solvers.qp.solve_within`'s)."""
-    return FEASIBILITY_TOL * (1.0 + math.hypot(*np.minimum(box.velocity, 1e300).tolist()))
 
 
 def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:
