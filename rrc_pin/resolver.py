@@ -218,7 +218,7 @@ class Resolver:
             FrameNotFound: A task names a frame the robot does not have (the error lists
                 them).
         """
-        q, q_pin = self.robot.configuration(q)
+        q, dof, q_pin = self.robot.positions(q)
         step = self.dt if dt is None else _dt(dt)
         previous = None if qdot_prev is None else as_vector(qdot_prev, "qdot_prev", self.robot.nv)
         if isinstance(command, Task) or _is_tasks(command):
@@ -236,8 +236,7 @@ class Resolver:
             ref = task.ref if ref is None else task.check_ref(ref)
         with self._lock:
             start = time.perf_counter()
-            kin = Kinematics(self.robot.model, self._data, self._layout,
-                             self.robot.dof_positions(q), q_pin)  # fmt: skip
+            kin = Kinematics(self.robot.model, self._data, self._layout, dof, q_pin)
             if twist is None:
                 rows = [[t.rows(kin) for t in level] for level in levels]
             else:
@@ -257,11 +256,10 @@ class Resolver:
             InvalidInput: A bad q, or a task that does not fit the robot.
             FrameNotFound: The task names a frame the robot does not have.
         """
-        q, q_pin = self.robot.configuration(q)
+        q, dof, q_pin = self.robot.positions(q)
         _typed(task, Task, "task").check(self._layout)
         with self._lock:
-            kin = Kinematics(self.robot.model, self._data, self._layout,
-                             self.robot.dof_positions(q), q_pin)  # fmt: skip
+            kin = Kinematics(self.robot.model, self._data, self._layout, dof, q_pin)
             return task.rows(kin)
 
     def _twist_task(self) -> FrameTask:

@@ -294,6 +294,20 @@ class Robot:
         q = self.check_q(q)
         return self._dof(q)
 
+    def positions(
+        self, q: npt.ArrayLike
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        """``q`` checked once, each rate's position and Pinocchio's configuration vector.
+
+        What one tick's kinematics reads: :meth:`dof_positions` and :meth:`configuration`
+        with one check.
+
+        Raises:
+            InvalidInput: ``q`` is not a finite (nq,) vector.
+        """
+        q, q_pin = self.configuration(q)
+        return q, self._dof(q), q_pin
+
     def _dof(self, q: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         if not self.floating:
             return q

@@ -42,6 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from solvers import kernels
 from solvers.validation import finite_number
 
 Array = npt.NDArray[np.float64]
@@ -74,6 +75,8 @@ class Damping:
     ) -> Array | None:
         """Squared damping per singular direction (k,), or None where none applies.
 
+        The module docstring's schedule (:func:`~solvers.kernels.damping_lambda_sq`).
+
         Args:
             sigma: Singular values (k,) of the level's normalised rows, descending.
             rank: How many of them count (the others are zero).
@@ -81,14 +84,7 @@ class Damping:
             along: :math:`|u_i^T b|` (k,), the command's size along each direction.
             dt: The step [s].
         """
-        if rank == 0 or scale >= 1.0:
+        lam = np.empty(sigma.size)
+        if not kernels.damping_lambda_sq(sigma, rank, scale, along, dt, float(self.threshold), lam):
             return None
-        onset = float(sigma[0]) / self.threshold
-        s = sigma[:rank]
-        if float(s[-1]) >= onset:
-            return None
-        lam = np.zeros(sigma.size)
-        weak = s < onset
-        floor = np.maximum(onset * onset, float(sigma[0]) * along[:rank][weak] * dt)
-        lam[:rank][weak] = (1.0 - (s[weak] / onset) ** 2) * floor * (1.0 - scale)
         return lam

@@ -22,7 +22,9 @@ solved here (:func:`along`):
 - without rows and null space: the largest uniform scale
   (:func:`~solvers.kernels.uniform_scale`);
 - without rows, one null direction (a 7-joint arm's six rows): exactly, by eliminating y
-  (:func:`~solvers.kernels.line_scale`);
+  (:func:`~solvers.kernels.line_scale`); for the top level's exact rates these two come in
+  the same kernel call as the rates (:func:`~solvers.kernels.direction_step`, through
+  :meth:`~solvers.factorization.Factorization.fitted`);
 - otherwise by the QP backend (:func:`direction_qp`: the LP with a small regularisation that
   picks the least-norm y; DAQP returns the LP's vertex), or exactly by scipy's HiGHS
   (:func:`direction_lp`, the fallback).

@@ -23,6 +23,7 @@ import numpy as np
 import numpy.typing as npt
 
 from solvers import kernels
+from solvers.direction import Along
 
 Array = npt.NDArray[np.float64]
 
@@ -55,11 +56,13 @@ class Factorization:
         self._svd: tuple[Array, Array, Array, int] | None = None
 
     @classmethod
-    def fitted(cls, J: Array, b: Array, lb: Array, ub: Array) -> tuple[Factorization, Array, bool]:
-        """The factorisation of J, the least-norm rates of ``J x ~= b`` and whether they fit.
+    def fitted(
+        cls, J: Array, b: Array, lb: Array, ub: Array
+    ) -> tuple[Factorization, Array, bool, Along | None]:
+        """The factorisation of J, the least-norm rates of ``J x ~= b``, whether they fit.
 
-        One kernel call where J has full row rank (:func:`~solvers.kernels.least_norm_fit`),
-        the SVD otherwise.
+        Where they do not, also the largest scale along them within the box. One kernel call
+        where J has full row rank (:func:`~solvers.kernels.direction_step`), the SVD otherwise.
 
         Args:
             J: The rows (m, n).
@@ -68,19 +71,22 @@ class Factorization:
             ub: Upper bounds (n,).
 
         Returns:
-            The factorisation, the rates (n,), and whether ``lb <= x <= ub``.
+            The factorisation, the rates (n,), whether ``lb <= x <= ub``, and where they do
+            not the direction problem's answer within the box alone (exact: at most one null
+            direction), else None.
         """
         m, n = J.shape
         factor = cls.__new__(cls)
         factor.J, factor._svd = J, None
         x: Array = np.empty(n)
+        qdot: Array = np.empty(n)
         factor.Q, factor.R = np.empty((n, n)), np.empty((n, m))
-        fit = kernels.least_norm_fit(J, b, lb, ub, factor.Q, factor.R, x)
+        fit, u = kernels.direction_step(J, b, lb, ub, factor.Q, factor.R, x, qdot)
         factor.regular = fit > 0
         if fit:
-            return factor, x, fit == 2
+            return factor, x, fit == 2, Along(qdot, u) if u >= 0.0 else None
         x = factor.rates(b, None)
-        return factor, x, kernels.inside(x, lb, ub)
+        return factor, x, kernels.inside(x, lb, ub), None
 
     def least_norm(self, b: Array) -> Array:
         """The least-squares rates of least norm, :math:`J^+ b` (n,), rank by :data:`RANK_TOL`."""

@@ -223,35 +223,6 @@ def least_norm_rates(Q: Array, R: Array, b: Array, x: Array) -> bool:
 
 
 @kernel
-def least_norm_fit(
-    J: Array, b: Array, lb: Array, ub: Array, Q: Array, R: Array, x: Array
-) -> int:
-    """One step of a tick: the QR of the rows, their least-norm rates, and whether they fit.
-
-    :func:`householder_qr` of :math:`J^T`, :func:`least_norm_rates` and :func:`inside`, in
-    one call.
-
-    Args:
-        J: Rows (m, n).
-        b: Their rates (m,).
-        lb: Lower bounds (n,).
-        ub: Upper bounds (n,).
-        Q: Out: orthogonal factor (n, n).
-        R: Out: triangular factor (n, m).
-        x: Out: the rates (n,), set unless 0 is returned.
-
-    Returns:
-        0 where the rows are numerically dependent or more than the joints (x not set), 1
-        where x is set outside ``[lb, ub]``, 2 inside.
-    """
-    m, n = J.shape
-    householder_qr(J.T, Q, R)
-    if m > n or not least_norm_rates(Q, R, b, x):
-        return 0
-    return 2 if inside(x, lb, ub) else 1
-
-
-@kernel
 def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
     r"""One-sided Jacobi SVD of a small ``A`` (m, k): ``A V = U diag(sigma)`` (Hestenes 1958).
 
@@ -411,6 +382,44 @@ def svd_rates(
             x[r] += c * right[r, i]
 
 
+@kernel
+def damping_lambda_sq(
+    sigma: Array, rank: int, scale: float, along: Array, dt: float, threshold: float, lam: Array
+) -> bool:
+    r"""Squared damping per singular direction (:mod:`solvers.damping`'s schedule).
+
+    With the onset :math:`\sigma_{on} = \sigma_1/\kappa`, every direction i < rank whose
+    singular value is below it gets :math:`\lambda_i^2 = (1 - (\sigma_i/\sigma_{on})^2)\,
+    \max(\sigma_{on}^2, \sigma_1 |u_i^T b|\,\Delta t)\,(1 - u^*)` (Maciejewski & Klein 1988's
+    smooth onset, with a floor for the step), the others zero.
+
+    Args:
+        sigma: Singular values (k,), descending.
+        rank: How many of them count.
+        scale: The LP maximum :math:`u^*` in [0, 1].
+        along: :math:`|u_i^T b|` (k,).
+        dt: The step [s].
+        threshold: :math:`\kappa`.
+        lam: Out: the squared damping (k,), set where True is returned.
+
+    Returns:
+        False where none applies (no rank, :math:`u^* \ge 1`, or every counted singular value
+        at or above the onset).
+    """
+    if rank == 0 or scale >= 1.0:
+        return False
+    onset = sigma[0] / threshold
+    if sigma[rank - 1] >= onset:
+        return False
+    for i in range(sigma.size):
+        lam[i] = 0.0
+        if i < rank and sigma[i] < onset:
+            floor = max(onset * onset, sigma[0] * along[i] * dt)
+            ratio = sigma[i] / onset
+            lam[i] = (1.0 - ratio * ratio) * floor * (1.0 - scale)
+    return True
+
+
 # -- feasibility and scales -------------------------------------------------------------------
 
 
@@ -522,6 +531,110 @@ def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
     # rounding at a vertex: the y that leaves both rows by the same rate (a row with a
     # null component of rounding size, 1e-15, pins u; its y bound is off by up to 0.1)
     return u, (v_lo * y_lo + v_hi * y_hi) / (v_lo + v_hi)
+
+
+@kernel
+def direction_step(
+    J: Array, b: Array, lb: Array, ub: Array, Q: Array, R: Array, w: Array, qdot: Array
+) -> tuple[int, float]:
+    r"""The top level's step within a box: its exact rates, whether they fit, else their scale.
+
+    :func:`householder_qr` of :math:`J^T`, the least-norm rates w of :math:`Jx = b`
+    (:func:`least_norm_rates`), :func:`inside`; where w leaves the box and the null space of J
+    has at most one direction (:math:`Q_{:,m}`, a 7-joint arm's six rows), the direction
+    problem's exact answer :math:`u\,w + y\,Q_{:,m}` (:func:`uniform_scale`,
+    :func:`line_scale`); one call for what most ticks need (:mod:`solvers.direction`).
+
+    Args:
+        J: Rows (m, n).
+        b: Their rates (m,).
+        lb: Lower bounds (n,) (containing zero where the scale is asked for).
+        ub: Upper bounds (n,).
+        Q: Out: orthogonal factor (n, n).
+        R: Out: triangular factor (n, m).
+        w: Out: the least-norm rates (n,), set unless 0 is returned.
+        qdot: Out: the scaled rates (n,), set where 1 is returned with u >= 0.
+
+    Returns:
+        ``(fit, u)``: fit 0 where the rows are numerically dependent or more than the joints
+        (w not set), 1 where w is outside ``[lb, ub]``, 2 inside; u the largest scale in
+        [0, 1] along w where fit is 1 and n - m <= 1, else -1.
+    """
+    m, n = J.shape
+    householder_qr(J.T, Q, R)
+    if m > n or not least_norm_rates(Q, R, b, w):
+        return 0, -1.0
+    if inside(w, lb, ub):
+        return 2, -1.0
+    if n - m > 1:
+        return 1, -1.0
+    if n == m:
+        u = uniform_scale(w, lb, ub)
+        for i in range(n):
+            qdot[i] = u * w[i]
+        return 1, u
+    v = Q[:, m]
+    u, y = line_scale(w, v, lb, ub)
+    for i in range(n):
+        qdot[i] = u * w[i] + y * v[i]
+    return 1, u
+
+
+@kernel
+def scale_and_veer(y: Array, b: Array, factor: Array | None = None) -> tuple[float, float]:
+    r"""Fraction of ``b`` achieved along it by ``y`` (in [0, 1]) and the angle between them [rad].
+
+    The scale is :math:`y^Tb/b^Tb` and the angle :math:`\arccos(y^Tb/(|y||b|))`, computed on
+    both divided by their largest entries so that no product overflows; the ratio of those
+    entries is formed with the larger one as divisor (a subnormal command's would overflow).
+
+    Args:
+        y: Achieved rates (m,).
+        b: Commanded rates (m,).
+        factor: Row factors (m,) of a level's metric, or None: the scale and angle of
+            ``factor * y`` and ``factor * b``, both first divided by b's largest entry where
+            it exceeds 1 (so that the factors cannot overflow a command near the float range;
+            a subnormal one is not divided up: the achieved rates would overflow).
+
+    Returns:
+        (scale, veer): (1, 0) for a zero command, (0, 0) for zero rates.
+    """
+    m = b.size
+    ys, bs = np.empty(m), np.empty(m)
+    if factor is None:
+        ys[:] = y
+        bs[:] = b
+    else:
+        peak = 1.0
+        for i in range(m):
+            peak = max(peak, abs(b[i]))
+        for i in range(m):
+            ys[i] = factor[i] * (y[i] / peak)
+            bs[i] = factor[i] * (b[i] / peak)
+    top_b = 0.0
+    top_y = 0.0
+    for i in range(m):
+        top_b = max(top_b, abs(bs[i]))
+        top_y = max(top_y, abs(ys[i]))
+    if top_b == 0.0:
+        return 1.0, 0.0
+    if top_y == 0.0:
+        return 0.0, 0.0
+    yb = yy = bb = 0.0
+    for i in range(m):
+        yn, bn = ys[i] / top_y, bs[i] / top_b
+        yb += yn * bn
+        yy += yn * yn
+        bb += bn * bn
+    cosine = yb / (math.sqrt(yy) * math.sqrt(bb))
+    veer = math.acos(min(max(cosine, -1.0), 1.0))
+    along = yb / bb  # the scale, times top_b / top_y
+    if along <= 0.0:
+        return 0.0, veer
+    if top_y <= top_b:
+        return min(along * (top_y / top_b), 1.0), veer
+    ratio = top_b / top_y
+    return (along / ratio if along < ratio else 1.0), veer
 
 
 # -- least squares of a stack -----------------------------------------------------------------

@@ -12,9 +12,10 @@ Its unconstrained optimum of least norm is the answer when it satisfies the cons
 by the normal equations :math:`B^TBz = B^Tc` (:func:`~solvers.kernels.cholesky_solve`) for
 more rows than unknowns, by the QR of :math:`B^T` (:class:`~solvers.factorization.Factorization`)
 otherwise, and by the SVD where either is rank deficient. Else the backend solves the QP
-with :math:`P = B^TB`: exactly the stated costs where P is definite (their optimum is one
-point). Where it is not (fewer independent rows than unknowns: one frame task on a
-redundant arm, a lower level in a null space) the optimal rates form a set, and the term
+with :math:`P = B^TB` and :math:`q = -B^Tc` (the same normal equations, computed once):
+exactly the stated costs where P is definite (their optimum is one point). Where it is not
+(fewer independent rows than unknowns: one frame task on a redundant arm, a lower level in a
+null space) the optimal rates form a set, and the term
 :math:`\epsilon\|z\|^2`, :math:`\epsilon` = :data:`TIE_BREAK` times the trace of P, picks
 the least-norm ones among them; it moves the optimum of the stated costs by at most
 :math:`\epsilon/\lambda` relative along an eigenvector of P of eigenvalue :math:`\lambda`,
@@ -54,6 +55,9 @@ ROUNDING = 1e-12
 them wherever a joint is at a bound."""
 
 
+_TINY = float(np.finfo(np.float64).tiny)
+
+
 class Subspace(NamedTuple):
     """Where a level may move: rates ``x + N^T z``.
 
@@ -66,12 +70,23 @@ class Subspace(NamedTuple):
     N: Array | None
 
 
-def optimum(B: Array, c: Array) -> tuple[Array, Factorization | None, bool]:
+def normal_equations(B: Array, c: Array) -> tuple[Array, Array]:
+    r""":math:`(B^TB, B^Tc)` (:func:`~solvers.kernels.normal_equations`): the optimum's normal
+    equations, and the QP's costs."""  # noqa: D205, D209
+    m, d = B.shape
+    H, g = np.empty((d, d)), np.empty(d)
+    kernels.normal_equations(B, c, np.ones(m), H, g)
+    return H, g
+
+
+def optimum(B: Array, c: Array, H: Array, g: Array) -> tuple[Array, Factorization | None, bool]:
     """The least-squares solution of least norm of ``B z ~= c``.
 
     Args:
         B: Rows (m, d).
         c: Rates (m,).
+        H: :math:`B^TB` (d, d).
+        g: :math:`B^Tc` (d,).
 
     Returns:
         z (d,), the :class:`Factorization` of B when it was computed (else None: the normal
@@ -79,8 +94,7 @@ def optimum(B: Array, c: Array) -> tuple[Array, Factorization | None, bool]:
     """
     m, d = B.shape
     if m > d:
-        H, g, z = np.empty((d, d)), np.empty(d), np.empty(d)
-        kernels.normal_equations(B, c, np.ones(m), H, g)
+        z = np.empty(d)
         if kernels.cholesky_solve(H, g, z):
             return z, None, True
     factor = Factorization(B)
@@ -121,21 +135,21 @@ def least_squares(
     x, N = space
     B = A if N is None else A @ N.T
     c = b if N is None or x is None else b - A @ x
-    z, factor, definite = optimum(B, c)
+    H, g = normal_equations(B, c)
+    z, factor, definite = optimum(B, c, H, g)
     candidate = z if N is None or x is None else x + z @ N
     feasible = kernels.inside(candidate, box.lb, box.ub) and (
         rows is None or kernels.rows_hold(rows.G, candidate, rows.h, 0.0)
     )
     if not feasible:
-        P = B.T @ B
-        q = -(c @ B)
+        P, q = H, -g
         d = B.shape[1]
         if not definite:
             P.flat[:: d + 1] += TIE_BREAK * max(float(P.trace()), 1.0)
         # Divided by their largest entry, the costs have the same minimiser and the backends'
         # absolute tolerances read as relative ones (a command saturating the box gave
         # gradients 1e7 times P, and proxqp iterated for 10 s).
-        size = max(float(np.abs(P).max()), float(np.abs(q).max()), np.finfo(float).tiny)
+        size = max(float(np.abs(P).max()), float(np.abs(q).max()), _TINY)
         P, q = P / size, q / size
         C: Array | None
         lo: Array | None

@@ -27,7 +27,7 @@ A least-squares level (the other modes, and every lower level): its unconstraine
 (:mod:`solvers.least_squares`) when it satisfies the constraints, else the backend's QP.
 
 When the top level finds no usable answer (a backend fault, an infeasible problem, an answer
-outside the constraints beyond :data:`FEASIBILITY_TOL`), the fallbacks answer it
+outside the constraints beyond :func:`~solvers.qp.tolerance`), the fallbacks answer it
 (:mod:`solvers.fallbacks`); a lower level that fails keeps the answer of the levels above
 (``dropped``). Every answer is finally clipped into the box, the size of the clip reported.
 Nothing here raises for numerical trouble.
@@ -47,9 +47,10 @@ from solvers.damping import Damping
 from solvers.direction import Along, along, direction_qp
 from solvers.errors import InvalidInput, NumericalFailure
 from solvers.factorization import Factorization
+from solvers.kernels import scale_and_veer
 from solvers.least_squares import Subspace, least_squares
 from solvers.problem import Box, Problem, Rows, largest_weight, row_factors
-from solvers.qp import FEASIBILITY_TOL, Work, solve_within
+from solvers.qp import Work, solve_within, tolerance
 from solvers.qp_backends.base import QPBackend
 
 Array = npt.NDArray[np.float64]
@@ -257,8 +258,10 @@ def _top(
         status: Status = "recovering" if box.recovering or _broken(rows) else (
             "exact" if met else "least_squares")  # fmt: skip
         return _Top(qdot, status, *_along_command(problem, qdot), 0.0, null)
+    boxed: Along | None = None  # the direction problem along w, where the box is all
     if space.N is None:
-        factor, w, fits = Factorization.fitted(A, b, box.lb, box.ub)
+        factor, w, fits, boxed = Factorization.fitted(A, b, box.lb, box.ub)
+        boxed = boxed if rows is None else None
         z = w
     else:
         factor = Factorization(A @ space.N.T)
@@ -276,7 +279,7 @@ def _top(
             work.attempts.append(("slide", f"{exc}; the command kept as given"))
         else:
             if rows is not None and (rows.slide is None or not rows.slide.all()):
-                within = kernels.rows_hold(rows.G, kept, rows.h, _tolerance(box))
+                within = kernels.rows_hold(rows.G, kept, rows.h, tolerance(box))
             else:
                 within = True  # every row slides: the least squares kept them all
             if within:  # the slid command met within every row: its rates as they are
@@ -295,7 +298,7 @@ def _top(
             return _Top(w, "singular", *_along_command(problem, w), 0.0, null)
         return _Top(w, "exact", 1.0, 0.0, 0.0, null)
     null = _null(factor, space)
-    u_w = _scaled(A, w, null, box, rows, backend, work)
+    u_w = boxed if boxed is not None else _scaled(A, w, null, box, rows, backend, work)
     if slid:
         return _Top(u_w.qdot, "sliding", *_along_command(problem, u_w.qdot), 0.0, null)
     if not outside_range and u_w.u >= 1.0 - EXACT_TOL:
@@ -342,7 +345,8 @@ def _clamped(factor: Factorization, w: Array, box: Box, dt: float) -> Factorizat
     if not kernels.clamp_pushed(factor.J, w, box.lb, box.ub, kernels.ON_LIMIT / dt, J):
         return factor
     clamped = Factorization(J)
-    return clamped if clamped.svd[3] >= factor.svd[3] else factor
+    rank = clamped.svd[3]  # at most the rows' own: where full, theirs is not needed (one SVD)
+    return clamped if rank == min(J.shape) or rank >= factor.svd[3] else factor
 
 
 STILL_SCALE = 1e-9
@@ -416,43 +420,19 @@ def _served(problem: Problem, k: int, qdot: Array) -> LevelStatus:
 
 
 def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
-    """The top level's scale and veer for ``qdot`` in its normalised metric."""
+    """The top level's scale and veer for ``qdot`` in its normalised metric.
+
+    Each row times its factor (:func:`~solvers.problem.row_factors`); the kernel first divides
+    a command near the float range down, so that its units cannot overflow it.
+    """
     level = problem.levels[0]
     top = largest_weight(level)
-    # A command near the float range is divided down so that its units cannot overflow it; a
-    # subnormal one is not divided up (the achieved rates divided by it overflowed: NaN scale)
-    peak = max(1.0, *(float(np.abs(t.b).max(initial=0.0)) for t in level))
-    y, b = [], []
-    for t in level:
-        factor = row_factors(t, top, units=True)
-        achieved, commanded = (t.A @ qdot) / peak, t.b / peak
-        y.append(achieved if factor is None else factor * achieved)
-        b.append(commanded if factor is None else factor * commanded)
-    return scale_and_veer(np.concatenate(y), np.concatenate(b))
-
-
-def scale_and_veer(y: Array, b: Array) -> tuple[float, float]:
-    """Fraction of ``b`` achieved along it by ``y`` (in [0, 1]) and the angle between them [rad].
-
-    Computed on both divided by their largest entries, so that no product overflows.
-    """
-    top_b = float(np.abs(b).max()) if b.size else 0.0
-    if top_b == 0.0:
-        return 1.0, 0.0
-    top_y = float(np.abs(y).max())
-    if top_y == 0.0:
-        return 0.0, 0.0
-    bn, yn = b / top_b, y / top_y
-    cosine = float(yn @ bn) / (_norm(yn) * _norm(bn))
-    veer = math.acos(min(max(cosine, -1.0), 1.0))
-    with np.errstate(over="ignore"):
-        ratio = float(np.float64(top_y) / top_b) * float(yn @ bn) / float(bn @ bn)
-    return min(max(ratio, 0.0), 1.0), veer
-
-
-def _tolerance(box: Box) -> float:
-    """How far a backend's answer may leave the rows (:func:`solvers.qp.solve_within`'s)."""
-    return FEASIBILITY_TOL * (1.0 + math.hypot(*np.minimum(box.velocity, 1e300).tolist()))
+    factors = [row_factors(t, top, units=True) for t in level]
+    factor = [np.ones(t.b.size) if f is None else f for t, f in zip(level, factors, strict=True)]
+    if len(level) == 1:
+        return scale_and_veer(level[0].A @ qdot, level[0].b, factor[0])
+    y = np.concatenate([t.A @ qdot for t in level])
+    return scale_and_veer(y, np.concatenate([t.b for t in level]), np.concatenate(factor))
 
 
 def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:

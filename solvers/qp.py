@@ -136,7 +136,7 @@ def solve_checked(backend: QPBackend, qp: QP, decoding: Decoding) -> Solved:
         raise NumericalFailure(f"{sol.backend}: took {sol.solve_time:.3g} s, past the time "
                                f"limit {limit:.3g} s")  # fmt: skip
     z = np.asarray(z, dtype=np.float64)
-    if z.shape != qp.q.shape or not np.isfinite(z).all():
+    if z.shape != qp.q.shape or not kernels.all_finite(z.reshape(-1)):
         raise NumericalFailure(f"{sol.backend}: answer of shape {z.shape}, finite "
                                f"{bool(np.isfinite(z).all())}; expected {qp.q.shape}")  # fmt: skip
     return Solved(decoding.rates(z), sol.backend, sol.iterations, sol.solve_time)
@@ -180,9 +180,17 @@ def solve_within(
     work.backend = solved.backend
     work.iterations += solved.iterations
     work.solve_time += solved.solve_time
-    x = box.clip(solved.x)
-    size = math.hypot(*(x - solved.x).tolist())
-    tol = FEASIBILITY_TOL * (1.0 + math.hypot(*np.minimum(box.velocity, 1e300).tolist()))
+    x: Array = solved.x.copy()
+    size = kernels.clip_into(x, box.lb, box.ub)
+    tol = tolerance(box)
     if not (size <= tol and (rows is None or kernels.rows_hold(rows.G, x, rows.h, tol))):
         raise NumericalFailure(f"{solved.backend}: answer outside the constraints by {size:.3g}")
     return x
+
+
+def tolerance(box: Box) -> float:
+    """How far a backend's answer may leave the box and rows [rad/s or m/s, or the rows' units].
+
+    :data:`FEASIBILITY_TOL` times (1 + the norm of the velocity limits).
+    """
+    return FEASIBILITY_TOL * (1.0 + math.hypot(*np.minimum(box.velocity, 1e300).tolist()))

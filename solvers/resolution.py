@@ -20,8 +20,8 @@ from typing import Literal, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from solvers.kernels import ACCELERATION, POSITION
-from solvers.pipeline import Answer, LevelStatus, Method, Status, scale_and_veer
+from solvers.kernels import ACCELERATION, POSITION, scale_and_veer
+from solvers.pipeline import Answer, LevelStatus, Method, Status
 from solvers.problem import Box, Problem, largest_weight, row_factors
 
 Array = npt.NDArray[np.float64]

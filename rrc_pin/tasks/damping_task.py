@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from rrc_pin.kinematics import Kinematics
-from rrc_pin.tasks.task import Task, check_weight, task_name
+from rrc_pin.tasks.task import Task, check_weight, identity, task_name
 from solvers.problem import TaskRows
 
 
@@ -35,4 +35,4 @@ class DampingTask(Task):
     def rows(self, kin: Kinematics) -> TaskRows:
         """Identity rows, zero rates."""
         n = kin.q.size
-        return TaskRows(np.eye(n), np.zeros(n), self._row_weights(n), self.name)
+        return TaskRows(identity(n), np.zeros(n), self._row_weights(n), self.name)

@@ -79,7 +79,6 @@ class FrameTask(Task):
         self.weight = check_weight(weight, len(self.selected))
         self.name = frame if name is None else task_name(name)
         self.twist = np.zeros(len(self.selected)) if twist is None else self.check_twist(twist)
-        self._units: dict[float, Array] = {}  # row units by reach: one array per robot frame
 
     def set_twist(self, twist: npt.ArrayLike) -> None:
         """Command a new twist (checked as at construction): keep a task across ticks.
@@ -180,12 +179,23 @@ class FrameTask(Task):
         selected = self.selected
         if len(selected) != 6:
             J = J[list(selected)]
-        unit = self._units.get(reach)
-        if unit is None:
-            unit = np.array([reach if r < 3 else 1.0 for r in selected])
-            unit.flags.writeable = False
-            self._units[reach] = unit
-        return TaskRows(J, b, self._row_weights(len(selected)), self.name, unit)
+        return TaskRows(J, b, self._row_weights(len(selected)), self.name, _units(selected, reach))
+
+
+_UNITS: dict[tuple[tuple[int, ...], float], Array] = {}
+
+
+def _units(selected: tuple[int, ...], reach: float) -> Array:
+    """The rows' units: the reach [m] for linear rows, 1 for angular ones.
+
+    Read-only, made once per selection and reach: the tasks built at every tick share them.
+    """
+    unit = _UNITS.get((selected, reach))
+    if unit is None:
+        unit = np.array([reach if r < 3 else 1.0 for r in selected])
+        unit.flags.writeable = False
+        _UNITS[(selected, reach)] = unit
+    return unit
 
 
 def task_rows(rows: str | Sequence[int] | Sequence[bool]) -> tuple[int, ...]:

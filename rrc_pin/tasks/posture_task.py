@@ -7,7 +7,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
-from rrc_pin.tasks.task import Task, check_weight, task_name
+from rrc_pin.tasks.task import Task, check_weight, identity, task_name
 from solvers.problem import TaskRows
 from solvers.validation import as_vector, positive
 
@@ -62,4 +62,4 @@ class PostureTask(Task):
             wrapped = np.remainder(error + np.pi, 2.0 * np.pi) - np.pi
             error = np.where(kin.layout.continuous, wrapped, error)
         n = error.size
-        return TaskRows(np.eye(n), self.gain * error, self._row_weights(n), self.name)
+        return TaskRows(identity(n), self.gain * error, self._row_weights(n), self.name)

@@ -53,6 +53,18 @@ class Task(ABC):
         return None if (self.weight == 1.0).all() else self.weight
 
 
+_IDENTITY: dict[int, Array] = {}
+
+
+def identity(n: int) -> Array:
+    """The identity rows (n, n), read-only, made once per size (joint-space tasks' Jacobian)."""
+    eye = _IDENTITY.get(n)
+    if eye is None:
+        eye = _IDENTITY[n] = np.eye(n)
+        eye.flags.writeable = False
+    return eye
+
+
 def check_weight(weight: float | npt.ArrayLike, size: int | None = None) -> float | Array:
     """A task weight: a finite number > 0, or (size,) of them.
 
