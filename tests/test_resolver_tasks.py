@@ -245,3 +245,21 @@ def test_a_cell_of_two_arms_is_one_stack() -> None:
         one = Resolver(panda).solve(q[:7], np.concatenate([T_left[:3, :3].T @ tl[:3],
                                                            T_left[:3, :3].T @ tl[3:]]))
         np.testing.assert_allclose(r.qdot[:7], one.qdot, atol=1e-9)
+
+
+def test_status_is_partial_while_a_lower_level_is_far_from_its_command() -> None:
+    """Issue 30's case: the grip at the top level, each hand commanded at the level below to
+    move apart (the grip forbids it). The lower level is not met, so no answer is ``exact``;
+    with the hands commanded alike the lower level is met, and the answers are ``exact``."""
+    cell = rrc_pin.load("gsfc_dual")
+    left, right = cell.tool_frames
+    resolver = Resolver(cell)
+    q = cell.ready()
+    grasp = relative_pose(cell, q, left, right).homogeneous
+    grip = RelativeFrameTask(left, right, target=grasp)
+    for apart, expected in ((0.05, "partial"), (0.0, "exact")):
+        lead = FrameTask(left, [0.0, apart, 0.02, 0.0, 0.0, 0.0], ref="world")
+        follow = FrameTask(right, [0.0, -apart, 0.02, 0.0, 0.0, 0.0], ref="world")
+        r = resolver.solve(q, [grip, [lead, follow]], priority="strict")
+        assert r.status == expected, (apart, r.status, r.levels)
+        assert r.levels[0] == "met" and (r.levels[1] == "met") == (expected == "exact")
