@@ -446,9 +446,12 @@ def test_sliding_reports_the_pair_and_its_distance() -> None:
 def test_a_slid_command_met_by_other_joints_is_met_not_scaled() -> None:
     """Four joints moving a point, joint 4 along z like joint 3; a slide row on joint 3 alone
     (-qdot_3 <= 1e-9, a held pair's bound: solvers.damper_kernels.SLACK). The least-norm
-    rates of a command down share z between joints 3 and 4 and cross the row; the slide's
-    least squares meets the whole command with joint 4 and keeps the row: those rates are the
-    answer (the least-norm rates scaled back to the row would stand still)."""
+    rates of a command down share z between joints 3 and 4 and cross the row; the slide
+    meets the command with joint 4 and keeps the row: those rates are the answer (the
+    least-norm rates scaled back to the row would stand still). To the sliding stage's pull
+    toward the least-norm rates (pipeline.SLIDE_DAMPING): joint 4 does
+    (0.1 + 0.05 mu) / (1 + mu) of the 0.1 down, mu its weight (1e-2 of the rows' mean squared
+    singular value, 4/3)."""
     n = 4
     free = np.full(n, 2.0)
     box = Box(-free, free.copy(), np.zeros((2, n), np.int8), True, False, free.copy())
@@ -460,5 +463,8 @@ def test_a_slid_command_met_by_other_joints_is_met_not_scaled() -> None:
     problem = build([[TaskRows(A, b, None, "hand")]], [Constraints(box), rows], n, DT)
     answer = solve(problem, make_backend("daqp"), Options())
     assert answer.status == "sliding"
-    np.testing.assert_allclose(A @ answer.qdot, b, rtol=1e-5, atol=1e-12)
-    assert -answer.qdot[2] <= SLACK and answer.scale == pytest.approx(1.0, abs=1e-5)
+    mu = pipeline_module.SLIDE_DAMPING * 4.0 / 3.0
+    down = -(0.1 + 0.05 * mu) / (1.0 + mu)
+    np.testing.assert_allclose(A @ answer.qdot, (0.1, 0.05, down), rtol=1e-8, atol=1e-12)
+    assert 0.1 + down < 1e-3  # the command met to 1 %
+    assert -answer.qdot[2] <= SLACK and answer.scale == pytest.approx(1.0, abs=1e-2)
