@@ -75,6 +75,14 @@ END = 0.5
 pair's own damper would slow a capsule sliding along another as its overhanging end comes in
 (tangential progress 0.75 of the command with the pair's xi on two pandas' hands)."""
 
+BLEND = 0.005
+"""[m] An end point's row takes the pair's own xi where the end is as close as the pair's
+closest points, and :data:`END`'s only where it is this much farther, linearly between. Two
+capsules near parallel have their closest points at either end, from one tick to the next:
+with the end's looser xi, turning about the pair's middle looked free to the row of the closest
+end and was taken (the far end may approach faster), the closest end then swapped; two pandas'
+hands held against each other had their wrists flip back and forth at 0.3-0.6 rad/s a tick."""
+
 STILL = 1e-9
 """[m/s per rad/s] A row whose every entry is below this is dropped: no joint changes the
 pair's distance (a base link turning about its own axis over the floor), so the row cannot
@@ -170,9 +178,7 @@ class CollisionLimit(Limit):
         names = list(gather(scene.labels, prox.pair))
         distance = prox.distance
         if k:
-            gains = np.full(k, xi)
-            pair = prox.pair
-            gains[1:][pair[1:] == pair[:-1]] = END * (self.detection - self.safety) / dt
+            gains = _gains(prox.pair, prox.distance, xi, END * (self.detection - self.safety) / dt)
             damper_rows(kin.data.J, self._support, prox.joint_a, prox.joint_b, prox.point_a,
                         prox.point_b, prox.normal, prox.distance, self.safety, self.detection,
                         gains, RECOVERY / dt, G, h)  # fmt: skip
@@ -216,6 +222,19 @@ class CollisionLimit(Limit):
 
 
 _NONE = Constraints()
+
+
+def _gains(pair: npt.NDArray[np.int64], distance: Array, xi: float, xi_end: float) -> Array:
+    """Each row's xi: the pair's own ``xi``; an end point's up to ``xi_end`` (:data:`BLEND`)."""
+    k = distance.size
+    gains = np.full(k, xi)
+    end = np.zeros(k, dtype=np.bool_)
+    end[1:] = pair[1:] == pair[:-1]
+    if end.any():
+        first = np.maximum.accumulate(np.where(end, 0, np.arange(k)))
+        excess = np.clip((distance - distance[first]) / BLEND, 0.0, 1.0)
+        gains[end] = xi + (xi_end - xi) * excess[end]
+    return gains
 
 
 def _pairs(model: CollisionModel, pairs: Sequence[tuple[str, str]]) -> frozenset[tuple[str, str]]:
