@@ -356,17 +356,14 @@ def _slide(
         kept, _ = least_squares(A, b, space, box, slide, backend, work, "slide", False)
         return kept
     n = w.size
-    M = A.T @ A
-    mu = SLIDE_DAMPING * max(float(M.trace()) / max(A.shape[0], 1), _TINY)
-    M.flat[:: n + 1] += mu
     x = np.empty(n)
-    # the rows tightened by a rounding's worth: an answer on a row at 0 must not cross it by
-    # 1e-17 (the last step, _within_rows, would shrink the whole answer to zero)
-    tight = slide.h - SLIDE_ROUNDING * (1.0 + np.abs(slide.h))
-    if project(M, w, box.lb, box.ub, slide.G, tight, x) == SOLVED:
-        clip = kernels.clip_into(x, box.lb, box.ub)
-        if clip <= tolerance(box):
-            return x
+    # the rows met with a rounding's worth to spare: an answer on a row at 0 must not cross it
+    # by 1e-17 (the last step, _within_rows, would shrink the whole answer to zero)
+    if project(A, SLIDE_DAMPING, w, box.lb, box.ub, slide.G, slide.h, SLIDE_ROUNDING, x) == SOLVED:
+        kernels.clip_into(x, box.lb, box.ub)  # by the kernel's rounding at most (1e-9)
+        return x
+    M = A.T @ A
+    M.flat[:: n + 1] += SLIDE_DAMPING * max(float(M.trace()) / max(A.shape[0], 1), _TINY)
     size = max(float(np.abs(M).max()), _TINY)
     qp = QP(M / size, -(M @ w) / size, slide.G, np.full(slide.h.size, -np.inf), slide.h, box.lb,
             box.ub, f"slide:{n}")  # fmt: skip
