@@ -102,16 +102,26 @@ def test_the_compiled_rows_equal_the_formula_written_in_numpy():
     pa, pb, nrm = rng.normal(size=(k, 3)), rng.normal(size=(k, 3)), rng.normal(size=(k, 3))
     nrm /= np.linalg.norm(nrm, axis=1)[:, None]
     d = rng.uniform(-0.05, 0.1, k)
-    G, h = np.empty((k, nv)), np.empty(k)
-    xi = rng.choice([0.5, 4.0], k)  # a pair's own row, an end point's
-    damper_rows(J, support, ja, jb, pa, pb, nrm, d, 0.02, 0.1, xi, 50.0, G, h)
+    ja[5], jb[5] = 0, 0  # no joint moves either body: not moved
+    pair = np.array([0, 0, 0, 1, 2, 2, 3])  # a pair's own row, then its end points'
+    d[0] = 0.05
+    d[1], d[2] = d[0] + 0.001, d[0] + 0.02  # an end 1 mm farther than its pair's, one 20 mm
+    G, h, moved = np.empty((k, nv)), np.empty(k), np.empty(k, dtype=np.bool_)
+    unmoved = damper_rows(J, support, ja, jb, pa, pb, nrm, d, pair, 0.02, 0.1, 0.5, 4.0, 0.005,
+                          50.0, 1e-9, G, h, moved)  # fmt: skip
+    own = {}
     for r in range(k):
         row = [support[j] * (nrm[r] @ J[:3] + np.cross(p, nrm[r]) @ J[3:])
                for j, p in ((ja[r], pa[r]), (jb[r], pb[r]))]  # fmt: skip
         assert np.allclose(G[r], -(row[1] - row[0]), atol=1e-12)
+        assert moved[r] == (np.abs(G[r]).max() > 1e-9)
+        first = own.setdefault(pair[r], r)
+        xi = 0.5 + 3.5 * min(max((d[r] - d[first]) / 0.005, 0.0), 1.0)
         gap = d[r] - 0.02
-        want = xi[r] * gap / 0.08 if gap >= 0 else max(50.0 * gap, -xi[r]) if gap < -1e-6 else 0.0
+        want = xi * gap / 0.08 if gap >= 0 else max(50.0 * gap, -xi) if gap < -1e-6 else 0.0
         assert h[r] == pytest.approx(want, abs=1e-15)
+    assert not moved[5] and unmoved == k - np.count_nonzero(moved)
+    assert h[1] == pytest.approx((0.5 + 3.5 * 0.2) * (d[1] - 0.02) / 0.08)  # BLEND 5 mm
 
 
 def hand_session(cm, robot, twist, ticks, q=None, limit=None):

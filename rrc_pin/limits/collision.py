@@ -177,18 +177,21 @@ class CollisionLimit(Limit):
         h: Array = np.empty(k)
         names = list(gather(scene.labels, prox.pair))
         distance = prox.distance
+        unmoved = 0
         if k:
-            gains = _gains(prox.pair, prox.distance, xi, END * (self.detection - self.safety) / dt)
-            damper_rows(kin.data.J, self._support, prox.joint_a, prox.joint_b, prox.point_a,
-                        prox.point_b, prox.normal, prox.distance, self.safety, self.detection,
-                        gains, RECOVERY / dt, G, h)  # fmt: skip
+            moved = np.empty(k, dtype=np.bool_)
+            span = self.detection - self.safety
+            unmoved = damper_rows(kin.data.J, self._support, prox.joint_a, prox.joint_b,
+                                  prox.point_a, prox.point_b, prox.normal, prox.distance,
+                                  prox.pair, self.safety, self.detection, xi, END * span / dt,
+                                  BLEND, RECOVERY / dt, STILL, G, h, moved)  # fmt: skip
         if walls:
             G, h, distance = self._walls(kin, walls, G, h, names, distance, dt)
-        if h.size:  # a pair no joint can move apart or together has no row (module docstring)
             moved = np.abs(G).max(axis=1) > STILL
-            if not moved.all():
-                G, h, distance = G[moved], h[moved], distance[moved]
-                names = [n for n, m in zip(names, moved.tolist(), strict=True) if m]
+            unmoved = int(h.size - np.count_nonzero(moved))
+        if unmoved:  # a pair no joint can move apart or together has no row (module docstring)
+            G, h, distance = G[moved], h[moved], distance[moved]
+            names = [n for n, m in zip(names, moved.tolist(), strict=True) if m]
         if not h.size:
             return _NONE
         return Constraints(G=G, h=h, names=tuple(names), slide=np.ones(h.size, dtype=np.bool_),
@@ -222,19 +225,6 @@ class CollisionLimit(Limit):
 
 
 _NONE = Constraints()
-
-
-def _gains(pair: npt.NDArray[np.int64], distance: Array, xi: float, xi_end: float) -> Array:
-    """Each row's xi: the pair's own ``xi``; an end point's up to ``xi_end`` (:data:`BLEND`)."""
-    k = distance.size
-    gains = np.full(k, xi)
-    end = np.zeros(k, dtype=np.bool_)
-    end[1:] = pair[1:] == pair[:-1]
-    if end.any():
-        first = np.maximum.accumulate(np.where(end, 0, np.arange(k)))
-        excess = np.clip((distance - distance[first]) / BLEND, 0.0, 1.0)
-        gains[end] = xi + (xi_end - xi) * excess[end]
-    return gains
 
 
 def _pairs(model: CollisionModel, pairs: Sequence[tuple[str, str]]) -> frozenset[tuple[str, str]]:
