@@ -19,8 +19,9 @@ The top level of the ``direction`` mode (:mod:`solvers.direction`, :mod:`solvers
 Before 2, where the exact rates cross a constraint row marked ``slide`` (a collision pair, which
 the command should slide along rather than stop at), the command is first projected onto what
 the slide rows and the box allow, :math:`b' = A\dot q^*` with :math:`\dot q^*` the least
-squares of :math:`A\dot q \approx b` within them (:mod:`solvers.least_squares`), and 1-2 run on
-:math:`b'` (``sliding``, the veer from :math:`b` reported). Without a crossed slide row nothing
+squares of :math:`A\dot q \approx b` within them pulled toward the exact rates by
+:data:`SLIDE_DAMPING` (:func:`_slide`, :mod:`solvers.slide_kernels`: one answer, continuous in
+the data), and 1-2 run on :math:`b'` (``sliding``, the veer from :math:`b` reported). Without a crossed slide row nothing
 changes: exact answers stay exact (0 veer).
 
 A least-squares level (the other modes, and every lower level): its unconstrained optimum
