@@ -276,7 +276,8 @@ def _top(
         # the exact rates cross a row the command may slide along: the command becomes what
         # the slide rows and the box let it keep (the rest of the pipeline is unchanged)
         try:
-            kept = _slide(A, b, w, space, box, slide, backend, work)
+            kept = _slide(A, b, w, factor, options.damping, problem.dt, space, box, slide,
+                          backend, work)  # fmt: skip
         except (NumericalFailure, np.linalg.LinAlgError) as exc:
             work.attempts.append(("slide", f"{exc}; the command kept as given"))
         else:
@@ -331,8 +332,8 @@ SLIDE_ROUNDING = 1e-12
 
 
 def _slide(
-    A: Array, b: Array, w: Array, space: Subspace, box: Box, slide: Rows, backend: QPBackend,
-    work: Work,
+    A: Array, b: Array, w: Array, factor: Factorization, damping: Damping | None, dt: float,
+    space: Subspace, box: Box, slide: Rows, backend: QPBackend, work: Work,
 ) -> Array:  # fmt: skip
     r"""What the slide rows and the box let the command keep: the rates nearest the exact ones.
 
@@ -360,17 +361,39 @@ def _slide(
         return kept
     n = w.size
     x = np.empty(n)
+    target = _slide_target(b, w, factor, damping, dt)
     # the rows met with a rounding's worth to spare: an answer on a row at 0 must not cross it
     # by 1e-17 (the last step, _within_rows, would shrink the whole answer to zero)
-    if project(A, SLIDE_DAMPING, w, box.lb, box.ub, slide.G, slide.h, SLIDE_ROUNDING, x) == SOLVED:
+    if project(A, SLIDE_DAMPING, target, box.lb, box.ub, slide.G, slide.h, SLIDE_ROUNDING,
+               x) == SOLVED:  # fmt: skip
         kernels.clip_into(x, box.lb, box.ub)  # by the kernel's rounding at most (1e-9)
         return x
     M = A.T @ A
     M.flat[:: n + 1] += SLIDE_DAMPING * max(float(M.trace()) / max(A.shape[0], 1), _TINY)
     size = max(float(np.abs(M).max()), _TINY)
-    qp = QP(M / size, -(M @ w) / size, slide.G, np.full(slide.h.size, -np.inf), slide.h, box.lb,
+    qp = QP(M / size, -(M @ target) / size, slide.G, np.full(slide.h.size, -np.inf), slide.h, box.lb,
             box.ub, f"slide:{n}")  # fmt: skip
     return solve_within(qp, Decoding(None, None), box, slide, backend, work)
+
+
+def _slide_target(
+    b: Array, w: Array, factor: Factorization, damping: Damping | None, dt: float
+) -> Array:
+    """What the sliding stage pulls toward: the exact rates ``w``, damped near a singularity.
+
+    Where the rows' condition number exceeds the damping threshold, the damped rates of the
+    schedule at its fullest (:meth:`~solvers.damping.Damping.lambda_sq` at scale 0; zero
+    damping at the threshold, so the target is continuous): near a singularity the exact rates
+    grow without bound, and pulled toward them a stretched panda's shoulder, elbow and wrist
+    flipped between opposite rate limits at every tick (5.2 rad/s apart; two pandas' hands
+    driven into each other as they rose out of reach).
+    """
+    if damping is None or factor.condition() <= damping.threshold:
+        return w
+    US, sigma, _, rank = factor.svd
+    along = np.abs(b @ US) / np.maximum(sigma, 1e-300)  # |u_i^T b|
+    lam = damping.lambda_sq(sigma, rank, 0.0, along, dt)
+    return w if lam is None else factor.rates(b, lam)
 
 
 def _damping(
