@@ -19,10 +19,10 @@ The top level of the ``direction`` mode (:mod:`solvers.direction`, :mod:`solvers
 Before 2, where the exact rates cross a constraint row marked ``slide`` (a collision pair, which
 the command should slide along rather than stop at), the command is first projected onto what
 the slide rows and the box allow, :math:`b' = A\dot q^*` with :math:`\dot q^*` the least
-squares of :math:`A\dot q \approx b` within them pulled toward the exact rates by
-:data:`SLIDE_DAMPING` (:func:`_slide`, :mod:`solvers.slide_kernels`: one answer, continuous in
-the data), and 1-2 run on :math:`b'` (``sliding``, the veer from :math:`b` reported). Without a crossed slide row nothing
-changes: exact answers stay exact (0 veer).
+squares of :math:`A\dot q \approx b` within them, damped by :data:`SLIDE_DAMPING`
+(:func:`_slide`, :mod:`solvers.slide_kernels`: one answer, continuous in the data), and 1-2
+run on :math:`b'` (``sliding``, the veer from :math:`b` reported). Without a crossed slide row
+nothing changes: exact answers stay exact (0 veer).
 
 A least-squares level (the other modes, and every lower level): its unconstrained optimum
 (:mod:`solvers.least_squares`) when it satisfies the constraints, else the backend's QP.
@@ -53,7 +53,7 @@ from solvers.least_squares import Subspace, least_squares
 from solvers.problem import Box, Problem, Rows, largest_weight, row_factors
 from solvers.qp import QP, Decoding, Work, solve_within, tolerance
 from solvers.qp_backends.base import QPBackend
-from solvers.slide_kernels import SOLVED, project
+from solvers.slide_kernels import SOLVED, damped_optimum, project
 
 Array = npt.NDArray[np.float64]
 
@@ -276,8 +276,7 @@ def _top(
         # the exact rates cross a row the command may slide along: the command becomes what
         # the slide rows and the box let it keep (the rest of the pipeline is unchanged)
         try:
-            kept = _slide(A, b, w, factor, options.damping, problem.dt, space, box, slide,
-                          backend, work)  # fmt: skip
+            kept = _slide(A, b, space, box, slide, backend, work)
         except (NumericalFailure, np.linalg.LinAlgError) as exc:
             work.attempts.append(("slide", f"{exc}; the command kept as given"))
         else:
@@ -318,13 +317,13 @@ def _top(
 
 
 SLIDE_DAMPING = 1e-2
-r"""Weight :math:`\mu` of the sliding stage's pull toward the exact rates, relative to the mean
-squared singular value of the top level's rows (:func:`_slide`). Two facing pandas' hands driven
-into each other (36 pairs, 600 ticks, with rrc_pin.limits.collision.BLEND): the largest
-joint-rate change between two ticks 0.19 rad/s at 1e-3, 0.086 at 1e-2 (2.4 at 1e-4, 2.35 with
-the tie-break alone); the command loses at most :math:`\mu/(\sigma^2 + \mu)` of its part
-along a singular direction :math:`\sigma` that a bound or row takes a joint from (1 % at
-:math:`\sigma^2` the mean), and the hands' tangential progress stayed at the command's."""
+r"""Weight :math:`\mu` of the sliding stage's damping, relative to the mean squared singular
+value of the top level's rows (:func:`_slide`). Two facing pandas' hands driven into each other
+(36 pairs, 600 ticks, with rrc_pin.limits.collision.BLEND): the largest joint-rate change
+between two ticks 0.19 rad/s at 1e-3, 0.086 at 1e-2 (2.4 at 1e-4, 2.35 with the former
+least-squares tie-break alone). A direction of singular value :math:`\sigma` keeps
+:math:`\sigma^2(\sigma^2 + 2\mu)/(\sigma^2 + \mu)^2` of its command where no constraint
+binds: 0.99990 at :math:`\sigma^2` the mean."""
 
 
 SLIDE_ROUNDING = 1e-12
@@ -332,26 +331,29 @@ SLIDE_ROUNDING = 1e-12
 
 
 def _slide(
-    A: Array, b: Array, w: Array, factor: Factorization, damping: Damping | None, dt: float,
-    space: Subspace, box: Box, slide: Rows, backend: QPBackend, work: Work,
-) -> Array:  # fmt: skip
-    r"""What the slide rows and the box let the command keep: the rates nearest the exact ones.
+    A: Array, b: Array, space: Subspace, box: Box, slide: Rows, backend: QPBackend, work: Work
+) -> Array:
+    r"""What the slide rows and the box let the command keep, damped.
 
-    .. math:: \min_{\dot q}\ \|A\dot q - b\|^2 + \mu\|\dot q - w\|^2
+    .. math:: \min_{\dot q}\ \|A\dot q - b\|^2 + \mu\|\dot q - t\|^2
        \quad\text{s.t. the box and the slide rows}
 
-    with ``w`` the exact rates (least squares of least norm, so that :math:`A^T(Aw - b) = 0`):
-    the same as :math:`(\dot q - w)^T (A^TA + \mu I)(\dot q - w)`, the projection of ``w``
-    onto the constraints in that metric. :math:`\mu` = :data:`SLIDE_DAMPING` times the mean
-    squared singular value of A. Without it (the least squares alone, a least-norm tie-break)
-    the optimal rates form a set along A's null space and the answer could move anywhere in it
-    from one tick to the next as rows enter and leave; with it the answer is one point,
-    Lipschitz in the data with a constant of order :math:`1/\mu` (rates in A's null space cost
-    :math:`\mu` each), and where no constraint binds it is ``w`` itself. It gives up at most the
-    part of the command that costs more joint motion than :math:`1/\mu` times its own size.
+    with ``t`` the damped least squares :math:`(A^TA + \mu I)^{-1}A^Tb` and :math:`\mu` =
+    :data:`SLIDE_DAMPING` times the mean squared singular value of A: the projection of its
+    unconstrained optimum (:func:`solvers.slide_kernels.damped_optimum`) onto the constraints
+    in the metric :math:`A^TA + \mu I` (:func:`solvers.slide_kernels.project`). Without the
+    damping (the least squares alone, with a least-norm tie-break 1e-6 of the trace) the
+    optimal rates formed a set along A's null space, and the answer moved anywhere in it from
+    one tick to the next as rows entered and left (2.35 rad/s between two sliding ticks); with
+    it the answer is one point, Lipschitz in the data (rates in A's null space cost
+    :math:`\mu` each). Pulled toward ``t`` rather than toward zero, a direction A moves well
+    keeps its command to second order in :math:`\mu/\sigma^2`; rather than toward the exact
+    rates, it stays bounded through a singularity (pulled toward the exact rates, which grow
+    without bound there, a stretched panda's shoulder, elbow and wrist flipped between
+    opposite rate limits every tick).
 
-    Solved by :func:`solvers.slide_kernels.project`; the backend answers the same QP where the
-    kernel cannot (and the least squares alone within the equality rows' null space).
+    The backend answers the same QP where the kernel refuses; within the equality rows' null
+    space, the least squares alone (:func:`~solvers.least_squares.least_squares`).
 
     Raises:
         NumericalFailure: The backend found no usable answer.
@@ -359,9 +361,10 @@ def _slide(
     if space.N is not None:
         kept, _ = least_squares(A, b, space, box, slide, backend, work, "slide", False)
         return kept
-    n = w.size
-    x = np.empty(n)
-    target = _slide_target(b, w, factor, damping, dt)
+    n = A.shape[1]
+    x, target = np.empty(n), np.empty(n)
+    if not damped_optimum(A, SLIDE_DAMPING, b, target):
+        raise NumericalFailure("the sliding stage's metric is not definite")
     # the rows met with a rounding's worth to spare: an answer on a row at 0 must not cross it
     # by 1e-17 (the last step, _within_rows, would shrink the whole answer to zero)
     if project(A, SLIDE_DAMPING, target, box.lb, box.ub, slide.G, slide.h, SLIDE_ROUNDING,
@@ -371,29 +374,9 @@ def _slide(
     M = A.T @ A
     M.flat[:: n + 1] += SLIDE_DAMPING * max(float(M.trace()) / max(A.shape[0], 1), _TINY)
     size = max(float(np.abs(M).max()), _TINY)
-    qp = QP(M / size, -(M @ target) / size, slide.G, np.full(slide.h.size, -np.inf), slide.h, box.lb,
-            box.ub, f"slide:{n}")  # fmt: skip
+    qp = QP(M / size, -(M @ target) / size, slide.G, np.full(slide.h.size, -np.inf), slide.h,
+            box.lb, box.ub, f"slide:{n}")  # fmt: skip
     return solve_within(qp, Decoding(None, None), box, slide, backend, work)
-
-
-def _slide_target(
-    b: Array, w: Array, factor: Factorization, damping: Damping | None, dt: float
-) -> Array:
-    """What the sliding stage pulls toward: the exact rates ``w``, damped near a singularity.
-
-    Where the rows' condition number exceeds the damping threshold, the damped rates of the
-    schedule at its fullest (:meth:`~solvers.damping.Damping.lambda_sq` at scale 0; zero
-    damping at the threshold, so the target is continuous): near a singularity the exact rates
-    grow without bound, and pulled toward them a stretched panda's shoulder, elbow and wrist
-    flipped between opposite rate limits at every tick (5.2 rad/s apart; two pandas' hands
-    driven into each other as they rose out of reach).
-    """
-    if damping is None or factor.condition() <= damping.threshold:
-        return w
-    US, sigma, _, rank = factor.svd
-    along = np.abs(b @ US) / np.maximum(sigma, 1e-300)  # |u_i^T b|
-    lam = damping.lambda_sq(sigma, rank, 0.0, along, dt)
-    return w if lam is None else factor.rates(b, lam)
 
 
 def _damping(

@@ -27,12 +27,14 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from solvers.kernels import kernel
+from solvers.kernels import cholesky_solve, kernel
 
 Array = npt.NDArray[np.float64]
 
 SOLVED, NOT_DEFINITE, INFEASIBLE, NOT_CONVERGED = 0, 1, 2, 3
 """What :func:`project` returns."""
+
+_TINY = 2.2250738585072014e-308
 
 CHECK = 1e-9
 """Relative violation of a constraint beyond which :func:`project`'s answer is refused
@@ -77,7 +79,7 @@ def project(
             M[i, j] = t
             M[j, i] = t
         trace += M[i, i]
-    mu = max(damping * trace / max(rows, 1), 2.2250738585072014e-308)
+    mu = max(damping * trace / max(rows, 1), _TINY)
     for i in range(n):
         M[i, i] += mu
     tight = np.empty(p)
@@ -320,3 +322,50 @@ def _least_distance(E: Array, m: int, n: int, L: Array, w: Array, x: Array) -> i
     for i in range(n):
         x[i] = w[i] + z[i]
     return SOLVED
+
+
+@kernel
+def damped_optimum(A: Array, damping: float, b: Array, out: Array) -> bool:
+    r"""``out`` the minimiser of :math:`\|A\dot q - b\|^2 + \mu\|\dot q - t\|^2`, t the damped
+    least squares :math:`(A^TA + \mu I)^{-1}A^Tb`: :math:`t + \mu M^{-1} t`, M and
+    :math:`\mu` as :func:`project`'s.
+
+    Along a right singular vector of A of singular value :math:`\sigma`, with
+    :math:`\beta` the command's part :math:`u^Tb`, that is
+    :math:`\beta\sigma(\sigma^2 + 2\mu)/(\sigma^2 + \mu)^2`: the exact
+    :math:`\beta/\sigma` to second order in :math:`\mu/\sigma^2` where A is well
+    conditioned, at most :math:`2\beta/\sqrt{\mu}`-ish and smooth through a singularity
+    (where the exact rates grow without bound).
+
+    Returns:
+        False where M is not numerically definite (``out`` not set).
+    """  # noqa: D205
+    rows, n = A.shape
+    M = np.empty((n, n))
+    trace = 0.0
+    for i in range(n):
+        for j in range(i + 1):
+            t = 0.0
+            for r in range(rows):
+                t += A[r, i] * A[r, j]
+            M[i, j] = t
+            M[j, i] = t
+        trace += M[i, i]
+    mu = max(damping * trace / max(rows, 1), _TINY)
+    for i in range(n):
+        M[i, i] += mu
+    g = np.empty(n)
+    for i in range(n):
+        t = 0.0
+        for r in range(rows):
+            t += A[r, i] * b[r]
+        g[i] = t
+    first = np.empty(n)
+    if not cholesky_solve(M, g, first):
+        return False
+    second = np.empty(n)
+    if not cholesky_solve(M, first, second):
+        return False
+    for i in range(n):
+        out[i] = first[i] + mu * second[i]
+    return True

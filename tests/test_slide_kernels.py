@@ -1,13 +1,13 @@
-"""solvers.slide_kernels.project: the sliding stage's projection against DAQP (1e-8) on random
-problems (redundant and square metrics, infinite bounds, rows broken at zero), infeasible data
-refused, never NaN."""
+"""solvers.slide_kernels: the sliding stage's projection against DAQP (1e-8) on random problems
+(redundant and square metrics, infinite bounds, rows broken at zero), infeasible data refused,
+never NaN; its damped optimum against the normal equations and bounded through a singularity."""
 
 from __future__ import annotations
 
 import numpy as np
 import qpsolvers
 
-from solvers.slide_kernels import INFEASIBLE, SOLVED, project
+from solvers.slide_kernels import INFEASIBLE, SOLVED, damped_optimum, project
 
 TRIALS = 1500
 
@@ -68,3 +68,22 @@ def test_project_refuses_a_row_of_zeros_broken_at_w() -> None:
     code = project(np.eye(2), 1e-2, np.zeros(2), np.full(2, -1.0), np.full(2, 1.0),
                    np.zeros((1, 2)), np.array([-1.0]), 0.0, x)  # fmt: skip
     assert code == INFEASIBLE
+
+
+def test_damped_optimum_minimises_its_cost_and_stays_bounded_at_a_singularity() -> None:
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        n = int(rng.integers(2, 15))
+        A = rng.normal(size=(int(rng.integers(1, n + 1)), n))
+        b = rng.normal(size=A.shape[0])
+        mu = 1e-2 * np.trace(A.T @ A) / A.shape[0]
+        M = A.T @ A + mu * np.eye(n)
+        t = np.linalg.solve(M, A.T @ b)
+        out = np.empty(n)
+        assert damped_optimum(A, 1e-2, b, out)
+        np.testing.assert_allclose(out, np.linalg.solve(M, A.T @ b + mu * t), rtol=1e-9,
+                                   atol=1e-12)  # fmt: skip
+    A = np.array([[1.0, 0.0], [0.0, 1e-9]])  # one direction nearly lost: the exact rates 1e9
+    out = np.empty(2)
+    assert damped_optimum(A, 1e-2, np.array([1.0, 1.0]), out)
+    assert np.isfinite(out).all() and np.abs(out).max() < 2.0
