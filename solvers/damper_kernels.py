@@ -65,13 +65,18 @@ def damper_rows(
     point_b: Array,
     normal: Array,
     distance: Array,
+    pair: Index,
     safety: float,
     detection: float,
-    xi: Array,
+    xi: float,
+    xi_end: float,
+    blend: float,
     recovery: float,
+    still: float,
     G: Array,
     h: Array,
-) -> None:
+    moved: npt.NDArray[np.bool_],
+) -> int:
     """Fill the damper rows ``G qdot <= h`` of k pairs (module docstring).
 
     Args:
@@ -83,17 +88,34 @@ def damper_rows(
         point_b: Witness points on B (k, 3) [m].
         normal: Unit normals from A to B (k, 3).
         distance: Signed distances (k,) [m].
+        pair: The pair of each row (k,): a pair's own row first, then its end points' rows.
         safety: d_s [m].
         detection: d_i [m], > d_s.
-        xi: Approach speed allowed at d_i (k,) [m/s], per row.
+        xi: Approach speed allowed at d_i [m/s] of a pair's own row.
+        xi_end: That of an end point's row ``blend`` [m] farther than its pair's own row, >=
+            ``xi``; an end point's row as close as its pair's has ``xi``, linearly between.
+        blend: See xi_end, > 0.
         recovery: rho / dt [1/s], the rate restoring a shortfall below d_s.
+        still: A row whose every entry is at most this in size is not ``moved``.
         G: Out (k, nv).
         h: Out (k,) [m/s].
+        moved: Out (k,), whether a row has an entry above ``still``.
+
+    Returns:
+        The number of rows not ``moved``.
     """
     k = distance.size
     nv = J.shape[1]
     span = detection - safety
+    unmoved = 0
+    own = 0.0  # the distance of the current pair's own row
     for r in range(k):
+        gain = xi
+        if r > 0 and pair[r] == pair[r - 1]:
+            excess = min(max((distance[r] - own) / blend, 0.0), 1.0)
+            gain = xi + (xi_end - xi) * excess
+        else:
+            own = distance[r]
         n0, n1, n2 = normal[r, 0], normal[r, 1], normal[r, 2]
         # p x n for each witness point
         a0 = point_a[r, 1] * n2 - point_a[r, 2] * n1
@@ -103,6 +125,7 @@ def damper_rows(
         b1 = point_b[r, 2] * n0 - point_b[r, 0] * n2
         b2 = point_b[r, 0] * n1 - point_b[r, 1] * n0
         ja, jb = joint_a[r], joint_b[r]
+        largest = 0.0
         for c in range(nv):
             linear = n0 * J[0, c] + n1 * J[1, c] + n2 * J[2, c]
             value = 0.0
@@ -111,8 +134,13 @@ def damper_rows(
             if support[ja, c]:
                 value += linear + a0 * J[3, c] + a1 * J[4, c] + a2 * J[5, c]
             G[r, c] = value
+            largest = max(largest, abs(value))
+        moved[r] = largest > still
+        if not moved[r]:
+            unmoved += 1
         gap = distance[r] - safety
         if gap > -HELD:
-            h[r] = max(xi[r] * gap / span, SLACK)
+            h[r] = max(gain * gap / span, SLACK)
         else:
-            h[r] = max(recovery * gap, -xi[r])
+            h[r] = max(recovery * gap, -gain)
+    return unmoved

@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 import rrc_pin
 from rrc_pin import Damping, FrameTask, JointLimits, PostureTask, QPOptions, Resolver
 from rrc_pin.errors import InvalidInput, RrcPinError
+from solvers.kernels import ON_LIMIT
 from solvers.qp_backends import installed_backends
 
 ARMS = ("barker6", "rrc_k1607", "kr5_3r", "panda")
@@ -45,14 +46,18 @@ def random_case(arm: rrc_pin.Robot, rng: np.random.Generator) -> tuple[np.ndarra
 
 def check_step(arm: rrc_pin.Robot, q: np.ndarray, qdot: np.ndarray, dt: float) -> None:
     """Velocity limits exactly; the step inside the position limits, or no further out and
-    moving back, in floating point (no tolerance)."""
+    moving back, in floating point (no tolerance). A start outside by at most ON_LIMIT (the
+    rounding of ``lower + 1.0 * (upper - lower)``) is on its limit (solvers.kernels.joint_box):
+    it may stand still, never move further out."""
     assert np.all(np.isfinite(qdot))
     assert np.all(np.abs(qdot) <= arm.velocity_limit)
     step = q + qdot * dt
     inside = (q >= arm.lower) & (q <= arm.upper)
     assert np.all(step[inside] >= arm.lower[inside]) and np.all(step[inside] <= arm.upper[inside])
-    above, below = q > arm.upper, q < arm.lower
+    above, below = q > arm.upper + ON_LIMIT, q < arm.lower - ON_LIMIT
     assert np.all(qdot[above] < 0.0) and np.all(qdot[below] > 0.0)
+    on_upper, on_lower = (q > arm.upper) & ~above, (q < arm.lower) & ~below
+    assert np.all(qdot[on_upper] <= 0.0) and np.all(qdot[on_lower] >= 0.0)
 
 
 def angle(a: np.ndarray, b: np.ndarray) -> float:

@@ -75,6 +75,14 @@ END = 0.5
 pair's own damper would slow a capsule sliding along another as its overhanging end comes in
 (tangential progress 0.75 of the command with the pair's xi on two pandas' hands)."""
 
+BLEND = 0.005
+"""[m] An end point's row takes the pair's own xi where the end is as close as the pair's
+closest points, and :data:`END`'s only where it is this much farther, linearly between. Two
+capsules near parallel have their closest points at either end, from one tick to the next:
+with the end's looser xi, turning about the pair's middle looked free to the row of the closest
+end and was taken (the far end may approach faster), the closest end then swapped; two pandas'
+hands held against each other had their wrists flip back and forth at 0.3-0.6 rad/s a tick."""
+
 STILL = 1e-9
 """[m/s per rad/s] A row whose every entry is below this is dropped: no joint changes the
 pair's distance (a base link turning about its own axis over the floor), so the row cannot
@@ -169,20 +177,21 @@ class CollisionLimit(Limit):
         h: Array = np.empty(k)
         names = list(gather(scene.labels, prox.pair))
         distance = prox.distance
+        unmoved = 0
         if k:
-            gains = np.full(k, xi)
-            pair = prox.pair
-            gains[1:][pair[1:] == pair[:-1]] = END * (self.detection - self.safety) / dt
-            damper_rows(kin.data.J, self._support, prox.joint_a, prox.joint_b, prox.point_a,
-                        prox.point_b, prox.normal, prox.distance, self.safety, self.detection,
-                        gains, RECOVERY / dt, G, h)  # fmt: skip
+            moved = np.empty(k, dtype=np.bool_)
+            span = self.detection - self.safety
+            unmoved = damper_rows(kin.data.J, self._support, prox.joint_a, prox.joint_b,
+                                  prox.point_a, prox.point_b, prox.normal, prox.distance,
+                                  prox.pair, self.safety, self.detection, xi, END * span / dt,
+                                  BLEND, RECOVERY / dt, STILL, G, h, moved)  # fmt: skip
         if walls:
             G, h, distance = self._walls(kin, walls, G, h, names, distance, dt)
-        if h.size:  # a pair no joint can move apart or together has no row (module docstring)
             moved = np.abs(G).max(axis=1) > STILL
-            if not moved.all():
-                G, h, distance = G[moved], h[moved], distance[moved]
-                names = [n for n, m in zip(names, moved.tolist(), strict=True) if m]
+            unmoved = int(h.size - np.count_nonzero(moved))
+        if unmoved:  # a pair no joint can move apart or together has no row (module docstring)
+            G, h, distance = G[moved], h[moved], distance[moved]
+            names = [n for n, m in zip(names, moved.tolist(), strict=True) if m]
         if not h.size:
             return _NONE
         return Constraints(G=G, h=h, names=tuple(names), slide=np.ones(h.size, dtype=np.bool_),
