@@ -388,13 +388,17 @@ def _null(factor: Factorization, space: Subspace) -> Array:
 def _equality_space(problem: Problem) -> Subspace:
     """The rates that meet the equality rows, ``x0 + N^T z`` (least norm x0), or all rates."""
     if problem.equalities is None:
-        return Subspace(None, None)
+        return _EVERY_RATE
     C, d = problem.equalities
     factor = Factorization(C)
     x0 = factor.least_norm(d)
     if not _met(C @ x0, d):
         raise NumericalFailure("the equality rows contradict each other")
     return Subspace(x0, factor.null_basis())
+
+
+_EVERY_RATE = Subspace(None, None)
+"""The subspace of a problem without equality rows: every rate."""
 
 
 def _broken(rows: Rows | None) -> bool:
