@@ -237,7 +237,7 @@ def solve(problem: Problem, backend: QPBackend, options: Options) -> Answer:
     qdot, shrink = _within_rows(qdot, box, rows)
     qdot.flags.writeable = False
     status = top.status
-    if status == "exact" and any(s != "met" for s in levels[1:]):
+    if status == "exact" and levels.count("met") < len(levels):
         status = "partial"
     return Answer(
         qdot, method, status, tuple(levels), top.scale * shrink, top.veer, top.lambda_sq,

@@ -219,7 +219,7 @@ def build(
         A, b, factor = _stack(level, k == 0 and mode == "direction", box)
         stacked.append((A, b))
         rate_factor = factor if k == 0 else rate_factor
-    kept = tuple(tuple(level) for level in levels)
+    kept = tuple(map(tuple, levels))
     return Problem(kept, tuple(stacked), rate_factor, box, rows, equalities, equality_names,
                    mode, dt)  # fmt: skip
 
