@@ -50,7 +50,7 @@ from solvers.errors import InvalidInput, NumericalFailure
 from solvers.factorization import Factorization
 from solvers.kernels import scale_and_veer
 from solvers.least_squares import Subspace, least_squares
-from solvers.problem import Box, Problem, Rows, largest_weight, row_factors
+from solvers.problem import Box, Problem, Rows, TaskRows, largest_weight, row_factors
 from solvers.qp import QP, Decoding, Work, solve_within, tolerance
 from solvers.qp_backends.base import QPBackend
 from solvers.slide_kernels import SOLVED, damped_optimum, project
@@ -239,7 +239,7 @@ def solve(problem: Problem, backend: QPBackend, options: Options) -> Answer:
     qdot, shrink = _within_rows(qdot, box, rows)
     qdot.flags.writeable = False
     status = top.status
-    if status == "exact" and any(s != "met" for s in levels[1:]):
+    if status == "exact" and levels.count("met") < len(levels):
         status = "partial"
     return Answer(
         qdot, method, status, tuple(levels), top.scale * shrink, top.veer, top.lambda_sq,
@@ -316,7 +316,7 @@ def _top(
         return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
     z = usable.rates(b, lam)
     damped = _scaled(A, z if space.N is None else z @ space.N, null, box, rows, backend, work)
-    return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot), float(np.max(lam)),
+    return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot), float(lam.max()),
                 null)  # fmt: skip
 
 
@@ -480,13 +480,17 @@ def _null(factor: Factorization, space: Subspace) -> Array:
 def _equality_space(problem: Problem) -> Subspace:
     """The rates that meet the equality rows, ``x0 + N^T z`` (least norm x0), or all rates."""
     if problem.equalities is None:
-        return Subspace(None, None)
+        return _EVERY_RATE
     C, d = problem.equalities
     factor = Factorization(C)
     x0 = factor.least_norm(d)
     if not _met(C @ x0, d):
         raise NumericalFailure("the equality rows contradict each other")
     return Subspace(x0, factor.null_basis())
+
+
+_EVERY_RATE = Subspace(None, None)
+"""The subspace of a problem without equality rows: every rate."""
 
 
 def _broken(rows: Rows | None) -> bool:
@@ -519,12 +523,18 @@ def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
     """
     level = problem.levels[0]
     top = largest_weight(level)
-    factors = [row_factors(t, top, units=True) for t in level]
-    factor = [np.ones(t.b.size) if f is None else f for t, f in zip(level, factors, strict=True)]
     if len(level) == 1:
-        return scale_and_veer(level[0].A @ qdot, level[0].b, factor[0])
+        t = level[0]
+        return scale_and_veer(t.A @ qdot, t.b, _metric(t, top))
     y = np.concatenate([t.A @ qdot for t in level])
-    return scale_and_veer(y, np.concatenate([t.b for t in level]), np.concatenate(factor))
+    factor = np.concatenate([_metric(t, top) for t in level])
+    return scale_and_veer(y, np.concatenate([t.b for t in level]), factor)
+
+
+def _metric(t: TaskRows, top: float) -> Array:
+    """The factors (m,) of a top-level task's rows in the normalised metric (ones for none)."""
+    factor = row_factors(t, top, units=True)
+    return np.ones(t.b.size) if factor is None else factor
 
 
 def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:

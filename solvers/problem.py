@@ -221,7 +221,7 @@ def build(
         A, b, factor = _stack(level, k == 0 and mode == "direction", box)
         stacked.append((A, b))
         rate_factor = factor if k == 0 else rate_factor
-    kept = tuple(tuple(level) for level in levels)
+    kept = tuple(map(tuple, levels))
     return Problem(kept, tuple(stacked), rate_factor, box, rows, equalities, equality_names,
                    mode, dt)  # fmt: skip
 
@@ -239,7 +239,7 @@ def _stack(tasks: Sequence[TaskRows], normalised: bool, box: Box) -> tuple[Array
             A, b = tasks[0].A, tasks[0].b
             peak = float(np.abs(b).max()) if b.size else 0.0
             return _capped(A, b, peak, normalised, box)
-    m = sum(t.b.size for t in tasks)
+    m = tasks[0].b.size if len(tasks) == 1 else sum(t.b.size for t in tasks)
     A, b = np.empty((m, tasks[0].A.shape[1])), np.empty(m)
     peak = _weighted(tasks, top, normalised, 1.0, A, b)
     if normalised and peak > LARGE:  # the direction alone: b / its largest, before the
@@ -263,7 +263,8 @@ def _weighted(
         k = t.b.size
         weight = _ones(k) if t.weight is None else t.weight
         unit = t.unit if normalised and t.unit is not None else _ones(k)
-        rows = kernels.weighted_rows(t.A, t.b, weight, top, unit, scale, A[r : r + k], b[r : r + k])
+        rows_A, rows_b = (A, b) if k == b.size else (A[r : r + k], b[r : r + k])  # one task: all
+        rows = kernels.weighted_rows(t.A, t.b, weight, top, unit, scale, rows_A, rows_b)
         peak, r = max(peak, rows), r + k
     return peak
 
