@@ -316,7 +316,7 @@ def _top(
         return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
     z = usable.rates(b, lam)
     damped = _scaled(A, z if space.N is None else z @ space.N, null, box, rows, backend, work)
-    return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot), float(lam.max()),
+    return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot), float(np.max(lam)),
                 null)  # fmt: skip
 
 
