@@ -704,27 +704,26 @@ def normal_equations(A: Array, b: Array, weight: Array, H: Array, g: Array) -> N
 
 
 @kernel
-def cholesky_solve(H: Array, g: Array, x: Array) -> bool:
-    r"""``x`` solving :math:`Hx = g` for a symmetric positive definite H (Cholesky, :math:`LL^T`).
+def cholesky(H: Array, relative: float, L: Array) -> bool:
+    r"""``L`` (n, n) lower triangular with :math:`H = LL^T`, H symmetric (n, n).
 
-    Golub & Van Loan, Algorithm 4.2.1, then two triangular solves.
+    Golub & Van Loan, Algorithm 4.2.1.
 
     Returns:
-        False where H is not numerically definite (a pivot below ``1e-12`` times the largest
-        diagonal entry); ``x`` is then not set.
+        False where H is not numerically definite: a pivot at or below ``relative`` times
+        the largest diagonal entry, or not a number (``L`` is then not set).
     """
-    n = g.size
-    L = np.zeros((n, n))
+    n = H.shape[0]
     largest = 0.0
     for i in range(n):
         largest = max(largest, H[i, i])
-    if largest <= 0.0:
+    if not largest > 0.0:
         return False
     for j in range(n):
         s = H[j, j]
         for k in range(j):
             s -= L[j, k] * L[j, k]
-        if s <= 1e-12 * largest:
+        if not s > relative * largest:
             return False
         L[j, j] = math.sqrt(s)
         for i in range(j + 1, n):
@@ -732,6 +731,22 @@ def cholesky_solve(H: Array, g: Array, x: Array) -> bool:
             for k in range(j):
                 s -= L[i, k] * L[j, k]
             L[i, j] = s / L[j, j]
+    return True
+
+
+@kernel
+def cholesky_solve(H: Array, g: Array, x: Array) -> bool:
+    r"""``x`` solving :math:`Hx = g` for a symmetric positive definite H: :func:`cholesky`,
+    then two triangular solves.
+
+    Returns:
+        False where H is not numerically definite (a pivot at or below ``1e-12`` times the
+        largest diagonal entry); ``x`` is then not set.
+    """  # noqa: D205
+    n = g.size
+    L = np.zeros((n, n))
+    if not cholesky(H, 1e-12, L):
+        return False
     y = np.empty(n)
     for i in range(n):
         s = g[i]

@@ -26,6 +26,7 @@ for minutes: gradient 1e99 against a box of 2 rad/s).
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Sequence
 from typing import Literal, NamedTuple
@@ -283,15 +284,11 @@ def _capped(
     return (A, b, 1.0) if peak <= cap else (A, b * (cap / peak), cap / peak)
 
 
-_ONES: dict[int, Array] = {}
-
-
+@functools.cache
 def _ones(m: int) -> Array:
     """A read-only (m,) array of ones, made once per size."""
-    ones = _ONES.get(m)
-    if ones is None:
-        ones = _ONES[m] = np.ones(m)
-        ones.flags.writeable = False
+    ones = np.ones(m)
+    ones.flags.writeable = False
     return ones
 
 

@@ -27,7 +27,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from solvers.kernels import cholesky_solve, kernel
+from solvers.kernels import cholesky, cholesky_solve, kernel
 
 Array = npt.NDArray[np.float64]
 
@@ -39,6 +39,26 @@ _TINY = 2.2250738585072014e-308
 CHECK = 1e-9
 """Relative violation of a constraint beyond which :func:`project`'s answer is refused
 (INFEASIBLE: constraints that admit no point leave a residual of rounding in NNLS)."""
+
+
+@kernel
+def _damped_gram(A: Array, damping: float) -> tuple[Array, float]:
+    r""":math:`M = A^TA + \mu I` (n, n) and :math:`\mu` of rows A (m, n), as in :func:`project`."""
+    rows, n = A.shape
+    M = np.empty((n, n))
+    trace = 0.0
+    for i in range(n):
+        for j in range(i + 1):
+            t = 0.0
+            for r in range(rows):
+                t += A[r, i] * A[r, j]
+            M[i, j] = t
+            M[j, i] = t
+        trace += M[i, i]
+    mu = max(damping * trace / max(rows, 1), _TINY)
+    for i in range(n):
+        M[i, i] += mu
+    return M, mu
 
 
 @kernel
@@ -68,43 +88,14 @@ def project(
     """
     n = w.size
     p = h.size
-    rows = A.shape[0]
-    M = np.empty((n, n))
-    trace = 0.0
-    for i in range(n):
-        for j in range(i + 1):
-            t = 0.0
-            for r in range(rows):
-                t += A[r, i] * A[r, j]
-            M[i, j] = t
-            M[j, i] = t
-        trace += M[i, i]
-    mu = max(damping * trace / max(rows, 1), _TINY)
-    for i in range(n):
-        M[i, i] += mu
+    M = _damped_gram(A, damping)[0]
     tight = np.empty(p)
     for r in range(p):
         tight[r] = h[r] - margin * (1.0 + abs(h[r]))
     h = tight
-    # M = L L^T
     L = np.zeros((n, n))
-    largest = 0.0
-    for i in range(n):
-        largest = max(largest, M[i, i])
-    if not largest > 0.0:
+    if not cholesky(M, 1e-13, L):
         return NOT_DEFINITE
-    for j in range(n):
-        s = M[j, j]
-        for k in range(j):
-            s -= L[j, k] * L[j, k]
-        if not s > 1e-13 * largest:
-            return NOT_DEFINITE
-        L[j, j] = math.sqrt(s)
-        for i in range(j + 1, n):
-            s = M[i, j]
-            for k in range(j):
-                s -= L[i, k] * L[j, k]
-            L[i, j] = s / L[j, j]
     total = 2 * n + p
     E = np.empty((n + 1, total))  # the columns of the constraints taken in, in order
     taken = np.zeros(total, dtype=np.bool_)
@@ -341,19 +332,7 @@ def damped_optimum(A: Array, damping: float, b: Array, out: Array) -> bool:
         False where M is not numerically definite (``out`` not set).
     """  # noqa: D205
     rows, n = A.shape
-    M = np.empty((n, n))
-    trace = 0.0
-    for i in range(n):
-        for j in range(i + 1):
-            t = 0.0
-            for r in range(rows):
-                t += A[r, i] * A[r, j]
-            M[i, j] = t
-            M[j, i] = t
-        trace += M[i, i]
-    mu = max(damping * trace / max(rows, 1), _TINY)
-    for i in range(n):
-        M[i, i] += mu
+    M, mu = _damped_gram(A, damping)
     g = np.empty(n)
     for i in range(n):
         t = 0.0

@@ -119,7 +119,11 @@ def test_normal_equations_and_cholesky(rng: np.random.Generator) -> None:
         assert definite == (m >= n)
         if definite:
             np.testing.assert_allclose(x, np.linalg.solve(H, g), rtol=1e-9, atol=1e-12)
+            L = np.zeros((n, n))
+            assert kernels.cholesky(H, 1e-12, L)
+            np.testing.assert_allclose(L, np.linalg.cholesky(H), rtol=1e-10, atol=1e-12)
     assert not kernels.cholesky_solve(np.zeros((2, 2)), np.ones(2), np.empty(2))
+    assert not kernels.cholesky(np.array([[1.0, 0.0], [0.0, np.nan]]), 1e-12, np.zeros((2, 2)))
 
 
 def test_weighted_rows_and_clip_into(rng: np.random.Generator) -> None:

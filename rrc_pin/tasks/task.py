@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from abc import ABC, abstractmethod
 
 import numpy as np
@@ -53,15 +54,11 @@ class Task(ABC):
         return None if (self.weight == 1.0).all() else self.weight
 
 
-_IDENTITY: dict[int, Array] = {}
-
-
+@functools.cache
 def identity(n: int) -> Array:
     """The identity rows (n, n), read-only, made once per size (joint-space tasks' Jacobian)."""
-    eye = _IDENTITY.get(n)
-    if eye is None:
-        eye = _IDENTITY[n] = np.eye(n)
-        eye.flags.writeable = False
+    eye = np.eye(n)
+    eye.flags.writeable = False
     return eye
 
 
