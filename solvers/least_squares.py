@@ -11,7 +11,10 @@ the levels above and their null space; all rates for the first level), so the le
 Its unconstrained optimum of least norm is the answer when it satisfies the constraints:
 by the normal equations :math:`B^TBz = B^Tc` (:func:`~solvers.kernels.cholesky_solve`) for
 more rows than unknowns, by the QR of :math:`B^T` (:class:`~solvers.factorization.Factorization`)
-otherwise, and by the SVD where either is rank deficient. Else the backend solves the QP
+otherwise, and by the SVD where either is rank deficient. Else, on the top level with
+:math:`B^TB` definite (the optimum one point), the optimum is projected onto the constraints in
+the metric :math:`B^TB` by hand (:func:`~solvers.slide_kernels.project`: the same costs up to a
+constant); else, or where that kernel refuses, the backend solves the QP
 with :math:`P = B^TB` and :math:`q = -B^Tc` (the same normal equations, computed once):
 exactly the stated costs where P is definite (their optimum is one point). Where it is not
 (fewer independent rows than unknowns: one frame task on a redundant arm, a lower level in a
@@ -39,7 +42,8 @@ from solvers import kernels
 from solvers.direction import constraint_rows
 from solvers.factorization import Factorization
 from solvers.problem import Box, Rows
-from solvers.qp import QP, Decoding, Work, solve_within
+from solvers.qp import QP, Decoding, Work, solve_within, tolerance
+from solvers.slide_kernels import MARGIN, SOLVED, project
 
 if TYPE_CHECKING:
     from solvers.qp_backends.base import QPBackend
@@ -142,32 +146,10 @@ def least_squares(
         rows is None or kernels.rows_hold(rows.G, candidate, rows.h, 0.0)
     )
     if not feasible:
-        P, q = H, -g
-        d = B.shape[1]
-        if not definite:
-            P.flat[:: d + 1] += TIE_BREAK * max(float(P.trace()), 1.0)
-        # Divided by their largest entry, the costs have the same minimiser and the backends'
-        # absolute tolerances read as relative ones (a command saturating the box gave
-        # gradients 1e7 times P, and proxqp iterated for 10 s).
-        size = max(float(np.abs(P).max()), float(np.abs(q).max()), _TINY)
-        P, q = P / size, q / size
-        C: Array | None
-        lo: Array | None
-        hi: Array | None
-        if N is None:
-            C, lo, hi = (None, None, None) if rows is None else (
-                rows.G, np.full(rows.h.size, -np.inf), rows.h)  # fmt: skip
-            qp = QP(P, q, C, lo, hi, box.lb, box.ub, f"{key}:{d}")
-            decoding = Decoding(None, None)
-        else:
-            C, lo, hi = constraint_rows(N.T, box, rows, x)
-            # z = 0 (the answer so far) is feasible: keep it so for the backend's tolerance
-            # where joints sit exactly on their bounds
-            lo, hi = np.minimum(lo, 0.0) - ROUNDING, np.maximum(hi, 0.0) + ROUNDING
-            free = np.full(d, np.inf)
-            qp = QP(P, q, C, lo, hi, -free, free, f"{key}:{d}:{hi.size}")
-            decoding = Decoding(x, N.T)
-        candidate = solve_within(qp, decoding, box, rows, backend, work)
+        qp, decoding = _level_qp(H, g, definite, space, box, rows, key)
+        kept = _projected(B, z, qp, decoding, box, rows) if definite else None
+        candidate = kept if kept is not None else solve_within(qp, decoding, box, rows,
+                                                               backend, work)  # fmt: skip
     if not need_null:
         return candidate, None
     if factor is None:
@@ -175,3 +157,61 @@ def least_squares(
         factor.least_norm(c)  # records whether B has full row rank, for its null basis
     null = factor.null_basis()
     return candidate, null if N is None else null @ N
+
+
+def _level_qp(
+    H: Array, g: Array, definite: bool, space: Subspace, box: Box, rows: Rows | None, key: str
+) -> tuple[QP, Decoding]:
+    """The level's QP in z (module docstring) from its normal equations ``(H, g)``, and how
+    its answer decodes into rates."""  # noqa: D205, D209
+    x, N = space
+    d = g.size
+    P, q = H, -g
+    if not definite:
+        P = H + TIE_BREAK * max(float(H.trace()), 1.0) * np.eye(d)
+    # Divided by their largest entry, the costs have the same minimiser and the backends'
+    # absolute tolerances read as relative ones (a command saturating the box gave
+    # gradients 1e7 times P, and proxqp iterated for 10 s).
+    size = max(float(np.abs(P).max()), float(np.abs(q).max()), _TINY)
+    P, q = P / size, q / size
+    if N is None:
+        if rows is None:
+            return QP(P, q, None, None, None, box.lb, box.ub, f"{key}:{d}"), Decoding(None, None)
+        qp = QP(P, q, rows.G, np.full(rows.h.size, -np.inf), rows.h, box.lb, box.ub,
+                f"{key}:{d}")  # fmt: skip
+        return qp, Decoding(None, None)
+    C, lo, hi = constraint_rows(N.T, box, rows, x)
+    # z = 0 (the answer so far) is feasible: keep it so for the backend's tolerance where
+    # joints sit exactly on their bounds
+    lo, hi = np.minimum(lo, 0.0) - ROUNDING, np.maximum(hi, 0.0) + ROUNDING
+    free = np.full(d, np.inf)
+    return QP(P, q, C, lo, hi, -free, free, f"{key}:{d}:{hi.size}"), Decoding(x, N.T)
+
+
+def _projected(
+    B: Array, z: Array, qp: QP, decoding: Decoding, box: Box, rows: Rows | None
+) -> Array | None:
+    r"""The level's QP solved by hand where :math:`B^TB` is definite: its optimum ``z``
+    projected onto the QP's constraints in the metric :math:`B^TB`
+    (:func:`~solvers.slide_kernels.project`; the same costs up to a constant), as rates.
+
+    Returns:
+        The rates (n,), or None where the kernel refuses or its answer leaves the box or rows
+        beyond :func:`~solvers.qp.tolerance` (the backend then answers).
+    """  # noqa: D205
+    d = z.size
+    if qp.C is None or qp.l is None or qp.u is None:
+        G, h = np.empty((0, d)), np.empty(0)
+    else:
+        low, high = np.isfinite(qp.l), np.isfinite(qp.u)
+        G, h = np.vstack([qp.C[high], -qp.C[low]]), np.concatenate([qp.u[high], -qp.l[low]])
+    out = np.empty(d)
+    if project(B, 0.0, z, qp.lb, qp.ub, G, h, MARGIN, out) != SOLVED:
+        return None
+    qdot = decoding.rates(out)
+    tol = tolerance(box)
+    if kernels.clip_into(qdot, box.lb, box.ub) > tol or (
+        rows is not None and not kernels.rows_hold(rows.G, qdot, rows.h, tol)
+    ):
+        return None
+    return qdot

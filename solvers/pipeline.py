@@ -50,10 +50,10 @@ from solvers.errors import InvalidInput, NumericalFailure
 from solvers.factorization import Factorization
 from solvers.kernels import scale_and_veer
 from solvers.least_squares import Subspace, least_squares
-from solvers.problem import Box, Problem, Rows, TaskRows, largest_weight, row_factors
+from solvers.problem import Box, Problem, Rows
 from solvers.qp import QP, Decoding, Work, solve_within, tolerance
 from solvers.qp_backends.base import QPBackend
-from solvers.slide_kernels import SOLVED, damped_optimum, project
+from solvers.slide_kernels import MARGIN, SOLVED, damped_optimum, project
 
 Array = npt.NDArray[np.float64]
 
@@ -330,10 +330,6 @@ least-squares tie-break alone). A direction of singular value :math:`\sigma` kee
 binds: 0.99990 at :math:`\sigma^2` the mean."""
 
 
-SLIDE_ROUNDING = 1e-12
-"""[m/s, relative above 1] How far inside its slide rows the sliding stage's answer is sought."""
-
-
 def _slide(
     A: Array, b: Array, space: Subspace, box: Box, slide: Rows, backend: QPBackend, work: Work
 ) -> Array:
@@ -369,10 +365,7 @@ def _slide(
     x, target = np.empty(n), np.empty(n)
     if not damped_optimum(A, SLIDE_DAMPING, b, target):
         raise NumericalFailure("the sliding stage's metric is not definite")
-    # the rows met with a rounding's worth to spare: an answer on a row at 0 must not cross it
-    # by 1e-17 (the last step, _within_rows, would shrink the whole answer to zero)
-    if project(A, SLIDE_DAMPING, target, box.lb, box.ub, slide.G, slide.h, SLIDE_ROUNDING,
-               x) == SOLVED:  # fmt: skip
+    if project(A, SLIDE_DAMPING, target, box.lb, box.ub, slide.G, slide.h, MARGIN, x) == SOLVED:
         kernels.clip_into(x, box.lb, box.ub)  # by the kernel's rounding at most (1e-9)
         return x
     M = A.T @ A
@@ -518,23 +511,18 @@ def _served(problem: Problem, k: int, qdot: Array) -> LevelStatus:
 def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
     """The top level's scale and veer for ``qdot`` in its normalised metric.
 
-    Each row times its factor (:func:`~solvers.problem.row_factors`); the kernel first divides
-    a command near the float range down, so that its units cannot overflow it.
+    The direction problem's stacked rows are in that metric already; the other modes' rows are
+    weighted, and their units divide them here. The scale is of the stacked rates, which the
+    problem's ``rate_factor`` relates to the command's.
     """
+    A, b = problem.stacked[0]
     level = problem.levels[0]
-    top = largest_weight(level)
-    if len(level) == 1:
-        t = level[0]
-        return scale_and_veer(t.A @ qdot, t.b, _metric(t, top))
-    y = np.concatenate([t.A @ qdot for t in level])
-    factor = np.concatenate([_metric(t, top) for t in level])
-    return scale_and_veer(y, np.concatenate([t.b for t in level]), factor)
-
-
-def _metric(t: TaskRows, top: float) -> Array:
-    """The factors (m,) of a top-level task's rows in the normalised metric (ones for none)."""
-    factor = row_factors(t, top, units=True)
-    return np.ones(t.b.size) if factor is None else factor
+    per_unit = None
+    if problem.mode != "direction" and any(t.unit is not None for t in level):
+        per_unit = np.concatenate([np.ones(t.b.size) if t.unit is None else 1.0 / t.unit
+                                   for t in level])  # fmt: skip
+    scale, veer = scale_and_veer(A @ qdot, b, per_unit)
+    return scale * problem.rate_factor, veer
 
 
 def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:

@@ -36,6 +36,11 @@ SOLVED, NOT_DEFINITE, INFEASIBLE, NOT_CONVERGED = 0, 1, 2, 3
 
 _TINY = 2.2250738585072014e-308
 
+MARGIN = 1e-12
+"""[relative above 1] How far inside its rows :func:`project`'s answer is sought: an answer on a
+row at 0 must not cross it by 1e-17 (the pipeline's last step would shrink the whole answer to
+zero)."""
+
 CHECK = 1e-9
 """Relative violation of a constraint beyond which :func:`project`'s answer is refused
 (INFEASIBLE: constraints that admit no point leave a residual of rounding in NNLS)."""
@@ -72,7 +77,7 @@ def project(
         A: Rows (m, n) of the metric :math:`M = A^TA + \mu I`, :math:`\mu` = ``damping``
             times :math:`\operatorname{tr}(A^TA) / m` (the mean squared singular value of A,
             for m <= n), or at least the smallest normal double.
-        damping: See A, > 0.
+        damping: See A, >= 0 (0: the least squares of A alone, M definite).
         w: The point projected (n,).
         lb: Lower bounds (n,), -inf allowed.
         ub: Upper bounds (n,), +inf allowed.

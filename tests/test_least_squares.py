@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import numpy as np
+import qpsolvers
 from scipy.optimize import lsq_linear
 
 from solvers.least_squares import Subspace, least_squares
-from solvers.problem import Box
+from solvers.problem import Box, Rows
 from solvers.qp import QP, Work
 from solvers.qp_backends import make_backend
 from solvers.qp_backends.base import QPBackend, QPSolution
@@ -55,3 +56,35 @@ def test_a_saturating_command_reaches_the_backend_with_costs_of_unit_size(
         assert max(np.abs(qp.P).max(), np.abs(qp.q).max()) == 1.0
         reference = lsq_linear(A, b, bounds=(-2.0, 2.0), method="bvls", tol=1e-14).x
         np.testing.assert_allclose(x, reference, atol=1e-6)
+
+
+def test_a_definite_level_outside_its_constraints_is_projected_without_the_backend(
+    rng: np.random.Generator,
+) -> None:
+    """Where the optimum is one point (more independent rows than unknowns), the kernel's
+    projection in the metric B^T B answers: the top level against BVLS, a lower level in a
+    null space with a row against qpsolvers' least squares (DAQP) on the same costs."""
+    for _ in range(100):
+        A, b = rng.normal(size=(9, 6)), rng.normal(size=9) * 3.0
+        backend = Recording()
+        x, _ = least_squares(A, b, Subspace(None, None), box(6, 1.0), None, backend, Work(),
+                             "t", False)  # fmt: skip
+        reference = lsq_linear(A, b, bounds=(-1.0, 1.0), method="bvls", tol=1e-14).x
+        np.testing.assert_allclose(x, reference, atol=1e-9)
+        assert backend.seen == []
+    n, d = 7, 3
+    for _ in range(100):
+        N = np.linalg.qr(rng.normal(size=(n, d)))[0].T  # orthonormal rows (d, n)
+        x0 = rng.uniform(-0.5, 0.5, n)
+        A, b = rng.normal(size=(5, n)), rng.normal(size=5) * 3.0
+        rows = Rows(rng.normal(size=(1, n)), np.array([0.3]), ("row",))
+        rows = Rows(rows.G, rows.G @ x0 + 0.3, ("row",))  # x0 meets it
+        backend = Recording()
+        x, _ = least_squares(A, b, Subspace(x0, N), box(n, 1.0), rows, backend, Work(), "t",
+                             False)  # fmt: skip
+        assert backend.seen == []
+        B, c = A @ N.T, b - A @ x0
+        G = np.vstack([N.T, -N.T, rows.G @ N.T])
+        h = np.concatenate([1.0 - x0, 1.0 + x0, rows.h - rows.G @ x0])
+        z = qpsolvers.solve_ls(B, c, G, h, solver="daqp")
+        np.testing.assert_allclose(x, x0 + z @ N, atol=1e-7)

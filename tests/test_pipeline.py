@@ -409,7 +409,7 @@ def test_a_slide_row_keeps_the_tangential_component_of_a_command_into_it() -> No
     # direction keeps sigma^2 (sigma^2 + 2 mu) / (sigma^2 + mu)^2 of its command
     mu = pipeline_module.SLIDE_DAMPING
     kept = (1.0 + 2.0 * mu) / (1.0 + mu) ** 2
-    # z: the row met with SLIDE_ROUNDING (1e-12 m/s) to spare
+    # z: the row met with slide_kernels.MARGIN (1e-12 m/s) to spare
     assert np.allclose(answer.qdot, (0.1 * kept, 0.05 * kept, 0.0), rtol=1e-9, atol=2e-12)
     tangential = np.hypot(0.1, 0.05)
     assert answer.veer == pytest.approx(np.arctan2(0.1, tangential), abs=1e-9)
