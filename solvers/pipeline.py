@@ -316,6 +316,10 @@ def _top(
         return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
     z = usable.rates(b, lam)
     damped = _scaled(A, z if space.N is None else z @ space.N, null, box, rows, backend, work)
+    if damped.u <= STILL_SCALE < u_w.u:
+        # a bound stops the damped rates and not the command's own: the command, scaled
+        # (standing still for up to ten ticks on panda where the LP allowed up to 19 %)
+        return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
     return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot), float(np.max(lam)),
                 null)  # fmt: skip
 

@@ -323,6 +323,33 @@ def test_a_joint_on_its_limit_is_clamped_before_the_damping() -> None:
     assert np.median(scales) > 0.1
 
 
+def test_where_a_bound_stops_the_damped_rates_the_command_is_scaled_instead() -> None:
+    """Past the damping threshold, panda's damped rates pushed a joint held on its bound and
+    scaled to zero: the arm stood still for up to ten ticks of a too-fast command where the LP
+    allowed up to 19 % of it (the resolver benchmark, seed 1786246609). The command's own
+    exact rates, scaled, move along it: that is the answer there (veer 0)."""
+    arm = rrc_pin.load("panda")
+    cases = [
+        ([-2.8951021107736215, 1.7628, 2.6339370564604128, -0.1023262460387971,
+          2.87488825372525, 3.7522314637713468, -2.8973],
+         [1.2913009546046101, -0.3586075984262472, -0.6737525027695128, -1.900672009684901,
+          -0.29022729656089996, -2.302870823109996]),
+        ([-2.8973, 1.701014043407033, 2.596264785517972, -0.0698, 2.8897853647394127,
+          3.7017869919847834, -2.754308967152932],
+         [-0.9433412500033777, 1.1563928877013505, 0.1512044156623636, -2.4832036525482235,
+          -1.3177287307573282, -1.0475164018323728]),
+    ]  # fmt: skip
+    for q, twist in cases:
+        r = Resolver(arm, dt=0.01).solve(q, twist)
+        check_step(arm, np.array(q), r.qdot, 0.01)
+        assert r.status == "scaled" and r.veer == 0.0
+        assert r.scale > 1e-3
+        J = arm.jacobian(q)
+        achieved = J @ r.qdot
+        cosine = achieved @ twist / (np.linalg.norm(achieved) * np.linalg.norm(twist))
+        assert cosine > 1.0 - 1e-12
+
+
 def test_singular_configurations_give_finite_rates_within_limits(arms: dict) -> None:
     rng = np.random.default_rng(11)
     cases = [("barker6", np.zeros(6)), ("rrc_k1607", np.zeros(7)),
