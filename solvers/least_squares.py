@@ -11,8 +11,8 @@ the levels above and their null space; all rates for the first level), so the le
 Its unconstrained optimum of least norm is the answer when it satisfies the constraints:
 by the normal equations :math:`B^TBz = B^Tc` (:func:`~solvers.kernels.cholesky_solve`) for
 more rows than unknowns, by the QR of :math:`B^T` (:class:`~solvers.factorization.Factorization`)
-otherwise, and by the SVD where either is rank deficient. Else, on the top level with
-:math:`B^TB` definite (the optimum one point), the optimum is projected onto the constraints in
+otherwise, and by the SVD where either is rank deficient. Else, where :math:`B^TB` is
+definite (the optimum one point), the optimum is projected onto the constraints in
 the metric :math:`B^TB` by hand (:func:`~solvers.slide_kernels.project`: the same costs up to a
 constant); else, or where that kernel refuses, the backend solves the QP
 with :math:`P = B^TB` and :math:`q = -B^Tc` (the same normal equations, computed once):
