@@ -206,7 +206,9 @@ def _projected(
         low, high = np.isfinite(qp.l), np.isfinite(qp.u)
         G, h = np.vstack([qp.C[high], -qp.C[low]]), np.concatenate([qp.u[high], -qp.l[low]])
     out = np.empty(d)
-    if project(B, 0.0, z, qp.lb, qp.ub, G, h, MARGIN, out) != SOLVED:
+    # C order always (Pinocchio's Jacobians are Fortran's): one compiled signature, no
+    # compilation inside a running control loop
+    if project(np.ascontiguousarray(B), 0.0, z, qp.lb, qp.ub, G, h, MARGIN, out) != SOLVED:
         return None
     qdot = decoding.rates(out)
     tol = tolerance(box)

@@ -367,6 +367,7 @@ def _slide(
         return kept
     n = A.shape[1]
     x, target = np.empty(n), np.empty(n)
+    A = np.ascontiguousarray(A)  # one compiled signature (see least_squares._projected)
     if not damped_optimum(A, SLIDE_DAMPING, b, target):
         raise NumericalFailure("the sliding stage's metric is not definite")
     if project(A, SLIDE_DAMPING, target, box.lb, box.ub, slide.G, slide.h, MARGIN, x) == SOLVED:

@@ -27,7 +27,8 @@ def checkout_files() -> set[str]:
     out = set()
     for folder, subfolders, files in os.walk(ROOT):
         subfolders[:] = [d for d in subfolders
-                         if not d.startswith((".git", ".venv", ".pytest", ".mypy", ".ruff"))
+                         if not d.startswith((".git", ".venv", ".pytest", ".mypy", ".ruff",
+                                               ".hypothesis"))
                          and d != "__pycache__" and not d.endswith(".egg-info")]  # fmt: skip
         out.update(os.path.relpath(os.path.join(folder, f), ROOT) for f in files)
     return out
