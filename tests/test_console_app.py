@@ -22,7 +22,7 @@ import pinocchio as pin
 import pytest
 
 from rrc_pin.console import Console
-from rrc_pin.console.commands import AXES, Latch
+from rrc_pin.console.commands import AXES, Home, Latch
 
 viser = pytest.importorskip("viser")
 sync_api = pytest.importorskip("playwright.sync_api")
@@ -292,8 +292,16 @@ def test_bad_input_from_pages_never_stops_or_corrupts_the_loop(console, page, br
 
 
 def test_dragging_the_gizmo_servoes_the_hand_to_it(console, page):
+    """From home: the flood above leaves the arm wherever its timing took it."""
     loop = console.loop
-    loop.mailbox.post(Latch(True))  # (as the page's checkbox does)
+    loop.mailbox.post(Home())
+    wait_for(lambda: np.array_equal(loop.snapshot.q, loop.start_q), what="the arm at home")
+    # going home is a stop: latched only once the page shows it released (latched before, the
+    # page's release came after and unlatched the servo half a second in)
+    latch = page.get_by_label("deadman latched")
+    wait_for(lambda: not latch.is_checked(), what="the page's latch released")
+    latch.check()
+    wait_for(lambda: loop.operator.latched, what="the deadman latched")
     start = loop.robot_pose()
     target = start.copy()
     target[:3, 3] += 0.03 * start[:3, 1]  # 3 cm along the hand's y axis
