@@ -704,14 +704,15 @@ def normal_equations(A: Array, b: Array, weight: Array, H: Array, g: Array) -> N
 
 
 @kernel
-def cholesky(H: Array, relative: float, L: Array) -> bool:
+def cholesky(H: Array, relative: float, L: Array, floor: float = 0.0) -> bool:
     r"""``L`` (n, n) lower triangular with :math:`H = LL^T`, H symmetric (n, n).
 
-    Golub & Van Loan, Algorithm 4.2.1.
+    Golub & Van Loan, Algorithm 4.2.1. Reads H's lower triangle only, so ``L`` may be H
+    itself (factorised in place).
 
     Returns:
         False where H is not numerically definite: a pivot at or below ``relative`` times
-        the largest diagonal entry, or not a number (``L`` is then not set).
+        the largest diagonal entry or ``floor``, or not a number (``L`` is then not set).
     """
     n = H.shape[0]
     largest = 0.0
@@ -719,11 +720,12 @@ def cholesky(H: Array, relative: float, L: Array) -> bool:
         largest = max(largest, H[i, i])
     if not largest > 0.0:
         return False
+    least = max(relative * largest, floor)
     for j in range(n):
         s = H[j, j]
         for k in range(j):
             s -= L[j, k] * L[j, k]
-        if not s > relative * largest:
+        if not s > least:
             return False
         L[j, j] = math.sqrt(s)
         for i in range(j + 1, n):
@@ -735,18 +737,11 @@ def cholesky(H: Array, relative: float, L: Array) -> bool:
 
 
 @kernel
-def cholesky_solve(H: Array, g: Array, x: Array) -> bool:
-    r"""``x`` solving :math:`Hx = g` for a symmetric positive definite H: :func:`cholesky`,
-    then two triangular solves.
-
-    Returns:
-        False where H is not numerically definite (a pivot at or below ``1e-12`` times the
-        largest diagonal entry); ``x`` is then not set.
+def solve_factored(L: Array, g: Array, x: Array) -> None:
+    r"""``x`` solving :math:`LL^Tx = g`, L (n, n) lower triangular (:func:`cholesky`'s; its
+    upper triangle is not read): two triangular solves.
     """  # noqa: D205
     n = g.size
-    L = np.zeros((n, n))
-    if not cholesky(H, 1e-12, L):
-        return False
     y = np.empty(n)
     for i in range(n):
         s = g[i]
@@ -758,4 +753,20 @@ def cholesky_solve(H: Array, g: Array, x: Array) -> bool:
         for k in range(i + 1, n):
             s -= L[k, i] * x[k]
         x[i] = s / L[i, i]
+
+
+@kernel
+def cholesky_solve(H: Array, g: Array, x: Array) -> bool:
+    r"""``x`` solving :math:`Hx = g` for a symmetric positive definite H: :func:`cholesky`,
+    then :func:`solve_factored`.
+
+    Returns:
+        False where H is not numerically definite (a pivot at or below ``1e-12`` times the
+        largest diagonal entry); ``x`` is then not set.
+    """  # noqa: D205
+    n = g.size
+    L = np.zeros((n, n))
+    if not cholesky(H, 1e-12, L):
+        return False
+    solve_factored(L, g, x)
     return True

@@ -27,7 +27,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from solvers.kernels import cholesky, cholesky_solve, kernel
+from solvers.kernels import cholesky, cholesky_solve, kernel, solve_factored
 
 Array = npt.NDArray[np.float64]
 
@@ -246,28 +246,10 @@ def _least_distance(E: Array, m: int, n: int, L: Array, w: Array, x: Array) -> i
                         t += E[r, ci] * E[r, cj]
                     H[i, j] = t
                 g[i] = E[n, ci]
-            for j in range(k):
-                t = H[j, j]
-                for q in range(j):
-                    t -= H[j, q] * H[j, q]
-                if not t > 1e-14:
-                    return NOT_CONVERGED
-                H[j, j] = math.sqrt(t)
-                for i in range(j + 1, k):
-                    t = H[i, j]
-                    for q in range(j):
-                        t -= H[i, q] * H[j, q]
-                    H[i, j] = t / H[j, j]
-            for i in range(k):
-                t = g[i]
-                for q in range(i):
-                    t -= H[i, q] * z[q]
-                z[i] = t / H[i, i]
-            for i in range(k - 1, -1, -1):
-                t = z[i]
-                for q in range(i + 1, k):
-                    t -= H[q, i] * z[q]
-                z[i] = t / H[i, i]
+            # in place; the columns' unit parts make every diagonal entry at least 1
+            if not cholesky(H[:k, :k], 0.0, H[:k, :k], 1e-14):
+                return NOT_CONVERGED
+            solve_factored(H[:k, :k], g[:k], z[:k])
             for j in range(m):
                 s[j] = 0.0
             positive = True
