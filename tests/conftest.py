@@ -1,16 +1,34 @@
-"""Shared fixtures: seeded generators and the paper arms."""
+"""Shared fixtures: seeded generators and two facing pandas."""
 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 
 import numpy as np
 import pytest
+
+import rrc_pin
 
 
 @pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(20261122)
+
+
+@pytest.fixture(scope="session")
+def facing_pandas() -> Callable[..., rrc_pin.Robot]:
+    """Two pandas combined, the second facing the first (turned 180 deg about z) ``gap`` [m]
+    along x: ``facing_pandas(gap, names=("left", "right"))``."""
+    panda = rrc_pin.load("panda")
+
+    def make(gap: float, names: tuple[str, str] = ("left", "right")) -> rrc_pin.Robot:
+        facing = np.eye(4)
+        facing[:3, :3] = np.diag([-1.0, -1.0, 1.0])
+        facing[0, 3] = gap
+        return rrc_pin.combine({names[0]: (panda, np.eye(4)), names[1]: (panda, facing)})
+
+    return make
 
 
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:

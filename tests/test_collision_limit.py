@@ -32,12 +32,9 @@ def panda_with_table(height=0.2):
     return panda, cm
 
 
-def test_rows_match_pinocchio_joint_jacobians_shifted_to_the_witness_points():
+def test_rows_match_pinocchio_joint_jacobians_shifted_to_the_witness_points(facing_pandas):
     panda = rrc_pin.load("panda")
-    facing = np.eye(4)
-    facing[:3, :3] = np.diag([-1.0, -1.0, 1.0])
-    facing[0, 3] = 0.8
-    two = rrc_pin.combine({"l": (panda, np.eye(4)), "r": (panda, facing)})
+    two = facing_pandas(0.8, ("l", "r"))
     rng = np.random.default_rng(3)
     checked = 0
     for robot in (panda, two):
@@ -212,15 +209,11 @@ measured; 2.35 before the sliding stage's pull toward the exact rates and the en
 blend: solvers.pipeline.SLIDE_DAMPING, rrc_pin.limits.collision.BLEND)."""
 
 
-def test_two_hands_sliding_against_each_other_change_their_rates_continuously():
+def test_two_hands_sliding_against_each_other_change_their_rates_continuously(facing_pandas):
     """Two facing pandas' hands commanded into each other (0.3 m/s, 0.05 m/s up), pairs from
     link 6 out (the benchmark's 36): 1.5 s through activation and sliding, the joint rates
     change by at most SLIDE_JUMP a tick and the pairs stay apart."""
-    panda = rrc_pin.load("panda")
-    facing = np.eye(4)
-    facing[:3, :3] = np.diag([-1.0, -1.0, 1.0])
-    facing[0, 3] = 1.0
-    robot = rrc_pin.combine({"left": (panda, np.eye(4)), "right": (panda, facing)})
+    robot = facing_pandas(1.0)
     cm = CollisionModel(robot, "capsules")
 
     def link(body):
@@ -314,15 +307,11 @@ def test_a_limit_of_another_robot_is_refused_by_the_resolver():
     assert err.value.argument == "model"
 
 
-def test_a_limit_on_chosen_pairs_gives_exactly_their_rows():
+def test_a_limit_on_chosen_pairs_gives_exactly_their_rows(facing_pandas):
     """The pairs a limit is given are selected inside the query (the others never measured):
     the rows are those of every pair's query restricted to them, end points included, and
     an obstacle added later (a new scene, new pair indices) keeps the selection by name."""
-    panda = rrc_pin.load("panda")
-    facing = np.eye(4)
-    facing[:3, :3] = np.diag([-1.0, -1.0, 1.0])
-    facing[0, 3] = 0.8
-    robot = rrc_pin.combine({"l": (panda, np.eye(4)), "r": (panda, facing)})
+    robot = facing_pandas(0.8, ("l", "r"))
     cm = CollisionModel(robot)
     chosen = [p for p in cm.pairs if p[0].startswith("l/") != p[1].startswith("l/")][::2]
     limit = CollisionLimit(cm, 0.02, 0.3, pairs=chosen)

@@ -233,13 +233,9 @@ def test_the_broad_phase_never_drops_a_pair_within_the_detection_distance(label,
     assert rows > 50  # the scenes do come near
 
 
-def test_rows_hold_their_conventions_on_a_cell(rng):
+def test_rows_hold_their_conventions_on_a_cell(rng, facing_pandas):
     """p_b - p_a = d n with a unit n, joints of the model, A before B, in the pairs' order."""
-    panda = rrc_pin.load("panda")
-    facing = np.eye(4)
-    facing[:3, :3] = np.diag([-1.0, -1.0, 1.0])
-    facing[0, 3] = 0.7
-    cell = rrc_pin.combine({"left": (panda, np.eye(4)), "right": (panda, facing)})
+    cell = facing_pandas(0.7)
     cm = CollisionModel(cell, "hulls")
     cm.add_halfspace((0, 0, 1), 0.0, name="floor")
     order = {names: k for k, names in enumerate(cm.pairs)}

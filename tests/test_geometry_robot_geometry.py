@@ -132,12 +132,9 @@ def test_panda_leaves_out_the_pairs_its_srdf_disables(variant):
         assert len(cm.pairs) == 44  # the count: panda's meshes after SRDF and adjacency
 
 
-def test_two_combined_pandas_keep_their_own_pairs_and_pair_every_body_across():
+def test_two_combined_pandas_keep_their_own_pairs_and_pair_every_body_across(facing_pandas):
     panda = rrc_pin.load("panda")
-    facing = np.eye(4)
-    facing[:3, :3] = np.diag([-1.0, -1.0, 1.0])
-    facing[0, 3] = 1.0
-    cell = rrc_pin.combine({"left": (panda, np.eye(4)), "right": (panda, facing)})
+    cell = facing_pandas(1.0)
     one = CollisionModel(panda)
     two = CollisionModel(cell)
     n = len(one.bodies)
