@@ -310,18 +310,17 @@ def _top(
     if not outside_range and u_w.u >= 1.0 - EXACT_TOL:
         return _Top(u_w.qdot, "exact", 1.0, 0.0, 0.0, null)
     lam, usable = _damping(options.damping, factor, b, w, u_w.u, box, problem.dt, space.N is None)
-    if lam is None and outside_range:
+    if lam is not None:
+        z = usable.rates(b, lam)
+        damped = _scaled(A, z if space.N is None else z @ space.N, null, box, rows, backend, work)
+        if not damped.u <= STILL_SCALE < u_w.u:
+            return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot),
+                        float(np.max(lam)), null)  # fmt: skip
+        # a bound stops the damped rates and not the command's own: the undamped answer
+        # (panda stood still for up to ten ticks where the LP allowed up to 19 %)
+    if outside_range:
         return _Top(u_w.qdot, "singular", *_along_command(problem, u_w.qdot), 0.0, null)
-    if lam is None:
-        return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
-    z = usable.rates(b, lam)
-    damped = _scaled(A, z if space.N is None else z @ space.N, null, box, rows, backend, work)
-    if damped.u <= STILL_SCALE < u_w.u:
-        # a bound stops the damped rates and not the command's own: the command, scaled
-        # (standing still for up to ten ticks on panda where the LP allowed up to 19 %)
-        return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
-    return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot), float(np.max(lam)),
-                null)  # fmt: skip
+    return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
 
 
 SLIDE_DAMPING = 1e-2
