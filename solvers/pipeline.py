@@ -313,11 +313,12 @@ def _top(
     if lam is not None:
         z = usable.rates(b, lam)
         damped = _scaled(A, z if space.N is None else z @ space.N, null, box, rows, backend, work)
-        if not damped.u <= STILL_SCALE < u_w.u:
+        if boxed is None or not damped.u <= STILL_SCALE < u_w.u:
             return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot),
                         float(np.max(lam)), null)  # fmt: skip
-        # a bound stops the damped rates and not the command's own: the undamped answer
-        # (panda stood still for up to ten ticks where the LP allowed up to 19 %)
+        # a bound stops the damped rates and not the command's own exact answer (the box's
+        # kernels): that answer (panda stood still for up to ten ticks where the LP allowed
+        # up to 19 %; a backend's inexact answer is not taken for the command's direction)
     if outside_range:
         return _Top(u_w.qdot, "singular", *_along_command(problem, u_w.qdot), 0.0, null)
     return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
