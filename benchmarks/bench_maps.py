@@ -5,7 +5,7 @@ Run from a checkout: ``python benchmarks/bench_maps.py --out DIR`` (``--record``
 ``benchmarks/results/maps.json`` and ``.png``, ``--quick`` a smoke run of a few seconds);
 ``rrc-pin bench --only maps`` runs it. Needs the maps extra (dask[distributed], zarr).
 
-- **Per-core rate**: the work of a map's tasks on one thread (``solvers.map_work.
+- **Per-core rate**: the work of a map's tasks on one thread (``rrc_pin.solvers.maps.work.
   compute_blocks``: draw the blocks' samples, evaluate them, accumulate them into voxels),
   on 2^18 samples (8 blocks of 2^15) per case, the cases interleaved in a shuffled order
   for :data:`ROUNDS` rounds; the median round is recorded with the range. Timed as the
@@ -60,10 +60,10 @@ from rrc_pin import maps  # noqa: E402
 from rrc_pin.maps.kinematics import arm_kinematics, chain_of  # noqa: E402
 from rrc_pin.maps.voxels import chain_grid, quanta  # noqa: E402
 from rrc_pin.robot import frame_id  # noqa: E402
-from solvers.map_batch import Fields  # noqa: E402
-from solvers.map_kinematics import ChainKinematics, task_rows  # noqa: E402
-from solvers.map_sampling import Plan, block_samples  # noqa: E402
-from solvers.map_work import Job, compute_blocks  # noqa: E402
+from rrc_pin.solvers.maps.batch import Fields  # noqa: E402
+from rrc_pin.solvers.maps.kinematics import ChainKinematics, task_rows  # noqa: E402
+from rrc_pin.solvers.maps.sampling import Plan, block_samples  # noqa: E402
+from rrc_pin.solvers.maps.work import Job, compute_blocks  # noqa: E402
 
 ROUNDS = 5
 """Interleaved rounds of the per-core cases and of the scaling runs (full mode)."""

@@ -40,7 +40,7 @@ import numpy as np
 import numpy.typing as npt
 
 import rrc_pin
-from solvers.closed_form.quaternion import (
+from rrc_pin.solvers.closed_form.quaternion import (
     differential_rotation,
     quaternion_difference,
     quaternion_from_matrix,

@@ -15,11 +15,12 @@ benchmark:
   needs more than one frame), of which ``jacobian`` is one frame's (``Kinematics.jacobian``);
 - ``task rows``: the tasks' rows (``FrameTask.rows_at`` and every task's ``rows``);
 - ``limits``: the limits' constraints (``JointLimits.constraints``: the step's box);
-- ``problem``: the problem built (``solvers.problem.build``);
-- ``numerics``: ``solvers.pipeline.solve``'s own code, of which ``factorization`` (the QR
+- ``problem``: the problem built (``rrc_pin.solvers.tick.problem.build``);
+- ``numerics``: ``rrc_pin.solvers.tick.pipeline.solve``'s own code, of which ``factorization`` (the
+QR
   and the SVD on demand), ``direction`` (the direction problem: the exact kernels and the
   QP's build), ``backend`` (the backend's ``solve``, its data conversion included) and
-  ``lower levels`` (``solvers.least_squares.least_squares``);
+  ``lower levels`` (``rrc_pin.solvers.tick.least_squares.least_squares``);
 - ``report``: building the ``Resolution``.
 
 Times are exclusive (self time): a stage's time is what its function spent outside the
@@ -43,12 +44,12 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-import solvers.pipeline as pipeline_module
+import rrc_pin.solvers.tick.pipeline as pipeline_module
 from rrc_pin import kinematics as kinematics_module
 from rrc_pin import tasks as tasks_module
 from rrc_pin.limits import JointLimits
-from solvers.factorization import Factorization
-from solvers.resolution import Resolution
+from rrc_pin.solvers.tick.factorization import Factorization
+from rrc_pin.solvers.tick.resolution import Resolution
 
 Array = npt.NDArray[np.float64]
 
@@ -61,8 +62,8 @@ STAGES = {
     "jacobian": "one frame's Jacobian (Kinematics.jacobian)",
     "task rows": "the tasks' rows",
     "limits": "the limits' constraints (the step's box)",
-    "problem": "solvers.problem.build",
-    "numerics": "solvers.pipeline.solve's own code (status, clip, checks)",
+    "problem": "rrc_pin.solvers.tick.problem.build",
+    "numerics": "rrc_pin.solvers.tick.pipeline.solve's own code (status, clip, checks)",
     "factorization": "QR, least-norm rates, SVD on demand",
     "direction": "the direction problem: exact kernels, QP build",
     "backend": "the backend's solve (its data conversion included)",

@@ -9,35 +9,41 @@ and its answer, :class:`Resolution`; the teleoperation loop :class:`Controller` 
 :mod:`rrc_pin.control.strategies`).
 """
 
-from rrc_pin.cells import Cell, CellController, MasterSlave, make_cell
-from rrc_pin.combine import combine
-from rrc_pin.control import Controller, Deadman, DriftCorrection, TrajectoryLog
-from rrc_pin.errors import (
-    FrameNotFound,
-    InvalidInput,
-    RrcPinError,
-    ToolFrameRequired,
-    UnknownArm,
-    UnknownBackend,
-    URDFError,
-)
-from rrc_pin.geometry import CollisionModel
-from rrc_pin.limits import CollisionLimit, ContactLimit, GripLimit, JointLimits, Limit
-from rrc_pin.loading import arms, load
-from rrc_pin.resolver import QPOptions, Resolver
-from rrc_pin.robot import Robot
-from rrc_pin.tasks import (
-    DampingTask,
-    FrameTask,
-    JointTask,
-    PostureTask,
-    RelativeFrameTask,
-    Task,
-    TaskRows,
-)
-from solvers.damping import Damping
-from solvers.problem import Constraints
-from solvers.resolution import ActiveLimit, ActiveRow, Resolution, TaskReport
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from rrc_pin.cells import Cell, CellController, MasterSlave, make_cell
+    from rrc_pin.combined import combine
+    from rrc_pin.control import Controller, Deadman, DriftCorrection, TrajectoryLog
+    from rrc_pin.errors import (
+        FrameNotFound,
+        InvalidInput,
+        RrcPinError,
+        ToolFrameRequired,
+        UnknownArm,
+        UnknownBackend,
+        URDFError,
+    )
+    from rrc_pin.geometry import CollisionModel
+    from rrc_pin.limits import CollisionLimit, ContactLimit, GripLimit, JointLimits, Limit
+    from rrc_pin.loading import arms, load
+    from rrc_pin.resolver import QPOptions, Resolver
+    from rrc_pin.robot import Robot
+    from rrc_pin.solvers.tick.damping import Damping
+    from rrc_pin.solvers.tick.problem import Constraints
+    from rrc_pin.solvers.tick.resolution import ActiveLimit, ActiveRow, Resolution, TaskReport
+    from rrc_pin.tasks import (
+        DampingTask,
+        FrameTask,
+        JointTask,
+        PostureTask,
+        RelativeFrameTask,
+        Task,
+        TaskRows,
+    )
 
 __all__ = [
     "ActiveLimit",
@@ -81,3 +87,62 @@ __all__ = [
     "load",
     "make_cell",
 ]
+
+_HOME: dict[str, str] = {
+    "ActiveLimit": "rrc_pin.solvers.tick.resolution",
+    "ActiveRow": "rrc_pin.solvers.tick.resolution",
+    "Cell": "rrc_pin.cells",
+    "CellController": "rrc_pin.cells",
+    "CollisionLimit": "rrc_pin.limits",
+    "CollisionModel": "rrc_pin.geometry",
+    "Constraints": "rrc_pin.solvers.tick.problem",
+    "ContactLimit": "rrc_pin.limits",
+    "Controller": "rrc_pin.control",
+    "Damping": "rrc_pin.solvers.tick.damping",
+    "DampingTask": "rrc_pin.tasks",
+    "Deadman": "rrc_pin.control",
+    "DriftCorrection": "rrc_pin.control",
+    "FrameNotFound": "rrc_pin.errors",
+    "FrameTask": "rrc_pin.tasks",
+    "GripLimit": "rrc_pin.limits",
+    "InvalidInput": "rrc_pin.errors",
+    "JointLimits": "rrc_pin.limits",
+    "JointTask": "rrc_pin.tasks",
+    "Limit": "rrc_pin.limits",
+    "MasterSlave": "rrc_pin.cells",
+    "PostureTask": "rrc_pin.tasks",
+    "QPOptions": "rrc_pin.resolver",
+    "RelativeFrameTask": "rrc_pin.tasks",
+    "Resolution": "rrc_pin.solvers.tick.resolution",
+    "Resolver": "rrc_pin.resolver",
+    "Robot": "rrc_pin.robot",
+    "RrcPinError": "rrc_pin.errors",
+    "Task": "rrc_pin.tasks",
+    "TaskReport": "rrc_pin.solvers.tick.resolution",
+    "TaskRows": "rrc_pin.tasks",
+    "ToolFrameRequired": "rrc_pin.errors",
+    "TrajectoryLog": "rrc_pin.control",
+    "URDFError": "rrc_pin.errors",
+    "UnknownArm": "rrc_pin.errors",
+    "UnknownBackend": "rrc_pin.errors",
+    "arms": "rrc_pin.loading",
+    "combine": "rrc_pin.combined",
+    "load": "rrc_pin.loading",
+    "make_cell": "rrc_pin.cells",
+}
+"""Where each public name lives, imported on its first use: ``import rrc_pin`` itself loads
+neither Pinocchio nor the compiled kernels (the command line's ``--help`` stays fast, and
+``rrc_pin.solvers`` imports nothing above it)."""
+
+
+def __getattr__(name: str) -> Any:
+    home = _HOME.get(name)
+    if home is None:
+        raise AttributeError(f"module 'rrc_pin' has no attribute {name!r}")
+    value = getattr(importlib.import_module(home), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted([*globals(), *__all__])

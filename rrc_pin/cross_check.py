@@ -21,8 +21,8 @@ from rrc_pin.errors import InvalidInput
 from rrc_pin.loading import load
 from rrc_pin.models.arm_spec import ArmSpec
 from rrc_pin.robot import Robot
+from rrc_pin.solvers.spatial import REFERENCES, Reference
 from rrc_pin.urdf_export import COMMITTED_DIR, TOOL_FRAME, to_urdf
-from solvers.spatial import REFERENCES, Reference
 
 FD_STEP = 1e-6  # [rad] or [m]
 REFS = cast(tuple[Reference, ...], REFERENCES)  # the three frame names, typed

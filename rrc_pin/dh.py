@@ -26,8 +26,8 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from solvers.spatial import Reference, check_reference, from_world_aligned
-from solvers.validation import as_vector
+from rrc_pin.solvers.checks import as_vector
+from rrc_pin.solvers.spatial import Reference, check_reference, from_world_aligned
 
 Convention = Literal["standard", "modified", "nadkarni"]
 JointKind = Literal["revolute", "prismatic", "screw"]
@@ -218,7 +218,7 @@ class DHChain:
 
         Args:
             q: Joint positions (nq,).
-            ref: ``world_aligned``, ``local`` or ``world`` (see :mod:`solvers.spatial`).
+            ref: ``world_aligned``, ``local`` or ``world`` (see :mod:`rrc_pin.solvers.spatial`).
 
         Returns:
             (6, nq) array, rows [v; w].

@@ -1,4 +1,4 @@
-"""Exceptions of rrc_pin: one root, :class:`RrcPinError`, shared with :mod:`solvers.errors`.
+"""Exceptions of rrc_pin: one root, :class:`RrcPinError`, shared with :mod:`rrc_pin.solvers.errors`.
 
 Bad input raises before any state changes, with a message naming the argument. Numerical
 trouble (singularities, infeasible QPs) is never an exception: the resolver falls back and
@@ -7,7 +7,7 @@ reports which method answered.
 
 from __future__ import annotations
 
-from solvers.errors import InvalidInput, RrcPinError, UnknownBackend
+from rrc_pin.solvers.errors import InvalidInput, RrcPinError, UnknownBackend
 
 __all__ = [
     "ForeignMap",

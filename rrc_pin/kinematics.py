@@ -18,7 +18,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.robot import PIN_REFERENCE, Robot, frame_index
-from solvers.spatial import Reference
+from rrc_pin.solvers.spatial import Reference
 
 Array = npt.NDArray[np.float64]
 

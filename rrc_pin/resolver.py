@@ -6,10 +6,10 @@ One pipeline, each stage a module, entered once per tick (docs/api.md, "The reso
    of the tick; ``solve(q, twist)`` is its :class:`~rrc_pin.tasks.FrameTask` with this tick's
    twist;
 2. **limits** give a box and named constraint rows (:mod:`rrc_pin.limits`);
-3. **the problem** is built apart from solving it (:func:`solvers.problem.build`);
+3. **the problem** is built apart from solving it (:func:`rrc_pin.solvers.tick.problem.build`);
 4. **the numerics** solve it: compiled kernels, the QP backend where rows need it, the
-   fallbacks (:func:`solvers.pipeline.solve`);
-5. **the report**, decided once (:class:`~solvers.resolution.Resolution`).
+   fallbacks (:func:`rrc_pin.solvers.tick.pipeline.solve`);
+5. **the report**, decided once (:class:`~rrc_pin.solvers.tick.resolution.Resolution`).
 
 Every argument is checked here, at the public boundary, before any state changes: bad input
 raises :class:`~rrc_pin.errors.InvalidInput` (or another
@@ -38,14 +38,14 @@ from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.limits import JointLimits, Limit
 from rrc_pin.loading import load
 from rrc_pin.robot import Robot
+from rrc_pin.solvers.checks import as_vector, finite_number, positive
+from rrc_pin.solvers.qp_backends import make_backend
+from rrc_pin.solvers.spatial import Reference
+from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.pipeline import DEFAULT_FALLBACKS, Method, Options, solve
+from rrc_pin.solvers.tick.problem import TaskRows, build
+from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.tasks import FrameTask, Task
-from solvers.damping import Damping
-from solvers.pipeline import DEFAULT_FALLBACKS, Method, Options, solve
-from solvers.problem import TaskRows, build
-from solvers.qp_backends import make_backend
-from solvers.resolution import Resolution
-from solvers.spatial import Reference
-from solvers.validation import as_vector, finite_number, positive
 
 Array = npt.NDArray[np.float64]
 
@@ -67,7 +67,7 @@ class QPOptions:
     """The QP backend, its time cap and the fallbacks of a resolver.
 
     Attributes:
-        backend: A name of :func:`solvers.qp_backends.installed_backends`: ``"daqp"``
+        backend: A name of :func:`rrc_pin.solvers.qp_backends.installed_backends`: ``"daqp"``
             (default: exact active-set answers), ``"osqp"``, or a qpsolvers solver
             (``proxqp``, ``quadprog``, ``clarabel``...).
         options: The backend's own settings (a mapping), checked at construction.
@@ -210,7 +210,7 @@ class Resolver:
                 rates this resolver returned last (zero at the first step).
 
         Returns:
-            The :class:`~solvers.resolution.Resolution` (finite, within the box).
+            The :class:`~rrc_pin.solvers.tick.resolution.Resolution` (finite, within the box).
 
         Raises:
             InvalidInput: A bad q, twist, task, level, ref, priority, dt or qdot_prev, named;

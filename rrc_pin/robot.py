@@ -39,9 +39,9 @@ import pinocchio as pin
 
 from rrc_pin.errors import FrameNotFound, InvalidInput, ToolFrameRequired, URDFError
 from rrc_pin.models.arm_spec import ArmSpec
-from solvers.closed_form.base import ClosedForm
-from solvers.spatial import Reference, check_reference
-from solvers.validation import as_vector, finite_number
+from rrc_pin.solvers.checks import as_vector, finite_number
+from rrc_pin.solvers.closed_form.base import ClosedForm
+from rrc_pin.solvers.spatial import Reference, check_reference
 
 PIN_REFERENCE = {
     "world_aligned": pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
@@ -227,7 +227,7 @@ class Robot:
 
     @property
     def closed_form(self) -> ClosedForm | None:
-        """The paper's closed-form fast path (a ``solvers.closed_form`` object), or None.
+        """The paper's closed-form fast path (a ``rrc_pin.solvers.closed_form`` object), or None.
 
         Built once from this arm's actual parameters (a variant gets a matching closed form).
         None for arms the papers do not cover, and whenever the tool frame is not the frame

@@ -14,7 +14,7 @@ from typing import Literal
 import numpy as np
 import numpy.typing as npt
 
-from solvers.errors import InvalidInput
+from rrc_pin.solvers.errors import InvalidInput
 
 Array = npt.NDArray[np.float64]
 Reference = Literal["world_aligned", "local", "world"]

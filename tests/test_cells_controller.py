@@ -9,7 +9,7 @@ from scipy.optimize import linprog
 import rrc_pin
 from rrc_pin.cells.controller import CellController
 from rrc_pin.errors import InvalidInput
-from solvers.pipeline import scale_and_veer
+from rrc_pin.solvers.tick.pipeline import scale_and_veer
 
 GRIP_BOUND = 1e-5
 """[m] The grip's bound over a session: one tick's second-order integration remainder after

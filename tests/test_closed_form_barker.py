@@ -15,8 +15,8 @@ import pytest
 
 import rrc_pin
 from rrc_pin.models import barker6
-from solvers.closed_form.barker import BarkerClosedForm, BarkerSingularity
-from solvers.errors import InvalidInput
+from rrc_pin.solvers.closed_form.barker import BarkerClosedForm, BarkerSingularity
+from rrc_pin.solvers.errors import InvalidInput
 
 TOL = 1e-9
 MODEL_TOL = 1e-13  # Pinocchio (URDF at 15 significant digits) against exact formulas

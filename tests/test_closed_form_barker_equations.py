@@ -14,7 +14,7 @@ import pytest
 
 import rrc_pin
 from rrc_pin.models import barker6
-from solvers.closed_form import barker_equations as eqs
+from rrc_pin.solvers.closed_form import barker_equations as eqs
 
 N = 2000
 ARMS = {

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from solvers.closed_form.base import finite, vector
-from solvers.errors import InvalidInput
+from rrc_pin.solvers.closed_form.base import finite, vector
+from rrc_pin.solvers.errors import InvalidInput
 
 
 def test_vector_passes_float_vectors_and_converts_the_rest() -> None:

@@ -1,16 +1,17 @@
-"""The exports of solvers.closed_form: every name in ``__all__`` exists, sorted, complete."""
+"""The exports of rrc_pin.solvers.closed_form: every name in ``__all__`` exists, sorted,
+complete."""
 
 from __future__ import annotations
 
 import inspect
 
-import solvers.closed_form as package
-from solvers.closed_form import barker, base, quaternion, rrc_k1607, three_r
+import rrc_pin.solvers.closed_form as package
+from rrc_pin.solvers.closed_form import barker, base, quaternion, rrc_k1607, three_r
 
 
 def test_star_import_provides_every_exported_name():
     namespace: dict = {}
-    exec("from solvers.closed_form import *", namespace)
+    exec("from rrc_pin.solvers.closed_form import *", namespace)
     assert set(package.__all__) <= set(namespace)
     assert package.__all__ == sorted(package.__all__)
     assert len(set(package.__all__)) == len(package.__all__)

@@ -6,7 +6,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from solvers.closed_form.quaternion import (
+from rrc_pin.solvers.closed_form.quaternion import (
     differential_rotation,
     matrix_from_quaternion,
     quaternion_difference,
@@ -14,7 +14,7 @@ from solvers.closed_form.quaternion import (
     rotation_vector,
     small_rotation,
 )
-from solvers.errors import InvalidInput
+from rrc_pin.solvers.errors import InvalidInput
 
 
 def random_rotations(rng: np.random.Generator, n: int) -> np.ndarray:

@@ -6,9 +6,13 @@ import numpy as np
 import pytest
 
 import rrc_pin
-from solvers.closed_form import null_space_projector, weighted_pseudo_inverse, weighted_rates
-from solvers.closed_form.rrc_k1607 import RrcK1607ClosedForm
-from solvers.errors import InvalidInput
+from rrc_pin.solvers.closed_form import (
+    null_space_projector,
+    weighted_pseudo_inverse,
+    weighted_rates,
+)
+from rrc_pin.solvers.closed_form.rrc_k1607 import RrcK1607ClosedForm
+from rrc_pin.solvers.errors import InvalidInput
 
 ARM = rrc_pin.load("rrc_k1607")  # Pinocchio, from the generated URDF
 CF = ARM.closed_form
@@ -409,7 +413,7 @@ def nguyen_printed(q: np.ndarray, printed: frozenset[str] = frozenset()):
     """Nguyen eqs. (5)-(11) transcribed; the names in ``printed`` keep the report's typo.
 
     Typos: "f3" (eq. 8), "f6" (eq. 8), "g1" (eq. 9), "px" (eq. 5, d5 term). Returns (R, p)
-    with Table 1 in metres. Independent of solvers.closed_form.
+    with Table 1 in metres. Independent of rrc_pin.solvers.closed_form.
     """
     c, s = np.cos(q), np.sin(q)
     c1, c2, c3, c4, c5, c6, c7 = c

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import rrc_pin
-from solvers.closed_form import rrc_k1607_equations as eqs
+from rrc_pin.solvers.closed_form import rrc_k1607_equations as eqs
 
 N = 2000
 ARM = rrc_pin.load("rrc_k1607")

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import rrc_pin
-from solvers.closed_form.three_r import AngularRates, ThreeRClosedForm, minimum_norm_shift
-from solvers.errors import InvalidInput
+from rrc_pin.solvers.closed_form.three_r import AngularRates, ThreeRClosedForm, minimum_norm_shift
+from rrc_pin.solvers.errors import InvalidInput
 
 ARM = rrc_pin.load("kr5_3r")  # Pinocchio, from the generated URDF
 CF = ARM.closed_form

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import rrc_pin
-from solvers.closed_form import three_r_equations as eqs
+from rrc_pin.solvers.closed_form import three_r_equations as eqs
 
 N = 3000
 ARM = rrc_pin.load("kr5_3r")

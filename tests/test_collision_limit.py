@@ -13,7 +13,7 @@ import pytest
 import rrc_pin
 from rrc_pin import CollisionLimit, CollisionModel, FrameTask, InvalidInput, JointLimits, Resolver
 from rrc_pin.kinematics import Kinematics, Layout
-from solvers.damper_kernels import damper_rows
+from rrc_pin.solvers.collision.damper_kernels import damper_rows
 
 DT = 0.01
 
@@ -206,7 +206,7 @@ SLIDE_JUMP = 0.15
 """[rad/s] The largest joint-rate change between two ticks of
 :func:`test_two_hands_sliding_against_each_other_change_their_rates_continuously` (0.086
 measured; 2.35 before the sliding stage's pull toward the exact rates and the end-point rows'
-blend: solvers.pipeline.SLIDE_DAMPING, rrc_pin.limits.collision.BLEND)."""
+blend: rrc_pin.solvers.tick.pipeline.SLIDE_DAMPING, rrc_pin.limits.collision.BLEND)."""
 
 
 def test_two_hands_sliding_against_each_other_change_their_rates_continuously(facing_pandas):

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from solvers.damping import MIN_THRESHOLD, Damping
-from solvers.errors import InvalidInput
+from rrc_pin.solvers.errors import InvalidInput
+from rrc_pin.solvers.tick.damping import MIN_THRESHOLD, Damping
 
 
 def test_none_below_the_threshold_or_where_the_command_can_be_met() -> None:

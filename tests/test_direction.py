@@ -7,12 +7,18 @@ import itertools
 import numpy as np
 import pytest
 
-from solvers.direction import REGULARIZATION, along, constraint_rows, direction_lp, direction_qp
-from solvers.errors import NumericalFailure
-from solvers.factorization import Factorization
-from solvers.kernels import line_scale, uniform_scale
-from solvers.problem import Box, Rows
-from solvers.qp_backends import installed_backends, make_backend
+from rrc_pin.solvers.errors import NumericalFailure
+from rrc_pin.solvers.qp_backends import installed_backends, make_backend
+from rrc_pin.solvers.tick.direction import (
+    REGULARIZATION,
+    along,
+    constraint_rows,
+    direction_lp,
+    direction_qp,
+)
+from rrc_pin.solvers.tick.factorization import Factorization
+from rrc_pin.solvers.tick.kernels import line_scale, uniform_scale
+from rrc_pin.solvers.tick.problem import Box, Rows
 
 
 def box(lb: np.ndarray, ub: np.ndarray) -> Box:

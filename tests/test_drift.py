@@ -11,7 +11,7 @@ import rrc_pin
 from rrc_pin.control import Controller
 from rrc_pin.control.controller import REANCHOR, _followed
 from rrc_pin.control.drift import DriftCorrection, advance, pose_error
-from solvers.closed_form.quaternion import (
+from rrc_pin.solvers.closed_form.quaternion import (
     differential_rotation,
     quaternion_difference,
     quaternion_from_matrix,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from solvers.factorization import RANK_TOL, Factorization
+from rrc_pin.solvers.tick.factorization import RANK_TOL, Factorization
 
 
 @pytest.mark.parametrize(

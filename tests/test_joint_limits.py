@@ -1,4 +1,5 @@
-"""JointLimits: the step's box (solvers.kernels.joint_box), exact in floating point, recovery,
+"""JointLimits: the step's box (rrc_pin.solvers.tick.kernels.joint_box), exact in floating point,
+recovery,
 priorities, kinds; its fields checked at construction and against the robot."""
 
 from __future__ import annotations
@@ -11,9 +12,9 @@ import pytest
 
 import rrc_pin
 from rrc_pin import InvalidInput, JointLimits, Resolver
-from solvers import kernels
-from solvers.kernels import ON_LIMIT, SHRINK
-from solvers.resolution import KIND_NAMES
+from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.kernels import ON_LIMIT, SHRINK
+from rrc_pin.solvers.tick.resolution import KIND_NAMES
 
 KINDS = ("velocity", "position", "acceleration")
 

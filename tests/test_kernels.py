@@ -12,7 +12,7 @@ import itertools
 import numpy as np
 import pytest
 
-from solvers import kernels
+from rrc_pin.solvers.tick import kernels
 
 
 def random_rows(
@@ -219,7 +219,7 @@ def test_direction_step_against_its_parts(m: int, n: int, rng: np.random.Generat
 def lambda_sq_reference(
     sigma: np.ndarray, rank: int, scale: float, along: np.ndarray, dt: float, threshold: float
 ) -> np.ndarray | None:
-    """The damping schedule in plain numpy (solvers/damping.py's former implementation)."""
+    """The damping schedule in plain numpy (solvers/tick/damping.py's former implementation)."""
     if rank == 0 or scale >= 1.0:
         return None
     onset = float(sigma[0]) / threshold

@@ -6,11 +6,11 @@ import numpy as np
 import qpsolvers
 from scipy.optimize import lsq_linear
 
-from solvers.least_squares import Subspace, least_squares
-from solvers.problem import Box, Rows
-from solvers.qp import QP, Work
-from solvers.qp_backends import make_backend
-from solvers.qp_backends.base import QPBackend, QPSolution
+from rrc_pin.solvers.qp_backends import make_backend
+from rrc_pin.solvers.qp_backends.base import QPBackend, QPSolution
+from rrc_pin.solvers.qp_backends.qp import QP, Work
+from rrc_pin.solvers.tick.least_squares import Subspace, least_squares
+from rrc_pin.solvers.tick.problem import Box, Rows
 
 
 class Recording(QPBackend):

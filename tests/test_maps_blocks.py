@@ -10,7 +10,7 @@ import pytest
 from rrc_pin.errors import ForeignMap
 from rrc_pin.maps.blocks import BlockStore, fingerprint
 from rrc_pin.maps.voxels import VoxelStats
-from solvers.map_batch import Fields, Sparse
+from rrc_pin.solvers.maps.batch import Fields, Sparse
 
 
 def _part(keys, value):

@@ -178,7 +178,7 @@ def test_barker6_voxels_flagged_singular_hold_the_samples_where_eqs_32_33_s5_hol
 
 
 def maps_block(m: maps.CapabilityMap, block: int) -> np.ndarray:
-    from solvers.map_sampling import block_samples
+    from rrc_pin.solvers.maps.sampling import block_samples
 
     return block_samples(m.chain, int(m.meta["seed"]), m.plan, block)
 

@@ -1,4 +1,4 @@
-"""The maps' compiled kernels (solvers/map_kernels.py through solvers/map_batch.py) against
+"""The maps' compiled kernels (solvers/maps/kernels.py through solvers/maps/batch.py) against
 independent references: Pinocchio for the chain's pose and Jacobian, numpy's SVD for the
 singular values, numpy's scatter reductions for the accumulation; and the same source as
 plain Python (NUMBA_DISABLE_JIT=1) giving the same bits."""
@@ -20,8 +20,8 @@ import pytest
 
 import rrc_pin
 from rrc_pin.maps.kinematics import chain_of
-from solvers import map_kernels
-from solvers.map_batch import BINS, NONE, Rows, VoxelTable, direction_bins, singular_values
+from rrc_pin.solvers.maps import kernels as map_kernels
+from rrc_pin.solvers.maps.batch import BINS, NONE, Rows, VoxelTable, direction_bins, singular_values
 
 ROOT = Path(__file__).resolve().parents[1]
 JIT = not numba.config.DISABLE_JIT
@@ -225,9 +225,9 @@ JIT_FREE = textwrap.dedent(
     import numpy as np
     import rrc_pin
     from rrc_pin.maps.kinematics import arm_kinematics
-    from solvers.map_sampling import Plan, block_samples
+    from rrc_pin.solvers.maps.sampling import Plan, block_samples
     from rrc_pin.maps.voxels import chain_grid, quanta
-    from solvers.map_batch import Rows, VoxelTable
+    from rrc_pin.solvers.maps.batch import Rows, VoxelTable
     out = {}
     for name in ("panda", "barker6"):
         kin = arm_kinematics(rrc_pin.load(name))

@@ -10,9 +10,9 @@ import rrc_pin
 from rrc_pin.errors import FrameNotFound, InvalidInput, ToolFrameRequired
 from rrc_pin.maps.kinematics import arm_kinematics, chain_of, placed, z_to
 from rrc_pin.maps.voxels import chain_grid, quanta
-from solvers.map_batch import Rows
-from solvers.map_kinematics import BarkerKinematics, ChainKinematics, task_rows
-from solvers.map_sampling import Plan, block_samples
+from rrc_pin.solvers.maps.batch import Rows
+from rrc_pin.solvers.maps.kinematics import BarkerKinematics, ChainKinematics, task_rows
+from rrc_pin.solvers.maps.sampling import Plan, block_samples
 
 pytestmark = pytest.mark.compiled
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import io
 
 from rrc_pin.maps.progress import Progress, ProgressBar
-from solvers.map_sampling import Plan
+from rrc_pin.solvers.maps.sampling import Plan
 
 
 def test_progress_counts_and_bar_lines():

@@ -6,7 +6,7 @@ import numpy as np
 
 import rrc_pin
 from rrc_pin.maps.kinematics import chain_of
-from solvers.map_sampling import BLOCK, Plan, block_samples, block_stream, sample_at
+from rrc_pin.solvers.maps.sampling import BLOCK, Plan, block_samples, block_stream, sample_at
 
 
 def test_plan_blocks_and_tasks():

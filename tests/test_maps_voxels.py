@@ -8,7 +8,7 @@ import pytest
 import rrc_pin
 from rrc_pin.maps.kinematics import chain_of
 from rrc_pin.maps.voxels import SUM_BITS, Grid, VoxelStats, chain_grid, quanta
-from solvers.map_batch import NONE, Fields, Rows, VoxelTable
+from rrc_pin.solvers.maps.batch import NONE, Fields, Rows, VoxelTable
 
 
 def test_grid_is_aligned_and_keys_round_trip(rng):

@@ -1,4 +1,5 @@
-"""solvers.narrow_kernels: the compiled narrow phase against coal (1e-9) on thousands of random
+"""rrc_pin.solvers.collision.narrow_kernels: the compiled narrow phase against coal (1e-9) on
+thousands of random
 sphere, capsule and half-space pairs, including parallel and intersecting segments, and its
 end-point rows against the point-to-segment distance written in numpy."""
 
@@ -9,7 +10,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from solvers.narrow_kernels import BOX, CAPSULE, HALFSPACE, SPHERE, narrow_phase
+from rrc_pin.solvers.collision.narrow_kernels import BOX, CAPSULE, HALFSPACE, SPHERE, narrow_phase
 
 TOL = 1e-9
 TRIALS = 500

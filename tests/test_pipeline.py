@@ -1,4 +1,4 @@
-"""solvers.pipeline on random problems against independent references: strict levels
+"""rrc_pin.solvers.tick.pipeline on random problems against independent references: strict levels
 (Clarabel on the lexicographic definition), the weighted optimum (BVLS), the direction scale
 (HiGHS on the whole LP), constraint rows and equality rows, and the fallback chain."""
 
@@ -9,14 +9,14 @@ import pytest
 import qpsolvers
 from scipy.optimize import linprog, lsq_linear
 
-import solvers.pipeline as pipeline_module
-from solvers import kernels
-from solvers.damper_kernels import SLACK
-from solvers.damping import Damping
-from solvers.errors import InvalidInput, ProblemError
-from solvers.pipeline import Answer, Options, solve
-from solvers.problem import Box, Constraints, Problem, TaskRows, build
-from solvers.qp_backends import QPBackend, QPSolution, make_backend
+import rrc_pin.solvers.tick.pipeline as pipeline_module
+from rrc_pin.solvers.collision.damper_kernels import SLACK
+from rrc_pin.solvers.errors import InvalidInput, ProblemError
+from rrc_pin.solvers.qp_backends import QPBackend, QPSolution, make_backend
+from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.pipeline import Answer, Options, solve
+from rrc_pin.solvers.tick.problem import Box, Constraints, Problem, TaskRows, build
 
 N = 10
 DT = 0.01
@@ -439,7 +439,7 @@ def test_sliding_keeps_the_box_by_scaling_the_kept_command() -> None:
 
 
 def test_sliding_reports_the_pair_and_its_distance() -> None:
-    from solvers.resolution import Resolution
+    from rrc_pin.solvers.tick.resolution import Resolution
 
     problem = plane_problem(True, (0.1, 0.0, -0.1))
     answer = solve(problem, make_backend("daqp"), Options())
@@ -449,7 +449,8 @@ def test_sliding_reports_the_pair_and_its_distance() -> None:
 
 def test_a_slid_command_met_by_other_joints_is_met_not_scaled() -> None:
     """Four joints moving a point, joint 4 along z like joint 3; a slide row on joint 3 alone
-    (-qdot_3 <= 1e-9, a held pair's bound: solvers.damper_kernels.SLACK). The least-norm
+    (-qdot_3 <= 1e-9, a held pair's bound: rrc_pin.solvers.collision.damper_kernels.SLACK). The
+    least-norm
     rates of a command down share z between joints 3 and 4 and cross the row; the slide
     meets the command with joint 4 and keeps the row: those rates are the answer (the
     least-norm rates scaled back to the row would stand still). To the sliding stage's damping

@@ -1,4 +1,5 @@
-"""solvers.proximity_kernels: the compiled forward kinematics and bounding-sphere test, against
+"""rrc_pin.solvers.collision.proximity_kernels: the compiled forward kinematics and bounding-sphere
+test, against
 numpy references (1e-12) and Pinocchio."""
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ import pytest
 
 import rrc_pin
 from rrc_pin.geometry.tree import tree_of
-from solvers.proximity_kernels import joint_poses, near_pairs, world_centres
+from rrc_pin.solvers.collision.proximity_kernels import joint_poses, near_pairs, world_centres
 
 
 def rodrigues(axis, theta):

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import qpsolvers
 
-from solvers.qp import QP, Decoding
-from solvers.qp_backends import make_backend
+from rrc_pin.solvers.qp_backends import make_backend
+from rrc_pin.solvers.qp_backends.qp import QP, Decoding
 
 
 def feasible(qp: QP, z: np.ndarray, tol: float = 0.0) -> bool:

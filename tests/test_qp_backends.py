@@ -14,12 +14,11 @@ import pytest
 import qpsolvers
 from test_qp import feasible
 
-import solvers.qp_backends.daqp_backend as daqp_backend
-import solvers.qp_backends.osqp_backend as osqp_backend
-import solvers.qp_backends.qpsolvers_backend as qpsolvers_backend
-from solvers.errors import InvalidInput, ProblemError, UnknownBackend
-from solvers.qp import QP
-from solvers.qp_backends import (
+import rrc_pin.solvers.qp_backends.daqp_backend as daqp_backend
+import rrc_pin.solvers.qp_backends.osqp_backend as osqp_backend
+import rrc_pin.solvers.qp_backends.qpsolvers_backend as qpsolvers_backend
+from rrc_pin.solvers.errors import InvalidInput, ProblemError, UnknownBackend
+from rrc_pin.solvers.qp_backends import (
     NATIVE,
     DaqpBackend,
     OSQPBackend,
@@ -27,6 +26,7 @@ from solvers.qp_backends import (
     installed_backends,
     make_backend,
 )
+from rrc_pin.solvers.qp_backends.qp import QP
 
 MODULES = {"daqp": "daqp", "osqp": "osqp", "clarabel": "clarabel", "proxqp": "proxsuite",
            "quadprog": "quadprog"}  # fmt: skip

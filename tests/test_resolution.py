@@ -5,11 +5,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from solvers import kernels
-from solvers.pipeline import METHODS, Options, scale_and_veer, solve
-from solvers.problem import Box, Constraints, TaskRows, build
-from solvers.qp_backends import make_backend
-from solvers.resolution import ACTIVE_TOL, ActiveLimit, ActiveRow, Resolution, active_limits
+from rrc_pin.solvers.qp_backends import make_backend
+from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.pipeline import METHODS, Options, scale_and_veer, solve
+from rrc_pin.solvers.tick.problem import Box, Constraints, TaskRows, build
+from rrc_pin.solvers.tick.resolution import (
+    ACTIVE_TOL,
+    ActiveLimit,
+    ActiveRow,
+    Resolution,
+    active_limits,
+)
 
 
 def box(n: int = 3, v: float = 1.0, q: np.ndarray | None = None) -> Box:

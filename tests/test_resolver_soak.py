@@ -17,7 +17,7 @@ import pytest
 
 import rrc_pin
 from rrc_pin import FrameTask, PostureTask, QPOptions, Resolver
-from solvers.qp_backends import installed_backends
+from rrc_pin.solvers.qp_backends import installed_backends
 
 STEPS = int(os.environ.get("RRC_PIN_SOAK", "60"))
 """Steps per arm for the default backend; each other backend gets a tenth (at least 10)."""

@@ -1,4 +1,5 @@
-"""solvers.slide_kernels: the sliding stage's projection against DAQP (1e-8) on random problems
+"""rrc_pin.solvers.tick.slide_kernels: the sliding stage's projection against DAQP (1e-8) on random
+problems
 (redundant and square metrics, infinite bounds, rows broken at zero), infeasible data refused,
 never NaN; its damped optimum against the normal equations and bounded through a singularity."""
 
@@ -7,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import qpsolvers
 
-from solvers.slide_kernels import INFEASIBLE, SOLVED, damped_optimum, project
+from rrc_pin.solvers.tick.slide_kernels import INFEASIBLE, SOLVED, damped_optimum, project
 
 TRIALS = 1500
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import rrc_pin
-from solvers.errors import InvalidInput
-from solvers.spatial import REFERENCES, check_reference, from_world_aligned
+from rrc_pin.solvers.errors import InvalidInput
+from rrc_pin.solvers.spatial import REFERENCES, check_reference, from_world_aligned
 
 
 @pytest.mark.parametrize("ref", REFERENCES)

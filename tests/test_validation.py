@@ -7,8 +7,8 @@ import warnings
 import numpy as np
 import pytest
 
-from solvers.errors import InvalidInput
-from solvers.validation import as_array, as_vector, finite_number, positive
+from rrc_pin.solvers.checks import as_array, as_vector, finite_number, positive
+from rrc_pin.solvers.errors import InvalidInput
 
 
 def test_good_input_comes_back_as_float_arrays(rng: np.random.Generator) -> None:

@@ -10,7 +10,7 @@ take it unchanged) that also knows its parts:
 - ``body``: for a legged cell, the body frame of a free-flyer root joint (a floating base)
   under which the legs hang; its feet are the arms' tool frames.
 
-This module builds the model only (it sits with :mod:`rrc_pin.combine` in the foundation
+This module builds the model only (it sits with :mod:`rrc_pin.combined` in the foundation
 layer, so that :func:`rrc_pin.load` can build ready-made cells); the cooperative commands,
 the controller and the master-slave mapping of :mod:`rrc_pin.cells` sit above the control
 layer.
@@ -25,11 +25,11 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from rrc_pin.combine import Combined, Part, prefixed
+from rrc_pin.combined import Combined, Part, prefixed
 from rrc_pin.errors import InvalidInput
 from rrc_pin.models.cell_spec import CellSpec
 from rrc_pin.robot import Robot, frame_index
-from solvers.validation import as_vector, rigid_transform
+from rrc_pin.solvers.checks import as_vector, rigid_transform
 
 Array = npt.NDArray[np.float64]
 
@@ -73,7 +73,7 @@ class Grasp(NamedTuple):
 class Cell(Combined):
     """Several arms as one robot, with named parts (module docstring).
 
-    A :class:`~rrc_pin.combine.Combined` robot (its ``parts``: each arm's key, robot and
+    A :class:`~rrc_pin.combined.Combined` robot (its ``parts``: each arm's key, robot and
     base placement), so that what takes a combined robot takes a cell: the collision model
     (:class:`~rrc_pin.geometry.CollisionModel`, each arm's geometry at its base).
 

@@ -52,10 +52,10 @@ from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import ContactLimit, GripLimit, JointLimits, Limit
 from rrc_pin.loading import load
 from rrc_pin.resolver import QPOptions
+from rrc_pin.solvers.checks import as_vector, positive
+from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.tasks import FrameTask, PostureTask, Task
-from solvers.damping import Damping
-from solvers.resolution import Resolution
-from solvers.validation import as_vector, positive
 
 Array = npt.NDArray[np.float64]
 Ref = Literal["world", "local", "base"]

@@ -20,7 +20,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
-from solvers.validation import positive, rigid_transform
+from rrc_pin.solvers.checks import positive, rigid_transform
 
 Array = npt.NDArray[np.float64]
 

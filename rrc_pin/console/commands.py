@@ -19,7 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from solvers.validation import as_array, as_vector
+from rrc_pin.solvers.checks import as_array, as_vector
 
 Array = npt.NDArray[np.float64]
 Frame = Literal["local", "world_aligned"]

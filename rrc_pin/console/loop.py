@@ -36,9 +36,9 @@ from rrc_pin.errors import InvalidInput, RrcPinError
 from rrc_pin.limits import JointLimits
 from rrc_pin.resolver import QPOptions, Resolver
 from rrc_pin.robot import Robot
-from solvers.qp_backends import installed_backends
-from solvers.resolution import Resolution
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.qp_backends import installed_backends
+from rrc_pin.solvers.tick.resolution import Resolution
 
 Array = npt.NDArray[np.float64]
 LOOP_NICE = -10

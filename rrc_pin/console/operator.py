@@ -29,7 +29,7 @@ import pinocchio as pin
 
 from rrc_pin.console.commands import Frame, Hold, Jog, Latch, Target, Velocity
 from rrc_pin.errors import InvalidInput
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
 
 Array = npt.NDArray[np.float64]
 

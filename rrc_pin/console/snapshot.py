@@ -8,7 +8,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.console.commands import Frame
-from solvers.resolution import Resolution
+from rrc_pin.solvers.tick.resolution import Resolution
 
 Array = npt.NDArray[np.float64]
 Mode = Literal["teleop", "target", "reverse", "replay", "held"]

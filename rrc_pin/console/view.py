@@ -19,7 +19,7 @@ from rrc_pin.console.loop import ControlLoop
 from rrc_pin.console.panel import Panel
 from rrc_pin.console.readouts import Reader, joints_html, status_html
 from rrc_pin.console.scene import Scene
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
 
 DUTY = 0.2
 """Largest fraction of the time the view spends updating."""

@@ -37,9 +37,9 @@ from rrc_pin.limits import JointLimits
 from rrc_pin.loading import cells, load
 from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import Robot
-from solvers.damping import Damping
-from solvers.resolution import Resolution
-from solvers.validation import as_vector, finite_number
+from rrc_pin.solvers.checks import as_vector, finite_number
+from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.resolution import Resolution
 
 Array = npt.NDArray[np.float64]
 Frame = Literal["local", "world_aligned"]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
 
 
 @dataclass(frozen=True)

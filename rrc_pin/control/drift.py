@@ -13,7 +13,7 @@ differential rotations by eq. (37), ``2 delta s``:
 
 in hand axes (the controller turns it into base axes for a base-axes command), the linear
 and angular parts each clipped to its bound. The quaternion is Pinocchio's (one C++ call);
-``tests/test_drift.py`` shows the error is what :mod:`solvers.closed_form.quaternion` gives
+``tests/test_drift.py`` shows the error is what :mod:`rrc_pin.solvers.closed_form.quaternion` gives
 from eqs. (32)-(34) and (37), to 1e-12.
 """
 
@@ -25,7 +25,7 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
 
 Array = npt.NDArray[np.float64]
 
@@ -74,7 +74,7 @@ def pose_error(pose: pin.SE3, reference: pin.SE3) -> Array:
     of the orientation difference (eqs. (31)-(34)), with the sign of ``delta eta`` (``dq``
     and ``-dq`` are one rotation). Both parts are those of ``T^-1 T_ref``, so in hand axes:
     ``R^T`` times the base-axes error of
-    :func:`solvers.closed_form.quaternion.differential_rotation` applied to
+    :func:`rrc_pin.solvers.closed_form.quaternion.differential_rotation` applied to
     ``quaternion_difference(Q{R}, Q{R_ref})`` (the quaternion of ``R_ref R^T``), and
     ``R^T (p_ref - p)``.
 

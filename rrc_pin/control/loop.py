@@ -36,9 +36,9 @@ from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import Limit
 from rrc_pin.resolver import QPOptions, Resolver
 from rrc_pin.robot import Robot
-from solvers.damping import Damping
-from solvers.resolution import Resolution
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.resolution import Resolution
 
 Array = npt.NDArray[np.float64]
 

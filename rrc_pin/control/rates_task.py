@@ -6,8 +6,8 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.kinematics import Kinematics
+from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks import Task
-from solvers.problem import TaskRows
 
 Array = npt.NDArray[np.float64]
 

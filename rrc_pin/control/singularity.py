@@ -11,7 +11,7 @@ import numpy.typing as npt
 
 from rrc_pin.control.strategies.barker_arm import nearness
 from rrc_pin.robot import Robot
-from solvers.closed_form.barker import BarkerClosedForm
+from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
 
 Array = npt.NDArray[np.float64]
 AXES = ("vx", "vy", "vz", "wx", "wy", "wz")

@@ -11,7 +11,7 @@ import numpy.typing as npt
 from rrc_pin.dynamics.state import Reference, State
 from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
-from solvers.validation import as_vector, finite_number, real_array
+from rrc_pin.solvers.checks import as_vector, finite_number, real_array
 
 Array = npt.NDArray[np.float64]
 

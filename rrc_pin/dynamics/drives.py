@@ -16,7 +16,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from solvers.validation import as_array
+from rrc_pin.solvers.checks import as_array
 
 _PUMA_JM = np.array([200e-6, 200e-6, 200e-6, 33e-6, 33e-6, 33e-6])  # [kg m^2]
 _PUMA_G = np.array([-62.6111, 107.815, -53.7063, 76.0364, 71.923, 76.686])

@@ -8,7 +8,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from solvers.validation import as_vector, finite_number
+from rrc_pin.solvers.checks import as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
 

@@ -14,7 +14,7 @@ from rrc_pin.dynamics.pose_error import pose_error
 from rrc_pin.dynamics.reference import JointTrajectory
 from rrc_pin.dynamics.simulator import Simulator
 from rrc_pin.errors import InvalidInput
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
 
 Array = npt.NDArray[np.float64]
 Event = tuple[float, Callable[[Simulator], None]]

@@ -34,7 +34,7 @@ from rrc_pin.dynamics.pose_error import pose_error
 from rrc_pin.dynamics.state import Reference, State
 from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
-from solvers.validation import as_array, real_array
+from rrc_pin.solvers.checks import as_array, real_array
 
 
 class HybridForcePosition(Controller):

@@ -1,7 +1,7 @@
 """Cartesian error of a tool pose: position difference and the quaternion orientation error.
 
 The orientation error is Nguyen & Zhou's eqs. (32)-(37), computed by
-:mod:`solvers.closed_form.quaternion` (not rewritten here): the quaternion of ``R_d R^T``
+:mod:`rrc_pin.solvers.closed_form.quaternion` (not rewritten here): the quaternion of ``R_d R^T``
 from those of ``R`` and ``R_d`` (eqs. (32)-(34)), and the differential rotation
 ``2 delta s`` (eq. (37)), in base axes.
 """
@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form.quaternion import (
+from rrc_pin.solvers.closed_form.quaternion import (
     differential_rotation,
     quaternion_difference,
     quaternion_from_matrix,

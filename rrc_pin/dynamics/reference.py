@@ -21,7 +21,7 @@ from rrc_pin.dynamics.state import Reference
 from rrc_pin.errors import InvalidInput
 from rrc_pin.resolver import Resolver
 from rrc_pin.robot import Robot
-from solvers.validation import as_array, as_vector, finite_number
+from rrc_pin.solvers.checks import as_array, as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
 

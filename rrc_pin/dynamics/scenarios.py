@@ -46,7 +46,7 @@ from rrc_pin.dynamics.simulator import Simulator
 from rrc_pin.errors import InvalidInput
 from rrc_pin.models.inertia import LinkInertial, make
 from rrc_pin.robot import Robot
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
 
 Array = npt.NDArray[np.float64]
 SCENARIOS = ("tracking", "force")

@@ -30,7 +30,7 @@ from rrc_pin.dynamics.state import State
 from rrc_pin.errors import InvalidInput
 from rrc_pin.models.inertia import LinkInertial
 from rrc_pin.robot import Robot
-from solvers.validation import as_vector, finite_number
+from rrc_pin.solvers.checks import as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
 RATE = 1000.0

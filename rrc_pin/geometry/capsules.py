@@ -16,7 +16,8 @@ same axis, radius and length, with a half-sphere of its radius added at each end
 (baxter's fingers) the capsule along its longest side, of radius the half-diagonal of its
 cross-section. The capsule holds the shape, so distances to it are conservative (shorter by
 at most its radius), and every link gets the compiled capsule formulas and their end-point
-rows (:mod:`solvers.narrow_kernels`) instead of coal's GJK without them: a box's or
+rows (:mod:`rrc_pin.solvers.collision.narrow_kernels`) instead of coal's GJK without them: a box's
+or
 cylinder's closest point jumps across a face in one step where a capsule's end is already
 constrained (baxter's 10-minute session went 3.5 mm below the safety distance on cylinders,
 docs/api.md).

@@ -36,7 +36,7 @@ from rrc_pin.geometry.tree import tree_of
 from rrc_pin.geometry.walls import Wall, box_walls, plane_wall
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.robot import Robot, frame_index
-from solvers.validation import as_array, finite_number, rigid_transform
+from rrc_pin.solvers.checks import as_array, finite_number, rigid_transform
 
 Array = npt.NDArray[np.float64]
 
@@ -320,7 +320,8 @@ class CollisionModel:
             data: This caller's :meth:`create_data`.
             detection: Detection distance [m], >= 0.
             ends: Also a row for each capsule end point within ``detection`` of the other
-                body (:mod:`solvers.narrow_kernels`): what :class:`CollisionLimit` constrains.
+                body (:mod:`rrc_pin.solvers.collision.narrow_kernels`): what
+                :class:`CollisionLimit` constrains.
             select: Gives, from the scene the query reads, the pairs to answer for ((npairs,)
                 mask over its pairs); None: every pair.
 

@@ -5,11 +5,13 @@ The steps, in the order data flows:
 1. the joint placements of the tick, from q by the compiled forward kinematics of
    :mod:`~rrc_pin.geometry.tree` (or read from Pinocchio's ``data.oMi`` for a model it does
    not cover);
-2. the broad phase (:mod:`solvers.proximity_kernels`, compiled): bounding-sphere centres in
+2. the broad phase (:mod:`rrc_pin.solvers.collision.proximity_kernels`, compiled): bounding-sphere
+centres in
    the world, and the pairs whose distance bound is below the detection distance;
 3. the narrow phase for those candidates only, keeping those below the detection distance:
    pairs of spheres, capsules and half-spaces in one compiled pass
-   (:mod:`solvers.narrow_kernels`, also the capsules' end-point rows when asked), the others
+   (:mod:`rrc_pin.solvers.collision.narrow_kernels`, also the capsules' end-point rows when asked),
+   the others
    (boxes, cylinders, hulls, meshes) by coal: ``pinocchio.updateGeometryPlacements``, then
    ``pinocchio.computeDistance`` per pair (signed distance, EPA in penetration).
 
@@ -31,8 +33,8 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.geometry.scene import Scene
-from solvers.narrow_kernels import BOX, CAPSULE, SPHERE, narrow_phase
-from solvers.proximity_kernels import joint_poses, near_pairs, world_centres
+from rrc_pin.solvers.collision.narrow_kernels import BOX, CAPSULE, SPHERE, narrow_phase
+from rrc_pin.solvers.collision.proximity_kernels import joint_poses, near_pairs, world_centres
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
@@ -98,7 +100,8 @@ class CollisionData:
         npairs = len(scene.first)
         self.candidates = np.zeros(npairs, dtype=np.int64)
         self.other = np.zeros(npairs, dtype=np.int64)
-        rows = ROWS * npairs  # a pair's row and its end points' (solvers.narrow_kernels)
+        # a pair's row and its end points' (rrc_pin.solvers.collision.narrow_kernels)
+        rows = ROWS * npairs
         self.pair = np.zeros(rows, dtype=np.int64)
         self.distance = np.zeros(rows)
         self.point_a = np.zeros((rows, 3))
@@ -120,7 +123,8 @@ def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Dat
             (called only when a pair is near: the narrow phase reads it).
         cdata: The caller's :class:`CollisionData` (refreshed if older than ``scene``).
         detection: Detection distance [m]: pairs with a signed distance below it are rows.
-        ends: Also the rows of the capsules' end points (:mod:`solvers.narrow_kernels`): a
+        ends: Also the rows of the capsules' end points
+        (:mod:`rrc_pin.solvers.collision.narrow_kernels`): a
             pair may then have several rows, its first its closest points.
         select: Gives the pairs of ``scene`` to answer for ((npairs,) mask), or None: all.
     """

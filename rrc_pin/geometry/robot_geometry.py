@@ -35,7 +35,7 @@ from typing import Literal, NamedTuple
 
 import pinocchio as pin
 
-from rrc_pin.combine import Combined
+from rrc_pin.combined import Combined
 from rrc_pin.errors import InvalidInput, URDFError
 from rrc_pin.geometry.capsules import to_capsules
 from rrc_pin.geometry.hulls import with_hulls

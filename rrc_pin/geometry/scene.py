@@ -23,7 +23,7 @@ import pinocchio as pin
 from rrc_pin.geometry.pairs import Pair, Reason
 from rrc_pin.geometry.shapes import bounding_sphere
 from rrc_pin.geometry.tree import KinematicTree
-from solvers.narrow_kernels import BOX, CAPSULE, HALFSPACE, OTHER, SPHERE
+from rrc_pin.solvers.collision.narrow_kernels import BOX, CAPSULE, HALFSPACE, OTHER, SPHERE
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
@@ -65,7 +65,7 @@ class Scene:
         normal: Unit normals (ng, 3) of the half-spaces (zero rows for other bodies).
         offset: Offsets (ng,) [m] of the half-spaces.
         shape: Each body's shape for the compiled narrow phase (ng,): a code of
-            :mod:`solvers.narrow_kernels` (``OTHER``: coal measures its pairs).
+            :mod:`rrc_pin.solvers.collision.narrow_kernels` (``OTHER``: coal measures its pairs).
         segment: Each sphere's or capsule's segment end points (ng, 2, 3) in its joint's
             frame [m] (a sphere: its centre twice; zeros for other bodies).
         size: Sphere and capsule radii (ng,) [m] (zero for other bodies).

@@ -23,7 +23,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from solvers.validation import as_array, as_vector, finite_number, positive
+from rrc_pin.solvers.checks import as_array, as_vector, finite_number, positive
 
 Array = npt.NDArray[np.float64]
 Kind = Literal["box", "sphere", "capsule", "cylinder", "convex", "halfspace"]

@@ -2,7 +2,8 @@
 
 The broad phase needs every joint's placement at the tick. Reading them out of Pinocchio's
 ``data.oMi`` costs about 1 us a joint in Python (7.7 us for panda's 8, 2-core EPYC under
-load), more than the broad phase itself; :func:`solvers.proximity_kernels.joint_poses` computes
+load), more than the broad phase itself;
+:func:`rrc_pin.solvers.collision.proximity_kernels.joint_poses` computes
 them from q in about 1 us for the whole tree (two pandas included). It is a second forward
 kinematics, used only to place the bounding spheres: the narrow phase reads Pinocchio's own
 placements, and :func:`tree_of` checks the kernel against Pinocchio (1e-9 m) before it is used.
@@ -21,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from solvers.proximity_kernels import PRISMATIC, REVOLUTE, joint_poses
+from rrc_pin.solvers.collision.proximity_kernels import PRISMATIC, REVOLUTE, joint_poses
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
@@ -37,8 +38,8 @@ class KinematicTree(NamedTuple):
         parent: Parent joint (nj,).
         rotation: Joint placement rotations (nj, 3, 3) in the parent joint's frame.
         translation: Joint placement translations (nj, 3) [m].
-        kind: :data:`~solvers.proximity_kernels.REVOLUTE` or
-            :data:`~solvers.proximity_kernels.PRISMATIC`.
+        kind: :data:`~rrc_pin.solvers.collision.proximity_kernels.REVOLUTE` or
+            :data:`~rrc_pin.solvers.collision.proximity_kernels.PRISMATIC`.
         axis: Unit axes (nj, 3) in the joint's frame.
         coordinate: The coordinate of q (one per joint, the API's) that moves the joint.
     """

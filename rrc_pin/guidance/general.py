@@ -19,7 +19,7 @@ from rrc_pin.guidance.stepping import (
     run_steps,
     unit_axis,
 )
-from solvers.validation import finite_number, rigid_transform
+from rrc_pin.solvers.checks import finite_number, rigid_transform
 
 
 def general(

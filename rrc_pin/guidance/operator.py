@@ -30,7 +30,7 @@ from rrc_pin.guidance.stepping import (
     screw_step,
     unit_axis,
 )
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
 
 Frame = Literal["global", "hand"]
 

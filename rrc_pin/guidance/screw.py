@@ -27,7 +27,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
-from solvers.validation import real_array
+from rrc_pin.solvers.checks import real_array
 
 Array = npt.NDArray[np.float64]
 

@@ -43,7 +43,7 @@ from rrc_pin.guidance.stepping import (
     on_frame,
     run_steps,
 )
-from solvers.validation import rigid_transform
+from rrc_pin.solvers.checks import rigid_transform
 
 BForm = Literal["twist", "disp"]
 

@@ -34,8 +34,8 @@ import pinocchio as pin
 from rrc_pin.errors import InvalidInput
 from rrc_pin.resolver import Resolver
 from rrc_pin.robot import Robot
+from rrc_pin.solvers.checks import as_vector, finite_number
 from rrc_pin.tasks import FrameTask
-from solvers.validation import as_vector, finite_number
 
 Array = npt.NDArray[np.float64]
 Correction = Literal["none", "eq5_5", "newton"]

@@ -45,7 +45,7 @@ from rrc_pin.guidance.stepping import (
     on_frame,
     run_steps,
 )
-from solvers.validation import finite_number, rigid_transform
+from rrc_pin.solvers.checks import finite_number, rigid_transform
 
 Substeps = Union[int, Callable[[Screw], int]]  # noqa: UP007 (a runtime alias on 3.10)
 """Steps per division: a number, or a rule from the division's screw (from the hand reached)."""

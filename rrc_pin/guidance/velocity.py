@@ -7,7 +7,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.guidance.stepping import Array
-from solvers.validation import as_array, finite_number
+from rrc_pin.solvers.checks import as_array, finite_number
 
 
 def joint_rates(increments: npt.ArrayLike, hand_step: float, hand_speed: float) -> Array:

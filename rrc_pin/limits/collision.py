@@ -1,8 +1,10 @@
 r"""CollisionLimit: every pair of bodies kept apart, and tool frames inside their walls.
 
 One velocity-damper row per pair closer than the detection distance (Kanehiro et al. 2008,
-:mod:`solvers.damper_kernels`), and one per capsule end point within it of the other body
-(:mod:`solvers.narrow_kernels`: near-parallel capsules' closest points jump from end to end,
+:mod:`rrc_pin.solvers.collision.damper_kernels`), and one per capsule end point within it of the
+other body
+(:mod:`rrc_pin.solvers.collision.narrow_kernels`: near-parallel capsules' closest points jump from
+end to end,
 and the end about to become the closest is then already constrained; an end-point row
 may lose :data:`END` of its margin a step, a pair's own row the damper's share):
 
@@ -26,9 +28,10 @@ the same row for its frame's origin :math:`p` at distance :math:`o - n^T p` from
 with the wall itself as the safety distance (``d_s = 0``): :math:`n^T J_p \dot q \le
 \xi (o - n^T p) / d_i`.
 
-Every row is marked ``slide`` (:class:`~solvers.problem.Constraints`): the resolver's
+Every row is marked ``slide`` (:class:`~rrc_pin.solvers.tick.problem.Constraints`): the resolver's
 direction-preserving top level loses only the command's component into a pair, and slides
-along it (:mod:`solvers.pipeline`, ``sliding``). Rows are named ``"body_a|body_b"`` (walls
+along it (:mod:`rrc_pin.solvers.tick.pipeline`, ``sliding``). Rows are named ``"body_a|body_b"``
+(walls
 ``"frame|wall"``) and carry their distance, so ``Resolution.active_rows`` names the pairs
 that bound the answer and how close they are.
 """
@@ -45,9 +48,9 @@ from rrc_pin.errors import InvalidInput
 from rrc_pin.geometry import CollisionModel, Wall
 from rrc_pin.geometry.proximity import gather
 from rrc_pin.limits.limit import Limit
-from solvers.damper_kernels import damper_rows
-from solvers.problem import Constraints
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.collision.damper_kernels import damper_rows
+from rrc_pin.solvers.tick.problem import Constraints
 
 if TYPE_CHECKING:
     from rrc_pin.geometry.proximity import Proximity
@@ -67,7 +70,7 @@ GAIN = 0.5
 
 RECOVERY = 0.5
 """Fraction of a shortfall below the safety distance restored per step (at most at the gain):
-:mod:`solvers.damper_kernels`."""
+:mod:`rrc_pin.solvers.collision.damper_kernels`."""
 
 END = 0.5
 """Fraction of its margin above d_s an end-point row may lose in one step (its xi is

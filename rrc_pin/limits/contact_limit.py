@@ -10,7 +10,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits.limit import Limit
-from solvers.problem import Constraints
+from rrc_pin.solvers.tick.problem import Constraints
 
 if TYPE_CHECKING:
     from rrc_pin.kinematics import Kinematics, Layout

@@ -11,8 +11,8 @@ import numpy.typing as npt
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits.contact_limit import AXES
 from rrc_pin.limits.limit import Limit
+from rrc_pin.solvers.tick.problem import Constraints
 from rrc_pin.tasks.relative_frame_task import RelativeFrameTask
-from solvers.problem import Constraints
 
 if TYPE_CHECKING:
     from rrc_pin.kinematics import Kinematics, Layout

@@ -10,9 +10,9 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits.limit import Limit
-from solvers import kernels
-from solvers.problem import Box, Constraints
-from solvers.validation import as_vector, finite_number, real_array
+from rrc_pin.solvers.checks import as_vector, finite_number, real_array
+from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.problem import Box, Constraints
 
 if TYPE_CHECKING:
     from rrc_pin.kinematics import Kinematics, Layout
@@ -22,7 +22,7 @@ Array = npt.NDArray[np.float64]
 
 @dataclass(frozen=True)
 class JointLimits(Limit):
-    """The joint limits a resolver keeps: the box of :func:`solvers.kernels.joint_box`.
+    """The joint limits a resolver keeps: the box of :func:`rrc_pin.solvers.tick.kernels.joint_box`.
 
     Every step keeps the velocity limits and the position limits over the step exactly (in
     floating point); a start outside the position limits only moves back (``recovering``).
@@ -113,7 +113,7 @@ class JointLimits(Limit):
             )  # fmt: skip
 
     def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
-        """The step's box (:func:`solvers.kernels.joint_box`)."""
+        """The step's box (:func:`rrc_pin.solvers.tick.kernels.joint_box`)."""
         layout = kin.layout
         n = layout.nv
         velocity: Array = layout.velocity if self.velocity is None else np.asarray(self.velocity)

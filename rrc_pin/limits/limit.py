@@ -1,6 +1,6 @@
 """What every limit is: the constraints it puts on one tick's joint rates (pink's pattern).
 
-A limit gives, at each tick, a :class:`~solvers.problem.Constraints`: a box
+A limit gives, at each tick, a :class:`~rrc_pin.solvers.tick.problem.Constraints`: a box
 ``lb <= qdot <= ub``, inequality rows ``G qdot <= h`` and equality rows ``C qdot = d``, each
 row named for the report. The resolver merges every limit's constraints into one problem
 (the boxes intersected, the rows stacked) and keeps them all at every answer: exactly for the
@@ -26,7 +26,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
-from solvers.problem import Constraints
+from rrc_pin.solvers.tick.problem import Constraints
 
 if TYPE_CHECKING:
     from rrc_pin.kinematics import Kinematics, Layout

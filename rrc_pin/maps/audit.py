@@ -33,7 +33,7 @@ from rrc_pin.errors import InvalidInput
 from rrc_pin.maps.capability_map import CapabilityMap
 from rrc_pin.resolver import Resolver
 from rrc_pin.robot import Robot
-from solvers.map_kinematics import task_rows
+from rrc_pin.solvers.maps.kinematics import task_rows
 
 Array = npt.NDArray[np.float64]
 

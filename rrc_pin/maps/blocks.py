@@ -30,7 +30,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import ForeignMap
 from rrc_pin.maps.voxels import VoxelStats
-from solvers.map_batch import Fields, Sparse
+from rrc_pin.solvers.maps.batch import Fields, Sparse
 
 FORMAT = 1
 """Version of the folder's layout."""

@@ -31,10 +31,10 @@ from rrc_pin.maps.kinematics import arm_kinematics
 from rrc_pin.maps.progress import Progress, ProgressBar
 from rrc_pin.maps.voxels import MAX_SAMPLES, Grid, chain_grid, quanta
 from rrc_pin.robot import Robot
-from solvers.map_batch import MAX_KEYS, Chain, Fields
-from solvers.map_kinematics import ArmKinematics
-from solvers.map_sampling import BLOCK, Plan
-from solvers.map_work import Job
+from rrc_pin.solvers.maps.batch import MAX_KEYS, Chain, Fields
+from rrc_pin.solvers.maps.kinematics import ArmKinematics
+from rrc_pin.solvers.maps.sampling import BLOCK, Plan
+from rrc_pin.solvers.maps.work import Job
 
 ProgressArg = bool | Callable[[Progress], None]
 """``progress``: True (a text bar on stderr), False (none) or a callable given each update."""

@@ -15,8 +15,8 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.maps.voxels import Grid, VoxelStats
-from solvers.map_batch import BINS, NONE, Chain
-from solvers.map_sampling import Plan, sample_at
+from rrc_pin.solvers.maps.batch import BINS, NONE, Chain
+from rrc_pin.solvers.maps.sampling import Plan, sample_at
 
 Array = npt.NDArray[np.float64]
 

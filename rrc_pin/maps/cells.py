@@ -33,7 +33,7 @@ from rrc_pin.maps.capability_map import CapabilityMap
 from rrc_pin.maps.kinematics import chain_of
 from rrc_pin.maps.voxels import Grid, chain_grid
 from rrc_pin.robot import Robot
-from solvers.map_sampling import BLOCK
+from rrc_pin.solvers.maps.sampling import BLOCK
 
 Array = npt.NDArray[np.float64]
 

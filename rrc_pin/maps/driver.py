@@ -9,7 +9,7 @@
   draws its blocks' samples, evaluates them and accumulates them into a hash table of voxels
   on the worker, and ships only the voxels it reached (a sparse result). At most two tasks
   per worker thread are in flight, so the results waiting on the driver stay bounded too.
-- **Memory per worker thread**, whatever the samples (:mod:`solvers.map_work`): one
+- **Memory per worker thread**, whatever the samples (:mod:`rrc_pin.solvers.maps.work`): one
   block's samples and rows (``block_size x (8 n + 88)`` bytes, 2.6 MB for panda's 2^15)
   plus the task's voxel table, at most ``4 x 72`` bytes (120 for barker6) per distinct voxel
   of the task, itself at most ``min(voxels of the grid, samples of the task)``: with the
@@ -34,7 +34,7 @@ from rrc_pin.errors import InvalidInput, MissingExtra, SchedulerUnreachable
 from rrc_pin.maps.blocks import BlockStore
 from rrc_pin.maps.progress import Progress
 from rrc_pin.maps.voxels import VoxelStats
-from solvers.map_work import Job, TaskResult, compute_blocks
+from rrc_pin.solvers.maps.work import Job, TaskResult, compute_blocks
 
 CONNECT_TIMEOUT = 3.0
 """[s] How long to wait for a scheduler at an address."""

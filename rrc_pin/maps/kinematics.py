@@ -1,10 +1,10 @@
 """An arm's batch kinematics for a map: its serial chain read off the Pinocchio model.
 
-:func:`chain_of` builds the :class:`~solvers.map_batch.Chain` of a tool frame from the
+:func:`chain_of` builds the :class:`~rrc_pin.solvers.maps.batch.Chain` of a tool frame from the
 model's joint placements and axes; :func:`arm_kinematics` picks the evaluator
-(:mod:`solvers.map_kinematics`): Barker's batch closed form for ``barker6``, the compiled
+(:mod:`rrc_pin.solvers.maps.kinematics`): Barker's batch closed form for ``barker6``, the compiled
 chain for every other arm. The task rows are those of the resolver's default task
-(:func:`~solvers.map_kinematics.task_rows`).
+(:func:`~rrc_pin.solvers.maps.kinematics.task_rows`).
 """
 
 from __future__ import annotations
@@ -17,9 +17,14 @@ import pinocchio as pin
 
 from rrc_pin.errors import FrameNotFound, InvalidInput, ToolFrameRequired
 from rrc_pin.robot import Robot, frame_index
-from solvers.closed_form.barker import BarkerClosedForm
-from solvers.map_batch import PRISMATIC, REVOLUTE, Chain
-from solvers.map_kinematics import ArmKinematics, BarkerKinematics, ChainKinematics, task_rows
+from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
+from rrc_pin.solvers.maps.batch import PRISMATIC, REVOLUTE, Chain
+from rrc_pin.solvers.maps.kinematics import (
+    ArmKinematics,
+    BarkerKinematics,
+    ChainKinematics,
+    task_rows,
+)
 
 Array = npt.NDArray[np.float64]
 

@@ -27,10 +27,10 @@ from rrc_pin.maps.capability_map import CapabilityMap, popcount
 from rrc_pin.maps.kinematics import chain_of, placed
 from rrc_pin.maps.voxels import Grid, quanta
 from rrc_pin.robot import Robot
-from solvers.map_batch import BINS, Fields
-from solvers.map_kinematics import ChainKinematics, task_rows
-from solvers.map_sampling import BLOCK, Plan
-from solvers.map_work import Job, compute_blocks
+from rrc_pin.solvers.maps.batch import BINS, Fields
+from rrc_pin.solvers.maps.kinematics import ChainKinematics, task_rows
+from rrc_pin.solvers.maps.sampling import BLOCK, Plan
+from rrc_pin.solvers.maps.work import Job, compute_blocks
 
 Array = npt.NDArray[np.float64]
 

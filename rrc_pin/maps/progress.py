@@ -6,7 +6,7 @@ import sys
 import time
 from typing import TextIO
 
-from solvers.map_sampling import Plan
+from rrc_pin.solvers.maps.sampling import Plan
 
 
 class Progress:

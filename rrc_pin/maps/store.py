@@ -22,7 +22,7 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput, MissingExtra
 from rrc_pin.maps.capability_map import CapabilityMap
 from rrc_pin.maps.voxels import Grid, VoxelStats
-from solvers.map_batch import Chain, Fields
+from rrc_pin.solvers.maps.batch import Chain, Fields
 
 LAYOUT = 1
 """Version of the store's layout (attribute ``rrc_pin_map``)."""

@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from solvers.map_batch import MAX_KEYS, NONE, Chain, Fields, GridArrays, Sparse
+from rrc_pin.solvers.maps.batch import MAX_KEYS, NONE, Chain, Fields, GridArrays, Sparse
 
 Array = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]

@@ -11,10 +11,10 @@ import numpy as np
 from rrc_pin.dh import DHChain
 from rrc_pin.errors import InvalidInput
 from rrc_pin.models.inertia import LinkInertial
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
 
 if TYPE_CHECKING:
-    from solvers.closed_form.base import ClosedForm
+    from rrc_pin.solvers.closed_form.base import ClosedForm
 
 INCH = 0.0254
 """Metres per inch: the one place where the papers' inches become SI."""

@@ -20,7 +20,7 @@ from rrc_pin.models.arm_spec import ArmSpec, check_parameters
 from rrc_pin.models.puma560_inertia import barker_inertials
 
 if TYPE_CHECKING:
-    from solvers.closed_form.base import ClosedForm
+    from rrc_pin.solvers.closed_form.base import ClosedForm
 
 NAME = "barker6"
 JOINT_LIMITS_DEG = (160.0, 165.0, 135.0, 135.0, 105.0, 270.0)  # Barker's table, +-
@@ -109,7 +109,7 @@ def build(
         )
 
     def closed_form() -> ClosedForm:
-        from solvers.closed_form.barker import BarkerClosedForm
+        from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
 
         return BarkerClosedForm(no=no, es=es, sn=sn, we=we, a3=a3, r3=r3, alpha3=alpha3)
 

@@ -14,7 +14,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from solvers.validation import as_array, finite_number
+from rrc_pin.solvers.checks import as_array, finite_number
 
 TRIANGLE_TOL = 1e-12
 """Slack [kg m^2] of the triangle inequality on the principal moments (rounding only)."""

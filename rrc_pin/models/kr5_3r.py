@@ -14,7 +14,7 @@ from rrc_pin.dh import DHChain, DHRow
 from rrc_pin.models.arm_spec import ArmSpec, check_parameters
 
 if TYPE_CHECKING:
-    from solvers.closed_form.base import ClosedForm
+    from rrc_pin.solvers.closed_form.base import ClosedForm
 
 NAME = "kr5_3r"
 
@@ -34,7 +34,7 @@ def build(a1: float = 0.2, a2: float = 0.5, a3: float = 0.5, name: str = NAME) -
     limits = np.deg2rad((170.0, 135.0, 150.0))
 
     def closed_form() -> ClosedForm:
-        from solvers.closed_form.three_r import ThreeRClosedForm
+        from rrc_pin.solvers.closed_form.three_r import ThreeRClosedForm
 
         return ThreeRClosedForm(a1=a1, a2=a2, a3=a3)
 

@@ -16,7 +16,7 @@ import numpy.typing as npt
 from rrc_pin.dh import DHChain, DHRow, JointKind, pose, rot_z, translation
 from rrc_pin.errors import InvalidInput
 from rrc_pin.models.arm_spec import INCH
-from solvers.validation import as_array
+from rrc_pin.solvers.checks import as_array
 
 Row = tuple[float, float, float, float, JointKind | None]
 

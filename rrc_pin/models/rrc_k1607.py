@@ -18,7 +18,7 @@ from rrc_pin.models.arm_spec import INCH, ArmSpec
 from rrc_pin.models.inertia import LinkInertial, cylinder
 
 if TYPE_CHECKING:
-    from solvers.closed_form.base import ClosedForm
+    from rrc_pin.solvers.closed_form.base import ClosedForm
 
 NAME = "rrc_k1607"
 # Nguyen Table 1: alpha_{i-1} [deg], a_{i-1} [in], d_i [in]
@@ -61,7 +61,7 @@ def build(name: str = NAME) -> ArmSpec:
     limits = np.deg2rad(LIMITS_DEG)
 
     def closed_form() -> ClosedForm:
-        from solvers.closed_form.rrc_k1607 import RrcK1607ClosedForm
+        from rrc_pin.solvers.closed_form.rrc_k1607 import RrcK1607ClosedForm
 
         return RrcK1607ClosedForm(a=tuple(row.a for row in rows), d=tuple(row.d for row in rows))
 

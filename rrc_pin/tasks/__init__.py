@@ -1,12 +1,12 @@
 """Tasks of a resolution, one per module: each gives Jacobian rows and desired rates."""
 
+from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.damping_task import DampingTask
 from rrc_pin.tasks.frame_task import FrameTask
 from rrc_pin.tasks.joint_task import JointTask
 from rrc_pin.tasks.posture_task import PostureTask
 from rrc_pin.tasks.relative_frame_task import RelativeFrameTask
 from rrc_pin.tasks.task import Task
-from solvers.problem import TaskRows
 
 __all__ = [
     "DampingTask",

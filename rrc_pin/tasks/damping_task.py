@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from rrc_pin.kinematics import Kinematics
+from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.task import Task, check_weight, identity, task_name
-from solvers.problem import TaskRows
 
 
 class DampingTask(Task):

@@ -10,10 +10,10 @@ import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics
+from rrc_pin.solvers.checks import as_vector, positive, rigid_transform
+from rrc_pin.solvers.spatial import Reference, check_reference
+from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.task import Task, check_weight, task_name
-from solvers.problem import TaskRows
-from solvers.spatial import Reference, check_reference
-from solvers.validation import as_vector, positive, rigid_transform
 
 Array = npt.NDArray[np.float64]
 

@@ -6,9 +6,9 @@ import numpy as np
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
+from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.task import Task, check_weight, task_name
-from solvers.problem import TaskRows
-from solvers.validation import finite_number
 
 
 class JointTask(Task):

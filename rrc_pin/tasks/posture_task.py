@@ -7,9 +7,9 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
+from rrc_pin.solvers.checks import as_vector, positive
+from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.task import Task, check_weight, identity, task_name
-from solvers.problem import TaskRows
-from solvers.validation import as_vector, positive
 
 Array = npt.NDArray[np.float64]
 

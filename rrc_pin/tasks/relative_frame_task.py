@@ -10,10 +10,10 @@ import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics
+from rrc_pin.solvers.checks import positive, rigid_transform
+from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.frame_task import FrameTask
 from rrc_pin.tasks.task import Task
-from solvers.problem import TaskRows
-from solvers.validation import positive, rigid_transform
 
 Array = npt.NDArray[np.float64]
 

@@ -10,8 +10,8 @@ import numpy.typing as npt
 
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
-from solvers.problem import TaskRows
-from solvers.validation import as_vector, finite_number
+from rrc_pin.solvers.checks import as_vector, finite_number
+from rrc_pin.solvers.tick.problem import TaskRows
 
 Array = npt.NDArray[np.float64]
 

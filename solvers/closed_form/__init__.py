@@ -11,9 +11,9 @@
 Every closed form implements :class:`ClosedForm`.
 """
 
-from solvers.closed_form.barker import BarkerClosedForm, BarkerSingularity
-from solvers.closed_form.base import ClosedForm
-from solvers.closed_form.quaternion import (
+from rrc_pin.solvers.closed_form.barker import BarkerClosedForm, BarkerSingularity
+from rrc_pin.solvers.closed_form.base import ClosedForm
+from rrc_pin.solvers.closed_form.quaternion import (
     differential_rotation,
     matrix_from_quaternion,
     quaternion_difference,
@@ -21,9 +21,9 @@ from solvers.closed_form.quaternion import (
     rotation_vector,
     small_rotation,
 )
-from solvers.closed_form.rrc_k1607 import RrcK1607ClosedForm
-from solvers.closed_form.three_r import AngularRates, ThreeRClosedForm, minimum_norm_shift
-from solvers.closed_form.weighted import (
+from rrc_pin.solvers.closed_form.rrc_k1607 import RrcK1607ClosedForm
+from rrc_pin.solvers.closed_form.three_r import AngularRates, ThreeRClosedForm, minimum_norm_shift
+from rrc_pin.solvers.closed_form.weighted import (
     null_space_projector,
     weight_factor,
     weighted_pseudo_inverse,

@@ -1,7 +1,7 @@
 r"""Barker's closed-form resolved-rate equations (NASA TM-85685, 1983) for his PUMA-type arm.
 
 The closed form :class:`BarkerClosedForm`; its equations are in
-:mod:`solvers.closed_form.barker_equations`.
+:mod:`rrc_pin.solvers.closed_form.barker_equations`.
 
 Paths (``method``): ``"full"`` (default), eqs (34)-(36) for the arm and (49)-(51) for the
 wrist; ``"reduced"``, eq. (39) + eq. (44) with the 2x2 M1 for the arm (eqs (40)-(43)
@@ -41,11 +41,11 @@ from typing import Any, Literal, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form import barker_equations as eqs
-from solvers.closed_form.barker_equations import BarkerGeometry, FTerms
-from solvers.closed_form.base import Array, ClosedForm, first, row, vector
-from solvers.errors import InvalidInput
-from solvers.validation import as_array, as_vector, finite_number
+from rrc_pin.solvers.checks import as_array, as_vector, finite_number
+from rrc_pin.solvers.closed_form import barker_equations as eqs
+from rrc_pin.solvers.closed_form.barker_equations import BarkerGeometry, FTerms
+from rrc_pin.solvers.closed_form.base import Array, ClosedForm, first, row, vector
+from rrc_pin.solvers.errors import InvalidInput
 
 Method = Literal["full", "reduced"]
 METHODS: tuple[str, ...] = ("full", "reduced")
@@ -82,7 +82,7 @@ class BarkerClosedForm(ClosedForm):
     :meth:`hand_twist_to_base` (eq. (20)).
 
     Every method is one call of a compiled kernel of
-    :mod:`~solvers.closed_form.barker_equations`; a ``_batch`` method loops over its rows
+    :mod:`~rrc_pin.solvers.closed_form.barker_equations`; a ``_batch`` method loops over its rows
     inside the kernel, and the other methods of one configuration are a batch of one, except
     :meth:`jacobian` and :meth:`joint_rates`, which call their kernel directly.
 

@@ -8,9 +8,10 @@ is block lower-triangular (eq. (22)): the arm rates solve ``M thetadot_123 = TVE
 report: ``S1 = sin(theta_1)``, ``C23 = cos(theta_2 + theta_3)``, ``SAL3 = sin(alpha_3)``,
 ``SN~ = SN + R3`` (the OCR'd report drops the tilde).
 
-Each equation is one small kernel (:func:`~solvers.kernels.kernel`: ``numba.njit(cache=True)``)
+Each equation is one small kernel (:func:`~rrc_pin.solvers.tick.kernels.kernel`:
+``numba.njit(cache=True)``)
 on the floats of one configuration, cited once; corrections to the printed equations are
-cited as in docs/errata.md. The paths of :mod:`solvers.closed_form.barker` (the arm, the
+cited as in docs/errata.md. The paths of :mod:`rrc_pin.solvers.closed_form.barker` (the arm, the
 wrist, their bands) and the loops over N configurations are at the end: a batch is a
 compiled loop over the same kernels.
 
@@ -26,8 +27,8 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form.base import finite
-from solvers.kernels import jacobi_svd, kernel, svd_rates
+from rrc_pin.solvers.closed_form.base import finite
+from rrc_pin.solvers.tick.kernels import jacobi_svd, kernel, svd_rates
 
 Array = npt.NDArray[np.float64]
 Flags = npt.NDArray[np.bool_]
@@ -407,7 +408,8 @@ def band_solve(A: Array, b: Array, s2: float, eps: float, exact: bool, x: Array)
 
     ``s2`` the block's measure ``s^2 <= eps^2``. With ``exact``: the truncated pseudo-inverse,
     singular values ``<= eps`` dropped (M* of eq. (38), M1* of eq. (44), M2* of eq. (60)).
-    The SVD is one-sided Jacobi (:func:`~solvers.kernels.jacobi_svd`); ``A`` is overwritten.
+    The SVD is one-sided Jacobi (:func:`~rrc_pin.solvers.tick.kernels.jacobi_svd`); ``A`` is
+    overwritten.
     """
     m = b.size
     V = np.empty((m, m))

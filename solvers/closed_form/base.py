@@ -8,8 +8,8 @@ from abc import ABC, abstractmethod
 import numpy as np
 import numpy.typing as npt
 
-from solvers.kernels import kernel
-from solvers.validation import as_array, as_vector
+from rrc_pin.solvers.checks import as_array, as_vector
+from rrc_pin.solvers.tick.kernels import kernel
 
 Array = npt.NDArray[np.float64]
 _F64 = np.dtype(np.float64)
@@ -92,7 +92,7 @@ def vector(x: npt.ArrayLike, name: str, size: int) -> Array:
     """``x`` as a float64 vector for a kernel that checks its size and entries (:func:`finite`).
 
     A float64 vector passes as it is, anything else through
-    :func:`~solvers.validation.as_vector` (which raises :class:`InvalidInput` naming ``name``).
+    :func:`~rrc_pin.solvers.checks.as_vector` (which raises :class:`InvalidInput` naming ``name``).
     Where the kernel refuses it, the caller calls ``as_vector`` again to raise. The checks of
     the common case are one pass inside the kernel: ``BarkerClosedForm.jacobian`` takes about
     half the time it takes with ``as_vector`` first (2.0 against 3.8 us, measured).

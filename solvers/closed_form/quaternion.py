@@ -31,9 +31,9 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form.base import first
-from solvers.errors import InvalidInput
-from solvers.validation import as_array
+from rrc_pin.solvers.checks import as_array
+from rrc_pin.solvers.closed_form.base import first
+from rrc_pin.solvers.errors import InvalidInput
 
 Array = npt.NDArray[np.float64]
 ORTHONORMAL_TOL = 1e-6

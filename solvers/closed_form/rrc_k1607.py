@@ -2,7 +2,7 @@
 
 The arm of Nguyen Table 1 in Craig's modified DH (Nguyen eq. (2)), twists fixed at
 ``alpha_{i-1} = (0, -90, 90, -90, 90, -90, 90)`` deg. The hand frame is frame 7. The
-equations are compiled kernels of :mod:`solvers.closed_form.rrc_k1607_equations`:
+equations are compiled kernels of :mod:`rrc_pin.solvers.closed_form.rrc_k1607_equations`:
 
 - Forward kinematics: Nguyen eqs. (4)-(11), with the typos of eqs. (5), (8) and (9)
   corrected (docs/errata.md). Every ``a_{i-1}`` and ``d_i`` is honoured; for Table 1 (``a0
@@ -32,11 +32,11 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form import rrc_k1607_equations as eqs
-from solvers.closed_form.base import Array, ClosedForm, vector
-from solvers.closed_form.rrc_k1607_equations import NQ, TASK_DIM
-from solvers.closed_form.weighted import weight_factor
-from solvers.validation import as_array, as_vector, finite_number
+from rrc_pin.solvers.checks import as_array, as_vector, finite_number
+from rrc_pin.solvers.closed_form import rrc_k1607_equations as eqs
+from rrc_pin.solvers.closed_form.base import Array, ClosedForm, vector
+from rrc_pin.solvers.closed_form.rrc_k1607_equations import NQ, TASK_DIM
+from rrc_pin.solvers.closed_form.weighted import weight_factor
 
 ALPHA_DEG = (0.0, -90.0, 90.0, -90.0, 90.0, -90.0, 90.0)
 """Nguyen Table 1 twists alpha_{i-1} [deg]; the closed form is derived for these."""

@@ -2,7 +2,8 @@ r"""The equations of Nguyen & Zhou's closed forms for the RRC K-1607 (NAG 5-1124
 
 Craig's modified DH (Nguyen eq. (2)), twists fixed at ``alpha_{i-1} = (0, -90, 90, -90, 90,
 -90, 90)`` deg (Table 1); ``a`` holds ``a_0..a_6`` and ``d`` holds ``d_1..d_7`` [m]. Each
-equation is one small kernel (:func:`~solvers.kernels.kernel`) on one configuration, cited
+equation is one small kernel (:func:`~rrc_pin.solvers.tick.kernels.kernel`) on one configuration,
+cited
 once; the loops over N configurations at the end call the same kernels.
 
 - :func:`frame_axes`: the axes of the DH frames in base coordinates, Nguyen's auxiliaries of
@@ -24,8 +25,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form.base import finite
-from solvers.kernels import cholesky_solve, jacobi_svd, kernel, svd_rates
+from rrc_pin.solvers.closed_form.base import finite
+from rrc_pin.solvers.tick.kernels import cholesky_solve, jacobi_svd, kernel, svd_rates
 
 Array = npt.NDArray[np.float64]
 Vector3 = tuple[float, float, float]
@@ -134,7 +135,8 @@ def weighted_rates(
                = W J^T (J W J^T)^{-1} (\dot x - J z) + z
 
     (the same vector, one solve), with ``B = J L``: ``B B^T y = xdot - J z`` by Cholesky's
-    method (:func:`~solvers.kernels.cholesky_solve`), then ``qdot = L B^T y + z``. ``L``
+    method (:func:`~rrc_pin.solvers.tick.kernels.cholesky_solve`), then ``qdot = L B^T y + z``.
+    ``L``
     lower triangular, None for ``W = I``; ``z`` None for zero (eq. (23): the minimum-norm
     rates). Forming ``B B^T`` squares the condition number: accurate to about eps kappa(B)^2
     (1e-13 at kappa = 40, 1e-8 at kappa = 1e4).

@@ -26,7 +26,7 @@ O(rcond)), finite, never NaN.
 
 ``J_A`` has constant rank 2, null space ``span{(0, 1, -1)}`` (exam, step 5).
 
-The equations are compiled kernels of :mod:`solvers.closed_form.three_r_equations`; a batch
+The equations are compiled kernels of :mod:`rrc_pin.solvers.closed_form.three_r_equations`; a batch
 method loops over its rows inside the kernel.
 """
 
@@ -38,10 +38,10 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form import three_r_equations as eqs
-from solvers.closed_form.base import Array, ClosedForm, first, vector
-from solvers.errors import InvalidInput
-from solvers.validation import as_array, as_vector, finite_number
+from rrc_pin.solvers.checks import as_array, as_vector, finite_number
+from rrc_pin.solvers.closed_form import three_r_equations as eqs
+from rrc_pin.solvers.closed_form.base import Array, ClosedForm, first, vector
+from rrc_pin.solvers.errors import InvalidInput
 
 DEFAULT_RCOND = 1e-9
 """Relative threshold below which ``r`` or ``det M`` counts as singular (module docstring)."""

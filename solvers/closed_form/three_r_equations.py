@@ -2,9 +2,9 @@ r"""The equations of the 3R arm of the Robotics I exam (2012), as compiled kerne
 
 Standard DH (exam Table 1): ``alpha = (90, 0, 0)`` deg, ``a = (a1, a2, a3)``, ``d = 0``;
 ``p = (a1, a2, a3, a1 + a2 + a3)`` [m] holds the lengths and the reach. Each equation is one
-small kernel (:func:`~solvers.kernels.kernel`) on one configuration; the loops over N
+small kernel (:func:`~rrc_pin.solvers.tick.kernels.kernel`) on one configuration; the loops over N
 configurations at the end call the same kernels. The derivation of the inverse is in
-:mod:`solvers.closed_form.three_r`.
+:mod:`rrc_pin.solvers.closed_form.three_r`.
 """
 
 from __future__ import annotations
@@ -14,8 +14,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form.base import finite
-from solvers.kernels import kernel
+from rrc_pin.solvers.closed_form.base import finite
+from rrc_pin.solvers.tick.kernels import kernel
 
 Array = npt.NDArray[np.float64]
 Terms = tuple[float, float, float, float, float, float, float]

@@ -9,7 +9,8 @@ r"""Nguyen's weighted pseudo-inverse with null-space term (NAG 5-1124, eqs. (20)
 invertible, finite where it is not. Among the least-squares solutions of ``J qdot = xdot``
 it minimises ``(qdot - z)^T W^-1 (qdot - z)`` (Nguyen eq. (20)).
 
-These work for any Jacobian (m, n); :class:`~solvers.closed_form.rrc_k1607.RrcK1607ClosedForm`
+These work for any Jacobian (m, n);
+:class:`~rrc_pin.solvers.closed_form.rrc_k1607.RrcK1607ClosedForm`
 uses them (through :func:`pseudo_inverse`, on stacks) wherever its normal equations are not safe.
 """
 
@@ -18,10 +19,10 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from solvers.closed_form.base import Array
-from solvers.errors import InvalidInput
-from solvers.factorization import RANK_TOL  # the default rcond
-from solvers.validation import as_array, as_vector, finite_number
+from rrc_pin.solvers.checks import as_array, as_vector, finite_number
+from rrc_pin.solvers.closed_form.base import Array
+from rrc_pin.solvers.errors import InvalidInput
+from rrc_pin.solvers.tick.factorization import RANK_TOL  # the default rcond
 
 
 def weight_factor(W: npt.ArrayLike | None, n: int, name: str = "W") -> Array | None:

@@ -14,12 +14,12 @@ from typing import Any
 
 import numpy as np
 
-from solvers.errors import InvalidInput, ProblemError, UnknownBackend
-from solvers.qp import QP
-from solvers.qp_backends.base import QPBackend, QPSolution
-from solvers.qp_backends.daqp_backend import DaqpBackend
-from solvers.qp_backends.osqp_backend import OSQPBackend
-from solvers.qp_backends.qpsolvers_backend import QpsolversBackend
+from rrc_pin.solvers.errors import InvalidInput, ProblemError, UnknownBackend
+from rrc_pin.solvers.qp_backends.base import QPBackend, QPSolution
+from rrc_pin.solvers.qp_backends.daqp_backend import DaqpBackend
+from rrc_pin.solvers.qp_backends.osqp_backend import OSQPBackend
+from rrc_pin.solvers.qp_backends.qp import QP
+from rrc_pin.solvers.qp_backends.qpsolvers_backend import QpsolversBackend
 
 NATIVE: dict[str, type[QPBackend]] = {"daqp": DaqpBackend, "osqp": OSQPBackend}
 """Backends called through their own Python API."""
@@ -40,7 +40,8 @@ def make_backend(name: str, time_limit: float | None = None, **options: Any) -> 
     Args:
         name: One of :func:`installed_backends`.
         time_limit: [s] The most time one solve may take: an answer that took longer is
-            refused (:func:`solvers.qp.solve_checked`), or None for no limit. The backends'
+            refused (:func:`rrc_pin.solvers.qp_backends.qp.solve_checked`), or None for no limit.
+            The backends'
             own time limits are not used: they make the answers depend on the machine's load;
             their iteration limits (each backend's defaults) bound the time instead.
         **options: Backend settings (e.g. DAQP's ``iter_limit``, OSQP's ``eps_abs``).

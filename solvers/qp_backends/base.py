@@ -8,13 +8,13 @@ from typing import Any, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from solvers.qp import QP
+from rrc_pin.solvers.qp_backends.qp import QP
 
 Array = npt.NDArray[np.float64]
 
 
 class QPSolution(NamedTuple):
-    """What a backend returned for one :class:`~solvers.qp.QP`.
+    """What a backend returned for one :class:`~rrc_pin.solvers.qp_backends.qp.QP`.
 
     Attributes:
         x: Primal solution (nz,), or None when none was found. Within the backend's
@@ -36,10 +36,11 @@ class QPBackend(ABC):
     """A QP solver behind one method; keeps warm-start values per problem structure.
 
     Args:
-        **options: The solver's settings (checked by :func:`solvers.qp_backends.make_backend`).
+        **options: The solver's settings (checked by
+        :func:`rrc_pin.solvers.qp_backends.make_backend`).
 
     Attributes:
-        name: Backend name, as :func:`solvers.qp_backends.make_backend` takes it.
+        name: Backend name, as :func:`rrc_pin.solvers.qp_backends.make_backend` takes it.
         options: The settings passed to the solver at every solve.
         time_limit: [s] The most time a solve may take, or None (set by ``make_backend``).
     """

@@ -18,10 +18,10 @@ import time
 
 import numpy as np
 
-from solvers.errors import ProblemError
-from solvers.qp import QP
-from solvers.qp_backends.base import Array, QPBackend, QPSolution
-from solvers.validation import all_finite
+from rrc_pin.solvers.checks import all_finite
+from rrc_pin.solvers.errors import ProblemError
+from rrc_pin.solvers.qp_backends.base import Array, QPBackend, QPSolution
+from rrc_pin.solvers.qp_backends.qp import QP
 
 DEFAULT_SETTINGS = {"primal_tol": 1e-9}
 """DAQP settings used unless overridden. DAQP's default primal tolerance (1e-6) lets an
@@ -41,7 +41,7 @@ degenerate vertices of direction QPs (maximise the scale s <= 1, with collision 
 near-parallel capsules, cosines 0.994-0.999 between rows, active with s = 1); in 10-minute
 panda-folding sessions 10 and 2 ticks of 60,000 cycled at 1e-9, warm or cold, and went to the
 fallback. Two of them kept: both cycle at 1e-9, one still at 1e-8, both solve cold at 1e-7 in
-3 iterations (within :data:`solvers.qp.FEASIBILITY_TOL`)."""
+3 iterations (within :data:`rrc_pin.solvers.qp_backends.qp.FEASIBILITY_TOL`)."""
 
 RETRIES = {-1: RETRY_TOL, -2: CYCLING_TOL}
 """DAQP's exit flags retried once, cold, and the primal tolerance of the retry."""
@@ -60,7 +60,7 @@ class DaqpBackend(QPBackend):
         super().__init__(**{**DEFAULT_SETTINGS, **options})
 
     def solve(self, qp: QP) -> QPSolution:
-        """Solve ``qp`` (:class:`~solvers.qp_backends.base.QPBackend`).
+        """Solve ``qp`` (:class:`~rrc_pin.solvers.qp_backends.base.QPBackend`).
 
         Raises:
             ProblemError: DAQP raised (for instance on an unknown setting).

@@ -30,9 +30,9 @@ import numpy as np
 import numpy.typing as npt
 import scipy.sparse as sp
 
-from solvers.errors import ProblemError
-from solvers.qp import QP
-from solvers.qp_backends.base import Array, QPBackend, QPSolution
+from rrc_pin.solvers.errors import ProblemError
+from rrc_pin.solvers.qp_backends.base import Array, QPBackend, QPSolution
+from rrc_pin.solvers.qp_backends.qp import QP
 
 DEFAULT_SETTINGS: dict[str, Any] = {
     "eps_abs": 1e-7,

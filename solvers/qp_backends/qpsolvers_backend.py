@@ -25,9 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from solvers.errors import ProblemError
-from solvers.qp import QP
-from solvers.qp_backends.base import Array, QPBackend, QPSolution
+from rrc_pin.solvers.errors import ProblemError
+from rrc_pin.solvers.qp_backends.base import Array, QPBackend, QPSolution
+from rrc_pin.solvers.qp_backends.qp import QP
 
 WIDTH = 1e-9
 """Relative width given to zero-width bounds and rows."""

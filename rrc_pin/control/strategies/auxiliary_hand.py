@@ -41,9 +41,9 @@ from rrc_pin.control.strategies.barker_arm import (
 )
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
 from rrc_pin.robot import Robot
-from solvers.closed_form.barker import BarkerClosedForm
-from solvers.closed_form.barker_equations import f_terms, joint_trig, turn1
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
+from rrc_pin.solvers.closed_form.barker_equations import f_terms, joint_trig, turn1
 
 AT_SINGULAR = 1e-9
 """[rad] theta3 this close to the singular angle counts as at the singular point."""

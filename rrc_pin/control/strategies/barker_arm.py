@@ -10,8 +10,8 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
-from solvers.closed_form.barker import BarkerClosedForm
-from solvers.closed_form.barker_equations import eq33, f_terms, joint_trig
+from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
+from rrc_pin.solvers.closed_form.barker_equations import eq33, f_terms, joint_trig
 
 Array = npt.NDArray[np.float64]
 

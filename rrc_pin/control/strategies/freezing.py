@@ -14,8 +14,8 @@ from __future__ import annotations
 from rrc_pin.control.strategies.barker_arm import barker_closed_form, nearness
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
 from rrc_pin.robot import Robot
-from solvers.closed_form.barker import BarkerClosedForm
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
 
 ARM_JOINTS = (1, 2)
 """theta2, theta3 (indices): frozen near conditions (32) and (33)."""

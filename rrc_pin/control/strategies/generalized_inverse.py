@@ -8,7 +8,7 @@ from __future__ import annotations
 from rrc_pin.control.strategies.barker_arm import barker_closed_form
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
 from rrc_pin.robot import Robot
-from solvers.closed_form.barker import BarkerClosedForm
+from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
 
 
 class GeneralizedInverse(Strategy):

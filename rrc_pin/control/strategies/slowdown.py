@@ -23,7 +23,7 @@ import numpy.typing as npt
 
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
 from rrc_pin.errors import InvalidInput
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
 
 Measure = Literal["sigma_min", "manipulability"]
 STEP = 1e-6

@@ -15,9 +15,9 @@ import numpy as np
 from rrc_pin.control.strategies.barker_arm import barker_closed_form
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
 from rrc_pin.robot import Robot
-from solvers.closed_form.barker import BarkerClosedForm
-from solvers.closed_form.barker_equations import joint_trig, wrist_equations
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
+from rrc_pin.solvers.closed_form.barker_equations import joint_trig, wrist_equations
 
 
 class WristChoice(Strategy):

@@ -42,8 +42,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from solvers import kernels
-from solvers.validation import finite_number
+from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.tick import kernels
 
 Array = npt.NDArray[np.float64]
 
@@ -75,7 +75,7 @@ class Damping:
     ) -> Array | None:
         """Squared damping per singular direction (k,), or None where none applies.
 
-        The module docstring's schedule (:func:`~solvers.kernels.damping_lambda_sq`).
+        The module docstring's schedule (:func:`~rrc_pin.solvers.tick.kernels.damping_lambda_sq`).
 
         Args:
             sigma: Singular values (k,) of the level's normalised rows, descending.

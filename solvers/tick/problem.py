@@ -34,7 +34,7 @@ from typing import Literal, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from solvers import kernels
+from rrc_pin.solvers.tick import kernels
 
 Array = npt.NDArray[np.float64]
 
@@ -76,7 +76,7 @@ class Box(NamedTuple):
         lb: Lower bounds (n,) [rad/s or m/s].
         ub: Upper bounds (n,), ``lb <= ub``.
         kind: (2, n) codes of what sets each bound (lower, upper):
-            :data:`~solvers.kernels.VELOCITY`, ``POSITION`` or ``ACCELERATION``.
+            :data:`~rrc_pin.solvers.tick.kernels.VELOCITY`, ``POSITION`` or ``ACCELERATION``.
         contains_zero: Whether standing still is allowed.
         recovering: Whether a joint is outside its range and must move back.
         velocity: The velocity limits (n,), the scale of the backends' tolerance.
@@ -107,7 +107,7 @@ class Constraints(NamedTuple):
         names: One name per row of G, then of C, for the report.
         slide: Per row of G (p,), whether the top level's command may slide along it (a
             collision pair: the command loses its component into the row, not its speed along
-            the rest; :mod:`solvers.pipeline`), or None for none.
+            the rest; :mod:`rrc_pin.solvers.tick.pipeline`), or None for none.
         distance: Per row of G (p,), the distance [m] the row keeps (a collision pair's signed
             distance, reported with the active rows), NaN where none, or None.
     """
@@ -231,7 +231,8 @@ def _stack(tasks: Sequence[TaskRows], normalised: bool, box: Box) -> tuple[Array
     """Rows and rates of ``tasks`` stacked in the level's metric, and the rates' factor.
 
     Each row times the square root of its weight over the level's largest (and in the
-    normalised metric divided by its unit, :func:`solvers.kernels.weighted_rows`); the rates
+    normalised metric divided by its unit, :func:`rrc_pin.solvers.tick.kernels.weighted_rows`); the
+    rates
     capped as the module docstring says (:func:`_capped`).
     """
     top = largest_weight(tasks)

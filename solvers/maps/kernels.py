@@ -5,7 +5,7 @@ accumulation of samples into voxels. Every function is ``@njit(cache=True, nogil
 (numba): arrays in, arrays out, the caller preallocates; no Python object inside. ``nogil``
 lets the threads of a local Dask scheduler run the kernels side by side. The same source runs
 as plain Python under ``NUMBA_DISABLE_JIT=1`` (tests/test_maps_kernels.py checks both against
-numpy and Pinocchio references). The typed entry points are :mod:`solvers.map_batch`; mypy
+numpy and Pinocchio references). The typed entry points are :mod:`rrc_pin.solvers.maps.batch`; mypy
 ignores this module (pyproject.toml): numba's decorator is untyped.
 
 Sources, cited once here:

@@ -3,7 +3,7 @@
 Runs on the workers: numpy, numba and :mod:`solvers` only (a worker process imports no
 Pinocchio and no ``rrc_pin``). Memory of a task: one block's samples and rows
 (``block_size x (8 n + 88)`` bytes: 2.6 MB for panda's 2^15) and its voxel table
-(:class:`~solvers.map_batch.VoxelTable`), at most ``4 x (72 or 120)`` bytes per distinct
+(:class:`~rrc_pin.solvers.maps.batch.VoxelTable`), at most ``4 x (72 or 120)`` bytes per distinct
 voxel of the task; both measured and returned with the result.
 """
 
@@ -15,9 +15,9 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from solvers.map_batch import Fields, GridArrays, Rows, Sparse, VoxelTable
-from solvers.map_kinematics import ArmKinematics
-from solvers.map_sampling import Plan, block_samples
+from rrc_pin.solvers.maps.batch import Fields, GridArrays, Rows, Sparse, VoxelTable
+from rrc_pin.solvers.maps.kinematics import ArmKinematics
+from rrc_pin.solvers.maps.sampling import Plan, block_samples
 
 
 @dataclass(frozen=True)

@@ -20,12 +20,12 @@ import numpy as np
 import numpy.typing as npt
 import qpsolvers
 
-from solvers import kernels
-from solvers.errors import NumericalFailure
-from solvers.problem import Box, Rows
+from rrc_pin.solvers.errors import NumericalFailure
+from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.problem import Box, Rows
 
 if TYPE_CHECKING:
-    from solvers.qp_backends.base import QPBackend
+    from rrc_pin.solvers.qp_backends.base import QPBackend
 
 Array = npt.NDArray[np.float64]
 
@@ -118,7 +118,7 @@ def solve_checked(backend: QPBackend, qp: QP, decoding: Decoding) -> Solved:
     """``qp`` solved by ``backend``, its answer checked (shape, finite) and decoded.
 
     Anything the backend raises, an answer past its time limit, and an answer of the wrong
-    shape or with a non-finite entry, is a :class:`~solvers.errors.NumericalFailure`: the
+    shape or with a non-finite entry, is a :class:`~rrc_pin.solvers.errors.NumericalFailure`: the
     caller's fallbacks answer.
 
     Raises:

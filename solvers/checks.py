@@ -7,8 +7,8 @@ from math import isfinite
 import numpy as np
 import numpy.typing as npt
 
-from solvers import kernels
-from solvers.errors import InvalidInput
+from rrc_pin.solvers.errors import InvalidInput
+from rrc_pin.solvers.tick import kernels
 
 _F64 = np.dtype(np.float64)
 

@@ -8,7 +8,8 @@ worker process imports no Pinocchio):
   vectorised over the block), with his singular conditions (32), (33) and theta_5 = 0
   evaluated at each sample;
 - :class:`ChainKinematics`: any serial chain through the compiled kernel
-  (:mod:`solvers.map_kernels`); ``rrc_pin.maps.kinematics.chain_of`` builds the chain from a
+  (:mod:`rrc_pin.solvers.maps.kernels`); ``rrc_pin.maps.kinematics.chain_of`` builds the chain from
+  a
   Pinocchio model.
 """
 
@@ -20,9 +21,9 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from solvers import map_batch
-from solvers.closed_form.barker import BarkerClosedForm
-from solvers.map_batch import Chain, GridArrays, Rows
+from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
+from rrc_pin.solvers.maps import batch as map_batch
+from rrc_pin.solvers.maps.batch import Chain, GridArrays, Rows
 
 Array = npt.NDArray[np.float64]
 

@@ -20,11 +20,12 @@ equality rows appear)
 solved here (:func:`along`):
 
 - without rows and null space: the largest uniform scale
-  (:func:`~solvers.kernels.uniform_scale`);
+  (:func:`~rrc_pin.solvers.tick.kernels.uniform_scale`);
 - without rows, one null direction (a 7-joint arm's six rows): exactly, by eliminating y
-  (:func:`~solvers.kernels.line_scale`); for the top level's exact rates these two come in
-  the same kernel call as the rates (:func:`~solvers.kernels.direction_step`, through
-  :meth:`~solvers.factorization.Factorization.fitted`);
+  (:func:`~rrc_pin.solvers.tick.kernels.line_scale`); for the top level's exact rates these two
+  come in
+  the same kernel call as the rates (:func:`~rrc_pin.solvers.tick.kernels.direction_step`, through
+  :meth:`~rrc_pin.solvers.tick.factorization.Factorization.fitted`);
 - otherwise by the QP backend (:func:`direction_qp`: the LP with a small regularisation that
   picks the least-norm y; DAQP returns the LP's vertex), or exactly by scipy's HiGHS
   (:func:`direction_lp`, the fallback).
@@ -39,10 +40,10 @@ import numpy as np
 import numpy.typing as npt
 from scipy.optimize import linprog
 
-from solvers import kernels
-from solvers.errors import NumericalFailure
-from solvers.problem import Box, Rows
-from solvers.qp import QP, Decoding
+from rrc_pin.solvers.errors import NumericalFailure
+from rrc_pin.solvers.qp_backends.qp import QP, Decoding
+from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.problem import Box, Rows
 
 Array = npt.NDArray[np.float64]
 

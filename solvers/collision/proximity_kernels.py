@@ -10,7 +10,7 @@ has its plane instead. A lower bound of the signed distance of a pair, also in p
 A pair whose bound is below the detection distance is a candidate; only candidates go to the
 narrow phase (coal), so no pair within the detection distance is ever dropped.
 
-Compiled with numba through :func:`solvers.kernels.kernel`; plain arrays in and out.
+Compiled with numba through :func:`rrc_pin.solvers.tick.kernels.kernel`; plain arrays in and out.
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from solvers.kernels import kernel
+from rrc_pin.solvers.tick.kernels import kernel
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]

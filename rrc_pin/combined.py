@@ -1,4 +1,4 @@
-"""``rrc_pin.combine``: several robots, each at its base placement, as one :class:`Robot`.
+""":func:`rrc_pin.combine`: several robots, each at its base placement, as one :class:`Robot`.
 
 The multi-arm cells resolve this one model: the arms' models are joined under one base with
 ``pinocchio.appendModel``, so one ``computeJointJacobians`` serves every arm, and the
@@ -29,7 +29,7 @@ import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
-from solvers.validation import rigid_transform
+from rrc_pin.solvers.checks import rigid_transform
 
 
 class Part(NamedTuple):
@@ -78,7 +78,7 @@ def combine(
     Raises:
         InvalidInput: ``arms`` is empty or not a mapping, a key is not a non-empty name
             without ``/``, a value is not ``(Robot, T_base)``, ``T_base`` is not a (4, 4)
-            rigid transform (within :data:`solvers.validation.RIGID_TOL`), or ``name`` is not a
+            rigid transform (within :data:`rrc_pin.solvers.checks.RIGID_TOL`), or ``name`` is not a
             string.
 
     Example:

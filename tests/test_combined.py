@@ -1,4 +1,4 @@
-"""rrc_pin.combine: several arms at their base placements as one model, equal to the arms apart."""
+"""rrc_pin.combined: several arms at their base placements as one model, equal to the arms apart."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 
 import rrc_pin
-from rrc_pin.combine import Combined, combine
+from rrc_pin.combined import Combined, combine
 from rrc_pin.cross_check import finite_difference_jacobians
 from rrc_pin.errors import InvalidInput, ToolFrameRequired
 

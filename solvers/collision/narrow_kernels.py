@@ -33,7 +33,7 @@ each end against the box: in the box's frame the end point clamped to the box is
 box point outside it; inside, the nearest face (the signed distance to a convex set).
 
 Pairs of other shapes (cylinders, convex hulls, meshes) are returned for coal.
-Compiled with numba through :func:`solvers.kernels.kernel`; plain arrays in and out.
+Compiled with numba through :func:`rrc_pin.solvers.tick.kernels.kernel`; plain arrays in and out.
 """
 
 from __future__ import annotations
@@ -43,7 +43,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from solvers.kernels import kernel
+from rrc_pin.solvers.tick.kernels import kernel
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from solvers.map_batch import Chain
+from rrc_pin.solvers.maps.batch import Chain
 
 Array = npt.NDArray[np.float64]
 

@@ -1,6 +1,7 @@
 r"""The answer to one tick and how it was obtained: :class:`Resolution`, an immutable record.
 
-Its status, scale and veer are decided once, by the pipeline (:mod:`solvers.pipeline`); what
+Its status, scale and veer are decided once, by the pipeline
+(:mod:`rrc_pin.solvers.tick.pipeline`); what
 costs more to report is computed on first access from the problem it answered: ``active``
 (the joint bounds the answer touches, with the constraint behind each), ``active_rows`` (the
 constraint rows it touches, by name), ``tasks`` (per task: achieved rates, residual, scale)
@@ -20,9 +21,9 @@ from typing import Literal, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from solvers.kernels import ACCELERATION, POSITION, scale_and_veer
-from solvers.pipeline import Answer, LevelStatus, Method, Status
-from solvers.problem import Box, Problem, largest_weight, row_factors
+from rrc_pin.solvers.tick.kernels import ACCELERATION, POSITION, scale_and_veer
+from rrc_pin.solvers.tick.pipeline import Answer, LevelStatus, Method, Status
+from rrc_pin.solvers.tick.problem import Box, Problem, largest_weight, row_factors
 
 Array = npt.NDArray[np.float64]
 
@@ -120,14 +121,16 @@ class Resolution(_Record):
 
     Attributes:
         qdot: Joint rates (n,) [rad/s or m/s], finite and within the step's box (read-only).
-        status: What the answer is (:data:`~solvers.pipeline.Status`; docs/api.md, "Reading
+        status: What the answer is (:data:`~rrc_pin.solvers.tick.pipeline.Status`; docs/api.md,
+        "Reading
             a resolution").
-        method: How the top level was answered (:data:`~solvers.pipeline.Method`).
+        method: How the top level was answered (:data:`~rrc_pin.solvers.tick.pipeline.Method`).
         scale: Fraction in [0, 1] of the top level's command achieved along it (normalised
             metric): the common scale of its tasks when its direction was kept.
         veer: Angle [rad] between the top level's achieved and commanded rates (normalised
             metric): 0 unless damped, singular, least squares or a fallback.
-        levels: How each priority level was served (:data:`~solvers.pipeline.LevelStatus`).
+        levels: How each priority level was served
+        (:data:`~rrc_pin.solvers.tick.pipeline.LevelStatus`).
         attempts: ``(method or level, reason)`` of every method that failed.
         backend: Name of the last QP backend that answered, or "" (the exact kernels).
         iterations: Backend iterations (0 without a backend).

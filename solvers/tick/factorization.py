@@ -1,15 +1,15 @@
 r"""The factorisation of a level's rows: QR for the exact rates, the SVD only when needed.
 
 For rows J (m, n), the Householder QR of the transpose, :math:`J^T = QR`
-(:func:`~solvers.kernels.householder_qr`), gives at once:
+(:func:`~rrc_pin.solvers.tick.kernels.householder_qr`), gives at once:
 
 - the least-norm rates of a full-row-rank J, :math:`x = Q_1 R_1^{-T} b`
-  (:func:`~solvers.kernels.least_norm_rates`), what most ticks need;
+  (:func:`~rrc_pin.solvers.tick.kernels.least_norm_rates`), what most ticks need;
 - the null space, the last n - m columns of Q.
 
 The singular values are those of the small triangle :math:`R_1` (k = min(m, n) rows), so
 the SVD of J costs a one-sided Jacobi SVD of :math:`R_1^T` (m, k)
-(:func:`~solvers.kernels.jacobi_svd`): :math:`R_1^T V = U\Sigma` gives
+(:func:`~rrc_pin.solvers.tick.kernels.jacobi_svd`): :math:`R_1^T V = U\Sigma` gives
 :math:`J = U\Sigma (Q_1 V)^T`. It is computed on first use, where the rows are numerically
 dependent (a singularity, more rows than joints), and for the condition number and the
 damping near singularities.
@@ -22,8 +22,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from solvers import kernels
-from solvers.direction import Along
+from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.direction import Along
 
 Array = npt.NDArray[np.float64]
 
@@ -62,7 +62,8 @@ class Factorization:
         """The factorisation of J, the least-norm rates of ``J x ~= b``, whether they fit.
 
         Where they do not, also the largest scale along them within the box. One kernel call
-        where J has full row rank (:func:`~solvers.kernels.direction_step`), the SVD otherwise.
+        where J has full row rank (:func:`~rrc_pin.solvers.tick.kernels.direction_step`), the SVD
+        otherwise.
 
         Args:
             J: The rows (m, n).

@@ -1,4 +1,4 @@
-r"""The numerics of one tick: a :class:`~solvers.problem.Problem` in, an :class:`Answer` out.
+r"""The numerics of one tick: a :class:`~.problem.Problem` in, an :class:`Answer` out.
 
 The levels are solved in priority order, each exactly within the optimal set of those above
 (Kanoun, Lamiraux & Wieber 2011; Escande, Mansard & Wieber 2014): a level's answer fixes its
@@ -6,9 +6,11 @@ task rates, and the next level moves only in the null space of its rows (a
 :class:`Subspace`), so it cannot change them. Equality rows come first of all: every level
 moves in their null space.
 
-The top level of the ``direction`` mode (:mod:`solvers.direction`, :mod:`solvers.damping`):
+The top level of the ``direction`` mode (:mod:`rrc_pin.solvers.tick.direction`,
+:mod:`rrc_pin.solvers.tick.damping`):
 
-1. the exact rates (least-squares of least norm, :class:`~solvers.factorization.Factorization`)
+1. the exact rates (least-squares of least norm,
+:class:`~rrc_pin.solvers.tick.factorization.Factorization`)
    are the answer when they satisfy the constraints (``exact``; ``singular`` where part of
    the command is outside the rows' range);
 2. otherwise the LP maximum :math:`u^*` of the scale along them: ``exact`` at
@@ -20,16 +22,20 @@ Before 2, where the exact rates cross a constraint row marked ``slide`` (a colli
 the command should slide along rather than stop at), the command is first projected onto what
 the slide rows and the box allow, :math:`b' = A\dot q^*` with :math:`\dot q^*` the least
 squares of :math:`A\dot q \approx b` within them, damped by :data:`SLIDE_DAMPING`
-(:func:`_slide`, :mod:`solvers.slide_kernels`: one answer, continuous in the data), and 1-2
+(:func:`_slide`, :mod:`rrc_pin.solvers.tick.slide_kernels`: one answer, continuous in the data),
+and 1-2
 run on :math:`b'` (``sliding``, the veer from :math:`b` reported). Without a crossed slide row
 nothing changes: exact answers stay exact (0 veer).
 
 A least-squares level (the other modes, and every lower level): its unconstrained optimum
-(:mod:`solvers.least_squares`) when it satisfies the constraints, else the backend's QP.
+(:mod:`rrc_pin.solvers.tick.least_squares`) when it satisfies the constraints, else the backend's
+QP.
 
 When the top level finds no usable answer (a backend fault, an infeasible problem, an answer
-outside the constraints beyond :func:`~solvers.qp.tolerance`), the fallbacks answer it
-(:mod:`solvers.fallbacks`); a lower level that fails keeps the answer of the levels above
+outside the constraints beyond :func:`~rrc_pin.solvers.qp_backends.qp.tolerance`), the fallbacks
+answer it
+(:mod:`rrc_pin.solvers.tick.fallbacks`); a lower level that fails keeps the answer of the levels
+above
 (``dropped``). Every answer is finally clipped into the box, the size of the clip reported.
 Nothing here raises for numerical trouble.
 """
@@ -43,23 +49,23 @@ from typing import Literal, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from solvers import kernels
-from solvers.damping import Damping
-from solvers.direction import Along, along, direction_qp
-from solvers.errors import InvalidInput, NumericalFailure
-from solvers.factorization import Factorization
-from solvers.kernels import scale_and_veer
-from solvers.least_squares import Subspace, least_squares
-from solvers.problem import Box, Problem, Rows
-from solvers.qp import QP, Decoding, Work, solve_within, tolerance
-from solvers.qp_backends.base import QPBackend
-from solvers.slide_kernels import MARGIN, SOLVED, damped_optimum, project
+from rrc_pin.solvers.errors import InvalidInput, NumericalFailure
+from rrc_pin.solvers.qp_backends.base import QPBackend
+from rrc_pin.solvers.qp_backends.qp import QP, Decoding, Work, solve_within, tolerance
+from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.direction import Along, along, direction_qp
+from rrc_pin.solvers.tick.factorization import Factorization
+from rrc_pin.solvers.tick.kernels import scale_and_veer
+from rrc_pin.solvers.tick.least_squares import Subspace, least_squares
+from rrc_pin.solvers.tick.problem import Box, Problem, Rows
+from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, damped_optimum, project
 
 Array = npt.NDArray[np.float64]
 
 Method = Literal["qp", "scipy", "scaling", "hold"]
 """How the top level was answered: ``qp`` the pipeline (its exact kernels, or the backend),
-then the fallbacks (:mod:`solvers.fallbacks`)."""
+then the fallbacks (:mod:`rrc_pin.solvers.tick.fallbacks`)."""
 
 METHODS: tuple[Method, ...] = ("qp", "scipy", "scaling", "hold")
 
@@ -190,7 +196,7 @@ def solve(problem: Problem, backend: QPBackend, options: Options) -> Answer:
     """Joint rates serving ``problem``'s levels in priority order (module docstring).
 
     Args:
-        problem: The tick's problem (:func:`solvers.problem.build`), its arrays finite.
+        problem: The tick's problem (:func:`rrc_pin.solvers.tick.problem.build`), its arrays finite.
         backend: The QP backend (warm-started across calls).
         options: Damping and fallbacks.
 
@@ -207,7 +213,7 @@ def solve(problem: Problem, backend: QPBackend, options: Options) -> Answer:
     except (NumericalFailure, np.linalg.LinAlgError) as exc:
         work.attempts.append(("qp", str(exc)))
     if top is None:
-        from solvers.fallbacks import fallback
+        from rrc_pin.solvers.tick.fallbacks import fallback
 
         for name in options.fallbacks:
             try:
@@ -344,8 +350,10 @@ def _slide(
 
     with ``t`` the damped least squares :math:`(A^TA + \mu I)^{-1}A^Tb` and :math:`\mu` =
     :data:`SLIDE_DAMPING` times the mean squared singular value of A: the projection of its
-    unconstrained optimum (:func:`solvers.slide_kernels.damped_optimum`) onto the constraints
-    in the metric :math:`A^TA + \mu I` (:func:`solvers.slide_kernels.project`). Without the
+    unconstrained optimum (:func:`rrc_pin.solvers.tick.slide_kernels.damped_optimum`) onto the
+    constraints
+    in the metric :math:`A^TA + \mu I` (:func:`rrc_pin.solvers.tick.slide_kernels.project`).
+    Without the
     damping (the least squares alone, with a least-norm tie-break 1e-6 of the trace) the
     optimal rates formed a set along A's null space, and the answer moved anywhere in it from
     one tick to the next as rows entered and left (2.35 rad/s between two sliding ticks); with
@@ -357,7 +365,7 @@ def _slide(
     opposite rate limits every tick).
 
     The backend answers the same QP where the kernel refuses; within the equality rows' null
-    space, the least squares alone (:func:`~solvers.least_squares.least_squares`).
+    space, the least squares alone (:func:`~rrc_pin.solvers.tick.least_squares.least_squares`).
 
     Raises:
         NumericalFailure: The backend found no usable answer.

@@ -38,7 +38,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from solvers.kernels import kernel
+from rrc_pin.solvers.tick.kernels import kernel
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
@@ -51,7 +51,8 @@ such tick into a recovery, the whole problem a least-squares one)."""
 SLACK = 1e-9
 """[m/s] The least bound of a row not recovering: a pair held at d_s (bound 0) met by rates
 that cross it by rounding (1e-17) had the whole answer shrunk to zero by the pipeline's last
-step (``solvers.pipeline._within_rows`` scales the rates back into every row, and 0 / 1e-17 is
+step (``rrc_pin.solvers.tick.pipeline._within_rows`` scales the rates back into every row, and 0 /
+1e-17 is
 0): two hands held side by side stopped sliding. 1e-9 m/s is 6e-7 m in ten minutes."""
 
 

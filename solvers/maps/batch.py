@@ -1,4 +1,4 @@
-"""Typed entry points of the capability maps' compiled kernels (:mod:`solvers.map_kernels`).
+"""Typed entry points of the capability maps' compiled kernels (:mod:`.kernels`).
 
 - :class:`Chain`: a serial chain as arrays (joint placements, kinds, limits), every joint
   about or along its frame's z axis; its pose and Jacobian at one configuration, and bounds
@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from solvers import map_kernels as _k
+from rrc_pin.solvers.maps import kernels as _k
 
 Array = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]

@@ -1,4 +1,4 @@
-"""What answers the top level when the pipeline could not (:data:`~solvers.pipeline.METHODS`).
+"""What answers the top level when the pipeline could not (:data:`.pipeline.METHODS`).
 
 - ``scipy``: the same problem solved exactly by scipy.optimize: the direction LP by HiGHS
   (along the exact rates), or the bounded least squares by BVLS (without rows);
@@ -7,7 +7,7 @@
 - ``hold``: the feasible rates nearest zero in the box, which always answers.
 
 Each either answers (rates within the box, rows and equality rows) or raises
-:class:`~solvers.errors.NumericalFailure`, and the next one is tried.
+:class:`~rrc_pin.solvers.errors.NumericalFailure`, and the next one is tried.
 """
 
 from __future__ import annotations
@@ -16,12 +16,12 @@ import numpy as np
 import numpy.typing as npt
 from scipy.optimize import lsq_linear
 
-from solvers import kernels
-from solvers.direction import direction_lp
-from solvers.errors import NumericalFailure
-from solvers.factorization import Factorization
-from solvers.problem import Problem
-from solvers.qp import FEASIBILITY_TOL, Work
+from rrc_pin.solvers.errors import NumericalFailure
+from rrc_pin.solvers.qp_backends.qp import FEASIBILITY_TOL, Work
+from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.direction import direction_lp
+from rrc_pin.solvers.tick.factorization import Factorization
+from rrc_pin.solvers.tick.problem import Problem
 
 Array = npt.NDArray[np.float64]
 

@@ -9,11 +9,14 @@ the levels above and their null space; all rates for the first level), so the le
     \quad \text{s.t.} \quad lb \le x + N^Tz \le ub,\quad G(x + N^Tz) \le h.
 
 Its unconstrained optimum of least norm is the answer when it satisfies the constraints:
-by the normal equations :math:`B^TBz = B^Tc` (:func:`~solvers.kernels.cholesky_solve`) for
-more rows than unknowns, by the QR of :math:`B^T` (:class:`~solvers.factorization.Factorization`)
+by the normal equations :math:`B^TBz = B^Tc` (:func:`~rrc_pin.solvers.tick.kernels.cholesky_solve`)
+for
+more rows than unknowns, by the QR of :math:`B^T`
+(:class:`~rrc_pin.solvers.tick.factorization.Factorization`)
 otherwise, and by the SVD where either is rank deficient. Else, where :math:`B^TB` is
 definite (the optimum one point), the optimum is projected onto the constraints in
-the metric :math:`B^TB` by hand (:func:`~solvers.slide_kernels.project`: the same costs up to a
+the metric :math:`B^TB` by hand (:func:`~rrc_pin.solvers.tick.slide_kernels.project`: the same
+costs up to a
 constant); else, or where that kernel refuses, the backend solves the QP
 with :math:`P = B^TB` and :math:`q = -B^Tc` (the same normal equations, computed once):
 exactly the stated costs where P is definite (their optimum is one point). Where it is not
@@ -38,15 +41,15 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from solvers import kernels
-from solvers.direction import constraint_rows
-from solvers.factorization import Factorization
-from solvers.problem import Box, Rows
-from solvers.qp import QP, Decoding, Work, solve_within, tolerance
-from solvers.slide_kernels import MARGIN, SOLVED, project
+from rrc_pin.solvers.qp_backends.qp import QP, Decoding, Work, solve_within, tolerance
+from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.direction import constraint_rows
+from rrc_pin.solvers.tick.factorization import Factorization
+from rrc_pin.solvers.tick.problem import Box, Rows
+from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
 
 if TYPE_CHECKING:
-    from solvers.qp_backends.base import QPBackend
+    from rrc_pin.solvers.qp_backends.base import QPBackend
 
 Array = npt.NDArray[np.float64]
 
@@ -75,7 +78,8 @@ class Subspace(NamedTuple):
 
 
 def normal_equations(B: Array, c: Array) -> tuple[Array, Array]:
-    r""":math:`(B^TB, B^Tc)` (:func:`~solvers.kernels.normal_equations`): the optimum's normal
+    r""":math:`(B^TB, B^Tc)` (:func:`~rrc_pin.solvers.tick.kernels.normal_equations`): the
+    optimum's normal
     equations, and the QP's costs."""  # noqa: D205, D209
     m, d = B.shape
     H, g = np.empty((d, d)), np.empty(d)
@@ -193,11 +197,12 @@ def _projected(
 ) -> Array | None:
     r"""The level's QP solved by hand where :math:`B^TB` is definite: its optimum ``z``
     projected onto the QP's constraints in the metric :math:`B^TB`
-    (:func:`~solvers.slide_kernels.project`; the same costs up to a constant), as rates.
+    (:func:`~rrc_pin.solvers.tick.slide_kernels.project`; the same costs up to a constant), as
+    rates.
 
     Returns:
         The rates (n,), or None where the kernel refuses or its answer leaves the box or rows
-        beyond :func:`~solvers.qp.tolerance` (the backend then answers).
+        beyond :func:`~rrc_pin.solvers.qp_backends.qp.tolerance` (the backend then answers).
     """  # noqa: D205
     d = z.size
     if qp.C is None or qp.l is None or qp.u is None:

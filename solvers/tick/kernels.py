@@ -386,7 +386,7 @@ def svd_rates(
 def damping_lambda_sq(
     sigma: Array, rank: int, scale: float, along: Array, dt: float, threshold: float, lam: Array
 ) -> bool:
-    r"""Squared damping per singular direction (:mod:`solvers.damping`'s schedule).
+    r"""Squared damping per singular direction (:mod:`rrc_pin.solvers.tick.damping`'s schedule).
 
     With the onset :math:`\sigma_{on} = \sigma_1/\kappa`, every direction i < rank whose
     singular value is below it gets :math:`\lambda_i^2 = (1 - (\sigma_i/\sigma_{on})^2)\,
@@ -543,7 +543,7 @@ def direction_step(
     (:func:`least_norm_rates`), :func:`inside`; where w leaves the box and the null space of J
     has at most one direction (:math:`Q_{:,m}`, a 7-joint arm's six rows), the direction
     problem's exact answer :math:`u\,w + y\,Q_{:,m}` (:func:`uniform_scale`,
-    :func:`line_scale`); one call for what most ticks need (:mod:`solvers.direction`).
+    :func:`line_scale`); one call for what most ticks need (:mod:`rrc_pin.solvers.tick.direction`).
 
     Args:
         J: Rows (m, n).

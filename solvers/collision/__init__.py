@@ -1,0 +1,1 @@
+"""The collision limit's compiled kernels: broad phase, narrow phase, damper rows."""

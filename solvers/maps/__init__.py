@@ -1,0 +1,1 @@
+"""The capability maps' compiled kernels: sampling, chain kinematics, voxel statistics."""
