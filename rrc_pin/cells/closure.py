@@ -2,53 +2,55 @@ r"""Closing a cell's closed chains inside the tick's limits: the correction and 
 
 A grip (two hands on one object) and a foot in support close a kinematic chain. The
 resolver keeps their rows, :math:`C\dot q = 0`, at every answer: the chains stay closed to
-first order. What opens them is the integration, :math:`q_{k+1} = q_k \oplus \dot q\,\Delta t`:
-with :math:`e(q)` a chain's pose error (:class:`~rrc_pin.limits.contact_limit.Closure`),
+first order. What opens them is the integration, :math:`q_{k+1} = q_k \oplus u\,\Delta t`.
+With :math:`e(q)` a chain's pose error to its goal (the grip, the foot's anchor:
+:class:`~rrc_pin.limits.contact_limit.Closure`) and :math:`s(u) = D^2p[u, u]` its second
+derivative along the step (the frames' classical accelerations at :math:`\ddot q = 0`,
+:func:`second_order`),
 
 .. math::
 
-    e_{k+1} = e_k - C\dot q\,\Delta t - \tfrac12 \Delta t^2\, D^2\!p[\dot q, \dot q]
-              + O(\Delta t^3),
+    e_{k+1} = e_k - C u\,\Delta t - \tfrac12 \Delta t^2\, s(u)
+              - \tfrac16 \Delta t^3\, D^3p[u, u, u] + O(\Delta t^4).
 
-:math:`D^2p[\dot q, \dot q]` the chain's second derivative along the step (with
-:math:`\ddot q = 0`: the frames' classical accelerations). Each tick therefore adds
-:math:`e_k - C u\,\Delta t` to the error that its rates ``u`` leave, plus the second-order
-remainder. The correction (:func:`correction`) takes the error measured at the tick's own
-configuration out within the same step: rates :math:`\delta` with :math:`C\delta =
-e_k/\Delta t`, so that the error after the step is that step's remainder alone and never
-accumulates. It is the least squares
+Left alone (:math:`u = \dot q`, :math:`C\dot q = 0`) every tick adds its second-order
+remainder, and the chain drifts (gsfc_dual's grip 1e-5 m a tick at the commanded speeds).
+The correction :math:`\delta` (:func:`close`) takes the measured error and the second order
+out within the same step, :math:`C\delta = e_k/\Delta t - \tfrac12 \Delta t\, s(\dot q +
+\delta)` (two passes: the second order along the corrected step), inside the tick's limits:
 
 .. math::
 
-    \min_\delta \|C\delta - e_k/\Delta t\|^2 + \|A\delta\|^2 + \mu\|\delta - t\|^2
-    \quad\text{s.t.}\quad lb - \dot q \le \delta \le ub - \dot q,\quad
-    |\delta_i| \le \rho_i,\quad G\delta \le h - G\dot q,
+    lb - \dot q \le \delta \le ub - \dot q,\qquad |\delta_i| \le \rho_i,\qquad
+    G\delta \le \max(h - G\dot q, 0),
 
-with A the top level's task rows (the commanded motion kept: the correction moves in their
-null space where it can), damped (:math:`\mu` = :data:`DAMPING` times the mean squared
-singular value of the rows, pulled toward the damped least squares t: the sliding stage's
-projection, :func:`rrc_pin.solvers.tick.slide_kernels.project`), inside the box that is left
-of the resolver's (the velocity and one-step position bounds, exact in floating point), the
-trust region :math:`\rho_i` = :data:`TRUST` times each joint's velocity limit, and the
-constraint rows that are left (a collision limit's). Zero is always feasible: the correction
-never moves a joint beyond its limits, and it never opens a chain further
-(:math:`\|C\delta - r\|` is at most :math:`\|r\|`).
+the box the resolver's rates leave (its velocity and one-step position bounds, exact in
+floating point), the trust region :math:`\rho_i` = :data:`TRUST` times each joint's velocity
+limit, and the constraint rows (a collision limit's). It is solved as a damped least squares,
+in the resolver's metric (a chain's position rows divided by its reach): the chains' rates
+first, then, in their null space, the top level's task rates kept (:math:`A\delta = 0`: the
+commanded motion unchanged), each pulled toward its damped least squares with :data:`DAMPING`
+of its rows' mean squared singular value (the sliding stage's
+:func:`~rrc_pin.solvers.tick.slide_kernels.damped_optimum`: exact to second order where the
+rows are well conditioned, bounded near a singular chain); where that leaves the box, the
+point of the box nearest it in the chains' metric, then the top level's (weight
+:data:`KEEP`; :func:`~rrc_pin.solvers.tick.slide_kernels.project`). Zero is always feasible:
+the correction never moves a joint beyond its limits.
 
-The bound. With the rates in their box, the remainder of one tick is at most (a chain of
-revolute joints; :math:`\ell_j` the length of the chain from joint j to the frame, its
-:math:`\partial^2 p/\partial q_i\partial q_j` at most :math:`\ell_{\max(i,j)}`)
+The bound. What is left after a corrected tick is the third-order remainder. Each derivative
+of a point on a chain of revolute joints is a cross product with a unit axis, so with
+:math:`\ell` the chain's length (both arms' for a grip)
 
 .. math::
 
-    \|e_{k+1}\|_p \le \tfrac12 \Delta t^2 \Big(\sum_i |\dot q_i|\Big)^2 \ell, \qquad
-    \|e_{k+1}\|_R \le \tfrac12 \Delta t^2 \Big(\sum_i |\dot q_i|\Big)^2
+    \|e_{k+1}\| \le \tfrac16 \Big(\Delta t \sum_i |u_i|\Big)^3 \ell
 
-(the rotation's from :math:`\dot\omega = \sum_{i<j} \dot q_i \dot q_j\, z_i \times z_j`),
-tens of millimetres for every joint at its velocity limit at 100 Hz, while the rows keep the
-chain's own motion rigid: its measured remainder is that of the commanded motion, micrometres
-(docs/api.md, "Cells"). :class:`ClosureBound` is the bound a cell states and enforces: a tick
-that starts with a chain open beyond it stops the cell (``grip_lost`` / ``contact_lost``),
-never a jump and never a silent drift.
+(and without :math:`\ell` for the rotation): 2.7 mm with every joint of gsfc_dual at its
+velocity limit at 100 Hz, some 3e-5 m at its commanded speeds; measured at most 5e-6 m and
+6e-6 rad (docs/api.md, "Cells"), eight times less per halving of the period.
+:class:`ClosureBound` is what a cell states and enforces, 2e-5 m and 2e-5 rad: a tick that
+starts with a chain open beyond it stops the cell (``grip_lost`` / ``contact_lost``), never a
+jump and never a silent drift.
 """
 
 from __future__ import annotations
@@ -64,24 +66,21 @@ import pinocchio as pin
 from rrc_pin.limits.contact_limit import Closure
 from rrc_pin.solvers.checks import finite_number
 from rrc_pin.solvers.tick import kernels
-from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.factorization import Factorization
 from rrc_pin.solvers.tick.problem import Box, Rows
-from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
+from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, damped_optimum, project
 
 Array = npt.NDArray[np.float64]
 
-THRESHOLD = Damping().threshold
-"""The condition number of the correction's rows beyond which its directions are damped
-(the resolver's documented threshold, :class:`~rrc_pin.solvers.tick.damping.Damping`)."""
+DAMPING = 1e-4
+r"""The correction's damping, relative to its rows' mean squared singular value: a direction of
+singular value :math:`\sigma` keeps :math:`\sigma^2(\sigma^2 + 2\mu)/(\sigma^2 + \mu)^2` of
+its correction: all but 1e-8 at the mean, at least three quarters at a hundredth of the
+largest."""
 
 KEEP = 1e-2
 """Where the box binds, the weight of the top level's rows against the chains' (the chains
 first)."""
-
-DAMPING = 1e-6
-"""Where the box binds, the weight of the distance to the unbounded correction, relative to
-the rows' mean squared singular value (what keeps the projection's metric definite)."""
 
 PASSES = 2
 """Passes of the correction in a tick (:func:`close`)."""
@@ -178,7 +177,7 @@ def close(
     delta = np.zeros(n)
     for _ in range(PASSES):
         second = second_order(model, data, q, qdot + delta, chains.contacts, chains.grips)
-        delta = solve((closure.error - 0.5 * dt * dt * second) / (dt * closure.unit), dt)
+        delta = solve((closure.error - 0.5 * dt * dt * second) / (dt * closure.unit))
         if not (kernels.inside(delta, low, high) and kernels.rows_hold(G, delta, h, 0.0)):
             x = np.empty(n)
             M = np.ascontiguousarray(np.vstack([C, KEEP * top]))
@@ -234,36 +233,32 @@ def second_order(
 
 
 class _Lexicographic:
-    """The chains' rates ``C delta = r`` first, damped past :data:`THRESHOLD`; then, among the
-    corrections with those rates, the one that keeps the top level's rates (``top delta``
-    nearest zero), of least norm: one factorisation of each for every pass of a tick.
+    """The chains' rates ``C delta = r`` first, then, among the corrections with those rates,
+    the one that keeps the top level's rates (``top delta`` nearest zero): each a damped least
+    squares (:func:`rrc_pin.solvers.tick.slide_kernels.damped_optimum`, :data:`DAMPING`).
 
-    The damping is Maciejewski & Klein's smooth onset, the resolver's schedule
-    (:func:`rrc_pin.solvers.tick.kernels.damping_lambda_sq`, whole: no scale is sought).
+    One factorisation of each for every pass of a tick (the second stage in ``C``'s null
+    space, the last columns of the QR of its transpose).
     """  # noqa: D205
 
     def __init__(self, C: Array, top: Array) -> None:
-        self.chains = Factorization(C)
-        null = self.chains.null_basis()
-        self.null = null if top.shape[0] and null.shape[0] else None
+        m, n = C.shape
+        self.C = np.ascontiguousarray(C)
+        self.null = Factorization(C).Q[:, m:].T if top.shape[0] and m < n else None
         self.top = top
-        self.keep = None if self.null is None else Factorization(top @ null.T)
+        self.keep = None if self.null is None else np.ascontiguousarray(top @ self.null.T)
 
-    def __call__(self, r: Array, dt: float) -> Array:
-        delta = _damped(self.chains, r, dt)
+    def __call__(self, r: Array) -> Array:
+        delta = _damped(self.C, r)
         if self.keep is None or self.null is None:
             return delta
-        out: Array = delta + _damped(self.keep, -(self.top @ delta), dt) @ self.null
+        out: Array = delta + _damped(self.keep, -(self.top @ delta)) @ self.null
         return out
 
 
-def _damped(factor: Factorization, b: Array, dt: float) -> Array:
-    """The least-norm solution of ``J x = b`` (J ``factor``'s rows), damped past the threshold."""
-    US, sigma, _, rank = factor.svd
-    lam = np.empty(sigma.size)
-    along = np.abs(b @ US) / np.maximum(sigma, _TINY)
-    damped = kernels.damping_lambda_sq(sigma, rank, 0.0, along, dt, THRESHOLD, lam)
-    return factor.rates(b, lam if damped else None)
-
-
-_TINY = float(np.finfo(np.float64).tiny)
+def _damped(J: Array, b: Array) -> Array:
+    """The damped least squares of ``J x = b`` (zero where its metric is not definite)."""
+    out = np.zeros(J.shape[1])
+    if not damped_optimum(J, DAMPING, b, out):
+        out[:] = 0.0
+    return out
