@@ -8,13 +8,13 @@ Run from a checkout: ``python benchmarks/bench_cells.py --out DIR`` (``--record`
 
 - **gsfc_dual** (issue 30): the held object commanded by random world-axes twists (0.15 m/s
   and 0.4 rad/s per axis, normal, each held 0.5 s), a default ``CellController`` (deadman,
-  targets fed back, the grip's equality rows, the closed chain's projection, the log), at
+  targets fed back, the grip's equality rows, the closed chain's correction, the log), at
   100 Hz. The controllers take the same commands: joint limits only, and joint limits plus
   a ``CollisionLimit`` on the cell's capsules (every pair between the two arms and the
   kinematic rules' pairs within each; default safety and detection distances). At every
   tick each steps, in an order shuffled per tick (interleaved).
 - **yeh_tripod**: the body commanded by random twists (0.03 m/s, 0.1 rad/s per axis, held
-  0.5 s) over its three feet in support (the contacts' equality rows and projection), the
+  0.5 s) over its three feet in support (the contacts' equality rows and correction), the
   same controllers (the collision model: the three legs' capsules, rows over all 24 rates,
   the floating base's included).
 - A third controller of each cell adds a ball to its collision model (:data:`BALLS`), in the
@@ -240,7 +240,7 @@ def docs_section(results: dict[str, Any]) -> str:
         "The tick is the whole Python step: the commands checked and weighted (speed, deadman), "
         "the frames' kinematics, the tasks with their targets, the resolver (with the grip's "
         "or the contacts' equality rows and, with collision, the pairs' distances and rows), "
-        "the integration and the closed chains' projection, the log's record. A loop at the "
+        "the closed chains' correction and the integration, the log's record. A loop at the "
         "rate in the p99 column misses no deadline on this machine 99 % of the time.",
     ]
     return "\n".join(lines)
