@@ -65,8 +65,7 @@ def dual(quick: bool) -> tuple[CellController, list[tuple[str, str, str]]]:
 
 
 def _chains(ctl: CellController) -> list[tuple[str, str, str]]:
-    """The summary's rows on the closed chains (errors at the ticks' start, lost ticks) and
-    the statuses."""  # noqa: D205
+    """The summary's rows on the closed chains (errors at the ticks' start, lost ticks)."""
     chain = ctl.log.column("chain")
     statuses = [rec.status for rec in ctl.log]
     lost = sum(s in ("grip_lost", "contact_lost") for s in statuses)

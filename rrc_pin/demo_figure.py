@@ -109,8 +109,9 @@ def draw_cell(ctl: CellController, path: Path) -> bool:
         axes[1].plot(t, [pin.rpy.matrixToRpy(T[:3, :3]) for T in poses], lw=1,
                      label=["roll", "pitch", "yaw"])  # fmt: skip
         what = "body" if cell.body else f"held object '{frame}'"
-        axes[0].set_title(f"{cell.name}: {what} position from its start ({start[0]:.3f}, "
-                          f"{start[1]:.3f}, {start[2]:.3f}) m, the cell's axes", fontsize=9)  # fmt: skip
+        at = ", ".join(f"{x:.3f}" for x in start)
+        axes[0].set_title(f"{cell.name}: {what} position from its start ({at}) m, the cell's "
+                          "axes", fontsize=9)  # fmt: skip
         axes[1].set_title(f"{what} orientation: roll, pitch, yaw about the cell's axes",
                           fontsize=9)  # fmt: skip
         for ax in axes[:2]:
