@@ -19,8 +19,9 @@ UPPER = {"resolver", "control", "controller", "guidance", "cell", "cli", "demo",
          "maps", "console"}  # fmt: skip
 TOP = {"console", "cli"}
 """The entry points: nothing else in rrc_pin imports them."""
-LOWER = {"dh", "models", "urdf_export", "urdf_compare", "robot", "loading", "errors", "cross_check",
-         "link_capsules", "combined", "kinematics", "geometry"}  # fmt: skip
+LOWER = {"dh", "models", "urdf_export", "urdf_compare", "urdf_checks", "robot", "loading", "errors",
+         "cross_check", "link_capsules", "combined", "kinematics", "geometry",
+         "deprecated"}  # fmt: skip
 GEOMETRY_BELOW = {"tasks", "limits", *UPPER}
 """What the geometry layer never imports: it sits above robot, below the tasks and limits."""
 

@@ -267,6 +267,23 @@ def test_the_status_is_the_top_levels_and_levels_say_how_the_lower_ones_fared() 
         assert grip_served in ("met", "held") and hands == [lower, lower]  # grip: b ~ 1e-16
 
 
+def test_a_posture_of_another_size_is_refused_where_it_meets_the_robot() -> None:
+    """Issue 40: ``PostureTask(np.zeros(6))`` for a 7-joint arm: the task knows no robot, the
+    resolver refuses it at its first call, naming the task, the sizes and the joints, before
+    any state changes."""
+    panda = rrc_pin.load("panda")
+    resolver = Resolver(panda)
+    posture = PostureTask(np.zeros(6))  # no robot yet: nothing to check against
+    said = (r"^q_ref: the posture task 'posture' holds 6 positions, the robot has 7 joints "
+            r"\(panda_joint1, panda_joint2, panda_joint3, \.\.\., panda_joint7\)")
+    before = resolver.warm_start_state()
+    for call in (lambda: resolver.solve(panda.ready(), [posture]),
+                 lambda: resolver.rows_of(posture, panda.ready())):  # fmt: skip
+        with pytest.raises(rrc_pin.InvalidInput, match=said):
+            call()
+    assert np.array_equal(resolver.warm_start_state()["last_qdot"], before["last_qdot"])
+
+
 def test_a_zero_command_says_it_was_held_or_traded() -> None:
     """The README's baxter case: the posture at its reference (a zero command) gives way to
     the hands (traded, scale 0; its scale read 1.0 and its level 'scaled' before); a posture
