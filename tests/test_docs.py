@@ -9,7 +9,6 @@ is checked beside it where it says a number (:data:`CHECKS`).
 from __future__ import annotations
 
 import re
-import sys
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
@@ -121,24 +120,6 @@ def test_the_readme_says_what_robot_accepts():
     """The README said Robot refuses free-flyer joints; it accepts one as the root."""
     text = (ROOT / "README.md").read_text()
     assert "refuses (a free flyer)" not in text and "a free-flyer root" in text
-
-
-def test_a_users_solvers_module_beside_a_script_does_not_break_the_import(tmp_path):
-    """Issue 40: a top-level package named ``solvers`` was shadowed by a user's solvers.py
-    (``ModuleNotFoundError: No module named 'solvers.errors'``)."""
-    (tmp_path / "solvers.py").write_text("raise RuntimeError('the user solvers.py was imported')\n")
-    (tmp_path / "script.py").write_text(
-        "import rrc_pin\n"
-        "arm = rrc_pin.load('panda')\n"
-        "r = rrc_pin.Resolver(arm).solve(arm.ready(), [0.0, 0.0, 0.01, 0.0, 0.0, 0.0])\n"
-        "print(r.status, type(rrc_pin.errors.InvalidInput('x', 'y')).__module__)\n"
-    )
-    import subprocess
-
-    done = subprocess.run([sys.executable, "script.py"], cwd=tmp_path, capture_output=True,
-                          text=True, timeout=300)  # fmt: skip
-    assert done.returncode == 0, done.stderr
-    assert done.stdout.split() == ["exact", "rrc_pin.solvers.errors"]
 
 
 def test_every_erratum_names_existing_tests():
