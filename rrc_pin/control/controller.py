@@ -207,19 +207,7 @@ class Controller(Loop):
             InvalidInput: A bad ``twist`` (shape, NaN, inf) or ``ref``, raised before any
                 state changes.
         """
-        if frame is not None:
-            warn_renamed("Controller.step(frame=)", "Controller.step(ref=)")
-            if ref is not None:
-                raise InvalidInput("frame", "the old name of ref: pass ref alone")
-            ref = frame
-        if twist is not None:
-            command = _checked_twist(twist)
-            self._command_frame = self._checked_ref("world_aligned" if ref is None else ref)
-            self._command, self._command_time = command, self.t
-            if ref is None:
-                self._warn_default()
-        elif ref is not None:
-            self._checked_ref(ref)
+        self._take(twist, ref, frame)
         weight = self._weight()
         given = self._command if weight == 1.0 else weight * self._command  # in ``ref``
         ref = self._command_frame
@@ -268,6 +256,30 @@ class Controller(Loop):
                                       factor * fraction * self.dt, "world_aligned")
         return self._advance(r)
 
+    def _take(
+        self, twist: npt.ArrayLike | None, ref: Reference | None, frame: Reference | None
+    ) -> None:
+        """Keep a new command and its frame, checked (the old keyword ``frame`` mapped).
+
+        Raises:
+            InvalidInput: A bad ``twist`` or ``ref``, or both ``ref`` and ``frame``, before
+                anything is kept.
+        """
+        if frame is not None:
+            warn_renamed("Controller.step(frame=)", "Controller.step(ref=)", stacklevel=4)
+            if ref is not None:
+                raise InvalidInput("frame", "the old name of ref: pass ref alone")
+            ref = frame
+        if twist is None:
+            if ref is not None:
+                self._checked_ref(ref)
+            return
+        command = _checked_twist(twist)
+        self._command_frame = self._checked_ref("world_aligned" if ref is None else ref)
+        self._command, self._command_time = command, self.t
+        if ref is None:
+            self._warn_default()
+
     def _checked_ref(self, ref: object) -> Reference:
         """``ref`` if it names a frame this controller's task can be commanded in.
 
@@ -291,7 +303,7 @@ class Controller(Loop):
                 "Controller.step(twist) without ref: the twist is in 'world_aligned' (base "
                 "axes), the default of every entry point; before this release the "
                 "controller's default was 'local' (hand axes). Pass ref= to choose and "
-                "silence this", FutureWarning, stacklevel=3,
+                "silence this", FutureWarning, stacklevel=4,
             )
 
     # -- what the loop asks of it -----------------------------------------------------------
