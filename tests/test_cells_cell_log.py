@@ -87,7 +87,8 @@ def test_the_csv_has_a_row_per_tick_with_the_chains_errors(tmp_path):
     assert len(text) == 4 and header[:5] == ["t", "mode", "status", "scale", "levels"]
     assert "grip:object" in header and "chain_position" in header and "qdot13" in header
     row = dict(zip(header, text[2].split(","), strict=True))
-    assert row["status"] == "partial" and float(row["error:object"]) < 1e-6
+    assert row["status"] == "exact" and row["levels"] == "met/traded"
+    assert float(row["error:object"]) < 1e-6
     assert float(row["chain_position"]) < 1e-8
     with pytest.raises(InvalidInput, match="path: expected a .csv"):
         ctl.save(tmp_path / "cell.npz")

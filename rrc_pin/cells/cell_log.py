@@ -18,22 +18,20 @@ import math
 import os
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, get_args
 
 import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.control.trajectory_log import CAPACITY, RecordRing, checked_path, reason
 from rrc_pin.errors import InvalidInput
+from rrc_pin.solvers.tick.pipeline import LevelStatus, Status
 
 Array = npt.NDArray[np.float64]
 
-STATUSES: tuple[str, ...] = (
-    "exact", "partial", "scaled", "sliding", "damped", "singular", "least_squares", "recovering",
-    "fallback", "grip_lost", "contact_lost",
-)  # fmt: skip
+STATUSES: tuple[str, ...] = get_args(Status)
 """The statuses a row codes, by index."""
-LEVEL_STATUSES = ("met", "scaled", "traded", "dropped")
+LEVEL_STATUSES: tuple[str, ...] = get_args(LevelStatus)
 MODES = ("teleop", "reverse")
 LEVELS = 4
 """Level statuses a row keeps (a cell's tick has two levels, the top and the posture)."""
