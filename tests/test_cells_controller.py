@@ -475,3 +475,16 @@ def test_setting_q_moves_the_targets_and_anchors_there(tripod):
     for _ in range(10):
         ctl.step()
     np.testing.assert_allclose(ctl.q, q, atol=1e-9)
+
+
+def test_the_former_closure_keywords_warn_and_still_work(dual):
+    with pytest.warns(DeprecationWarning, match=r"project_contacts=\) is deprecated.*closure="):
+        ctl = CellController(dual, 0.01, project_contacts=False)
+    assert ctl.closure is None
+    with pytest.warns(DeprecationWarning, match="project_contacts"):
+        assert CellController(dual, 0.01, project_contacts=True).closure == ClosureBound()
+    ctl = CellController(dual, 0.01)
+    step = ctl.step({"object": SPEED})
+    with pytest.warns(DeprecationWarning, match="contact_correction is deprecated"):
+        size = ctl.contact_correction
+    assert size == pytest.approx(np.abs(step.resolution.correction).max()) and size > 0.0

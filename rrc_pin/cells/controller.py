@@ -48,6 +48,7 @@ from rrc_pin.cells.cell_resolution import CellResolution
 from rrc_pin.cells.closure import Chains, ClosureBound, close
 from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.loop import Loop, Step
+from rrc_pin.deprecated import warn_renamed
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import ContactLimit, GripLimit, JointLimits, Limit
 from rrc_pin.limits.contact_limit import Closure
@@ -111,6 +112,7 @@ class CellController(Loop):
             tick's error taken out inside the step (:mod:`rrc_pin.cells.closure`); None: no
             correction and no bound (for comparison: the integration's remainder then adds
             up).
+        project_contacts: Deprecated (goes in the next release): False is ``closure=None``.
 
     Raises:
         InvalidInput: A bad argument, named.
@@ -137,7 +139,11 @@ class CellController(Loop):
         posture_gain: float = 0.1,
         coupled: bool = True,
         closure: ClosureBound | None = ClosureBound(),  # noqa: B008 - immutable
+        project_contacts: bool | None = None,
     ) -> None:
+        if project_contacts is not None:  # the former closure step's switch
+            warn_renamed("CellController(project_contacts=)", "CellController(closure=)")
+            closure = closure if project_contacts else None
         if isinstance(cell, str):
             cell = load(cell)  # type: ignore[assignment]
         if not isinstance(cell, Cell):
@@ -166,7 +172,7 @@ class CellController(Loop):
         self.log: CellLog = CellLog(cell.nq, cell.nv, commands, list(cell.objects))
         self.chain_error = (0.0, 0.0)
         """The closed chains' largest position [m] and rotation [rad] error at the last
-        tick's start (zero without chains, or with ``closure`` None)."""
+        tick's start (zero without chains)."""
         self.lost: Lost | None = None
         """``"grip_lost"`` or ``"contact_lost"`` while a chain is open beyond its bound (the
         cell then holds still until a command closes it), else None."""
@@ -177,6 +183,7 @@ class CellController(Loop):
         self._targets: dict[str, Array] = {}
         self._tick: tuple[str, bool, dict[str, Array]] = ("teleop", False, {})
         self._applied = np.zeros(cell.nv)
+        self._correction_size = 0.0
         self._data = cell.model.createData()  # the closure's second-order pass
         self._frames = frame_index(cell.model)
         self._close_at()
@@ -369,6 +376,17 @@ class CellController(Loop):
         """Write the log as CSV to ``path`` (:meth:`CellLog.save`); return the path."""
         return self.log.save(path)
 
+    @property
+    def contact_correction(self) -> float:
+        """The former closure step's size (deprecated: goes in the next release).
+
+        The largest rate of the last tick's correction [rad/s or m/s]; each tick's whole
+        correction is its resolution's ``correction`` (:class:`CellResolution`).
+        """
+        warn_renamed("CellController.contact_correction",
+                     "CellController.step(...).resolution.correction", stacklevel=2)  # fmt: skip
+        return self._correction_size
+
     # -- the closed chains ------------------------------------------------------------------
 
     def _close_at(self) -> None:
@@ -385,12 +403,9 @@ class CellController(Loop):
 
     def _chains(self) -> None:
         """The contact and grip limits set to the support's anchors and the grips."""
-        measured = self.closure is not None
-        self.contact.set_frames(self.support, [self._anchors[f] for f in self.support]
-                                if measured else None)  # fmt: skip
+        self.contact.set_frames(self.support, [self._anchors[f] for f in self.support])
         grasps = [self.cell.objects[n] for n in self._grips]
-        grips = [self._grips[g.name] for g in grasps] if measured else None
-        self.grip.set_pairs([g.hands for g in grasps], grips)
+        self.grip.set_pairs([g.hands for g in grasps], [self._grips[g.name] for g in grasps])
 
     def _closed(self, r: Resolution) -> CellResolution:
         """``r`` with the closed chains' correction, or held still while one is lost.
@@ -404,15 +419,21 @@ class CellController(Loop):
         until the chain is back within the bound.
         """
         self._applied = r.qdot
+        self._correction_size = 0.0
         self.chain_error = (0.0, 0.0)
         hands = self._hands(r)
-        bound = self.closure
         measured: list[tuple[Closure | None, Lost]] = [(self.contact.last, "contact_lost"),
                                                       (self.grip.last, "grip_lost")]  # fmt: skip
         parts = [(last, kind) for last, kind in measured if last is not None]
-        if bound is None or not parts:
+        if not parts:
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
         closure = Closure(*(np.concatenate([c[i] for c, _ in parts]) for i in range(3)))
+        e = closure.error.reshape(-1, 6)
+        self.chain_error = (float(np.linalg.norm(e[:, :3], axis=1).max()),
+                            float(np.linalg.norm(e[:, 3:], axis=1).max()))  # fmt: skip
+        bound = self.closure
+        if bound is None:
+            return CellResolution.of_tick(r, r.qdot.copy(), hands)
         ids = self._frames
         chains = Chains(closure, tuple(ids[f] for f in self.contact.frames),
                         tuple((ids[a], ids[b]) for a, b in self.grip.pairs))  # fmt: skip
@@ -421,9 +442,6 @@ class CellController(Loop):
         box = r.problem.box
         delta, after = close(self.cell.model, self._data, self._pinocchio_q(self._q), chains,
                              r.qdot, top, box, r.problem.rows, self.dt)  # fmt: skip
-        e = closure.error.reshape(-1, 6)
-        self.chain_error = (float(np.linalg.norm(e[:, :3], axis=1).max()),
-                            float(np.linalg.norm(e[:, 3:], axis=1).max()))  # fmt: skip
         level = bound.level(closure.error)
         if level <= 1.0:
             self.lost = None
@@ -438,6 +456,7 @@ class CellController(Loop):
             return CellResolution.of_tick(r._replace(qdot=still, status=self.lost, scale=0.0,
                                                 veer=0.0), still.copy(), hands)  # fmt: skip
         self._applied = box.clip(r.qdot + delta)  # inside the box as the resolver's rates are
+        self._correction_size = float(np.abs(self._applied - r.qdot).max())
         return CellResolution.of_tick(r, self._applied, hands)
 
     def _hands(self, r: Resolution) -> Callable[[], tuple[TaskRows, ...]] | None:
