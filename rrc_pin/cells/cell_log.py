@@ -1,7 +1,7 @@
 """CellLog: a cell's ticks as rows of one packed array, a few hundred bytes a tick.
 
 Every tick of a :class:`~rrc_pin.cells.CellController` is one row of a numpy structured array
-(:meth:`CellLog.dtype`): the time, q and the rates applied (float64, exact: ``reverse``
+(:attr:`CellLog.dtype`): the time, q and the rates applied (float64, exact: ``reverse``
 retraces them), the top level's scale, each command's pose error, each grip's error, the
 closed chains' largest errors, and the status, mode and level statuses as one-byte codes. No
 Python object is kept per tick: gsfc_dual's row is 294 bytes, yeh_tripod's 462, so that the

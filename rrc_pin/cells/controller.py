@@ -2,9 +2,9 @@ r"""CellController: one tick of a cell, one command per object, body or free han
 
 What each command becomes (the cooperative commands):
 
-- an **object** held by two hands: its frame's twist with a target pose, and the grip (the
-  second hand's pose relative to the first, a :class:`~rrc_pin.tasks.RelativeFrameTask`
-  with the grasp as its target), both in the top level. The top level is the resolver's
+- an **object** held by two hands: its frame's twist with a target pose in the top level,
+  the grip (the second hand's relative twist zero, :class:`~rrc_pin.limits.GripLimit`)
+  equality rows that every level is solved within. The top level is the resolver's
   direction problem, :math:`\max s` with :math:`A\dot q = s\,b`: when an arm meets a limit
   or a singularity, both hands slow together by one common scale along the commanded
   direction and the grip is never stretched. ``coupled=False`` instead resolves each hand on
@@ -23,6 +23,11 @@ frame's own axes; ``"base"``: the arm's base axes, for a hand). The target poses
 drift correction: each advances by the command times the achieved scale, and the tasks feed
 their pose error back (gain ``gain``). Below the top level a posture task pulls toward the
 ready pose (the redundancy's use).
+
+The closed chains (grips, feet in support) are kept closed inside each tick: the error
+each shows at the tick's configuration and the step's second order are taken out by a
+correction inside the tick's box (:mod:`rrc_pin.cells.closure`), and a chain open beyond its
+bound stops the cell (``grip_lost`` / ``contact_lost``) until a command closes it.
 
 The loop itself is :class:`~rrc_pin.control.loop.Loop`, the one
 :class:`~rrc_pin.control.Controller` is built on: the speed override and the deadman weight
@@ -85,7 +90,8 @@ LOST: tuple[Lost, ...] = ("grip_lost", "contact_lost")
 
 
 CellStep = Step
-"""One tick's outcome: the configuration after it (nq,) and the resolution."""
+"""One tick's outcome: the configuration after it (nq,) and its resolution (a
+:class:`~rrc_pin.cells.cell_resolution.CellResolution`)."""
 
 
 class CellController(Loop):
