@@ -240,7 +240,7 @@ def docs_section(results: dict[str, Any]) -> str:
         "The tick is the whole Python step: the commands checked and weighted (speed, deadman), "
         "the frames' kinematics, the tasks with their targets, the resolver (with the grip's "
         "or the contacts' equality rows and, with collision, the pairs' distances and rows), "
-        "the closed chains' correction and the integration, the log's record. A loop at the "
+        "the integration and the closed chains' projection, the log's record. A loop at the "
         "rate in the p99 column misses no deadline on this machine 99 % of the time.",
     ]
     return "\n".join(lines)
