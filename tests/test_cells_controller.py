@@ -161,7 +161,7 @@ def test_the_tripod_sent_sideways_is_scaled_not_damped(tripod):
     of 300 ticks damped (the floating body's rows read a condition number of 284 in a metric
     of 0.01 m, 5 in metres), veer up to 0.80 rad, the body 63 mm off the line and turned
     0.452 rad, joints at up to 1.012 times their velocity limits. Now: scaled along the
-    command, the body on its line, no joint beyond its limit."""
+    command, the body on its line (0.3 mm, 0.0016 rad), no joint beyond its limit."""
     twist = [0.0, 0.25, 0.0, 0.0, 0.0, 0.0]
     _, T0, ticks = _body_run(tripod, twist)
     statuses = [r.status for r, *_ in ticks]
