@@ -4,6 +4,7 @@ from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.damping_task import DampingTask
 from rrc_pin.tasks.frame_task import FrameTask
 from rrc_pin.tasks.joint_task import JointTask
+from rrc_pin.tasks.manipulability_task import ManipulabilityTask
 from rrc_pin.tasks.posture_task import PostureTask
 from rrc_pin.tasks.relative_frame_task import RelativeFrameTask
 from rrc_pin.tasks.task import Task
@@ -12,6 +13,7 @@ __all__ = [
     "DampingTask",
     "FrameTask",
     "JointTask",
+    "ManipulabilityTask",
     "PostureTask",
     "RelativeFrameTask",
     "Task",
