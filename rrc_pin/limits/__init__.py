@@ -6,6 +6,7 @@ from rrc_pin.limits.grip_limit import GripLimit
 from rrc_pin.limits.joint_limits import JointLimits
 from rrc_pin.limits.limit import Limit
 from rrc_pin.limits.singularity_limit import SingularityLimit
+from rrc_pin.limits.support_polygon_limit import SupportPolygonLimit
 
 __all__ = [
     "CollisionLimit",
@@ -14,4 +15,5 @@ __all__ = [
     "JointLimits",
     "Limit",
     "SingularityLimit",
+    "SupportPolygonLimit",
 ]

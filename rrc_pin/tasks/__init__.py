@@ -2,6 +2,7 @@
 
 from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.axis_align_task import AxisAlignTask
+from rrc_pin.tasks.com_task import ComTask
 from rrc_pin.tasks.damping_task import DampingTask
 from rrc_pin.tasks.frame_task import FrameTask
 from rrc_pin.tasks.joint_task import JointTask
@@ -13,6 +14,7 @@ from rrc_pin.tasks.task import Task
 
 __all__ = [
     "AxisAlignTask",
+    "ComTask",
     "DampingTask",
     "FrameTask",
     "JointTask",
