@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from rrc_pin.combined import combine
     from rrc_pin.control import Controller, Deadman, DriftCorrection, TrajectoryLog
     from rrc_pin.control.pose_stream import PoseStream, StreamOptions
+    from rrc_pin.control.smoothing import JerkLimiter
     from rrc_pin.errors import (
         FrameNotFound,
         InvalidInput,
@@ -78,6 +79,7 @@ __all__ = [
     "FrameTask",
     "GripLimit",
     "InvalidInput",
+    "JerkLimiter",
     "JointLimits",
     "JointTask",
     "Limit",
@@ -129,6 +131,7 @@ _HOME: dict[str, str] = {
     "FrameTask": "rrc_pin.tasks",
     "GripLimit": "rrc_pin.limits",
     "InvalidInput": "rrc_pin.errors",
+    "JerkLimiter": "rrc_pin.control.smoothing",
     "JointLimits": "rrc_pin.limits",
     "JointTask": "rrc_pin.tasks",
     "Limit": "rrc_pin.limits",
