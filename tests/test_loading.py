@@ -351,3 +351,11 @@ def test_an_xml_that_is_neither_urdf_nor_mjcf_is_refused(tmp_path):
     with pytest.raises(URDFError) as info:
         rrc_pin.load(path)
     assert "MJCF" in str(info.value) and "<sdf>" in str(info.value)
+
+
+def test_a_malformed_mjcf_gives_path_and_parser_message(tmp_path):
+    path = tmp_path / "broken.xml"
+    path.write_text('<mujoco><worldbody><body><joint type="warp"/></body></worldbody></mujoco>')
+    with pytest.raises(URDFError) as info:
+        rrc_pin.load(path)
+    assert str(path) in str(info.value) and "Pinocchio could not parse it" in str(info.value)

@@ -112,8 +112,10 @@ class StreamOptions:
             raise InvalidInput("settle", f"expected an integer >= 1, got {self.settle!r}")
         axes = np.eye(4)
         if self.device_axes is not None:
-            axes[:3, :3] = real_array(self.device_axes, "device_axes").reshape(3, 3) if np.shape(
-                self.device_axes) == (3, 3) else np.full((3, 3), np.nan)  # fmt: skip
+            if np.shape(self.device_axes) != (3, 3):
+                raise InvalidInput("device_axes", f"expected a rotation (3, 3), got shape "
+                                   f"{np.shape(self.device_axes)}")  # fmt: skip
+            axes[:3, :3] = real_array(self.device_axes, "device_axes")
             rigid_transform(axes, "device_axes")
         object.__setattr__(self, "device_axes", axes[:3, :3].copy())
         if (self.lower is None) != (self.upper is None):
@@ -210,6 +212,11 @@ class PoseStream:
 
         Pressed, the hand holds its target while the device moves; released, the device is
         anchored where it is and the hand where its target is (no step).
+
+        Args:
+            pressed: The clutch's state now.
+            t: The time [s] recorded in :attr:`anchors` for a release (default the last
+                sample's).
 
         Raises:
             InvalidInput: ``pressed`` not a bool.
