@@ -19,8 +19,8 @@ exactly, as they did for the resolver's answer); where that clip changes the rat
 acceleration or jerk bound is broken for safety and the tick says so
 (:attr:`Smoothed.clipped`). To make that rare, given the joints' position limits and
 positions, a joint is slowed before a limit to a rate from which it can stop in the distance
-:math:`d` left (:math:`v^2/(2a_{max}) + v\,(a_{max}/j_{max} + \Delta t) \le d`): the
-resolver's box shows a position limit only within one step of it.
+:math:`d` left (:math:`v^2/(2a_b) + v\,(a_{max}/j_{max} + 2\Delta t) \le d`, :math:`a_b` half
+of :math:`a_{max}`): the resolver's box shows a position limit only within one step of it.
 
 **STOP.** :meth:`JerkLimiter.stop` commands zero rates: from rates :math:`v` and
 accelerations within the bounds the joints stand still (below 1e-9) within
@@ -48,6 +48,11 @@ Array = npt.NDArray[np.float64]
 
 STILL = 1e-9
 """[rad/s or m/s] A rate below this stands still (STOP's criterion)."""
+
+BRAKE = 0.5
+"""The fraction of a_max the braking before a position limit plans with: the rest is the
+filter's reserve to follow its own target down (planned with all of it, the rates trailed
+the braking curve and the box won for two ticks in one session of 40)."""
 
 
 class Smoothed(NamedTuple):
@@ -162,7 +167,7 @@ class JerkLimiter:
         """``command`` slowed where a position limit is near (module docstring)."""
         if position is None or self._lower is None or self._upper is None:
             return command
-        a, lead = self.a_max, self.a_max / self.j_max + self.dt
+        a, lead = BRAKE * self.a_max, self.a_max / self.j_max + 2.0 * self.dt
         out: Array = command.copy()
         for distance, sign in ((self._upper - position, 1.0), (position - self._lower, -1.0)):
             d = np.maximum(distance, 0.0)
