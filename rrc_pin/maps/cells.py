@@ -171,6 +171,7 @@ def cell_map(
     dexterity: bool = True,
     progress: ProgressArg = True,
     block_size: int = BLOCK,
+    dashboard: str | None = None,
 ) -> CellMap:
     """The map of every tool frame of ``cell`` on one grid, and their combination.
 
@@ -184,6 +185,7 @@ def cell_map(
         dexterity: As :func:`~rrc_pin.maps.capability`.
         progress: As :func:`~rrc_pin.maps.capability` (one bar per frame).
         block_size: As :func:`~rrc_pin.maps.capability`.
+        dashboard: As :func:`~rrc_pin.maps.capability`.
         out: Folder: each frame's map in ``<index>_<frame>/`` (resumable each) and the
             cell's ``summary.md``/``.json`` (plots: :func:`~rrc_pin.maps.plot_cell`).
 
@@ -205,7 +207,7 @@ def cell_map(
         maps.append(capability(
             robot, samples, float(voxel), scheduler, seed=seed, out=sub, workers=workers,
             dexterity=dexterity, frame=frame, progress=progress, block_size=block_size,
-            grid=grid,
+            grid=grid, dashboard=dashboard,
         ))  # fmt: skip
     result = CellMap(robot.name, tuple(robot.tool_frames), tuple(maps))
     if folder is not None:

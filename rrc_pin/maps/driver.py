@@ -1,10 +1,16 @@
 """The Dask driver: blocks to tasks, tasks to workers, results merged and written as they come.
 
-- **Scheduler.** ``None``: an in-process ``distributed.LocalCluster`` of ``workers`` threads
-  (no set-up; the compiled kernels release the GIL, so the threads run side by side); an
-  address (``tcp://host:8786``): that cluster, connected with a short timeout (an address
-  where no scheduler answers fails in :data:`CONNECT_TIMEOUT` seconds with
-  :class:`~rrc_pin.errors.SchedulerUnreachable`); or a ``distributed.Client`` already open.
+- **Scheduler.** ``None``: an in-process cluster of one worker of ``workers`` threads (no
+  set-up; the compiled kernels release the GIL, so the threads run side by side), talking
+  in-process (no socket); an address (``tcp://host:8786``): that cluster, connected with a
+  short timeout (an address where no scheduler answers fails in :data:`CONNECT_TIMEOUT`
+  seconds with :class:`~rrc_pin.errors.SchedulerUnreachable`); or a ``distributed.Client``
+  already open.
+- **Sockets.** The in-process scheduler and worker each start an HTTP server (distributed
+  always does, whatever ``dashboard_address``): both listen on :data:`LOOPBACK` at a free
+  port and serve nothing (no routes), unless the caller asks for the dashboard
+  (``dashboard="host:port"``; a port alone or ``":port"`` is on 127.0.0.1 too; an address
+  of every interface only when named, ``"0.0.0.0:8787"``).
 - **Tasks.** Runs of consecutive blocks (at most :data:`MAX_BLOCKS_PER_TASK`); each task
   draws its blocks' samples, evaluates them and accumulates them into a hash table of voxels
   on the worker, and ships only the voxels it reached (a sparse result). At most two tasks
@@ -36,6 +42,8 @@ from rrc_pin.maps.progress import Progress
 from rrc_pin.maps.voxels import VoxelStats
 from rrc_pin.solvers.maps.work import Job, TaskResult, compute_blocks
 
+LOOPBACK = "127.0.0.1"
+"""Where the servers of an in-process cluster listen, unless the caller names a host."""
 CONNECT_TIMEOUT = 3.0
 """[s] How long to wait for a scheduler at an address."""
 MAX_BLOCKS_PER_TASK = 8
@@ -52,11 +60,11 @@ def _distributed() -> Any:
     return distributed
 
 
-def check_scheduler(scheduler: object, workers: int | None) -> None:
-    """Refuse a scheduler argument of the wrong type, or workers with a remote scheduler.
+def check_scheduler(scheduler: object, workers: int | None, dashboard: object = None) -> None:
+    """Refuse a bad scheduler argument, or workers or a dashboard beside a remote scheduler.
 
     Raises:
-        InvalidInput: Naming ``scheduler`` or ``workers``.
+        InvalidInput: Naming ``scheduler``, ``workers`` or ``dashboard``.
     """
     if scheduler is not None:
         if isinstance(scheduler, str):
@@ -72,15 +80,37 @@ def check_scheduler(scheduler: object, workers: int | None) -> None:
             raise InvalidInput(
                 "workers", "sets the local scheduler's threads; a cluster has its own workers"
             )
+        if dashboard is not None:
+            raise InvalidInput("dashboard", "a cluster serves its own dashboard")
     elif workers is not None and (
         isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
     ):
         raise InvalidInput("workers", f"expected an int >= 1, got {workers!r}")
+    if dashboard is not None:
+        dashboard_address(dashboard)
+
+
+def dashboard_address(dashboard: object) -> str:
+    """``host:port`` of the dashboard asked for: ``"8787"`` and ``":8787"`` on :data:`LOOPBACK`.
+
+    Raises:
+        InvalidInput: Naming ``dashboard``: not a string ``[host]:port``, port 0 to 65535.
+    """
+    text = dashboard if isinstance(dashboard, str) else ""
+    host, _, port = text.rpartition(":")
+    if not port.isdigit() or int(port) > 65535 or any(c.isspace() or c == "/" for c in host):
+        raise InvalidInput(
+            "dashboard", f"expected an address 'host:port' or a port, got {dashboard!r}"
+        )
+    return f"{host or LOOPBACK}:{int(port)}"
 
 
 @contextlib.contextmanager
 def connect(
-    scheduler: object, workers: int | None, timeout: float = CONNECT_TIMEOUT
+    scheduler: object,
+    workers: int | None,
+    timeout: float = CONNECT_TIMEOUT,
+    dashboard: str | None = None,
 ) -> Iterator[Any]:
     """A ``distributed.Client`` for ``scheduler`` (see the module docstring), closed after.
 
@@ -90,18 +120,8 @@ def connect(
     """
     distributed = _distributed()
     if scheduler is None:
-        import os
-
-        threads = workers if workers is not None else (os.cpu_count() or 1)
-        cluster = distributed.LocalCluster(
-            n_workers=1, threads_per_worker=threads, processes=False, dashboard_address=None
-        )
-        client = distributed.Client(cluster)
-        try:
+        with local_cluster(workers, dashboard) as cluster, distributed.Client(cluster) as client:
             yield client
-        finally:
-            client.close()
-            cluster.close()
         return
     if not isinstance(scheduler, str):  # a Client the caller owns
         yield scheduler
@@ -114,6 +134,37 @@ def connect(
         yield client
     finally:
         client.close()
+
+
+def local_cluster(workers: int | None, dashboard: str | None = None) -> Any:
+    """The in-process cluster: one worker of ``workers`` threads (default: the cores).
+
+    A ``distributed.SpecCluster`` of one ``Scheduler`` and one ``Worker`` (what
+    ``LocalCluster(processes=False)`` builds, but with the HTTP servers' addresses and the
+    dashboard set apart: ``LocalCluster`` ties the worker's dashboard to its address, and
+    binds every interface when given none).
+    """
+    import logging
+    import os
+
+    import dask
+
+    distributed = _distributed()
+    loopback = f"{LOOPBACK}:0"
+    threads = workers if workers is not None else (os.cpu_count() or 1)
+    config: dict[str, Any] = {"distributed.worker.http.routes": []}
+    if dashboard is None:
+        config["distributed.scheduler.http.routes"] = []
+    inproc = {"protocol": "inproc://", "dashboard": False, "dashboard_address": loopback}
+    scheduler = {**inproc}
+    if dashboard is not None:
+        scheduler.update(dashboard=True, dashboard_address=dashboard_address(dashboard))
+    with dask.config.set(config):  # read as the servers start, inside the constructor
+        return distributed.SpecCluster(
+            scheduler={"cls": distributed.Scheduler, "options": scheduler},
+            workers={0: {"cls": distributed.Worker, "options": {**inproc, "nthreads": threads}}},
+            silence_logs=logging.WARNING,
+        )
 
 
 @dataclass
