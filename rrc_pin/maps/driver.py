@@ -22,8 +22,9 @@
   default 8 blocks a task, under 80 MB (130 MB for barker6) in the worst case, 10-30 MB for
   panda at 5 cm. Measured per task and recorded (``meta["memory"]``).
 - **Driver.** Dense statistics of the grid (:class:`~rrc_pin.maps.voxels.VoxelStats`); each
-  result is merged as it arrives and, with an output folder, written as a part at once;
-  checkpoints fold the parts every :data:`CHECKPOINT_PARTS` parts (:mod:`rrc_pin.maps.blocks`).
+  result is merged as it arrives and, with an output folder, written as a part at once; every
+  :data:`FOLD_PARTS` parts are folded into one file (:mod:`rrc_pin.maps.blocks`), and the
+  last ones at the end.
 - **Interruption.** Any exception (Ctrl-C included) cancels the tasks in flight and leaves
   what completed on disk; the same call resumes.
 """
@@ -33,7 +34,7 @@ from __future__ import annotations
 import contextlib
 import time
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from rrc_pin.errors import InvalidInput, MissingExtra, SchedulerUnreachable
@@ -48,8 +49,8 @@ CONNECT_TIMEOUT = 3.0
 """[s] How long to wait for a scheduler at an address."""
 MAX_BLOCKS_PER_TASK = 8
 """Blocks per task at most (2^18 samples at the default block size)."""
-CHECKPOINT_PARTS = 32
-"""Parts written between two checkpoints."""
+FOLD_PARTS = 32
+"""Parts folded into one file (so a damaged fold costs at most this many tasks again)."""
 
 
 def _distributed() -> Any:
@@ -180,6 +181,8 @@ class RunReport:
         threads: Worker threads of the cluster.
         worker_memory: Largest buffers + table of one task [bytes].
         driver_memory: The driver's dense statistics [bytes].
+        damaged: Files of the output folder's blocks found damaged or missing, repaired
+            (their blocks computed again).
     """
 
     blocks_resumed: int = 0
@@ -190,6 +193,7 @@ class RunReport:
     threads: int = 0
     worker_memory: int = 0
     driver_memory: int = 0
+    damaged: list[str] = field(default_factory=list)
 
 
 def run(
@@ -216,11 +220,11 @@ def run(
     """
     distributed = _distributed()
     if store is not None:
-        store.create()
         stats, done = store.load()
     else:
         stats, done = VoxelStats.empty(size, job.fields), set()
-    report = RunReport(blocks_resumed=len(done), driver_memory=stats.nbytes)
+    report = RunReport(blocks_resumed=len(done), driver_memory=stats.nbytes,
+                       damaged=list(store.damaged) if store is not None else [])  # fmt: skip
     todo = [b for b in range(job.plan.blocks) if b not in done]
     report.threads = threads = max(sum(client.nthreads().values()), 1)
     if per_task is None:
@@ -240,7 +244,7 @@ def run(
             in_flight.add(future)
             window.add(future)
 
-    since_checkpoint = 0
+    since_fold = 0
     try:
         for _ in range(2 * threads):
             submit()
@@ -252,10 +256,10 @@ def run(
             done.update(result.blocks)
             if store is not None:
                 store.write_part(result.blocks, result.part)
-                since_checkpoint += 1
-                if since_checkpoint >= CHECKPOINT_PARTS:
-                    store.checkpoint(stats, done)
-                    since_checkpoint = 0
+                since_fold += 1
+                if since_fold >= FOLD_PARTS:
+                    store.fold()
+                    since_fold = 0
             report.tasks += 1
             report.blocks_computed += len(result.blocks)
             report.compute_seconds += result.seconds
@@ -267,7 +271,7 @@ def run(
     except BaseException:
         client.cancel(list(in_flight))
         raise
-    if store is not None and since_checkpoint:
-        store.checkpoint(stats, done)
+    if store is not None:
+        store.fold()
     report.wall_seconds = time.perf_counter() - start
     return stats, report
