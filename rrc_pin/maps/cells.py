@@ -57,9 +57,11 @@ class CellQuery(NamedTuple):
     combined_manipulability: Array
 
 
-@dataclass
+@dataclass(repr=False)
 class CellMap:
     """The maps of a cell's tool frames on one grid, and their combination.
+
+    Its ``repr`` is a one-line summary.
 
     Attributes:
         name: The cell (robot) name.
@@ -70,6 +72,14 @@ class CellMap:
     name: str
     frames: tuple[str, ...]
     maps: tuple[CapabilityMap, ...]
+
+    def __repr__(self) -> str:
+        shared = np.count_nonzero(self.shared) * self.grid.voxel**3
+        return (
+            f"CellMap({self.name!r}, frames={list(self.frames)}, "
+            f"samples={int(self.maps[0].meta.get('samples', 0)):,} per frame, "
+            f"voxel={self.grid.voxel} m, shared {shared:.4g} m^3)"
+        )
 
     @property
     def grid(self) -> Grid:

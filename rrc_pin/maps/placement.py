@@ -55,9 +55,9 @@ def placements_grid(
     return np.array(out)
 
 
-@dataclass
+@dataclass(repr=False)
 class PlacementSearch:
-    """Scores of the candidate placements of the second arm.
+    """Scores of the candidate placements of the second arm (its ``repr``, a summary).
 
     Attributes:
         placements: Candidate base poses (K, 4, 4).
@@ -75,6 +75,15 @@ class PlacementSearch:
     region: Grid
     min_coverage: float
     seconds: float = 0.0
+
+    def __repr__(self) -> str:
+        k = self.best
+        x, y, z = self.placements[k][:3, 3]
+        return (
+            f"PlacementSearch({len(self.placements):,} placements, best #{k} at "
+            f"({x:.3f}, {y:.3f}, {z:.3f}) m: {self.shared_volume[k]:.4g} m^3 shared dexterous, "
+            f"{self.seconds:.1f} s)"
+        )
 
     @property
     def best(self) -> int:
