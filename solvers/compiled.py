@@ -16,9 +16,9 @@ Where the machine code is cached, first writable place first:
 
 So a read-only install with a read-only home still imports and runs. A cache entry that
 cannot be read back (truncated, empty, random bytes, unreadable, a directory in its place)
-is a miss: its function's index is reset and the kernel compiled again, the new entry
-written over the old where the folder is writable; where it is not, caching is off for that
-kernel in this process. Nothing the cache holds can make an import or a call fail.
+is a miss: the kernel is compiled again and the new entry written over the old where the
+folder is writable (a damaged index emptied first); where it is not, caching is off for
+that kernel in this process. Nothing the cache holds can make an import or a call fail.
 
 numba offers no public hook on reading a cache entry (a damaged one raises from inside
 ``Dispatcher.compile``, whatever pickle or LLVM raise), so two of its internals are used:
@@ -36,6 +36,7 @@ import functools
 import os
 import stat
 import tempfile
+import threading
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any, TypeVar, cast, overload
@@ -51,32 +52,38 @@ FunctionCache: Any = caching.FunctionCache
 
 PRIVATE_PREFIX = "rrc-pin-numba-"
 """Name of the fallback cache folder in the temporary directory, before the user id."""
+_SETTING = threading.Lock()
+"""Held while ``numba.config.CACHE_DIR`` is changed (modules may be imported in threads)."""
 
 
 class GuardedCache(FunctionCache):  # type: ignore[misc]  # an untyped base
     """numba's cache of one function, where a damaged entry is a miss and never an error."""
 
     def load_overload(self, sig: Any, target_context: Any) -> Any:
-        """The cached compile result of ``sig``, or None (not cached, or not readable)."""
+        """The cached compile result of ``sig``, or None (not cached, or not readable).
+
+        None makes numba compile ``sig`` and save it: over the damaged data file, where the
+        index is whole.
+        """
         try:
             return super().load_overload(sig, target_context)
         except Exception:  # a damaged entry raises whatever unpickling or LLVM raise
-            self.reset()
             return None
 
     def save_overload(self, sig: Any, data: Any) -> None:
-        """Write the compile result of ``sig``; a folder that refuses it turns caching off."""
+        """Write the compile result of ``sig``.
+
+        numba reads the function's index before writing it: a damaged index is emptied and
+        the write tried once more; a folder that refuses both turns caching off.
+        """
         try:
             super().save_overload(sig, data)
-        except Exception:  # the index or folder cannot be written: compile in memory
-            self.disable()
-
-    def reset(self) -> None:
-        """Empty the function's index (so the next save rewrites it), or stop caching."""
-        try:
-            self.flush()
-        except Exception:  # read-only folder, or a directory where the index should be
-            self.disable()
+        except Exception:  # a damaged index, or an unwritable folder
+            try:
+                self.flush()
+                super().save_overload(sig, data)
+            except Exception:  # read-only, or a directory where a file should be
+                self.disable()
 
 
 @overload
@@ -111,21 +118,22 @@ def kernel(function: Callable[..., Any] | None = None, /, *, nogil: bool = False
 
 def function_cache(f: Callable[..., Any]) -> GuardedCache | None:
     """The cache of ``f`` in the first writable place (module docstring), or None."""
-    try:
-        return GuardedCache(f)
-    except (RuntimeError, OSError):  # numba's "cannot cache function ...: no locator"
-        pass
-    folder = private_folder()
-    if folder is None:
-        return None
-    saved = numba_config.CACHE_DIR
-    numba_config.CACHE_DIR = str(folder)
-    try:
-        return GuardedCache(f)
-    except (RuntimeError, OSError):
-        return None
-    finally:
-        numba_config.CACHE_DIR = saved
+    with _SETTING:
+        try:
+            return GuardedCache(f)
+        except (RuntimeError, OSError):  # numba's "cannot cache function ...: no locator"
+            pass
+        folder = private_folder()
+        if folder is None:
+            return None
+        saved = numba_config.CACHE_DIR
+        numba_config.CACHE_DIR = str(folder)
+        try:
+            return GuardedCache(f)
+        except (RuntimeError, OSError):
+            return None
+        finally:
+            numba_config.CACHE_DIR = saved
 
 
 @functools.cache
