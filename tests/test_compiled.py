@@ -189,8 +189,8 @@ def signatures(result: dict) -> set[tuple[str, str]]:
 
 
 def recompiled(result: dict, seen: set[tuple[str, str]]) -> set[str]:
-    """The kernels a run compiled again for a signature cached before (a new one may come:
-    the QP's time cap can take another path under load)."""
+    """The kernels a run compiled again for a signature cached before (a signature new to the
+    cache may be compiled for the first time: not every run takes the same paths)."""
     return {k for k, (_, _, misses) in result["kernels"].items()
             if any((k, sig) in seen for sig in misses)}  # fmt: skip
 
