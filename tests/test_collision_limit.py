@@ -13,7 +13,7 @@ import pytest
 import rrc_pin
 from rrc_pin import CollisionLimit, CollisionModel, FrameTask, InvalidInput, JointLimits, Resolver
 from rrc_pin.kinematics import Kinematics, Layout
-from rrc_pin.solvers.collision.damper_kernels import damper_rows
+from rrc_pin.solvers.collision.damper_kernels import SLACK, damper_rows
 
 DT = 0.01
 
@@ -99,13 +99,14 @@ def test_the_compiled_rows_equal_the_formula_written_in_numpy():
     pa, pb, nrm = rng.normal(size=(k, 3)), rng.normal(size=(k, 3)), rng.normal(size=(k, 3))
     nrm /= np.linalg.norm(nrm, axis=1)[:, None]
     d = rng.uniform(-0.05, 0.1, k)
+    d[3], d[6] = 0.0195, 0.0185  # pushed back out, from 0.5 mm and 1.5 mm below d_s
     ja[5], jb[5] = 0, 0  # no joint moves either body: not moved
     pair = np.array([0, 0, 0, 1, 2, 2, 3])  # a pair's own row, then its end points'
     d[0] = 0.05
     d[1], d[2] = d[0] + 0.001, d[0] + 0.02  # an end 1 mm farther than its pair's, one 20 mm
     G, h, moved = np.empty((k, nv)), np.empty(k), np.empty(k, dtype=np.bool_)
     unmoved = damper_rows(J, support, ja, jb, pa, pb, nrm, d, pair, 0.02, 0.1, 0.5, 4.0, 0.005,
-                          50.0, 1e-9, G, h, moved)  # fmt: skip
+                          0.001, 50.0, 1e-9, G, h, moved)  # fmt: skip
     own = {}
     for r in range(k):
         row = [support[j] * (nrm[r] @ J[:3] + np.cross(p, nrm[r]) @ J[3:])
@@ -115,8 +116,11 @@ def test_the_compiled_rows_equal_the_formula_written_in_numpy():
         first = own.setdefault(pair[r], r)
         xi = 0.5 + 3.5 * min(max((d[r] - d[first]) / 0.005, 0.0), 1.0)
         gap = d[r] - 0.02
-        want = xi * gap / 0.08 if gap >= 0 else max(50.0 * gap, -xi) if gap < -1e-6 else 0.0
-        assert h[r] == pytest.approx(want, abs=1e-15)
+        if gap > -1e-6:  # outside d_s (or a rounding below): the damper, or held
+            want = max(xi * gap / 0.08, SLACK)
+        else:  # within 2 mm below d_s pushed back (up to 1 mm, then less), else no decrease
+            want = min(-50.0 * max(min(-gap, 0.002 + gap), 0.0), SLACK)
+        assert h[r] == pytest.approx(max(want, -xi), abs=1e-15)
     assert not moved[5] and unmoved == k - np.count_nonzero(moved)
     assert h[1] == pytest.approx((0.5 + 3.5 * 0.2) * (d[1] - 0.02) / 0.08)  # BLEND 5 mm
 
@@ -169,7 +173,11 @@ def test_commanded_away_from_the_table_the_hand_is_never_slowed():
     assert len(away[0][3].names) > 0  # the pairs were within detection: rows, not binding
 
 
-def test_a_start_inside_the_safety_distance_recovers():
+def test_a_start_inside_the_table_never_holds_and_leaves_at_the_commands_pace():
+    """The hand 1 cm into the table (30 mm inside the safety distance): commanded up, it moves
+    from the first tick at the command (exact, scale 1) and the distance grows by the command's
+    0.1 m/s until the pair is out (0.3 s, a tick to spare); commanded still, it stays; commanded
+    down into the table, the distance never decreases (the command slides, never a fallback)."""
     robot, cm = panda_with_table(height=0.2)
     q = robot.ready()
     start = table_distance(cm.proximity_at(q, 1.0))
@@ -178,12 +186,22 @@ def test_a_start_inside_the_safety_distance_recovers():
     inside = CollisionModel(robot)
     inside.add_box(T, (0.6, 0.8, 0.04), name="table")
     assert table_distance(inside.proximity_at(q, 1.0)) == pytest.approx(-0.01, abs=1e-6)
-    session = hand_session(inside, robot, np.zeros(3), 60, q=q)
-    assert session[0][0].status == "recovering"
-    distances = [table_distance(inside.proximity_at(q_k, 1.0)) for *_, q_k, _ in session]
-    assert all(np.isfinite(s[0].qdot).all() for s in session)
-    assert all(b >= a - 1e-6 for a, b in itertools.pairwise(distances))
-    assert distances[-1] >= 0.02 - 1e-3
+    up = hand_session(inside, robot, np.array([0.0, 0.0, 0.1]), 32, q=q)
+    distances = [table_distance(inside.proximity_at(q_k, 1.0)) for *_, q_k, _ in up]
+    before = [-0.01, *distances[:-1]]
+    for (res, v, _, _), d in zip(up, before, strict=True):
+        if d < 0.02:  # still inside: the command as it is (recovering within 2 mm of d_s:
+            # its row pushes it out, slower than the command)
+            assert res.status == ("exact" if d < 0.018 else "recovering")
+            assert res.scale == pytest.approx(1.0, abs=1e-12)
+            np.testing.assert_allclose(v, (0.0, 0.0, 0.1), atol=1e-9)
+    np.testing.assert_allclose(np.diff(distances[:29]), 0.001, atol=1e-6)
+    assert distances[31] >= 0.02
+    for twist in (np.zeros(3), np.array([0.05, 0.0, -0.1])):
+        session = hand_session(inside, robot, twist, 30, q=q)
+        assert all(np.isfinite(s[0].qdot).all() and s[0].status != "fallback" for s in session)
+        distances = [table_distance(inside.proximity_at(q_k, 1.0)) for *_, q_k, _ in session]
+        assert all(b >= a - 1e-6 for a, b in itertools.pairwise([-0.01, *distances]))
 
 
 def test_a_pair_entering_the_detection_distance_slower_than_the_gain_changes_nothing():

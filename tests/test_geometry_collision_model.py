@@ -43,7 +43,13 @@ def test_obstacles_get_names_and_pair_with_every_moving_body(cm):
     assert cm.bodies[-len(obstacles):] == tuple(obstacles)
     for name in obstacles:
         partners = {a for a, b in cm.pairs if b == name}
-        assert partners == set(moving), name  # not the base (fixed), not another obstacle
+        # not the base (fixed), not another obstacle, not a body no joint moves relative to it:
+        # panda_link1's capsule turns about its own axis (joint 1); link 2's lies along joint
+        # 2's axis, which stays at the shoulder's height (the floor's distance never changes)
+        still = {"panda_link1_0", "panda_link2_0"} if name == "floor" else {"panda_link1_0"}
+        assert partners == set(moving) - still, name
+        assert {a for a, b in cm.invariant if b == name} == still, name
+        assert all(cm.excluded[(a, name)] == "invariant" for a in still), name
         assert cm.excluded[("panda_link0_0", name)] == "rigid"
     floor = cm.scene.names.index("floor")
     np.testing.assert_allclose(cm.scene.normal[floor], (0, 0, 1))  # normalised

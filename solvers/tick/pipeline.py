@@ -399,14 +399,18 @@ def _damped_within(
     damping: Damping | None,
 ) -> tuple[Array, Array | None]:  # fmt: skip
     """A least-squares top level with slide rows: its exact optimum where that holds every
-    constraint, else the sliding stage's damped least squares within them all (:func:`_slide`).
+    constraint, else the sliding stage's least squares within them all (:func:`_slide`).
 
-    Most such problems are a collision pair below its safety distance (``recovering``: a row
-    asks the pair to separate, so standing still is not feasible and the problem is not a
-    direction one). The least squares alone there, undamped, drove baxter's wrists at their
-    4 rad/s limits for a pair 2 um below the safety distance, and the step's second-order error
-    took the pair 1.03 mm below it over four ticks (a 10-minute session); and a recovering tick
-    between two sliding ones changed the rates by 2.9 rad/s and back.
+    Most such problems are a collision pair just below its safety distance, its row asking it
+    back out (``recovering``: standing still is not feasible and the problem is not a direction
+    one). The least squares alone there, undamped, drove baxter's wrists at their 4 rad/s
+    limits for a pair 2 um below the safety distance, and the step's second-order error took
+    the pair 1.03 mm below it over four ticks (a 10-minute session); and a recovering tick
+    between two sliding ones changed the rates by 2.9 rad/s and back. Where no rates meet every
+    constraint, the slide rows that ask to move apart (a bound below zero) ask only not to
+    approach (bound zero), and the least squares is solved again: a pair is pushed out where
+    that is possible, and never holds the arm where it is not (two pairs asking for opposite
+    motions; a joint at its limit).
 
     Returns:
         The rates (n,), and A's null space (d, n) for the next level (None when not needed).
@@ -414,8 +418,25 @@ def _damped_within(
     factor = Factorization(A)
     w = factor.least_norm(b)
     if not (kernels.inside(w, box.lb, box.ub) and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
-        w = _slide(A, b, Subspace(None, None), box, rows, backend, work, factor, damping)
+        try:
+            w = _slide(A, b, Subspace(None, None), box, rows, backend, work, factor, damping)
+        except (NumericalFailure, np.linalg.LinAlgError) as exc:
+            relaxed = _not_approaching(rows)
+            if relaxed is None:
+                raise
+            work.attempts.append(("slide", f"{exc}; the pairs asked apart only kept apart"))
+            w = _slide(A, b, Subspace(None, None), box, relaxed, backend, work, factor, damping)
     return w, factor.null_basis() if need_null else None
+
+
+def _not_approaching(rows: Rows) -> Rows | None:
+    """``rows`` with every slide row's bound below zero raised to zero, or None if none is."""
+    if rows.slide is None:
+        return None
+    pushed = rows.slide & (rows.h < 0.0)
+    if not pushed.any():
+        return None
+    return rows._replace(h=np.where(pushed, 0.0, rows.h))
 
 
 def _damping(
