@@ -9,6 +9,7 @@ import itertools
 import numpy as np
 import pinocchio as pin
 import pytest
+from scipy.optimize import linprog
 
 import rrc_pin
 from rrc_pin import CollisionLimit, CollisionModel, FrameTask, InvalidInput, JointLimits, Resolver
@@ -218,6 +219,105 @@ def test_a_pair_entering_the_detection_distance_slower_than_the_gain_changes_not
             entered += 1
             assert np.abs(r1.qdot - free.solve(q, twist).qdot).max() <= 1e-9
     assert entered >= 1
+
+
+SEEDS = (37, int(np.random.SeedSequence().entropy % 2**63))
+"""A fixed seed and one drawn fresh each run (named in every failure's message)."""
+
+
+def wall_scene(robot_name, kind, rng, fixed):
+    """A wall the hand is commanded into at an angle, orientation held: the collision model,
+    the start, the twist (6,) and the wall's unit normal into it and tangent along it.
+
+    ``kind``: a half-space, a virtual wall of the tool frame, or a slab (a box) tilted 30 deg;
+    the fixed draw commands 0.1 m/s at 45 deg into it and down along it, others 0.05-0.15 m/s at
+    30-60 deg, the tangent turned at random within the wall. The wall starts 5 mm beyond the
+    safety distance."""
+    robot = rrc_pin.load(robot_name)
+    q = robot.ready()
+    p = robot.fk(q)[:3, 3]
+    R = pin.utils.rotate("y", np.deg2rad(30.0) if kind == "slab" else 0.0)
+    n = R[:, 0]  # into the wall: ahead of the hand (tilted down 30 deg for the slab)
+    turn = 0.0 if fixed else rng.uniform(-np.pi, np.pi)
+    t = -np.cos(turn) * R[:, 2] + np.sin(turn) * R[:, 1]  # along it: down, turned at random
+    angle = np.deg2rad(45.0 if fixed else rng.uniform(30.0, 60.0))
+    speed = 0.1 if fixed else rng.uniform(0.05, 0.15)
+
+    def model(offset):
+        cm = CollisionModel(robot)
+        if kind == "halfspace":  # the solid n . x >= offset
+            cm.add_halfspace(-n, -offset, name="wall")
+        elif kind == "virtual":
+            cm.add_wall(n, offset, frame=robot.tool_frame, name="wall")
+        else:
+            T = np.eye(4)
+            T[:3, :3], T[:3, 3] = R, p + n * (offset - float(n @ p) + 0.02)  # its face at offset
+            cm.add_box(T, (0.04, 0.3, 0.3), name="wall")
+        return cm
+
+    if kind == "virtual":  # the tool frame's origin 5 mm from it (a wall's safety is 0)
+        cm = model(float(n @ p) + 0.005)
+    else:  # 25 mm from the nearest body (which may change as it comes nearer)
+        offset = float(n @ p) + 0.3
+        cm = model(offset)
+        for _ in range(8):
+            offset -= cm_distance(cm, q) - 0.025
+            cm = model(offset)
+    twist = np.concatenate([speed * (np.sin(angle) * n + np.cos(angle) * t), np.zeros(3)])
+    return robot, cm, q, twist, n, t
+
+
+def cm_distance(cm, q):
+    prox = cm.proximity_at(q, 1.0)
+    return min(float(d) for name, d in zip(prox.names, prox.distance, strict=True)
+               if name[1] == "wall")  # fmt: skip
+
+
+def best_tangential(A, twist, n, t, rows, box):
+    """The LP's best speed along t [m/s] at the tick: max s up to the command's speed along t
+    with A qdot = s t + a n (twist frame, orientation held), a between 0 and the command's speed
+    into the wall, within the tick's rows and box."""
+    nv = A.shape[1]
+    tangent = np.concatenate([t, np.zeros(3)])
+    normal = np.concatenate([n, np.zeros(3)])
+    into, along = float(twist[:3] @ n), float(twist[:3] @ t)
+    cost = np.zeros(nv + 2)
+    cost[nv] = -1.0
+    result = linprog(cost, A_ub=np.hstack([rows.G, np.zeros((rows.h.size, 2))]), b_ub=rows.h,
+                     A_eq=np.hstack([A, -tangent[:, None], -normal[:, None]]),
+                     b_eq=np.zeros(6),
+                     bounds=[*zip(box.lb, box.ub, strict=True), (0.0, along), (0.0, into)],
+                     method="highs")  # fmt: skip
+    assert result.status == 0
+    return float(result.x[nv])
+
+
+@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "fresh"))
+@pytest.mark.parametrize("kind", ["halfspace", "virtual", "slab"])
+@pytest.mark.parametrize("robot_name", ["panda", "rrc_k1607"])
+def test_sliding_keeps_the_lps_best_tangential_speed(robot_name, kind, seed):
+    """A hand commanded into a wall at an angle, orientation held: on every sliding tick the
+    hand's speed along the wall is at least 0.99 of the best an LP over the same tick's rows
+    and box reaches (HiGHS). The sliding stage damps only past the damping threshold, which
+    no tick here reaches (before: 0.93 median, 0.89 min on panda's half-space)."""
+    rng = np.random.default_rng(seed)
+    robot, cm, q, twist, n, t = wall_scene(robot_name, kind, rng, seed == SEEDS[0])
+    limit, joints = CollisionLimit(cm), JointLimits()
+    resolver = Resolver(robot, DT, limits=[joints, limit])
+    sliding, previous = 0, np.zeros(robot.nv)
+    for _ in range(60):
+        kin = kinematics(robot, q)
+        rows, box = limit.constraints(kin, DT, previous), joints.constraints(kin, DT, previous).box
+        res = resolver.solve(q, twist)
+        assert res.status != "fallback", f"seed {seed}"
+        if res.status == "sliding":
+            sliding += 1
+            kept = float(t @ (robot.jacobian(q)[:3] @ res.qdot))
+            best = best_tangential(robot.jacobian(q), twist, n, t, rows, box)
+            assert kept >= 0.99 * best - 1e-9, f"seed {seed}: {kept} of the LP's {best} m/s"
+        previous = np.asarray(res.qdot)
+        q = q + DT * previous
+    assert sliding >= 20, f"seed {seed}: {sliding} sliding ticks"
 
 
 SLIDE_JUMP = 0.15
