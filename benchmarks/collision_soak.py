@@ -6,8 +6,10 @@ tests/test_collision_starts.py) and the soak (``bench_collision.py --soak``: 200
 
 **Sessions** (:func:`session`): at 100 Hz, the hands driven toward random targets chosen to
 collide (the panda's own base and links; under a table top; the other arm's hand), a new target
-every second, at up to 0.3 m/s; every tick's status counted, every fallback tick kept with the
-reasons its attempts give, the one-step linearisation error of the pairs near d_s measured.
+every second, at up to 0.3 m/s (and turning at random rates, with ``turn``); every tick's status
+counted, every fallback tick kept with the reasons its attempts give, the largest joint rate
+against its velocity limit and the one-step linearisation error of the pairs near d_s
+measured.
 
 **Starts** (:func:`panda_start`, :func:`two_pandas_start`, :func:`held_box_start`): a random
 placement where one pair starts at a chosen signed distance below the safety distance (into
@@ -116,9 +118,20 @@ class Session(NamedTuple):
     """Each fallback tick: (tick, nearest pair's distance [m], the attempts' reasons)."""
 
 
-def session(name: str, seconds: float, seed: int, limit: bool = True,
+def session(name: str, seconds: float, seed: int, limit: bool = True, turn: bool = False,
             measure_steps: bool = True) -> Session:  # fmt: skip
-    """One session of ``seconds`` simulated at 100 Hz (module docstring)."""
+    """One session of ``seconds`` simulated at 100 Hz (module docstring).
+
+    Args:
+        name: One of :data:`SCENES`.
+        seconds: Simulated time [s].
+        seed: The targets' (and turns') generator's seed.
+        limit: With the collision limit (else the joint limits alone).
+        turn: The hands' full twists, each turning at a random rate (0.3 rad/s a component,
+            drawn with each target), not their positions alone.
+        measure_steps: Measure the one-step linearisation error (a second proximity query a
+            tick).
+    """
     cm, targets = scene(name)
     robot = cm.robot
     frames = list(robot.tool_frames)
@@ -128,9 +141,10 @@ def session(name: str, seconds: float, seed: int, limit: bool = True,
     resolver = Resolver(robot, DT, limits=limits)
     probe = CollisionLimit(cm, SAFETY, DETECTION, GAIN) if limit and measure_steps else None
     layout = Layout.of(robot)
-    tasks = [FrameTask(f, rows="position") for f in frames]
+    tasks = [FrameTask(f, rows="full" if turn else "position") for f in frames]
     rng = np.random.default_rng(seed)
     q = robot.ready()
+    turning = {f: np.zeros(3) for f in frames}
     min_distance, worst, excess, over, finite, error = math.inf, ("", ""), 0.0, 0.0, True, 0.0
     statuses: dict[str, int] = {}
     fallbacks = []
@@ -140,10 +154,13 @@ def session(name: str, seconds: float, seed: int, limit: bool = True,
         hands = {f: robot.frame_pose(q, f)[:3, 3] for f in frames}
         if tick % 100 == 0:
             goal = targets(rng, hands)
+            if turn:
+                turning = {f: rng.normal(0.0, 0.3, 3) for f in frames}
         for task, f in zip(tasks, frames, strict=True):
             v = 2.0 * (goal[f] - hands[f])
             speed = float(np.linalg.norm(v))
-            task.set_twist(v * min(1.0, SPEED / speed) if speed > 0 else v)
+            v = v * min(1.0, SPEED / speed) if speed > 0 else v
+            task.set_twist(np.concatenate([v, turning[f]]) if turn else v)
         res = resolver.solve(q, [tasks], priority="strict")
         statuses[res.status] = statuses.get(res.status, 0) + 1
         qdot = np.asarray(res.qdot)
@@ -165,7 +182,8 @@ def session(name: str, seconds: float, seed: int, limit: bool = True,
             k = int(np.argmin(prox.distance))
             if prox.distance[k] < min_distance:
                 min_distance, worst = float(prox.distance[k]), prox.names[k]
-    return Session(ticks, min_distance, worst, excess, over, finite, statuses, error, fallbacks)
+    return Session(ticks, min_distance, worst, excess, over, finite, statuses, float(error),
+                   fallbacks)  # fmt: skip
 
 
 def _step_error(rows, cm: CollisionModel, q: np.ndarray, step: np.ndarray) -> float:
@@ -484,3 +502,66 @@ def _away(kin: Kinematics, frames: list[str], rows, box, speed: float
     if result.status != 0 or result.x[-1] < 1e-4:
         return None
     return np.asarray(result.x[:m] - result.x[m : 2 * m]), float(result.x[-1])
+
+
+# -- the soak ---------------------------------------------------------------------------------
+
+STARTS = {"panda": panda_start, "held box": held_box_start, "two pandas": two_pandas_start}
+"""The starts' kinds, drawn in turn."""
+
+
+def soak(starts: int, minutes: float, seed: int = 0,
+         progress: Callable[[str], None] = print) -> dict:  # fmt: skip
+    """``starts`` random starts (the kinds in turn, from touching to 8 cm deep) and each scene's
+    sessions of ``minutes``, positions (seed 7) and turning (seed 8): the soak's JSON body."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    kinds = list(STARTS)
+    while len(rows) < starts:
+        kind = kinds[len(rows) % len(kinds)]
+        start = STARTS[kind](rng, float(rng.uniform(-0.08, 0.0)))
+        if start is None:
+            continue
+        r = start_trial(start, rng)
+        rows.append({"kind": kind, "label": start.label, "distance_m": start.distance,
+                     **{k: _plain(v) for k, v in r._asdict().items()}})  # fmt: skip
+        progress(f"start {len(rows)}: {start.label}: {r}")
+    sessions = []
+    for name in SCENES:
+        for turn, session_seed in ((False, 7), (True, 8)):
+            s = session(name, 60.0 * minutes, session_seed, turn=turn)
+            sessions.append({
+                "scene": name, "turning": turn, "seed": session_seed, "ticks": s.ticks,
+                "min_distance_m": s.min_distance, "worst_pair": list(s.worst_pair),
+                "joint_excess": s.joint_excess, "rate_over_limit": s.rate_over_limit,
+                "finite": s.finite, "statuses": s.statuses,
+                "linearisation_m": s.linearisation, "fallback_ticks": len(s.fallbacks),
+                "fallbacks": [{"tick": t, "nearest_m": d, "attempts": [list(a) for a in why]}
+                              for t, d, why in s.fallbacks[:50]],
+            })  # fmt: skip
+            progress(f"session {name}{' turning' if turn else ''}: {sessions[-1]}")
+    away = [r for r in rows if r["away_ticks"]]
+    timed = [r for r in away if r["away_speed"] >= AWAY - 1e-9]
+    summary = {
+        "starts": len(rows),
+        "locked": sum(r["fallbacks"] > 0 for r in rows),
+        "commanded_away": len(away),
+        "moved_at_first_tick": sum(r["first_scale"] >= 0.99 and r["first_speed"] > 0.01
+                                   for r in away),
+        "at_full_speed_apart": len(timed),
+        "out_within_deadline": sum(r["exit_ticks"] is not None for r in timed),
+        "largest_decrease_m": max((r["decrease"] for r in rows), default=0.0),
+        "largest_rate_over_limit": max([r["rate_over_limit"] for r in rows]
+                                       + [s["rate_over_limit"] for s in sessions]),
+        "session_fallback_ticks": sum(s["fallback_ticks"] for s in sessions),
+    }
+    settings = {"starts": starts, "minutes": minutes, "seed": seed, "dt": DT, "safety": SAFETY,
+                "detection": DETECTION, "gain": GAIN, "away_speed": AWAY}  # fmt: skip
+    return {"settings": settings, "summary": summary, "starts": rows, "sessions": sessions}
+
+
+def _plain(value: object) -> object:
+    """A JSON value: NaN as None."""
+    if isinstance(value, float) and math.isnan(value):
+        return None
+    return value

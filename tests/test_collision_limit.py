@@ -14,6 +14,7 @@ from scipy.optimize import linprog
 import rrc_pin
 from rrc_pin import CollisionLimit, CollisionModel, FrameTask, InvalidInput, JointLimits, Resolver
 from rrc_pin.kinematics import Kinematics, Layout
+from rrc_pin.limits.collision import InvariantPairWarning
 from rrc_pin.solvers.collision.damper_kernels import SLACK, damper_rows
 
 DT = 0.01
@@ -203,6 +204,28 @@ def test_a_start_inside_the_table_never_holds_and_leaves_at_the_commands_pace():
         assert all(np.isfinite(s[0].qdot).all() and s[0].status != "fallback" for s in session)
         distances = [table_distance(inside.proximity_at(q_k, 1.0)) for *_, q_k, _ in session]
         assert all(b >= a - 1e-6 for a, b in itertools.pairwise([-0.01, *distances]))
+
+
+def test_a_pair_no_joint_moves_is_no_row_and_the_hand_moves_away_at_scale_one():
+    """A table whose side is 17 mm from panda_link1, inside the safety distance: the link's
+    capsule turns about joint 1, so no joint changes that distance. The pair is left out (a
+    warning at construction names it); commanded away from the table, the hand moves at the
+    command, scale 1, every tick (before: fallback, scale 0, every tick)."""
+    robot = rrc_pin.load("panda")
+    cm = CollisionModel(robot)
+    T = np.eye(4)
+    T[:3, 3] = (0.09 + 0.017 + 0.3, 0.0, 0.2)  # the capsule's radius, 17 mm, half the table
+    cm.add_box(T, (0.6, 0.8, 0.3), name="table")
+    assert cm.invariant[("panda_link1_0", "table")] == pytest.approx(0.017, abs=1e-9)
+    assert cm.excluded[("panda_link1_0", "table")] == "invariant"
+    with pytest.warns(InvariantPairWarning, match=r"panda_link1_0\|table \(17\.0 mm\)"):
+        limit = CollisionLimit(cm)
+    for twist in (np.array([0.0, 0.0, 0.1]), np.array([-0.05, 0.0, 0.05])):
+        session = hand_session(cm, robot, twist, 40, limit=limit)
+        for res, v, _, prox in session:
+            assert res.status == "exact" and res.scale == 1.0
+            np.testing.assert_allclose(v, twist, atol=1e-9)
+            assert ("panda_link1_0", "table") not in prox.names
 
 
 def test_a_pair_entering_the_detection_distance_slower_than_the_gain_changes_nothing():

@@ -12,7 +12,7 @@
 
 Every change (an obstacle added, moved, attached or removed) builds a new frozen
 :class:`~rrc_pin.geometry.scene.Scene` and swaps it in at once, so queries in other threads are
-never torn; a change is not meant for every tick (it costs about a millisecond, see
+never torn; a change is not meant for every tick (it costs a millisecond or two, see
 docs/api.md). Bad input raises :class:`~rrc_pin.errors.InvalidInput` naming the argument,
 before anything changes.
 """
@@ -103,6 +103,7 @@ class CollisionModel:
         self._frames = frame_index(robot.model)
         self._tree = tree_of(robot.model, robot.random_q(0))
         self._extras: dict[str, Extra] = {}
+        self._decided: dict[tuple[str, str], float | None] = {}  # the extras' pairs: invariant?
         self._walls: dict[str, tuple[Wall, ...]] = {}
         self._lock = threading.Lock()
         self._local = threading.local()
@@ -267,6 +268,7 @@ class CollisionModel:
         with self._lock:
             if name in self._extras:
                 extras = {k: v for k, v in self._extras.items() if k != name}
+                self._decided = {p: d for p, d in self._decided.items() if name not in p}
                 scene = self._build(extras)
                 self._extras, self._scene = extras, scene
             elif name in self._walls:
@@ -382,7 +384,7 @@ class CollisionModel:
     def _build(self, extras: dict[str, Extra]) -> Scene:
         return build_scene(self.robot.model, self._objects, self._robot_pairs,
                            self._robot_excluded, list(extras.values()), self._tree,
-                           self._robot_invariant)  # fmt: skip
+                           self._robot_invariant, self._decided)  # fmt: skip
 
     def _add_world(self, kind: str, shape: object, pose: pin.SE3, name: str | None) -> str:
         label = self._new_name(kind, name)

@@ -24,6 +24,7 @@ Every other pair of the robot's bodies is active.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Literal
 
 import numpy as np
@@ -117,11 +118,10 @@ def invariant(
     for a, b in candidates:
         probe.addCollisionPair(pin.CollisionPair(a, b))
     data, gdata = model.createData(), probe.createData()
-    rng = np.random.default_rng(0)
+    sample = _sampler(model, single)
 
     def measured(alive: list[int]) -> npt.NDArray[np.float64]:
-        q = _sample(model, single, rng)
-        pin.forwardKinematics(model, data, q)
+        pin.forwardKinematics(model, data, sample())
         pin.updateGeometryPlacements(model, data, probe, gdata)
         return np.array([pin.computeDistance(probe, gdata, k).min_distance for k in alive])
 
@@ -136,25 +136,29 @@ def invariant(
     return {candidates[k]: float(v) for k, v in zip(alive, first.tolist(), strict=True)}
 
 
-def _sample(
-    model: pin.Model, single: list[bool], rng: np.random.Generator
-) -> npt.NDArray[np.float64]:
-    """A configuration (nq,) drawn for :func:`invariant`.
+def _sampler(model: pin.Model, single: list[bool]) -> Callable[[], npt.NDArray[np.float64]]:
+    """Draws configurations (nq,) for :func:`invariant` (a fixed seed).
 
     Each joint of one coordinate within its limits (infinite sides at pi), a continuous one's
     angle in [-pi, pi], the others at their neutral value.
     """
-    q: npt.NDArray[np.float64] = pin.neutral(model)
-    for j in range(1, model.njoints):
-        if not single[j]:
-            continue
-        joint = model.joints[j]
-        i = joint.idx_q
-        if joint.nq == 2:
-            angle = rng.uniform(-np.pi, np.pi)
-            q[i : i + 2] = np.cos(angle), np.sin(angle)
-        else:
-            low, high = model.lowerPositionLimit[i], model.upperPositionLimit[i]
-            q[i] = rng.uniform(low if np.isfinite(low) else -np.pi,
-                               high if np.isfinite(high) else np.pi)  # fmt: skip
-    return q
+    rng = np.random.default_rng(0)
+    joints = [model.joints[j] for j in range(model.njoints)]
+    one = np.array([jt.idx_q for jt, s in zip(joints, single, strict=True) if s and jt.nq == 1],
+                   dtype=np.int64)  # fmt: skip
+    two = np.array([jt.idx_q for jt, s in zip(joints, single, strict=True) if s and jt.nq == 2],
+                   dtype=np.int64)  # fmt: skip
+    low, high = model.lowerPositionLimit[one], model.upperPositionLimit[one]
+    low = np.where(np.isfinite(low), low, -np.pi)
+    high = np.where(np.isfinite(high), high, np.pi)
+    neutral = pin.neutral(model)
+
+    def sample() -> npt.NDArray[np.float64]:
+        q: npt.NDArray[np.float64] = neutral.copy()
+        u = rng.random(one.size + two.size)
+        q[one] = low + (high - low) * u[: one.size]
+        angle = np.pi * (2.0 * u[one.size :] - 1.0)
+        q[two], q[two + 1] = np.cos(angle), np.sin(angle)
+        return q
+
+    return sample

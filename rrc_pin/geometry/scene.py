@@ -116,6 +116,7 @@ def build_scene(
     extras: list[Extra],
     tree: KinematicTree | None,
     robot_invariant: dict[tuple[str, str], float],
+    decided: dict[tuple[str, str], float | None],
 ) -> Scene:
     """The scene of ``robot``'s bodies (active pairs ``robot_pairs``) and the ``extras``.
 
@@ -124,6 +125,8 @@ def build_scene(
     world obstacles (neither moves) and pairs whose distance no joint changes (``invariant``:
     :func:`~rrc_pin.geometry.pairs.invariant`, decided here for the extras' pairs; the
     robot's own are decided once, ``robot_invariant`` by names with their distance [m]).
+    ``decided`` holds the extras' pairs decided before, by names (their distance, None for a
+    pair a joint moves): only new pairs are measured, and added to it.
     """
     held = [e for e in extras if e.joint != 0]
     world = [e for e in extras if e.joint == 0]
@@ -146,12 +149,20 @@ def build_scene(
                 excluded[(names[a], names[b])] = "rigid"
             else:
                 added.append((a, b))
-    still = invariant(model, geometry, added)
+    new = [(a, b) for a, b in added if (names[a], names[b]) not in decided]
+    found = invariant(model, geometry, new)
+    for a, b in new:
+        decided[(names[a], names[b])] = found.get((a, b))
     fixed = dict(robot_invariant)
-    for a, b in still:
-        excluded[(names[a], names[b])] = "invariant"
-        fixed[(names[a], names[b])] = still[(a, b)]
-    pairs = sorted([*robot_pairs, *(p for p in added if p not in still)])
+    pairs = list(robot_pairs)
+    for a, b in added:
+        distance = decided[(names[a], names[b])]
+        if distance is None:
+            pairs.append((a, b))
+        else:
+            excluded[(names[a], names[b])] = "invariant"
+            fixed[(names[a], names[b])] = distance
+    pairs.sort()
     for a, b in pairs:
         geometry.addCollisionPair(pin.CollisionPair(a, b))
     centre = np.zeros((len(objects), 3))
