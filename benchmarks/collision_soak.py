@@ -226,6 +226,8 @@ def panda_start(rng: np.random.Generator, distance: float) -> Start | None:
     if placed is None:
         return None
     name = _add(cm, kind, placed)
+    if (cm.bodies[body], name) in cm.invariant:  # no joint moves it: not a row, no start
+        return None
     return _start(cm, q, (cm.bodies[body], name), f"{kind} against {cm.bodies[body]}")
 
 
@@ -284,13 +286,8 @@ def _start(cm: CollisionModel, q: np.ndarray, pair: tuple[str, str], label: str)
 
 def _moving_body(rng: np.random.Generator, cm: CollisionModel, exclude: tuple[int, ...]) -> int:
     """A random robot body moved by some joint (and not on a joint of ``exclude``)."""
-    robot_bodies = [g for g in range(len(cm.bodies)) if cm.scene.joint[g] not in (0, *exclude)
-                    and cm.bodies[g] not in _INVARIANT_PANDA]  # fmt: skip
+    robot_bodies = [g for g in range(len(cm.bodies)) if cm.scene.joint[g] not in (0, *exclude)]
     return int(rng.choice(robot_bodies))
-
-
-_INVARIANT_PANDA = ("panda_link1_0",)
-"""A body no joint moves relative to a world obstacle (its capsule turns about joint 1)."""
 
 
 def _placed(rng: np.random.Generator, cm: CollisionModel, q: np.ndarray, body: int, kind: str,
