@@ -26,6 +26,7 @@ from rrc_pin import models
 from rrc_pin.errors import InvalidInput, UnknownArm, URDFError
 from rrc_pin.models.arm_spec import ArmSpec
 from rrc_pin.robot import Robot, moving_joints
+from rrc_pin.urdf_checks import check_tree, parser_messages, readable, replay
 from rrc_pin.urdf_compare import compare_urdf
 from rrc_pin.urdf_export import TOOL_FRAME, to_urdf
 
@@ -386,11 +387,13 @@ def load(
 
     Raises:
         UnknownArm: Not a known name nor a file; the message lists the available names.
-        InvalidInput: Parameters for anything but a catalogue name, a parameter its builder
-            does not take (the message lists those it takes), or a value that is not a
-            finite real number (named).
-        URDFError: A missing or malformed URDF, with the path and the parser's message; a
-            model with no moving joint or with a joint that is not one coordinate.
+        InvalidInput: An empty ``name_or_path``, parameters for anything but a catalogue
+            name, a parameter its builder does not take (the message lists those it takes),
+            or a value that is not a finite real number (named).
+        URDFError: A folder, a missing or malformed URDF, with the path and the reason: the
+            joint and link of a broken tree (:func:`rrc_pin.urdf_checks.check_tree`), else
+            the parser's own message; a model with no moving joint or with a joint that is
+            not one coordinate.
         ToolFrameRequired: A URDF whose tree has several end links, loaded without
             ``tool_frame`` (the message lists them).
         FrameNotFound: ``tool_frame`` is not a frame of the model.
@@ -403,6 +406,9 @@ def load(
             "name_or_path", f"expected a name, a path or an ArmSpec, got {name_or_path!r}"
         )
     key = os.fspath(name_or_path)
+    if not key.strip():
+        raise InvalidInput("name_or_path", f"empty ({key!r}): expected an arm's name (one of "
+                           f"{', '.join(arms() + cells())}) or a URDF file's path")  # fmt: skip
     if key in models.CELLS:
         _refuse_parameters(parameters, f"the cell {key!r}")
         if tool_frame is not None:
@@ -523,6 +529,8 @@ def srdf_state(path: Path, state: str) -> dict[str, float]:
 
 
 def _from_file(path: Path, tool_frame: ToolFrames) -> Robot:
+    if path.is_dir():
+        raise URDFError(str(path), "name_or_path is a folder, not a URDF file")
     try:
         text = path.read_text()
     except FileNotFoundError as exc:
@@ -535,6 +543,7 @@ def _from_file(path: Path, tool_frame: ToolFrames) -> Robot:
         raise URDFError(str(path), f"not XML: {exc}") from exc
     if root.tag != "robot":
         raise URDFError(str(path), f"not a URDF: the root element is <{root.tag}>, not <robot>")
+    check_tree(root, str(path))
     model = _parse(path)
     spec = models.CATALOGUE.get(root.get("name", ""))
     if spec is not None and not compare_urdf(text, to_urdf(spec)):
@@ -557,14 +566,22 @@ def _parse(path: Path) -> pin.Model:
     """
     if not path.is_file():
         raise URDFError(str(path), "no such file")
-    try:
+    with parser_messages() as said:
         try:
-            return pin.buildModelFromUrdf(str(path), mimic=True)
-        except TypeError:  # a Pinocchio without mimic support (before 3.4)
-            model = pin.buildModelFromUrdf(str(path))
-    except (RuntimeError, ValueError) as exc:
-        raise URDFError(str(path), f"Pinocchio could not parse it: {exc}") from exc
-    refuse_mimic(path)
+            try:
+                model = pin.buildModelFromUrdf(str(path), mimic=True)
+                mimic = True
+            except TypeError:  # a Pinocchio without mimic support (before 3.4)
+                model, mimic = pin.buildModelFromUrdf(str(path)), False
+            failure = None
+        except (RuntimeError, ValueError) as exc:
+            failure = exc
+    if failure is not None:
+        reason = readable(said) or str(failure)
+        raise URDFError(str(path), f"Pinocchio could not parse it: {reason}") from failure
+    replay(said)
+    if not mimic:
+        refuse_mimic(path)
     return model
 
 

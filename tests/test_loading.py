@@ -170,11 +170,58 @@ def test_malformed_urdf_gives_path_and_parser_message(tmp_path):
     with pytest.raises(URDFError, match=f"{path}: not XML: .+"):
         rrc_pin.load(path)
     path.write_text('<robot name="x"><link name="a"/><joint name="j" type="revolute"/></robot>')
-    with pytest.raises(URDFError, match=f"{path}: Pinocchio could not parse it: .+"):
+    with pytest.raises(URDFError, match=f"{path}: joint 'j': its parent link has none"):
         rrc_pin.load(path)
     path.write_text("<launch/>")
     with pytest.raises(URDFError, match=f"{path}: not a URDF: the root element is <launch>"):
         rrc_pin.load(path)
+
+
+JOINT = ('<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+         '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>')
+
+
+def urdf(*joints: dict[str, str], links: tuple[str, ...] = ("base", "l1")) -> str:
+    body = "".join(f'<link name="{n}"/>' for n in links)
+    return f'<robot name="x">{body}{"".join(JOINT.format(**j) for j in joints)}</robot>'
+
+
+@pytest.mark.parametrize(
+    ("joints", "said"),
+    [
+        # issue 40: urdfdom printed "child link [nowhere] of joint [j2] not found" on stderr,
+        # the exception said only "does not contain a valid URDF model"
+        ([{"name": "j1", "kind": "revolute", "parent": "base", "child": "l1"},
+          {"name": "j2", "kind": "revolute", "parent": "l1", "child": "nowhere"}],
+         "joint 'j2': its child link 'nowhere' is not a link of the file"),
+        ([{"name": "j1", "kind": "revolute", "parent": "base", "child": "l1"},
+          {"name": "j2", "kind": "revolute", "parent": "base", "child": "l1"}],
+         r"link 'l1' is the child of two joints \('j1' and 'j2'\)"),
+        ([{"name": "j1", "kind": "revolute", "parent": "l1", "child": "base"},
+          {"name": "j2", "kind": "revolute", "parent": "base", "child": "l1"}],
+         "the links hang from 0 roots"),
+        # what only the parser knows: its own words, captured from its stderr
+        ([{"name": "j1", "kind": "revolut", "parent": "base", "child": "l1"}],
+         r"Pinocchio could not parse it: Joint \[j1\] has no known type \[revolut\]"),
+    ],
+)
+def test_a_broken_tree_is_named_in_the_error_and_nothing_is_printed(tmp_path, capfd, joints,
+                                                                     said):
+    path = tmp_path / "broken.urdf"
+    path.write_text(urdf(*joints))
+    with pytest.raises(URDFError, match=f"^URDF {path}: {said}"):
+        rrc_pin.load(path)
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+
+
+def test_an_empty_name_or_a_folder_is_named_as_such(tmp_path):
+    """Issue 40: ``load("")`` said "URDF .: cannot read it: Is a directory"."""
+    with pytest.raises(InvalidInput, match=r"^name_or_path: empty \(''\): expected an arm's "
+                       "name .*barker6.*or a URDF file's path"):  # fmt: skip
+        rrc_pin.load("")
+    with pytest.raises(URDFError, match=f"^URDF {tmp_path}: name_or_path is a folder, not a URDF"):
+        rrc_pin.load(tmp_path)
 
 
 def test_unknown_tool_frame():
