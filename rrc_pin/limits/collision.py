@@ -97,9 +97,10 @@ end and was taken (the far end may approach faster), the closest end then swappe
 hands held against each other had their wrists flip back and forth at 0.3-0.6 rad/s a tick."""
 
 STILL = 1e-9
-"""[m/s per rad/s] A row whose every entry is below this is dropped: no joint changes the
-pair's distance (a base link turning about its own axis over the floor), so the row cannot
-be met if it asks for separation, and constrains nothing otherwise."""
+"""[m/s per rad/s] A row whose every entry is below this is dropped: at this configuration no
+joint changes the pair's distance to first order (a pair no joint ever moves is left out of the
+model's pairs: :func:`~rrc_pin.geometry.pairs.invariant`), so the row constrains nothing, and
+could not be met where it asks the pair out."""
 
 
 class InvariantPairWarning(UserWarning):
