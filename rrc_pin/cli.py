@@ -156,6 +156,15 @@ def parser() -> argparse.ArgumentParser:
     mapping.add_argument(
         "--workers", type=int, default=None, help="threads on this machine (default: its cores)"
     )
+    mapping.add_argument(
+        "--dashboard",
+        nargs="?",
+        const="127.0.0.1:8787",
+        default=None,
+        metavar="[HOST:]PORT",
+        help="serve Dask's dashboard of the local cluster (needs bokeh; default 127.0.0.1:8787; "
+        "a port alone is on 127.0.0.1); without it, nothing listens beyond 127.0.0.1",
+    )
     mapping.add_argument("--seed", type=int, default=0, help="seed of the samples")
     mapping.add_argument(
         "--no-dexterity",
@@ -465,12 +474,14 @@ def map_command(args: argparse.Namespace) -> int:
     dexterity = not args.no_dexterity
     if len(robot.tool_frames) > 1:
         cell = maps.cell_map(robot, args.samples, args.voxel, args.scheduler, seed=args.seed,
-                             out=out, workers=args.workers, dexterity=dexterity)  # fmt: skip
+                             out=out, workers=args.workers, dexterity=dexterity,
+                             dashboard=args.dashboard)  # fmt: skip
         maps.plot_cell(cell, out)
         print(cell.summary_table())
     else:
         m = maps.capability(robot, args.samples, args.voxel, args.scheduler, seed=args.seed,
-                            out=out, workers=args.workers, dexterity=dexterity)  # fmt: skip
+                            out=out, workers=args.workers, dexterity=dexterity,
+                            dashboard=args.dashboard)  # fmt: skip
         maps.plot_map(m, out)
         print(m.summary_table())
         if args.audit > 0:

@@ -1,4 +1,4 @@
-"""``rrc_pin.load``: catalogue arms, example-robot-data robots and URDF files, as a Robot.
+"""``rrc_pin.load``: catalogue arms, example-robot-data robots, URDF and MJCF files, as a Robot.
 
 example-robot-data's URDFs are found inside the installed package (no network); only the
 kinematic model is built, so meshes are never needed. Robots with several arms (baxter, pr2,
@@ -376,7 +376,9 @@ def load(
             (``"gsfc_dual"``, ``"yeh_tripod"``: a :class:`~rrc_pin.cells.Cell`), an
             example-robot-data robot
             (``"panda"``, ``"ur5"``, ``"baxter"``, ...), an :class:`ArmSpec` (e.g. a variant
-            from ``rrc_pin.models.barker6.build(alpha3=...)``), or the path of any URDF. A
+            from ``rrc_pin.models.barker6.build(alpha3=...)``), or the path of any URDF or
+            MJCF (a ``<mujoco>`` file, Pinocchio's MJCF parser; MJCF gives no velocity
+            limits: pass ``JointLimits(velocity=...)``). A
             committed catalogue URDF (its robot name is a catalogue name and its content
             equals the generated URDF as numbers, see :mod:`rrc_pin.urdf_compare`) loads as
             that catalogue arm.
@@ -541,8 +543,12 @@ def _from_file(path: Path, tool_frame: ToolFrames) -> Robot:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
         raise URDFError(str(path), f"not XML: {exc}") from exc
+    if root.tag == "mujoco":  # MJCF: Pinocchio's parser, the same tool frame and limits rules
+        return Robot(_parse(path, mjcf=True), tool_frame, name=root.get("model") or path.stem,
+                     source=str(path))  # fmt: skip
     if root.tag != "robot":
-        raise URDFError(str(path), f"not a URDF: the root element is <{root.tag}>, not <robot>")
+        raise URDFError(str(path), f"not a URDF: the root element is <{root.tag}>, not <robot> "
+                        "(nor <mujoco>, an MJCF)")  # fmt: skip
     check_tree(root, str(path))
     model = _parse(path)
     spec = models.CATALOGUE.get(root.get("name", ""))
@@ -557,11 +563,13 @@ def _catalogue_tool(tool_frame: ToolFrames) -> ToolFrames:
     return TOOL_FRAME if tool_frame is None else tool_frame
 
 
-def _parse(path: Path) -> pin.Model:
+def _parse(path: Path, mjcf: bool = False) -> pin.Model:
     """The model of the URDF at ``path``, its mimic joints following their primary joints.
 
+    With ``mjcf``, the model of the MJCF file at ``path`` (``pinocchio.buildModelFromMJCF``).
+
     Raises:
-        URDFError: No such file, a URDF Pinocchio cannot parse, or mimic joints with a
+        URDFError: No such file, a file Pinocchio cannot parse, or mimic joints with a
             Pinocchio too old to honour them (named).
     """
     if not path.is_file():
@@ -569,8 +577,10 @@ def _parse(path: Path) -> pin.Model:
     with parser_messages() as said:
         try:
             try:
-                model = pin.buildModelFromUrdf(str(path), mimic=True)
-                mimic = True
+                if mjcf:
+                    model, mimic = pin.buildModelFromMJCF(str(path)), True
+                else:
+                    model, mimic = pin.buildModelFromUrdf(str(path), mimic=True), True
             except TypeError:  # a Pinocchio without mimic support (before 3.4)
                 model, mimic = pin.buildModelFromUrdf(str(path)), False
             failure = None
