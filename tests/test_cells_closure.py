@@ -7,7 +7,7 @@ import pinocchio as pin
 import pytest
 
 import rrc_pin
-from rrc_pin.cells.closure import Chains, ClosureBound, close, second_order
+from rrc_pin.cells.closure import DAMPING, Chains, ClosureBound, _damped, close, second_order
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits.contact_limit import Closure
 from rrc_pin.robot import frame_index
@@ -209,3 +209,20 @@ def test_the_bound_is_checked_and_reads_each_chain(dual):
     for bad in ({"position": 0.0}, {"rotation": -1.0}, {"position": np.nan}):
         with pytest.raises(InvalidInput, match=next(iter(bad))):
             ClosureBound(**bad)
+
+
+@pytest.mark.parametrize("seed", [FIXED, None])
+def test_the_damped_least_squares_is_its_formula(seed):
+    """``_damped`` against numpy: t = (J^T J + mu I)^-1 J^T b, then t + mu (J^T J + mu I)^-1 t,
+    mu = 1e-4 tr(J^T J) / m; near the exact solution where J is well conditioned."""
+    seed = fresh() if seed is None else seed
+    rng = np.random.default_rng(seed)
+    for m, n in ((6, 14), (18, 24), (6, 6)):
+        J, b = rng.normal(size=(m, n)), rng.normal(size=m)
+        M = J.T @ J + DAMPING * np.trace(J.T @ J) / m * np.eye(n)
+        t = np.linalg.solve(M, J.T @ b)
+        want = t + DAMPING * np.trace(J.T @ J) / m * np.linalg.solve(M, t)
+        np.testing.assert_allclose(_damped(J, b), want, rtol=1e-9, atol=1e-12,
+                                   err_msg=f"seed {seed}")  # fmt: skip
+        if np.linalg.cond(J) < 10:
+            np.testing.assert_allclose(J @ _damped(J, b), b, atol=1e-6 * np.abs(b).max())

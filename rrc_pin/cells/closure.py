@@ -29,10 +29,10 @@ floating point), the trust region :math:`\rho_i` = :data:`TRUST` times each join
 limit, and the constraint rows (a collision limit's). It is solved as a damped least squares,
 in the resolver's metric (a chain's position rows divided by its reach): the chains' rates
 first, then, in their null space, the top level's task rates kept (:math:`A\delta = 0`: the
-commanded motion unchanged), each pulled toward its damped least squares with :data:`DAMPING`
-of its rows' mean squared singular value (the sliding stage's
-:func:`~rrc_pin.solvers.tick.slide_kernels.damped_optimum`: exact to second order where the
-rows are well conditioned, bounded near a singular chain); where that leaves the box, the
+commanded motion unchanged), each a damped least squares pulled toward itself (damping
+:data:`DAMPING` of its rows' mean squared singular value, :func:`_damped`: exact to second
+order where the rows are well conditioned, bounded near a singular chain); where that leaves
+the box, the
 point of the box nearest it in the chains' metric, then the top level's (weight
 :data:`KEEP`; :func:`~rrc_pin.solvers.tick.slide_kernels.project`). Zero is always feasible:
 the correction never moves a joint beyond its limits.
@@ -68,7 +68,7 @@ from rrc_pin.solvers.checks import finite_number
 from rrc_pin.solvers.tick import kernels
 from rrc_pin.solvers.tick.factorization import Factorization
 from rrc_pin.solvers.tick.problem import Box, Rows
-from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, damped_optimum, project
+from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
 
 Array = npt.NDArray[np.float64]
 
@@ -235,7 +235,7 @@ def second_order(
 class _Lexicographic:
     """The chains' rates ``C delta = r`` first, then, among the corrections with those rates,
     the one that keeps the top level's rates (``top delta`` nearest zero): each a damped least
-    squares (:func:`rrc_pin.solvers.tick.slide_kernels.damped_optimum`, :data:`DAMPING`).
+    squares pulled toward itself (:func:`_damped`, :data:`DAMPING`).
 
     The second stage moves in ``C``'s null space (the last columns of the QR of its
     transpose), made once for every pass of a tick.
@@ -257,8 +257,27 @@ class _Lexicographic:
 
 
 def _damped(J: Array, b: Array) -> Array:
-    """The damped least squares of ``J x = b`` (zero where its metric is not definite)."""
-    out = np.zeros(J.shape[1])
-    if not damped_optimum(J, DAMPING, b, out):
-        out[:] = 0.0
-    return out
+    r"""The damped least squares of ``J x = b`` pulled toward itself (zero where not definite).
+
+    With :math:`M = J^TJ + \mu I` (:math:`\mu` = :data:`DAMPING` times the mean squared
+    singular value :math:`\operatorname{tr}(J^TJ)/m`) and :math:`t = M^{-1}J^Tb`, the
+    minimiser of :math:`\|Jx - b\|^2 + \mu\|x - t\|^2`, :math:`t + \mu M^{-1}t`: along a
+    right singular vector of singular value :math:`\sigma`,
+    :math:`\beta\sigma(\sigma^2 + 2\mu)/(\sigma^2 + \mu)^2` of the exact
+    :math:`\beta/\sigma`, bounded through a singularity. One Cholesky factorisation
+    (:func:`~rrc_pin.solvers.tick.kernels.cholesky`), two triangular solves.
+    """
+    m, n = J.shape
+    M = J.T @ J
+    mu = max(DAMPING * float(M.trace()) / max(m, 1), _TINY)
+    M.flat[:: n + 1] += mu
+    L, t, out = np.zeros((n, n)), np.empty(n), np.empty(n)
+    if not kernels.cholesky(M, 1e-12, L):
+        return np.zeros(n)
+    kernels.solve_factored(L, J.T @ b, t)
+    kernels.solve_factored(L, t, out)
+    result: Array = t + mu * out
+    return result
+
+
+_TINY = float(np.finfo(np.float64).tiny)
