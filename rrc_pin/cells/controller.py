@@ -527,7 +527,7 @@ class CellController(Loop):
                                    "expected world_aligned, local or world")  # fmt: skip
             twist = as_vector(value, label, 6)
             out[name] = np.concatenate([twist, [REFS.index(ref)]])
-        if any(REFS[int(c[6])] == "world" for c in out.values()):
+        if any(c[6] == REFS.index("world") for c in out.values()):
             self._warn_world()
         return out
 
