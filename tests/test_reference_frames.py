@@ -131,8 +131,6 @@ ENTRY_POINTS: dict[str, Callable[[rrc_pin.Robot, np.ndarray, str], np.ndarray]] 
 }
 WHOLE_POSE = ("guidance.operator", "CellController.step")
 """Entry points that steer the whole pose of the hand (six-joint arms and up)."""
-NOT_A_CELL = {"z1": "two frames named gripperStator: make_cell's pinocchio.appendModel raises"}
-"""Arms ``make_cell`` cannot take yet, and why."""
 WORLD_WARNS = "ignore:CellController.step. ref 'world':FutureWarning"
 """The cells' 'world' meant world_aligned before (tests/test_cells_controller.py tests it)."""
 
@@ -143,9 +141,7 @@ def cases() -> list[tuple[str, str, str]]:
         arm = rrc_pin.load(name)
         refs = FRAMES if full(arm) else ("local", "world_aligned")
         for entry in ENTRY_POINTS:
-            if (entry in WHOLE_POSE and not full(arm)) or (
-                entry == "CellController.step" and name in NOT_A_CELL
-            ):
+            if entry in WHOLE_POSE and not full(arm):
                 continue
             out += [(name, entry, ref) for ref in refs]
     return out
