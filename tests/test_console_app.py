@@ -28,7 +28,8 @@ import pinocchio as pin
 import pytest
 
 from rrc_pin.console import Console
-from rrc_pin.console.commands import AXES, Home, Latch
+from rrc_pin.console.commands import AXES, Home, Latch, Record, Velocity
+from rrc_pin.console.loop import ControlLoop
 
 viser = pytest.importorskip("viser")
 sync_api = pytest.importorskip("playwright.sync_api")
@@ -180,6 +181,7 @@ def test_keyboard_jogs_and_stop(console, page):
     page.evaluate("document.activeElement && document.activeElement.blur()")
     page.keyboard.press(" ")  # STOP
     wait_for(lambda: not loop.operator.latched and loop.snapshot.stops == 1, what="STOP")
+    assert console.guard.urgents == 1  # taken as its message came, ahead of every queue
     wait_for(lambda: console.panel.sliders[0].value == 0.0, what="sliders back at zero")
     wait_for(lambda: not page.get_by_label("deadman latched").is_checked(), what="unchecked")
     wait_for(lambda: not loop.snapshot.enabled, what="released")
@@ -377,6 +379,26 @@ def test_bad_input_from_pages_never_stops_or_corrupts_the_loop(console, page, br
     assert len(loop.mailbox) < loop.mailbox.capacity
     assert loop.operator.latched  # a page is still there: the deadman is not released
     assert page.locator(".rrc-joint").count() == 6  # and it still shows the console
+
+
+def test_a_record_uploaded_by_the_page_is_replayed(console, page, tmp_path):
+    """A record of three parts (viser uploads in parts of 512 kB): the intake takes each."""
+    loop = console.loop
+    recorder = ControlLoop(console.robot, rate=100.0)
+    for command in (Record(True), Latch(True), Velocity(np.array([0.01, 0, 0, 0, 0, 0]))):
+        recorder.mailbox.post(command)
+    for k in range(2500):
+        recorder.tick(k * recorder.dt)
+    path = recorder.ctl.log.save(tmp_path / "record.csv")
+    assert path.stat().st_size > 2 * 2**19
+    closed = dict(console.guard.closed)
+    page.get_by_text("Trajectory").click()
+    page.locator("input[type=file]").set_input_files(path)
+    wait_for(lambda: loop.snapshot.mode == "replay", what="the uploaded record replayed")
+    assert console.guard.closed == closed
+    page.evaluate("document.activeElement && document.activeElement.blur()")
+    page.keyboard.press(" ")  # STOP ends the replay
+    wait_for(lambda: loop.snapshot.mode == "teleop", what="the replay stopped")
 
 
 def test_dragging_the_gizmo_servoes_the_hand_to_it(console, page):

@@ -72,7 +72,7 @@ def wait_for(condition, what: str, timeout: float = PATIENCE) -> None:
     while not condition():
         if time.monotonic() > deadline:
             raise AssertionError(f"timed out waiting for {what}")
-        time.sleep(0.002)
+        time.sleep(0.01)  # (a polling thread of its own would take the GIL from the loop)
 
 
 def encode(kind: str, **fields) -> bytes:
@@ -272,13 +272,15 @@ def stop_latency(console: Console, operator, arrivals: list[int]) -> tuple[int, 
     raise AssertionError("this process was late sending a STOP a hundred times")
 
 
-@pytest.mark.parametrize(("rate", "realtime"), [(100.0, False), (1000.0, True)])
+@pytest.mark.parametrize("rate", [100.0, 1000.0])
 def test_a_flood_of_four_sockets_costs_the_loop_nothing_and_stop_comes_next_tick(
-    rate, realtime, tmp_path, capfd, caplog
+    rate, tmp_path, capfd, caplog
 ):
-    """1 kHz as the docs advise it, under real-time scheduling where the OS grants it (else
-    nice): the quiet loop then makes its deadlines, and what the flood takes shows."""
-    c = Console("barker6", port=0, rate=rate, out=tmp_path, realtime=realtime).start()
+    """Under real-time scheduling where the OS grants it (``realtime``; else nice): the quiet
+    loop then makes its deadlines whatever else the machine runs, and what the flood takes
+    from it shows (under nice, on a loaded machine, the OS's own stalls move both shares by
+    up to 10 points from one window to the next)."""
+    c = Console("barker6", port=0, rate=rate, out=tmp_path, realtime=True).start()
     try:
         loop = c.loop
         operator = page_socket(c)

@@ -57,11 +57,11 @@ LOG = logging.getLogger("rrc_pin.console")
 FRAME_HEADERS = {"X-Frame-Options": "DENY", "Content-Security-Policy": "frame-ancestors 'none'",
                  "Referrer-Policy": "no-referrer"}  # fmt: skip
 """Headers of every page answered: no other site may frame the console (and click it)."""
-RECEIVE_BUFFER = 2048
-"""The kernel's receive buffer of a page's socket [bytes] (Linux doubles it): what a page sent
-beyond it waits in the page's own socket, and the server never parses more than a few dozen
-of its messages at once (a flood read 256 kB at a time held the event loop, and a STOP,
-for tens of milliseconds per read)."""
+RECEIVE_BUFFER = 16384
+"""The kernel's receive buffer of a page's socket [bytes] (Linux doubles it: 32 kB): what a
+page sent beyond it waits in the page's own socket, and the server parses at most a few
+hundred of its messages at once (a flood read 256 kB at a time held the event loop, and a
+STOP, for tens of milliseconds; a buffer under 16 kB stalls TCP: uploads crawled at 40 kB/s)."""
 URGENT_RATE, URGENT_BURST = 20.0, 5
 """How many urgent messages a second a connection may send ahead of its budget, and at once
 (an operator's STOPs, a held space key's repeats: the rest wait like any message)."""
