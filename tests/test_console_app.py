@@ -207,6 +207,12 @@ def test_keyboard_jogs_and_stop(console, page):
 
     jog_until(console, page, "Shift+U", lambda: np.linalg.norm(turn()) > 0.05)  # +wz
     assert turn()[2] / np.linalg.norm(turn()) > 0.99  # about the hand's z axis
+    # the latch unchecked and the STOP button, as the page sends them: ahead of every queue too
+    page.get_by_label("deadman latched").uncheck()
+    wait_for(lambda: not loop.operator.latched, what="the latch let go")
+    page.get_by_role("button", name="STOP (space)").click()
+    wait_for(lambda: loop.snapshot.stops == 2, what="the STOP button")
+    assert console.guard.urgents == 3
 
 
 def test_readouts_show_the_joints_against_their_limits(console, page):

@@ -6,8 +6,8 @@ Threads, from the robot outward:
    at ``rate`` (100 Hz by default), reads the mailbox at every tick;
 2. viser's event loop: checks every request and message (:mod:`~rrc_pin.console.guard`),
    receives the pages' messages and runs the panel's callbacks in the order the messages
-   came, which only post commands to the mailbox; it asks for the loop's nice value (a STOP
-   travels through it);
+   came, which only post commands to the mailbox; it asks for the loop's scheduling, a step
+   below (a STOP travels through it);
 3. the view (:class:`~rrc_pin.console.view.View`): reads the loop's latest snapshot at a lower
    rate and sends the scene and the readouts to the pages.
 

@@ -15,10 +15,10 @@ least private way found, in three steps on viser's event loop:
    connections that reached viser before (the milliseconds between its start and this step,
    before the console has any control on the page) are dropped;
 3. each websocket admitted gets websockets' own message size limit, a small kernel receive
-   buffer (:data:`RECEIVE_BUFFER`), and its ``recv``, which
-   viser's reader awaits for every message, wrapped by :meth:`Guard.admit`: a message too
-   big, too deep, too long or not viser's protocol closes the connection (1008, the reason
-   said) before viser decodes it; the others spend from the connection's budget
+   buffer (:data:`RECEIVE_BUFFER`), and its ``recv``, which viser's reader awaits for every
+   message, replaced by :meth:`Guard.admit`'s: a message too big, too deep, too long or not
+   viser's protocol closes the connection (1008, the reason said) before viser decodes it;
+   the others spend from the connection's budget
    (:class:`~rrc_pin.console.intake.TokenBucket`) and wait when it is empty; a connection
    whose messages have all waited for ``Intake.patience`` is closed (1008). A message that
    stops or releases the arm is taken there, as it arrives, ahead of the budget and of
@@ -257,4 +257,3 @@ class _Reader:
                 return data
             guard.urgents += 1
             act()
-
