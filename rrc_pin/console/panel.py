@@ -129,7 +129,7 @@ class Panel:
             self.speed = gui.add_slider("speed override [%]", min=0, max=100, step=5,
                                         initial_value=100)  # fmt: skip
             self.speed.on_update(self._guard(lambda e: cmd.Speed(self.speed.value / 100.0),
-                                             reset=lambda: self._put(self.speed, 100)))  # fmt: skip
+                                             reset=self._reset_speed))  # fmt: skip
             drop = gui.add_button("drop the target")
             drop.on_click(self._guard(lambda e: cmd.Target(None)))
         with gui.add_folder("Readouts"):
@@ -202,6 +202,8 @@ class Panel:
         """A callback posting ``make(event)``; a refused value is told to the page instead."""
 
         async def callback(event: Any) -> None:
+            if getattr(event, "client", None) is None:
+                return  # a value the server set (viser calls back for those too): no request
             try:
                 command = make(event)
                 if isinstance(command, REBUILDS) and not self._rebuilds.take(time.monotonic()):
@@ -229,6 +231,10 @@ class Panel:
         for slider, value in zip(self.sliders, twist, strict=True):
             self._put(slider, float(value))
         self._put(self.frame, self.loop.operator.frame)
+
+    def _reset_speed(self) -> None:
+        """Put back the speed override the loop has (after a refused value)."""
+        self._put(self.speed, round(100 * self.loop.ctl.speed))
 
     def _zero(self) -> None:
         for slider in self.sliders:
@@ -288,7 +294,7 @@ class Panel:
             client.add_notification("refused", text, color="red", auto_close_seconds=6.0)
 
     def _put(self, handle: Any, value: object) -> None:
-        """Set a control's value from the server (no callback runs)."""
+        """Set a control's value from the server (its callback skips it: no page sent it)."""
         if handle.value != value:
             handle.value = value
 
