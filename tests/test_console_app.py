@@ -65,7 +65,11 @@ def chromium() -> str:
 
 @pytest.fixture(scope="module")
 def console(tmp_path_factory):
-    c = Console("barker6", port=0, out=tmp_path_factory.mktemp("records"), view_rate=20.0)
+    """Under real-time scheduling where the OS grants it (else nice), as an operator runs it on
+    a busy machine: at a load of 10 on 2 cores, chromium drawing in software, a nice loop made
+    201 of 408 deadlines in the rate test's 2 s."""
+    c = Console("barker6", port=0, out=tmp_path_factory.mktemp("records"), view_rate=20.0,
+                realtime=True)  # fmt: skip
     c.start()
     yield c
     c.stop()
@@ -296,7 +300,7 @@ def test_the_loop_keeps_its_rate_with_a_browser_connected(console, page):
     wait_for(lambda: loop.clock.ticks > ticks + 200, what="200 ticks")  # 2 s at 100 Hz
     stats = loop.clock.stats()
     deadlines = (time.perf_counter() - start) * loop.rate
-    print(f"\n100 Hz with a browser: median {1e3 * stats.median:.2f} ms, "
+    print(f"\n100 Hz ({loop.scheduling}) with a browser: median {1e3 * stats.median:.2f} ms, "
           f"p99 {1e3 * stats.p99:.2f} ms, max {1e3 * stats.max:.1f} ms over {stats.n} periods "
           f"({loop.clock.ticks - ticks} ticks of {deadlines:.0f} deadlines), "
           f"view update {1e3 * console.view.cost:.1f} ms")  # fmt: skip

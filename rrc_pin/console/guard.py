@@ -95,6 +95,7 @@ class Guard:
         throttled: Messages that waited for their connection's budget.
         urgents: Messages taken as urgent (STOP, the latch let go).
         faults: Errors on viser's event loop (each also reported as asyncio reports it).
+        last_fault: The last one, in a line.
     """
 
     def __init__(self, server: Any, access: Access, intake: Intake,
@@ -112,6 +113,7 @@ class Guard:
         self.throttled = 0
         self.urgents = 0
         self.faults = 0
+        self.last_fault = ""
         self._pages: weakref.WeakSet[ServerConnection] = weakref.WeakSet()
         self._opens = TokenBucket(1.0, 2 * intake.max_pages, time.monotonic())
         self._viser: Callable[[ServerConnection, Request], Any] = lambda c, r: None
@@ -143,6 +145,7 @@ class Guard:
 
     def _fault(self, loop: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
         self.faults += 1
+        self.last_fault = f"{context.get('message')}: {context.get('exception')!r}"
         loop.default_exception_handler(context)
 
     async def process_request(self, connection: ServerConnection,
