@@ -392,7 +392,7 @@ def test_bad_input_from_pages_never_stops_or_corrupts_the_loop(console, page, br
 
 
 def test_a_record_uploaded_by_the_page_is_replayed(console, page, tmp_path):
-    """A record of three parts (viser uploads in parts of 512 kB): the intake takes each."""
+    """A record of three parts (viser uploads in parts of 512 kiB): the intake takes each."""
     loop = console.loop
     recorder = ControlLoop(console.robot, rate=100.0)
     for command in (Record(True), Latch(True), Velocity(np.array([0.01, 0, 0, 0, 0, 0]))):
