@@ -251,3 +251,70 @@ def test_a_private_folder_open_to_others_or_not_owned_is_refused(tmp_path, monke
         assert compiled.private_folder() is None
     finally:
         compiled.private_folder.cache_clear()
+
+
+CALLEE = """
+from rrc_pin.solvers.compiled import kernel
+
+
+@kernel
+def value() -> float:
+    return 1.0
+"""
+
+CALLER = """
+from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.probe_callee import value
+
+
+@kernel
+def twice() -> float:
+    return 2.0 * value()
+"""
+
+PROBE = """
+import rrc_pin.solvers.probe_caller as caller
+out = {"file": caller.__file__, "twice": caller.twice(),
+       "misses": len(caller.twice.stats.cache_misses)}
+"""
+
+
+def test_a_kernel_is_compiled_again_when_a_kernel_it_calls_changes_in_another_file(tmp_path):
+    """numba stamps an entry with its function's own file: a caller's entry would keep the
+    machine code of a callee since changed in another file. Two tiny modules of the numerics,
+    the callee changed between runs: the caller is compiled again and gives the new answer."""
+    root = tmp_path / "probe"
+    solvers = root / "rrc_pin" / "solvers"
+    solvers.mkdir(parents=True)
+    (root / "rrc_pin" / "__init__.py").write_text("")
+    (solvers / "__init__.py").write_text("")
+    shutil.copy(PACKAGE / "solvers" / "compiled.py", solvers / "compiled.py")
+    (solvers / "probe_callee.py").write_text(CALLEE)
+    (solvers / "probe_caller.py").write_text(CALLER)
+    script = f"import sys; sys.path.insert(0, {str(root)!r})\n{PROBE}\n{REPORT}"
+    code = script.replace("for name in MODULES:", "for name in ():")
+
+    def probe() -> dict:
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                              timeout=300, cwd=root)  # fmt: skip
+        assert done.returncode == 0, done.stderr[-3000:]
+        line = next(x for x in done.stdout.splitlines() if x.startswith("RESULT "))
+        return json.loads(line.removeprefix("RESULT "))
+
+    first = probe()
+    assert (first["twice"], first["misses"]) == (2.0, 1)  # compiled, cached
+    again = probe()
+    assert (again["twice"], again["misses"]) == (2.0, 0)  # loaded
+    (solvers / "probe_callee.py").write_text(CALLEE.replace("1.0", "5.25"))
+    changed = probe()
+    assert (changed["twice"], changed["misses"]) == (10.5, 1)  # compiled again
+
+
+def test_a_kernels_stamp_is_that_of_every_module_of_the_package_it_reaches():
+    from rrc_pin.solvers.tick import kernels
+
+    stamp = compiled.source_stamp(kernels)
+    names = [name for name, _, _ in stamp]
+    assert names == sorted(names)
+    assert {"rrc_pin.solvers.tick.kernels", "rrc_pin.solvers.compiled"} <= set(names)
+    assert not any(n.startswith(("numpy", "numba", "rrc_pin.geometry")) for n in names)
