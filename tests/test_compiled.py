@@ -53,8 +53,15 @@ for name in ("barker6", "rrc_k1607", "kr5_3r"):
     out[name] = arm.closed_form.joint_rates(qa, np.ones(arm.closed_form.task_dim)).tolist()
 m = maps.capability("kr5_3r", 2000, 0.1, workers=1, progress=False, block_size=1024)
 out["maps"] = m.stats.isum.sum(axis=0).tolist()
-from rrc_pin.solvers.closed_form.base import finite  # only kernels call it: its entry read here
+# only kernels call these: their own entries read here
+from rrc_pin.solvers.closed_form.base import finite
+from rrc_pin.solvers.collision.damper_kernels import damper_bound
+from rrc_pin.solvers.collision.narrow_kernels import segment_closest
+from rrc_pin.solvers.collision.vectors import dot
 out["finite"] = [bool(finite(np.ones(6), 6))]
+out["callees"] = [damper_bound(0.01, 0.1, 0.5, 1e-3, 50.0), dot((1.0, 2.0, 3.0), (4.0, 5.0, 6.0)),
+                  *segment_closest((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.5, 1.0, 0.0),
+                                   (0.0, 0.0, 1.0))]
 """
 
 SOLVE_ONE = """
@@ -311,10 +318,13 @@ def test_a_kernel_is_compiled_again_when_a_kernel_it_calls_changes_in_another_fi
 
 
 def test_a_kernels_stamp_is_that_of_every_module_of_the_package_it_reaches():
-    from rrc_pin.solvers.tick import kernels
+    from rrc_pin.solvers.collision import collision_pass
 
-    stamp = compiled.source_stamp(kernels)
+    stamp = compiled.source_stamp(collision_pass)
     names = [name for name, _, _ in stamp]
     assert names == sorted(names)
-    assert {"rrc_pin.solvers.tick.kernels", "rrc_pin.solvers.compiled"} <= set(names)
+    assert {"rrc_pin.solvers.collision.collision_pass", "rrc_pin.solvers.collision.narrow_kernels",
+            "rrc_pin.solvers.collision.damper_kernels", "rrc_pin.solvers.collision.vectors",
+            "rrc_pin.solvers.collision.proximity_kernels"} <= set(names)  # fmt: skip
     assert not any(n.startswith(("numpy", "numba", "rrc_pin.geometry")) for n in names)
+    assert collision_pass.collision_pass._cache._cache_file._source_stamp == stamp
