@@ -71,6 +71,7 @@ METHODS: tuple[Method, ...] = ("qp", "scipy", "scaling", "hold")
 
 Status = Literal[
     "exact", "scaled", "sliding", "damped", "singular", "least_squares", "recovering", "fallback",
+    "grip_lost", "contact_lost",
 ]
 """What the answer is for the top level (docs/api.md, "Reading a resolution"); how each lower
 level fared is in ``levels`` (:data:`LevelStatus`):
@@ -92,7 +93,10 @@ level fared is in ``levels`` (:data:`LevelStatus`):
 - ``recovering``: a joint outside its range, or a constraint row broken at the start, must
   be restored: the least-squares optimum within the constraints;
 - ``fallback``: the pipeline found no usable answer for the top level; a fallback did
-  (``attempts`` says why).
+  (``attempts`` says why);
+- ``grip_lost``, ``contact_lost``: never the pipeline's; a cell's controller
+  (``rrc_pin.cells``) found a closed chain (two hands' grip, a foot in support) open beyond
+  its bound: the cell holds still (zero rates) until a command closes it.
 """
 
 LevelStatus = Literal["met", "scaled", "traded", "dropped"]
