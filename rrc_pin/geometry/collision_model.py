@@ -149,6 +149,8 @@ class CollisionModel:
         A :class:`~rrc_pin.geometry.walls.Wall` holds the origin of its frame where
         ``normal . p <= offset`` (world frame).
         """
+        if not self._walls:
+            return ()
         return tuple(w for group in self._walls.values() for w in group
                      if frame is None or w.frame == frame)  # fmt: skip
 
@@ -331,7 +333,8 @@ class CollisionModel:
 
         Args:
             kin: The tick's :class:`~rrc_pin.kinematics.Kinematics` of this robot (its
-                ``data`` holds every joint's placement).
+                ``data`` read only where the compiled forward kinematics does not cover the
+                model, or coal measures a pair).
             data: This caller's :meth:`create_data`.
             detection: Detection distance [m], >= 0.
             ends: Also a row for each capsule end point within ``detection`` of the other
