@@ -442,8 +442,8 @@ class CellController(Loop):
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
         closure = Closure(*(np.concatenate([c[i] for c, _ in parts]) for i in range(3)))
         e = closure.error.reshape(-1, 6)
-        self.chain_error = (float(np.linalg.norm(e[:, :3], axis=1).max()),
-                            float(np.linalg.norm(e[:, 3:], axis=1).max()))  # fmt: skip
+        self.chain_error = (float(np.max(np.linalg.norm(e[:, :3], axis=1))),
+                            float(np.max(np.linalg.norm(e[:, 3:], axis=1))))  # fmt: skip
         bound = self.closure
         if bound is None:
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
