@@ -199,6 +199,44 @@ def test_where_the_lp_maximum_is_one_the_command_is_met_exactly(rng: np.random.G
     assert met > 20  # the exact rates did not fit: the null space answered
 
 
+@pytest.mark.parametrize("seed", [20261209, int(np.random.SeedSequence().entropy % 2**63)])
+def test_a_command_beyond_large_is_scaled_never_exact(seed: int) -> None:
+    """Commands of 1e100-1e300 are divided down before the numerics (problem.LARGE). Before,
+    their exact rates fitted the box after the division and the answer said ``exact``, scale 1,
+    while the hand moved at the command over its largest entry. Now: ``scaled``, the scale the
+    fraction of the command achieved, which is the LP maximum along it (HiGHS, on the
+    command's direction at a size the LP can hold)."""
+    rng = np.random.default_rng(seed)
+    for _ in range(60):
+        levels = levels_at(rng, (6,), 1.0)
+        box = box_at(rng)
+        A, d = stacked(levels[0])
+        size = 10.0 ** rng.uniform(100, 300)
+        problem, answer = run([[levels[0][0]._replace(b=d * size)]], box)
+        assert problem.factors[0] < 1.0 and answer.status == "scaled", seed
+        best = lp_maximum(A, d * 1e3, box) * 1e3 / size  # the LP along d, below one at 1e3
+        assert answer.scale == pytest.approx(best, rel=1e-6), seed
+        np.testing.assert_allclose(A @ answer.qdot, answer.scale * size * d,
+                                   atol=1e-9 * best * size * np.abs(d).max())  # fmt: skip
+
+
+def test_a_divided_command_met_in_an_unbounded_box_is_a_scale_of_it(
+    rng: np.random.Generator,
+) -> None:
+    """Without bounds the divided command is met: at the top level ``scaled`` by the factor it
+    was divided by, a lower level ``scaled`` too, never ``exact`` or ``met``."""
+    free = Box(np.full(N, -np.inf), np.full(N, np.inf), np.zeros((2, N), np.int8), True, False,
+               np.full(N, np.inf))  # fmt: skip
+    for direction in (True, False):
+        levels = levels_at(rng, (3, 3), 1e200)
+        problem, answer = run(levels, free, direction=direction)
+        assert answer.status in ("scaled", "least_squares") and answer.levels[1] != "met"
+        assert 0.0 < answer.scale <= problem.factors[0] < 1e-190
+        A, b = stacked(levels[0])
+        np.testing.assert_allclose(A @ answer.qdot, answer.scale * b, atol=1e-9 * answer.scale
+                                   * np.abs(b).max())  # fmt: skip
+
+
 @pytest.mark.filterwarnings("ignore:Converted matrix")
 def test_weighted_is_the_exact_optimum_of_its_costs(rng: np.random.Generator) -> None:
     """Within 1e-6 rad/s of scipy's BVLS on the same costs and box, limits active."""
