@@ -24,6 +24,7 @@ import pinocchio as pin
 
 from rrc_pin import models
 from rrc_pin.errors import InvalidInput, UnknownArm, URDFError
+from rrc_pin.mimic import mimics_of, urdf_mimic_limits
 from rrc_pin.models.arm_spec import ArmSpec
 from rrc_pin.robot import Robot, moving_joints
 from rrc_pin.urdf_compare import compare_urdf
@@ -540,7 +541,9 @@ def _from_file(path: Path, tool_frame: ToolFrames) -> Robot:
     if spec is not None and not compare_urdf(text, to_urdf(spec)):
         tools = _catalogue_tool(tool_frame)
         return Robot(model, tools, name=spec.name, source=str(path), spec=spec)
-    return Robot(model, tool_frame, name=path.stem, source=str(path))
+    followers = {m.name for m in mimics_of(model)}
+    limits = {k: v for k, v in urdf_mimic_limits(root, str(path)).items() if k in followers}
+    return Robot(model, tool_frame, name=path.stem, source=str(path), mimic_limits=limits)
 
 
 def _catalogue_tool(tool_frame: ToolFrames) -> ToolFrames:
