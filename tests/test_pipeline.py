@@ -4,6 +4,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 import qpsolvers
@@ -329,13 +331,30 @@ class Broken(QPBackend):
             return QPSolution(np.zeros(2), "solved", 1, 0.0, self.name)
         if self.mode == "nan":
             return QPSolution(np.full(qp.q.size, np.nan), "solved", 1, 0.0, self.name)  # type: ignore[attr-defined]
+        nz = qp.q.size  # type: ignore[attr-defined]
+        malformed: dict[str, Any] = {
+            "None": None,
+            "tuple": (np.zeros(nz), "solved", 1, 0.0, self.name),
+            "strings": QPSolution(np.array(["0"] * nz), "solved", 1, 0.0, self.name),
+            "ragged": QPSolution([0.0, [0.0]], "solved", 1, 0.0, self.name),
+            "complex": QPSolution(np.zeros(nz, complex), "solved", 1, 0.0, self.name),
+            "iterations": QPSolution(np.zeros(nz), "solved", "3", 0.0, self.name),
+            "time": QPSolution(np.zeros(nz), "solved", 3, np.nan, self.name),
+        }
+        if self.mode in malformed:
+            return malformed[self.mode]  # type: ignore[no-any-return]
         return QPSolution(None, "maximum iterations reached", 4000, 0.0, self.name)
 
 
-@pytest.mark.parametrize("mode", ["raise", "foreign", "shape", "nan", "not found"])
+MALFORMED = ["None", "tuple", "strings", "ragged", "complex", "iterations", "time"]
+
+
+@pytest.mark.parametrize("mode", ["raise", "foreign", "shape", "nan", "not found", *MALFORMED])
 def test_every_backend_fault_falls_back(mode: str, rng: np.random.Generator) -> None:
     """Issue 28 item 4: a backend's exception (its own or foreign), an answer of the wrong
-    shape or a non-finite one always goes to the fallback chain."""
+    shape or a non-finite one always goes to the fallback chain; and so does an answer that
+    is not a QPSolution (None escaped as an AttributeError before), or one whose solution,
+    iterations or time are not what they say."""
     levels = levels_at(rng, (3,), 50.0)  # seven null directions: the backend's QP
     box = box_at(rng)
     _, answer = run(levels, box, Broken(mode))
