@@ -142,7 +142,8 @@ def test_a_compacting_ring_makes_rows_a_batch_at_a_time() -> None:
     small = Ring(derive, capacity=3, compact=compact)  # one batch longer than the ring
     for k in range(BATCH):
         small.append_tick((float(k), 0.0))
-    assert [r.t for r in small] == [BATCH - 3.0, BATCH - 2.0, BATCH - 1.0] and small.dropped == BATCH - 3
+    assert [r.t for r in small] == [BATCH - 3.0, BATCH - 2.0, BATCH - 1.0]
+    assert small.dropped == BATCH - 3
     small.append_tick((99.0, 0.0))
     small.clear()
     assert len(small) == 0 and small.records == []
