@@ -27,6 +27,7 @@ from rrc_pin.errors import InvalidInput, UnknownArm, URDFError
 from rrc_pin.mimic import mimics_of, urdf_mimic_limits
 from rrc_pin.models.arm_spec import ArmSpec
 from rrc_pin.robot import Robot, moving_joints
+from rrc_pin.solvers.checks import MAX_LENGTH, finite_number
 from rrc_pin.urdf_compare import compare_urdf
 from rrc_pin.urdf_export import TOOL_FRAME, to_urdf
 
@@ -425,6 +426,25 @@ def load(
     raise UnknownArm(key, arms() + cells())
 
 
+def loaded(value: Robot | str | os.PathLike[str], argument: str) -> Robot:
+    """``value`` if it is a :class:`Robot`, else :func:`load` of its name or path.
+
+    Raises:
+        InvalidInput: Neither a robot nor a (non-empty) name or path, naming ``argument``.
+        UnknownArm, URDFError: As :func:`load`, naming ``argument``.
+    """
+    if isinstance(value, Robot):
+        return value
+    if not isinstance(value, (str, os.PathLike)) or not os.fspath(value):
+        raise InvalidInput(argument, f"expected a rrc_pin.Robot, a name or a path, got {value!r}")
+    try:
+        return load(value)
+    except UnknownArm as exc:
+        raise UnknownArm(exc.name, exc.available, argument) from exc
+    except URDFError as exc:
+        raise URDFError(exc.path, exc.reason, argument) from exc
+
+
 def _refuse_parameters(parameters: dict[str, float], what: str) -> None:
     if parameters:
         raise InvalidInput(
@@ -444,6 +464,8 @@ def _build(name: str, parameters: dict[str, float]) -> ArmSpec:
             ", ".join(unknown),
             f"not a parameter of {name}; it takes: {', '.join(accepted) or 'none'}",
         )
+    for key, value in parameters.items():  # lengths [m] or angles [rad]: none beyond
+        finite_number(value, key, -MAX_LENGTH, upper=MAX_LENGTH)
     return BUILDERS[name](**parameters)
 
 

@@ -50,9 +50,9 @@ from rrc_pin.control.loop import Loop, Step
 from rrc_pin.control.trajectory_log import CAPACITY, RecordRing, checked_path, reason
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import ContactLimit, GripLimit, JointLimits, Limit
-from rrc_pin.loading import load
+from rrc_pin.loading import loaded
 from rrc_pin.resolver import QPOptions
-from rrc_pin.solvers.checks import as_vector, positive
+from rrc_pin.solvers.checks import as_vector, flag, positive
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.tasks import FrameTask, PostureTask, Task
@@ -195,8 +195,8 @@ class CellController(Loop):
         coupled: bool = True,
         project_contacts: bool = True,
     ) -> None:
-        if isinstance(cell, str):
-            cell = load(cell)  # type: ignore[assignment]
+        if isinstance(cell, (str, os.PathLike)):
+            cell = loaded(cell, "cell")  # type: ignore[assignment]
         if not isinstance(cell, Cell):
             raise InvalidInput("cell", f"expected a Cell or a cell's name, got {cell!r}")
         given: list[Limit]
@@ -207,6 +207,9 @@ class CellController(Loop):
         else:
             given = [limits]
         gain = positive(gain, "gain")
+        posture_gain = positive(posture_gain, "posture_gain")
+        coupled = flag(coupled, "coupled")
+        project_contacts = flag(project_contacts, "project_contacts")
         self.contact = ContactLimit((), name="contact")
         self.grip = GripLimit((), name="grip")
         super().__init__(cell, dt, q0, limits=[*given, self.contact, self.grip], qp=qp,
@@ -215,8 +218,8 @@ class CellController(Loop):
         self.gain = gain
         self.posture = PostureTask(cell.dof_positions(cell.ready()), gain=posture_gain,
                                    weight=1e-3, name="posture")  # fmt: skip
-        self.coupled = bool(coupled)
-        self.project_contacts = bool(project_contacts)
+        self.coupled = coupled
+        self.project_contacts = project_contacts
         self.log: CellLog = CellLog(cell.nq, cell.nv)
         self.contact_correction = 0.0
         self.support: list[str] = list(cell.tool_frames) if cell.body is not None else []
@@ -250,8 +253,14 @@ class CellController(Loop):
         return out
 
     def frame_of(self, name: str) -> str:
-        """The frame command ``name`` moves (the object's, the body's or the hand's)."""
+        """The frame command ``name`` moves (the object's, the body's or the hand's).
+
+        Raises:
+            InvalidInput: ``name`` is no command of this cell (not an object, body or arm).
+        """
         cell = self.cell
+        if not isinstance(name, str):
+            raise InvalidInput("name", f"expected a command's name, got {type(name).__name__}")
         if name in cell.objects or name == cell.body:
             return name
         return cell.arm(name, "name").hand

@@ -17,6 +17,7 @@ recording the tick in a :class:`~rrc_pin.control.trajectory_log.TrajectoryLog`.
 
 from __future__ import annotations
 
+import os
 from typing import Any, Literal, NamedTuple
 
 import numpy as np
@@ -34,11 +35,12 @@ from rrc_pin.control.strategies.base import KEEP, to_base_axes
 from rrc_pin.control.trajectory_log import LogRecord, TrajectoryLog
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import JointLimits
-from rrc_pin.loading import cells, load
+from rrc_pin.loading import cells, loaded
 from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import Robot
 from rrc_pin.solvers.checks import as_vector, finite_number
 from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.problem import LARGE
 from rrc_pin.solvers.tick.resolution import ACTIVE_TOL, Resolution
 
 Array = npt.NDArray[np.float64]
@@ -261,9 +263,10 @@ class Controller(Loop):
         hand = pose if local else None
         if self.strategy.passive:  # it keeps the command: no Situation to build
             decision = KEEP
-        else:
-            decision = self.strategy.decide(Situation(self.robot, q, wanted, self.dt, command,
-                                                      self._rows, hand))
+        else:  # (a command beyond LARGE divided down along itself: no rates overflow)
+            down = _within_large(wanted)
+            decision = self.strategy.decide(Situation(
+                self.robot, q, wanted * down, self.dt, command * down, self._rows, hand))
         factor = decision.factor
         if decision.rates is None:
             r = self.resolver.solve(q, wanted if factor == 1.0 else factor * wanted,
@@ -367,8 +370,8 @@ def _loaded(robot: Robot | str) -> Robot:
     Raises:
         InvalidInput: Neither a Robot nor a name, naming ``robot``.
     """
-    if isinstance(robot, str):
-        robot = load(robot)
+    if isinstance(robot, (str, os.PathLike)):
+        robot = loaded(robot, "robot")
     if not isinstance(robot, Robot):
         raise InvalidInput("robot", f"expected a rrc_pin.Robot or a name, got {robot!r}")
     return robot
@@ -392,6 +395,17 @@ def _checked_twist(twist: npt.ArrayLike) -> Array:
     """
     out: Array = as_vector(twist, "twist", 6).copy()
     return out
+
+
+def _within_large(twist: Array) -> float:
+    """The factor (1, or less) that brings ``twist`` within :data:`LARGE` [m/s, rad/s].
+
+    The strategies' closed forms divide a command by the arm's singular values: beyond it
+    their rates overflow (a NaN configuration, before). The resolver divides its own commands
+    down the same way (:mod:`rrc_pin.solvers.tick.problem`).
+    """
+    peak = float(np.abs(twist).max())
+    return 1.0 if peak <= LARGE else LARGE / peak
 
 
 def _followed(r: Resolution) -> float | None:

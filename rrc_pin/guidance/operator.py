@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from typing import Literal, NamedTuple
 
-import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
@@ -30,7 +29,7 @@ from rrc_pin.guidance.stepping import (
     screw_step,
     unit_axis,
 )
-from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.checks import as_vector, choice, finite_number
 
 Frame = Literal["global", "hand"]
 
@@ -83,6 +82,9 @@ def operator(
     """
     arm = on_frame(arm, frame)
     q = check_q0(arm, q0)
+    if not isinstance(commands, (list, tuple)):
+        raise InvalidInput("commands", f"expected a list of guidance.Command, got "
+                           f"{type(commands).__name__}")  # fmt: skip
     ks = [steps] * len(commands) if not isinstance(steps, list) else steps
     if len(ks) != len(commands):
         raise InvalidInput("steps", f"expected {len(commands)} step counts, got {len(ks)}")
@@ -114,11 +116,6 @@ def _check(c: Command, i: int) -> tuple[Array, float, float, Frame, Array | None
     axis = unit_axis(c.axis, f"{name}.axis")
     d = finite_number(c.d, f"{name}.d")
     theta = finite_number(c.theta, f"{name}.theta")
-    if c.frame not in ("global", "hand"):
-        raise InvalidInput(f"{name}.frame", f"expected 'global' or 'hand', got {c.frame!r}")
-    point = None
-    if c.point is not None:
-        point = np.asarray(c.point, dtype=float)
-        if point.shape != (3,) or not np.isfinite(point).all():
-            raise InvalidInput(f"{name}.point", f"expected a finite (3,) point, got {c.point!r}")
-    return axis, d, theta, c.frame, point
+    frame = choice(c.frame, f"{name}.frame", ("global", "hand"))
+    point = None if c.point is None else as_vector(c.point, f"{name}.point", 3)
+    return axis, d, theta, frame, point  # type: ignore[return-value]

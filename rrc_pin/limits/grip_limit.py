@@ -11,6 +11,7 @@ import numpy.typing as npt
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits.contact_limit import AXES
 from rrc_pin.limits.limit import Limit
+from rrc_pin.solvers.checks import names
 from rrc_pin.solvers.tick.problem import Constraints
 from rrc_pin.tasks.relative_frame_task import RelativeFrameTask
 
@@ -51,9 +52,11 @@ class GripLimit(Limit):
             InvalidInput: Not pairs of two different frame names; the limit is unchanged.
             FrameNotFound: A frame the robot (of the resolver holding it) does not have.
         """
-        items = tuple(tuple(p) for p in pairs)
+        if not isinstance(pairs, (list, tuple)):
+            raise InvalidInput("pairs", f"expected (frame_a, frame_b) pairs, got {pairs!r}")
+        items = tuple(names(p, "pairs", 2) if not isinstance(p, str) else (p,) for p in pairs)
         for p in items:
-            if len(p) != 2 or not all(isinstance(f, str) for f in p) or p[0] == p[1]:
+            if len(p) != 2 or p[0] == p[1]:
                 raise InvalidInput("pairs", f"expected (frame_a, frame_b) pairs, got {pairs!r}")
             if self._layout is not None:
                 for frame in p:

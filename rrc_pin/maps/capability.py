@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 from collections.abc import Callable
 from dataclasses import asdict
@@ -23,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.loading import load
+from rrc_pin.loading import loaded
 from rrc_pin.maps import driver
 from rrc_pin.maps.blocks import BlockStore
 from rrc_pin.maps.capability_map import CapabilityMap
@@ -31,6 +30,7 @@ from rrc_pin.maps.kinematics import arm_kinematics
 from rrc_pin.maps.progress import Progress, ProgressBar
 from rrc_pin.maps.voxels import MAX_SAMPLES, Grid, chain_grid, quanta
 from rrc_pin.robot import Robot
+from rrc_pin.solvers.checks import length
 from rrc_pin.solvers.maps.batch import MAX_KEYS, Chain, Fields
 from rrc_pin.solvers.maps.kinematics import ArmKinematics
 from rrc_pin.solvers.maps.sampling import BLOCK, Plan
@@ -102,7 +102,7 @@ def capability(
     """
     robot = arm if isinstance(arm, Robot) else _load(arm)
     samples = _count(samples, "samples", 1, MAX_SAMPLES)
-    voxel = _positive(voxel, "voxel")
+    voxel = length(voxel, "voxel")
     seed = _count(seed, "seed", 0, 2**63 - 1)
     block_size = _block_size(block_size)
     if blocks_per_task is not None:
@@ -202,9 +202,7 @@ def chain_digest(chain: Chain) -> str:
 
 
 def _load(arm: object) -> Robot:
-    if not isinstance(arm, str):
-        raise InvalidInput("arm", f"expected a Robot, a name or a path, got {arm!r}")
-    return load(arm)
+    return loaded(arm, "arm")  # type: ignore[arg-type]
 
 
 def _count(value: object, name: str, lo: int, hi: int) -> int:
@@ -213,15 +211,6 @@ def _count(value: object, name: str, lo: int, hi: int) -> int:
     if not lo <= value <= hi:
         raise InvalidInput(name, f"expected {lo} <= {name} <= {hi}, got {value}")
     return int(value)
-
-
-def _positive(value: object, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InvalidInput(name, f"expected a number [m], got {value!r}")
-    x = float(value)
-    if not math.isfinite(x) or x <= 0.0:
-        raise InvalidInput(name, f"expected a finite length > 0 [m], got {value!r}")
-    return x
 
 
 def _block_size(value: object) -> int:

@@ -13,6 +13,7 @@ Layout of ``<path>`` (a Zarr group, zarr-python 2 or 3, each in its default form
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -49,10 +50,26 @@ def write_array(group: Any, name: str, data: npt.NDArray[Any], chunks: tuple[int
     arr[...] = data
 
 
-def save_map(m: CapabilityMap, path: str | Path) -> Path:
-    """Write ``m`` to the Zarr store ``path`` (replaced if it exists); returns the path."""
+def save_map(m: CapabilityMap, path: str | os.PathLike[str]) -> Path:
+    """Write ``m`` to the Zarr store ``path``; returns the path.
+
+    A map store already at ``path`` is replaced; anything else there (a file, a folder that
+    is not a map store: the current folder for ``"."``) is refused, never deleted (Zarr's
+    ``mode="w"`` empties the folder it is given).
+
+    Raises:
+        InvalidInput: ``m`` is not a :class:`CapabilityMap`, or ``path`` not a file name, or
+            something other than a map store is there (each named).
+    """
+    if not isinstance(m, CapabilityMap):
+        raise InvalidInput("m", f"expected a CapabilityMap, got {type(m).__name__}")
+    if not isinstance(path, (str, os.PathLike)) or not os.fspath(path):
+        raise InvalidInput("path", f"expected a folder name (str or os.PathLike), got {path!r}")
     zarr = _zarr()
     path = Path(path)
+    if path.exists() and not _is_map_store(path):
+        raise InvalidInput("path", f"{str(path)!r} exists and is not a map store of rrc-pin:"
+                           " it is not replaced (name a new folder, or delete it yourself)")
     group = zarr.open_group(str(path), mode="w")
     group.attrs.update(
         {"rrc_pin_map": LAYOUT, "grid": m.grid.to_dict(), "meta": _jsonable(m.meta)}
@@ -65,6 +82,16 @@ def save_map(m: CapabilityMap, path: str | Path) -> Path:
         data = np.asarray(getattr(m.chain, name))
         write_array(chain, name, data, data.shape or (1,))
     return path
+
+
+def _is_map_store(path: Path) -> bool:
+    """Whether ``path`` is a folder holding a map store (its ``rrc_pin_map`` attribute)."""
+    if not path.is_dir():
+        return False
+    try:
+        return bool(_zarr().open_group(str(path), mode="r").attrs.get("rrc_pin_map") == LAYOUT)
+    except (KeyError, OSError, ValueError, TypeError):
+        return False
 
 
 def load_map(path: str | Path) -> CapabilityMap:
