@@ -5,6 +5,10 @@ Run with the peers' environment from a checkout:
 ``PYTHONPATH=. .venv-peers/bin/python benchmarks/bench_collision.py --out DIR`` (``--record``
 writes ``benchmarks/results/collision.{json,png}``; ``--quick`` a short smoke run).
 
+``--soak`` (rrc-pin alone, any environment) runs the held-out soak of benchmarks/collision_soak.py
+instead: 200 random starts in penetration and each scene's 10-minute sessions (``--quick``: 12
+starts, 10 s), written as ``collision_soak.{json,png}``.
+
 The cell: two pandas facing each other 1.0 m apart (``rrc_pin.combine``), capsule geometry
 (:class:`rrc_pin.CollisionModel`); for mink the same joint tree and capsules written as MJCF
 (:mod:`collision_peers`; MuJoCo's ``mj_geomDistance`` equals coal's distance to 1e-15 on them).
@@ -28,6 +32,7 @@ default) with the same distances; pink's barrier gain 1, d_min 0.02, every pair 
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
@@ -39,6 +44,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np
 import pinocchio as pin
 from collision_peers import mjcf
+from collision_soak import soak
 from script import arguments, make_parser, mark_quick, measure, pyplot, write
 from timing import progress
 
@@ -243,7 +249,7 @@ def _table(results: dict[str, Any], full: bool) -> str:
     for n in sets:
         by = {r["contender"]: r for r in rows if r["pairs"] == n}
         cells = [f"{by[lb]['median_us']:,.0f} / {by[lb]['p99_us']:,.0f} | "
-                 f"{by[lb]['min_distance_m'] * 1e3:.1f}" for lb in labels]  # fmt: skip
+                 f"{_millimetres(by[lb]['min_distance_m'])}" for lb in labels]  # fmt: skip
         line = f"| {n} | " + " | ".join(cells) + " |"
         ours = by.get(Rrc.label, {})
         if full and "limit_median_us" in ours:
@@ -254,10 +260,17 @@ def _table(results: dict[str, Any], full: bool) -> str:
     load = results.get("load_average", {})
     start, end = (load.get(k, [float("nan")])[0] for k in ("start", "end"))
     s = results["settings"]
+    never = "" if all(math.isfinite(r["min_distance_m"]) for r in rows) else (
+        f" min -: no pair came within the detection distance ({s['detection'] * 1e3:.0f} mm).")
     lines += ["", f"Safety {s['safety'] * 1e3:.0f} mm, {s['ticks']:,} ticks a pair set, "
               f"interleaved in one process; load average {start:.1f} at the start, {end:.1f} "
-              "at the end (2 cores)."]  # fmt: skip
+              f"at the end (2 cores).{never}"]  # fmt: skip
     return "\n".join(lines)
+
+
+def _millimetres(distance: float) -> str:
+    """A minimum distance [m] in mm, or ``-`` where no pair came near (infinite)."""
+    return f"{distance * 1e3:.1f}" if math.isfinite(distance) else "-"
 
 
 def readme_table(results: dict[str, Any]) -> str:
@@ -294,11 +307,47 @@ def plot(results: dict[str, Any], path: Path) -> bool:
         if all("limit_median_us" in r for r in rows):
             ax[0].plot(x, [r["limit_median_us"] for r in rows], "s--", color=line.get_color(),
                        label=f"{label}: the limit's share")  # fmt: skip
-        ax[1].plot(x, [r["min_distance_m"] * 1e3 for r in rows], "o-", label=label)
+        near = [(n, r["min_distance_m"] * 1e3) for n, r in zip(x, rows, strict=True)
+                if math.isfinite(r["min_distance_m"])]  # fmt: skip
+        never = [n for n, r in zip(x, rows, strict=True) if not math.isfinite(r["min_distance_m"])]
+        note = f" (no pair within {DETECTION * 1e3:.0f} mm at {never} pairs: not drawn)"
+        ax[1].plot([n for n, _ in near], [d for _, d in near], "o-", color=line.get_color(),
+                   label=label + (note if never else ""))  # fmt: skip
     ax[0].set(xscale="log", yscale="log", xlabel="pairs", ylabel="step median [us]")
-    ax[1].axhline(SAFETY * 1e3, color="gray", ls="--")
+    ax[1].axhline(SAFETY * 1e3, color="gray", ls="--", label="safety distance")
     ax[1].set(xscale="log", xlabel="pairs", ylabel="minimum distance [mm]")
     ax[0].legend(fontsize=8)
+    ax[1].legend(fontsize=7)
+    mark_quick(fig, results)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def plot_soak(results: dict[str, Any], path: Path) -> bool:
+    """The soak: each start's ticks to leave the safety distance against the command's time,
+    and each session's nearest pair."""
+    plt = pyplot()
+    if plt is None:
+        return False
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    for kind in sorted({r["kind"] for r in results["starts"]}):
+        rows = [r for r in results["starts"] if r["kind"] == kind and r["exit_ticks"] is not None]
+        ax[0].plot([r["deadline"] * DT for r in rows], [r["exit_ticks"] * DT for r in rows], "o",
+                   ms=3, label=kind)  # fmt: skip
+    top = max([r["deadline"] * DT for r in results["starts"]] + [0.1])
+    ax[0].plot([0, top], [0, top], color="gray", ls="--", label="the command's time")
+    ax[0].set(xlabel="the command's time to leave [s]", ylabel="out of the safety distance [s]")
+    ax[0].legend(fontsize=8)
+    sessions = results["sessions"]
+    labels = [f"{s['scene']}{' (turning)' if s['turning'] else ''}" for s in sessions]
+    ax[1].barh(labels, [s["min_distance_m"] * 1e3 for s in sessions])
+    ax[1].axvline(SAFETY * 1e3, color="gray", ls="--")
+    ax[1].set(xlabel="minimum distance [mm]", xlim=(SAFETY * 1e3 - 2, SAFETY * 1e3 + 1))
+    for k, s in enumerate(sessions):
+        ax[1].text(SAFETY * 1e3 - 1.9, k, f"{s['fallback_ticks']} fallback ticks", va="center",
+                   fontsize=7, color="white")  # fmt: skip
     mark_quick(fig, results)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -309,7 +358,15 @@ def plot(results: dict[str, Any], path: Path) -> bool:
 def main(argv: list[str] | None = None) -> None:
     parser = make_parser(__doc__, "collision")
     parser.add_argument("--ticks", type=int, default=None, help="ticks per pair set")
+    parser.add_argument("--soak", action="store_true", help="the held-out soak, not the peers")
     args = arguments(parser, argv)
+    if args.soak:
+        starts, minutes = (12, 10 / 60) if args.quick else (200, 10.0)
+        soaked = measure("collision_soak", args.quick, lambda: soak(starts, minutes, 0, progress),
+                         "coal")  # fmt: skip
+        print(soaked["summary"])
+        write(args, "collision_soak", soaked, lambda p: plot_soak(soaked, p))
+        return
     ticks = args.ticks or (60 if args.quick else 1000)
     results = measure("collision", args.quick, lambda: run(ticks), "mink", "mujoco", "pink",
                       "coal")  # fmt: skip

@@ -21,6 +21,7 @@ import numpy as np
 
 import rrc_pin
 from rrc_pin import guidance, maps
+from rrc_pin.cells.closure import ClosureBound
 from rrc_pin.control import strategies
 from rrc_pin.solvers.tick.damping import Damping
 
@@ -66,7 +67,7 @@ class World:
         self.T[:3, 3] = [0.5, 0.0, 0.3]
         ctl = rrc_pin.Controller(self.panda)
         for _ in range(3):
-            ctl.step(self.twist)
+            ctl.step(self.twist, ref="local")
         self.log_path = ctl.log.save(tmp / "run.csv")
         self.map = maps.capability(self.barker, samples=256, voxel=0.2, workers=1,
                                    progress=False, block_size=64)
@@ -74,7 +75,7 @@ class World:
 
     def controller(self) -> rrc_pin.Controller:
         ctl = rrc_pin.Controller(self.panda)
-        ctl.step(self.twist)
+        ctl.step(self.twist, ref="local")
         return ctl
 
     def collision(self) -> rrc_pin.CollisionModel:
@@ -92,7 +93,8 @@ class World:
 def sites(w: World) -> list[Site]:
     """Every site of the fuzz, on the objects of ``w``."""
     return [*_robot(w), *_resolver(w), *_tasks(w), *_limits(w), *_collision(w),
-            *_controller(w), *_cells(w), *_guidance(w), *_maps(w), *_strategies(w)]
+            *_controller(w), *_cells(w), *_guidance(w), *_maps(w), *_strategies(w),
+            *_teleoperation(w)]
 
 
 def _robot(w: World) -> list[Site]:
@@ -290,7 +292,7 @@ def _cells(w: World) -> list[Site]:
         Site("CellController.land", lambda: _swung(w.tripod).land, {"leg": "leg1"}),
         Site("CellController", lambda: rrc_pin.CellController, {
             "cell": cell, "dt": 0.01, "q0": None, "limits": None, "qp": None, "speed": 1.0,
-            "gain": 10.0, "posture_gain": 0.1, "coupled": True, "project_contacts": True}),
+            "gain": 10.0, "posture_gain": 0.1, "coupled": True, "closure": ClosureBound()}),
         Site("CellController.step", lambda: w.cell_controller().step,
              {"commands": {"object": np.array([0.01, 0, 0, 0, 0, 0])}}),
         Site("CellController.target", lambda: w.cell_controller().target, {"name": "object"}),
@@ -396,4 +398,55 @@ def _strategies(w: World) -> list[Site]:
         Site("GeneralizedInverse", lambda: strategies.GeneralizedInverse, {"exact": False}),
         Site("Uncoupled", lambda: strategies.Uncoupled, {}),
         Site("ResolverOnly", lambda: strategies.ResolverOnly, {}),
+    ]
+
+
+def _teleoperation(w: World) -> list[Site]:
+    """The teleoperation aids: their tasks and limits, the pose stream, the jerk limiter."""
+    tool, z = w.tool, [0.0, 0.0, 1.0]
+    return [
+        Site("AxisAlignTask", lambda: rrc_pin.AxisAlignTask, {
+            "frame": tool, "axis": z, "direction": [0.0, 0.0, -1.0], "gain": 5.0, "weight": 1.0,
+            "name": None}),
+        Site("AxisAlignTask.set_direction", lambda: rrc_pin.AxisAlignTask(tool).set_direction,
+             {"direction": [1.0, 0.0, 0.0]}),
+        Site("LookAtTask", lambda: rrc_pin.LookAtTask, {
+            "frame": tool, "point": [1.0, 0.0, 0.0], "axis": z, "gain": 5.0, "weight": 1.0,
+            "name": None}),
+        Site("LookAtTask.set_point", lambda: rrc_pin.LookAtTask(tool, [1.0, 0, 0]).set_point,
+             {"point": [0.0, 1.0, 0.0]}),
+        Site("ComTask", lambda: rrc_pin.ComTask, {
+            "velocity": [0.0, 0.0, 0.01], "axes": "xyz", "gain": 5.0, "weight": 1.0,
+            "name": "com"}, aliases={"axes": ("velocity",)}),  # the velocity fits the axes
+        Site("ComTask.set_target", lambda: rrc_pin.ComTask().set_target,
+             {"target": [0.1, 0.0, 0.5], "velocity": None}),
+        Site("ManipulabilityTask", lambda: rrc_pin.ManipulabilityTask,
+             {"frame": tool, "gain": 0.05, "rows": "full", "weight": 1.0, "name": None}),
+        Site("SingularityLimit", lambda: rrc_pin.SingularityLimit, {
+            "frame": tool, "threshold": 0.02, "detection": 0.06, "gain": 0.5, "rows": "full",
+            "name": None}, aliases={"threshold": ("detection",)}),  # the later of the pair
+        Site("SupportPolygonLimit", lambda: rrc_pin.SupportPolygonLimit,
+             {"feet": ["leg1/foot", "leg2/foot", "leg3/foot"], "margin": 0.02, "gain": 0.5,
+              "name": "support"}),
+        Site("SupportPolygonLimit.set_feet", lambda: rrc_pin.SupportPolygonLimit().set_feet,
+             {"feet": ["leg1/foot", "leg2/foot"]}),
+        Site("StreamOptions", lambda: rrc_pin.StreamOptions, {
+            "gain": 10.0, "linear_speed": 0.5, "angular_speed": 1.5, "jump": 0.05,
+            "jump_angle": 0.3, "device_speed": 2.0, "device_rate": 10.0, "timeout": 0.05,
+            "decay": 0.05, "settle": 5, "scale": 1.0, "device_axes": None, "lower": None,
+            "upper": None}),
+        Site("PoseStream", lambda: rrc_pin.PoseStream, {"hand": w.T, "options": None}),
+        Site("PoseStream.push", lambda: rrc_pin.PoseStream(w.T).push, {"t": 0.0, "device": w.T}),
+        Site("PoseStream.clutch", lambda: rrc_pin.PoseStream(w.T).clutch,
+             {"pressed": True, "t": 0.0}),
+        Site("PoseStream.target_for", lambda: rrc_pin.PoseStream(w.T).target_for,
+             {"device": w.T}),
+        Site("PoseStream.twist", lambda: rrc_pin.PoseStream(w.T).twist, {"t": 0.0, "hand": w.T}),
+        Site("JerkLimiter", lambda: rrc_pin.JerkLimiter, {
+            "n": 7, "dt": 0.01, "acceleration": 10.0, "jerk": 100.0, "lower": None,
+            "upper": None, "margin": 0.0}),
+        Site("JerkLimiter.reset", lambda: rrc_pin.JerkLimiter(7, 0.01, 10.0, 100.0).reset,
+             {"rates": np.zeros(7)}),
+        Site("JerkLimiter.stop", lambda: rrc_pin.JerkLimiter(7, 0.01, 10.0, 100.0).stop,
+             {"stopping": True}),
     ]

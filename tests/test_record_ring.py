@@ -183,7 +183,7 @@ def test_a_tick_of_the_controllers_log_costs_a_few_hundred_bytes(
     append = log.append_tick
     monkeypatch.setattr(log, "append_tick", lambda tick: (seen.append(tick), append(tick)))
     for k in range(128):  # the kernels, the caches and the first columns warmed up too
-        ctl.step(rng.normal(size=6) * 0.1 if k % 16 == 0 else None)
+        ctl.step(rng.normal(size=6) * 0.1 if k % 16 == 0 else None, ref="local")
     monkeypatch.undo()
     log.clear()
     gc.collect()

@@ -27,7 +27,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.solvers.checks import MAX_LENGTH, finite_array, real_array
+from rrc_pin.solvers.checks import finite_array, real_array, within_length
 
 Array = npt.NDArray[np.float64]
 
@@ -74,7 +74,7 @@ def frames_from_points(points: npt.ArrayLike, name: str = "points") -> Array:
         raise InvalidInput(name, f"expected shape (..., 3, 3), got {P.shape}")
     if not np.isfinite(P).all():
         raise InvalidInput(name, "non-finite coordinate")
-    _within_reach(P, name)
+    within_length(P, name)
     a, b, c = P[..., 0, :], P[..., 1, :], P[..., 2, :]
     ab, ac = b - a, c - a
     n_ab = np.linalg.norm(ab, axis=-1)
@@ -138,7 +138,7 @@ def screw_of_displacement(Q: npt.ArrayLike, q: npt.ArrayLike) -> Screw:
     """
     Q = _rotations(Q, "Q")
     q = finite_array(q, "q")
-    _within_reach(q, "q")
+    within_length(q, "q")
     if q.shape != Q.shape[:-1]:
         raise InvalidInput("q", f"expected translations of shape {Q.shape[:-1]} (Q's), got "
                            f"{q.shape}")  # fmt: skip
@@ -208,7 +208,7 @@ def check_screw(screw: Screw, name: str = "screw") -> Screw:
         raise InvalidInput(name, f"expected a guidance.Screw, got {type(screw).__name__}")
     u, rho, d, theta = (finite_array(v, name) for v in screw[:4])
     for value in (rho, d, theta):
-        _within_reach(value, name)
+        within_length(value, name)
     if u.shape[-1:] != (3,) or rho.shape != u.shape or not d.shape == theta.shape == u.shape[:-1]:
         raise InvalidInput(name, f"fields of shapes u {u.shape}, rho {rho.shape}, d {d.shape}, "
                            f"theta {theta.shape}: expected (..., 3), (..., 3), (...), (...)")
@@ -288,11 +288,6 @@ def _poses(T: npt.ArrayLike, name: str) -> Array:
     if np.abs(A[..., 3, :] - (0.0, 0.0, 0.0, 1.0)).max(initial=0.0) > 1e-9:
         raise InvalidInput(name, "the last row of a pose must be (0, 0, 0, 1)")
     _rotations(A[..., :3, :3], name)
-    _within_reach(A[..., :3, 3], name)
+    within_length(A[..., :3, 3], name)
     return A
 
-
-def _within_reach(x: Array, name: str) -> None:
-    """Refuse coordinates beyond :data:`~rrc_pin.solvers.checks.MAX_LENGTH` [m]."""
-    if np.abs(x).max(initial=0.0) > MAX_LENGTH:
-        raise InvalidInput(name, f"a coordinate beyond {MAX_LENGTH:g} m")

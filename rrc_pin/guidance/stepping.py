@@ -23,7 +23,6 @@ iterates on the exact pose (every term, quadratic convergence).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal, NamedTuple, Protocol
@@ -35,7 +34,7 @@ import pinocchio as pin
 from rrc_pin.errors import InvalidInput
 from rrc_pin.resolver import Resolver
 from rrc_pin.robot import Robot
-from rrc_pin.solvers.checks import as_array, as_vector, choice, finite_number, integer
+from rrc_pin.solvers.checks import as_array, as_vector, choice, direction, finite_number, integer
 from rrc_pin.tasks import FrameTask
 
 Array = npt.NDArray[np.float64]
@@ -420,11 +419,9 @@ def unit_axis(axis: npt.ArrayLike, name: str) -> Array:
     Raises:
         InvalidInput: Not a finite, nonzero 3-vector.
     """
-    a = as_vector(axis, name, 3)
-    length = math.hypot(*a.tolist())
-    if not 1e-12 <= length < math.inf:
+    out, length = direction(axis, name)
+    if length < 1e-12:
         raise InvalidInput(name, f"expected a nonzero axis of shape (3,), got {axis!r}")
-    out: Array = a / length
     return out
 
 

@@ -9,8 +9,8 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.checks import all_finite, as_array, as_vector
+from rrc_pin.solvers.compiled import kernel
 from rrc_pin.solvers.errors import InvalidInput
-from rrc_pin.solvers.tick.kernels import kernel
 
 Array = npt.NDArray[np.float64]
 _F64 = np.dtype(np.float64)
