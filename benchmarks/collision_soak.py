@@ -300,7 +300,7 @@ def _placed(rng: np.random.Generator, cm: CollisionModel, q: np.ndarray, body: i
     obj = cm.scene.geometry.geometryObjects[body]
     M = data.oMi[obj.parentJoint] * obj.placement
     mine = (obj.geometry, coal.Transform3s(M.rotation, M.translation))
-    centre = data.oMi[int(cm.scene.joint[body])].act(cm.scene.centre[body])
+    centre = data.oMi[int(cm.scene.joint[body])].act(cm.scene.bodies["centre"][body])
     u = rng.normal(size=3)
     u /= np.linalg.norm(u)
     if kind == "halfspace":  # the solid u . x <= o, farther from the body as o falls

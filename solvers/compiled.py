@@ -21,10 +21,18 @@ folder is writable (a damaged index emptied first); where it is not, caching is 
 that kernel in this process. Nothing the cache holds can make an import or a call fail.
 
 numba offers no public hook on reading a cache entry (a damaged one raises from inside
-``Dispatcher.compile``, whatever pickle or LLVM raise), so two of its internals are used:
+``Dispatcher.compile``, whatever pickle or LLVM raise), so three of its internals are used:
 the class ``numba.core.caching.FunctionCache`` (subclassed, its ``load_overload`` and
-``save_overload`` guarded) and the dispatcher's ``_cache`` attribute (set to it, as
-``Dispatcher.enable_caching`` does). tests/test_compiled.py pins both.
+``save_overload`` guarded), the dispatcher's ``_cache`` attribute (set to it, as
+``Dispatcher.enable_caching`` does) and the cache file's ``_source_stamp``. tests/test_compiled.py
+pins them.
+
+numba stamps an entry with its function's source file only (modification time and size), but
+a kernel calls kernels of other modules (the collision pass calls the narrow phase, the damper
+rows, ...), whose machine code is compiled into the caller's entry: changed, they would leave
+the caller's entry stale. The stamp here is that of every file of this package the kernel's
+module reaches through its globals (kernels and modules it imports, and theirs), so an entry
+is compiled again when any of them changes.
 
 A bit flipped inside an entry's machine code that still unpickles is not detected: numba
 keeps no checksum of its entries.
@@ -35,10 +43,12 @@ from __future__ import annotations
 import functools
 import os
 import stat
+import sys
 import tempfile
 import threading
 from collections.abc import Callable
 from pathlib import Path
+from types import ModuleType
 from typing import Any, TypeVar, cast, overload
 
 import numba
@@ -56,8 +66,21 @@ _SETTING = threading.Lock()
 """Held while ``numba.config.CACHE_DIR`` is changed (modules may be imported in threads)."""
 
 
+PACKAGE = __name__.rpartition(".")[0]
+"""The package whose modules a kernel's stamp covers (this module's)."""
+
+
 class GuardedCache(FunctionCache):  # type: ignore[misc]  # an untyped base
-    """numba's cache of one function, where a damaged entry is a miss and never an error."""
+    """numba's cache of one function, where a damaged entry is a miss and never an error.
+
+    Stamped with the sources the function's module reaches (module docstring).
+    """
+
+    def __init__(self, py_func: Callable[..., Any]) -> None:
+        super().__init__(py_func)
+        cache_file = getattr(self, "_cache_file", None)
+        if cache_file is not None:
+            cache_file._source_stamp = source_stamp(sys.modules[py_func.__module__])
 
     def load_overload(self, sig: Any, target_context: Any) -> Any:
         """The cached compile result of ``sig``, or None (not cached, or not readable).
@@ -84,6 +107,32 @@ class GuardedCache(FunctionCache):  # type: ignore[misc]  # an untyped base
                 super().save_overload(sig, data)
             except Exception:  # read-only, or a directory where a file should be
                 self.disable()
+
+
+def source_stamp(module: ModuleType) -> tuple[tuple[str, float, int], ...]:
+    """(module, modification time, size of its file) of ``module`` and the modules it reaches.
+
+    Every module of :data:`PACKAGE` reached through the globals of ``module`` and of those
+    modules (kernels called, modules imported), sorted by name.
+    """
+    reached: dict[str, ModuleType] = {}
+    todo = [module]
+    while todo:
+        current = todo.pop()
+        reached[current.__name__] = current
+        for value in vars(current).values():
+            name = value.__name__ if isinstance(value, ModuleType) else getattr(
+                value, "__module__", None)  # fmt: skip
+            inside = isinstance(name, str) and (name == PACKAGE or name.startswith(PACKAGE + "."))
+            if inside and name not in reached and name in sys.modules:
+                todo.append(sys.modules[name])
+    stamps = []
+    for name, reached_module in sorted(reached.items()):
+        path = getattr(reached_module, "__file__", None)
+        if path:
+            st = os.stat(path)
+            stamps.append((name, st.st_mtime, st.st_size))
+    return tuple(stamps)
 
 
 @overload

@@ -1,7 +1,7 @@
-"""The compiled kernels' cache cannot break the library: damaged entries (truncated, empty,
-random bytes) of every compiled module are compiled again and written anew; a read-only
-install with a read-only home caches in the user's private temporary folder, or compiles in
-memory; ``import rrc_pin`` and the solves succeed every time, with the same answers.
+"""The compiled kernels' cache cannot break the library: damaged entries (truncated, empty, random
+bytes, each in a compiled module drawn at random) are compiled again and written anew; a read-only
+install with a read-only home caches in the user's private temporary folder, or compiles in memory;
+``import rrc_pin`` and the solves succeed every time, with the same answers.
 
 Each case runs in a fresh interpreter on a copy of the package in a temporary folder (the
 symlinked numerics copied as files), so that the checkout's own cache is never touched.
@@ -53,17 +53,25 @@ for name in ("barker6", "rrc_k1607", "kr5_3r"):
     out[name] = arm.closed_form.joint_rates(qa, np.ones(arm.closed_form.task_dim)).tolist()
 m = maps.capability("kr5_3r", 2000, 0.1, workers=1, progress=False, block_size=1024)
 out["maps"] = m.stats.isum.sum(axis=0).tolist()
-from rrc_pin.solvers.closed_form.base import finite  # only kernels call it: its entry read here
+# only kernels call these: their own entries read here
+from rrc_pin.solvers.closed_form.base import finite
+from rrc_pin.solvers.collision.damper_kernels import damper_bound
+from rrc_pin.solvers.collision.narrow_kernels import segment_closest
+from rrc_pin.solvers.collision.vectors import dot
 out["finite"] = [bool(finite(np.ones(6), 6))]
+out["callees"] = [damper_bound(0.01, 0.1, 0.5, 1e-3, 50.0), dot((1.0, 2.0, 3.0), (4.0, 5.0, 6.0)),
+                  *segment_closest((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.5, 1.0, 0.0),
+                                   (0.0, 0.0, 1.0))]
 """
 
 SOLVE_ONE = """
+import numpy as np
 import rrc_pin
-from rrc_pin import Resolver
-panda = rrc_pin.load("panda")
+import rrc_pin.solvers.tick.kernels  # every tick kernel made a dispatcher with its cache
+arm = rrc_pin.load("kr5_3r")
+q = arm.random_q(np.random.default_rng(1))
 out = {"file": rrc_pin.__file__,
-       "tick": Resolver(panda, dt=0.01).solve(panda.ready(), [0.05, 0, -0.05, 0, 0, 0.1])
-       .qdot.tolist()}
+       "rates": arm.closed_form.joint_rates(q, np.ones(arm.closed_form.task_dim)).tolist()}
 """
 
 REPORT = """
@@ -146,7 +154,7 @@ def damage(path: Path, kind: str, rng: np.random.Generator) -> None:
         path.write_bytes(rng.bytes(len(data)))
 
 
-def test_damaged_entries_of_every_module_are_compiled_again_and_rewritten(tmp_path):
+def test_damaged_entries_are_compiled_again_and_rewritten(tmp_path):
     seed = int(np.random.SeedSequence().entropy % 2**63)
     rng = np.random.default_rng(seed)
     run(PACKAGE.parent, SOLVE_ALL)  # compiles, if the suite has not yet, in the checkout
@@ -165,14 +173,15 @@ def test_damaged_entries_of_every_module_are_compiled_again_and_rewritten(tmp_pa
     }
     assert {m for m, paths in files.items() if paths} == set(modules)
     lost: set[str] = set()
-    for kind in ("truncated", "empty", "random bytes"):
-        damaged = set()
-        for module, paths in files.items():  # one kernel's index, or its data (every signature)
-            path = paths[int(rng.integers(len(paths)))]
-            for other in paths:
-                if other.suffix == path.suffix and kernel_of(other) == kernel_of(path):
-                    damage(other, kind, rng)
-            damaged.add(f"{module}.{kernel_of(path)}")
+    kinds = ("truncated", "empty", "random bytes")  # each in a module of its own, drawn fresh
+    modules_damaged = rng.choice(sorted(files), len(kinds), replace=False)
+    for kind, module in zip(kinds, modules_damaged, strict=True):
+        paths = files[module]  # one kernel's index, or its data (every signature)
+        path = paths[int(rng.integers(len(paths)))]
+        for other in paths:
+            if other.suffix == path.suffix and kernel_of(other) == kernel_of(path):
+                damage(other, kind, rng)
+        damaged = {f"{module}.{kernel_of(path)}"}
         lost |= damaged  # entries of signatures only their callers ask for, until asked
         again = run(root, SOLVE_ALL)
         same_answers(reference, again)
@@ -251,3 +260,73 @@ def test_a_private_folder_open_to_others_or_not_owned_is_refused(tmp_path, monke
         assert compiled.private_folder() is None
     finally:
         compiled.private_folder.cache_clear()
+
+
+CALLEE = """
+from rrc_pin.solvers.compiled import kernel
+
+
+@kernel
+def value() -> float:
+    return 1.0
+"""
+
+CALLER = """
+from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.probe_callee import value
+
+
+@kernel
+def twice() -> float:
+    return 2.0 * value()
+"""
+
+PROBE = """
+import rrc_pin.solvers.probe_caller as caller
+out = {"file": caller.__file__, "twice": caller.twice(),
+       "misses": len(caller.twice.stats.cache_misses)}
+"""
+
+
+def test_a_kernel_is_compiled_again_when_a_kernel_it_calls_changes_in_another_file(tmp_path):
+    """numba stamps an entry with its function's own file: a caller's entry would keep the
+    machine code of a callee since changed in another file. Two tiny modules of the numerics,
+    the callee changed between runs: the caller is compiled again and gives the new answer."""
+    root = tmp_path / "probe"
+    solvers = root / "rrc_pin" / "solvers"
+    solvers.mkdir(parents=True)
+    (root / "rrc_pin" / "__init__.py").write_text("")
+    (solvers / "__init__.py").write_text("")
+    shutil.copy(PACKAGE / "solvers" / "compiled.py", solvers / "compiled.py")
+    (solvers / "probe_callee.py").write_text(CALLEE)
+    (solvers / "probe_caller.py").write_text(CALLER)
+    script = f"import sys; sys.path.insert(0, {str(root)!r})\n{PROBE}\n{REPORT}"
+    code = script.replace("for name in MODULES:", "for name in ():")
+
+    def probe() -> dict:
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                              timeout=300, cwd=root)  # fmt: skip
+        assert done.returncode == 0, done.stderr[-3000:]
+        line = next(x for x in done.stdout.splitlines() if x.startswith("RESULT "))
+        return json.loads(line.removeprefix("RESULT "))
+
+    first = probe()
+    assert (first["twice"], first["misses"]) == (2.0, 1)  # compiled, cached
+    again = probe()
+    assert (again["twice"], again["misses"]) == (2.0, 0)  # loaded
+    (solvers / "probe_callee.py").write_text(CALLEE.replace("1.0", "5.25"))
+    changed = probe()
+    assert (changed["twice"], changed["misses"]) == (10.5, 1)  # compiled again
+
+
+def test_a_kernels_stamp_is_that_of_every_module_of_the_package_it_reaches():
+    from rrc_pin.solvers.collision import collision_pass
+
+    stamp = compiled.source_stamp(collision_pass)
+    names = [name for name, _, _ in stamp]
+    assert names == sorted(names)
+    assert {"rrc_pin.solvers.collision.collision_pass", "rrc_pin.solvers.collision.narrow_kernels",
+            "rrc_pin.solvers.collision.damper_kernels", "rrc_pin.solvers.collision.vectors",
+            "rrc_pin.solvers.collision.proximity_kernels"} <= set(names)  # fmt: skip
+    assert not any(n.startswith(("numpy", "numba", "rrc_pin.geometry")) for n in names)
+    assert collision_pass.collision_pass._cache._cache_file._source_stamp == stamp

@@ -52,7 +52,7 @@ def test_obstacles_get_names_and_pair_with_every_moving_body(cm):
         assert all(cm.excluded[(a, name)] == "invariant" for a in still), name
         assert cm.excluded[("panda_link0_0", name)] == "rigid"
     floor = cm.scene.names.index("floor")
-    np.testing.assert_allclose(cm.scene.normal[floor], (0, 0, 1))  # normalised
+    np.testing.assert_allclose(cm.scene.bodies["normal"][floor], (0, 0, 1))  # normalised
 
 
 def test_the_halfspace_side_is_normal_dot_x_below_offset(panda, cm):

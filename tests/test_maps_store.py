@@ -78,16 +78,16 @@ def _damage(path, kind, rng):
 
 
 def test_random_damage_is_detected_named_and_repaired_exactly(finished, client, tmp_path):
-    """100 corruptions (bytes flipped, truncated, files deleted), each of a fresh copy of a
-    finished map's folder: a damaged file of the store is named by ``load_map`` (never a
-    wrong value); a damaged file of its blocks by the resume; the resume computes again only
-    the blocks of the file damaged and gives the same bits as the map never damaged."""
+    """20 corruptions drawn fresh each run (bytes flipped, truncated, files deleted), each of a
+    fresh copy of a finished map's folder: a damaged file of the store is named by ``load_map``
+    (never a wrong value); a damaged file of its blocks by the resume; the resume computes again
+    only the blocks of the file damaged and gives the same bits as the map never damaged."""
     folder, whole = finished
     seed = int(np.random.SeedSequence().entropy % 2**63)
     rng = np.random.default_rng(seed)
     areas = {a: sorted(p.relative_to(folder) for p in (folder / a).rglob("*") if p.is_file())
              for a in ("map.zarr", "blocks")}  # fmt: skip
-    for trial in range(100):
+    for trial in range(20):
         case = tmp_path / f"case{trial}"
         shutil.copytree(folder, case)
         files = areas["map.zarr" if rng.random() < 0.5 else "blocks"]

@@ -10,7 +10,16 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from rrc_pin.solvers.collision.narrow_kernels import BOX, CAPSULE, HALFSPACE, SPHERE, narrow_phase
+from rrc_pin.geometry import shapes
+from rrc_pin.solvers.collision.narrow_kernels import (
+    BOX,
+    CAPSULE,
+    HALFSPACE,
+    OTHER,
+    SPHERE,
+    narrow_phase,
+)
+from rrc_pin.solvers.collision.records import BODY, FOUND
 
 TOL = 1e-9
 TRIALS = 500
@@ -31,28 +40,32 @@ def body(kind, rng):
     return CAPSULE, np.array([[0, 0, -half], [0, 0, half]]), r, coal.Capsule(r, 2 * half)
 
 
+def records(shapes, segments, radii, joints):
+    """Two bodies as the kernel reads them (bounding spheres never read by these pairs)."""
+    bodies = np.zeros(2, dtype=BODY)
+    bodies["shape"], bodies["segment"], bodies["radius"] = shapes, segments, radii
+    bodies["joint"] = joints
+    return bodies
+
+
+def run(bodies, poses, ends, detection, rows=5):
+    """The kernel on the pair (0, 1): (rows, others, found, other)."""
+    found = np.zeros(rows, dtype=FOUND)
+    other = np.zeros(1, dtype=np.int64)
+    rows, others = narrow_phase(poses, bodies, np.zeros((2, 3)), np.array([0]), np.array([1]),
+                                np.array([0]), 1, np.ones(1, dtype=np.bool_), detection, ends,
+                                found, other)  # fmt: skip
+    return rows, others, found, other
+
+
 def solve(shapes, segments, radii, poses, plane=None, ends=False, detection=FAR):
     """The kernel on one pair (body 0 on joint 1, body 1 on joint 2 or a world half-space)."""
-    ng = 2
-    shape = np.array(shapes, dtype=np.int64)
-    joint = np.array([1, 2 if plane is None else 0], dtype=np.int64)
-    normal = np.zeros((ng, 3))
-    offset = np.zeros(ng)
+    bodies = records(shapes, np.array(segments), radii, [1, 2 if plane is None else 0])
     if plane is not None:
-        normal[1], offset[1] = plane
-    out = {
-        "pair": np.zeros(5, dtype=np.int64), "distance": np.zeros(5),
-        "point_a": np.zeros((5, 3)), "point_b": np.zeros((5, 3)), "normal": np.zeros((5, 3)),
-    }  # fmt: skip
-    other = np.zeros(1, dtype=np.int64)
-    rows, others = narrow_phase(poses, joint, shape, np.array(segments), np.array(radii),
-                                np.zeros((ng, 3, 4)), np.zeros((ng, 3)), normal, offset,
-                                np.array([0]), np.array([1]), np.array([0]), 1,
-                                np.ones(1, dtype=np.bool_), detection, ends, out["pair"],
-                                out["distance"], out["point_a"], out["point_b"], out["normal"],
-                                np.zeros(5, dtype=np.int8), other)  # fmt: skip
+        bodies["normal"][1], bodies["offset"][1] = plane
+    rows, others, found, _ = run(bodies, poses, ends, detection)
     assert others == 0
-    return rows, out
+    return rows, found
 
 
 def coal_distance(shape_a, Ma, shape_b, Mb):
@@ -230,20 +243,9 @@ def test_capsule_end_points_against_a_box_match_coal():
         poses = np.array([np.eye(4), pose(rotation(rng), rng.normal(size=3) * 0.1),
                           pose(rotation(rng), rng.normal(size=3) * 0.1)])  # fmt: skip
         placement = pose(rotation(rng), rng.normal(size=3) * 0.05)  # the box in its joint
-        out = {"pair": np.zeros(5, dtype=np.int64), "distance": np.zeros(5),
-               "point_a": np.zeros((5, 3)), "point_b": np.zeros((5, 3)),
-               "normal": np.zeros((5, 3)), "end": np.zeros(5, dtype=np.int8)}  # fmt: skip
-        frames = np.zeros((2, 3, 4))
-        frames[1] = placement[:3]
-        halves = np.zeros((2, 3))
-        halves[1] = half
-        other = np.zeros(1, dtype=np.int64)
-        rows, others = narrow_phase(
-            poses, np.array([1, 2]), np.array([a[0], BOX]), np.array([a[1], np.zeros((2, 3))]),
-            np.array([a[2], 0.0]), frames, halves, np.zeros((2, 3)), np.zeros(2), np.array([0]),
-            np.array([1]), np.array([0]), 1, np.ones(1, dtype=np.bool_), FAR, True,
-            out["pair"], out["distance"], out["point_a"], out["point_b"], out["normal"],
-            out["end"], other)  # fmt: skip
+        bodies = records([a[0], BOX], [a[1], np.zeros((2, 3))], [a[2], 0.0], [1, 2])
+        bodies["box"][1], bodies["half"][1] = placement[:3], half
+        rows, others, out, other = run(bodies, poses, True, FAR)
         assert others == 1 and other[0] == 0  # the closest points: coal's
         ends = a[1] @ poses[1][:3, :3].T + poses[1][:3, 3]
         assert rows == (1 if not (a[1][1] - a[1][0]).any() else 2)
@@ -257,3 +259,48 @@ def test_capsule_end_points_against_a_box_match_coal():
             assert np.linalg.norm(n) == pytest.approx(1.0, abs=1e-12)
             inside += d < -a[2]
     assert inside >= 20
+
+
+
+SEEDS = (17, int(np.random.SeedSequence().entropy % 2**63))
+"""A fixed seed and one drawn fresh each run (named in every failure's message)."""
+
+
+@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "fresh"))
+@pytest.mark.parametrize("kind", ["box", "cylinder", "convex"])
+def test_coal_gets_a_pair_unless_its_bound_is_beyond_the_detection_distance(kind, seed):
+    """A sphere or capsule against a shape coal measures: left for coal unless the segment's
+    distance to the other's bounding sphere, less both radii, is at least the detection
+    distance; so coal never misses a pair within it (coal's distance against the bound), and
+    pairs farther are often not measured at all."""
+    rng = np.random.default_rng(seed)
+    detection = 0.1
+    skipped = measured = 0
+    for _ in range(TRIALS):
+        a = body("capsule" if rng.random() < 0.8 else "sphere", rng)
+        size = rng.uniform(0.03, 0.3, 3)
+        if kind == "box":
+            shape = coal.Box(*size)
+        elif kind == "cylinder":
+            shape = coal.Cylinder(size[0], size[1])
+        else:
+            shape = shapes.convex(rng.normal(size=(10, 3)) * size)
+        centre, bounding = shapes.bounding_sphere(shape)
+        poses = np.array([np.eye(4), pose(rotation(rng), rng.normal(size=3) * 0.1),
+                          pose(rotation(rng), rng.normal(size=3) * 0.3)])  # fmt: skip
+        bodies = records([a[0], BOX if kind == "box" else OTHER], [a[1], np.zeros((2, 3))],
+                         [a[2], 0.0], [1, 2])  # fmt: skip
+        bodies["bounding"][1] = bounding
+        bodies["box"][1], bodies["half"][1] = np.eye(4)[:3], size / 2
+        world = np.zeros((2, 3))
+        world[1] = poses[2][:3, :3] @ centre + poses[2][:3, 3]
+        found = np.zeros(5, dtype=FOUND)
+        other = np.zeros(1, dtype=np.int64)
+        _, others = narrow_phase(poses, bodies, world, np.array([0]), np.array([1]),
+                                 np.array([0]), 1, np.ones(1, dtype=np.bool_), detection, False,
+                                 found, other)  # fmt: skip
+        d = coal_distance(a[3], poses[1], shape, poses[2]).min_distance
+        assert others == 1 or d >= detection - 1e-9, f"seed {seed}: d {d} not measured"
+        skipped += others == 0
+        measured += d < detection
+    assert skipped > TRIALS // 10 and measured > TRIALS // 10, f"seed {seed}: {skipped}, {measured}"

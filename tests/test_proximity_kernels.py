@@ -1,6 +1,5 @@
-"""rrc_pin.solvers.collision.proximity_kernels: the compiled forward kinematics and bounding-sphere
-test, against
-numpy references (1e-12) and Pinocchio."""
+"""rrc_pin.solvers.collision.proximity_kernels: the compiled forward kinematics, joint Jacobians
+and bounding-sphere test, against numpy references (1e-12) and Pinocchio."""
 
 from __future__ import annotations
 
@@ -10,7 +9,12 @@ import pytest
 
 import rrc_pin
 from rrc_pin.geometry.tree import tree_of
-from rrc_pin.solvers.collision.proximity_kernels import joint_poses, near_pairs, world_centres
+from rrc_pin.solvers.collision.proximity_kernels import (
+    joint_jacobians,
+    joint_poses,
+    near_pairs,
+    world_centres,
+)
 
 
 def rodrigues(axis, theta):
@@ -46,6 +50,31 @@ def test_joint_poses_match_pinocchio_and_a_numpy_product(name, rng):
             reference[j] = reference[tree.parent[j]] @ M @ motion
             np.testing.assert_allclose(out[j], data.oMi[j].homogeneous, atol=1e-12)
         np.testing.assert_allclose(out, reference, atol=1e-12)
+
+
+SEEDS = (41, int(np.random.SeedSequence().entropy % 2**63))
+"""A fixed seed and one drawn fresh each run (named in every failure's message)."""
+
+
+@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "fresh"))
+@pytest.mark.parametrize("name", ["barker6", "nadkarni_c2", "panda", "kinova", "baxter"])
+def test_joint_jacobians_match_pinocchio(name, seed):
+    """Every column of ``data.J`` after ``computeJointJacobians`` (WORLD: [v_O; w]), from the
+    compiled placements: revolute, prismatic (nadkarni_c2), continuous (kinova), a tree."""
+    robot = rrc_pin.load(name)
+    model = robot.model
+    rng = np.random.default_rng(seed)
+    tree = tree_of(model, robot.random_q(rng))
+    poses = np.zeros((model.njoints, 4, 4))
+    J = np.full((6, model.nv), np.nan)
+    for _ in range(20):
+        q = robot.random_q(rng)
+        joint_poses(q, tree.parent, tree.rotation, tree.translation, tree.kind, tree.axis,
+                    tree.coordinate, poses)  # fmt: skip
+        joint_jacobians(poses, tree.kind, tree.axis, tree.coordinate, J)
+        data = model.createData()
+        pin.computeJointJacobians(model, data, robot.to_pinocchio(q))
+        np.testing.assert_allclose(J, data.J, atol=1e-12, err_msg=f"seed {seed}")
 
 
 def test_world_centres_and_near_pairs_against_numpy(rng):

@@ -162,6 +162,8 @@ class CollisionModel:
         """
         if frame is not None and not isinstance(frame, str):
             raise InvalidInput("frame", f"expected a frame's name or None, got {frame!r}")
+        if not self._walls:
+            return ()
         return tuple(w for group in self._walls.values() for w in group
                      if frame is None or w.frame == frame)  # fmt: skip
 
@@ -347,7 +349,8 @@ class CollisionModel:
 
         Args:
             kin: The tick's :class:`~rrc_pin.kinematics.Kinematics` of this robot (its
-                ``data`` holds every joint's placement).
+                ``data`` read only where the compiled forward kinematics does not cover the
+                model, or coal measures a pair).
             data: This caller's :meth:`create_data`.
             detection: Detection distance [m], >= 0.
             ends: Also a row for each capsule end point within ``detection`` of the other

@@ -1,19 +1,20 @@
 """One tick's proximity query: the pairs closer than a detection distance, with witnesses.
 
-The steps, in the order data flows:
+One compiled pass (:mod:`rrc_pin.solvers.collision.collision_pass`) runs the steps in the order
+data flows:
 
 1. the joint placements of the tick, from q by the compiled forward kinematics of
-   :mod:`~rrc_pin.geometry.tree` (or read from Pinocchio's ``data.oMi`` for a model it does
-   not cover);
-2. the broad phase (:mod:`rrc_pin.solvers.collision.proximity_kernels`, compiled): bounding-sphere
-centres in
-   the world, and the pairs whose distance bound is below the detection distance;
+   :mod:`~rrc_pin.geometry.tree` (with their Jacobians where damper rows are asked for), or
+   read from Pinocchio's ``data.oMi`` (and ``data.J``) for a model it does not cover;
+2. the broad phase: bounding-sphere centres in the world, and the pairs whose distance bound is
+   below the detection distance;
 3. the narrow phase for those candidates only, keeping those below the detection distance:
-   pairs of spheres, capsules and half-spaces in one compiled pass
-   (:mod:`rrc_pin.solvers.collision.narrow_kernels`, also the capsules' end-point rows when asked),
-   the others
-   (boxes, cylinders, hulls, meshes) by coal: ``pinocchio.updateGeometryPlacements``, then
-   ``pinocchio.computeDistance`` per pair (signed distance, EPA in penetration).
+   pairs of spheres, capsules and half-spaces measured in the pass (also the capsules'
+   end-point rows when asked), the others (boxes, cylinders, hulls, meshes) left for coal where
+   a sphere's or capsule's exact distance to their bounding sphere is below it too; coal then
+   measures those (``pinocchio.updateGeometryPlacements``, then ``pinocchio.computeDistance``
+   per pair: signed distance, EPA in penetration), here;
+4. for the collision limit, the damper row of each row (in the pass when coal had nothing).
 
 Conventions of a :class:`Proximity` row (coal's): the witness points ``p_a`` on body A and
 ``p_b`` on body B, world frame; the signed distance ``d`` (negative in penetration); the unit
@@ -33,11 +34,13 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.geometry.scene import Scene
-from rrc_pin.solvers.collision.narrow_kernels import BOX, CAPSULE, SPHERE, narrow_phase
-from rrc_pin.solvers.collision.proximity_kernels import joint_poses, near_pairs, world_centres
+from rrc_pin.solvers.collision.collision_pass import collision_pass, pair_rows
+from rrc_pin.solvers.collision.narrow_kernels import BOX, CAPSULE, SPHERE
+from rrc_pin.solvers.collision.records import FOUND, SETTINGS
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
+Records = npt.NDArray[np.void]
 T = TypeVar("T")
 Select = Callable[[Scene], npt.NDArray[np.bool_]]
 """Gives the pairs of a scene to answer for, as a mask (npairs,) over its pairs."""
@@ -80,12 +83,13 @@ class CollisionData:
     """The per-caller state of proximity queries: one per resolver (one per thread).
 
     Holds a ``pinocchio.GeometryData`` (coal's results and cached solver guesses) and the
-    broad phase's arrays; rebuilt when it meets a scene newer than its own (an obstacle added).
-    Create it with :meth:`CollisionModel.create_data`; never share one between threads.
+    compiled pass's arrays (placements, Jacobians, the rows found, their damper rows); rebuilt
+    when it meets a scene newer than its own (an obstacle added). Create it with
+    :meth:`CollisionModel.create_data`; never share one between threads.
     """
 
-    __slots__ = ("candidates", "distance", "end", "geometry_data", "normal", "other", "pair",
-                 "point_a", "point_b", "poses", "scene", "world")  # fmt: skip
+    __slots__ = ("G", "J", "candidates", "found", "geometry_data", "h", "other", "poses", "scene",
+                 "world")  # fmt: skip
 
     def __init__(self, scene: Scene) -> None:
         self.refresh(scene)
@@ -96,18 +100,22 @@ class CollisionData:
         self.geometry_data = pin.GeometryData(scene.geometry)
         self.poses = np.zeros((scene.njoints, 4, 4))
         self.poses[0] = np.eye(4)
+        self.J = np.zeros((6, scene.nv))
         self.world = np.zeros((len(scene.names), 3))
         npairs = len(scene.first)
         self.candidates = np.zeros(npairs, dtype=np.int64)
         self.other = np.zeros(npairs, dtype=np.int64)
-        # a pair's row and its end points' (rrc_pin.solvers.collision.narrow_kernels)
-        rows = ROWS * npairs
-        self.pair = np.zeros(rows, dtype=np.int64)
-        self.distance = np.zeros(rows)
-        self.point_a = np.zeros((rows, 3))
-        self.point_b = np.zeros((rows, 3))
-        self.normal = np.zeros((rows, 3))
-        self.end = np.zeros(rows, dtype=np.int8)
+        rows = ROWS * npairs  # a pair's row and its end points' (narrow_kernels)
+        self.found = np.zeros(rows, dtype=FOUND)
+        self.G = np.zeros((rows, scene.nv))
+        self.h = np.zeros(rows)
+
+
+def search(detection: float, ends: bool) -> Records:
+    """The settings (1,) of a query without damper rows (:data:`SETTINGS`)."""
+    settings = np.zeros(1, dtype=SETTINGS)
+    settings["detection"], settings["ends"] = detection, ends
+    return settings
 
 
 def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Data],
@@ -120,51 +128,76 @@ def query(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Dat
         model: The robot's ``pinocchio.Model``.
         q: Joint positions (nv,) [rad or m], one coordinate per joint.
         placed: Gives the ``pinocchio.Data`` holding the joint placements ``oMi`` at ``q``
-            (called only when a pair is near: the narrow phase reads it).
+            (called only where the compiled forward kinematics does not cover the model, or
+            coal has pairs to measure).
         cdata: The caller's :class:`CollisionData` (refreshed if older than ``scene``).
         detection: Detection distance [m]: pairs with a signed distance below it are rows.
         ends: Also the rows of the capsules' end points
-        (:mod:`rrc_pin.solvers.collision.narrow_kernels`): a
-            pair may then have several rows, its first its closest points.
+            (:mod:`rrc_pin.solvers.collision.narrow_kernels`): a pair may then have several
+            rows, its first its closest points.
         select: Gives the pairs of ``scene`` to answer for ((npairs,) mask), or None: all.
+    """
+    keep = scene.every if select is None else select(scene)
+    rows, _ = measure(scene, model, q, placed, cdata, search(detection, ends), keep)
+    return proximity_of(cdata, rows)
+
+
+def measure(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.Data],
+            cdata: CollisionData, settings: Records,
+            keep: npt.NDArray[np.bool_]) -> tuple[int, int]:  # fmt: skip
+    """Run the pass at ``q`` into ``cdata``: the rows found, and their damper rows if asked.
+
+    Args:
+        scene: The scene to answer for.
+        model: The robot's ``pinocchio.Model``.
+        q: Joint positions (nv,) [rad or m], one coordinate per joint.
+        placed: Gives the ``pinocchio.Data`` at ``q`` with every joint's placement and
+            Jacobian (called only where the compiled forward kinematics does not cover the
+            model, or coal has pairs to measure).
+        cdata: The caller's :class:`CollisionData` (refreshed if older than ``scene``).
+        settings: One :data:`SETTINGS` record (1,): the detection distance, the end points'
+            rows, the damper rows and their parameters.
+        keep: The pairs of ``scene`` to answer for ((npairs,) mask).
+
+    Returns:
+        rows: The number of rows in ``cdata.found`` (each pair's own row, then its end
+        points'; pairs in the scene's order); ``unmoved``: how many of them no joint moves
+        (with damper rows, in ``cdata.G`` and ``cdata.h``; else 0).
     """
     if cdata.scene is not scene:
         cdata.refresh(scene)
-    poses = cdata.poses
-    tree = scene.tree
-    if tree is not None:
-        joint_poses(q, tree.parent, tree.rotation, tree.translation, tree.kind, tree.axis,
-                    tree.coordinate, poses)  # fmt: skip
-    else:
-        poses[:] = [M.homogeneous for M in placed().oMi.tolist()]
-    world_centres(poses, scene.joint, scene.centre, cdata.world)
-    count = near_pairs(scene.first, scene.second, cdata.world, scene.radius, scene.normal,
-                       scene.offset, detection, cdata.candidates)  # fmt: skip
-    if count == 0:
-        return EMPTY
-    keep = scene.every if select is None else select(scene)
-    rows, others = narrow_phase(poses, scene.joint, scene.shape, scene.segment, scene.size,
-                                scene.box_frame, scene.half, scene.normal, scene.offset,
-                                scene.first, scene.second, cdata.candidates, count, keep,
-                                detection, ends, cdata.pair, cdata.distance, cdata.point_a,
-                                cdata.point_b, cdata.normal, cdata.end, cdata.other)  # fmt: skip
+    if scene.tree is None:
+        data = placed()
+        cdata.poses[:] = [M.homogeneous for M in data.oMi.tolist()]
+        if settings["rows"][0]:
+            cdata.J[:] = data.J
+    rows, others, unmoved = collision_pass(
+        q, scene.joints, scene.bodies, scene.first, scene.second, keep, settings,
+        scene.support, cdata.poses, cdata.J, cdata.world, cdata.candidates, cdata.other,
+        cdata.found, cdata.G, cdata.h,
+    )  # fmt: skip
     if others:
-        rows = _coal(scene, model, placed(), cdata, detection, rows, others, ends)
+        rows = _coal(scene, model, placed(), cdata, float(settings["detection"][0]), rows, others,
+                     bool(settings["ends"][0]))  # fmt: skip
+        if settings["rows"][0]:
+            unmoved = pair_rows(cdata.J, scene.support, scene.bodies, scene.first, scene.second,
+                                settings, cdata.found, rows, cdata.G, cdata.h)  # fmt: skip
+    return rows, unmoved
+
+
+def proximity_of(cdata: CollisionData, rows: int) -> Proximity:
+    """The :class:`Proximity` of the first ``rows`` rows of ``cdata`` (copies)."""
     if rows == 0:
         return EMPTY
-    index = cdata.pair[:rows].copy()
-    taken: slice | Index = slice(0, rows)
-    if others:  # coal's rows came last: each pair's own row first, then its end points'
-        order = np.argsort(2 * index + cdata.end[:rows], kind="stable")
-        order = order[_distinct(order, cdata)]
-        index, taken = index[order], order
-    names = scene.pair_names
+    scene = cdata.scene
+    found = cdata.found[:rows]
+    index = found["pair"].copy()
     return Proximity(
-        names=gather(names, index),
-        distance=cdata.distance[taken].copy(),
-        point_a=cdata.point_a[taken].copy(),
-        point_b=cdata.point_b[taken].copy(),
-        normal=cdata.normal[taken].copy(),
+        names=gather(scene.pair_names, index),
+        distance=found["distance"].copy(),
+        point_a=found["point_a"].copy(),
+        point_b=found["point_b"].copy(),
+        normal=found["normal"].copy(),
         joint_a=scene.joint[scene.first[index]],
         joint_b=scene.joint[scene.second[index]],
         pair=index,
@@ -186,13 +219,15 @@ def _coal(scene: Scene, model: pin.Model, data: pin.Data, cdata: CollisionData,
     With ``ends``, a capsule against a shape the compiled phase leaves to coal (a hull, a
     cylinder, a mesh; a box that is the pair's first body) also gets its end points' rows here:
     each end as a sphere of the capsule's radius against the other body, as the compiled phase
-    does for a capsule against a box.
+    does for a capsule against a box. The rows are then put in order (each pair's own row
+    first, then its end points', pairs in the scene's order).
 
     Returns:
         The number of rows now written.
     """
     gdata = cdata.geometry_data
     geometry = scene.geometry
+    shape, radius, segment = scene.bodies["shape"], scene.bodies["radius"], scene.bodies["segment"]
     pin.updateGeometryPlacements(model, data, geometry, gdata)
     for k in cdata.other[:others].tolist():
         result = pin.computeDistance(geometry, gdata, k)
@@ -203,16 +238,16 @@ def _coal(scene: Scene, model: pin.Model, data: pin.Data, cdata: CollisionData,
         if not ends:
             continue
         for side, g, o in ((0, a, b), (1, b, a)):
-            if scene.shape[g] != CAPSULE or scene.shape[o] in (CAPSULE, SPHERE) or (
-                side == 0 and scene.shape[o] == BOX  # the compiled phase wrote these ends
+            if shape[g] != CAPSULE or shape[o] in (CAPSULE, SPHERE) or (
+                side == 0 and shape[o] == BOX  # the compiled phase wrote these ends
             ):
                 continue
-            sphere = coal.Sphere(float(scene.size[g]))
+            sphere = coal.Sphere(float(radius[g]))
             other = geometry.geometryObjects[o].geometry
             M = cdata.poses[scene.joint[g]]
             there = coal.Transform3s(gdata.oMg[o].rotation, gdata.oMg[o].translation)
             for e in range(2):
-                centre = M[:3, :3] @ scene.segment[g, e] + M[:3, 3]
+                centre = M[:3, :3] @ segment[g, e] + M[:3, 3]
                 at = coal.Transform3s(np.eye(3), centre)
                 end_result = coal.DistanceResult()
                 if side == 0:
@@ -221,39 +256,40 @@ def _coal(scene: Scene, model: pin.Model, data: pin.Data, cdata: CollisionData,
                     coal.distance(other, there, sphere, at, coal.DistanceRequest(), end_result)
                 if end_result.min_distance < detection:
                     rows = _coal_row(scene, cdata, k, end_result, 1, rows)
-    return rows
+    found = cdata.found
+    order = np.argsort(2 * found["pair"][:rows] + found["end"][:rows], kind="stable")
+    order = order[_distinct(found[order])]
+    found[: order.size] = found[order]
+    return int(order.size)
 
 
 def _coal_row(scene: Scene, cdata: CollisionData, k: int, result: coal.DistanceResult,
               end: int, rows: int) -> int:  # fmt: skip
     """Write coal's ``result`` for pair ``k`` as row ``rows`` (``end``: an end point's)."""
     d = result.min_distance
-    cdata.pair[rows] = k
-    cdata.end[rows] = end
-    cdata.distance[rows] = d
     point_a, point_b = result.getNearestPoint1(), result.getNearestPoint2()
-    cdata.point_a[rows] = point_a
-    cdata.point_b[rows] = point_b
     centres = cdata.world[scene.second[k]] - cdata.world[scene.first[k]]
-    cdata.normal[rows] = _unit(result.normal, d, point_a, point_b, centres)
+    row = cdata.found[rows]
+    row["pair"], row["end"], row["distance"] = k, end, d
+    row["point_a"], row["point_b"] = point_a, point_b
+    row["normal"] = _unit(result.normal, d, point_a, point_b, centres)
     return rows + 1
 
 
-def _distinct(order: Index, cdata: CollisionData) -> npt.NDArray[np.bool_]:
-    """Which rows of ``order`` (sorted: a pair's own row, then its end points') to keep.
+def _distinct(rows: Records) -> npt.NDArray[np.bool_]:
+    """Which of ``rows`` (sorted: a pair's own row, then its end points') to keep.
 
     An end point's row that repeats its pair's own (coal's closest points at a capsule's end
     against a box, within :data:`REPEAT`) is left out.
     """
-    end = cdata.end[order] == 1
-    keep = np.ones(order.size, dtype=np.bool_)
+    end = rows["end"] == 1
+    keep = np.ones(rows.size, dtype=np.bool_)
     if not end.any():
         return keep
-    first = np.maximum.accumulate(np.where(end, 0, np.arange(order.size)))
-    own = order[first]
-    same = (np.abs(cdata.point_a[order] - cdata.point_a[own]).max(axis=1) <= REPEAT) & (
-        np.abs(cdata.point_b[order] - cdata.point_b[own]).max(axis=1) <= REPEAT)  # fmt: skip
-    keep[end & same & (cdata.pair[order] == cdata.pair[own])] = False
+    own = rows[np.maximum.accumulate(np.where(end, 0, np.arange(rows.size)))]
+    same = (np.abs(rows["point_a"] - own["point_a"]).max(axis=1) <= REPEAT) & (
+        np.abs(rows["point_b"] - own["point_b"]).max(axis=1) <= REPEAT)  # fmt: skip
+    keep[end & same & (rows["pair"] == own["pair"])] = False
     return keep
 
 
@@ -284,4 +320,4 @@ def _empty() -> Proximity:
 
 
 EMPTY = _empty()
-"""The answer with no row (read-only arrays, shared: building it costs 4 us a tick)."""
+"""The answer with no row (read-only arrays, shared)."""

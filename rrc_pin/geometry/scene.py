@@ -24,9 +24,11 @@ from rrc_pin.geometry.pairs import Pair, Reason, invariant
 from rrc_pin.geometry.shapes import bounding_sphere
 from rrc_pin.geometry.tree import KinematicTree
 from rrc_pin.solvers.collision.narrow_kernels import BOX, CAPSULE, HALFSPACE, OTHER, SPHERE
+from rrc_pin.solvers.collision.records import BODY, JOINT
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
+Records = npt.NDArray[np.void]
 
 
 class Extra(NamedTuple):
@@ -59,19 +61,10 @@ class Scene:
         geometry: The ``pinocchio.GeometryModel``: every body, its collision pairs the active
             pairs in order.
         names: Body names (ng,).
-        joint: The joint (ng,) each body moves with (0: the world).
-        centre: Bounding-sphere centres (ng, 3) in the frames of their joints [m].
-        radius: Bounding radii (ng,) [m]; ``inf`` for a half-space.
-        normal: Unit normals (ng, 3) of the half-spaces (zero rows for other bodies).
-        offset: Offsets (ng,) [m] of the half-spaces.
-        shape: Each body's shape for the compiled narrow phase (ng,): a code of
-            :mod:`rrc_pin.solvers.collision.narrow_kernels` (``OTHER``: coal measures its pairs).
-        segment: Each sphere's or capsule's segment end points (ng, 2, 3) in its joint's
-            frame [m] (a sphere: its centre twice; zeros for other bodies).
-        size: Sphere and capsule radii (ng,) [m] (zero for other bodies).
-        box_frame: Each box's placement (ng, 3, 4) ``[R | t]`` in its joint's frame (zeros for
-            other bodies).
-        half: Each box's half sides (ng, 3) [m] (zeros for other bodies).
+        bodies: Every body (ng,) as the compiled pass reads it
+            (:data:`~rrc_pin.solvers.collision.records.BODY`: its joint, shape code, bounding
+            sphere, half-space plane, sphere or capsule segment and radius, box placement and
+            half sides; ``OTHER``: coal measures its pairs).
         first: First body (npairs,) of each active pair.
         second: Second body (npairs,).
         pair_names: ``(name_a, name_b)`` of each active pair.
@@ -81,22 +74,17 @@ class Scene:
         invariant: The pairs left out because no joint changes their distance
             (:func:`~rrc_pin.geometry.pairs.invariant`), by names, with that distance [m].
         njoints: Number of joints of the model (including the world, 0).
+        nv: Number of joint rates of the model.
+        support: (njoints, nv) whether rate c moves joint j (row 0, the world: none).
         tree: The model's joints for the compiled forward kinematics, or None (a query reads
             Pinocchio's placements).
+        joints: ``tree`` as :data:`~rrc_pin.solvers.collision.records.JOINT` records (empty
+            for None).
     """
 
     geometry: pin.GeometryModel
     names: tuple[str, ...]
-    joint: Index
-    centre: Array
-    radius: Array
-    normal: Array
-    offset: Array
-    shape: Index
-    segment: Array
-    size: Array
-    box_frame: Array
-    half: Array
+    bodies: Records
     first: Index
     second: Index
     pair_names: tuple[tuple[str, str], ...]
@@ -105,7 +93,16 @@ class Scene:
     excluded: dict[tuple[str, str], Reason]
     invariant: dict[tuple[str, str], float]
     njoints: int
+    nv: int
+    support: npt.NDArray[np.bool_]
     tree: KinematicTree | None
+    joints: Records
+
+    @property
+    def joint(self) -> Index:
+        """The joint (ng,) each body moves with (0: the world)."""
+        joint: Index = self.bodies["joint"]
+        return joint
 
 
 def build_scene(
@@ -165,41 +162,63 @@ def build_scene(
     pairs.sort()
     for a, b in pairs:
         geometry.addCollisionPair(pin.CollisionPair(a, b))
-    centre = np.zeros((len(objects), 3))
-    radius = np.zeros(len(objects))
-    normal = np.zeros((len(objects), 3))
-    offset = np.zeros(len(objects))
-    shape = np.full(len(objects), OTHER, dtype=np.int64)
-    segment = np.zeros((len(objects), 2, 3))
-    size = np.zeros(len(objects))
-    box_frame = np.zeros((len(objects), 3, 4))
-    halves = np.zeros((len(objects), 3))
-    planes = {e.name: e.plane for e in extras if e.plane is not None}
-    for g, obj in enumerate(objects):
-        c, r = bounding_sphere(obj.geometry)
-        centre[g] = obj.placement.act(c)
-        radius[g] = r
-        if names[g] in planes:
-            normal[g], offset[g] = planes[names[g]]
-            shape[g] = HALFSPACE
-        elif isinstance(obj.geometry, coal.Sphere | coal.Capsule):
-            half = obj.geometry.halfLength if isinstance(obj.geometry, coal.Capsule) else 0.0
-            shape[g] = CAPSULE if isinstance(obj.geometry, coal.Capsule) else SPHERE
-            segment[g] = [obj.placement.act(np.array([0.0, 0.0, z])) for z in (-half, half)]
-            size[g] = obj.geometry.radius
-        elif isinstance(obj.geometry, coal.Box):
-            shape[g] = BOX
-            box_frame[g] = obj.placement.homogeneous[:3]
-            halves[g] = obj.geometry.halfSide
+    bodies = _bodies(objects, planes={e.name: e.plane for e in extras if e.plane is not None})
     first = np.array([a for a, _ in pairs], dtype=np.int64)
     second = np.array([b for _, b in pairs], dtype=np.int64)
     return Scene(
-        geometry=geometry, names=names, joint=joint, centre=centre, radius=radius,
-        normal=normal, offset=offset, shape=shape, segment=segment, size=size,
-        box_frame=box_frame, half=halves, first=first,
-        second=second,
+        geometry=geometry, names=names, bodies=bodies, first=first, second=second,
         pair_names=tuple((names[a], names[b]) for a, b in pairs),
         labels=tuple(f"{names[a]}|{names[b]}" for a, b in pairs),
         every=np.ones(len(pairs), dtype=np.bool_), excluded=excluded, invariant=fixed,
-        njoints=model.njoints, tree=tree,
+        njoints=model.njoints, nv=model.nv, support=_support(model), tree=tree,
+        joints=_joints(tree, model.njoints),
     )  # fmt: skip
+
+
+def _bodies(objects: list[pin.GeometryObject], planes: dict[str, tuple[Array, float]]) -> Records:
+    """The :data:`~rrc_pin.solvers.collision.records.BODY` records of ``objects``.
+
+    ``planes``: the half-spaces' unit normals and offsets [m], by name.
+    """
+    bodies = np.zeros(len(objects), dtype=BODY)
+    for g, obj in enumerate(objects):
+        body = bodies[g]
+        body["joint"] = obj.parentJoint
+        body["shape"] = OTHER
+        c, r = bounding_sphere(obj.geometry)
+        body["centre"], body["bounding"] = obj.placement.act(c), r
+        if str(obj.name) in planes:
+            body["normal"], body["offset"] = planes[str(obj.name)]
+            body["shape"] = HALFSPACE
+        elif isinstance(obj.geometry, coal.Sphere | coal.Capsule):
+            capsule = isinstance(obj.geometry, coal.Capsule)
+            half = obj.geometry.halfLength if capsule else 0.0
+            body["shape"] = CAPSULE if capsule else SPHERE
+            body["segment"] = [obj.placement.act(np.array([0.0, 0.0, z])) for z in (-half, half)]
+            body["radius"] = obj.geometry.radius
+        elif isinstance(obj.geometry, coal.Box):
+            body["shape"] = BOX
+            body["box"] = obj.placement.homogeneous[:3]
+            body["half"] = obj.geometry.halfSide
+    return bodies
+
+
+def _support(model: pin.Model) -> npt.NDArray[np.bool_]:
+    """(njoints, nv): whether rate c moves joint j (its supporting joints' rates)."""
+    support = np.zeros((model.njoints, model.nv), dtype=np.bool_)
+    for j in range(1, model.njoints):
+        for i in model.supports[j].tolist()[1:]:
+            start = model.joints[i].idx_v
+            support[j, start : start + model.joints[i].nv] = True
+    return support
+
+
+def _joints(tree: KinematicTree | None, njoints: int) -> Records:
+    """``tree`` as :data:`~rrc_pin.solvers.collision.records.JOINT` records (None: none)."""
+    if tree is None:
+        return np.zeros(0, dtype=JOINT)
+    joints = np.zeros(njoints, dtype=JOINT)
+    joints["parent"], joints["kind"], joints["coordinate"] = tree.parent, tree.kind, tree.coordinate
+    joints["rotation"], joints["translation"], joints["axis"] = (tree.rotation, tree.translation,
+                                                                tree.axis)  # fmt: skip
+    return joints

@@ -1,12 +1,11 @@
-"""A robot's joints as plain arrays, for the compiled broad phase's forward kinematics.
+"""A robot's joints as plain arrays, for the compiled collision pass's forward kinematics.
 
-The broad phase needs every joint's placement at the tick. Reading them out of Pinocchio's
-``data.oMi`` costs about 1 us a joint in Python (7.7 us for panda's 8, 2-core EPYC under
-load), more than the broad phase itself;
-:func:`rrc_pin.solvers.collision.proximity_kernels.joint_poses` computes
-them from q in about 1 us for the whole tree (two pandas included). It is a second forward
-kinematics, used only to place the bounding spheres: the narrow phase reads Pinocchio's own
-placements, and :func:`tree_of` checks the kernel against Pinocchio (1e-9 m) before it is used.
+A proximity query needs every joint's placement at the tick, and the collision limit every
+joint's Jacobian. Pinocchio's ``data.oMi`` is read by a Python loop over the joints, and its
+``data.J`` needs a ``computeJointJacobians`` call that a tick may not otherwise make;
+:func:`rrc_pin.solvers.collision.proximity_kernels.joint_poses` and
+:func:`~rrc_pin.solvers.collision.proximity_kernels.joint_jacobians` compute them from q inside
+the pass. :func:`tree_of` checks the kernel against Pinocchio (1e-9 m) before it is used.
 
 Each joint is revolute or prismatic about one axis of its own frame, found from Pinocchio's
 motion subspace (the joint's LOCAL Jacobian column); a model with any other joint (a URDF

@@ -41,6 +41,7 @@ that bound the answer and how close they are.
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
@@ -50,14 +51,14 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.geometry import CollisionModel, Wall
-from rrc_pin.geometry.proximity import gather
+from rrc_pin.geometry.proximity import Proximity, gather, measure, proximity_of
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import finite_number
-from rrc_pin.solvers.collision.damper_kernels import damper_bound, damper_rows
+from rrc_pin.solvers.collision.damper_kernels import damper_bound
+from rrc_pin.solvers.collision.records import SETTINGS
 from rrc_pin.solvers.tick.problem import Constraints
 
 if TYPE_CHECKING:
-    from rrc_pin.geometry.proximity import Proximity
     from rrc_pin.geometry.scene import Scene
     from rrc_pin.kinematics import Kinematics, Layout
 
@@ -122,7 +123,7 @@ class CollisionLimit(Limit):
 
     Attributes:
         last: The :class:`~rrc_pin.geometry.Proximity` of the last tick (the rows' pairs, a
-            pair's end-point rows after its own).
+            pair's end-point rows after its own), built when read; None before the first.
 
     Raises:
         InvalidInput: ``model`` not a CollisionModel, a distance or gain out of range, a pair
@@ -156,15 +157,10 @@ class CollisionLimit(Limit):
         chosen = None if pairs is None else _pairs(model, pairs)
         self.model, self.safety, self.detection, self.gain, self.name = model, d_s, d_i, xi, name
         self.pairs = chosen
-        self.last: Proximity | None = None
         self._data = model.create_data()
-        robot = model.robot.model
-        support = np.zeros((robot.njoints, robot.nv), dtype=np.bool_)
-        for j in range(1, robot.njoints):
-            for i in robot.supports[j].tolist()[1:]:
-                start = robot.joints[i].idx_v
-                support[j, start : start + robot.joints[i].nv] = True
-        self._support = support
+        self._rows: int | None = None  # the last tick's rows in self._data, None before one
+        self._last: Proximity | None = None
+        self._settings: tuple[float, npt.NDArray[np.void]] = (math.nan, np.zeros(1, SETTINGS))
         self._kept: tuple[Scene | None, npt.NDArray[np.bool_]] = (None, np.zeros(0, np.bool_))
         self._seen: Scene | None = None
         self._warn_invariant(model.scene)
@@ -181,43 +177,64 @@ class CollisionLimit(Limit):
                                f"{list(robot.dof_names)}), not of this robot's rates "
                                f"{list(layout.joints)}")  # fmt: skip
 
+    @property
+    def last(self) -> Proximity | None:
+        """The :class:`~rrc_pin.geometry.Proximity` of the last tick (class docstring)."""
+        if self._last is None and self._rows is not None:
+            self._last = proximity_of(self._data, self._rows)
+        return self._last
+
     def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
         """The damper rows of the pairs within the detection distance, and of the walls."""
-        select = None if self.pairs is None else self._keep
-        prox = self.model.proximity(kin, self._data, self.detection, True, select)
-        scene = self._data.scene
+        model = self.model
+        if kin.model is not model.robot.model:
+            raise InvalidInput("kin", f"kinematics of another model than {model.robot.name}'s")
+        scene = model.scene
         if scene is not self._seen:  # an obstacle added since: its pairs no joint moves
             self._warn_invariant(scene)
-        self.last = prox
-        walls = self.model.walls()
-        k = len(prox.names)
-        if not k and not walls:
+        keep = scene.every if self.pairs is None else self._keep(scene)
+        rows, unmoved = measure(scene, kin.model, kin.q, lambda: kin.data, self._data,
+                                self._damper(dt), keep)  # fmt: skip
+        self._rows, self._last = rows, None
+        walls = model.walls()
+        if not rows and not walls:
             return _NONE
-        xi = min(self.gain, (self.detection - self.safety) / dt)
-        nv = kin.model.nv
-        G: Array = np.empty((k, nv))
-        h: Array = np.empty(k)
-        names = list(gather(scene.labels, prox.pair))
-        distance = prox.distance
-        unmoved = 0
-        if k:
-            moved = np.empty(k, dtype=np.bool_)
-            span = self.detection - self.safety
-            unmoved = damper_rows(kin.data.J, self._support, prox.joint_a, prox.joint_b,
-                                  prox.point_a, prox.point_b, prox.normal, prox.distance,
-                                  prox.pair, self.safety, self.detection, xi, END * span / dt,
-                                  BLEND, BAND, RECOVERY / dt, STILL, G, h, moved)  # fmt: skip
+        found = self._data.found[:rows]
+        G, h, distance = self._data.G[:rows].copy(), self._data.h[:rows].copy(), found["distance"]
+        names = gather(scene.labels, found["pair"])
+        if walls or unmoved:
+            G, h, distance, names = self._trimmed(kin, walls, G, h, distance, names,
+                                                  found["moved"], dt)  # fmt: skip
+            if not h.size:
+                return _NONE
+        return Constraints(G=G, h=h, names=names, slide=np.ones(h.size, dtype=np.bool_),
+                           distance=distance.copy())  # fmt: skip
+
+    def _trimmed(
+        self, kin: Kinematics, walls: Sequence[Wall], G: Array, h: Array, distance: Array,
+        names: tuple[str, ...], moved: npt.NDArray[np.bool_], dt: float,
+    ) -> tuple[Array, Array, Array, tuple[str, ...]]:  # fmt: skip
+        """The pairs' rows with the walls' after them, less those no joint moves."""
+        listed = list(names)
         if walls:
-            G, h, distance = self._walls(kin, walls, G, h, names, distance, dt)
+            G, h, distance = self._walls(kin, walls, G, h, listed, distance, dt)
             moved = np.abs(G).max(axis=1) > STILL
-            unmoved = int(h.size - np.count_nonzero(moved))
-        if unmoved:  # a pair no joint can move apart or together has no row (module docstring)
+        if not moved.all():  # a pair no joint can move apart or together has no row
             G, h, distance = G[moved], h[moved], distance[moved]
-            names = [n for n, m in zip(names, moved.tolist(), strict=True) if m]
-        if not h.size:
-            return _NONE
-        return Constraints(G=G, h=h, names=tuple(names), slide=np.ones(h.size, dtype=np.bool_),
-                           distance=distance)  # fmt: skip
+            listed = [n for n, m in zip(listed, moved.tolist(), strict=True) if m]
+        return G, h, distance, tuple(listed)
+
+    def _damper(self, dt: float) -> npt.NDArray[np.void]:
+        """The pass's settings (1,) at step ``dt`` [s] (kept while ``dt`` is the same)."""
+        if self._settings[0] != dt:
+            span = self.detection - self.safety
+            settings = np.zeros(1, dtype=SETTINGS)
+            settings["detection"], settings["ends"], settings["rows"] = self.detection, True, True
+            settings["safety"], settings["xi"] = self.safety, min(self.gain, span / dt)
+            settings["xi_end"], settings["blend"], settings["band"] = END * span / dt, BLEND, BAND
+            settings["recovery"], settings["still"] = RECOVERY / dt, STILL
+            self._settings = (dt, settings)
+        return self._settings[1]
 
     def _walls(
         self, kin: Kinematics, walls: Sequence[Wall], G: Array, h: Array, names: list[str],

@@ -32,8 +32,14 @@ A capsule against a box (body B) goes to coal for its closest points; its end-po
 each end against the box: in the box's frame the end point clamped to the box is the nearest
 box point outside it; inside, the nearest face (the signed distance to a convex set).
 
-Pairs of other shapes (cylinders, convex hulls, meshes) are returned for coal.
-Compiled with numba through :func:`rrc_pin.solvers.tick.kernels.kernel`; plain arrays in and out.
+Pairs of other shapes (cylinders, convex hulls, meshes) are returned for coal, only where they
+may be within the detection distance: besides the broad phase's bounding spheres, a sphere or
+capsule is measured exactly against the other body's bounding sphere (the distance from its
+segment to that sphere's centre, less both radii), a lower bound of the pair's signed distance
+(the other body lies inside its sphere).
+
+Bodies are :data:`~rrc_pin.solvers.collision.records.BODY` records, rows
+:data:`~rrc_pin.solvers.collision.records.FOUND` records.
 """
 
 from __future__ import annotations
@@ -43,14 +49,18 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.solvers.collision.vectors import Vector, along, dot, norm, placed, sub
 from rrc_pin.solvers.compiled import kernel
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
+Records = npt.NDArray[np.void]
+Row = tuple[float, Vector, Vector, Vector]
+"""A row's signed distance [m], witness points on A and B and unit normal from A to B."""
 
 OTHER, SPHERE, CAPSULE, HALFSPACE, BOX = 0, 1, 2, 3, 4
-"""Codes of a body's shape (:func:`narrow_phase`'s ``shape``); OTHER and BOX go to coal (a
-capsule against a box gets its end-point rows here)."""
+"""Codes of a body's shape (:data:`~rrc_pin.solvers.collision.records.BODY`'s ``shape``); OTHER
+and BOX go to coal (a capsule against a box gets its end-point rows here)."""
 
 SAME = 1e-9
 """[m] An end-point row whose two points are both within this of the pair's closest points is
@@ -59,57 +69,42 @@ that row again, and is left out."""
 MET = 1e-12
 """[m] Closest points nearer than this: the segments meet (the normal from their directions)."""
 
+ZERO: Vector = (0.0, 0.0, 0.0)
+
 
 @kernel
-def segment_closest(
-    a0: Array, u: Array, b0: Array, v: Array, out: Array
-) -> None:  # fmt: skip
-    """Closest points of the segments ``a0 + s u`` and ``b0 + t v``, s, t in [0, 1] (5.1.9).
+def segment_closest(a0: Vector, u: Vector, b0: Vector, v: Vector) -> tuple[float, float]:
+    """Parameters (s, t) of the closest points of ``a0 + s u`` and ``b0 + t v``, s, t in [0, 1].
 
-    Args:
-        a0: Start (3,) of segment A [m].
-        u: Its direction (3,) [m], end minus start.
-        b0: Start (3,) of segment B [m].
-        v: Its direction (3,) [m].
-        out: (2, 3) written: the point on A, the point on B [m].
+    Ericson 5.1.9. ``u`` or ``v`` zero: a point against a segment (or a point).
     """
-    rx, ry, rz = a0[0] - b0[0], a0[1] - b0[1], a0[2] - b0[2]
-    a = u[0] * u[0] + u[1] * u[1] + u[2] * u[2]
-    e = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
-    f = v[0] * rx + v[1] * ry + v[2] * rz
+    r = sub(a0, b0)
+    a = dot(u, u)
+    e = dot(v, v)
+    f = dot(v, r)
     if a <= 0.0 and e <= 0.0:
-        s, t = 0.0, 0.0
-    elif a <= 0.0:
-        s, t = 0.0, min(max(f / e, 0.0), 1.0)
-    else:
-        c = u[0] * rx + u[1] * ry + u[2] * rz
-        if e <= 0.0:
-            s, t = min(max(-c / a, 0.0), 1.0), 0.0
-        else:
-            b = u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
-            denom = a * e - b * b
-            s = min(max((b * f - c * e) / denom, 0.0), 1.0) if denom > 0.0 else 0.0
-            t = (b * s + f) / e
-            if t < 0.0:
-                t, s = 0.0, min(max(-c / a, 0.0), 1.0)
-            elif t > 1.0:
-                t, s = 1.0, min(max((b - c) / a, 0.0), 1.0)
-    for r in range(3):
-        out[0, r] = a0[r] + s * u[r]
-        out[1, r] = b0[r] + t * v[r]
+        return 0.0, 0.0
+    if a <= 0.0:
+        return 0.0, min(max(f / e, 0.0), 1.0)
+    c = dot(u, r)
+    if e <= 0.0:
+        return min(max(-c / a, 0.0), 1.0), 0.0
+    b = dot(u, v)
+    denom = a * e - b * b
+    s = min(max((b * f - c * e) / denom, 0.0), 1.0) if denom > 0.0 else 0.0
+    t = (b * s + f) / e
+    if t < 0.0:
+        return min(max(-c / a, 0.0), 1.0), 0.0
+    if t > 1.0:
+        return min(max((b - c) / a, 0.0), 1.0), 1.0
+    return s, t
 
 
 @kernel
 def narrow_phase(
     poses: Array,
-    joint: Index,
-    shape: Index,
-    segment: Array,
-    radius: Array,
-    box_frame: Array,
-    half: Array,
-    plane: Array,
-    offset: Array,
+    bodies: Records,
+    world: Array,
     first: Index,
     second: Index,
     candidates: Index,
@@ -117,27 +112,15 @@ def narrow_phase(
     keep: npt.NDArray[np.bool_],
     detection: float,
     ends: bool,
-    pair: Index,
-    distance: Array,
-    point_a: Array,
-    point_b: Array,
-    normal: Array,
-    end: npt.NDArray[np.int8],
+    found: Records,
     other: Index,
 ) -> tuple[int, int]:
     """The rows of the candidate pairs below ``detection`` (module docstring), in one pass.
 
     Args:
         poses: Joint placements (nj, 4, 4) in the world frame.
-        joint: The joint (ng,) each body moves with.
-        shape: :data:`SPHERE`, :data:`CAPSULE`, :data:`HALFSPACE` or :data:`OTHER` (ng,).
-        segment: Each sphere's or capsule's segment end points (ng, 2, 3) in its joint's
-            frame [m] (a sphere: its centre twice).
-        radius: Sphere and capsule radii (ng,) [m].
-        box_frame: Each box's placement (ng, 3, 4) ``[R | t]`` in its joint's frame.
-        half: Each box's half sides (ng, 3) [m].
-        plane: Unit outward normals (ng, 3) of the half-spaces, world frame.
-        offset: Offsets (ng,) [m] of the half-spaces (the solid ``plane . x <= offset``).
+        bodies: The bodies (ng,), :data:`~rrc_pin.solvers.collision.records.BODY` records.
+        world: Bounding-sphere centres (ng, 3) in the world frame [m].
         first: First body (npairs,) of each pair.
         second: Second body (npairs,).
         candidates: Pair indices from the broad phase.
@@ -145,251 +128,268 @@ def narrow_phase(
         keep: Whether each pair (npairs,) is asked for (the others are skipped).
         detection: Detection distance [m].
         ends: Add the end-point rows.
-        pair: Out (>= 5 count,): the pair index of each row.
-        distance: Out (>= 5 count,): signed distances [m].
-        point_a: Out (>= 5 count, 3): witness points on A, world frame [m].
-        point_b: Out (>= 5 count, 3): witness points on B [m].
-        normal: Out (>= 5 count, 3): unit normals from A to B.
-        end: Out (>= 5 count,): 1 for an end point's row, 0 for a pair's closest points'.
+        found: Out (>= 5 count,) rows (``pair``, ``end``, ``distance``, ``point_a``,
+            ``point_b``, ``normal`` written).
         other: Out (>= count,): the candidates of other shapes, for coal.
 
     Returns:
         rows: The number of rows written; ``others``: the number of pairs left for coal.
     """
+    shape = bodies["shape"]
     rows = 0
     others = 0
-    seg = np.empty((2, 2, 3))  # the two bodies' segments in the world
-    close = np.empty((2, 3))
-    main = np.empty((2, 3))
-    swap = np.empty((2, 3))
-    still = np.zeros(3)
-    direction = np.empty((2, 3))
     for i in range(count):
         k = candidates[i]
         if not keep[k]:
             continue
-        ab = (first[k], second[k])
-        sa, sb = shape[ab[0]], shape[ab[1]]
-        if sa == OTHER or sb == OTHER or sa == HALFSPACE or sa == BOX:
+        a, b = first[k], second[k]
+        sa, sb = shape[a], shape[b]
+        if sa == OTHER or sb == OTHER or sa == HALFSPACE or sa == BOX or sb == BOX:
+            if _apart(poses, bodies, world, a, b) >= detection:
+                continue
             other[others] = k
             others += 1
-            continue
-        if sb == BOX:
-            other[others] = k
-            others += 1
-            if ends and sa == CAPSULE:
-                rows = _box_ends(poses, joint, segment, radius, box_frame, half, ab[0], ab[1],
-                                 k, detection, pair, distance, point_a, point_b, normal, end,
-                                 rows)  # fmt: skip
-            continue
-        for side in range(2):
-            g = ab[side]
-            M = poses[joint[g]]
-            for e in range(2):
-                for r in range(3):
-                    seg[side, e, r] = (
-                        M[r, 0] * segment[g, e, 0] + M[r, 1] * segment[g, e, 1]
-                        + M[r, 2] * segment[g, e, 2] + M[r, 3]
-                    )  # fmt: skip
-            for r in range(3):
-                direction[side, r] = seg[side, 1, r] - seg[side, 0, r]
-        ra = radius[ab[0]]
-        if shape[ab[1]] == HALFSPACE:
-            h = ab[1]
-            height0 = (
-                plane[h, 0] * seg[0, 0, 0] + plane[h, 1] * seg[0, 0, 1] + plane[h, 2] * seg[0, 0, 2]
-            )
-            height1 = (
-                plane[h, 0] * seg[0, 1, 0] + plane[h, 1] * seg[0, 1, 1] + plane[h, 2] * seg[0, 1, 2]
-            )
-            lowest = 0 if height0 <= height1 else 1
-            for e in (lowest, 1 - lowest):  # the pair's own row (its lowest end) first
-                if e != lowest and not ends:
-                    continue
-                height = (height0 if e == 0 else height1) - offset[h]
-                if height - ra >= detection:
-                    continue
-                if (
-                    e != lowest
-                    and direction[0, 0] ** 2 + direction[0, 1] ** 2 + direction[0, 2] ** 2 <= 0.0
-                ):
-                    continue
-                pair[rows] = k
-                end[rows] = 0 if e == lowest else 1
-                distance[rows] = height - ra
-                for r in range(3):
-                    normal[rows, r] = -plane[h, r]
-                    point_a[rows, r] = seg[0, e, r] - ra * plane[h, r]
-                    point_b[rows, r] = seg[0, e, r] - height * plane[h, r]
-                rows += 1
-            continue
-        rb = radius[ab[1]]
-        segment_closest(seg[0, 0], direction[0], seg[1, 0], direction[1], close)
-        if not _row(close, ra, rb, seg, direction, detection, distance, point_a, point_b,
-                    normal, rows):  # fmt: skip
-            continue  # the ends are no nearer than the closest points
-        pair[rows] = k
-        end[rows] = 0
-        rows += 1
-        if not ends:
-            continue
-        main[:] = close
-        for side in range(2):
-            if direction[side, 0] ** 2 + direction[side, 1] ** 2 + direction[side, 2] ** 2 <= 0.0:
-                continue  # a sphere has no ends of its own
-            o = 1 - side
-            for e in range(2):  # the end point against the other body's segment
-                segment_closest(seg[side, e], still, seg[o, 0], direction[o], swap)
-                for r in range(3):
-                    close[side, r] = swap[0, r]
-                    close[o, r] = swap[1, r]
-                gap = 0.0
-                for r in range(3):
-                    gap = max(gap, abs(close[0, r] - main[0, r]), abs(close[1, r] - main[1, r]))
-                if gap <= SAME:
-                    continue
-                if _row(close, ra, rb, seg, direction, detection, distance, point_a, point_b,
-                        normal, rows):  # fmt: skip
-                    pair[rows] = k
-                    end[rows] = 1
-                    rows += 1
+            if ends and sa == CAPSULE and sb == BOX:
+                rows = _box_ends(poses, bodies, a, b, k, detection, found, rows)
+        elif sb == HALFSPACE:
+            rows = _plane_rows(poses, bodies, a, b, k, detection, ends, found, rows)
+        else:
+            rows = _segment_rows(poses, bodies, a, b, k, detection, ends, found, rows)
     return rows, others
 
 
 @kernel
+def _segment(poses: Array, bodies: Records, g: int) -> tuple[Vector, Vector]:
+    """The end points of body ``g``'s segment in the world frame [m]."""
+    segment = bodies["segment"]
+    j = bodies["joint"][g]
+    start = placed(poses, j, (segment[g, 0, 0], segment[g, 0, 1], segment[g, 0, 2]))
+    end = placed(poses, j, (segment[g, 1, 0], segment[g, 1, 1], segment[g, 1, 2]))
+    return start, end
+
+
+@kernel
+def _apart(poses: Array, bodies: Records, world: Array, a: int, b: int) -> float:
+    """A lower bound [m] of the signed distance of a pair coal measures (module docstring).
+
+    A sphere or capsule against the other body's bounding sphere, else ``-inf`` (no bound
+    beyond the broad phase's).
+    """
+    shape = bodies["shape"]
+    for g, o in ((a, b), (b, a)):
+        if shape[g] == SPHERE or shape[g] == CAPSULE:
+            start, end = _segment(poses, bodies, g)
+            centre = (world[o, 0], world[o, 1], world[o, 2])
+            s, _ = segment_closest(start, sub(end, start), centre, ZERO)
+            gap = norm(sub(centre, along(start, s, sub(end, start))))
+            bound: float = gap - bodies["radius"][g] - bodies["bounding"][o]
+            return bound
+    return -math.inf
+
+
+@kernel
+def _write(found: Records, row: int, k: int, end: int, measured: Row) -> int:
+    """Write ``measured`` as row ``row`` of pair ``k`` (``end``: 1 for an end point's row)."""
+    d, pa, pb, n = measured
+    record = found[row]
+    record["pair"] = k
+    record["end"] = end
+    record["distance"] = d
+    point_a, point_b, normal = record["point_a"], record["point_b"], record["normal"]
+    for r in range(3):
+        point_a[r] = pa[r]
+        point_b[r] = pb[r]
+        normal[r] = n[r]
+    return row + 1
+
+
+@kernel
+def _plane_rows(
+    poses: Array, bodies: Records, a: int, h: int, k: int, detection: float, ends: bool,
+    found: Records, rows: int,
+) -> int:  # fmt: skip
+    """Append the rows of sphere or capsule ``a`` against half-space ``h`` (pair ``k``).
+
+    The pair's own row (its lower end) first, then, with ``ends``, the other end's.
+    """
+    start, end = _segment(poses, bodies, a)
+    m = (bodies["normal"][h, 0], bodies["normal"][h, 1], bodies["normal"][h, 2])
+    ra = bodies["radius"][a]
+    heights = (dot(m, start), dot(m, end))
+    lowest = 0 if heights[0] <= heights[1] else 1
+    u = sub(end, start)
+    for e in (lowest, 1 - lowest):
+        if e != lowest and (not ends or dot(u, u) <= 0.0):
+            continue
+        height = heights[e] - bodies["offset"][h]
+        if height - ra >= detection:
+            continue
+        p = start if e == 0 else end
+        inward = (-m[0], -m[1], -m[2])
+        row = (height - ra, along(p, -ra, m), along(p, -height, m), inward)
+        rows = _write(found, rows, k, 0 if e == lowest else 1, row)
+    return rows
+
+
+@kernel
+def _segment_rows(
+    poses: Array, bodies: Records, a: int, b: int, k: int, detection: float, ends: bool,
+    found: Records, rows: int,
+) -> int:  # fmt: skip
+    """Append the rows of two spheres or capsules ``a``, ``b`` (pair ``k``).
+
+    The closest points' row first; with ``ends``, then each end point's against the other
+    segment (module docstring), unless it is the closest points' row again.
+    """
+    a0, a1 = _segment(poses, bodies, a)
+    b0, b1 = _segment(poses, bodies, b)
+    u, v = sub(a1, a0), sub(b1, b0)
+    ra, rb = bodies["radius"][a], bodies["radius"][b]
+    s, t = segment_closest(a0, u, b0, v)
+    ca, cb = along(a0, s, u), along(b0, t, v)
+    row = _between(ca, cb, ra, rb, a0, a1, b0, b1)
+    if row[0] >= detection:
+        return rows  # the ends are no nearer than the closest points
+    rows = _write(found, rows, k, 0, row)
+    if not ends:
+        return rows
+    for side in range(2):
+        p0, p1, w = (a0, a1, u) if side == 0 else (b0, b1, v)
+        q0, z = (b0, v) if side == 0 else (a0, u)
+        if dot(w, w) <= 0.0:
+            continue  # a sphere has no ends of its own
+        for e in range(2):  # the end point against the other body's segment
+            p = p0 if e == 0 else p1
+            _, t_end = segment_closest(p, ZERO, q0, z)
+            c = along(q0, t_end, z)
+            xa, xb = (p, c) if side == 0 else (c, p)
+            gap = max(abs(xa[0] - ca[0]), abs(xa[1] - ca[1]), abs(xa[2] - ca[2]),
+                      abs(xb[0] - cb[0]), abs(xb[1] - cb[1]), abs(xb[2] - cb[2]))  # fmt: skip
+            if gap <= SAME:
+                continue
+            row = _between(xa, xb, ra, rb, a0, a1, b0, b1)
+            if row[0] < detection:
+                rows = _write(found, rows, k, 1, row)
+    return rows
+
+
+@kernel
+def _between(
+    ca: Vector, cb: Vector, ra: float, rb: float, a0: Vector, a1: Vector, b0: Vector, b1: Vector
+) -> Row:  # fmt: skip
+    """The row of the points ``ca`` on segment A, ``cb`` on B, inflated by ``ra``, ``rb``.
+
+    The segments ``a0``-``a1`` and ``b0``-``b1`` give the normal where the points meet (module
+    docstring).
+    """
+    gap = sub(cb, ca)
+    length = norm(gap)
+    d = length - ra - rb
+    if length > MET:
+        n = (gap[0] / length, gap[1] / length, gap[2] / length)
+    else:
+        n = _meeting_normal(a0, a1, b0, b1)
+    return d, along(ca, ra, n), along(cb, -rb, n), n
+
+
+@kernel
+def _meeting_normal(a0: Vector, a1: Vector, b0: Vector, b1: Vector) -> Vector:
+    r"""The unit normal of two segments that meet (:math:`u \times v`, module docstring).
+
+    Else the direction between their mid-points, else +z; from A's mid-point towards B's.
+    """
+    mid = (0.5 * (b0[0] + b1[0] - a0[0] - a1[0]), 0.5 * (b0[1] + b1[1] - a0[1] - a1[1]),
+           0.5 * (b0[2] + b1[2] - a0[2] - a1[2]))  # fmt: skip
+    u, v = sub(a1, a0), sub(b1, b0)
+    n = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
+    size = norm(n)
+    if size <= 1e-9 * (norm(u) * norm(v)) or size == 0.0:
+        n = mid
+        size = norm(n)
+    if size <= MET:
+        n, size = (0.0, 0.0, 1.0), 1.0
+    sign = 1.0 if dot(n, mid) >= 0.0 else -1.0
+    return (sign * n[0] / size, sign * n[1] / size, sign * n[2] / size)
+
+
+@kernel
 def _box_ends(
-    poses: Array,
-    joint: Index,
-    segment: Array,
-    radius: Array,
-    box_frame: Array,
-    half: Array,
-    a: int,
-    b: int,
-    k: int,
-    detection: float,
-    pair: Index,
-    distance: Array,
-    point_a: Array,
-    point_b: Array,
-    normal: Array,
-    end: npt.NDArray[np.int8],
+    poses: Array, bodies: Records, a: int, b: int, k: int, detection: float, found: Records,
     rows: int,
-) -> int:
+) -> int:  # fmt: skip
     """Append the end-point rows of capsule ``a`` against box ``b`` (module docstring).
 
     Returns:
         The number of rows now written.
     """
-    Ma = poses[joint[a]]
-    Mj = poses[joint[b]]
-    R = np.empty((3, 3))  # the box's rotation and centre in the world
-    t = np.empty(3)
-    for r in range(3):
-        t[r] = Mj[r, 3]
-        for c in range(3):
-            R[r, c] = Mj[r, 0] * box_frame[b, 0, c] + Mj[r, 1] * box_frame[b, 1, c] + (
-                Mj[r, 2] * box_frame[b, 2, c])  # fmt: skip
-            t[r] += Mj[r, c] * box_frame[b, c, 3]
-    p = np.empty(3)
-    local = np.empty(3)
-    near = np.empty(3)
-    ra = radius[a]
-    for e in range(2):
-        if e == 1 and segment[a, 0, 0] == segment[a, 1, 0] and segment[a, 0, 1] == segment[
-                a, 1, 1] and segment[a, 0, 2] == segment[a, 1, 2]:  # fmt: skip
-            break  # a sphere: one point
-        for r in range(3):
-            p[r] = (Ma[r, 0] * segment[a, e, 0] + Ma[r, 1] * segment[a, e, 1]
-                    + Ma[r, 2] * segment[a, e, 2] + Ma[r, 3])  # fmt: skip
-        for c in range(3):  # R^T (p - t)
-            local[c] = R[0, c] * (p[0] - t[0]) + R[1, c] * (p[1] - t[1]) + R[2, c] * (p[2] - t[2])
-            near[c] = min(max(local[c], -half[b, c]), half[b, c])
-        gap = math.sqrt((local[0] - near[0]) ** 2 + (local[1] - near[1]) ** 2
-                        + (local[2] - near[2]) ** 2)  # fmt: skip
-        n0, n1, n2 = 0.0, 0.0, 0.0  # from the end point towards the box, box frame
-        if gap > MET:
+    R, t = _box_pose(poses, bodies, b)
+    half = (bodies["half"][b, 0], bodies["half"][b, 1], bodies["half"][b, 2])
+    ra = bodies["radius"][a]
+    start, end = _segment(poses, bodies, a)
+    count = 1 if start == end else 2  # a sphere: one point
+    for e in range(count):
+        p = start if e == 0 else end
+        rel = sub(p, t)
+        local = (dot(R[0], rel), dot(R[1], rel), dot(R[2], rel))  # R^T (p - t)
+        near = (min(max(local[0], -half[0]), half[0]), min(max(local[1], -half[1]), half[1]),
+                min(max(local[2], -half[2]), half[2]))  # fmt: skip
+        gap = norm(sub(local, near))
+        if gap > MET:  # n from the end point towards the box, box frame
             sd = gap
-            n0, n1, n2 = (near[0] - local[0]) / gap, (near[1] - local[1]) / gap, (
-                near[2] - local[2]) / gap  # fmt: skip
+            n = ((near[0] - local[0]) / gap, (near[1] - local[1]) / gap,
+                 (near[2] - local[2]) / gap)  # fmt: skip
         else:  # inside (or on the surface): the nearest face
-            axis, depth = 0, half[b, 0] - abs(local[0])
+            axis, depth = 0, half[0] - abs(local[0])
             for c in range(1, 3):
-                if half[b, c] - abs(local[c]) < depth:
-                    axis, depth = c, half[b, c] - abs(local[c])
+                if half[c] - abs(local[c]) < depth:
+                    axis, depth = c, half[c] - abs(local[c])
             sd = -depth
             face = 1.0 if local[axis] >= 0.0 else -1.0
-            near[axis] = face * half[b, axis]
-            if axis == 0:
-                n0 = -face
-            elif axis == 1:
-                n1 = -face
-            else:
-                n2 = -face
+            near = (face * half[0] if axis == 0 else near[0],
+                    face * half[1] if axis == 1 else near[1],
+                    face * half[2] if axis == 2 else near[2])  # fmt: skip
+            n = (-face if axis == 0 else 0.0, -face if axis == 1 else 0.0,
+                 -face if axis == 2 else 0.0)  # fmt: skip
         d = sd - ra
         if d >= detection:
             continue
-        pair[rows] = k
-        end[rows] = 1
-        distance[rows] = d
-        for r in range(3):
-            n = R[r, 0] * n0 + R[r, 1] * n1 + R[r, 2] * n2
-            normal[rows, r] = n
-            point_a[rows, r] = p[r] + ra * n
-            point_b[rows, r] = t[r] + R[r, 0] * near[0] + R[r, 1] * near[1] + R[r, 2] * near[2]
-        rows += 1
+        normal = _turned(R, n)
+        point_b = (t[0] + R[0][0] * near[0] + R[1][0] * near[1] + R[2][0] * near[2],
+                   t[1] + R[0][1] * near[0] + R[1][1] * near[1] + R[2][1] * near[2],
+                   t[2] + R[0][2] * near[0] + R[1][2] * near[1] + R[2][2] * near[2])  # fmt: skip
+        rows = _write(found, rows, k, 1, (d, along(p, ra, normal), point_b, normal))
     return rows
 
 
 @kernel
-def _row(
-    close: Array,
-    ra: float,
-    rb: float,
-    seg: Array,
-    direction: Array,
-    detection: float,
-    distance: Array,
-    point_a: Array,
-    point_b: Array,
-    normal: Array,
-    row: int,
-) -> bool:
-    """Write row ``row`` from the segment points ``close`` (2, 3) if below ``detection``."""
-    nx = close[1, 0] - close[0, 0]
-    ny = close[1, 1] - close[0, 1]
-    nz = close[1, 2] - close[0, 2]
-    length = math.sqrt(nx * nx + ny * ny + nz * nz)
-    d = length - ra - rb
-    if d >= detection:
-        return False
-    if length > MET:
-        nx, ny, nz = nx / length, ny / length, nz / length
-    else:  # the segments meet (module docstring)
-        mx = 0.5 * (seg[1, 0, 0] + seg[1, 1, 0] - seg[0, 0, 0] - seg[0, 1, 0])
-        my = 0.5 * (seg[1, 0, 1] + seg[1, 1, 1] - seg[0, 0, 1] - seg[0, 1, 1])
-        mz = 0.5 * (seg[1, 0, 2] + seg[1, 1, 2] - seg[0, 0, 2] - seg[0, 1, 2])
-        u, v = direction[0], direction[1]
-        nx = u[1] * v[2] - u[2] * v[1]
-        ny = u[2] * v[0] - u[0] * v[2]
-        nz = u[0] * v[1] - u[1] * v[0]
-        size = math.sqrt(nx * nx + ny * ny + nz * nz)
-        scale = math.sqrt(u[0] ** 2 + u[1] ** 2 + u[2] ** 2) * math.sqrt(
-            v[0] ** 2 + v[1] ** 2 + v[2] ** 2
-        )
-        if size <= 1e-9 * scale or size == 0.0:
-            nx, ny, nz = mx, my, mz
-            size = math.sqrt(nx * nx + ny * ny + nz * nz)
-        if size <= MET:
-            nx, ny, nz, size = 0.0, 0.0, 1.0, 1.0
-        sign = 1.0 if nx * mx + ny * my + nz * mz >= 0.0 else -1.0
-        nx, ny, nz = sign * nx / size, sign * ny / size, sign * nz / size
-    distance[row] = d
-    normal[row, 0], normal[row, 1], normal[row, 2] = nx, ny, nz
-    point_a[row, 0] = close[0, 0] + ra * nx
-    point_a[row, 1] = close[0, 1] + ra * ny
-    point_a[row, 2] = close[0, 2] + ra * nz
-    point_b[row, 0] = close[1, 0] - rb * nx
-    point_b[row, 1] = close[1, 1] - rb * ny
-    point_b[row, 2] = close[1, 2] - rb * nz
-    return True
+def _box_pose(
+    poses: Array, bodies: Records, b: int
+) -> tuple[tuple[Vector, Vector, Vector], Vector]:  # fmt: skip
+    """Box ``b``'s rotation, by its columns (each a box axis in the world), and centre [m]."""
+    box = bodies["box"]
+    j = bodies["joint"][b]
+    M = _columns(poses, j)
+    R = (_turned(M, (box[b, 0, 0], box[b, 1, 0], box[b, 2, 0])),
+         _turned(M, (box[b, 0, 1], box[b, 1, 1], box[b, 2, 1])),
+         _turned(M, (box[b, 0, 2], box[b, 1, 2], box[b, 2, 2])))  # fmt: skip
+    x, y, z = box[b, 0, 3], box[b, 1, 3], box[b, 2, 3]
+    centre = (poses[j, 0, 3] + poses[j, 0, 0] * x + poses[j, 0, 1] * y + poses[j, 0, 2] * z,
+              poses[j, 1, 3] + poses[j, 1, 0] * x + poses[j, 1, 1] * y + poses[j, 1, 2] * z,
+              poses[j, 2, 3] + poses[j, 2, 0] * x + poses[j, 2, 1] * y + poses[j, 2, 2] * z)
+    return R, centre
+
+
+@kernel
+def _columns(poses: Array, j: int) -> tuple[Vector, Vector, Vector]:
+    """The rotation of placement ``j`` of ``poses`` (n, 4, 4), by its columns."""
+    return ((poses[j, 0, 0], poses[j, 1, 0], poses[j, 2, 0]),
+            (poses[j, 0, 1], poses[j, 1, 1], poses[j, 2, 1]),
+            (poses[j, 0, 2], poses[j, 1, 2], poses[j, 2, 2]))  # fmt: skip
+
+
+@kernel
+def _turned(R: tuple[Vector, Vector, Vector], x: Vector) -> Vector:
+    r""":math:`R\,x` for ``R`` given by its columns."""
+    return (R[0][0] * x[0] + R[1][0] * x[1] + R[2][0] * x[2],
+            R[0][1] * x[0] + R[1][1] * x[1] + R[2][1] * x[2],
+            R[0][2] * x[0] + R[1][2] * x[1] + R[2][2] * x[2])  # fmt: skip

@@ -10,7 +10,7 @@ has its plane instead. A lower bound of the signed distance of a pair, also in p
 A pair whose bound is below the detection distance is a candidate; only candidates go to the
 narrow phase (coal), so no pair within the detection distance is ever dropped.
 
-Compiled with numba through :func:`rrc_pin.solvers.tick.kernels.kernel`; plain arrays in and out.
+Compiled with numba (:func:`rrc_pin.solvers.compiled.kernel`); plain arrays in and out.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.solvers.collision.vectors import cross
 from rrc_pin.solvers.compiled import kernel
 
 Array = npt.NDArray[np.float64]
@@ -99,6 +100,44 @@ def joint_poses(
             )  # fmt: skip
             out[j, 3, r] = 0.0
         out[j, 3, 3] = 1.0
+
+
+@kernel
+def joint_jacobians(poses: Array, kind: Index, axis: Array, index: Index, J: Array) -> None:
+    r"""Every joint's Jacobian column in Pinocchio's WORLD convention, from its placement.
+
+    The spatial velocity at the world origin, :math:`[v_O; \omega]`, that a unit rate of joint
+    :math:`j` gives: with its axis in the world :math:`w_j = R_j a_j` and its origin
+    :math:`p_j`,
+
+    .. math:: J_{c(j)} = \begin{bmatrix} p_j \times w_j \\ w_j \end{bmatrix} \text{ (revolute)},
+              \qquad J_{c(j)} = \begin{bmatrix} w_j \\ 0 \end{bmatrix} \text{ (prismatic)}
+
+    (:math:`v_O = \omega \times (0 - p_j)`), what ``pinocchio.computeJointJacobians`` writes
+    into ``data.J``.
+
+    Args:
+        poses: Placements (nj, 4, 4) of the joints in the world frame (:func:`joint_poses`).
+        kind: :data:`REVOLUTE` or :data:`PRISMATIC` (nj,).
+        axis: Unit axes (nj, 3) in each joint's frame.
+        index: Coordinate (nj,) of q, and column of J, moving each joint.
+        J: (6, nv), rows [v_O; w] (written: every column, one a joint).
+    """
+    for j in range(1, kind.shape[0]):
+        w = (
+            poses[j, 0, 0] * axis[j, 0] + poses[j, 0, 1] * axis[j, 1] + poses[j, 0, 2] * axis[j, 2],
+            poses[j, 1, 0] * axis[j, 0] + poses[j, 1, 1] * axis[j, 1] + poses[j, 1, 2] * axis[j, 2],
+            poses[j, 2, 0] * axis[j, 0] + poses[j, 2, 1] * axis[j, 1] + poses[j, 2, 2] * axis[j, 2],
+        )
+        c = index[j]
+        if kind[j] == REVOLUTE:
+            linear = cross((poses[j, 0, 3], poses[j, 1, 3], poses[j, 2, 3]), w)
+            angular = w
+        else:
+            linear, angular = w, (0.0, 0.0, 0.0)
+        for r in range(3):
+            J[r, c] = linear[r]
+            J[3 + r, c] = angular[r]
 
 
 @kernel
