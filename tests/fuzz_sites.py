@@ -4,8 +4,8 @@ Every class of ``rrc_pin.__all__`` (its constructor and public methods) and func
 documented entry points of the submodules: guidance, maps, the control strategies, cells. A
 site is a callable made fresh for each call where a call that succeeds with a strange value
 could change what the next one sees (a controller's configuration; a collision model that
-only gains shapes is shared), and the valid value of each argument the fuzz replaces, one at
-a time. Records (``NamedTuple``: ``TaskRows``, ``Constraints``, guidance's
+only gains shapes serves all calls of a site), and the valid value of each argument the fuzz
+replaces, one at a time. Records (``NamedTuple``: ``TaskRows``, ``Constraints``, guidance's
 ``Command``...) are data: they are checked where a call takes them, and the fuzz passes bad
 ones there.
 """
@@ -219,36 +219,43 @@ def _limits(w: World) -> list[Site]:
 def _collision(w: World) -> list[Site]:
     T = w.T
     tetrahedron = np.array([[0.0, 0, 0], [0.1, 0, 0], [0, 0.1, 0], [0, 0, 0.1]])
-    m = w.collision()  # one model for the sites that add to it or read it (a model costs 6 ms)
-    m.add_wall([0.0, 0.0, 1.0], -0.5, name="floor")  # walls(frame=...) compares their frames
     return [
         Site("CollisionModel", lambda: rrc_pin.CollisionModel,
              {"robot": w.panda, "geometry": None}),
-        Site("CollisionModel.add_box", lambda: m.add_box,
+        Site("CollisionModel.add_box", _shared(w, "add_box"),
              {"T": T, "size": [0.1, 0.2, 0.3], "name": None}),
-        Site("CollisionModel.add_capsule", lambda: m.add_capsule,
+        Site("CollisionModel.add_capsule", _shared(w, "add_capsule"),
              {"T": T, "radius": 0.05, "length": 0.2, "name": None}),
-        Site("CollisionModel.add_cylinder", lambda: m.add_cylinder,
+        Site("CollisionModel.add_cylinder", _shared(w, "add_cylinder"),
              {"T": T, "radius": 0.05, "length": 0.2, "name": None}),
-        Site("CollisionModel.add_sphere", lambda: m.add_sphere,
+        Site("CollisionModel.add_sphere", _shared(w, "add_sphere"),
              {"center_or_T": [0.5, 0.0, 0.3], "radius": 0.05, "name": None}),
-        Site("CollisionModel.add_convex", lambda: m.add_convex,
+        Site("CollisionModel.add_convex", _shared(w, "add_convex"),
              {"T": T, "points": tetrahedron, "name": None}),
-        Site("CollisionModel.add_halfspace", lambda: m.add_halfspace,
+        Site("CollisionModel.add_halfspace", _shared(w, "add_halfspace"),
              {"normal": [0.0, 0.0, 1.0], "offset": -0.5, "name": None}),
-        Site("CollisionModel.add_wall", lambda: m.add_wall,
+        Site("CollisionModel.add_wall", _shared(w, "add_wall"),
              {"normal": [0.0, 0.0, 1.0], "offset": -0.5, "frame": None, "name": None}),
-        Site("CollisionModel.add_workspace", lambda: m.add_workspace,
+        Site("CollisionModel.add_workspace", _shared(w, "add_workspace"),
              {"T": T, "size": [2.0, 2.0, 2.0], "frame": None, "name": None}),
-        Site("CollisionModel.attach", lambda: m.attach, {
+        Site("CollisionModel.attach", _shared(w, "attach"), {
             "link": "panda_link7", "kind": "sphere", "T_link_shape": np.eye(4), "name": None,
             "radius": 0.03}),
         Site("CollisionModel.remove", lambda: w.collision().remove, {"name": "box"}),
-        Site("CollisionModel.create_data", lambda: m.create_data, {}),
-        Site("CollisionModel.walls", lambda: m.walls, {"frame": None}),
-        Site("CollisionModel.proximity_at", lambda: m.proximity_at,
+        Site("CollisionModel.create_data", _shared(w, "create_data"), {}),
+        Site("CollisionModel.walls", _shared(w, "walls"), {"frame": None}),
+        Site("CollisionModel.proximity_at", _shared(w, "proximity_at"),
              {"q": w.q, "detection": 0.1, "data": None, "ends": False}),
     ]
+
+
+def _shared(w: World, method: str) -> Callable[[], Callable[..., Any]]:
+    """A method of a collision model of the site's own, built once (a model costs 6 ms): the
+    shapes the odd value that succeeds adds stay, a few."""
+    model = w.collision()
+    model.add_wall([0.0, 0.0, 1.0], -0.5, name="floor")  # walls(frame=...) compares frames
+    bound = getattr(model, method)
+    return lambda: bound
 
 
 def _controller(w: World) -> list[Site]:
@@ -367,7 +374,7 @@ def _maps(w: World) -> list[Site]:
     m = w.map
     return [
         Site("capability", lambda: maps.capability, {
-            "arm": w.barker, "samples": 128, "voxel": 0.2, "seed": 0, "workers": 1,
+            "arm": w.barker, "samples": 64, "voxel": 0.2, "seed": 0, "workers": 1,
             "dexterity": False, "frame": None, "block_size": 64, "blocks_per_task": None},
             {"progress": False}),
         Site("load_map", lambda: maps.load_map, {"path": w.map_path}),
@@ -434,7 +441,7 @@ def _teleoperation(w: World) -> list[Site]:
             "gain": 10.0, "linear_speed": 0.5, "angular_speed": 1.5, "jump": 0.05,
             "jump_angle": 0.3, "device_speed": 2.0, "device_rate": 10.0, "timeout": 0.05,
             "decay": 0.05, "settle": 5, "scale": 1.0, "device_axes": None, "lower": None,
-            "upper": None}),
+            "upper": None}, aliases={"upper": ("lower",)}),  # a lone bound: named by the first
         Site("PoseStream", lambda: rrc_pin.PoseStream, {"hand": w.T, "options": None}),
         Site("PoseStream.push", lambda: rrc_pin.PoseStream(w.T).push, {"t": 0.0, "device": w.T}),
         Site("PoseStream.clutch", lambda: rrc_pin.PoseStream(w.T).clutch,
@@ -444,7 +451,7 @@ def _teleoperation(w: World) -> list[Site]:
         Site("PoseStream.twist", lambda: rrc_pin.PoseStream(w.T).twist, {"t": 0.0, "hand": w.T}),
         Site("JerkLimiter", lambda: rrc_pin.JerkLimiter, {
             "n": 7, "dt": 0.01, "acceleration": 10.0, "jerk": 100.0, "lower": None,
-            "upper": None, "margin": 0.0}),
+            "upper": None, "margin": 0.0}, aliases={"upper": ("lower",)}),
         Site("JerkLimiter.reset", lambda: rrc_pin.JerkLimiter(7, 0.01, 10.0, 100.0).reset,
              {"rates": np.zeros(7)}),
         Site("JerkLimiter.stop", lambda: rrc_pin.JerkLimiter(7, 0.01, 10.0, 100.0).stop,

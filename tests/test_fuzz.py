@@ -380,13 +380,15 @@ def world(tmp_path_factory: pytest.TempPathFactory) -> Any:
     return World(tmp_path_factory.mktemp("fuzz"))
 
 
+@pytest.mark.filterwarnings("ignore:Controller.step.twist. without ref:FutureWarning")  # ref=None
 def test_every_public_call_site_refuses_bad_values_by_name(
     world: Any, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """Every public call site (tests/fuzz_sites.py), each argument with 30 bad values drawn
     fresh: each call succeeds with finite numbers or raises the package's error naming the
     argument, and an error leaves the object called as it was. Before: 21 foreign exceptions
-    in 55 sites (ragged lists: ValueError at 5; an unhashable name: TypeError). The working
+    in 55 sites (ragged lists: ValueError at 5; an unhashable name: TypeError); on these 142
+    sites, 827 foreign exceptions at 44 of the first 123, and a crash. The working
     folder is a temporary one: a path the fuzz passes (``""``, ``"."``) is never this one."""
     from fuzz_sites import sites
 

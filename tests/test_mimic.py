@@ -115,7 +115,7 @@ def test_limits_hold_over_a_random_run(tmp_path, seed: int, k: float) -> None:
     assert touched > 5, seed  # the run did reach the mimic's limits
     ctl = rrc_pin.Controller(arm, dt=0.01, q0=arm.ready())
     for _ in range(200):
-        q, r = ctl.step(rng.normal(size=6) * 2.0)
+        q, r = ctl.step(rng.normal(size=6) * 2.0, ref="local")
         assert -0.3 <= mimic.position(q[1]) <= 0.5 and abs(k * r.qdot[1]) <= 2.0, seed
 
 

@@ -115,7 +115,7 @@ class StreamOptions:
             rigid_transform(axes, "device_axes")
         object.__setattr__(self, "device_axes", axes[:3, :3].copy())
         if (self.lower is None) != (self.upper is None):
-            raise InvalidInput("lower, upper", "give both corners of the workspace box, or neither")
+            raise InvalidInput("lower", "give both corners of the workspace box, or neither")
         if self.lower is not None:
             lo = _vector3(self.lower, "lower")
             hi = _vector3(self.upper, "upper")

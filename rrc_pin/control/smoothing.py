@@ -109,7 +109,7 @@ class JerkLimiter:
         self.a_max = _positive(acceleration, "acceleration", n)
         self.j_max = _positive(jerk, "jerk", n)
         if (lower is None) != (upper is None):
-            raise InvalidInput("lower, upper", "give both position limits, or neither")
+            raise InvalidInput("lower", "give both position limits, or neither")
         margin = finite_number(margin, "margin", 0.0)
         self._lower = None if lower is None else _limits(lower, "lower", n) + margin
         self._upper = None if upper is None else _limits(upper, "upper", n) - margin
