@@ -151,7 +151,7 @@ def finite_number(
     return out
 
 
-def integer(value: int, name: str, lower: int | None = None, upper: int | None = None) -> int:
+def integer(value: object, name: str, lower: int | None = None, upper: int | None = None) -> int:
     """Return ``value`` as an int, optionally within ``[lower, upper]``.
 
     Raises:
