@@ -38,6 +38,7 @@ FRESH = int(np.random.SeedSequence().entropy % 2**63)
 """The turning sessions' seed, drawn fresh each run (named in every failure)."""
 
 
+@pytest.mark.compiled
 @pytest.mark.parametrize("turn", [False, True], ids=("positions", "turning"))
 @pytest.mark.parametrize("name", soak.SCENES)
 def test_a_session_keeps_every_pair_apart(name, turn):

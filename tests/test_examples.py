@@ -54,7 +54,15 @@ def test_there_are_examples_of_each_kind():
             "custom_task", "guidance", "control_schemes"} <= names  # fmt: skip
 
 
-@pytest.mark.parametrize("path", EXAMPLES, ids=[p.stem for p in EXAMPLES])
+SESSIONS = {"tripod_balance", "tripod_walk"}
+"""Examples that run a cell for thousands of ticks: minutes with the kernels as plain Python."""
+
+
+@pytest.mark.parametrize(
+    "path",
+    [pytest.param(p, marks=pytest.mark.compiled) if p.stem in SESSIONS else p for p in EXAMPLES],
+    ids=[p.stem for p in EXAMPLES],
+)
 def test_the_example_runs_and_says_what_it_shows(path, tmp_path, monkeypatch, capsys):
     text = path.read_text()
     doc = text.split('"""')[1]

@@ -106,6 +106,7 @@ def test_limits_hold_property(name: str, u: list, twist: list, dt: float, direct
     check_step(arm, q, r.qdot, dt)
 
 
+@pytest.mark.compiled
 def test_a_long_session_near_the_limits_stays_inside_in_floating_point(arms: dict) -> None:
     """Issue 18 item 10: q + dt * qdot never leaves the position limits, however long."""
     arm = arms["panda"]

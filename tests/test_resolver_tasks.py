@@ -139,6 +139,7 @@ def grip_session(
     return float(np.linalg.norm(error[:3])), float(np.linalg.norm(error[3:])), active
 
 
+@pytest.mark.compiled
 def test_relative_frame_task_keeps_the_grip_over_a_long_session(baxter: rrc_pin.Robot) -> None:
     """Two hands holding one object: their relative pose drifts by the Euler integration's
     error only (a finer step drifts less), and with the pose feedback not at all, while the

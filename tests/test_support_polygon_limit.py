@@ -76,6 +76,7 @@ def random_body_run(seed: int, limit: bool) -> Tripod:
     return tripod
 
 
+@pytest.mark.compiled
 @pytest.mark.parametrize("seed", SEEDS, ids=["fixed", "fresh"])
 def test_random_body_commands_keep_the_com_in_the_shrunk_region(seed):
     held = random_body_run(seed, limit=True)
@@ -85,12 +86,14 @@ def test_random_body_commands_keep_the_com_in_the_shrunk_region(seed):
         assert held.scaled > 0, seed
 
 
+@pytest.mark.compiled
 def test_the_fixed_run_leaves_the_region_without_the_limit():
     free = random_body_run(SEEDS[0], limit=False)
     held = random_body_run(SEEDS[0], limit=True)
     assert free.worst > 0.05 and held.worst <= 0.0 and held.scaled > 100
 
 
+@pytest.mark.compiled
 def test_a_walk_with_one_foot_lifted():
     """Each leg in turn: the centre of mass moved over the two other feet (a ComTask, three
     feet in support), the foot lifted 5 cm and set down 5 cm forward while the body is
