@@ -55,7 +55,10 @@ class Combined(Robot):
 
     def __init__(self, model: pin.Model, tool_frames: Sequence[str], *, name: str, source: str,
                  poses: Mapping[str, npt.ArrayLike], parts: Sequence[Part]) -> None:  # fmt: skip
-        super().__init__(model, tool_frames, name=name, source=source, poses=poses)
+        limits = {f"{p.key}/{m.name}": (m.lower, m.upper, m.velocity)
+                  for p in parts for m in p.robot.mimics}  # fmt: skip
+        super().__init__(model, tool_frames, name=name, source=source, poses=poses,
+                         mimic_limits=limits)  # fmt: skip
         self.parts: tuple[Part, ...] = tuple(parts)
 
 

@@ -30,13 +30,15 @@ class UnknownArm(RrcPinError, ValueError):
     Attributes:
         name: The requested name.
         available: Every name :func:`rrc_pin.load` accepts.
+        argument: The argument that named it (``name_or_path``, ``robot``...).
     """
 
-    def __init__(self, name: str, available: list[str]) -> None:
+    def __init__(self, name: str, available: list[str], argument: str = "name_or_path") -> None:
         self.name = name
         self.available = available
+        self.argument = argument
         super().__init__(
-            f"name_or_path: unknown arm {name!r} (not a file either); available: "
+            f"{argument}: unknown arm {name!r} (not a file either); available: "
             + ", ".join(available)
         )
 
@@ -47,11 +49,13 @@ class URDFError(RrcPinError, ValueError):
     Attributes:
         path: The file (or ``"<string>"``).
         reason: The parser's or the library's message.
+        argument: The argument that named the file or model (``name_or_path``, ``robot``...).
     """
 
-    def __init__(self, path: str, reason: str) -> None:
+    def __init__(self, path: str, reason: str, argument: str = "name_or_path") -> None:
         self.path = path
         self.reason = reason
+        self.argument = argument
         super().__init__(f"URDF {path}: {reason}")
 
 

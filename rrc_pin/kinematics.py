@@ -43,6 +43,8 @@ class Layout(NamedTuple):
         tool_frame: The frame the closed form answers for, or None.
         actuated: Mask (nv,) of the rates a joint drives (False for a floating base's), or
             None when every rate is.
+        mimic_velocity: Speed limits (nv,) that mimic joints put on the joints they follow
+            (:attr:`Robot.mimic_velocity`), or None where there are none.
     """
 
     nv: int
@@ -56,6 +58,7 @@ class Layout(NamedTuple):
     closed_form: Any = None
     tool_frame: str | None = None
     actuated: npt.NDArray[np.bool_] | None = None
+    mimic_velocity: Array | None = None
 
     @classmethod
     def of(cls, robot: Robot, closed_form: Any = None) -> Layout:
@@ -75,6 +78,7 @@ class Layout(NamedTuple):
             robot.velocity_limit, reaches, closed_form,
             robot.tool_frame if closed_form is not None else None,
             robot.actuated if robot.floating else None,
+            robot.mimic_velocity if np.isfinite(robot.mimic_velocity).any() else None,
         )  # fmt: skip
 
 

@@ -24,8 +24,10 @@ import pinocchio as pin
 
 from rrc_pin import models
 from rrc_pin.errors import InvalidInput, UnknownArm, URDFError
+from rrc_pin.mimic import mimics_of, urdf_mimic_limits
 from rrc_pin.models.arm_spec import ArmSpec
 from rrc_pin.robot import Robot, moving_joints
+from rrc_pin.solvers.checks import MAX_LENGTH, finite_number
 from rrc_pin.urdf_checks import check_tree, parser_messages, readable, replay
 from rrc_pin.urdf_compare import compare_urdf
 from rrc_pin.urdf_export import TOOL_FRAME, to_urdf
@@ -432,6 +434,25 @@ def load(
     raise UnknownArm(key, arms() + cells())
 
 
+def loaded(value: Robot | str | os.PathLike[str], argument: str) -> Robot:
+    """``value`` if it is a :class:`Robot`, else :func:`load` of its name or path.
+
+    Raises:
+        InvalidInput: Neither a robot nor a (non-empty) name or path, naming ``argument``.
+        UnknownArm, URDFError: As :func:`load`, naming ``argument``.
+    """
+    if isinstance(value, Robot):
+        return value
+    if not isinstance(value, (str, os.PathLike)) or not os.fspath(value):
+        raise InvalidInput(argument, f"expected a rrc_pin.Robot, a name or a path, got {value!r}")
+    try:
+        return load(value)
+    except UnknownArm as exc:
+        raise UnknownArm(exc.name, exc.available, argument) from exc
+    except URDFError as exc:
+        raise URDFError(exc.path, exc.reason, argument) from exc
+
+
 def _refuse_parameters(parameters: dict[str, float], what: str) -> None:
     if parameters:
         raise InvalidInput(
@@ -451,6 +472,8 @@ def _build(name: str, parameters: dict[str, float]) -> ArmSpec:
             ", ".join(unknown),
             f"not a parameter of {name}; it takes: {', '.join(accepted) or 'none'}",
         )
+    for key, value in parameters.items():  # lengths [m] or angles [rad]: none beyond
+        finite_number(value, key, -MAX_LENGTH, upper=MAX_LENGTH)
     return BUILDERS[name](**parameters)
 
 
@@ -555,7 +578,9 @@ def _from_file(path: Path, tool_frame: ToolFrames) -> Robot:
     if spec is not None and not compare_urdf(text, to_urdf(spec)):
         tools = _catalogue_tool(tool_frame)
         return Robot(model, tools, name=spec.name, source=str(path), spec=spec)
-    return Robot(model, tool_frame, name=path.stem, source=str(path))
+    followers = {m.name for m in mimics_of(model)}
+    limits = {k: v for k, v in urdf_mimic_limits(root, str(path)).items() if k in followers}
+    return Robot(model, tool_frame, name=path.stem, source=str(path), mimic_limits=limits)
 
 
 def _catalogue_tool(tool_frame: ToolFrames) -> ToolFrames:

@@ -24,6 +24,7 @@ sequences, or pass ``qdot_prev`` explicitly.
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 from collections.abc import Mapping, Sequence
@@ -36,9 +37,9 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput, UnknownBackend
 from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.limits import JointLimits, Limit
-from rrc_pin.loading import load
+from rrc_pin.loading import loaded
 from rrc_pin.robot import Robot
-from rrc_pin.solvers.checks import as_vector, finite_number, positive
+from rrc_pin.solvers.checks import all_finite, as_vector, finite_number, positive
 from rrc_pin.solvers.qp_backends import make_backend
 from rrc_pin.solvers.spatial import Reference
 from rrc_pin.solvers.tick.damping import Damping
@@ -133,8 +134,8 @@ class Resolver:
         direction_preserving: bool = True,
         use_closed_form: bool = False,
     ) -> None:
-        if isinstance(robot, str):
-            robot = load(robot)
+        if isinstance(robot, (str, os.PathLike)):
+            robot = loaded(robot, "robot")
         if not isinstance(robot, Robot):
             raise InvalidInput("robot", f"expected a rrc_pin.Robot or a name, got {robot!r}")
         if not isinstance(direction_preserving, bool):
@@ -227,11 +228,11 @@ class Resolver:
             levels, weighted = self._levels(cast(TaskCommand, command), priority)
             twist = None
         else:
+            task = self._twist_task()
+            twist = task.check_twist(cast(npt.ArrayLike, command))  # a bad one named first
             if not isinstance(priority, str) or priority != "weighted":
                 raise InvalidInput("priority", "a twist is one task: priority is for lists of "
                                    f"tasks, got {priority!r}")
-            task = self._twist_task()
-            twist = task.check_twist(cast(npt.ArrayLike, command))
             levels, weighted = [[task]], False
             ref = task.ref if ref is None else task.check_ref(ref)
         with self._lock:
@@ -241,6 +242,7 @@ class Resolver:
                 rows = [[t.rows(kin) for t in level] for level in levels]
             else:
                 rows = [[cast(FrameTask, levels[0][0]).rows_at(kin, twist, cast(Reference, ref))]]
+            _check_rows(rows)
             before = self._last_qdot if previous is None else previous
             constraints = [limit.constraints(kin, step, before) for limit in self.limits]
             problem = build(rows, constraints, self.robot.nv, step, weighted=weighted,
@@ -327,6 +329,18 @@ class Resolver:
                 "task", f"the closed form has {cf.task_dim} rows; rows {task.selected} asked"
             )
         return cf
+
+
+def _check_rows(levels: list[list[TaskRows]]) -> None:
+    """Refuse a task whose rows are not finite (a user's task, or a command that overflowed).
+
+    Raises:
+        InvalidInput: Naming ``command`` and the task.
+    """
+    for level in levels:
+        for t in level:
+            if not (all_finite(t.b) and all_finite(t.A)):
+                raise InvalidInput("command", f"task {t.name!r} gave rows that are not finite")
 
 
 def _dt(dt: float) -> float:

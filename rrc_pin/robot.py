@@ -38,6 +38,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.errors import FrameNotFound, InvalidInput, ToolFrameRequired, URDFError
+from rrc_pin.mimic import Mimic, MimicLimits, mimics_of, tightened, velocity_caps
 from rrc_pin.models.arm_spec import ArmSpec
 from rrc_pin.solvers.checks import as_vector, finite_number
 from rrc_pin.solvers.closed_form.base import ClosedForm
@@ -93,6 +94,12 @@ class Robot:
         poses: Named configurations (nq,) [rad or m] (read-only arrays); ``"ready"``, where
             present, is :meth:`ready`'s.
         mimic_joints: Joints that follow another (URDF ``<mimic>``): in the model, not in q.
+        mimics: Each mimic joint: its primary, multiplier, offset and own limits
+            (:class:`rrc_pin.mimic.Mimic`), which tighten the primary's ``lower``, ``upper``
+            and ``velocity_limit``.
+        mimic_velocity: Speed limits (nv,) the mimic joints put on their primaries [rad/s or
+            m/s] (inf where none): within ``velocity_limit``, and kept by
+            :class:`~rrc_pin.limits.JointLimits` where its ``velocity`` replaces the robot's.
         continuous: Mask (nq,) of the continuous (unbounded revolute) joints.
     """
 
@@ -105,6 +112,7 @@ class Robot:
         source: str,
         spec: ArmSpec | None = None,
         poses: Mapping[str, npt.ArrayLike] | None = None,
+        mimic_limits: MimicLimits | None = None,
     ) -> None:
         """Wrap ``model``; every entry of ``tool_frames`` must name one of its frames.
 
@@ -119,13 +127,19 @@ class Robot:
             poses: Named configurations (nq,) [rad or m], each within the joint limits;
                 ``"ready"`` is the one :meth:`ready` returns. Default: the ``spec``'s named
                 poses, else none.
+            mimic_limits: The mimic joints' own limits by name, ``(lower, upper, velocity)``
+                [rad or m, rad/s or m/s] (a URDF's ``<limit>``, which Pinocchio's model does
+                not keep): each tightens its primary's limits through the multiplier and
+                offset (:mod:`rrc_pin.mimic`); default none.
 
         Raises:
             InvalidInput: ``model`` is not a ``pinocchio.Model``, ``name`` or ``source`` not a
                 string, ``spec`` not an ArmSpec, ``tool_frames`` empty, not names or naming a
-                frame twice, or a pose not a finite (nq,) vector within the limits (named).
-            URDFError: The model has no moving joint, or a joint that is not one coordinate
-                (free-flyer, spherical...).
+                frame twice, a pose not a finite (nq,) vector within the limits, or
+                ``mimic_limits`` not limits of the model's mimic joints (named).
+            URDFError: The model has no moving joint, a joint that is not one coordinate
+                (free-flyer, spherical...), or a mimic joint's limits that no position of its
+                primary keeps.
             ToolFrameRequired: ``tool_frames`` is None and the tree has several end links
                 (lists them).
             FrameNotFound: A tool frame is not a frame of the model.
@@ -139,6 +153,8 @@ class Robot:
             raise InvalidInput("spec", f"expected an ArmSpec or None, got {_brief(spec)}")
         if model.nv == 0:
             raise URDFError(source, "no moving joint: there is nothing to control")
+        mimics = mimics_of(model, mimic_limits)
+        model = tightened(model, mimics, source, UNBOUNDED)
         scalar_api, scalar_pin, angle_api, angle_pin = [], [], [], []
         moving: list[tuple[int, str]] = []  # (index in qdot, joint name)
         mimic: list[str] = []
@@ -198,6 +214,9 @@ class Robot:
         base_dofs = [f"{self.base_joint}:{axis}" for axis in BASE_AXES] if floating else []
         self.dof_names: tuple[str, ...] = (*base_dofs, *self.joint_names)
         self.mimic_joints: tuple[str, ...] = tuple(mimic)
+        self.mimics: tuple[Mimic, ...] = mimics
+        self.mimic_velocity = velocity_caps(model, mimics)
+        self.mimic_velocity.flags.writeable = False
         self._scalar = (np.array(scalar_api, dtype=int), np.array(scalar_pin, dtype=int))
         self._angle = (np.array(angle_api, dtype=int), np.array(angle_pin, dtype=int))
         self._offset = offset

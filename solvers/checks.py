@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from math import isfinite
 
 import numpy as np
@@ -49,6 +50,18 @@ def as_array(
         want is not None and got != want for got, want in zip(arr.shape, shape, strict=True)
     ):
         raise InvalidInput(name, f"expected shape {_fmt(shape)}, got {arr.shape}")
+    if not all_finite(arr):
+        _non_finite(arr, name)
+    return arr
+
+
+def finite_array(x: npt.ArrayLike, name: str) -> npt.NDArray[np.float64]:
+    """Return ``x`` as a finite float array of any shape (a ragged one refused).
+
+    Raises:
+        InvalidInput: Not real numbers, or NaN or inf.
+    """
+    arr = real_array(x, name)
     if not all_finite(arr):
         _non_finite(arr, name)
     return arr
@@ -138,6 +151,83 @@ def finite_number(
     return out
 
 
+def integer(value: object, name: str, lower: int | None = None, upper: int | None = None) -> int:
+    """Return ``value`` as an int, optionally within ``[lower, upper]``.
+
+    Raises:
+        InvalidInput: ``value`` is not an integer (a bool, a float, a string are refused), or
+            outside the bounds; the message states the expected range.
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise InvalidInput(name, f"expected {_integer_range(lower, upper)}, got {_brief(value)}")
+    out = int(value)
+    if (lower is not None and out < lower) or (upper is not None and out > upper):
+        got = f"an int of {len(str(out))} digits" if abs(out) > 10**30 else str(out)
+        raise InvalidInput(name, f"expected {_integer_range(lower, upper)}, got {got}")
+    return out
+
+
+def flag(value: bool, name: str) -> bool:
+    """Return ``value`` as a bool: True or False only (numpy's too; not 1, not an array).
+
+    Raises:
+        InvalidInput: ``value`` is not a boolean.
+    """
+    if not isinstance(value, (bool, np.bool_)):
+        raise InvalidInput(name, f"expected True or False, got {_brief(value)}")
+    return bool(value)
+
+
+def choice(value: str, name: str, choices: tuple[str, ...]) -> str:
+    """Return ``value``, a string among ``choices``.
+
+    Raises:
+        InvalidInput: ``value`` is not one of them (an array or an unhashable included); the
+            message lists them.
+    """
+    if not isinstance(value, str) or value not in choices:
+        options = ", ".join(repr(c) for c in choices)
+        raise InvalidInput(name, f"expected one of {options}, got {_brief(value)}")
+    return value
+
+
+def names(value: object, name: str, size: int | None = None) -> tuple[str, ...]:
+    """Return ``value`` as a tuple of strings: one string, or a list or tuple of them.
+
+    Args:
+        value: What to check.
+        name: Argument name used in the error message.
+        size: The number of names expected, or None for any.
+
+    Raises:
+        InvalidInput: Not a string nor a list or tuple of strings (an array, a set, a number
+            refused), or not ``size`` of them.
+    """
+    items = (value,) if isinstance(value, str) else value
+    if not isinstance(items, (list, tuple)) or not all(isinstance(v, str) for v in items):
+        raise InvalidInput(name, f"expected names (str, or a list of them), got {_brief(value)}")
+    if size is not None and len(items) != size:
+        raise InvalidInput(name, f"expected {size} names, got {len(items)}: {_brief(value)}")
+    return tuple(items)
+
+
+def _brief(value: object, limit: int = 60) -> str:
+    """``repr(value)`` cut to ``limit`` characters (an error names a huge array briefly)."""
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _integer_range(lower: int | None, upper: int | None) -> str:
+    """The range :func:`integer` expects, in words."""
+    if lower is None and upper is None:
+        return "an integer"
+    if upper is None:
+        return f"an integer >= {lower}"
+    if lower is None:
+        return f"an integer <= {upper}"
+    return f"an integer in [{lower}, {upper}]"
+
+
 def _wanted(lower: float | None, inclusive: bool, upper: float | None) -> str:
     """The range :func:`finite_number` expects, in words."""
     if lower is None and upper is None:
@@ -170,6 +260,51 @@ def _fmt(shape: tuple[int | None, ...]) -> str:
 RIGID_TOL = 1e-9
 """Largest departure of a pose from a rigid transform (R^T R - I, last row) accepted."""
 
+MAX_LENGTH = 1e9
+"""[m] The largest translation of a pose accepted: far beyond any robot's workspace, and
+small enough that distances, their squares and products never overflow."""
+
+
+def length(value: float, name: str, lower: float = 0.0, inclusive: bool = False) -> float:
+    """A length [m]: a finite number above ``lower`` (``> 0`` by default), below
+    :data:`MAX_LENGTH`.
+
+    Raises:
+        InvalidInput: Not such a number.
+    """  # noqa: D205
+    try:
+        return finite_number(value, name, lower, inclusive, upper=MAX_LENGTH)
+    except InvalidInput as exc:
+        got = exc.reason.rsplit(", got ", 1)[-1]
+        wanted = f"{'>=' if inclusive else '>'} {lower:g} [m] (below {MAX_LENGTH:g})"
+        raise InvalidInput(name, f"expected a finite length {wanted}, got {got}") from None
+
+
+def within_length(x: npt.NDArray[np.float64], name: str) -> npt.NDArray[np.float64]:
+    """``x``, whose entries are lengths [m] within :data:`MAX_LENGTH` of zero.
+
+    Raises:
+        InvalidInput: An entry beyond it.
+    """
+    if np.abs(x).max(initial=0.0) > MAX_LENGTH:
+        raise InvalidInput(name, f"an entry beyond {MAX_LENGTH:g} m: {_brief(x.tolist())}")
+    return x
+
+
+def direction(x: npt.ArrayLike, name: str) -> tuple[npt.NDArray[np.float64], float]:
+    """``x`` (3,) as a unit vector, and its norm (which may be inf: no entry is).
+
+    Raises:
+        InvalidInput: Not a finite (3,) vector, or zero.
+    """
+    v = as_vector(x, name, 3)
+    top = float(np.abs(v).max())
+    if top < 1e-300:
+        raise InvalidInput(name, f"expected a non-zero vector, got {v.tolist()}")
+    scaled = v / top  # no overflow in the norm
+    size = math.hypot(*scaled.tolist())
+    return scaled / size, top * size
+
 
 def rigid_transform(
     x: npt.ArrayLike, name: str
@@ -181,11 +316,14 @@ def rigid_transform(
     """
     T = as_array(x, name, (4, 4))
     R = T[:3, :3]
-    rigid = (
-        np.abs(R.T @ R - np.eye(3)).max() <= RIGID_TOL
-        and np.linalg.det(R) > 0.0
-        and np.abs(T[3] - (0.0, 0.0, 0.0, 1.0)).max() <= RIGID_TOL
-    )
+    with np.errstate(over="ignore", invalid="ignore"):  # huge entries: not rigid, refused
+        rigid = (
+            np.abs(R.T @ R - np.eye(3)).max() <= RIGID_TOL
+            and np.linalg.det(R) > 0.0
+            and np.abs(T[3] - (0.0, 0.0, 0.0, 1.0)).max() <= RIGID_TOL
+        )
     if not rigid:
         raise InvalidInput(name, f"not a rigid transform: {T.tolist()}")
+    if np.abs(T[:3, 3]).max() > MAX_LENGTH:
+        raise InvalidInput(name, f"a translation beyond {MAX_LENGTH:g} m: {T[:3, 3].tolist()}")
     return T

@@ -19,9 +19,9 @@ UPPER = {"resolver", "control", "controller", "guidance", "cell", "cli", "demo",
          "maps", "console"}  # fmt: skip
 TOP = {"console", "cli"}
 """The entry points: nothing else in rrc_pin imports them."""
-LOWER = {"dh", "models", "urdf_export", "urdf_compare", "urdf_checks", "robot", "loading", "errors",
-         "cross_check", "link_capsules", "combined", "kinematics", "geometry",
-         "deprecated"}  # fmt: skip
+LOWER = {"dh", "models", "urdf_export", "urdf_compare", "urdf_checks", "mimic", "robot",
+         "loading", "errors", "cross_check", "link_capsules", "combined", "kinematics",
+         "geometry", "deprecated"}  # fmt: skip
 GEOMETRY_BELOW = {"tasks", "limits", *UPPER}
 """What the geometry layer never imports: it sits above robot, below the tasks and limits."""
 
@@ -66,13 +66,14 @@ def test_lower_layers_never_import_upper_ones():
 def test_geometry_sits_below_the_tasks_and_limits():
     for path in (ROOT / "rrc_pin").rglob("*.py"):
         rel = path.relative_to(ROOT / "rrc_pin").with_suffix("")
-        below = rel.parts[0] in ("geometry", "link_capsules", "combined", "robot", "kinematics")
+        below = rel.parts[0] in ("geometry", "link_capsules", "combined", "mimic", "robot",
+                                 "kinematics")
         for name in imported_names(path):
             parts = name.split(".")
             if below:
                 assert not (parts[0] == "rrc_pin" and len(parts) > 1
                             and parts[1] in GEOMETRY_BELOW), (rel, name)  # fmt: skip
-            if rel.parts[0] in ("models", "dh", "urdf_export", "robot", "loading"):
+            if rel.parts[0] in ("models", "dh", "urdf_export", "mimic", "robot", "loading"):
                 assert not (parts[:2] == ["rrc_pin", "geometry"]), (rel, name)
 
 

@@ -95,5 +95,5 @@ def test_an_object_naming_an_unknown_arm_lists_the_arms():
 
 
 def test_an_unknown_arm_of_a_cell_lists_them(dual):
-    with pytest.raises(InvalidInput, match="^arm: no arm 'middle'.*left, right"):
+    with pytest.raises(InvalidInput, match="^key: no arm 'middle'.*left, right"):
         dual.arm("middle")

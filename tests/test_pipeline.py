@@ -4,6 +4,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pytest
 import qpsolvers
@@ -199,6 +201,44 @@ def test_where_the_lp_maximum_is_one_the_command_is_met_exactly(rng: np.random.G
     assert met > 20  # the exact rates did not fit: the null space answered
 
 
+@pytest.mark.parametrize("seed", [20261209, int(np.random.SeedSequence().entropy % 2**63)])
+def test_a_command_beyond_large_is_scaled_never_exact(seed: int) -> None:
+    """Commands of 1e100-1e300 are divided down before the numerics (problem.LARGE). Before,
+    their exact rates fitted the box after the division and the answer said ``exact``, scale 1,
+    while the hand moved at the command over its largest entry. Now: ``scaled``, the scale the
+    fraction of the command achieved, which is the LP maximum along it (HiGHS, on the
+    command's direction at a size the LP can hold)."""
+    rng = np.random.default_rng(seed)
+    for _ in range(60):
+        levels = levels_at(rng, (6,), 1.0)
+        box = box_at(rng)
+        A, d = stacked(levels[0])
+        size = 10.0 ** rng.uniform(100, 300)
+        problem, answer = run([[levels[0][0]._replace(b=d * size)]], box)
+        assert problem.factors[0] < 1.0 and answer.status == "scaled", seed
+        best = lp_maximum(A, d * 1e3, box) * 1e3 / size  # the LP along d, below one at 1e3
+        assert answer.scale == pytest.approx(best, rel=1e-6), seed
+        np.testing.assert_allclose(A @ answer.qdot, answer.scale * size * d,
+                                   atol=1e-9 * best * size * np.abs(d).max())  # fmt: skip
+
+
+def test_a_divided_command_met_in_an_unbounded_box_is_a_scale_of_it(
+    rng: np.random.Generator,
+) -> None:
+    """Without bounds the divided command is met: at the top level ``scaled`` by the factor it
+    was divided by, a lower level ``scaled`` too, never ``exact`` or ``met``."""
+    free = Box(np.full(N, -np.inf), np.full(N, np.inf), np.zeros((2, N), np.int8), True, False,
+               np.full(N, np.inf))  # fmt: skip
+    for direction in (True, False):
+        levels = levels_at(rng, (3, 3), 1e200)
+        problem, answer = run(levels, free, direction=direction)
+        assert answer.status in ("scaled", "least_squares") and answer.levels[1] != "met"
+        assert 0.0 < answer.scale <= problem.factors[0] < 1e-190
+        A, b = stacked(levels[0])
+        np.testing.assert_allclose(A @ answer.qdot, answer.scale * b, atol=1e-9 * answer.scale
+                                   * np.abs(b).max())  # fmt: skip
+
+
 @pytest.mark.filterwarnings("ignore:Converted matrix")
 def test_weighted_is_the_exact_optimum_of_its_costs(rng: np.random.Generator) -> None:
     """Within 1e-6 rad/s of scipy's BVLS on the same costs and box, limits active."""
@@ -291,13 +331,30 @@ class Broken(QPBackend):
             return QPSolution(np.zeros(2), "solved", 1, 0.0, self.name)
         if self.mode == "nan":
             return QPSolution(np.full(qp.q.size, np.nan), "solved", 1, 0.0, self.name)  # type: ignore[attr-defined]
+        nz = qp.q.size  # type: ignore[attr-defined]
+        malformed: dict[str, Any] = {
+            "None": None,
+            "tuple": (np.zeros(nz), "solved", 1, 0.0, self.name),
+            "strings": QPSolution(np.array(["0"] * nz), "solved", 1, 0.0, self.name),
+            "ragged": QPSolution([0.0, [0.0]], "solved", 1, 0.0, self.name),
+            "complex": QPSolution(np.zeros(nz, complex), "solved", 1, 0.0, self.name),
+            "iterations": QPSolution(np.zeros(nz), "solved", "3", 0.0, self.name),
+            "time": QPSolution(np.zeros(nz), "solved", 3, np.nan, self.name),
+        }
+        if self.mode in malformed:
+            return malformed[self.mode]  # type: ignore[no-any-return]
         return QPSolution(None, "maximum iterations reached", 4000, 0.0, self.name)
 
 
-@pytest.mark.parametrize("mode", ["raise", "foreign", "shape", "nan", "not found"])
+MALFORMED = ["None", "tuple", "strings", "ragged", "complex", "iterations", "time"]
+
+
+@pytest.mark.parametrize("mode", ["raise", "foreign", "shape", "nan", "not found", *MALFORMED])
 def test_every_backend_fault_falls_back(mode: str, rng: np.random.Generator) -> None:
     """Issue 28 item 4: a backend's exception (its own or foreign), an answer of the wrong
-    shape or a non-finite one always goes to the fallback chain."""
+    shape or a non-finite one always goes to the fallback chain; and so does an answer that
+    is not a QPSolution (None escaped as an AttributeError before), or one whose solution,
+    iterations or time are not what they say."""
     levels = levels_at(rng, (3,), 50.0)  # seven null directions: the backend's QP
     box = box_at(rng)
     _, answer = run(levels, box, Broken(mode))

@@ -636,3 +636,49 @@ def test_qpsolvers_defaults() -> None:
     assert QpsolversBackend("proxqp", eps_abs=1e-7).options["eps_abs"] == 1e-7
     assert QpsolversBackend("quadprog").options == {}
     assert QpsolversBackend("clarabel").name == "clarabel"
+
+
+# -- malformed answers of the solver libraries ----------------------------------------------
+
+MALFORMED = [None, "x", [0.1, [0.2]], np.array(["a"] * 4), np.zeros(4, complex),
+             np.ones(4, bool), np.zeros(3), np.zeros((4, 1)), np.full(4, np.inf), {},
+             object()]  # fmt: skip
+"""What a solver library might hand back as its solution x: never an answer."""
+
+
+@pytest.mark.parametrize("x", MALFORMED, ids=lambda x: type(x).__name__)
+def test_a_malformed_solution_from_any_library_is_no_answer(
+    x: Any, monkeypatch: pytest.MonkeyPatch, rng: np.random.Generator
+) -> None:
+    """Each library patched to return ``x`` as its solution (status solved), or to return
+    None or a foreign object instead of its result: the backend answers no solution or
+    raises ProblemError, nothing else (an AttributeError escaped before)."""
+    import daqp
+
+    qp = box_and_rows(rng)
+    for returned in ((x, 0.0, 1, {"iterations": 1}), None, 3.5):
+        monkeypatch.setattr(daqp, "solve", lambda *a, r=returned, **k: r)
+        outcome(DaqpBackend(), qp)
+
+    def qpsolvers_answer(problem: qpsolvers.Problem, **kwargs: Any) -> Any:
+        sol = qpsolvers.Solution(problem)
+        sol.found, sol.x = True, x
+        return sol
+
+    for fake in (qpsolvers_answer, lambda *a, **k: None, lambda *a, **k: "solved"):
+        monkeypatch.setattr(qpsolvers, "solve_problem", fake)
+        outcome(QpsolversBackend("quadprog"), qp)
+
+    for result in (fake("solved", 3, x), None, "solved"):
+        with monkeypatch.context() as patch:
+            fail_first_solves(patch, 1, result)
+            outcome(OSQPBackend(), qp)
+
+
+def outcome(backend: Any, qp: QP) -> None:
+    """The backend's answer to ``qp``: no solution, or a ProblemError; nothing else."""
+    try:
+        sol = backend.solve(qp)
+    except ProblemError:
+        return
+    assert sol.x is None, sol

@@ -41,12 +41,22 @@ def start(arm: rrc_pin.Robot, rng: np.random.Generator) -> np.ndarray:
 
 
 def command(rng: np.random.Generator) -> np.ndarray:
-    """A twist from 1e-3 to 1e3, or (one in ten) with extreme entries up to 1.7e308."""
+    """A twist from 1e-3 to 1e3, or (one in ten) of magnitude 1e100 to 1e300, or (one in ten)
+    with extreme entries up to 1.7e308."""
+    kind = rng.random()
     twist = rng.normal(size=6) * 10.0 ** rng.uniform(-3, 3)
-    if rng.random() < 0.1:
+    if kind < 0.1:
+        twist = rng.normal(size=6) * 10.0 ** rng.uniform(100, 300)
+    elif kind < 0.2:
         picks = rng.random(6) < 0.5
         twist[picks] = rng.choice(EXTREME, picks.sum()) * rng.choice([-1.0, 1.0], picks.sum())
     return twist
+
+
+def met(t: rrc_pin.TaskRows, qdot: np.ndarray) -> bool:
+    """Whether the task's rates are its command (relative 1e-6, no overflow)."""
+    top = np.abs(t.b).max(initial=0.0) or 1.0
+    return bool(np.abs(t.A @ qdot / top - t.b / top).max(initial=0.0) <= 1e-6)
 
 
 def check(arm: rrc_pin.Robot, q: np.ndarray, r: rrc_pin.Resolution, dt: float) -> None:
@@ -57,6 +67,11 @@ def check(arm: rrc_pin.Robot, q: np.ndarray, r: rrc_pin.Resolution, dt: float) -
     after = q + qdot * dt
     assert np.all(after[inside] >= arm.lower[inside]) and np.all(after[inside] <= arm.upper[inside])
     assert 0.0 <= r.scale <= 1.0 and np.isfinite(r.veer)
+    for k, (level, served) in enumerate(zip(r.problem.levels, r.levels, strict=True)):
+        if served == "met" or (k == 0 and r.status == "exact"):  # the command, not a fraction
+            assert all(met(t, qdot) for t in level), (k, served, r)
+    if r.status == "exact":
+        assert r.scale >= 1.0 - 1e-6, r
     if r.status == "scaled":  # the command's direction kept: achieved = scale * command
         level = r.problem.levels[0]
         for t in level:

@@ -89,10 +89,12 @@ def test_the_log_keeps_its_capacity_and_its_memory_stays_flat():
     try:
         for _ in range(100):  # the ring refilled with ticks allocated under tracemalloc
             ctl.step(command, ref="local")
+        assert ctl.log.dropped == 300  # (the ticks kept as they came made rows)
         gc.collect()
         before = tracemalloc.get_traced_memory()[0]
         for _ in range(400):
             ctl.step(command, ref="local")
+        assert ctl.log.dropped == 700
         gc.collect()
         grown = tracemalloc.get_traced_memory()[0] - before
     finally:

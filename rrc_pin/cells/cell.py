@@ -92,7 +92,7 @@ class Cell(Combined):
     body: str | None
     cell_spec: CellSpec | None
 
-    def arm(self, key: str, argument: str = "arm") -> Arm:
+    def arm(self, key: str, argument: str = "key") -> Arm:
         """The arm ``key``.
 
         Raises:
@@ -105,7 +105,13 @@ class Cell(Combined):
         return found
 
     def holder(self, hand: str) -> str | None:
-        """The object that hand frame ``hand`` holds, or None."""
+        """The object that hand frame ``hand`` holds, or None.
+
+        Raises:
+            InvalidInput: ``hand`` is not a frame name (str).
+        """
+        if not isinstance(hand, str):
+            raise InvalidInput("hand", f"expected a hand frame's name, got {type(hand).__name__}")
         for grasp in self.objects.values():
             if hand in grasp.hands:
                 return grasp.name

@@ -103,7 +103,7 @@ class CellLog(RecordRing[CellRecord]):
             ("errors", "f8", (len(self.commands),)), ("grip", "f8", (len(self.objects),)),
             ("chain", "f8", (2,)), ("status", "u1"), ("mode", "u1"), ("levels", "u1", (LEVELS,)),
         ])  # fmt: skip
-        self._rows = np.zeros(0, self.dtype)
+        self._table = np.zeros(0, self.dtype)
         self._start = 0  # the oldest row's index in the ring
         self._count = 0
 
@@ -116,7 +116,7 @@ class CellLog(RecordRing[CellRecord]):
     @property
     def nbytes(self) -> int:
         """Bytes the log's array holds now (its rows times :attr:`dtype`'s size)."""
-        return int(self._rows.nbytes)
+        return int(self._table.nbytes)
 
     @property
     def capacity(self) -> int:
@@ -127,10 +127,10 @@ class CellLog(RecordRing[CellRecord]):
     def capacity(self, value: int) -> None:
         value = RecordRing[Any](None, value).capacity  # checked as every ring's
         kept = self.table()
-        self.dropped += max(0, kept.size - value)
+        self._dropped += max(0, kept.size - value)
         self._capacity = value
-        self._rows = kept[kept.size - min(kept.size, value) :].copy()
-        self._start, self._count = 0, self._rows.size
+        self._table = kept[kept.size - min(kept.size, value) :].copy()
+        self._start, self._count = 0, self._table.size
 
     def add(
         self, t: float, q: Array, qdot: Array, status: str, scale: float,
@@ -169,8 +169,8 @@ class CellLog(RecordRing[CellRecord]):
 
     def table(self) -> npt.NDArray[Any]:
         """The ticks kept, oldest first, as a structured array (a copy; :attr:`dtype`)."""
-        index = (self._start + np.arange(self._count)) % max(self._rows.size, 1)
-        return self._rows[index]
+        index = (self._start + np.arange(self._count)) % max(self._table.size, 1)
+        return self._table[index]
 
     def column(self, name: str) -> npt.NDArray[Any]:
         """One field over the ticks kept, oldest first: (N,) or (N, k) (a copy).
@@ -197,7 +197,7 @@ class CellLog(RecordRing[CellRecord]):
         """
         if not -self._count <= index < self._count:
             raise IndexError(f"record {index} of {self._count}")
-        return self._record(self._rows[(self._start + index % self._count) % self._rows.size])
+        return self._record(self._table[(self._start + index % self._count) % self._table.size])
 
     def positions(self, n: int) -> list[Array]:
         """Joint positions ``q`` of the last ``n`` ticks kept, oldest first (copies).
@@ -247,20 +247,20 @@ class CellLog(RecordRing[CellRecord]):
 
     def _next(self) -> Any:
         """The row the next tick goes in (the array grown, or the oldest row reused)."""
-        size = self._rows.size
+        size = self._table.size
         if self._count < size:
             index = (self._start + self._count) % size
             self._count += 1
         elif size < self._capacity:  # grow: the rows in time order, then room
             grown = np.zeros(min(max(2 * size, FIRST), self._capacity), self.dtype)
             grown[:size] = self.table()
-            self._rows, self._start, index = grown, 0, size
+            self._table, self._start, index = grown, 0, size
             self._count += 1
         else:  # full: the oldest row is reused
             index = self._start
             self._start = (self._start + 1) % size
-            self.dropped += 1
-        return self._rows[index]
+            self._dropped += 1
+        return self._table[index]
 
     def _record(self, row: Any) -> CellRecord:
         errors = {n: float(e) for n, e in zip(self.commands, row["errors"], strict=True)

@@ -60,10 +60,10 @@ from rrc_pin.deprecated import warn_renamed
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import ContactLimit, GripLimit, JointLimits, Limit
 from rrc_pin.limits.contact_limit import Closure
-from rrc_pin.loading import load
+from rrc_pin.loading import loaded
 from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import frame_index
-from rrc_pin.solvers.checks import as_vector, positive
+from rrc_pin.solvers.checks import as_vector, flag, positive
 from rrc_pin.solvers.spatial import to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.kernels import scale_and_veer
@@ -153,10 +153,11 @@ class CellController(Loop):
         project_contacts: bool | None = None,
     ) -> None:
         if project_contacts is not None:  # the former closure step's switch
+            project_contacts = flag(project_contacts, "project_contacts")
             warn_renamed("CellController(project_contacts=)", "CellController(closure=)")
             closure = closure if project_contacts else None
-        if isinstance(cell, str):
-            cell = load(cell)  # type: ignore[assignment]
+        if isinstance(cell, (str, os.PathLike)):
+            cell = loaded(cell, "cell")  # type: ignore[assignment]
         if not isinstance(cell, Cell):
             raise InvalidInput("cell", f"expected a Cell or a cell's name, got {cell!r}")
         if closure is not None and not isinstance(closure, ClosureBound):
@@ -169,6 +170,8 @@ class CellController(Loop):
         else:
             given = [limits]
         gain = positive(gain, "gain")
+        posture_gain = positive(posture_gain, "posture_gain")
+        coupled = flag(coupled, "coupled")
         self.contact = ContactLimit((), name="contact")
         self.grip = GripLimit((), name="grip")
         super().__init__(cell, dt, q0, limits=[*given, self.contact, self.grip], qp=qp,
@@ -177,7 +180,7 @@ class CellController(Loop):
         self.gain = gain
         self.posture = PostureTask(cell.dof_positions(cell.ready()), gain=posture_gain,
                                    weight=1e-3, name="posture")  # fmt: skip
-        self.coupled = bool(coupled)
+        self.coupled = coupled
         self.closure = closure
         commands = [*cell.objects, *([cell.body] if cell.body else []), *cell.arms]
         self.log: CellLog = CellLog(cell.nq, cell.nv, commands, list(cell.objects))
@@ -225,8 +228,14 @@ class CellController(Loop):
         return out
 
     def frame_of(self, name: str) -> str:
-        """The frame command ``name`` moves (the object's, the body's or the hand's)."""
+        """The frame command ``name`` moves (the object's, the body's or the hand's).
+
+        Raises:
+            InvalidInput: ``name`` is no command of this cell (not an object, body or arm).
+        """
         cell = self.cell
+        if not isinstance(name, str):
+            raise InvalidInput("name", f"expected a command's name, got {type(name).__name__}")
         if name in cell.objects or name == cell.body:
             return name
         return cell.arm(name, "name").hand

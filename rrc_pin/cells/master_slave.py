@@ -20,7 +20,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.solvers.checks import positive, rigid_transform
+from rrc_pin.solvers.checks import as_array, positive, rigid_transform
 
 Array = npt.NDArray[np.float64]
 
@@ -41,9 +41,7 @@ class MasterSlave:
         self, scale: float = 1.0, rotation: npt.ArrayLike | None = None, dt: float = 0.01
     ) -> None:
         self.scale = positive(scale, "scale")
-        R = np.eye(3) if rotation is None else np.asarray(rotation, dtype=float)
-        if R.shape != (3, 3):
-            raise InvalidInput("rotation", f"expected a (3, 3) rotation, got shape {R.shape}")
+        R = np.eye(3) if rotation is None else as_array(rotation, "rotation", (3, 3))
         T = np.eye(4)
         T[:3, :3] = R
         self.rotation = rigid_transform(T, "rotation")[:3, :3]

@@ -18,7 +18,7 @@ recording the tick in a :class:`~rrc_pin.control.trajectory_log.TrajectoryLog`.
 
 from __future__ import annotations
 
-import math
+import os
 import warnings
 from typing import Any, NamedTuple
 
@@ -30,6 +30,7 @@ from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.drift import DriftCorrection, advance, pose_error
 from rrc_pin.control.loop import Loop, Step
 from rrc_pin.control.rates_task import RatesTask
+from rrc_pin.control.record_ring import SHARED_TEXTS
 from rrc_pin.control.singularity import SingularityLabel
 from rrc_pin.control.strategies import Situation, Strategy, make_strategy
 from rrc_pin.control.strategies.base import KEEP, to_base_axes
@@ -37,13 +38,14 @@ from rrc_pin.control.trajectory_log import LogRecord, TrajectoryLog
 from rrc_pin.deprecated import warn_renamed
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import JointLimits
-from rrc_pin.loading import cells, load
+from rrc_pin.loading import cells, loaded
 from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import Robot, frame_id
 from rrc_pin.solvers.checks import as_vector, finite_number
 from rrc_pin.solvers.spatial import Reference, check_reference, to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
-from rrc_pin.solvers.tick.resolution import Resolution
+from rrc_pin.solvers.tick.problem import LARGE
+from rrc_pin.solvers.tick.resolution import ACTIVE_TOL, Resolution
 
 Array = npt.NDArray[np.float64]
 LINEAR = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
@@ -55,8 +57,8 @@ NO_ERROR = np.zeros(6)
 NO_ERROR.flags.writeable = False
 
 
-class Tick(NamedTuple):
-    """One tick as the controller keeps it; the log derives its :class:`LogRecord` when read.
+class RawTick(NamedTuple):
+    """One tick as the controller hands it to its log (made rows a batch at a time).
 
     Attributes:
         t: Time at the start of the tick [s].
@@ -80,6 +82,44 @@ class Tick(NamedTuple):
     error: Array
     mode: str
     note: str
+
+
+class Tick(NamedTuple):
+    """Ticks as the log keeps them: the fields of their :class:`LogRecord` a tick knows.
+
+    One tick (its record derived from it, ``_log_record``: the rest comes from the
+    kinematics at q), or a batch of them, each field then an array of one row per tick
+    (:meth:`Controller._compact`).
+
+    Attributes:
+        t: Time at the start of the tick [s].
+        q: Joint positions at the start of the tick (nq,) [rad or m].
+        qdot: Joint rates applied over the tick (nq,) [rad/s or m/s].
+        commanded: The operator's command, base axes (6,) [m/s, rad/s].
+        scale: The resolution's scale.
+        factor: The strategy's speed factor.
+        drift_position: Distance [m] from the reference pose.
+        drift_rotation: Angle [rad] from the reference orientation.
+        mode: ``"teleop"`` or ``"reverse"``.
+        method: The resolution's method.
+        status: The resolution's status.
+        active: The active limits, ``joint:side:kind`` joined by ``;``.
+        note: What the strategy did.
+    """
+
+    t: Any
+    q: Array
+    qdot: Array
+    commanded: Array
+    scale: Any
+    factor: Any
+    drift_position: Any
+    drift_rotation: Any
+    mode: Any
+    method: Any
+    status: Any
+    active: Any
+    note: Any
 
 
 class Controller(Loop):
@@ -160,7 +200,9 @@ class Controller(Loop):
         self.strategy.check(robot)
         self.drift = drift
         self.label = SingularityLabel(robot, finite_number(near, "near", 0.0, inclusive=False))
-        self.log: TrajectoryLog = TrajectoryLog(robot.joint_names, self._log_record)
+        self.log: TrajectoryLog = TrajectoryLog(robot.joint_names, self._log_record,
+                                                compact=self._compact)  # fmt: skip
+        self._active_texts: dict[bytes, str] = {}
         assert self.resolver.task is not None  # one tool frame: the resolver has its task
         self._rows = tuple(self.resolver.task.selected)
         self._full = len(self._rows) == 6
@@ -233,9 +275,10 @@ class Controller(Loop):
         hand = pose if local else None
         if self.strategy.passive:  # it keeps the command: no Situation to build
             decision = KEEP
-        else:
-            decision = self.strategy.decide(Situation(self.robot, q, wanted, self.dt, command,
-                                                      self._rows, hand))
+        else:  # (a command beyond LARGE divided down along itself: no rates overflow)
+            down = _within_large(wanted)
+            decision = self.strategy.decide(Situation(
+                self.robot, q, wanted * down, self.dt, command * down, self._rows, hand))
         factor = decision.factor
         if decision.rates is None:
             r = self.resolver.solve(q, wanted if factor == 1.0 else factor * wanted,
@@ -243,8 +286,8 @@ class Controller(Loop):
         else:
             r = self.resolver.solve(q, [RatesTask(decision.rates)], priority="strict")
         # q itself, not a copy: read-only, replaced at every tick.
-        self.log.append_tick(Tick(self.t, q, r, command, hand, factor, error, "teleop",
-                                  decision.note))
+        self.log.append_tick(RawTick(self.t, q, r, command, hand, factor, error, "teleop",
+                                     decision.note))
         fraction = None if decision.rates is not None else _followed(r)
         if fraction is None:
             self._reanchor = True
@@ -309,7 +352,8 @@ class Controller(Loop):
     # -- what the loop asks of it -----------------------------------------------------------
 
     def _log_reverse(self, q: Array, r: Resolution) -> None:
-        self.log.append_tick(Tick(self.t, q, r, np.zeros(6), None, 1.0, NO_ERROR, "reverse", ""))
+        self.log.append_tick(RawTick(self.t, q, r, np.zeros(6), None, 1.0, NO_ERROR, "reverse",
+                                     ""))
 
     def _stopped(self) -> None:
         self._command = np.zeros(6)
@@ -324,27 +368,60 @@ class Controller(Loop):
         pose: pin.SE3 = pin.updateFramePlacement(model, data, self._frame_id)
         return pose
 
-    def _log_record(self, values: tuple[Any, ...]) -> LogRecord:
-        """The log's record of a tick (:class:`Tick`'s fields), computed now.
+    def _compact(self, ticks: list[RawTick]) -> Tick:
+        """Ticks as the log keeps them, a row each (vectorised over the batch).
 
-        The kinematics and the resolution's lazily computed fields.
+        The command in base axes (:func:`to_base_axes`), the drift's two norms, and the
+        active limits' text (``Resolution.active``'s, made once per pattern of bounds
+        touched: the touches' codes are its key).
         """
-        tick = Tick(*values)
-        r = tick.resolution
+        n = len(ticks)
+        rs = [tick.resolution for tick in ticks]
+        qdot = np.array([r.qdot for r in rs])
+        commanded = np.array([tick.command for tick in ticks])
+        local = [k for k, tick in enumerate(ticks) if tick.hand is not None]
+        if local:
+            rotations = np.array([ticks[k].hand.rotation for k in local])  # type: ignore[union-attr]
+            commanded[local] = to_base_axes(rotations, commanded[local])
+        error = np.array([tick.error for tick in ticks])
+        boxes = [r.problem.box for r in rs]
+        lb, ub = np.array([b.lb for b in boxes]), np.array([b.ub for b in boxes])
+        kind = np.array([b.kind for b in boxes]).astype(np.int8)  # (n, 2, nv)
+        low = (qdot - lb <= ACTIVE_TOL).astype(np.int8)
+        high = (ub - qdot <= ACTIVE_TOL).astype(np.int8)
+        codes = low * (1 + kind[:, 0]) + 4 * high * (1 + kind[:, 1])
+        touched = codes.any(axis=1).tolist()
+        active = [self._active_text(codes[k], rs[k]) if touched[k] else "" for k in range(n)]
+        return Tick(
+            np.array([tick.t for tick in ticks]), np.array([tick.q for tick in ticks]), qdot,
+            commanded, np.array([r.scale for r in rs]), np.array([t.factor for t in ticks]),
+            np.linalg.norm(error[:, :3], axis=1), np.linalg.norm(error[:, 3:], axis=1),
+            [t.mode for t in ticks], [r.method for r in rs], [r.status for r in rs], active,
+            [t.note for t in ticks],
+        )  # fmt: skip
+
+    def _active_text(self, codes: npt.NDArray[np.int8], r: Resolution) -> str:
+        """The active limits of ``r`` as the log writes them, ``joint:side:kind;...``."""
+        key = codes.tobytes()
+        text = self._active_texts.get(key)
+        if text is None:
+            text = ";".join(f"{a.name or a.joint}:{a.side}:{a.kind}" for a in r.active)
+            if len(self._active_texts) < SHARED_TEXTS:
+                self._active_texts[key] = text
+        return text
+
+    def _log_record(self, tick: Tick) -> LogRecord:
+        """The log's record of a tick: the tick and the kinematics at its q, computed now."""
         J = self.robot.jacobian(tick.q)  # world_aligned, the tick's start
         J_task = J if self._full else J[list(self._rows)]
         sv: Array = np.asarray(np.linalg.svd(J_task, compute_uv=False), np.float64)
-        active = ";".join(f"{a.name or a.joint}:{a.side}:{a.kind}" for a in r.active)
-        commanded = tick.command
-        if tick.hand is not None:
-            commanded = to_base_axes(tick.hand.rotation, commanded)
         return LogRecord(
-            t=tick.t, q=tick.q, qdot=r.qdot.copy(), commanded=commanded, achieved=J @ r.qdot,
-            scale=r.scale, factor=tick.factor, sigma_min=float(sv[-1]),
-            manipulability=float(np.prod(sv)), drift_position=math.hypot(*tick.error[:3]),
-            drift_rotation=math.hypot(*tick.error[3:]), mode=tick.mode, method=r.method,
-            status=r.status, active=active, singularity=self.label(tick.q, J_task, sv),
-            note=tick.note,
+            t=tick.t, q=tick.q, qdot=tick.qdot, commanded=tick.commanded,
+            achieved=J @ tick.qdot, scale=tick.scale, factor=tick.factor,
+            sigma_min=float(sv[-1]), manipulability=float(np.prod(sv)),
+            drift_position=tick.drift_position, drift_rotation=tick.drift_rotation,
+            mode=tick.mode, method=tick.method, status=tick.status, active=tick.active,
+            singularity=self.label(tick.q, J_task, sv), note=tick.note,
         )
 
 
@@ -354,8 +431,8 @@ def _loaded(robot: Robot | str) -> Robot:
     Raises:
         InvalidInput: Neither a Robot nor a name, naming ``robot``.
     """
-    if isinstance(robot, str):
-        robot = load(robot)
+    if isinstance(robot, (str, os.PathLike)):
+        robot = loaded(robot, "robot")
     if not isinstance(robot, Robot):
         raise InvalidInput("robot", f"expected a rrc_pin.Robot or a name, got {robot!r}")
     return robot
@@ -379,6 +456,17 @@ def _checked_twist(twist: npt.ArrayLike) -> Array:
     """
     out: Array = as_vector(twist, "twist", 6).copy()
     return out
+
+
+def _within_large(twist: Array) -> float:
+    """The factor (1, or less) that brings ``twist`` within :data:`LARGE` [m/s, rad/s].
+
+    The strategies' closed forms divide a command by the arm's singular values: beyond it
+    their rates overflow (a NaN configuration, before). The resolver divides its own commands
+    down the same way (:mod:`rrc_pin.solvers.tick.problem`).
+    """
+    peak = float(np.abs(twist).max())
+    return 1.0 if peak <= LARGE else LARGE / peak
 
 
 def _followed(r: Resolution) -> float | None:

@@ -19,13 +19,14 @@ from eqs. (32)-(34) and (37), to 1e-12.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.checks import as_vector, finite_number
 from rrc_pin.solvers.spatial import Reference
 
 Array = npt.NDArray[np.float64]
@@ -62,9 +63,13 @@ class DriftCorrection:
         Args:
             error: Position error [m] and differential rotation [rad] to the reference (6,)
                 (:func:`pose_error`).
+
+        Raises:
+            InvalidInput: ``error`` is not a finite (6,) vector.
         """
-        a = _gain(self.gain, self.max_linear, float(np.linalg.norm(error[:3])))
-        b = _gain(self.gain, self.max_angular, float(np.linalg.norm(error[3:])))
+        error = as_vector(error, "error", 6)
+        a = _gain(self.gain, self.max_linear, math.hypot(*error[:3].tolist()))
+        b = _gain(self.gain, self.max_angular, math.hypot(*error[3:].tolist()))
         return np.concatenate([a * error[:3], b * error[3:]])
 
 

@@ -54,7 +54,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.solvers.checks import finite_number, real_array, rigid_transform
+from rrc_pin.solvers.checks import as_array, finite_number, integer, real_array, rigid_transform
 
 Array = npt.NDArray[np.float64]
 
@@ -108,14 +108,10 @@ class StreamOptions:
         for name in ("gain", "linear_speed", "angular_speed", "jump", "jump_angle",
                      "device_speed", "device_rate", "timeout", "decay", "scale"):  # fmt: skip
             finite_number(getattr(self, name), name, 0.0, inclusive=False)
-        if not isinstance(self.settle, int) or self.settle < 1:
-            raise InvalidInput("settle", f"expected an integer >= 1, got {self.settle!r}")
+        integer(self.settle, "settle", 1)
         axes = np.eye(4)
         if self.device_axes is not None:
-            if np.shape(self.device_axes) != (3, 3):
-                raise InvalidInput("device_axes", f"expected a rotation (3, 3), got shape "
-                                   f"{np.shape(self.device_axes)}")  # fmt: skip
-            axes[:3, :3] = real_array(self.device_axes, "device_axes")
+            axes[:3, :3] = as_array(self.device_axes, "device_axes", (3, 3))
             rigid_transform(axes, "device_axes")
         object.__setattr__(self, "device_axes", axes[:3, :3].copy())
         if (self.lower is None) != (self.upper is None):

@@ -41,8 +41,11 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.solvers.checks import as_vector, finite_number, real_array
+from rrc_pin.solvers.checks import as_vector, finite_number, flag, integer, real_array
 from rrc_pin.solvers.tick.problem import Box
+
+MAX_JOINTS = 100_000
+"""The most joints a limiter takes (``n``): more than any robot has."""
 
 Array = npt.NDArray[np.float64]
 
@@ -101,9 +104,7 @@ class JerkLimiter:
         upper: npt.ArrayLike | None = None,
         margin: float = 0.0,
     ) -> None:
-        if not isinstance(n, int) or n < 1:
-            raise InvalidInput("n", f"expected a number of joints >= 1, got {n!r}")
-        self.n = n
+        self.n = n = integer(n, "n", 1, MAX_JOINTS)
         self.dt = finite_number(dt, "dt", 0.0, inclusive=False)
         self.a_max = _positive(acceleration, "acceleration", n)
         self.j_max = _positive(jerk, "jerk", n)
@@ -124,7 +125,7 @@ class JerkLimiter:
 
     def stop(self, stopping: bool = True) -> None:
         """STOP (zero rates commanded from now on, whatever :meth:`step` is given), or resume."""
-        self._stopping = bool(stopping)
+        self._stopping = flag(stopping, "stopping")
 
     def stop_time(self) -> float:
         """[s] Within this time of :meth:`stop` every rate is below :data:`STILL`."""

@@ -1,8 +1,10 @@
 """TrajectoryLog: what a controller did at every tick, saved to CSV or NPZ and loaded back.
 
-The log is a ring: it keeps the last :data:`CAPACITY` ticks (10 minutes at 100 Hz) and
-forgets the oldest beyond, so that its memory is bounded however long a controller runs
-(about 2.9 kB a tick until the records are read, 1.5 kB a record: at most some 175 MB).
+The log is a :class:`~rrc_pin.control.record_ring.RecordRing`: it keeps the last
+:data:`CAPACITY` ticks (10 minutes at 100 Hz) as columns of arrays and forgets the oldest
+beyond, so that its memory is bounded however long a controller runs: ``8 (19 + 2 nq) + 48``
+bytes a tick (the numbers, and a pointer per text field), 312 B for a 7-joint arm, 18.7 MB at
+the default capacity (docs/api.md, "The trajectory log's memory").
 """
 
 from __future__ import annotations
@@ -10,18 +12,18 @@ from __future__ import annotations
 import csv
 import os
 import zipfile
-from collections import deque
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, Generic, NamedTuple, TypeVar
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.control.record_ring import CAPACITY as CAPACITY  # where the logs import it
+from rrc_pin.control.record_ring import RecordRing as RecordRing
 from rrc_pin.errors import InvalidInput
 
 Array = npt.NDArray[np.float64]
-R = TypeVar("R", bound=tuple[Any, ...])
 TWIST = ("vx", "vy", "vz", "wx", "wy", "wz")
 TEXT = ("mode", "method", "status", "active", "singularity", "note")
 """Text columns (the rest are numbers)."""
@@ -70,145 +72,18 @@ class LogRecord(NamedTuple):
     note: str
 
 
-CAPACITY = 60_000
-"""Ticks a log keeps by default: 10 minutes at 100 Hz (:attr:`TrajectoryLog.capacity`)."""
 VECTORS = ("q", "qdot", "commanded", "achieved")
 SCALARS = ("t", "scale", "factor", "sigma_min", "manipulability", "drift_position",
            "drift_rotation")  # fmt: skip
-
-
-class RecordRing(Generic[R]):
-    """The last ticks of a controller, in time order: a ring of records derived when read.
-
-    What every controller's log shares (:class:`TrajectoryLog` for one arm,
-    :class:`~rrc_pin.cells.controller.CellLog` for a cell): a controller appends its ticks as
-    they are (:meth:`append_tick`) and the log derives their records when it is read
-    (``records``); the ring keeps the last ``capacity`` ticks (appending to a full log forgets
-    the oldest, :attr:`dropped` counts them), and :meth:`positions` gives the joint positions
-    ``Controller.reverse`` retraces without deriving a record.
-
-    Args:
-        derive: Makes the record of a tick passed to :meth:`append_tick` (the controller's),
-            or None for a log of records only.
-        capacity: Ticks kept, >= 1 (default :data:`CAPACITY`: 10 minutes at 100 Hz);
-            settable (a smaller one forgets the oldest ticks at once).
-
-    Raises:
-        InvalidInput: ``derive`` not callable, or a bad ``capacity``, named.
-    """
-
-    record_type: type[tuple[Any, ...]] = tuple
-    """The records' class (:meth:`append` refuses others); a record's second field is q."""
-
-    def __init__(
-        self, derive: Callable[[Any], R] | None = None, capacity: int = CAPACITY,
-    ) -> None:  # fmt: skip
-        if derive is not None and not callable(derive):
-            raise InvalidInput("derive", f"expected a callable or None, got {derive!r}")
-        self._capacity = _checked_capacity(capacity)
-        # Records (derived) then pending ticks, oldest first; the pending ones are the newest.
-        self._entries: deque[R | tuple[Any, ...]] = deque(maxlen=self._capacity)
-        self._pending = 0  # ticks at the end of _entries not yet derived
-        self._derive = derive
-        self.dropped = 0
-        """Ticks forgotten because the log was full (the oldest first)."""
-
-    def __len__(self) -> int:
-        return len(self._entries)
-
-    @property
-    def capacity(self) -> int:
-        """Ticks kept (the oldest forgotten beyond), >= 1."""
-        return self._capacity
-
-    @capacity.setter
-    def capacity(self, value: int) -> None:
-        value = _checked_capacity(value)
-        self.dropped += max(0, len(self._entries) - value)
-        self._pending = min(self._pending, value)
-        self._entries = deque(self._entries, maxlen=value)
-        self._capacity = value
-
-    @property
-    def records(self) -> list[R]:
-        """The records kept, in time order, as a new list (the ticks pending derived now)."""
-        self._derive_pending()
-        return list(self._entries)  # type: ignore[arg-type]  # every entry derived above
-
-    def __getitem__(self, index: int) -> R:
-        """Record ``index`` (negative from the newest), without copying the others.
-
-        Raises:
-            IndexError: No such record.
-        """
-        self._derive_pending()
-        return self._entries[index]  # type: ignore[return-value]  # derived above
-
-    def _derive_pending(self) -> None:
-        """Turn the ticks not yet derived into their records, in place."""
-        if self._pending:
-            assert self._derive is not None  # append_tick refuses a log without derive
-            ticks = [self._entries.pop() for _ in range(self._pending)][::-1]
-            self._entries.extend(map(self._derive, ticks))
-            self._pending = 0
-
-    def append(self, record: R) -> None:
-        """Add one tick's record (forgetting the oldest tick when the log is full).
-
-        Raises:
-            InvalidInput: ``record`` is not a :attr:`record_type`.
-        """
-        if not isinstance(record, self.record_type):
-            raise InvalidInput("record", f"expected a {self.record_type.__name__}, got "
-                               f"{type(record).__name__}")  # fmt: skip
-        self._derive_pending()  # they are older
-        self._push(record)
-
-    def append_tick(self, tick: tuple[Any, ...]) -> None:
-        """Add one tick, its record derived when the log is read (``derive``).
-
-        Args:
-            tick: What ``derive`` takes: a tuple that starts as its record, ``(t, q, ...)``.
-        """
-        if self._derive is None:
-            raise InvalidInput("tick", "this log has no derive: append records")
-        self._push(tick)
-        self._pending = min(self._pending + 1, self._capacity)
-
-    def _push(self, entry: R | tuple[Any, ...]) -> None:
-        if len(self._entries) == self._capacity:
-            self.dropped += 1
-        self._entries.append(entry)
-
-    def positions(self, n: int) -> list[Array]:
-        """Joint positions ``q`` of the last ``n`` ticks kept, oldest first, no record derived.
-
-        (What ``Controller.reverse`` retraces: reading ``records`` after a long session
-        would derive every record first.)
-
-        Raises:
-            InvalidInput: ``n`` is not an integer >= 0.
-        """
-        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
-            raise InvalidInput("n", f"expected an integer >= 0, got {n!r}")
-        n = min(int(n), len(self._entries))
-        start = len(self._entries) - n
-        # a record's q, or a tick's (t, q, ...)
-        return [self._entries[i][1] for i in range(start, len(self._entries))]
-
-    def clear(self) -> None:
-        """Forget every record."""
-        self._entries.clear()
-        self._pending = 0
 
 
 class TrajectoryLog(RecordRing[LogRecord]):
     """The records of one arm's controller (:class:`LogRecord`), with array views and files.
 
     A :class:`RecordRing` (its ring, lazy records and ``positions``): what a record adds to
-    a tick (the singular values, the singularity's name, the achieved twist, the
-    resolution's status, scale and active limits) costs more than the rest of a controller's
-    tick, and is paid once, when someone looks. Save it (:meth:`save`) before it fills to
+    a tick (the kinematics at q: the singular values, the singularity's name, the achieved
+    twist) costs more than the rest of a controller's tick, and is paid once, when someone
+    looks. Save it (:meth:`save`) before it fills to
     keep a whole session; ``Controller.reverse`` retraces within what is kept.
 
     Args:
@@ -216,10 +91,11 @@ class TrajectoryLog(RecordRing[LogRecord]):
         derive: Makes the record of a tick passed to :meth:`append_tick` (the controller's),
             or None for a log of records only.
         capacity: Ticks kept, >= 1 (default :data:`CAPACITY`: 10 minutes at 100 Hz).
+        compact: Turns a batch of ticks into rows (:class:`RecordRing`), or None.
 
     Raises:
-        InvalidInput: ``joint_names`` not a sequence of names, ``derive`` not callable, or a
-            bad ``capacity``, named.
+        InvalidInput: ``joint_names`` not a sequence of names, ``derive`` or ``compact`` not
+            callable, or a bad ``capacity``, named.
     """
 
     record_type = LogRecord
@@ -228,12 +104,14 @@ class TrajectoryLog(RecordRing[LogRecord]):
         self, joint_names: list[str] | tuple[str, ...],
         derive: Callable[[Any], LogRecord] | None = None,
         capacity: int = CAPACITY,
+        *,
+        compact: Callable[[list[Any]], tuple[Any, ...]] | None = None,
     ) -> None:  # fmt: skip
         if isinstance(joint_names, str) or not isinstance(joint_names, (list, tuple)) or not all(
             isinstance(n, str) for n in joint_names
         ):
             raise InvalidInput("joint_names", f"expected a list of names, got {joint_names!r}")
-        super().__init__(derive, capacity)
+        super().__init__(derive, capacity, compact=compact)
         self.joint_names = tuple(joint_names)
 
     def column(self, name: str) -> Array | npt.NDArray[np.str_]:
@@ -245,13 +123,13 @@ class TrajectoryLog(RecordRing[LogRecord]):
         if not isinstance(name, str) or name not in LogRecord._fields:
             columns = ", ".join(LogRecord._fields)
             raise InvalidInput("name", f"no column {name!r}; columns: {columns}")
-        values = [getattr(r, name) for r in self.records]
+        values = self.column_values(name)
         if name in TEXT:
-            return np.array(values, dtype=str)
-        width = len(self.joint_names) if name in ("q", "qdot") else 6
+            return np.array(values.tolist(), dtype=str)
         if name in VECTORS:
-            return np.array(values, dtype=np.float64).reshape(len(values), width)
-        return np.array(values, dtype=np.float64)
+            width = len(self.joint_names) if name in ("q", "qdot") else 6
+            return np.asarray(values, dtype=np.float64).reshape(len(values), width)
+        return np.asarray(values, dtype=np.float64)
 
     # -- files ----------------------------------------------------------------------------
 
@@ -329,12 +207,6 @@ class TrajectoryLog(RecordRing[LogRecord]):
 
 class _NotALog(Exception):
     """A file's contents are not a trajectory log's (turned into InvalidInput by ``load``)."""
-
-
-def _checked_capacity(value: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-        raise InvalidInput("capacity", f"expected an integer >= 1 (ticks), got {value!r}")
-    return int(value)
 
 
 def checked_path(path: str | os.PathLike[str]) -> Path:

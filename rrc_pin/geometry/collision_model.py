@@ -36,7 +36,15 @@ from rrc_pin.geometry.tree import tree_of
 from rrc_pin.geometry.walls import Wall, box_walls, plane_wall
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.robot import Robot, frame_index
-from rrc_pin.solvers.checks import as_array, finite_number, rigid_transform
+from rrc_pin.solvers.checks import (
+    MAX_LENGTH,
+    as_array,
+    direction,
+    finite_number,
+    length,
+    real_array,
+    rigid_transform,
+)
 
 Array = npt.NDArray[np.float64]
 
@@ -148,7 +156,12 @@ class CollisionModel:
 
         A :class:`~rrc_pin.geometry.walls.Wall` holds the origin of its frame where
         ``normal . p <= offset`` (world frame).
+
+        Raises:
+            InvalidInput: ``frame`` is neither None nor a frame's name (str).
         """
+        if frame is not None and not isinstance(frame, str):
+            raise InvalidInput("frame", f"expected a frame's name or None, got {frame!r}")
         if not self._walls:
             return ()
         return tuple(w for group in self._walls.values() for w in group
@@ -164,9 +177,11 @@ class CollisionModel:
     def add_sphere(self, center_or_T: npt.ArrayLike, radius: float, name: str | None = None
                    ) -> str:  # fmt: skip
         """A sphere of ``radius`` [m] at a centre (3,) or pose (4, 4) in the world; its name."""
-        arr = np.asarray(center_or_T) if not isinstance(center_or_T, np.ndarray) else center_or_T
+        arr = real_array(center_or_T, "center_or_T", "expected a centre (3,) or a pose (4, 4)")
         if arr.shape == (3,):
-            pose = pin.SE3(np.eye(3), as_array(arr, "center_or_T", (3,)).copy())
+            T = np.eye(4)
+            T[:3, 3] = arr
+            pose = _pose(T, "center_or_T")
         else:
             pose = _pose(center_or_T, "center_or_T")
         return self._add_world("sphere", shapes.sphere(radius), pose, name)
@@ -236,7 +251,7 @@ class CollisionModel:
         (the hand that holds it).
         """
         fid = self._link(link, "link")
-        if kind not in shapes.ATTACHABLE:
+        if not isinstance(kind, str) or kind not in shapes.ATTACHABLE:
             raise InvalidInput(
                 "kind", f"expected one of {', '.join(shapes.ATTACHABLE)}, got {kind!r}"
             )
@@ -265,8 +280,11 @@ class CollisionModel:
         """Remove an obstacle, a held object or a group of walls by its name.
 
         Raises:
-            InvalidInput: No obstacle, held object or walls of that name (lists them).
+            InvalidInput: ``name`` not a string, or no obstacle, held object or walls of that
+                name (lists them).
         """
+        if not isinstance(name, str):
+            raise InvalidInput("name", f"expected a name (str), got {type(name).__name__}")
         with self._lock:
             if name in self._extras:
                 extras = {k: v for k, v in self._extras.items() if k != name}
@@ -311,14 +329,12 @@ class CollisionModel:
 
         World frame, [m]. ``normal`` need not be unit (both are divided by its norm).
         """
-        n = as_array(normal, "normal", (3,))
-        if float(np.linalg.norm(n)) < 1e-12:
-            raise InvalidInput("normal", f"expected a non-zero vector, got {n.tolist()}")
-        d = finite_number(offset, "offset")
+        unit, norm = direction(normal, "normal")
+        d = length(offset, "offset", -MAX_LENGTH) / norm
         held = self._wall_frame(frame)
         with self._lock:
             label = self._new_name("wall", name)
-            self._walls = {**self._walls, label: (plane_wall(label, held, n, d),)}
+            self._walls = {**self._walls, label: (plane_wall(label, held, unit, d),)}
         return label
 
     # -- queries ----------------------------------------------------------------------------

@@ -23,7 +23,8 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.solvers.checks import as_array, as_vector, finite_number, positive
+from rrc_pin.solvers import checks
+from rrc_pin.solvers.checks import MAX_LENGTH, as_array, as_vector, direction, within_length
 
 Array = npt.NDArray[np.float64]
 Kind = Literal["box", "sphere", "capsule", "cylinder", "convex", "halfspace"]
@@ -44,7 +45,7 @@ HALFSPACE_RADIUS = np.inf
 
 def box(size: npt.ArrayLike, name: str = "size") -> coal.Box:
     """A box of sides ``size`` (3,) [m], each > 0."""
-    sides = as_vector(size, name, 3)
+    sides = within_length(as_vector(size, name, 3), name)
     if np.any(sides <= 0.0):
         raise InvalidInput(name, f"expected three sides > 0 [m], got {sides.tolist()}")
     return coal.Box(float(sides[0]), float(sides[1]), float(sides[2]))
@@ -52,24 +53,23 @@ def box(size: npt.ArrayLike, name: str = "size") -> coal.Box:
 
 def sphere(radius: float) -> coal.Sphere:
     """A sphere of ``radius`` [m] > 0."""
-    return coal.Sphere(positive(radius, "radius"))
+    return coal.Sphere(checks.length(radius, "radius"))
 
 
 def capsule(radius: float, length: float) -> coal.Capsule:
     """A capsule of ``radius`` > 0 about an axis of ``length`` >= 0 [m] along z."""
-    r = positive(radius, "radius")
-    return coal.Capsule(r, finite_number(length, "length", 0.0))
+    r = checks.length(radius, "radius")
+    return coal.Capsule(r, checks.length(length, "length", 0.0, inclusive=True))
 
 
 def cylinder(radius: float, length: float) -> coal.Cylinder:
     """A cylinder of ``radius`` and height ``length`` [m] along z, both > 0."""
-    r = positive(radius, "radius")
-    return coal.Cylinder(r, positive(length, "length"))
+    return coal.Cylinder(checks.length(radius, "radius"), checks.length(length, "length"))
 
 
 def convex(points: npt.ArrayLike) -> coal.ConvexBase:
     """The convex hull of ``points`` (N, 3) [m]: at least four, not all in one plane."""
-    P = as_array(points, "points", (None, 3))
+    P = within_length(as_array(points, "points", (None, 3)), "points")
     centred = P - P.mean(axis=0) if len(P) else P
     if len(P) < 4 or np.linalg.matrix_rank(centred, tol=1e-9 * max(1.0, np.abs(P).max())) < 3:
         raise InvalidInput("points", f"expected >= 4 points (N, 3) spanning a volume, got {len(P)}")
@@ -87,12 +87,8 @@ def halfspace(normal: npt.ArrayLike, offset: float) -> tuple[coal.Halfspace, Arr
     Returns:
         The coal shape, the unit normal (3,) and the offset [m].
     """
-    n = as_vector(normal, "normal", 3)
-    norm = float(np.linalg.norm(n))
-    if norm < 1e-12:
-        raise InvalidInput("normal", f"expected a non-zero vector, got {n.tolist()}")
-    d = finite_number(offset, "offset") / norm
-    unit = n / norm
+    unit, norm = direction(normal, "normal")
+    d = checks.length(offset, "offset", -MAX_LENGTH) / norm
     return coal.Halfspace(unit, d), unit, d
 
 

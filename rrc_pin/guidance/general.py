@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy.typing as npt
 
+from rrc_pin.errors import InvalidInput
 from rrc_pin.guidance.screw import screw_from_poses
 from rrc_pin.guidance.stepping import (
     Array,
@@ -19,7 +20,7 @@ from rrc_pin.guidance.stepping import (
     run_steps,
     unit_axis,
 )
-from rrc_pin.solvers.checks import finite_number, rigid_transform
+from rrc_pin.solvers.checks import MAX_LENGTH, finite_number, flag, rigid_transform
 
 
 def general(
@@ -63,7 +64,7 @@ def general(
     arm = on_frame(arm, frame)
     target = rigid_transform(goal, "goal")
     k = check_steps(steps)
-    start = None if relocate else arm.fk(check_q0(arm, q0))
+    start = None if flag(relocate, "relocate") else arm.fk(check_q0(arm, q0))
 
     def twist(i: int, T: Array) -> Step:
         frm, left = (T, k - i) if start is None else (start, k)
@@ -102,16 +103,27 @@ def general_axes(
             robot), or any frame of a :class:`rrc_pin.Robot`; None: its one tool frame.
 
     Raises:
-        InvalidInput: A zero or non-finite axis, a non-finite angle or distance, bad steps.
+        InvalidInput: Not ``(axis, amount)`` pairs, a zero or non-finite axis, an angle or
+            distance not finite (or beyond ``MAX_LENGTH``), bad steps.
     """
     arm = on_frame(arm, frame)
-    u_w = unit_axis(rotation[0], "rotation")
-    u_v = unit_axis(translation[0], "translation")
-    theta = finite_number(rotation[1], "rotation")
-    r = finite_number(translation[1], "translation")
+    u_w, theta = _axis_and_amount(rotation, "rotation")
+    u_v, r = _axis_and_amount(translation, "translation")
     k = check_steps(steps)
 
     def twist(i: int, T: Array) -> Step:
         return hand_step(u_w, theta / k, r / k * u_v, T)
 
     return run_steps(arm, q0, twist, k, solver=solver, correction=correction)
+
+
+def _axis_and_amount(pair: tuple[npt.ArrayLike, float], name: str) -> tuple[Array, float]:
+    """``(axis, amount)``: the unit axis (3,) and the angle [rad] or distance [m].
+
+    Raises:
+        InvalidInput: Not such a pair, naming ``name``.
+    """
+    if not isinstance(pair, (tuple, list)) or len(pair) != 2:
+        raise InvalidInput(name, f"expected (axis (3,), amount), got {pair!r}")
+    amount = finite_number(pair[1], name, -MAX_LENGTH, upper=MAX_LENGTH)
+    return unit_axis(pair[0], name), amount

@@ -33,7 +33,7 @@ from rrc_pin.guidance.stepping import (
     screw_step,
     unit_axis,
 )
-from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.checks import as_vector, choice, finite_number
 from rrc_pin.solvers.spatial import REFERENCES, Reference
 
 RENAMED: dict[str, Reference] = {"global": "world_aligned", "hand": "local"}
@@ -121,6 +121,9 @@ def operator(
     """
     arm = on_frame(arm, frame)
     q = check_q0(arm, q0)
+    if not isinstance(commands, (list, tuple)):
+        raise InvalidInput("commands", f"expected a list of guidance.Command, got "
+                           f"{type(commands).__name__}")  # fmt: skip
     ks = [steps] * len(commands) if not isinstance(steps, list) else steps
     if len(ks) != len(commands):
         raise InvalidInput("steps", f"expected {len(commands)} step counts, got {len(ks)}")
@@ -152,11 +155,6 @@ def _check(c: Command, i: int) -> tuple[Array, float, float, Reference, Array | 
     axis = unit_axis(c.axis, f"{name}.axis")
     d = finite_number(c.d, f"{name}.d")
     theta = finite_number(c.theta, f"{name}.theta")
-    if not isinstance(c.ref, str) or c.ref not in REFERENCES:
-        raise InvalidInput(f"{name}.ref", f"expected one of {', '.join(REFERENCES)}, got {c.ref!r}")
-    point = None
-    if c.point is not None:
-        point = np.asarray(c.point, dtype=float)
-        if point.shape != (3,) or not np.isfinite(point).all():
-            raise InvalidInput(f"{name}.point", f"expected a finite (3,) point, got {c.point!r}")
-    return axis, d, theta, c.ref, point
+    ref = choice(c.ref, f"{name}.ref", REFERENCES)
+    point = None if c.point is None else as_vector(c.point, f"{name}.point", 3)
+    return axis, d, theta, ref, point  # type: ignore[return-value]

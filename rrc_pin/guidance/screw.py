@@ -27,7 +27,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.solvers.checks import real_array
+from rrc_pin.solvers.checks import finite_array, real_array, within_length
 
 Array = npt.NDArray[np.float64]
 
@@ -74,6 +74,7 @@ def frames_from_points(points: npt.ArrayLike, name: str = "points") -> Array:
         raise InvalidInput(name, f"expected shape (..., 3, 3), got {P.shape}")
     if not np.isfinite(P).all():
         raise InvalidInput(name, "non-finite coordinate")
+    within_length(P, name)
     a, b, c = P[..., 0, :], P[..., 1, :], P[..., 2, :]
     ab, ac = b - a, c - a
     n_ab = np.linalg.norm(ab, axis=-1)
@@ -136,9 +137,11 @@ def screw_of_displacement(Q: npt.ArrayLike, q: npt.ArrayLike) -> Screw:
         InvalidInput: Bad shapes, non-finite entries, or ``Q`` not a rotation.
     """
     Q = _rotations(Q, "Q")
-    q = real_array(q, "q", "expected translations of shape (..., 3)")
-    if q.shape != Q.shape[:-1] or not np.isfinite(q).all():
-        raise InvalidInput("q", f"expected finite translations of shape {Q.shape[:-1]}")
+    q = finite_array(q, "q")
+    within_length(q, "q")
+    if q.shape != Q.shape[:-1]:
+        raise InvalidInput("q", f"expected translations of shape {Q.shape[:-1]} (Q's), got "
+                           f"{q.shape}")  # fmt: skip
     u, theta = axis_angle(Q)
     pure = np.abs(theta) < PURE_TRANSLATION
     shift = np.linalg.norm(q, axis=-1)
@@ -158,8 +161,12 @@ def displacement(screw: Screw) -> Array:
     """The displacement (..., 4, 4) of a screw: rotation by ``theta`` about the axis, then ``d``.
 
     ``Q`` by Rodrigues' formula and ``q = (I - Q) rho + d u`` (Nadkarni eq. (3-39)).
+
+    Raises:
+        InvalidInput: ``screw`` is not a :class:`Screw` of finite arrays (:func:`check_screw`).
     """
-    u, theta = np.asarray(screw.u), np.asarray(screw.theta)
+    screw = check_screw(screw)
+    u, theta = screw.u, screw.theta
     K = _skew(u)
     s, c = np.sin(theta)[..., None, None], np.cos(theta)[..., None, None]
     Q = np.eye(3) + s * K + (1.0 - c) * (K @ K)
@@ -178,11 +185,34 @@ def screw_twist(screw: Screw) -> Array:
     ``w = theta u`` and ``v = d u - theta u x rho``: the velocity of the base origin, base axes
     (Pinocchio's WORLD frame; Nadkarni's vector B of eq. (4-19a) for ``theta / k``, rows
     reordered). ``pinocchio.log6`` of the displacement returns the same.
+
+    Raises:
+        InvalidInput: ``screw`` is not a :class:`Screw` of finite arrays (:func:`check_screw`).
     """
-    u, theta = np.asarray(screw.u), np.asarray(screw.theta)[..., None]
+    screw = check_screw(screw)
+    u, theta = screw.u, screw.theta[..., None]
     v = np.asarray(screw.d)[..., None] * u - theta * np.cross(u, np.asarray(screw.rho))
     out: Array = np.concatenate([v, theta * u], axis=-1)
     return out
+
+
+def check_screw(screw: Screw, name: str = "screw") -> Screw:
+    """``screw`` with its fields as finite float arrays of matching shapes (its pitch as given).
+
+    Raises:
+        InvalidInput: Not a :class:`Screw`, a field not finite (or beyond ``MAX_LENGTH``), or
+            shapes that do not match (``u``, ``rho`` (..., 3); ``d``, ``theta`` (...)), naming
+            ``name``.
+    """
+    if not isinstance(screw, Screw):
+        raise InvalidInput(name, f"expected a guidance.Screw, got {type(screw).__name__}")
+    u, rho, d, theta = (finite_array(v, name) for v in screw[:4])
+    for value in (rho, d, theta):
+        within_length(value, name)
+    if u.shape[-1:] != (3,) or rho.shape != u.shape or not d.shape == theta.shape == u.shape[:-1]:
+        raise InvalidInput(name, f"fields of shapes u {u.shape}, rho {rho.shape}, d {d.shape}, "
+                           f"theta {theta.shape}: expected (..., 3), (..., 3), (...), (...)")
+    return Screw(u, rho, d, theta, screw.h)
 
 
 def axis_angle(Q: Array) -> tuple[Array, Array]:
@@ -241,8 +271,10 @@ def _rotations(Q: npt.ArrayLike, name: str) -> Array:
         raise InvalidInput(name, f"expected shape (..., 3, 3), got {R.shape}")
     if not np.isfinite(R).all():
         raise InvalidInput(name, "non-finite entry")
-    error = np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)).max(initial=0.0)
-    if error > 1e-9 or np.any(np.linalg.det(R) <= 0.0):
+    with np.errstate(over="ignore", invalid="ignore"):  # huge entries: not a rotation
+        error = np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)).max(initial=0.0)
+        determinant = np.linalg.det(R)
+    if not error <= 1e-9 or np.any(~(determinant > 0.0)):
         raise InvalidInput(name, f"not a rotation (|Q Q^T - I| = {error:.2e} or det <= 0)")
     return R
 
@@ -256,4 +288,6 @@ def _poses(T: npt.ArrayLike, name: str) -> Array:
     if np.abs(A[..., 3, :] - (0.0, 0.0, 0.0, 1.0)).max(initial=0.0) > 1e-9:
         raise InvalidInput(name, "the last row of a pose must be (0, 0, 0, 1)")
     _rotations(A[..., :3, :3], name)
+    within_length(A[..., :3, 3], name)
     return A
+

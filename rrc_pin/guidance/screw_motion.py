@@ -29,9 +29,9 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from rrc_pin.errors import InvalidInput
-from rrc_pin.guidance.screw import Screw, screw_from_poses, screw_twist
+from rrc_pin.guidance.screw import Screw, check_screw, screw_from_poses, screw_twist
 from rrc_pin.guidance.stepping import (
+    MAX_STEPS,
     Array,
     Correction,
     GuidancePath,
@@ -43,7 +43,7 @@ from rrc_pin.guidance.stepping import (
     on_frame,
     run_steps,
 )
-from rrc_pin.solvers.checks import rigid_transform
+from rrc_pin.solvers.checks import choice, flag, integer, rigid_transform
 
 BForm = Literal["twist", "disp"]
 
@@ -58,14 +58,15 @@ def disp_step(screw: Screw, k: int, b_form: BForm = "disp") -> Array:
             second-order term of the base origin's displacement, module docstring).
 
     Raises:
-        InvalidInput: A bad ``k`` or ``b_form``.
+        InvalidInput: A bad ``screw``, ``k`` or ``b_form``.
     """
-    k = check_steps(k)
+    k = check_steps(k, "k")
+    screw = check_screw(screw)
     twist = screw_twist(screw) / k
     if check_b_form(b_form) == "twist":
         return twist
-    u, rho = np.asarray(screw.u), np.asarray(screw.rho)
-    dtheta = np.asarray(screw.theta)[..., None] / k
+    u, rho = screw.u, screw.rho
+    dtheta = screw.theta[..., None] / k
     out: Array = twist.copy()
     out[..., :3] -= 0.5 * dtheta**2 * np.cross(u, np.cross(u, rho))
     return out
@@ -77,9 +78,7 @@ def check_b_form(b_form: BForm) -> BForm:
     Raises:
         InvalidInput: Not ``"twist"`` or ``"disp"``.
     """
-    if b_form not in ("twist", "disp"):
-        raise InvalidInput("b_form", f"expected 'twist' or 'disp', got {b_form!r}")
-    return b_form
+    return choice(b_form, "b_form", ("twist", "disp"))  # type: ignore[return-value]
 
 
 def screw_step_b(screw: Screw, k: int, b_form: BForm, T: Array) -> Step:
@@ -95,14 +94,12 @@ def screw_step_b(screw: Screw, k: int, b_form: BForm, T: Array) -> Step:
 
 
 def check_closing(closing: int) -> int:
-    """``closing`` as an int >= 0.
+    """``closing`` as an int in [0, MAX_STEPS].
 
     Raises:
-        InvalidInput: Not an integer >= 0.
+        InvalidInput: Not an integer in [0, MAX_STEPS].
     """
-    if isinstance(closing, bool) or not isinstance(closing, (int, np.integer)) or closing < 0:
-        raise InvalidInput("closing", f"expected an integer >= 0, got {closing!r}")
-    return int(closing)
+    return integer(closing, "closing", 0, MAX_STEPS)
 
 
 def screw_motion(
@@ -148,6 +145,7 @@ def screw_motion(
     k = check_steps(steps)
     extra = check_closing(closing)
     check_b_form(b_form)
+    relocate = flag(relocate, "relocate")
     first = screw_from_poses(arm.fk(check_q0(arm, q0)), target)
 
     def twist(i: int, T: Array) -> Step:

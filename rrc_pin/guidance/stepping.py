@@ -34,7 +34,7 @@ import pinocchio as pin
 from rrc_pin.errors import InvalidInput
 from rrc_pin.resolver import Resolver
 from rrc_pin.robot import Robot
-from rrc_pin.solvers.checks import as_vector, finite_number
+from rrc_pin.solvers.checks import as_array, as_vector, choice, direction, finite_number, integer
 from rrc_pin.tasks import FrameTask
 
 Array = npt.NDArray[np.float64]
@@ -64,9 +64,9 @@ class ThesisSolver:
     def __post_init__(self) -> None:
         finite_number(self.singular_cond, "singular_cond", lower=1.0, inclusive=False)  # fmt: skip
         if self.escape is not None:
-            kick = np.asarray(self.escape, dtype=float)
-            if kick.ndim != 1 or not np.isfinite(kick).all() or not kick.any():
-                raise InvalidInput("escape", f"expected finite nonzero increments, got {kick}")
+            kick = as_array(self.escape, "escape", (None,))
+            if not kick.any():
+                raise InvalidInput("escape", f"expected nonzero increments, got {kick}")
 
     def kick(self, nq: int) -> Array:
         """The escape's joint increments (nq,).
@@ -134,9 +134,15 @@ def on_frame(arm: Kinematics, frame: str | None) -> Kinematics:
     Raises:
         InvalidInput: Naming ``frame``: not a str, ``arm`` not a :class:`rrc_pin.Robot` (a
             DH chain has its one hand), or no frame of the robot (the error lists its tool
-            frames, and a cell's objects and body); naming ``arm``: a floating base (guidance
-            adds increments to q).
+            frames, and a cell's objects and body); naming ``arm``: neither a robot nor a
+            chain, or a floating base (guidance adds increments to q).
     """
+    if not isinstance(arm, (Robot, OnFrame)) and not (
+        isinstance(getattr(arm, "nq", None), int) and callable(getattr(arm, "fk", None))
+        and callable(getattr(arm, "jacobian", None))
+    ):  # fmt: skip
+        raise InvalidInput("arm", f"expected a rrc_pin.Robot or a DHChain, got "
+                           f"{type(arm).__name__}")  # fmt: skip
     if isinstance(arm, Robot) and arm.nq != arm.nv:
         raise InvalidInput("arm", f"{arm.name} has a floating base: guidance steps q + dq "
                            "on joints only (drive a legged cell with its controller)")  # fmt: skip
@@ -209,15 +215,17 @@ def hand_step(axis: Array, angle: float, translation: Array, T: Array) -> Step:
     return Step(hand_twist(axis, angle, translation, T[:3, 3]), target)
 
 
-def check_steps(steps: int) -> int:
-    """``steps`` as a positive int (the thesis's k).
+MAX_STEPS = 1_000_000
+"""The most steps a guided motion takes (the thesis's k is tens): more would run for hours."""
+
+
+def check_steps(steps: int, name: str = "steps") -> int:
+    """``steps`` as a positive int (the thesis's k), at most :data:`MAX_STEPS`.
 
     Raises:
-        InvalidInput: ``steps`` is not an integer >= 1.
+        InvalidInput: ``steps`` is not an integer in [1, MAX_STEPS], naming ``name``.
     """
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
-        raise InvalidInput("steps", f"expected an integer k >= 1, got {steps!r}")
-    return int(steps)
+    return integer(steps, name, 1, MAX_STEPS)
 
 
 def run_steps(
@@ -251,10 +259,7 @@ def run_steps(
     arm = on_frame(arm, frame)
     steps = check_steps(steps)
     q = check_q0(arm, q0)
-    if correction not in ("none", "eq5_5", "newton"):
-        raise InvalidInput(
-            "correction", f"expected 'none', 'eq5_5' or 'newton', got {correction!r}"
-        )
+    choice(correction, "correction", ("none", "eq5_5", "newton"))
     if isinstance(solver, str) and solver == "thesis":
         solver = ThesisSolver()
     if not isinstance(solver, (ThesisSolver, Resolver)):
@@ -414,10 +419,9 @@ def unit_axis(axis: npt.ArrayLike, name: str) -> Array:
     Raises:
         InvalidInput: Not a finite, nonzero 3-vector.
     """
-    a = np.asarray(axis, dtype=float) if not isinstance(axis, str) else np.array([np.nan])
-    if a.shape != (3,) or not np.isfinite(a).all() or np.linalg.norm(a) < 1e-12:
-        raise InvalidInput(name, f"expected a finite nonzero axis of shape (3,), got {axis!r}")
-    out: Array = a / float(np.linalg.norm(a))
+    out, length = direction(axis, name)
+    if length < 1e-12:
+        raise InvalidInput(name, f"expected a nonzero axis of shape (3,), got {axis!r}")
     return out
 
 

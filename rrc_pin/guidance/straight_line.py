@@ -34,6 +34,7 @@ from rrc_pin.errors import InvalidInput
 from rrc_pin.guidance.screw import Screw, axis_angle, frames_from_points, screw_from_poses
 from rrc_pin.guidance.screw_motion import BForm, check_b_form, check_closing, screw_step_b
 from rrc_pin.guidance.stepping import (
+    MAX_STEPS,
     Array,
     Correction,
     GuidancePath,
@@ -45,7 +46,7 @@ from rrc_pin.guidance.stepping import (
     on_frame,
     run_steps,
 )
-from rrc_pin.solvers.checks import finite_number, rigid_transform
+from rrc_pin.solvers.checks import MAX_LENGTH, as_array, finite_number, integer, rigid_transform
 
 Substeps = Union[int, Callable[[Screw], int]]  # noqa: UP007 (a runtime alias on 3.10)
 """Steps per division: a number, or a rule from the division's screw (from the hand reached)."""
@@ -167,12 +168,12 @@ def straight_line_points(
     """
     arm = on_frame(arm, frame)
     k = check_steps(steps)
-    gap = finite_number(spacing, "spacing", lower=0.0, inclusive=False)
-    goal = frames_from_points(goal_points, "goal_points")
+    gap = finite_number(spacing, "spacing", lower=0.0, inclusive=False, upper=MAX_LENGTH)
+    end = as_array(goal_points, "goal_points", (3, 3))
+    goal = frames_from_points(end, "goal_points")
     extra = check_closing(closing)
     if not callable(substeps):
         check_substeps(substeps)
-    end = np.asarray(goal_points, dtype=np.float64)
     q = check_q0(arm, q0)
     start = hand_points(arm.fk(q), gap)
     check_b_form(b_form)
@@ -213,7 +214,7 @@ def run_divisions(
         if i >= divisions:
             n = 1
         else:
-            n = check_substeps(substeps(screw) if callable(substeps) else substeps)
+            n = check_substeps(_division_steps(substeps, screw))
 
         def twist(_: int, T: Array, screw: Screw = screw, n: int = n) -> Step:
             return screw_step_b(screw, n, b_form, T)
@@ -224,15 +225,27 @@ def run_divisions(
     return joined(pieces)
 
 
-def check_substeps(n: int) -> int:
-    """A division's number of steps as an int >= 1.
+def _division_steps(substeps: Substeps, screw: Screw) -> int:
+    """A division's steps: ``substeps``, or what the rule ``substeps(screw)`` gives.
 
     Raises:
-        InvalidInput: Not an integer >= 1 (named ``substeps``).
+        InvalidInput: The rule raised (its error kept as the cause), naming ``substeps``.
     """
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
-        raise InvalidInput("substeps", f"expected an integer >= 1 per division, got {n!r}")
-    return int(n)
+    if not callable(substeps):
+        return substeps
+    try:
+        return substeps(screw)  # checked by the caller
+    except Exception as exc:  # the caller's rule: whatever it raises, named as its argument
+        raise InvalidInput("substeps", f"the rule raised {type(exc).__name__}: {exc}") from exc
+
+
+def check_substeps(n: int) -> int:
+    """A division's number of steps as an int in [1, MAX_STEPS].
+
+    Raises:
+        InvalidInput: Not an integer in [1, MAX_STEPS] (named ``substeps``).
+    """
+    return integer(n, "substeps", 1, MAX_STEPS)
 
 
 def joined(pieces: list[GuidancePath]) -> GuidancePath:

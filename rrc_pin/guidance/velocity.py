@@ -7,7 +7,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.guidance.stepping import Array
-from rrc_pin.solvers.checks import as_array, finite_number
+from rrc_pin.solvers.checks import finite_array, finite_number
 
 
 def joint_rates(increments: npt.ArrayLike, hand_step: float, hand_speed: float) -> Array:
@@ -31,12 +31,17 @@ def joint_rates(increments: npt.ArrayLike, hand_step: float, hand_speed: float) 
         (..., nq) joint rates [rad/s or m/s], signed as the increments.
 
     Raises:
-        InvalidInput: Non-finite input, or ``hand_step`` zero.
+        InvalidInput: Non-finite input, ``hand_step`` zero, or so small against the
+            increments that the rates overflow.
     """
-    D = as_array(increments, "increments", (None,) * np.ndim(increments))
+    D = finite_array(increments, "increments")
     step = finite_number(hand_step, "hand_step")
     if step == 0.0:
         raise InvalidInput("hand_step", "the hand must move in the step (nonzero)")
     speed = finite_number(hand_speed, "hand_speed")
-    out: Array = D / step * speed
+    with np.errstate(over="ignore"):
+        out: Array = D / step * speed
+    if not np.isfinite(out).all():
+        raise InvalidInput("increments, hand_step", f"the rates overflow: increments up to "
+                           f"{np.abs(D).max():g} over a step of {step:g} at {speed:g}")  # fmt: skip
     return out

@@ -10,7 +10,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits.limit import Limit
-from rrc_pin.solvers.checks import rigid_transform
+from rrc_pin.solvers.checks import names, rigid_transform
 from rrc_pin.solvers.tick.problem import Constraints
 from rrc_pin.tasks.frame_task import FrameTask
 
@@ -84,8 +84,8 @@ class ContactLimit(Limit):
                 then unchanged.
             FrameNotFound: A frame the robot (of the resolver holding it) does not have.
         """
-        items = (frames,) if isinstance(frames, str) else tuple(frames)
-        if not all(isinstance(f, str) for f in items) or len(set(items)) != len(items):
+        items = names(frames, "frames")
+        if len(set(items)) != len(items):
             raise InvalidInput("frames", f"expected distinct frame names, got {frames!r}")
         if self._layout is not None:
             for frame in items:

@@ -11,7 +11,7 @@ import numpy.typing as npt
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits.contact_limit import AXES, Closure
 from rrc_pin.limits.limit import Limit
-from rrc_pin.solvers.checks import rigid_transform
+from rrc_pin.solvers.checks import names, rigid_transform
 from rrc_pin.solvers.tick.problem import Constraints
 from rrc_pin.tasks.relative_frame_task import RelativeFrameTask
 
@@ -65,9 +65,11 @@ class GripLimit(Limit):
                 the limit is unchanged.
             FrameNotFound: A frame the robot (of the resolver holding it) does not have.
         """
-        items = tuple(tuple(p) for p in pairs)
+        if not isinstance(pairs, (list, tuple)):
+            raise InvalidInput("pairs", f"expected (frame_a, frame_b) pairs, got {pairs!r}")
+        items = tuple(names(p, "pairs", 2) if not isinstance(p, str) else (p,) for p in pairs)
         for p in items:
-            if len(p) != 2 or not all(isinstance(f, str) for f in p) or p[0] == p[1]:
+            if len(p) != 2 or p[0] == p[1]:
                 raise InvalidInput("pairs", f"expected (frame_a, frame_b) pairs, got {pairs!r}")
             if self._layout is not None:
                 for frame in p:

@@ -32,7 +32,9 @@ class JointLimits(Limit):
             every joint's range (checked against the robot when a Resolver is built).
         acceleration: Joint acceleration limits [rad/s^2 or m/s^2] > 0, a scalar or (nq,),
             or None for none.
-        velocity: Velocity limits (nv,) [rad/s or m/s] > 0 replacing the robot's, or None.
+        velocity: Velocity limits (nv,) [rad/s or m/s] > 0 replacing the robot's, or None
+            (those its mimic joints put on the joints they follow are kept either way:
+            :attr:`rrc_pin.Robot.mimic_velocity`).
         position_gain: Fraction in (0, 1] of the distance to a position limit allowed in one
             step (pink's ``config_limit_gain``).
         name: Name in the report.
@@ -117,6 +119,8 @@ class JointLimits(Limit):
         layout = kin.layout
         n = layout.nv
         velocity: Array = layout.velocity if self.velocity is None else np.asarray(self.velocity)
+        if self.velocity is not None and layout.mimic_velocity is not None:
+            velocity = np.minimum(velocity, layout.mimic_velocity)
         acceleration = _NO_ACCELERATION if self.acceleration is None else np.asarray(
             self.acceleration
         )

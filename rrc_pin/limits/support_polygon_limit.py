@@ -33,7 +33,7 @@ import numpy.typing as npt
 from rrc_pin.center_of_mass import center_of_mass, check_mass
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits.limit import Limit
-from rrc_pin.solvers.checks import finite_number, real_array
+from rrc_pin.solvers.checks import finite_number, names, real_array
 from rrc_pin.solvers.tick.problem import Constraints
 
 if TYPE_CHECKING:
@@ -94,8 +94,8 @@ class SupportPolygonLimit(Limit):
             InvalidInput: Not distinct frame names; the limit is then unchanged.
             FrameNotFound: A frame the robot (of the resolver holding it) does not have.
         """
-        items = (feet,) if isinstance(feet, str) else tuple(feet)
-        if not all(isinstance(f, str) for f in items) or len(set(items)) != len(items):
+        items = names(feet, "feet")
+        if len(set(items)) != len(items):
             raise InvalidInput("feet", f"expected distinct frame names, got {feet!r}")
         if self._layout is not None:
             _check_frames(items, self._layout)

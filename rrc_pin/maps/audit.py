@@ -33,6 +33,7 @@ from rrc_pin.errors import InvalidInput
 from rrc_pin.maps.capability_map import CapabilityMap
 from rrc_pin.resolver import Resolver
 from rrc_pin.robot import Robot
+from rrc_pin.solvers.checks import integer
 from rrc_pin.solvers.maps.kinematics import task_rows
 
 Array = npt.NDArray[np.float64]
@@ -43,6 +44,8 @@ DT = 0.05
 """[s] Integration step of the IK loop."""
 GAIN = 0.5
 """Share of the error commanded per step."""
+MAX_COUNT = 1_000_000
+"""The most voxels, starts or steps per start an audit takes (more would run for days)."""
 STALL_STEPS = 20
 """A start is abandoned after this many steps without getting :data:`STALL_M` closer."""
 STALL_M = 1e-4
@@ -152,15 +155,31 @@ def reach_box(
     return False, len(starts), steps, distance, total
 
 
+def _map(m: CapabilityMap) -> None:
+    """Refuse anything but a map.
+
+    Raises:
+        InvalidInput: Naming ``m``.
+    """
+    if not isinstance(m, CapabilityMap):
+        raise InvalidInput("m", f"expected a CapabilityMap, got {type(m).__name__}")
+
+
+def _try_arguments(starts: int, max_steps: int) -> None:
+    """Refuse starts and steps that are not counts in [1, MAX_COUNT].
+
+    Raises:
+        InvalidInput: Naming ``starts`` or ``max_steps``.
+    """
+    integer(starts, "starts", 1, MAX_COUNT)
+    integer(max_steps, "max_steps", 1, MAX_COUNT)
+
+
 def _try(
     m: CapabilityMap, robot: Robot, keys: npt.NDArray[np.int64], seed: int, starts: int,
     max_steps: int,
 ) -> AuditReport:  # fmt: skip
     robot, _ = _robot(m, robot)
-    if isinstance(starts, bool) or not isinstance(starts, int) or starts < 1:
-        raise InvalidInput("starts", f"expected an int >= 1, got {starts!r}")
-    if isinstance(max_steps, bool) or not isinstance(max_steps, int) or max_steps < 1:
-        raise InvalidInput("max_steps", f"expected an int >= 1, got {max_steps!r}")
     rng = np.random.default_rng(seed)
     resolver = Resolver(robot, dt=DT)
     v = m.grid.voxel
@@ -203,8 +222,10 @@ def audit(
         InvalidInput: ``robot`` is not the map's arm; bad ``voxels``, ``starts``,
             ``max_steps``.
     """
-    if isinstance(voxels, bool) or not isinstance(voxels, int) or voxels < 1:
-        raise InvalidInput("voxels", f"expected an int >= 1, got {voxels!r}")
+    _map(m)
+    voxels = integer(voxels, "voxels", 1, MAX_COUNT)
+    seed = integer(seed, "seed", 0)
+    _try_arguments(starts, max_steps)
     reached = np.flatnonzero(m.reached)
     rng = np.random.default_rng(seed)
     keys = np.sort(rng.choice(reached, size=min(voxels, reached.size), replace=False))
@@ -247,10 +268,12 @@ def refine(
     Raises:
         InvalidInput: As :func:`audit`.
     """
+    _map(m)
+    seed = integer(seed, "seed", 0)
+    _try_arguments(starts, max_steps)
     keys = boundary(m)
     if limit is not None:
-        if isinstance(limit, bool) or not isinstance(limit, int) or limit < 1:
-            raise InvalidInput("limit", f"expected an int >= 1 or None, got {limit!r}")
+        limit = integer(limit, "limit", 1, MAX_COUNT)
         if keys.size > limit:
             keys = np.sort(np.random.default_rng(seed).choice(keys, size=limit, replace=False))
     return _try(m, robot, keys, seed + 1, starts, max_steps)

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 from collections.abc import Callable
 from dataclasses import asdict
@@ -23,7 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.loading import load
+from rrc_pin.loading import loaded
 from rrc_pin.maps import driver
 from rrc_pin.maps.blocks import BlockStore
 from rrc_pin.maps.capability_map import CapabilityMap
@@ -31,6 +30,7 @@ from rrc_pin.maps.kinematics import arm_kinematics
 from rrc_pin.maps.progress import Progress, ProgressBar
 from rrc_pin.maps.voxels import MAX_SAMPLES, Grid, chain_grid, quanta
 from rrc_pin.robot import Robot
+from rrc_pin.solvers.checks import integer, length
 from rrc_pin.solvers.maps.batch import MAX_KEYS, Chain, Fields
 from rrc_pin.solvers.maps.kinematics import ArmKinematics
 from rrc_pin.solvers.maps.sampling import BLOCK, Plan
@@ -106,12 +106,12 @@ def capability(
         MissingExtra: dask.distributed (or zarr, with ``out``) is not installed.
     """
     robot = arm if isinstance(arm, Robot) else _load(arm)
-    samples = _count(samples, "samples", 1, MAX_SAMPLES)
-    voxel = _positive(voxel, "voxel")
-    seed = _count(seed, "seed", 0, 2**63 - 1)
+    samples = integer(samples, "samples", 1, MAX_SAMPLES)
+    voxel = length(voxel, "voxel")
+    seed = integer(seed, "seed", 0, 2**63 - 1)
     block_size = _block_size(block_size)
     if blocks_per_task is not None:
-        blocks_per_task = _count(blocks_per_task, "blocks_per_task", 1, 64)
+        blocks_per_task = integer(blocks_per_task, "blocks_per_task", 1, 64)
     driver.check_scheduler(scheduler, workers, dashboard)
     if not isinstance(dexterity, bool):
         raise InvalidInput("dexterity", f"expected True or False, got {dexterity!r}")
@@ -207,30 +207,11 @@ def chain_digest(chain: Chain) -> str:
 
 
 def _load(arm: object) -> Robot:
-    if not isinstance(arm, str):
-        raise InvalidInput("arm", f"expected a Robot, a name or a path, got {arm!r}")
-    return load(arm)
-
-
-def _count(value: object, name: str, lo: int, hi: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InvalidInput(name, f"expected an integer, got {value!r}")
-    if not lo <= value <= hi:
-        raise InvalidInput(name, f"expected {lo} <= {name} <= {hi}, got {value}")
-    return int(value)
-
-
-def _positive(value: object, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise InvalidInput(name, f"expected a number [m], got {value!r}")
-    x = float(value)
-    if not math.isfinite(x) or x <= 0.0:
-        raise InvalidInput(name, f"expected a finite length > 0 [m], got {value!r}")
-    return x
+    return loaded(arm, "arm")  # type: ignore[arg-type]
 
 
 def _block_size(value: object) -> int:
-    n = _count(value, "block_size", 2**6, 2**20)
+    n = integer(value, "block_size", 2**6, 2**20)
     if n & (n - 1):
         raise InvalidInput("block_size", f"expected a power of two, got {n}")
     return n

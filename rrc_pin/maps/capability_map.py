@@ -14,7 +14,9 @@ from typing import Any, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.errors import InvalidInput
 from rrc_pin.maps.voxels import Grid, VoxelStats
+from rrc_pin.solvers.checks import choice, finite_array, real_array
 from rrc_pin.solvers.maps.batch import BINS, NONE, Chain
 from rrc_pin.solvers.maps.sampling import Plan, sample_at
 
@@ -108,7 +110,12 @@ class CapabilityMap:
         """A statistic by name (V,): a stored column, ``coverage``, or a ``*_mean``.
 
         Maxima and means are NaN where the voxel was not reached (or not computed).
+
+        Raises:
+            InvalidInput: No such statistic (the message lists them).
         """
+        columns = ("coverage", *self.stats.arrays(), "manipulability_mean", "sigma_min_mean")
+        choice(name, "name", columns)
         if name == "coverage":
             return self.coverage
         if name.endswith("_mean"):
@@ -144,10 +151,8 @@ class CapabilityMap:
         Raises:
             InvalidInput: ``points`` is not a finite (N, 3) or (3,) array.
         """
-        from rrc_pin.errors import InvalidInput
-
-        P = np.asarray(points, dtype=float)
-        if P.ndim not in (1, 2) or P.shape[-1] != 3 or not np.all(np.isfinite(P)):
+        P = finite_array(points, "points")
+        if P.ndim not in (1, 2) or P.shape[-1] != 3:
             raise InvalidInput("points", f"expected finite (N, 3) positions [m], got {P.shape}")
         keys = self.grid.keys_of(P)
         inside = keys >= 0
@@ -160,7 +165,15 @@ class CapabilityMap:
         return MapQuery(**values)
 
     def volume(self, mask: npt.NDArray[np.bool_] | None = None) -> float:
-        """Volume of the voxels reached (or of ``mask``) [m^3]."""
+        """Volume of the voxels reached (or of ``mask`` (V,), booleans) [m^3].
+
+        Raises:
+            InvalidInput: ``mask`` is not booleans of the grid's size.
+        """
+        if mask is not None and not (isinstance(mask, np.ndarray) and mask.dtype == np.bool_
+                                     and mask.shape == (self.grid.size,)):  # fmt: skip
+            raise InvalidInput("mask", f"expected ({self.grid.size},) booleans, got "
+                               f"{type(mask).__name__}")  # fmt: skip
         n = int(np.count_nonzero(self.reached if mask is None else mask))
         return n * self.grid.voxel**3
 
@@ -168,11 +181,21 @@ class CapabilityMap:
         """The chain's joint positions (k, n) of the witness samples of ``keys`` (reached).
 
         ``column``: ``witness`` (the voxel's first sample), or a condition's
-        (``eq32_witness``...). Raises ValueError where the voxel has none.
+        (``eq32_witness``...).
+
+        Raises:
+            InvalidInput: ``keys`` not voxel keys of the grid (integers in [0, V)), a
+                ``column`` that is not a witness column, or a voxel without a witness.
         """
-        idx = self.stats.arrays()[column][np.asarray(keys, dtype=np.int64)]
+        witness = tuple(c for c in self.stats.arrays() if c.endswith("witness"))
+        col = self.stats.arrays()[choice(column, "column", witness)]
+        k = real_array(keys, "keys", "expected voxel keys (integers)")
+        if k.ndim != 1 or not np.all((k == np.floor(k)) & (k >= 0) & (k < col.size)):
+            raise InvalidInput("keys", f"expected (k,) voxel keys in [0, {col.size}), got "
+                               f"{k.shape} values")  # fmt: skip
+        idx = col[k.astype(np.int64)]
         if np.any(idx == NONE):
-            raise ValueError(f"no {column} sample in some of these voxels")
+            raise InvalidInput("keys", f"no {column} sample in some of these voxels")
         return sample_at(self.chain, int(self.meta["seed"]), self.plan, list(idx))
 
     def summary(self) -> dict[str, Any]:

@@ -41,12 +41,16 @@ from rrc_pin.errors import InvalidInput, MissingExtra, SchedulerUnreachable
 from rrc_pin.maps.blocks import BlockStore
 from rrc_pin.maps.progress import Progress
 from rrc_pin.maps.voxels import VoxelStats
+from rrc_pin.solvers.checks import integer
 from rrc_pin.solvers.maps.work import Job, TaskResult, compute_blocks
 
 LOOPBACK = "127.0.0.1"
 """Where the servers of an in-process cluster listen, unless the caller names a host."""
 CONNECT_TIMEOUT = 3.0
 """[s] How long to wait for a scheduler at an address."""
+
+MAX_THREADS = 1024
+"""The most threads an in-process cluster is given (``workers``): more is no machine's."""
 MAX_BLOCKS_PER_TASK = 8
 """Blocks per task at most (2^18 samples at the default block size)."""
 FOLD_PARTS = 32
@@ -83,10 +87,8 @@ def check_scheduler(scheduler: object, workers: int | None, dashboard: object = 
             )
         if dashboard is not None:
             raise InvalidInput("dashboard", "a cluster serves its own dashboard")
-    elif workers is not None and (
-        isinstance(workers, bool) or not isinstance(workers, int) or workers < 1
-    ):
-        raise InvalidInput("workers", f"expected an int >= 1, got {workers!r}")
+    elif workers is not None:
+        integer(workers, "workers", 1, MAX_THREADS)
     if dashboard is not None:
         dashboard_address(dashboard)
 

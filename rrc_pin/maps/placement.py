@@ -27,12 +27,17 @@ from rrc_pin.maps.capability_map import CapabilityMap, popcount
 from rrc_pin.maps.kinematics import chain_of, placed
 from rrc_pin.maps.voxels import Grid, quanta
 from rrc_pin.robot import Robot
+from rrc_pin.solvers.checks import MAX_LENGTH, as_array, finite_number, within_length
 from rrc_pin.solvers.maps.batch import BINS, Fields
 from rrc_pin.solvers.maps.kinematics import ChainKinematics, task_rows
 from rrc_pin.solvers.maps.sampling import BLOCK, Plan
 from rrc_pin.solvers.maps.work import Job, compute_blocks
 
 Array = npt.NDArray[np.float64]
+
+
+MAX_PLACEMENTS = 10**6
+"""The most base poses :func:`placements_grid` makes (128 MB of poses)."""
 
 
 def placements_grid(
@@ -42,17 +47,26 @@ def placements_grid(
 
     Positions ``x``, ``y`` [m] at height ``z`` [m], headings ``yaw`` [rad] about the
     vertical, in the first map's base frame; x slowest, yaw fastest.
+
+    Raises:
+        InvalidInput: ``x``, ``y`` or ``yaw`` not finite (N,) numbers, ``z`` not a finite
+            number, positions beyond ``MAX_LENGTH`` (each named), or more than
+            :data:`MAX_PLACEMENTS` poses (naming ``x, y, yaw``).
     """
-    out = []
-    for xi in x:
-        for yi in y:
-            for a in yaw:
-                T = np.eye(4)
-                c, s = np.cos(a), np.sin(a)
-                T[:2, :2] = [[c, -s], [s, c]]
-                T[:3, 3] = (xi, yi, z)
-                out.append(T)
-    return np.array(out)
+    xs, ys, yaws = (as_array(v, n, (None,)) for v, n in ((x, "x"), (y, "y"), (yaw, "yaw")))
+    height = finite_number(z, "z", -MAX_LENGTH, upper=MAX_LENGTH)
+    within_length(xs, "x")
+    within_length(ys, "y")
+    if xs.size * ys.size * yaws.size > MAX_PLACEMENTS:
+        raise InvalidInput("x, y, yaw", f"{xs.size} x {ys.size} x {yaws.size} poses: expected "
+                           f"at most {MAX_PLACEMENTS:,}")  # fmt: skip
+    X, Y, A = (g.reshape(-1) for g in np.meshgrid(xs, ys, yaws, indexing="ij"))
+    c, s = np.cos(A), np.sin(A)
+    out: Array = np.zeros((X.size, 4, 4))
+    out[:, 0, 0], out[:, 0, 1], out[:, 1, 0], out[:, 1, 1] = c, -s, s, c
+    out[:, 2, 2] = out[:, 3, 3] = 1.0
+    out[:, 0, 3], out[:, 1, 3], out[:, 2, 3] = X, Y, height
+    return out
 
 
 @dataclass(repr=False)

@@ -66,10 +66,15 @@ def save_map(m: CapabilityMap, path: str | os.PathLike[str]) -> Path:
     """Write ``m`` to the Zarr store ``path`` (a map store there is replaced); returns it.
 
     Raises:
-        InvalidInput: ``path`` is a file, or a folder holding something else than a map.
+        InvalidInput: ``m`` is not a :class:`CapabilityMap`, ``path`` not a folder's name, a
+            file, or a folder holding something else than a map (each named).
     """
+    if not isinstance(m, CapabilityMap):
+        raise InvalidInput("m", f"expected a CapabilityMap, got {type(m).__name__}")
+    path = _folder(path)
+    if not path.name:  # ".", "/": no name to write beside it
+        raise InvalidInput("path", f"expected a folder's name, got {str(path)!r}")
     zarr = _zarr()
-    path = Path(path)
     if path.exists() and not (path.is_dir() and (_is_store(path) or not any(path.iterdir()))):
         raise InvalidInput("path", f"{path} exists and is not a map store: not replaced")
     new, old = (path.with_name(f".{path.name}.{what}{os.getpid()}") for what in ("new", "old"))
@@ -101,7 +106,7 @@ def verify_store(path: str | os.PathLike[str]) -> None:
         CorruptStore: A file changed, missing or added since the store was written (named,
             with the way to repair the store).
     """
-    path = Path(path)
+    path = _folder(path)
     if not path.is_dir() or not _is_store(path):
         raise InvalidInput("path", f"{path} is not a map store of rrc-pin")
     listing = path / CHECKSUMS
@@ -113,6 +118,19 @@ def verify_store(path: str | os.PathLike[str]) -> None:
     bad = checksums.damaged(path, files, frozenset({CHECKSUMS}))
     if bad:
         raise CorruptStore(path, bad, _repair(path))
+
+
+def _folder(path: str | os.PathLike[str]) -> Path:
+    """``path`` as a Path.
+
+    Raises:
+        InvalidInput: Not a non-empty str or os.PathLike of str (named ``path``).
+    """
+    if not isinstance(path, (str, os.PathLike)) or not isinstance(os.fspath(path), str) or (
+        not os.fspath(path)
+    ):  # fmt: skip
+        raise InvalidInput("path", f"expected a folder name (str or os.PathLike), got {path!r}")
+    return Path(path)
 
 
 def _is_store(path: Path) -> bool:

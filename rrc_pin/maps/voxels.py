@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.errors import InvalidInput
 from rrc_pin.solvers.maps.batch import MAX_KEYS, NONE, Chain, Fields, GridArrays, Sparse
 
 Array = npt.NDArray[np.float64]
@@ -65,10 +66,17 @@ class Grid:
         """The aligned grid covering the ball of ``radius`` [m] about ``centre`` (3,) [m].
 
         One voxel of margin on the upper side, so a point exactly on the bound is inside.
+
+        Raises:
+            InvalidInput: A ``voxel`` so small that the grid's indices leave int64 (named).
         """
         c = np.asarray(centre, dtype=float)
-        lo = np.floor((c - radius) / voxel).astype(np.int64)
-        hi = np.floor((c + radius) / voxel).astype(np.int64) + 1
+        with np.errstate(over="ignore"):
+            ends = np.floor(np.array([c - radius, c + radius]) / voxel)
+        if not np.all(np.abs(ends) < 2.0**62):
+            raise InvalidInput("voxel", f"{voxel} m is too small for a reach of {radius:g} m")
+        lo = ends[0].astype(np.int64)
+        hi = ends[1].astype(np.int64) + 1
         return cls(_ints(lo), _ints(hi - lo + 1), float(voxel))
 
     def union(self, other: Grid) -> Grid:
@@ -94,9 +102,13 @@ class Grid:
         return GridArrays(start, self.voxel, np.asarray(self.shape, dtype=np.int64))
 
     def keys_of(self, points: npt.ArrayLike) -> IntArray:
-        """Voxel keys (N,) of ``points`` (N, 3) [m]; -1 outside the grid."""
+        """Voxel keys (N,) of ``points`` (N, 3) [m]; -1 outside the grid (or beyond 2^62 voxels)."""
         P = np.asarray(points, dtype=float).reshape(-1, 3)
-        idx = np.floor(P / self.voxel).astype(np.int64) - np.asarray(self.start)
+        with np.errstate(over="ignore", invalid="ignore"):
+            cells = np.floor(P / self.voxel)
+        far = ~np.all(np.abs(cells) < 2.0**62, axis=1)
+        idx = np.where(far[:, None], -1.0, cells).astype(np.int64) - np.asarray(self.start)
+        idx[far] = -1
         inside = np.all((idx >= 0) & (idx < np.asarray(self.shape)), axis=1)
         keys = np.ravel_multi_index(tuple(np.where(inside, idx.T, 0)), self.shape)
         out: IntArray = np.where(inside, keys, -1)

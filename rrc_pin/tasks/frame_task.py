@@ -10,7 +10,7 @@ import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics
-from rrc_pin.solvers.checks import as_vector, positive, rigid_transform
+from rrc_pin.solvers.checks import as_vector, positive, real_array, rigid_transform
 from rrc_pin.solvers.spatial import Reference, check_reference
 from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.task import Task, check_weight, task_name
@@ -114,7 +114,8 @@ class FrameTask(Task):
             InvalidInput: Wrong shape or a non-finite entry.
         """
         m = len(self.selected)
-        size = np.shape(twist)
+        twist = real_array(twist, "twist", "expected a real (6,) twist")
+        size = twist.shape
         if size == (6,) and m != 6:
             return self.selected_rates(as_vector(twist, "twist", 6))
         if size != (m,):
@@ -210,7 +211,10 @@ def task_rows(rows: str | Sequence[int] | Sequence[bool]) -> tuple[int, ...]:
                 "rows", f"expected one of {', '.join(ROWS)} or indices, got {rows!r}"
             )
         return ROWS[rows]
-    arr = np.asarray(rows)
+    try:
+        arr = np.asarray(rows)
+    except (TypeError, ValueError) as exc:  # a ragged sequence
+        raise InvalidInput("rows", f"expected row indices, got {rows!r}") from exc
     if arr.dtype == bool:
         if arr.shape != (6,):
             raise InvalidInput("rows", f"a boolean mask must have shape (6,), got {arr.shape}")

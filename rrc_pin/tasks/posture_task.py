@@ -7,7 +7,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
-from rrc_pin.solvers.checks import as_vector, positive
+from rrc_pin.solvers.checks import as_array, positive
 from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.task import Task, check_weight, identity, task_name
 
@@ -41,7 +41,7 @@ class PostureTask(Task):
         weight: float | npt.ArrayLike = 1.0,
         name: str = "posture",
     ) -> None:
-        self.q_ref = as_vector(q_ref, "q_ref", np.size(q_ref))
+        self.q_ref = as_array(q_ref, "q_ref", (None,))
         self.gain = positive(gain, "gain")
         self.weight = check_weight(weight, self.q_ref.size)
         self.name = task_name(name)

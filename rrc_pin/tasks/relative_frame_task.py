@@ -61,8 +61,9 @@ class RelativeFrameTask(Task):
         gain: float = 10.0,
         name: str | None = None,
     ) -> None:
-        if not isinstance(frame_a, str):
-            raise InvalidInput("frame_a", f"expected a frame name, got {frame_a!r}")
+        for label, frame in (("frame_a", frame_a), ("frame_b", frame_b)):
+            if not isinstance(frame, str):
+                raise InvalidInput(label, f"expected a frame name, got {frame!r}")
         # b's twist, rows and weights, checked and selected as a FrameTask's
         self._spec = FrameTask(
             frame_b, twist, rows=rows, weight=weight,

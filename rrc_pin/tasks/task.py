@@ -68,7 +68,7 @@ def check_weight(weight: float | npt.ArrayLike, size: int | None = None) -> floa
     Raises:
         InvalidInput: Not positive, not finite, or the wrong shape.
     """
-    if type(weight) is float or np.ndim(weight) == 0:
+    if not isinstance(weight, (list, tuple, np.ndarray)):
         return finite_number(weight, "weight", 0.0, inclusive=False)  # type: ignore[arg-type]
     if size is None:
         raise InvalidInput("weight", f"expected a number > 0, got {weight!r}")

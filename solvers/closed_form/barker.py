@@ -41,10 +41,17 @@ from typing import Any, Literal, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.checks import as_array, as_vector, finite_number
+from rrc_pin.solvers.checks import as_array, as_vector, choice, finite_number, flag
 from rrc_pin.solvers.closed_form import barker_equations as eqs
 from rrc_pin.solvers.closed_form.barker_equations import BarkerGeometry, FTerms
-from rrc_pin.solvers.closed_form.base import Array, ClosedForm, first, row, vector
+from rrc_pin.solvers.closed_form.base import (
+    Array,
+    ClosedForm,
+    finite_rates,
+    first,
+    row,
+    vector,
+)
 from rrc_pin.solvers.errors import InvalidInput
 
 Method = Literal["full", "reduced"]
@@ -231,7 +238,7 @@ class BarkerClosedForm(ClosedForm):
         Q = as_array(Q, "Q", (None, 6))
         T = as_array(TVEL, "TVEL", (Q.shape[0], 3))
         out = np.empty((Q.shape[0], 3))
-        eqs.arm_rates_batch(self._p, Q, T, reduced, bool(exact), out)
+        eqs.arm_rates_batch(self._p, Q, T, reduced, flag(exact, "exact"), out)
         return out
 
     def rvel_tilde(self, q: npt.ArrayLike, arm_rates: npt.ArrayLike, rvel: npt.ArrayLike) -> Array:
@@ -272,7 +279,7 @@ class BarkerClosedForm(ClosedForm):
         Q = as_array(Q, "Q", (None, 6))
         R = as_array(RVEL_TILDE, "RVEL_TILDE", (Q.shape[0], 3))
         out = np.empty((Q.shape[0], 3))
-        eqs.wrist_rates_batch(self._p, Q, R, bool(exact), out)
+        eqs.wrist_rates_batch(self._p, Q, R, flag(exact, "exact"), out)
         return out
 
     def joint_rates(
@@ -299,10 +306,10 @@ class BarkerClosedForm(ClosedForm):
         reduced = self._reduced(method)
         qv, xv = vector(q, "q", 6), vector(xdot, "xdot", 6)
         out = np.empty(6)
-        if not eqs.joint_rates_at(self._p, qv, xv, reduced, bool(exact), out):
+        if not eqs.joint_rates_at(self._p, qv, xv, reduced, flag(exact, "exact"), out):
             as_vector(q, "q", 6)  # one of the two raises, naming the entry
             as_vector(xdot, "xdot", 6)
-        return out
+        return finite_rates(out, "xdot")
 
     def joint_rates_batch(
         self, Q: npt.ArrayLike, X: npt.ArrayLike, method: Method = "full", exact: bool = False
@@ -315,8 +322,8 @@ class BarkerClosedForm(ClosedForm):
         reduced = self._reduced(method)
         Q, X = self._check_batch(Q, X)
         out = np.empty((Q.shape[0], 6))
-        eqs.joint_rates_batch(self._p, Q, X, reduced, bool(exact), out)
-        return out
+        eqs.joint_rates_batch(self._p, Q, X, reduced, flag(exact, "exact"), out)
+        return finite_rates(out, "X")
 
     def hand_to_base(self, q: npt.ArrayLike) -> Array:
         """R0_6 (3, 3) by eqs (B2)-(B24): hand (frame 6) axes in base axes."""
@@ -353,10 +360,8 @@ class BarkerClosedForm(ClosedForm):
         return out
 
     def _reduced(self, method: str) -> bool:
-        if method == "full":
+        if choice(method, "method", METHODS) == "full":
             return False
-        if method != "reduced":
-            raise InvalidInput("method", f"expected one of {', '.join(METHODS)}, got {method!r}")
         if not self._has_reduced:
             raise InvalidInput(
                 "method", "the reduced path divides by F2 = SN + R3 + cos(alpha3) WE = 0"

@@ -8,8 +8,9 @@ from abc import ABC, abstractmethod
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.checks import as_array, as_vector
+from rrc_pin.solvers.checks import all_finite, as_array, as_vector
 from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.errors import InvalidInput
 
 Array = npt.NDArray[np.float64]
 _F64 = np.dtype(np.float64)
@@ -80,6 +81,17 @@ class ClosedForm(ABC):
 def row(x: npt.ArrayLike, name: str, size: int) -> Array:
     """``x`` checked as a finite (size,) vector named ``name``, as a batch of one (1, size)."""
     return as_vector(x, name, size)[None]
+
+
+def finite_rates(rates: Array, name: str) -> Array:
+    """``rates``, checked finite: a command so large that its joint rates overflow is refused.
+
+    Raises:
+        InvalidInput: Naming ``name`` (the command) where a rate is not finite.
+    """
+    if not all_finite(rates):
+        raise InvalidInput(name, "a command whose joint rates overflow the float range")
+    return rates
 
 
 def first(batch: Array) -> Array:

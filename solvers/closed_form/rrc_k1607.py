@@ -34,7 +34,7 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.checks import as_array, as_vector, finite_number
 from rrc_pin.solvers.closed_form import rrc_k1607_equations as eqs
-from rrc_pin.solvers.closed_form.base import Array, ClosedForm, vector
+from rrc_pin.solvers.closed_form.base import Array, ClosedForm, finite_rates, vector
 from rrc_pin.solvers.closed_form.rrc_k1607_equations import NQ, TASK_DIM
 from rrc_pin.solvers.closed_form.weighted import weight_factor
 
@@ -159,7 +159,7 @@ class RrcK1607ClosedForm(ClosedForm):
         if not eqs.joint_rates_at(self._p, qv, xv, L, zv, self.rcond, out):
             as_vector(q, "q", NQ)  # one of the two raises, naming the entry
             as_vector(xdot, "xdot", TASK_DIM)
-        return out
+        return finite_rates(out, "xdot")
 
     def joint_rates_batch(
         self, Q: npt.ArrayLike, X: npt.ArrayLike, W: npt.ArrayLike | None = None,
@@ -175,5 +175,5 @@ class RrcK1607ClosedForm(ClosedForm):
         Zm = None if Z is None else as_array(Z, "Z", (Q.shape[0], NQ))
         out = np.empty((Q.shape[0], NQ))
         eqs.joint_rates_batch(self._p, Q, X, L, Zm, self.rcond, out)
-        return out
+        return finite_rates(out, "X")
 

@@ -40,7 +40,7 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.checks import as_array, as_vector, finite_number
 from rrc_pin.solvers.closed_form import three_r_equations as eqs
-from rrc_pin.solvers.closed_form.base import Array, ClosedForm, first, vector
+from rrc_pin.solvers.closed_form.base import Array, ClosedForm, finite_rates, first, vector
 from rrc_pin.solvers.errors import InvalidInput
 
 DEFAULT_RCOND = 1e-9
@@ -141,7 +141,7 @@ class ThreeRClosedForm(ClosedForm):
         if not eqs.joint_rates_at(self._p, self.rcond, qv, xv, out):
             as_vector(q, "q", 3)  # one of the two raises, naming the entry
             as_vector(xdot, "xdot", 3)
-        return out
+        return finite_rates(out, "xdot")
 
     def angular_velocity(self, q: npt.ArrayLike, qdot: npt.ArrayLike) -> Array:
         """Angular velocity ``omega = J_A thetadot`` (3,) [rad/s] of frame 3, base axes.
@@ -214,7 +214,7 @@ class ThreeRClosedForm(ClosedForm):
         Q, X = self._check_batch(Q, X)
         out = np.empty((Q.shape[0], 3))
         eqs.joint_rates_batch(self._p, self.rcond, Q, X, out)
-        return out
+        return finite_rates(out, "X")
 
 
 def minimum_norm_shift(qdot: npt.ArrayLike, direction: npt.ArrayLike) -> float:

@@ -14,11 +14,11 @@ from typing import Any
 
 import numpy as np
 
-from rrc_pin.solvers.errors import InvalidInput, ProblemError, UnknownBackend
+from rrc_pin.solvers.errors import InvalidInput, NumericalFailure, ProblemError, UnknownBackend
 from rrc_pin.solvers.qp_backends.base import QPBackend, QPSolution
 from rrc_pin.solvers.qp_backends.daqp_backend import DaqpBackend
 from rrc_pin.solvers.qp_backends.osqp_backend import OSQPBackend
-from rrc_pin.solvers.qp_backends.qp import QP
+from rrc_pin.solvers.qp_backends.qp import QP, checked
 from rrc_pin.solvers.qp_backends.qpsolvers_backend import QpsolversBackend
 
 NATIVE: dict[str, type[QPBackend]] = {"daqp": DaqpBackend, "osqp": OSQPBackend}
@@ -55,12 +55,19 @@ def make_backend(name: str, time_limit: float | None = None, **options: Any) -> 
         raise UnknownBackend(str(name), installed)
     try:
         backend = NATIVE[name](**options) if name in NATIVE else QpsolversBackend(name, **options)
-        probe = backend.solve(_PROBE)  # every setting is read at the first solve
+        answer = backend.solve(_PROBE)  # every setting is read at the first solve
     except ProblemError as exc:
         reason = str(exc).splitlines()[0][:300]
         raise InvalidInput("backend_options", f"{name} refused {options}: {reason}") from exc
-    if probe.x is None or not np.allclose(probe.x, [0.5, 0.5], atol=1e-3):
-        raise InvalidInput("backend_options", f"{name} with {options} fails a 2-variable QP")
+    try:
+        probe = checked(answer, 2, name)
+    except NumericalFailure as exc:
+        reason = f"fails a 2-variable QP ({exc})"
+    else:
+        good = np.allclose(probe.x, [0.5, 0.5], atol=1e-3)
+        reason = "" if good else f"fails a 2-variable QP (answers {probe.x.tolist()})"
+    if reason:
+        raise InvalidInput("backend_options", f"{name} with {options} {reason}")
     backend.reset()
     backend.time_limit = time_limit
     return backend

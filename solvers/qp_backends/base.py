@@ -3,33 +3,15 @@
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.qp_backends.qp import QP
+from rrc_pin.solvers.qp_backends.qp import QPSolution as QPSolution  # its home once
 
 Array = npt.NDArray[np.float64]
-
-
-class QPSolution(NamedTuple):
-    """What a backend returned for one :class:`~rrc_pin.solvers.qp_backends.qp.QP`.
-
-    Attributes:
-        x: Primal solution (nz,), or None when none was found. Within the backend's
-            tolerance only: the caller checks it and enforces the bounds exactly.
-        status: The backend's own status ("solved" when found).
-        iterations: Iterations used (0 where the backend does not say).
-        solve_time: Time spent in the backend's solver [s].
-        backend: Backend name.
-    """
-
-    x: Array | None
-    status: str
-    iterations: int
-    solve_time: float
-    backend: str
 
 
 class QPBackend(ABC):

@@ -18,10 +18,9 @@ import time
 
 import numpy as np
 
-from rrc_pin.solvers.checks import all_finite
 from rrc_pin.solvers.errors import ProblemError
 from rrc_pin.solvers.qp_backends.base import Array, QPBackend, QPSolution
-from rrc_pin.solvers.qp_backends.qp import QP
+from rrc_pin.solvers.qp_backends.qp import QP, finite_solution
 
 DEFAULT_SETTINGS = {"primal_tol": 1e-9}
 """DAQP settings used unless overridden. DAQP's default primal tolerance (1e-6) lets an
@@ -91,10 +90,10 @@ class DaqpBackend(QPBackend):
                 retry = {**self.options, "primal_tol": loose, "primal_start": None}
                 x, _, exitflag, info = daqp.solve(qp.P, qp.q, A, upper, lower, sense, **retry)
                 iterations += int(info["iterations"])
-        except Exception as exc:
+            z = finite_solution(x, nz) if exitflag > 0 else None
+        except Exception as exc:  # raised, or answered something that is not its tuple
             raise ProblemError(f"daqp: {exc}") from exc
         solve_time = time.perf_counter() - t0
-        found = exitflag > 0 and all_finite(x)
-        self._remember(qp, x if found else None)
-        status = "solved" if found else f"exitflag {exitflag}"
-        return QPSolution(x if found else None, status, iterations, solve_time, self.name)
+        self._remember(qp, z)
+        status = "solved" if z is not None else f"exitflag {exitflag}"
+        return QPSolution(z, status, iterations, solve_time, self.name)

@@ -32,7 +32,7 @@ import scipy.sparse as sp
 
 from rrc_pin.solvers.errors import ProblemError
 from rrc_pin.solvers.qp_backends.base import Array, QPBackend, QPSolution
-from rrc_pin.solvers.qp_backends.qp import QP
+from rrc_pin.solvers.qp_backends.qp import QP, finite_solution
 
 DEFAULT_SETTINGS: dict[str, Any] = {
     "eps_abs": 1e-7,
@@ -114,14 +114,14 @@ class OSQPBackend(QPBackend):
                 ws.solver.warm_start(x=np.zeros(nz), y=np.zeros(rows.shape[0]))
                 result = ws.solver.solve(raise_error=False)
                 iterations += int(result.info.iter)
-        except Exception as exc:
+            status = str(result.info.status)
+            x = finite_solution(result.x, nz) if status in ACCEPTED else None
+        except Exception as exc:  # raised, or answered something that is not a result
             self._workspaces.pop(qp.key, None)
             raise ProblemError(f"osqp: {exc}") from exc
         solve_time = time.perf_counter() - t0
-        status = str(result.info.status)
-        x = np.array(result.x) if status in ACCEPTED else None
-        if x is not None and not np.isfinite(x).all():
-            x, status = None, "non-finite solution"
+        if x is None and status in ACCEPTED:
+            status = "non-finite solution"
         ws.cold = x is None
         self._remember(qp, x)  # after a failure the next solve starts from zero
         return QPSolution(x, "solved" if x is not None else status, iterations, solve_time,

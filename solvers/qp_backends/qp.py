@@ -98,11 +98,48 @@ class Decoding(NamedTuple):
         return x if self.x0 is None else x + self.x0
 
 
+class QPSolution(NamedTuple):
+    """What a backend returned for one :class:`QP`.
+
+    Attributes:
+        x: Primal solution (nz,), or None when none was found. Within the backend's
+            tolerance only: the caller checks it and enforces the bounds exactly.
+        status: The backend's own status ("solved" when found).
+        iterations: Iterations used (0 where the backend does not say).
+        solve_time: Time spent in the backend's solver [s].
+        backend: Backend name.
+    """
+
+    x: Array | None
+    status: str
+    iterations: int
+    solve_time: float
+    backend: str
+
+
+def finite_solution(x: object, nz: int) -> Array | None:
+    """``x`` as a new finite real (nz,) float array, or None where it is not one.
+
+    What a solver library returned is checked here before it is an answer: None, a ragged
+    or non-numeric sequence, complex or boolean entries, the wrong shape and a non-finite
+    entry are no solution.
+    """
+    try:
+        z = np.asarray(x)
+    except (TypeError, ValueError, OverflowError):
+        return None
+    if z.dtype.kind not in "fiu" or z.shape != (nz,):
+        return None
+    z = np.array(z, dtype=np.float64)
+    return z if kernels.all_finite(z) else None
+
+
 class Solved(NamedTuple):
     """A backend's answer, checked and decoded.
 
     Attributes:
-        x: The decoded rates (n,).
+        x: The decoded rates (n,) (:func:`solve_checked`), or the solution z (nz,)
+            (:func:`checked`).
         backend: The backend's name.
         iterations: Its iterations.
         solve_time: Time in its solver [s].
@@ -128,18 +165,40 @@ def solve_checked(backend: QPBackend, qp: QP, decoding: Decoding) -> Solved:
         sol = backend.solve(qp)
     except Exception as exc:
         raise NumericalFailure(f"{backend.name}: {type(exc).__name__}: {exc}") from exc
-    z = sol.x
-    if z is None:
-        raise NumericalFailure(f"{sol.backend}: {sol.status}")
+    solved = checked(sol, qp.q.size, backend.name)
     limit = backend.time_limit
-    if limit is not None and sol.solve_time > limit:
-        raise NumericalFailure(f"{sol.backend}: took {sol.solve_time:.3g} s, past the time "
-                               f"limit {limit:.3g} s")  # fmt: skip
-    z = np.asarray(z, dtype=np.float64)
-    if z.shape != qp.q.shape or not kernels.all_finite(z.reshape(-1)):
-        raise NumericalFailure(f"{sol.backend}: answer of shape {z.shape}, finite "
-                               f"{bool(np.isfinite(z).all())}; expected {qp.q.shape}")  # fmt: skip
-    return Solved(decoding.rates(z), sol.backend, sol.iterations, sol.solve_time)
+    if limit is not None and solved.solve_time > limit:
+        raise NumericalFailure(f"{solved.backend}: took {solved.solve_time:.3g} s, past the "
+                               f"time limit {limit:.3g} s")  # fmt: skip
+    return solved._replace(x=decoding.rates(solved.x))
+
+
+def checked(sol: object, nz: int, name: str) -> Solved:
+    """A backend's answer ``sol`` checked field by field: its solution z (nz,) undecoded.
+
+    Raises:
+        NumericalFailure: ``sol`` is not a :class:`QPSolution`, has no solution, a solution
+            that is not a finite real (nz,) array (:func:`finite_solution`), or iterations
+            or a time that are not numbers >= 0.
+    """
+    if not isinstance(sol, QPSolution):
+        raise NumericalFailure(f"{name}: answered a {type(sol).__name__}, not a QPSolution")
+    label = sol.backend if isinstance(sol.backend, str) else name
+    if sol.x is None:
+        raise NumericalFailure(f"{label}: {sol.status}")
+    z = finite_solution(sol.x, nz)
+    if z is None:
+        what = (f"{sol.x.dtype} {sol.x.shape}" if isinstance(sol.x, np.ndarray)
+                else type(sol.x).__name__)  # fmt: skip
+        raise NumericalFailure(f"{label}: answer ({what}) is not a finite real ({nz},) array")
+    iterations, elapsed = sol.iterations, sol.solve_time
+    if not (isinstance(iterations, (int, np.integer)) and not isinstance(iterations, bool)
+            and iterations >= 0):  # fmt: skip
+        raise NumericalFailure(f"{label}: iterations {iterations!r}, not a count")
+    if not (isinstance(elapsed, (float, int, np.floating, np.integer))
+            and not isinstance(elapsed, bool) and 0.0 <= elapsed < math.inf):  # fmt: skip
+        raise NumericalFailure(f"{label}: solve time {elapsed!r}, not a time [s]")
+    return Solved(z, label, int(iterations), float(elapsed))
 
 
 @dataclass(slots=True)

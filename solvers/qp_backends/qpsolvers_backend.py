@@ -27,7 +27,7 @@ import numpy as np
 
 from rrc_pin.solvers.errors import ProblemError
 from rrc_pin.solvers.qp_backends.base import Array, QPBackend, QPSolution
-from rrc_pin.solvers.qp_backends.qp import QP
+from rrc_pin.solvers.qp_backends.qp import QP, finite_solution
 
 WIDTH = 1e-9
 """Relative width given to zero-width bounds and rows."""
@@ -79,20 +79,18 @@ class QpsolversBackend(QPBackend):
                     widened.problem(), solver=self.name, initvals=self._start(qp),
                     **self.options,
                 )  # fmt: skip
-        except Exception as exc:
+            solve_time = time.perf_counter() - t0
+            x = finite_solution(sol.x, qp.q.size) if sol.found is True else None
+            extras = sol.extras if isinstance(sol.extras, dict) else {}
+            iterations = int(np.max(extras.get("iterations", extras.get("iter", [0])), initial=0))
+        except Exception as exc:  # raised, or answered something that is not a Solution
             raise ProblemError(f"{self.name}: {exc}") from exc
-        solve_time = time.perf_counter() - t0
-        x = np.array(sol.x, dtype=np.float64) if sol.found and sol.x is not None else None
-        if x is not None and not np.isfinite(x).all():
-            x = None
         if x is not None:  # a failure keeps the last solution of the key as the next start:
             self._remember(qp, x)  # proxqp: 58 of 300 degenerate direction QPs refused, 100 if cold
-        extras = sol.extras if isinstance(sol.extras, dict) else {}
-        iterations = extras.get("iterations", extras.get("iter", 0))
         return QPSolution(
             None if x is None else x.copy(),  # the warm start is not the caller's
             "solved" if x is not None else "not found",
-            int(np.max(iterations)) if np.size(iterations) else 0,
+            iterations,
             solve_time,
             self.name,
         )

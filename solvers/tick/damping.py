@@ -37,12 +37,14 @@ from the command.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.checks import as_array, finite_number, integer, positive
+from rrc_pin.solvers.errors import InvalidInput
 from rrc_pin.solvers.tick import kernels
 
 Array = npt.NDArray[np.float64]
@@ -83,8 +85,38 @@ class Damping:
             scale: The LP maximum :math:`u^*` in [0, 1] of the exact command.
             along: :math:`|u_i^T b|` (k,), the command's size along each direction.
             dt: The step [s].
+
+        Raises:
+            InvalidInput: An argument of the wrong shape or type, non-finite or negative, a
+                rank beyond ``sigma``'s size or a scale outside [0, 1], named (before the
+                kernel reads them).
         """
+        sigma, along = _singular(sigma, along)
+        rank = integer(rank, "rank", 0, sigma.size)
+        scale = finite_number(scale, "scale", 0.0, upper=math.nextafter(1.0, 2.0))
+        dt = positive(dt, "dt")
         lam = np.empty(sigma.size)
         if not kernels.damping_lambda_sq(sigma, rank, scale, along, dt, float(self.threshold), lam):
             return None
-        return lam
+        return np.minimum(lam, _HUGE, out=lam)  # finite where sigma_1 or the command overflow
+
+
+_HUGE = float(np.finfo(np.float64).max)
+
+
+def _singular(sigma: Array, along: Array) -> tuple[Array, Array]:
+    """``sigma`` and ``along``: (k,) each, finite and >= 0.
+
+    Raises:
+        InvalidInput: Naming ``sigma, along`` where their sizes differ, else the one that is
+            bad.
+    """
+    out = []
+    for value, name in ((sigma, "sigma"), (along, "along")):
+        arr = as_array(value, name, (None,))
+        if (arr < 0.0).any():
+            raise InvalidInput(name, f"expected values >= 0, got {arr}")
+        out.append(arr)
+    if out[0].size != out[1].size:
+        raise InvalidInput("sigma, along", f"sizes differ: {out[0].size} and {out[1].size}")
+    return out[0], out[1]

@@ -271,7 +271,7 @@ def _top(
         else:
             qdot, null = least_squares(A, b, space, box, rows, backend, work, "least_squares",
                                        not last)  # fmt: skip
-        met = _met(A @ qdot, b)
+        met = _met(A @ qdot, b) and problem.rate_factor == 1.0
         status: Status = "recovering" if box.recovering or _broken(rows) else (
             "exact" if met else "least_squares")  # fmt: skip
         return _Top(qdot, status, *_along_command(problem, qdot), 0.0, null)
@@ -313,13 +313,13 @@ def _top(
             return _Top(w, "sliding", *_along_command(problem, w), 0.0, null)
         if outside_range:
             return _Top(w, "singular", *_along_command(problem, w), 0.0, null)
-        return _Top(w, "exact", 1.0, 0.0, 0.0, null)
+        return _met_top(problem, w, null)
     null = _null(factor, space)
     u_w = boxed if boxed is not None else _scaled(A, w, null, box, rows, backend, work)
     if slid:
         return _Top(u_w.qdot, "sliding", *_along_command(problem, u_w.qdot), 0.0, null)
     if not outside_range and u_w.u >= 1.0 - EXACT_TOL:
-        return _Top(u_w.qdot, "exact", 1.0, 0.0, 0.0, null)
+        return _met_top(problem, u_w.qdot, null)
     lam, usable = _damping(options.damping, factor, b, w, u_w.u, box, problem.dt, space.N is None)
     if lam is not None:
         z = usable.rates(b, lam)
@@ -333,6 +333,16 @@ def _top(
     if outside_range:
         return _Top(u_w.qdot, "singular", *_along_command(problem, u_w.qdot), 0.0, null)
     return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
+
+
+def _met_top(problem: Problem, qdot: Array, null: Array | None) -> _Top:
+    """The top level's stacked command met: ``exact`` where that is the command itself.
+
+    Else (a command divided down, :mod:`rrc_pin.solvers.tick.problem`) ``scaled`` by its factor.
+    """
+    if problem.rate_factor == 1.0:
+        return _Top(qdot, "exact", 1.0, 0.0, 0.0, null)
+    return _Top(qdot, "scaled", problem.rate_factor, 0.0, 0.0, null)
 
 
 SLIDE_DAMPING = 1e-2
@@ -550,7 +560,8 @@ def _level_status(status: Status) -> LevelStatus:
 def _served(problem: Problem, k: int, qdot: Array) -> LevelStatus:
     """How level ``k`` was served by ``qdot`` (:func:`served`)."""
     A, b = problem.stacked[k]
-    return served(A @ qdot, b)
+    status = served(A @ qdot, b)  # a command divided down (Problem.factors) met is scaled
+    return "scaled" if status == "met" and problem.factors[k] != 1.0 else status
 
 
 def served(y: Array, b: Array) -> LevelStatus:

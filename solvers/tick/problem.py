@@ -15,13 +15,16 @@ how the levels are solved (:data:`Mode`):
 - ``weighted``: one level, its tasks traded by their weights.
 
 Every level's stacked rows are made safe for the numerics here, once. Each level's weights are
-divided by their largest (the optimum does not change). The direction problem depends on the
-command's direction only, so a command is divided by its largest entry where it exceeds
-:data:`LARGE`. A least-squares level whose rates exceed :data:`SATURATION` times what its
-rows can reach within the box (``1 + max|A| sum_j max(|lb_j|, |ub_j|)``) is divided down to
-that along its direction: its optimum is then saturated against the box, and a longer
-command no longer changes it (capped at 1e100 instead, a tracking QP of panda hung proxqp
-for minutes: gradient 1e99 against a box of 2 rad/s).
+divided by their largest (the optimum does not change). A least-squares level whose rates
+exceed :data:`SATURATION` times what its rows can reach within the box
+(``1 + max|A| sum_j max(|lb_j|, |ub_j|)``, the box's finite sides) is divided down to that
+along its direction: its optimum is then saturated against the box, and a longer command no
+longer changes it (capped at 1e100 instead, a tracking QP of panda hung proxqp for minutes:
+gradient 1e99 against a box of 2 rad/s). A direction level's rates beyond :data:`LARGE` are
+divided down the same way (to at most :data:`LARGE`): the direction problem's answer is then
+the largest scale along the command that the box allows, as for any command beyond reach.
+The factor each level's rates were multiplied by is kept (``Problem.factors``): an answer
+that meets a divided command is a scale of the command, never the command itself.
 """
 
 from __future__ import annotations
@@ -41,8 +44,8 @@ Array = npt.NDArray[np.float64]
 Mode = Literal["direction", "least_squares", "weighted"]
 
 LARGE = 1e100
-"""[task units] A direction level's rates beyond this are divided by their largest entry
-(module docstring): their squares stay far from overflow (1e308)."""
+"""[task units] A direction level's rates beyond this are divided down to its reach (module
+docstring), and never left above it: their squares stay far from overflow (1e308)."""
 
 SATURATION = 1e6
 """A least-squares level's rates beyond this many times its reach within the box are divided
@@ -158,8 +161,9 @@ class Problem(NamedTuple):
         levels: The task rows by priority level, highest first.
         stacked: Per level, its rows and rates stacked ``(A, b)`` in the metric it is solved
             in (row-weighted; the direction level also divided by the rows' units).
-        rate_factor: The factor the top level's stacked rates were multiplied by (1 unless
-            they exceeded :data:`LARGE`): its scale of the command is that of ``b`` times it.
+        factors: Per level, the factor its stacked rates were multiplied by (1 unless they
+            were divided down, module docstring): a level's scale of its command is that of
+            ``b`` times it.
         box: The intersected joint-rate bounds.
         rows: The inequality rows, or None.
         equalities: The equality rows ``(C, d)``, or None.
@@ -170,7 +174,7 @@ class Problem(NamedTuple):
 
     levels: tuple[tuple[TaskRows, ...], ...]
     stacked: tuple[tuple[Array, Array], ...]
-    rate_factor: float
+    factors: tuple[float, ...]
     box: Box
     rows: Rows | None
     equalities: tuple[Array, Array] | None
@@ -182,6 +186,11 @@ class Problem(NamedTuple):
     def n(self) -> int:
         """Number of joint rates."""
         return self.box.lb.size
+
+    @property
+    def rate_factor(self) -> float:
+        """The factor the top level's stacked rates were multiplied by (``factors[0]``)."""
+        return self.factors[0] if self.factors else 1.0
 
 
 def build(
@@ -217,13 +226,13 @@ def build(
             mode = "least_squares"  # rates to keep: no scale of the command stands still
     else:
         mode = "least_squares"
-    stacked, rate_factor = [], 1.0
+    stacked, factors = [], []
     for k, level in enumerate(levels):
         A, b, factor = _stack(level, k == 0 and mode == "direction", box)
         stacked.append((A, b))
-        rate_factor = factor if k == 0 else rate_factor
+        factors.append(factor)
     kept = tuple(map(tuple, levels))
-    return Problem(kept, tuple(stacked), rate_factor, box, rows, equalities, equality_names,
+    return Problem(kept, tuple(stacked), tuple(factors), box, rows, equalities, equality_names,
                    mode, dt)  # fmt: skip
 
 
@@ -244,11 +253,11 @@ def _stack(tasks: Sequence[TaskRows], normalised: bool, box: Box) -> tuple[Array
     m = tasks[0].b.size if len(tasks) == 1 else sum(t.b.size for t in tasks)
     A, b = np.empty((m, tasks[0].A.shape[1])), np.empty(m)
     peak = _weighted(tasks, top, normalised, 1.0, A, b)
-    if normalised and peak > LARGE:  # the direction alone: b / its largest, before the
+    if normalised and peak > LARGE:  # the direction first: b / its largest, before the
         # rows' factors (up to 1 / MIN_REACH) could overflow
         scale = 1.0 / max(float(np.abs(t.b).max(initial=0.0)) for t in tasks)
-        _weighted(tasks, top, normalised, scale, A, b)
-        return A, b, scale
+        return _capped(A, b, _weighted(tasks, top, normalised, scale, A, b), normalised, box,
+                       scale)  # fmt: skip
     return _capped(A, b, peak, normalised, box)
 
 
@@ -272,17 +281,28 @@ def _weighted(
 
 
 def _capped(
-    A: Array, b: Array, peak: float, normalised: bool, box: Box
+    A: Array, b: Array, peak: float, normalised: bool, box: Box, factor: float = 1.0
 ) -> tuple[Array, Array, float]:
-    """``(A, b, factor)``: b times the factor that :func:`_stack` gives it (1 mostly)."""
-    if normalised:
-        return (A, b, 1.0) if peak <= LARGE else (A, b / peak, 1.0 / peak)
-    if peak <= SATURATION:  # within any reach of 1 or more: no need to look further
-        return A, b, 1.0
+    """``(A, b, factor)``: b as :func:`_stack` gives it (unchanged mostly), and its factor.
+
+    Args:
+        A: The level's stacked rows.
+        b: Its rates, the command's times ``factor``, their largest magnitude ``peak``.
+        peak: That magnitude.
+        normalised: The direction level (capped beyond :data:`LARGE`), else a least-squares
+            one (beyond :data:`SATURATION`).
+        box: The step's bounds, whose finite sides give the rows' reach.
+        factor: What the command's rates were already multiplied by (> 0).
+    """
+    command = peak / factor  # the command's own magnitude (inf beyond the float range)
+    if command <= (LARGE if normalised else SATURATION):
+        return A, b, factor
     sides = np.maximum(-box.lb, box.ub)
     reach = 1.0 + float(np.abs(A).max(initial=0.0)) * float(sides[np.isfinite(sides)].sum())
-    cap = SATURATION * reach
-    return (A, b, 1.0) if peak <= cap else (A, b * (cap / peak), cap / peak)
+    cap = min(SATURATION * reach, LARGE) if normalised else SATURATION * reach
+    if command <= cap:
+        return A, b, factor
+    return A, b * (cap / peak), factor * (cap / peak)
 
 
 @functools.cache

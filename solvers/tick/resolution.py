@@ -261,16 +261,16 @@ def active_limits(
         The active bounds, by joint then side (lower first).
     """
     out: list[ActiveLimit] = []
-    above = (qdot - box.lb).tolist()
-    below = (box.ub - qdot).tolist()
-    kinds = box.kind.tolist()
-    for j, (low, high) in enumerate(zip(above, below, strict=True)):
+    above = qdot - box.lb
+    below = box.ub - qdot
+    for j in np.flatnonzero((above <= ACTIVE_TOL) | (below <= ACTIVE_TOL)).tolist():
+        low, high, kinds = above[j], below[j], box.kind[:, j].tolist()
         name = names[j] if names else None
         if low <= ACTIVE_TOL:
-            kind = KIND_NAMES.get(kinds[0][j], "velocity")
+            kind = KIND_NAMES.get(kinds[0], "velocity")
             out.append(ActiveLimit(j, "lower", kind, float(box.lb[j]), name))
         if high <= ACTIVE_TOL:
-            kind = KIND_NAMES.get(kinds[1][j], "velocity")
+            kind = KIND_NAMES.get(kinds[1], "velocity")
             out.append(ActiveLimit(j, "upper", kind, float(box.ub[j]), name))
     return tuple(out)
 

@@ -67,8 +67,12 @@ class Situation:
 
 
 def to_base_axes(R: Array, twist: Array) -> Array:
-    """``[R v; R w]``: a hand-axes twist (6,) in base axes, ``R`` the hand's orientation."""
-    out: Array = (twist.reshape(2, 3) @ R.T).reshape(6)
+    """``[R v; R w]``: a hand-axes twist (6,) in base axes, ``R`` the hand's orientation.
+
+    Stacked alike: twists (n, 6) with orientations (n, 3, 3).
+    """
+    out: Array = (twist.reshape(*twist.shape[:-1], 2, 3) @ np.swapaxes(R, -1, -2)).reshape(
+        twist.shape)  # fmt: skip
     return out
 
 

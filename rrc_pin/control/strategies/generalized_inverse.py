@@ -8,6 +8,7 @@ from __future__ import annotations
 from rrc_pin.control.strategies.barker_arm import barker_closed_form
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
 from rrc_pin.robot import Robot
+from rrc_pin.solvers.checks import flag
 from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
 
 
@@ -27,7 +28,7 @@ class GeneralizedInverse(Strategy):
     chooses_rates = True
 
     def __init__(self, exact: bool = False) -> None:
-        self.exact = bool(exact)
+        self.exact = flag(exact, "exact")
         self.closed_form: BarkerClosedForm | None = None
 
     def check(self, robot: Robot) -> None:

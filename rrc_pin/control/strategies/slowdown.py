@@ -22,8 +22,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.control.strategies.base import Decision, Situation, Strategy
-from rrc_pin.errors import InvalidInput
-from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.checks import choice, finite_number
 
 Measure = Literal["sigma_min", "manipulability"]
 STEP = 1e-6
@@ -53,11 +52,7 @@ class Slowdown(Strategy):
         self, measure: Measure = "sigma_min", *, start: float = 0.05, stop: float = 0.005,
         rate: float = 4.0, release: float = 1.2,
     ) -> None:  # fmt: skip
-        if measure not in ("sigma_min", "manipulability"):
-            raise InvalidInput(
-                "measure", f"expected 'sigma_min' or 'manipulability', got {measure!r}"
-            )
-        self.measure: Measure = measure
+        self.measure: Measure = choice(measure, "measure", ("sigma_min", "manipulability"))  # type: ignore[assignment]
         self.stop = finite_number(stop, "stop", 0.0)
         self.start = finite_number(start, "start", self.stop, inclusive=False)
         self.rate = finite_number(rate, "rate", 0.0, inclusive=False)

@@ -1,0 +1,409 @@
+"""RecordRing: a controller's last ticks as columns of arrays, their records derived when read.
+
+A tick or a record is a tuple of named fields (a ``NamedTuple``: a tick's field names are
+those of the record fields it fills). Each field is one column, made at the first value it
+gets: a float is a float64 column, an array of numbers a (rows, *shape) column of its dtype,
+anything else (text, a mapping) an object column whose equal strings share one object. A
+row is then its numbers and a pointer per text field: a few hundred bytes a tick for an arm
+(docs/api.md, "The trajectory log's memory"), not the objects a tick was made of. A value
+that does not fit its column (another shape, a None) turns that column into an object
+column: nothing is refused or lost.
+
+A ring given ``compact`` keeps the ticks it is handed as they are, up to :data:`BATCH` of
+them, and turns them into rows a batch at a time (vectorised over the batch: a fraction of
+a microsecond a tick, where writing each tick's fields costs several).
+
+The columns grow by doubling up to the capacity, then the ring overwrites its oldest rows.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from typing import Any, Generic, TypeVar
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.errors import InvalidInput
+
+Array = npt.NDArray[np.float64]
+R = TypeVar("R", bound=tuple[Any, ...])
+
+CAPACITY = 60_000
+"""Ticks a log keeps by default: 10 minutes at 100 Hz (:attr:`RecordRing.capacity`)."""
+
+FIRST_ROWS = 256
+"""Rows the columns are made with; they double up to the capacity."""
+
+BATCH = 64
+"""Ticks a ring with ``compact`` keeps as they came before turning them into rows."""
+
+SHARED_TEXTS = 4096
+"""Distinct strings a ring shares between its rows (more are kept as they come)."""
+
+_NUMBER, _ARRAY, _OBJECT = 0, 1, 2
+"""Kinds of column (:func:`_column_for`)."""
+
+Plan = list[tuple[npt.NDArray[Any], int, tuple[int, ...]]]
+"""The columns of a kind of entry, in its fields' order, each with its kind and row shape."""
+
+
+class RecordRing(Generic[R]):
+    """The last ticks of a controller, in time order: a ring of records derived when read.
+
+    What every controller's log shares (:class:`~rrc_pin.control.TrajectoryLog` for one
+    arm, :class:`~rrc_pin.cells.controller.CellLog` for a cell): a controller appends its
+    ticks as they are (:meth:`append_tick`) and the log derives their records when it is
+    read (``records``, in place: once); the ring keeps the last ``capacity`` ticks
+    (appending to a full log forgets the oldest, :attr:`dropped` counts them), and
+    :meth:`positions` gives the joint positions ``Controller.reverse`` retraces without
+    deriving a record. Storage: the module docstring.
+
+    Args:
+        derive: Makes the record of a tick (the controller's), or None for a log of records
+            only.
+        capacity: Ticks kept, >= 1 (default :data:`CAPACITY`: 10 minutes at 100 Hz);
+            settable (a smaller one forgets the oldest ticks at once).
+        compact: Turns a list of the ticks passed to :meth:`append_tick` (oldest first) into
+            what ``derive`` takes, one ``NamedTuple`` whose fields hold one row per tick
+            (arrays, the first axis the ticks'), or None: each tick is stored as it comes.
+
+    Raises:
+        InvalidInput: ``derive`` or ``compact`` not callable, or a bad ``capacity``, named.
+    """
+
+    record_type: type[tuple[Any, ...]] = tuple
+    """The records' class (:meth:`append` refuses others); a record's second field is q."""
+
+    def __init__(
+        self, derive: Callable[[Any], R] | None = None, capacity: int = CAPACITY, *,
+        compact: Callable[[list[Any]], tuple[Any, ...]] | None = None,
+    ) -> None:  # fmt: skip
+        for name, value in (("derive", derive), ("compact", compact)):
+            if value is not None and not callable(value):
+                raise InvalidInput(name, f"expected a callable or None, got {value!r}")
+        self._capacity = _checked_capacity(capacity)
+        self._derive = derive
+        self._compact = compact
+        self._raw: list[Any] = []  # ticks as they came, not yet rows (with ``compact``)
+        self._columns: dict[str, npt.NDArray[Any]] = {}
+        self._rows = 0  # rows every column has
+        self._start = 0  # the row of the oldest entry
+        self._size = 0
+        self._pending = 0  # the newest entries, ticks not yet derived
+        self._tick: tuple[type, tuple[str, ...]] | None = None  # the ticks' class and fields
+        self._fields: tuple[str, ...] = getattr(self.record_type, "_fields", ())  # records'
+        self._texts: dict[str, str] = {}  # one object per string (SHARED_TEXTS of them)
+        self._plans: dict[tuple[type, int], Plan] = {}  # per kind of entry, its columns
+        self._dropped = 0
+
+    @property
+    def dropped(self) -> int:
+        """Ticks forgotten because the log was full (the oldest first)."""
+        self._flush()
+        return self._dropped
+
+    def __len__(self) -> int:
+        return min(self._size + len(self._raw), self._capacity)
+
+    def __iter__(self) -> Iterator[R]:
+        return iter(self.records)
+
+    @property
+    def capacity(self) -> int:
+        """Ticks kept (the oldest forgotten beyond), >= 1."""
+        return self._capacity
+
+    @capacity.setter
+    def capacity(self, value: int) -> None:
+        value = _checked_capacity(value)
+        self._flush()
+        keep = min(self._size, value)
+        self._dropped += self._size - keep
+        order = self._order()[self._size - keep:]
+        rows = min(value, max(keep, FIRST_ROWS))
+        for name, column in self._columns.items():
+            fresh = np.empty((rows, *column.shape[1:]), column.dtype)
+            fresh[:keep] = column[order]
+            self._columns[name] = fresh
+        self._plans.clear()
+        self._rows = rows if self._columns else 0
+        self._start, self._size = 0, keep
+        self._pending = min(self._pending, keep)
+        self._capacity = value
+
+    @property
+    def records(self) -> list[R]:
+        """The records kept, in time order, as a new list (the ticks pending derived now)."""
+        self._derive_pending()
+        return [self._record(row) for row in self._order().tolist()]
+
+    def __getitem__(self, index: int) -> R:
+        """Record ``index`` (negative from the newest), without making the others.
+
+        Raises:
+            IndexError: No such record.
+        """
+        if isinstance(index, bool) or not isinstance(index, (int, np.integer)):
+            raise TypeError(f"record indices are integers, not {type(index).__name__}")
+        self._derive_pending()
+        if not -self._size <= index < self._size:
+            raise IndexError(f"record {index} of {self._size}")
+        return self._record(self._row(int(index) % self._size))
+
+    def append(self, record: R) -> None:
+        """Add one tick's record (forgetting the oldest tick when the log is full).
+
+        Raises:
+            InvalidInput: ``record`` is not a :attr:`record_type`.
+        """
+        if not isinstance(record, self.record_type):
+            raise InvalidInput("record", f"expected a {self.record_type.__name__}, got "
+                               f"{type(record).__name__}")  # fmt: skip
+        self._derive_pending()  # they are older
+        self._fields = self._fields or _fields(record)
+        self._store(self._push(1)[0], record)
+
+    def append_tick(self, tick: Any) -> None:
+        """Add one tick, its record derived when the log is read (``derive``).
+
+        Args:
+            tick: What ``compact`` takes, one tick; without ``compact``, what ``derive``
+                takes: a tuple that starts as its record, ``(t, q, ...)`` (a ``NamedTuple``
+                whose field names are those of the record it fills).
+        """
+        if self._derive is None:
+            raise InvalidInput("tick", "this log has no derive: append records")
+        if self._compact is not None:
+            self._raw.append(tick)
+            if len(self._raw) >= BATCH:
+                self._flush()
+            return
+        if self._tick is None or type(tick) is not self._tick[0]:
+            self._tick = (type(tick), _fields(tick))
+        self._store(self._push(1)[0], tick)
+        self._pending = min(self._pending + 1, self._size)
+
+    def positions(self, n: int) -> list[Array]:
+        """Joint positions ``q`` of the last ``n`` ticks kept, oldest first, no record derived.
+
+        (What ``Controller.reverse`` retraces: reading ``records`` after a long session
+        would derive every record first.)
+
+        Raises:
+            InvalidInput: ``n`` is not an integer >= 0.
+        """
+        if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
+            raise InvalidInput("n", f"expected an integer >= 0, got {n!r}")
+        self._flush()
+        n = min(int(n), self._size)
+        if not n:
+            return []
+        column = self._columns[self._q_name()]
+        return [_value(column, row) for row in self._order()[self._size - n:].tolist()]
+
+    def clear(self) -> None:
+        """Forget every record (the columns are kept for the next ones)."""
+        self._raw.clear()
+        self._start = self._size = self._pending = 0
+
+    def column_values(self, name: str) -> npt.NDArray[Any]:
+        """Field ``name`` of every record kept, in time order: a new (N, ...) array.
+
+        Raises:
+            KeyError: No record has that field.
+        """
+        self._derive_pending()
+        if not self._size:
+            return np.empty(0)
+        return self._columns[name][self._order()]
+
+    # -- storage -----------------------------------------------------------------------------
+
+    def _order(self) -> npt.NDArray[np.intp]:
+        """The rows of the entries kept, oldest first."""
+        return (self._start + np.arange(self._size)) % max(self._rows, 1)
+
+    def _row(self, i: int) -> int:
+        """The row of entry ``i`` (0 the oldest)."""
+        return (self._start + i) % self._rows
+
+    def _push(self, n: int) -> npt.NDArray[np.intp]:
+        """The rows of ``n`` new newest entries: free ones, else the oldest, forgotten."""
+        wanted = min(self._capacity, self._size + n)
+        if wanted > self._rows:
+            self._grow(min(self._capacity, max(FIRST_ROWS, 2 * self._rows, wanted)))
+        rows = (self._start + self._size + np.arange(n)) % self._rows
+        over = max(0, self._size + n - self._capacity)
+        self._dropped += over
+        self._start = (self._start + over) % self._rows
+        self._size = min(self._size + n, self._capacity)
+        return rows[n - min(n, self._capacity):]  # of a batch larger than the ring: its last
+
+    def _grow(self, rows: int) -> None:
+        """Every column to ``rows`` rows, the entries kept in order from row 0."""
+        order = self._order()
+        for name, column in self._columns.items():
+            fresh = np.empty((rows, *column.shape[1:]), column.dtype)
+            fresh[: self._size] = column[order]
+            self._columns[name] = fresh
+        self._plans.clear()
+        self._rows, self._start = rows, 0
+
+    def _flush(self) -> None:
+        """The ticks kept as they came, made rows (``compact``), pending their records."""
+        if not self._raw:
+            return
+        assert self._compact is not None  # only append_tick with compact keeps them
+        batch = self._compact(self._raw)
+        n = len(self._raw)
+        self._raw = []
+        self._tick = (type(batch), _fields(batch))
+        rows = self._push(n)
+        skip = n - rows.size  # a batch longer than the ring: its last ticks
+        for name, values in zip(self._tick[1], batch, strict=True):
+            numbers = isinstance(values, np.ndarray) and values.dtype.kind in "biuf"
+            column = self._columns.get(name)
+            if column is None:
+                column = self._columns[name] = (
+                    np.empty((self._rows, *values.shape[1:]), values.dtype) if numbers
+                    else np.empty(self._rows, dtype=object))  # fmt: skip
+            elif column.dtype != object and not (numbers and values.shape[1:] == column.shape[1:]):
+                column = self._columns[name] = self._as_objects(column)
+            if column.dtype == object:
+                column[rows] = self._objects(list(values)[skip:])
+            else:
+                column[rows] = values[skip:]
+        self._plans.clear()
+        self._pending = min(self._pending + n, self._size)
+
+    def _objects(self, values: list[Any]) -> npt.NDArray[Any]:
+        """``values`` as an object array, equal strings one object (:data:`SHARED_TEXTS`)."""
+        texts = self._texts
+        out = np.empty(len(values), dtype=object)
+        for k, value in enumerate(values):
+            if type(value) is str:
+                known = texts.get(value)
+                if known is None and len(texts) < SHARED_TEXTS:
+                    texts[value] = value
+                value = value if known is None else known
+            out[k] = value
+        return out
+
+    def _store(self, row: int, entry: tuple[Any, ...]) -> None:
+        """Write ``entry``'s fields into ``row`` of their columns."""
+        key = (type(entry), len(entry))  # plain tuples: their length tells them apart
+        plan = self._plans.get(key)
+        if plan is None:
+            plan = self._plans[key] = self._plan(entry)
+        texts = self._texts
+        for (column, kind, shape), value in zip(plan, entry, strict=True):
+            if kind == _OBJECT:
+                column[row] = texts.get(value, value) if type(value) is str else value
+            elif kind == _NUMBER and (type(value) is float or isinstance(value, np.floating)):
+                column[row] = value
+            elif (kind == _ARRAY and type(value) is np.ndarray and value.shape == shape
+                  and value.dtype == column.dtype):  # fmt: skip
+                column[row] = value
+            else:  # a value its column cannot hold: the column holds objects from now on
+                self._plans.clear()
+                self._store_slowly(row, entry)
+                return
+        if len(texts) < SHARED_TEXTS:
+            for value in entry:
+                if type(value) is str and value not in texts:
+                    texts[value] = value
+
+    def _plan(self, entry: tuple[Any, ...]) -> Plan:
+        """The columns of ``entry``'s fields (made where missing), each with its kind."""
+        out = []
+        for name, value in zip(_fields(entry), entry, strict=True):
+            column = self._columns.get(name)
+            if column is None:
+                column = self._columns[name] = _column_for(value, self._rows)
+            kind = _OBJECT if column.dtype == object else _NUMBER if column.ndim == 1 else _ARRAY
+            out.append((column, kind, column.shape[1:]))
+        return out
+
+    def _store_slowly(self, row: int, entry: tuple[Any, ...]) -> None:
+        """:meth:`_store` where a column must first become an object column."""
+        for name, value in zip(_fields(entry), entry, strict=True):
+            column = self._columns.get(name)
+            if column is None:
+                column = self._columns[name] = _column_for(value, self._rows)
+            elif not _fits(column, value):
+                column = self._columns[name] = self._as_objects(column)
+            column[row] = value
+
+    def _as_objects(self, column: npt.NDArray[Any]) -> npt.NDArray[Any]:
+        """``column`` as an object column holding the same values."""
+        out = np.empty(self._rows, dtype=object)
+        for row in self._order().tolist():
+            out[row] = _value(column, row)
+        return out
+
+    def _record(self, row: int) -> R:
+        """The record stored in ``row`` (new arrays: the ring reuses its rows)."""
+        values = (_value(self._columns[name], row) for name in self._fields)
+        if self.record_type is tuple:
+            return tuple(values)  # type: ignore[return-value]
+        return self.record_type(*values)  # type: ignore[return-value]
+
+    def _derive_pending(self) -> None:
+        """Turn the ticks not yet derived into their records, in their rows."""
+        self._flush()
+        if not self._pending:
+            return
+        assert self._derive is not None and self._tick is not None  # append_tick's checks
+        kind, names = self._tick
+        for row in self._order()[self._size - self._pending:].tolist():
+            values = [_value(self._columns[n], row) for n in names]
+            record = self._derive(kind(*values) if hasattr(kind, "_fields") else kind(values))
+            self._fields = self._fields or _fields(record)
+            self._store(row, record)
+        self._pending = 0
+
+    def _q_name(self) -> str:
+        """The name of the entries' second field, q (a record's, else a tick's)."""
+        names = self._fields or (self._tick[1] if self._tick is not None else ())
+        return names[1]
+
+
+def _fields(entry: tuple[Any, ...]) -> tuple[str, ...]:
+    """An entry's field names: a NamedTuple's, else its positions."""
+    names: tuple[str, ...] | None = getattr(entry, "_fields", None)
+    return names if names is not None else tuple(str(i) for i in range(len(entry)))
+
+
+def _column_for(value: Any, rows: int) -> npt.NDArray[Any]:
+    """An empty column of ``rows`` rows for values like ``value`` (module docstring)."""
+    if isinstance(value, (float, np.floating)):
+        return np.empty(rows, np.float64)
+    if isinstance(value, np.ndarray) and value.dtype.kind in "biuf":
+        return np.empty((rows, *value.shape), value.dtype)
+    return np.empty(rows, dtype=object)
+
+
+def _fits(column: npt.NDArray[Any], value: Any) -> bool:
+    """Whether ``value`` is stored in ``column`` as it is."""
+    if column.dtype == object:
+        return True
+    if column.ndim == 1:
+        return isinstance(value, (float, np.floating))
+    return (isinstance(value, np.ndarray) and value.shape == column.shape[1:]
+            and value.dtype == column.dtype)  # fmt: skip
+
+
+def _value(column: npt.NDArray[Any], row: int) -> Any:
+    """The value in ``row``: a float, a new array, or the object stored."""
+    if column.dtype == object:
+        return column[row]
+    if column.ndim == 1:
+        return float(column[row])
+    return column[row].copy()
+
+
+def _checked_capacity(value: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+        raise InvalidInput("capacity", f"expected an integer >= 1 (ticks), got {value!r}")
+    return int(value)

@@ -1,0 +1,204 @@
+"""RecordRing: ticks and records kept as columns of arrays, in time order, within a capacity."""
+
+from __future__ import annotations
+
+import gc
+import tracemalloc
+from typing import NamedTuple
+
+import numpy as np
+import pytest
+
+import rrc_pin
+from rrc_pin.control import Controller
+from rrc_pin.control.record_ring import BATCH, CAPACITY, FIRST_ROWS, RecordRing
+
+
+class Rec(NamedTuple):
+    t: float
+    q: np.ndarray
+    label: str
+    extra: object
+
+
+class Tick(NamedTuple):
+    t: float
+    q: np.ndarray
+
+
+class Ring(RecordRing[Rec]):
+    record_type = Rec
+
+
+def rec(k: int) -> Rec:
+    return Rec(float(k), np.array([k, -k], float), f"label {k % 3}", {"k": k})
+
+
+def derive(tick: Tick) -> Rec:
+    return Rec(tick.t, tick.q, "derived", None)
+
+
+def test_records_come_back_in_order_through_growth_and_wrap() -> None:
+    ring = Ring(capacity=FIRST_ROWS * 3)  # grows 256 -> 512 -> 768, then wraps
+    for k in range(FIRST_ROWS * 4 + 7):
+        ring.append(rec(k))
+    assert len(ring) == FIRST_ROWS * 3 and ring.dropped == FIRST_ROWS + 7
+    first = FIRST_ROWS + 7
+    assert [r.t for r in ring.records] == [float(k) for k in range(first, FIRST_ROWS * 4 + 7)]
+    r = ring[-1]
+    assert r.q.tolist() == [FIRST_ROWS * 4 + 6, -(FIRST_ROWS * 4 + 6)] and r.extra == {
+        "k": FIRST_ROWS * 4 + 6}  # fmt: skip
+    assert ring[0].t == first and ring[-len(ring)].t == first
+    with pytest.raises(IndexError):
+        ring[len(ring)]
+    np.testing.assert_array_equal(ring.column_values("t"), np.arange(first, FIRST_ROWS * 4 + 7))
+
+
+def test_what_is_read_is_a_copy_the_ring_reuses_its_rows() -> None:
+    ring = Ring(capacity=3)
+    for k in range(3):
+        ring.append(rec(k))
+    old, q = ring[0], ring.positions(1)[0]
+    q[:] = 99.0
+    for k in range(3, 9):  # every row overwritten twice
+        ring.append(rec(k))
+    assert old.t == 0.0 and old.q.tolist() == [0.0, 0.0] and ring[-1].q.tolist() == [8.0, -8.0]
+
+
+def test_equal_strings_share_one_object() -> None:
+    ring = Ring()
+    for k in range(30):
+        ring.append(rec(k)._replace(label="".join(["lab", "el"])))  # a new object each time
+    labels = ring.column_values("label")
+    assert len({id(x) for x in labels}) == 1
+
+
+def test_a_value_that_does_not_fit_its_column_is_kept_as_it_is() -> None:
+    ring = Ring()
+    ring.append(rec(0))
+    ring.append(Rec(None, np.zeros(3), "x", 1))  # type: ignore[arg-type]
+    ring.append(rec(2))
+    got = ring.records
+    assert got[0].t == 0.0 and got[1].t is None and got[2].t == 2.0
+    assert got[1].q.shape == (3,) and got[0].q.tolist() == [0.0, 0.0]
+
+
+def test_capacity_shrinks_and_grows_keeping_the_newest() -> None:
+    ring = Ring(capacity=10)
+    for k in range(10):
+        ring.append(rec(k))
+    ring.capacity = 4
+    assert [r.t for r in ring] == [6.0, 7.0, 8.0, 9.0] and ring.dropped == 6
+    ring.capacity = 1000
+    for k in range(10, 300):
+        ring.append(rec(k))
+    assert len(ring) == 294 and ring[0].t == 6.0 and ring[-1].t == 299.0
+    ring.clear()
+    assert len(ring) == 0 and ring.records == [] and ring.positions(5) == []
+    ring.append(rec(5))
+    assert [r.t for r in ring] == [5.0]
+
+
+def test_ticks_are_derived_once_when_read_and_positions_need_none() -> None:
+    calls: list[float] = []
+
+    def counted(tick: Tick) -> Rec:
+        calls.append(tick.t)
+        return derive(tick)
+
+    ring = Ring(counted, capacity=5)
+    for k in range(8):
+        ring.append_tick(Tick(float(k), np.array([k, 0.0])))
+    assert [q[0] for q in ring.positions(3)] == [5.0, 6.0, 7.0] and calls == []
+    assert [r.label for r in ring.records] == ["derived"] * 5
+    assert len(ring.records) == 5 and calls == [3.0, 4.0, 5.0, 6.0, 7.0]  # derived once
+    ring.append(rec(8))
+    assert calls == [3.0, 4.0, 5.0, 6.0, 7.0] and ring[-1].label == "label 2"
+
+
+def compact(ticks: list[tuple[float, float]]) -> Tick:
+    """Ticks ``(t, x)`` as one Tick of arrays: q = (x, 0)."""
+    t = np.array([k[0] for k in ticks])
+    return Tick(t, np.stack([np.array([k[1] for k in ticks]), np.zeros(len(ticks))], axis=1))
+
+
+def test_a_compacting_ring_makes_rows_a_batch_at_a_time() -> None:
+    calls: list[int] = []
+
+    def counted(ticks: list[tuple[float, float]]) -> Tick:
+        calls.append(len(ticks))
+        return compact(ticks)
+
+    ring = Ring(derive, capacity=100, compact=counted)
+    for k in range(BATCH + 5):
+        ring.append_tick((float(k), float(k)))
+    assert calls == [BATCH] and len(ring) == BATCH + 5  # five kept as they came
+    assert [q[0] for q in ring.positions(2)] == [BATCH + 3.0, BATCH + 4.0] and calls == [BATCH, 5]
+    for k in range(BATCH + 5, 250):
+        ring.append_tick((float(k), float(k)))
+    assert len(ring) == 100 and ring.dropped == 150  # reading dropped makes the rows first
+    assert [r.t for r in ring] == [float(k) for k in range(150, 250)]
+    assert ring[-1].label == "derived" and ring[-1].q.tolist() == [249.0, 0.0]
+    small = Ring(derive, capacity=3, compact=compact)  # one batch longer than the ring
+    for k in range(BATCH):
+        small.append_tick((float(k), 0.0))
+    assert [r.t for r in small] == [BATCH - 3.0, BATCH - 2.0, BATCH - 1.0]
+    assert small.dropped == BATCH - 3
+    small.append_tick((99.0, 0.0))
+    small.clear()
+    assert len(small) == 0 and small.records == []
+
+
+def test_plain_tuples_and_bad_arguments() -> None:
+    ring: RecordRing[tuple] = RecordRing(lambda tick: (*tick, "x"))
+    ring.append_tick((0.0, np.zeros(2)))
+    assert ring.records[0][2] == "x" and ring.positions(1)[0].tolist() == [0.0, 0.0]
+    with pytest.raises(rrc_pin.InvalidInput, match="capacity"):
+        RecordRing(capacity=0)
+    with pytest.raises(rrc_pin.InvalidInput, match="derive"):
+        RecordRing(derive=3)  # type: ignore[arg-type]
+    with pytest.raises(rrc_pin.InvalidInput, match="record"):
+        Ring().append((0.0, np.zeros(2), "", None))  # type: ignore[arg-type]
+    with pytest.raises(rrc_pin.InvalidInput, match="tick"):
+        Ring().append_tick(Tick(0.0, np.zeros(2)))
+
+
+TICKS = 16 * BATCH
+"""Ticks the memory test logs: a multiple of the batch, so none is left pending."""
+
+
+def test_a_tick_of_the_controllers_log_costs_a_few_hundred_bytes(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Issue 38: the log kept each tick's resolution (3.4-3.5 kB a tick pending, 1.1-1.3 kB
+    derived; 212-225 MB at 60,000 ticks). Its columns now: 242 B a tick pending and 323 B
+    derived for panda (8 (19 + 2 nq) + 48 B and its strings), measured here by tracemalloc
+    over 1,024 ticks (the controller's own 128 ticks in turn: stepping it under tracemalloc
+    cost minutes without the compiler); at the default capacity under 32 MB."""
+    ctl = Controller(rrc_pin.load("panda"))
+    log = ctl.log
+    log.capacity = TICKS
+    rng = np.random.default_rng(0)
+    seen: list[object] = []
+    append = log.append_tick
+    monkeypatch.setattr(log, "append_tick", lambda tick: (seen.append(tick), append(tick)))
+    for k in range(128):  # the kernels, the caches and the first columns warmed up too
+        ctl.step(rng.normal(size=6) * 0.1 if k % 16 == 0 else None, ref="local")
+    monkeypatch.undo()
+    log.clear()
+    gc.collect()
+    tracemalloc.start()
+    try:
+        before = tracemalloc.get_traced_memory()[0]
+        for k in range(TICKS):
+            log.append_tick(seen[k % len(seen)])
+        assert log.dropped == 0  # (the last batch of ticks made rows)
+        gc.collect()
+        pending = (tracemalloc.get_traced_memory()[0] - before) / TICKS
+        assert len(log.records) == TICKS
+        gc.collect()
+        derived = (tracemalloc.get_traced_memory()[0] - before) / TICKS
+    finally:
+        tracemalloc.stop()
+    assert 150 < pending < 400 and 200 < derived < 400, (pending, derived)
+    assert derived * CAPACITY < 32e6
