@@ -50,6 +50,8 @@ SEGMENT = 20
 """Ticks of one segment."""
 SIZES = (1.0, 1.0, 1.0, 1e-3, 10.0, 300.0)
 """Factors on a segment's commands, drawn uniformly."""
+STILL = 1e-9
+"""A scale below this stands still along the command: its veer is not compared."""
 SEED = 20261206
 """The recording's seed (every case draws from ``(SEED, its index)``)."""
 
@@ -296,12 +298,14 @@ def differences(data: Any, name: str, now: dict[str, Any]) -> dict[str, Any]:
     scale = np.maximum(1.0, np.abs(old["qdot"]).max(axis=1))
     rates = np.abs(now["qdot"] - old["qdot"]).max(axis=1) / scale
     same = {key: old[key] == now[key] for key in ("status", "method", "levels")}
+    moving = np.maximum(old["scale"], now["scale"]) > STILL
+    # the angle of rates standing still along the command is the rounding of a zero's
     return {
         "ticks": k,
         "rates": float(rates.max(initial=0.0)),
         "worst": int(rates.argmax()) if k else -1,
         "scale": float(np.abs(now["scale"] - old["scale"]).max(initial=0.0)),
-        "veer": float(np.abs(now["veer"] - old["veer"]).max(initial=0.0)),
+        "veer": float(np.abs(now["veer"] - old["veer"])[moving].max(initial=0.0)),
         "differ": {key: np.flatnonzero(~s).tolist() for key, s in same.items() if not s.all()},
         "status": old["status"],
         "per_tick": rates,

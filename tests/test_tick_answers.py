@@ -25,9 +25,14 @@ finally:
     sys.path.remove(str(ROOT / "benchmarks"))
 
 DATA = ROOT / "tests" / "data" / "tick_answers.npz"
-TOL = 1e-9
-"""Relative difference of the rates allowed: the recording's CPU may round otherwise (the same
-machine answers within 1e-12)."""
+TOL = 1e-8
+"""Relative difference of the rates and scales allowed. The kernels' answers agree to 1e-14 on
+the recording's machine; a QP the backend answers moves with the last bits of its data (the
+compiled tick forms them in its own loops, not numpy's BLAS): up to 1.1e-9 here, on a strict
+stack whose damped rates DAQP scales. Another CPU rounds otherwise too."""
+VEER_TOL = 1e-7
+"""[rad] The veer of rates along the command is the arccosine of a cosine within rounding of 1:
+a difference of 1e-16 in it reads 1.5e-8 rad."""
 
 
 @pytest.fixture(scope="module")
@@ -51,4 +56,4 @@ def test_recorded_ticks_answered_alike(recorded: dict[str, np.ndarray], name: st
     assert found["ticks"] == len(recorded[f"{name}/qdot"]) >= 20
     assert found["differ"] == {}, f"{name}: ticks with another status, method or levels"
     assert found["rates"] <= TOL, f"{name}: tick {found['worst']}"
-    assert found["scale"] <= TOL and found["veer"] <= TOL
+    assert found["scale"] <= TOL and found["veer"] <= VEER_TOL

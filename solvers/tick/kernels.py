@@ -44,6 +44,19 @@ def kernel(function: F) -> F:
     return cast(F, njit(cache=True)(function))
 
 
+def inlined(function: F) -> F:
+    """``numba.njit(cache=True, inline="always")``: compiled into each compiled caller.
+
+    At numba's IR, not apart: for the compiled tick's glue between its kernels.
+
+    A kernel that calls another links the callee's code into its own and LLVM optimises it
+    again there, so along a chain of compiled wrappers the kernels at its end are optimised
+    once per link. Inlined, the glue is optimised once, in the tick's entry, and each kernel
+    twice: on its own and there (docs/benchmarks.md, "Compiling the tick").
+    """
+    return cast(F, njit(cache=True, inline="always")(function))
+
+
 # -- the step's joint box ---------------------------------------------------------------------
 
 
