@@ -28,6 +28,7 @@ default) with the same distances; pink's barrier gain 1, d_min 0.02, every pair 
 
 from __future__ import annotations
 
+import math
 import os
 import sys
 import time
@@ -243,7 +244,7 @@ def _table(results: dict[str, Any], full: bool) -> str:
     for n in sets:
         by = {r["contender"]: r for r in rows if r["pairs"] == n}
         cells = [f"{by[lb]['median_us']:,.0f} / {by[lb]['p99_us']:,.0f} | "
-                 f"{by[lb]['min_distance_m'] * 1e3:.1f}" for lb in labels]  # fmt: skip
+                 f"{_millimetres(by[lb]['min_distance_m'])}" for lb in labels]  # fmt: skip
         line = f"| {n} | " + " | ".join(cells) + " |"
         ours = by.get(Rrc.label, {})
         if full and "limit_median_us" in ours:
@@ -254,10 +255,17 @@ def _table(results: dict[str, Any], full: bool) -> str:
     load = results.get("load_average", {})
     start, end = (load.get(k, [float("nan")])[0] for k in ("start", "end"))
     s = results["settings"]
+    never = "" if all(math.isfinite(r["min_distance_m"]) for r in rows) else (
+        f" min -: no pair came within the detection distance ({s['detection'] * 1e3:.0f} mm).")
     lines += ["", f"Safety {s['safety'] * 1e3:.0f} mm, {s['ticks']:,} ticks a pair set, "
               f"interleaved in one process; load average {start:.1f} at the start, {end:.1f} "
-              "at the end (2 cores)."]  # fmt: skip
+              f"at the end (2 cores).{never}"]  # fmt: skip
     return "\n".join(lines)
+
+
+def _millimetres(distance: float) -> str:
+    """A minimum distance [m] in mm, or ``-`` where no pair came near (infinite)."""
+    return f"{distance * 1e3:.1f}" if math.isfinite(distance) else "-"
 
 
 def readme_table(results: dict[str, Any]) -> str:
@@ -294,11 +302,17 @@ def plot(results: dict[str, Any], path: Path) -> bool:
         if all("limit_median_us" in r for r in rows):
             ax[0].plot(x, [r["limit_median_us"] for r in rows], "s--", color=line.get_color(),
                        label=f"{label}: the limit's share")  # fmt: skip
-        ax[1].plot(x, [r["min_distance_m"] * 1e3 for r in rows], "o-", label=label)
+        near = [(n, r["min_distance_m"] * 1e3) for n, r in zip(x, rows, strict=True)
+                if math.isfinite(r["min_distance_m"])]  # fmt: skip
+        never = [n for n, r in zip(x, rows, strict=True) if not math.isfinite(r["min_distance_m"])]
+        note = f" (no pair within {DETECTION * 1e3:.0f} mm at {never} pairs: not drawn)"
+        ax[1].plot([n for n, _ in near], [d for _, d in near], "o-", color=line.get_color(),
+                   label=label + (note if never else ""))  # fmt: skip
     ax[0].set(xscale="log", yscale="log", xlabel="pairs", ylabel="step median [us]")
-    ax[1].axhline(SAFETY * 1e3, color="gray", ls="--")
+    ax[1].axhline(SAFETY * 1e3, color="gray", ls="--", label="safety distance")
     ax[1].set(xscale="log", xlabel="pairs", ylabel="minimum distance [mm]")
     ax[0].legend(fontsize=8)
+    ax[1].legend(fontsize=7)
     mark_quick(fig, results)
     fig.tight_layout()
     fig.savefig(path, dpi=110)

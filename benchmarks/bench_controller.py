@@ -121,7 +121,7 @@ def session(name: str, minutes: float, corrected: bool) -> dict[str, Any]:
     clock = time.perf_counter
     for k, twist in enumerate(commands):
         start = clock()
-        ctl.step(twist)
+        ctl.step(twist, ref="local")
         seconds[k] = clock() - start
     log = ctl.log
     q, qdot, t = log.column("q"), log.column("qdot"), log.column("t")

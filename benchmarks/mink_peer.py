@@ -175,7 +175,7 @@ def mink_step(
         configuration.update(qpos)
         for i, (frame, task) in enumerate(zip(frames, hands, strict=True)):
             T = pin.SE3(configuration.get_transform_frame_to_world(frame, "body").as_matrix())
-            moved = advance(T, x[6 * i : 6 * i + 6], dt, local=False).homogeneous
+            moved = advance(T, x[6 * i : 6 * i + 6], dt, "world_aligned").homogeneous
             task.set_target(mink.SE3.from_matrix(moved))
         v = mink.solve_ik(configuration, tasks, dt, solver, limits=limits)
         return v[index]

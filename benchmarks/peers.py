@@ -164,7 +164,7 @@ def pink_step(
         configuration.update(q)
         for i, (frame, task) in enumerate(zip(frames, hands, strict=True)):
             T = configuration.get_transform_frame_to_world(frame)
-            task.set_target(advance(T, x[6 * i : 6 * i + 6], dt, local=False))
+            task.set_target(advance(T, x[6 * i : 6 * i + 6], dt, "world_aligned"))
         return pink.solve_ik(
             configuration, tasks, dt, solver=QP_SOLVER, limits=limits, safety_break=False
         )

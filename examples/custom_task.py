@@ -54,4 +54,4 @@ moved = arm.fk(q)[:3, 3] - start
 print(f"after {ticks} ticks of 'sideways and down' under the height task:")
 print(f"  sideways {1e3 * moved[1]:.2f} mm (commanded {1e3 * 0.05 * ticks * 0.01:.2f})")
 print(f"  down     {1e3 * -moved[2]:.4f} mm (the height task keeps it)")
-print(f"  tasks: {[(t.name, t.level, round(t.scale, 3)) for t in r.tasks]}")
+print(f"  tasks: {[(t.name, t.level, t.served, round(t.scale, 3)) for t in r.tasks]}")

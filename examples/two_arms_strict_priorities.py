@@ -32,9 +32,9 @@ for speed in (0.05, 2.0):  # [m/s], base axes
         rrc_pin.PostureTask(baxter.ready(), gain=1.0),  # then the posture
     ]  # fmt: skip
     r = resolver.solve(q, tasks, priority="strict")
-    print(f"left hand up, right hand forward, {speed} m/s: status {r.status}")
+    print(f"left hand up, right hand forward, {speed} m/s: status {r.status}, levels {r.levels}")
     for t in r.tasks:
-        print(f"  level {t.level} {t.name:28s} scale {t.scale:.3f}")
+        print(f"  level {t.level} {t.name:28s} {t.served:7s} scale {t.scale:.3f}")
 
 for _ in range(ticks):  # integrate the slow command
     r = resolver.solve(q, [[rrc_pin.FrameTask(left, [0, 0, 0.05, 0, 0, 0]),

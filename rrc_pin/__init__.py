@@ -18,6 +18,8 @@ if TYPE_CHECKING:
     from rrc_pin.cells import Cell, CellController, MasterSlave, make_cell
     from rrc_pin.combined import combine
     from rrc_pin.control import Controller, Deadman, DriftCorrection, TrajectoryLog
+    from rrc_pin.control.pose_stream import PoseStream, StreamOptions
+    from rrc_pin.control.smoothing import JerkLimiter
     from rrc_pin.errors import (
         FrameNotFound,
         InvalidInput,
@@ -28,7 +30,15 @@ if TYPE_CHECKING:
         URDFError,
     )
     from rrc_pin.geometry import CollisionModel
-    from rrc_pin.limits import CollisionLimit, ContactLimit, GripLimit, JointLimits, Limit
+    from rrc_pin.limits import (
+        CollisionLimit,
+        ContactLimit,
+        GripLimit,
+        JointLimits,
+        Limit,
+        SingularityLimit,
+        SupportPolygonLimit,
+    )
     from rrc_pin.loading import arms, load
     from rrc_pin.resolver import QPOptions, Resolver
     from rrc_pin.robot import Robot
@@ -36,9 +46,13 @@ if TYPE_CHECKING:
     from rrc_pin.solvers.tick.problem import Constraints
     from rrc_pin.solvers.tick.resolution import ActiveLimit, ActiveRow, Resolution, TaskReport
     from rrc_pin.tasks import (
+        AxisAlignTask,
+        ComTask,
         DampingTask,
         FrameTask,
         JointTask,
+        LookAtTask,
+        ManipulabilityTask,
         PostureTask,
         RelativeFrameTask,
         Task,
@@ -48,10 +62,12 @@ if TYPE_CHECKING:
 __all__ = [
     "ActiveLimit",
     "ActiveRow",
+    "AxisAlignTask",
     "Cell",
     "CellController",
     "CollisionLimit",
     "CollisionModel",
+    "ComTask",
     "Constraints",
     "ContactLimit",
     "Controller",
@@ -63,10 +79,14 @@ __all__ = [
     "FrameTask",
     "GripLimit",
     "InvalidInput",
+    "JerkLimiter",
     "JointLimits",
     "JointTask",
     "Limit",
+    "LookAtTask",
+    "ManipulabilityTask",
     "MasterSlave",
+    "PoseStream",
     "PostureTask",
     "QPOptions",
     "RelativeFrameTask",
@@ -74,6 +94,9 @@ __all__ = [
     "Resolver",
     "Robot",
     "RrcPinError",
+    "SingularityLimit",
+    "StreamOptions",
+    "SupportPolygonLimit",
     "Task",
     "TaskReport",
     "TaskRows",
@@ -91,10 +114,12 @@ __all__ = [
 _HOME: dict[str, str] = {
     "ActiveLimit": "rrc_pin.solvers.tick.resolution",
     "ActiveRow": "rrc_pin.solvers.tick.resolution",
+    "AxisAlignTask": "rrc_pin.tasks",
     "Cell": "rrc_pin.cells",
     "CellController": "rrc_pin.cells",
     "CollisionLimit": "rrc_pin.limits",
     "CollisionModel": "rrc_pin.geometry",
+    "ComTask": "rrc_pin.tasks",
     "Constraints": "rrc_pin.solvers.tick.problem",
     "ContactLimit": "rrc_pin.limits",
     "Controller": "rrc_pin.control",
@@ -106,10 +131,14 @@ _HOME: dict[str, str] = {
     "FrameTask": "rrc_pin.tasks",
     "GripLimit": "rrc_pin.limits",
     "InvalidInput": "rrc_pin.errors",
+    "JerkLimiter": "rrc_pin.control.smoothing",
     "JointLimits": "rrc_pin.limits",
     "JointTask": "rrc_pin.tasks",
     "Limit": "rrc_pin.limits",
+    "LookAtTask": "rrc_pin.tasks",
+    "ManipulabilityTask": "rrc_pin.tasks",
     "MasterSlave": "rrc_pin.cells",
+    "PoseStream": "rrc_pin.control.pose_stream",
     "PostureTask": "rrc_pin.tasks",
     "QPOptions": "rrc_pin.resolver",
     "RelativeFrameTask": "rrc_pin.tasks",
@@ -117,6 +146,9 @@ _HOME: dict[str, str] = {
     "Resolver": "rrc_pin.resolver",
     "Robot": "rrc_pin.robot",
     "RrcPinError": "rrc_pin.errors",
+    "SingularityLimit": "rrc_pin.limits",
+    "StreamOptions": "rrc_pin.control.pose_stream",
+    "SupportPolygonLimit": "rrc_pin.limits",
     "Task": "rrc_pin.tasks",
     "TaskReport": "rrc_pin.solvers.tick.resolution",
     "TaskRows": "rrc_pin.tasks",

@@ -5,16 +5,15 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import os
+import shutil
 import subprocess
 import sys
+import textwrap
 import time
 from collections.abc import Sequence
 from pathlib import Path
 
-from rrc_pin import models, urdf_export
-from rrc_pin.cells import Cell
 from rrc_pin.errors import RrcPinError
-from rrc_pin.loading import INSTALLED, arms, cells, load
 
 ILLUSTRATIONS = (1, 2, 4, 5, 6, 7)
 """The Appendix II illustrations ``rrc-pin guidance`` reproduces."""
@@ -157,6 +156,15 @@ def parser() -> argparse.ArgumentParser:
     mapping.add_argument(
         "--workers", type=int, default=None, help="threads on this machine (default: its cores)"
     )
+    mapping.add_argument(
+        "--dashboard",
+        nargs="?",
+        const="127.0.0.1:8787",
+        default=None,
+        metavar="[HOST:]PORT",
+        help="serve Dask's dashboard of the local cluster (needs bokeh; default 127.0.0.1:8787; "
+        "a port alone is on 127.0.0.1); without it, nothing listens beyond 127.0.0.1",
+    )
     mapping.add_argument("--seed", type=int, default=0, help="seed of the samples")
     mapping.add_argument(
         "--no-dexterity",
@@ -196,7 +204,8 @@ def parser() -> argparse.ArgumentParser:
     mode.add_argument("--check", action="store_true", help="fail if a committed file differs")
     mode.add_argument("--write", action="store_true", help="rewrite the committed files")
     urdf.add_argument(
-        "--dir", type=Path, default=urdf_export.COMMITTED_DIR, help="folder of the URDFs"
+        "--dir", type=Path, default=CHECKOUT / "urdf", help="folder of the URDFs (default: the "
+        "checkout's urdf/)"
     )
     return out
 
@@ -269,12 +278,20 @@ def _discard_stdout() -> None:
         pass
 
 
-def arms_table() -> str:
-    """The robots: name, DOF, joint types, tool frames, source, assumptions or locked joints.
+def arms_table(width: int | None = None) -> str:
+    """The robots: name, DOF, joint types, tool frames, then source and assumptions below.
 
-    The last column also says where each robot's ready pose comes from.
+    Each robot's first line holds its columns (tool frames wrapped in theirs); its source and
+    what is assumed or locked, and where its ready pose comes from, follow on indented lines,
+    every line at most ``width`` characters (default the terminal's, else 100) where no single
+    word is longer.
     """
-    rows = [("name", "dof", "joints", "tool frames", "source", "assumed / locked, ready pose")]
+    from rrc_pin import models
+    from rrc_pin.cells import Cell
+    from rrc_pin.loading import INSTALLED, arms, cells, load
+
+    width = width or shutil.get_terminal_size((100, 24)).columns
+    rows = []
     for name in arms():
         robot = load(name)
         kinds = "".join(
@@ -283,7 +300,7 @@ def arms_table() -> str:
         )
         spec = models.CATALOGUE.get(name)
         if spec is not None:
-            source, notes = spec.source, "; ".join(spec.assumed)
+            source, notes = spec.source, "assumed: " + "; ".join(spec.assumed)
         else:
             installed = INSTALLED[name]
             source = f"example-robot-data: {installed.path}"
@@ -291,20 +308,34 @@ def arms_table() -> str:
             notes += f"ready pose: {installed.ready.reason}"
             if installed.ready.srdf:
                 notes += f" ({installed.ready.srdf})"
-        tools = ", ".join(robot.tool_frames)
-        rows.append((name, str(robot.nq), kinds, tools, source, notes))
+        rows.append((name, str(robot.nq), kinds, ", ".join(robot.tool_frames), source, notes))
     for name in cells():
         cell = load(name)
         assert isinstance(cell, Cell)  # load gives a Cell for a cell's name
         layout = models.CELLS[name]
         dof = f"{cell.nv}" + (" (6 floating)" if cell.floating else "")
         rows.append((name, dof, "cell", ", ".join(cell.tool_frames), layout.source,
-                     f"{cell.describe()}; " + "; ".join(layout.assumed)))  # fmt: skip
-    widths = [max(len(r[i]) for r in rows) for i in range(5)]
-    return "\n".join(
-        "  ".join(cell.ljust(w) for cell, w in zip(r[:5], widths, strict=True)) + "  " + r[5]
-        for r in rows
-    )
+                     f"{cell.describe()}; assumed: " + "; ".join(layout.assumed)))  # fmt: skip
+    return _table(("name", "dof", "joints", "tool frames"), rows, width)
+
+
+def _table(head: tuple[str, ...], rows: Sequence[tuple[str, ...]], width: int) -> str:
+    """Columns ``head`` (the last one wrapped), then each row's two texts on indented lines."""
+    widths = [max(len(r[i]) for r in [head, *rows]) for i in range(len(head) - 1)]
+    left = sum(widths) + 2 * len(widths)
+    last = textwrap.TextWrapper(max(20, width - left), break_long_words=False,
+                                break_on_hyphens=False)  # fmt: skip
+    text = textwrap.TextWrapper(width, initial_indent="    ", subsequent_indent="      ",
+                                break_long_words=False, break_on_hyphens=False)  # fmt: skip
+    lines = []
+    for row in [head, *rows]:
+        first = "  ".join(c.ljust(w) for c, w in zip(row, widths, strict=False)) + "  "
+        wrapped = last.wrap(row[len(head) - 1]) or [""]
+        lines.append((first + wrapped[0]).rstrip())
+        lines += [" " * left + more for more in wrapped[1:]]
+        for extra in row[len(head):]:
+            lines += text.wrap(extra)
+    return "\n".join(lines)
 
 
 def urdf_command(directory: Path, *, write: bool) -> int:
@@ -312,6 +343,8 @@ def urdf_command(directory: Path, *, write: bool) -> int:
 
     Exit codes: 0 all match (or written), 1 some differ, 2 ``directory`` is not a folder.
     """
+    from rrc_pin import models, urdf_export
+
     specs = list(models.CATALOGUE.values())
     if not directory.is_dir() and (directory.exists() or not write):
         print(f"rrc-pin urdf: --dir {directory} is not a folder", file=sys.stderr)
@@ -327,8 +360,8 @@ def urdf_command(directory: Path, *, write: bool) -> int:
     return 1 if problems else 0
 
 
-CHECKOUT = urdf_export.COMMITTED_DIR.parent
-"""The checkout whose ``benchmarks/`` ``rrc-pin bench`` runs."""
+CHECKOUT = Path(__file__).resolve().parents[1]
+"""The checkout whose ``benchmarks/`` ``rrc-pin bench`` runs (and whose ``urdf/`` it checks)."""
 
 BENCHMARKS = (
     "closed_form",
@@ -434,18 +467,21 @@ def map_command(args: argparse.Namespace) -> int:
     import json
 
     from rrc_pin import maps
+    from rrc_pin.loading import load
 
     robot = load(args.robot)
     out: Path = args.out if args.out is not None else _fresh(Path.cwd(), "rrc-pin-map")
     dexterity = not args.no_dexterity
     if len(robot.tool_frames) > 1:
         cell = maps.cell_map(robot, args.samples, args.voxel, args.scheduler, seed=args.seed,
-                             out=out, workers=args.workers, dexterity=dexterity)  # fmt: skip
+                             out=out, workers=args.workers, dexterity=dexterity,
+                             dashboard=args.dashboard)  # fmt: skip
         maps.plot_cell(cell, out)
         print(cell.summary_table())
     else:
         m = maps.capability(robot, args.samples, args.voxel, args.scheduler, seed=args.seed,
-                            out=out, workers=args.workers, dexterity=dexterity)  # fmt: skip
+                            out=out, workers=args.workers, dexterity=dexterity,
+                            dashboard=args.dashboard)  # fmt: skip
         maps.plot_map(m, out)
         print(m.summary_table())
         if args.audit > 0:

@@ -10,6 +10,7 @@ from __future__ import annotations
 from rrc_pin.solvers.errors import InvalidInput, RrcPinError, UnknownBackend
 
 __all__ = [
+    "CorruptStore",
     "ForeignMap",
     "FrameNotFound",
     "InvalidInput",
@@ -99,6 +100,24 @@ class ForeignMap(InvalidInput):
         super().__init__(
             "out", f"{folder} holds {reason}; give another folder or delete this one"
         )
+
+
+class CorruptStore(RrcPinError, ValueError):
+    """Stored results whose files differ from the checksums written with them: never read.
+
+    Attributes:
+        path: The store (a folder).
+        files: The damaged files, relative to ``path``, and what is wrong with each.
+        repair: How to repair it.
+    """
+
+    def __init__(self, path: object, files: dict[str, str], repair: str) -> None:
+        self.path = path
+        self.files = files
+        self.repair = repair
+        shown = [f"{name} ({why})" for name, why in list(files.items())[:5]]
+        more = f" and {len(files) - 5} more files" if len(files) > 5 else ""
+        super().__init__(f"{path}: damaged: {', '.join(shown)}{more}. To repair it, {repair}")
 
 
 class SchedulerUnreachable(InvalidInput):

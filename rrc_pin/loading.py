@@ -1,4 +1,4 @@
-"""``rrc_pin.load``: catalogue arms, example-robot-data robots and URDF files, as a Robot.
+"""``rrc_pin.load``: catalogue arms, example-robot-data robots, URDF and MJCF files, as a Robot.
 
 example-robot-data's URDFs are found inside the installed package (no network); only the
 kinematic model is built, so meshes are never needed. Robots with several arms (baxter, pr2,
@@ -26,6 +26,7 @@ from rrc_pin import models
 from rrc_pin.errors import InvalidInput, UnknownArm, URDFError
 from rrc_pin.models.arm_spec import ArmSpec
 from rrc_pin.robot import Robot, moving_joints
+from rrc_pin.urdf_checks import check_tree, parser_messages, readable, replay
 from rrc_pin.urdf_compare import compare_urdf
 from rrc_pin.urdf_export import TOOL_FRAME, to_urdf
 
@@ -375,7 +376,9 @@ def load(
             (``"gsfc_dual"``, ``"yeh_tripod"``: a :class:`~rrc_pin.cells.Cell`), an
             example-robot-data robot
             (``"panda"``, ``"ur5"``, ``"baxter"``, ...), an :class:`ArmSpec` (e.g. a variant
-            from ``rrc_pin.models.barker6.build(alpha3=...)``), or the path of any URDF. A
+            from ``rrc_pin.models.barker6.build(alpha3=...)``), or the path of any URDF or
+            MJCF (a ``<mujoco>`` file, Pinocchio's MJCF parser; MJCF gives no velocity
+            limits: pass ``JointLimits(velocity=...)``). A
             committed catalogue URDF (its robot name is a catalogue name and its content
             equals the generated URDF as numbers, see :mod:`rrc_pin.urdf_compare`) loads as
             that catalogue arm.
@@ -386,11 +389,13 @@ def load(
 
     Raises:
         UnknownArm: Not a known name nor a file; the message lists the available names.
-        InvalidInput: Parameters for anything but a catalogue name, a parameter its builder
-            does not take (the message lists those it takes), or a value that is not a
-            finite real number (named).
-        URDFError: A missing or malformed URDF, with the path and the parser's message; a
-            model with no moving joint or with a joint that is not one coordinate.
+        InvalidInput: An empty ``name_or_path``, parameters for anything but a catalogue
+            name, a parameter its builder does not take (the message lists those it takes),
+            or a value that is not a finite real number (named).
+        URDFError: A folder, a missing or malformed URDF, with the path and the reason: the
+            joint and link of a broken tree (:func:`rrc_pin.urdf_checks.check_tree`), else
+            the parser's own message; a model with no moving joint or with a joint that is
+            not one coordinate.
         ToolFrameRequired: A URDF whose tree has several end links, loaded without
             ``tool_frame`` (the message lists them).
         FrameNotFound: ``tool_frame`` is not a frame of the model.
@@ -403,6 +408,9 @@ def load(
             "name_or_path", f"expected a name, a path or an ArmSpec, got {name_or_path!r}"
         )
     key = os.fspath(name_or_path)
+    if not key.strip():
+        raise InvalidInput("name_or_path", f"empty ({key!r}): expected an arm's name (one of "
+                           f"{', '.join(arms() + cells())}) or a URDF file's path")  # fmt: skip
     if key in models.CELLS:
         _refuse_parameters(parameters, f"the cell {key!r}")
         if tool_frame is not None:
@@ -523,6 +531,8 @@ def srdf_state(path: Path, state: str) -> dict[str, float]:
 
 
 def _from_file(path: Path, tool_frame: ToolFrames) -> Robot:
+    if path.is_dir():
+        raise URDFError(str(path), "name_or_path is a folder, not a URDF file")
     try:
         text = path.read_text()
     except FileNotFoundError as exc:
@@ -533,8 +543,13 @@ def _from_file(path: Path, tool_frame: ToolFrames) -> Robot:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
         raise URDFError(str(path), f"not XML: {exc}") from exc
+    if root.tag == "mujoco":  # MJCF: Pinocchio's parser, the same tool frame and limits rules
+        return Robot(_parse(path, mjcf=True), tool_frame, name=root.get("model") or path.stem,
+                     source=str(path))  # fmt: skip
     if root.tag != "robot":
-        raise URDFError(str(path), f"not a URDF: the root element is <{root.tag}>, not <robot>")
+        raise URDFError(str(path), f"not a URDF: the root element is <{root.tag}>, not <robot> "
+                        "(nor <mujoco>, an MJCF)")  # fmt: skip
+    check_tree(root, str(path))
     model = _parse(path)
     spec = models.CATALOGUE.get(root.get("name", ""))
     if spec is not None and not compare_urdf(text, to_urdf(spec)):
@@ -548,23 +563,35 @@ def _catalogue_tool(tool_frame: ToolFrames) -> ToolFrames:
     return TOOL_FRAME if tool_frame is None else tool_frame
 
 
-def _parse(path: Path) -> pin.Model:
+def _parse(path: Path, mjcf: bool = False) -> pin.Model:
     """The model of the URDF at ``path``, its mimic joints following their primary joints.
 
+    With ``mjcf``, the model of the MJCF file at ``path`` (``pinocchio.buildModelFromMJCF``).
+
     Raises:
-        URDFError: No such file, a URDF Pinocchio cannot parse, or mimic joints with a
+        URDFError: No such file, a file Pinocchio cannot parse, or mimic joints with a
             Pinocchio too old to honour them (named).
     """
     if not path.is_file():
         raise URDFError(str(path), "no such file")
-    try:
+    with parser_messages() as said:
         try:
-            return pin.buildModelFromUrdf(str(path), mimic=True)
-        except TypeError:  # a Pinocchio without mimic support (before 3.4)
-            model = pin.buildModelFromUrdf(str(path))
-    except (RuntimeError, ValueError) as exc:
-        raise URDFError(str(path), f"Pinocchio could not parse it: {exc}") from exc
-    refuse_mimic(path)
+            try:
+                if mjcf:
+                    model, mimic = pin.buildModelFromMJCF(str(path)), True
+                else:
+                    model, mimic = pin.buildModelFromUrdf(str(path), mimic=True), True
+            except TypeError:  # a Pinocchio without mimic support (before 3.4)
+                model, mimic = pin.buildModelFromUrdf(str(path)), False
+            failure = None
+        except (RuntimeError, ValueError) as exc:
+            failure = exc
+    if failure is not None:
+        reason = readable(said) or str(failure)
+        raise URDFError(str(path), f"Pinocchio could not parse it: {reason}") from failure
+    replay(said)
+    if not mimic:
+        refuse_mimic(path)
     return model
 
 

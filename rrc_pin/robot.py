@@ -168,8 +168,9 @@ class Robot:
         if tool_frames is None:
             ends = end_links(model)
             if len(ends) != 1:
+                shape = "a serial chain ending in" if is_chain(model) else "a tree with"
                 raise ToolFrameRequired(
-                    "tool_frame", f"{source} is a tree with {len(ends)} end links", ends
+                    "tool_frame", f"{source} is {shape} {len(ends)} end links", ends
                 )
             tool_frames = ends
         tools = (tool_frames,) if isinstance(tool_frames, str) else tool_frames
@@ -580,15 +581,23 @@ def end_links(model: pin.Model) -> list[str]:
 
     A link (body frame) is an end link when no other link hangs from it and it is not fixed
     to the base: a serial arm has one (a chain URDF's last link), baxter's tree has its
-    grippers, fingertips, cameras and sensor links.
+    grippers, fingertips, cameras and sensor links. A model whose frames name no link as
+    another's parent (built in code, as ``pinocchio.buildSampleModelManipulator()``) has its
+    tree in its joints: its end links are the links of the joints no joint hangs from.
     """
     bodies = [i for i, f in enumerate(model.frames) if f.type == pin.FrameType.BODY]
+    moved = [i for i in bodies if model.frames[i].parentJoint != 0]
     parents = {parent_link(model, i) for i in bodies}
-    return [
-        str(model.frames[i].name)
-        for i in bodies
-        if i not in parents and model.frames[i].parentJoint != 0
-    ]
+    if moved and parents <= {0}:
+        leaves = set(range(1, model.njoints)) - set(model.parents[1:])
+        return [str(model.frames[i].name) for i in moved if model.frames[i].parentJoint in leaves]
+    return [str(model.frames[i].name) for i in moved if i not in parents]
+
+
+def is_chain(model: pin.Model) -> bool:
+    """Whether the model's joints make one serial chain (no joint carries two)."""
+    children = list(model.parents[1:])
+    return all(children.count(j) <= 1 for j in set(children))
 
 
 def parent_link(model: pin.Model, frame: int) -> int:

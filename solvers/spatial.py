@@ -47,3 +47,26 @@ def from_world_aligned(M: Array, rotation: Array, position: Array, ref: Referenc
         return np.concatenate([rotation.T @ v, rotation.T @ w])
     return np.concatenate([v - np.cross(w, position, axis=0), w])
 
+
+
+def to_world_aligned(M: Array, rotation: Array, position: Array, ref: Reference) -> Array:
+    """Express a twist (6,) given in frame ``ref`` in ``world_aligned``.
+
+    The inverse of :func:`from_world_aligned`.
+
+    Args:
+        M: (6,) twist, rows [v; w], in frame ``ref``.
+        rotation: (3, 3) tool orientation in the base frame.
+        position: (3,) tool-frame origin in the base frame [m].
+        ref: Its frame.
+
+    Returns:
+        (6,) twist in ``world_aligned``: ``[R v; R w]`` from ``local``, ``[v + w x p; w]``
+        from ``world``.
+    """
+    if ref == "world_aligned":
+        return M
+    v, w = M[:3], M[3:]
+    if ref == "local":
+        return np.concatenate([rotation @ v, rotation @ w])
+    return np.concatenate([v + np.cross(w, position), w])

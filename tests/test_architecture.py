@@ -19,8 +19,9 @@ UPPER = {"resolver", "control", "controller", "guidance", "cell", "cli", "demo",
          "maps", "console"}  # fmt: skip
 TOP = {"console", "cli"}
 """The entry points: nothing else in rrc_pin imports them."""
-LOWER = {"dh", "models", "urdf_export", "urdf_compare", "robot", "loading", "errors", "cross_check",
-         "link_capsules", "combined", "kinematics", "geometry"}  # fmt: skip
+LOWER = {"dh", "models", "urdf_export", "urdf_compare", "urdf_checks", "robot", "loading", "errors",
+         "cross_check", "link_capsules", "combined", "kinematics", "geometry",
+         "deprecated"}  # fmt: skip
 GEOMETRY_BELOW = {"tasks", "limits", *UPPER}
 """What the geometry layer never imports: it sits above robot, below the tasks and limits."""
 
@@ -146,3 +147,19 @@ def test_ruff_is_clean():
         text=True,
     )
     assert out.returncode == 0, out.stdout + out.stderr
+
+
+def test_a_users_solvers_module_beside_a_script_does_not_break_the_import(tmp_path):
+    """Issue 40: a top-level package named ``solvers`` was shadowed by a user's solvers.py
+    (``ModuleNotFoundError: No module named 'solvers.errors'``)."""
+    (tmp_path / "solvers.py").write_text("raise RuntimeError('the user solvers.py was imported')\n")
+    (tmp_path / "script.py").write_text(
+        "import rrc_pin\n"
+        "arm = rrc_pin.load('panda')\n"
+        "r = rrc_pin.Resolver(arm).solve(arm.ready(), [0.0, 0.0, 0.01, 0.0, 0.0, 0.0])\n"
+        "print(r.status, type(rrc_pin.errors.InvalidInput('x', 'y')).__module__)\n"
+    )
+    done = subprocess.run([sys.executable, "script.py"], cwd=tmp_path, capture_output=True,
+                          text=True, timeout=300)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["exact", "rrc_pin.solvers.errors"]

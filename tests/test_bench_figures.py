@@ -95,3 +95,19 @@ def test_replot_draws_a_figure_from_its_json(bench, tmp_path, capsys):
     assert bench("replot").main(["controller", "--results", str(tmp_path)]) == 0
     assert (tmp_path / "controller.png").stat().st_size > 10_000
     assert capsys.readouterr().out == f"wrote {tmp_path / 'controller.png'}\n"
+
+
+def test_the_collision_figure_and_table_say_where_no_pair_came_near(bench, drawn, tmp_path):
+    """Issue 40: a quick run's pink never came within the detection distance (its minimum
+    distance inf), and the figure dropped it without a word."""
+    collision = bench("bench_collision")
+    quick = copy.deepcopy(recorded("collision"))
+    for row in quick["rows"]:
+        if row["contender"].startswith("pink") and row["pairs"] < 50:
+            row["min_distance_m"] = float("inf")
+    assert collision.plot(quick, tmp_path / "quick.png")
+    labels = drawn[-1].axes[1].get_legend().get_texts()
+    pink = next(t.get_text() for t in labels if t.get_text().startswith("pink"))
+    assert pink.endswith("(no pair within 100 mm at [9, 36] pairs: not drawn)"), pink
+    table = collision.readme_table(quick)
+    assert "inf" not in table and "no pair came within the detection distance (100 mm)" in table

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import re
 import shutil
 import subprocess
@@ -20,7 +21,12 @@ def test_arms_table_lists_tool_frames_sources_and_assumptions(capsys):
     assert main(["arms"]) == 0
     lines = capsys.readouterr().out.splitlines()
     assert lines[0].split()[:5] == ["name", "dof", "joints", "tool", "frames"]
-    rows = {line.split()[0]: line for line in lines[1:]}
+    rows: dict[str, str] = {}
+    for line in lines[1:]:  # a robot's line, then its wrapped ones (indented)
+        if line.startswith(" "):
+            rows[next(reversed(rows))] += " " + line.strip()
+        else:
+            rows[line.split()[0]] = line
     assert list(rows) == rrc_pin.arms() + rrc_pin.loading.cells()
     assert rows["barker6"].split()[1:4] == ["6", "RRRRRR", "tool"]
     assert "PUMA 560 values" in rows["barker6"]
@@ -37,6 +43,28 @@ def test_arms_table_lists_tool_frames_sources_and_assumptions(capsys):
     assert rows["gsfc_dual"].split()[1:3] == ["14", "cell"] and "shoulder spacing" in rows[
         "gsfc_dual"]  # fmt: skip
     assert "24 (6 floating)" in rows["yeh_tripod"] and "leg1/flange" in rows["yeh_tripod"]
+
+
+@pytest.mark.parametrize("columns", ["100", "80"])
+def test_arms_lines_fit_the_terminal(columns):
+    """Issue 40: lines were up to 1,066 characters; wrapped to the terminal's width (100 when
+    stdout is not a terminal), words never broken."""
+    env = {**os.environ, "COLUMNS": columns}
+    out = subprocess.run([sys.executable, "-m", "rrc_pin.cli", "arms"], capture_output=True,
+                         text=True, check=True, env=env).stdout  # fmt: skip
+    lines = out.splitlines()
+    assert len(lines) > 2 * len(rrc_pin.arms())
+    assert max(map(len, lines)) <= int(columns), max(lines, key=len)
+
+
+def test_help_loads_no_pinocchio_and_no_robot():
+    """``rrc-pin --help`` imported the whole library (2.1 s): it imports the parser only."""
+    code = ("import sys\nfrom rrc_pin.cli import parser\nparser().format_help()\n"
+            "print(sorted(m for m in sys.modules if m.split('.')[0] in ('pinocchio', 'numpy',"
+            " 'numba', 'scipy') or m.startswith(('rrc_pin.models', 'rrc_pin.robot'))))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout  # fmt: skip
+    assert out.strip() == "[]"
 
 
 def test_help_is_plain_text_and_lists_the_illustrations(capsys):

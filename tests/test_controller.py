@@ -70,7 +70,7 @@ def test_reverse_returns_to_the_recorded_start(name, rng):
     ctl = Controller(arm, q0=start(name))
     q_start = ctl.q.copy()
     for twist in random_commands(rng, 2.0, ctl.dt, speed=0.03, turn=0.1, pause=0.0):
-        ctl.step(twist)
+        ctl.step(twist, ref="local")
     assert not any(ctl.log.column("active"))  # no limit intervened
     moved = np.max(np.abs(ctl.q - q_start))
     result = ctl.reverse(2.0)
@@ -85,7 +85,7 @@ def test_reverse_keeps_the_limits_when_they_intervene(panda):
     limits = rrc_pin.JointLimits(acceleration=20.0)
     ctl = Controller(panda, q0=PANDA_Q0, limits=limits)
     for _ in range(100):
-        ctl.step([0.1, 0.0, 0.0, 0.0, 0.0, 0.5])
+        ctl.step([0.1, 0.0, 0.0, 0.0, 0.0, 0.5], ref="local")
     result = ctl.reverse(1.0)
     qdot = ctl.log.column("qdot")[-result.steps:]
     assert result.steps > 100
@@ -99,7 +99,7 @@ def test_a_simulated_session_stays_in_the_limits_with_bounded_drift(name):
     arm = rrc_pin.load(name)
     ctl = Controller(arm, q0=start(name))
     for twist in random_commands(np.random.default_rng(1), 20.0, ctl.dt):
-        ctl.step(twist)
+        ctl.step(twist, ref="local")
     q, qdot = ctl.log.column("q"), ctl.log.column("qdot")
     assert np.isfinite(q).all() and np.isfinite(qdot).all()
     assert np.all(q >= arm.lower - 1e-12) and np.all(q <= arm.upper + 1e-12)
@@ -115,7 +115,7 @@ def test_drift_grows_without_the_correction_and_stays_small_with_it(barker):
     for correction in (DriftCorrection(), None):
         ctl = Controller(barker, q0=BARKER_Q0, drift=correction)
         for twist in random_commands(np.random.default_rng(1), 8.0, ctl.dt):
-            ctl.step(twist)
+            ctl.step(twist, ref="local")
         drift[correction is None] = ctl.log.column("drift_position")
     assert drift[False].max() < 0.5 * drift[True].max()
     assert drift[False][-100:].mean() < 0.2 * drift[True][-100:].mean()
@@ -125,7 +125,7 @@ def test_drift_grows_without_the_correction_and_stays_small_with_it(barker):
 def test_deadman_fades_an_old_command_smoothly_to_zero(panda):
     deadman = Deadman(timeout=0.1, fade=0.2)
     ctl = Controller(panda, q0=PANDA_Q0, deadman=deadman, drift=None)
-    first = ctl.step([0.05, 0.0, 0.0, 0.0, 0.0, 0.0]).resolution.qdot
+    first = ctl.step([0.05, 0.0, 0.0, 0.0, 0.0, 0.0], ref="local").resolution.qdot
     speeds = [np.linalg.norm(ctl.step().resolution.qdot) for _ in range(40)]
     ages = ctl.dt * np.arange(1, 41)
     factors = np.array([deadman.factor(a) for a in ages])
@@ -139,17 +139,17 @@ def test_speed_override_scales_the_command(panda):
     full = Controller(panda, q0=PANDA_Q0)
     half = Controller(panda, q0=PANDA_Q0, speed=0.5)
     twist = [0.05, 0.02, 0.0, 0.0, 0.1, 0.0]
-    assert np.allclose(half.step(twist).resolution.qdot,
-                       0.5 * full.step(twist).resolution.qdot, atol=1e-12)
+    assert np.allclose(half.step(twist, ref="local").resolution.qdot,
+                       0.5 * full.step(twist, ref="local").resolution.qdot, atol=1e-12)
     half.speed = 0.0
-    assert np.all(half.step(twist).resolution.qdot == 0.0)
+    assert np.all(half.step(twist, ref="local").resolution.qdot == 0.0)
 
 
 def test_joint_limit_margins_are_kept(panda):
     margin = 0.1
     ctl = Controller(panda, q0=PANDA_Q0, limits=rrc_pin.JointLimits(margin=margin))
     for _ in range(300):  # rotate the hand about its z axis far beyond joint 7's range
-        ctl.step([0.0, 0.0, 0.0, 0.0, 0.0, 2.0])
+        ctl.step([0.0, 0.0, 0.0, 0.0, 0.0, 2.0], ref="local")
     q = ctl.log.column("q")
     assert np.all(q >= panda.lower + margin - 1e-12) and np.all(q <= panda.upper - margin + 1e-12)
     assert abs(ctl.q[6] - (panda.upper[6] - margin)) < 1e-9 or abs(
@@ -160,15 +160,16 @@ def test_joint_limit_margins_are_kept(panda):
 @pytest.mark.parametrize(
     ("call", "argument"),
     [
-        (lambda c: c.step([0.0, 0.0, np.nan, 0.0, 0.0, 0.0]), "twist"),
+        (lambda c: c.step([0.0, 0.0, np.nan, 0.0, 0.0, 0.0], ref="local"), "twist"),
         # float (6,) arrays, checked on Python floats (Controller's fast path)
-        (lambda c: c.step(np.array([0.0, 0.0, np.nan, 0.0, 0.0, 0.0])), "twist"),
-        (lambda c: c.step(np.array([0.0, np.inf, 0.0, 0.0, 0.0, 0.0])), "twist"),
-        (lambda c: c.step(np.array([np.inf, -np.inf, 0.0, 0.0, 0.0, 0.0])), "twist"),
+        (lambda c: c.step(np.array([0.0, 0.0, np.nan, 0.0, 0.0, 0.0]), ref="local"), "twist"),
+        (lambda c: c.step(np.array([0.0, np.inf, 0.0, 0.0, 0.0, 0.0]), ref="local"), "twist"),
+        (lambda c: c.step(np.array([np.inf, -np.inf, 0.0, 0.0, 0.0, 0.0]), ref="local"), "twist"),
         (lambda c: c.step(np.zeros((6, 1))), "twist"),
-        (lambda c: c.step([0.0, 0.0, 0.1]), "twist"),
+        (lambda c: c.step([0.0, 0.0, 0.1], ref="local"), "twist"),
         (lambda c: c.step([0.1, 0, 0, 0, 0, 0], ref="tool"), "ref"),
-        (lambda c: c.step([0.1, 0, 0, 0, 0, 0], ref="world"), "ref"),
+        (lambda c: c.step([0.1, 0, 0, 0, 0, 0], ref="base"), "ref"),
+        (lambda c: c.step(None, ref="hand"), "ref"),
         (lambda c: c.reverse(10.0), "seconds"),
         (lambda c: c.reverse(-1.0), "seconds"),
         (lambda c: setattr(c, "speed", 1.5), "speed"),
@@ -180,7 +181,7 @@ def test_joint_limit_margins_are_kept(panda):
 def test_bad_input_names_the_argument_and_changes_nothing(panda, call, argument):
     ctl = Controller(panda, q0=PANDA_Q0)
     for _ in range(5):
-        ctl.step([0.01, 0.0, 0.0, 0.0, 0.0, 0.0])
+        ctl.step([0.01, 0.0, 0.0, 0.0, 0.0, 0.0], ref="local")
     q, t, n, reference = ctl.q.copy(), ctl.t, len(ctl.log), ctl.reference
     with pytest.raises(rrc_pin.InvalidInput) as info:
         call(ctl)
@@ -214,8 +215,8 @@ def test_a_float_array_command_is_kept_as_a_copy_and_judged_like_any_other(panda
     reused = Controller(panda, q0=PANDA_Q0)
     fresh = Controller(panda, q0=PANDA_Q0)
     buffer = np.array([0.02, -0.01, 0.0, 0.0, 0.1, 0.0])
-    reused.step(buffer)
-    fresh.step(buffer.copy())
+    reused.step(buffer, ref="local")
+    fresh.step(buffer.copy(), ref="local")
     buffer[:] = 5.0  # the caller's buffer changes after the call: the held command does not
     for _ in range(3):
         assert np.array_equal(reused.step().q, fresh.step().q)
@@ -223,7 +224,7 @@ def test_a_float_array_command_is_kept_as_a_copy_and_judged_like_any_other(panda
     kept = _checked_twist(huge)
     assert np.array_equal(kept, huge) and kept is not huge
     ints = Controller(panda, q0=PANDA_Q0)
-    assert np.array_equal(ints.step(np.array([0, 0, 0, 0, 0, 0])).q, PANDA_Q0)
+    assert np.array_equal(ints.step(np.array([0, 0, 0, 0, 0, 0]), ref="local").q, PANDA_Q0)
 
 
 def test_q_is_read_only_and_set_checked_the_tick_resolves_as_solve_does(panda):
@@ -237,7 +238,7 @@ def test_q_is_read_only_and_set_checked_the_tick_resolves_as_solve_does(panda):
     with pytest.raises(ValueError):
         ctl.q[0] = 0.0
     twist = np.array([0.05, -0.02, 0.03, 0.1, 0.0, -0.2])
-    step = ctl.step(twist)
+    step = ctl.step(twist, ref="local")
     with pytest.raises(ValueError):
         step.q[0] = 0.0
     expected = rrc_pin.Resolver(panda).solve(PANDA_Q0 + 0.05, twist, ref="local")
@@ -259,7 +260,8 @@ def test_the_resolvers_strategy_is_skipped_as_its_decision_would_keep_the_comman
     passive = Controller(panda, q0=PANDA_Q0)
     ordinary = Controller(panda, q0=PANDA_Q0, strategy=Keep())
     for twist in random_commands(rng, 0.3, 0.01, hold=0.05):
-        assert np.array_equal(passive.step(twist).q, ordinary.step(twist).q)
+        assert np.array_equal(passive.step(twist, ref="local").q,
+                              ordinary.step(twist, ref="local").q)
     assert np.array_equal(passive.log.column("drift_position"),
                           ordinary.log.column("drift_position"))  # fmt: skip
 
@@ -273,7 +275,7 @@ def test_a_robot_with_two_hands_is_refused():
 def test_records_name_the_singularity_met(barker):
     ctl = Controller(barker, q0=np.deg2rad([20.0, 30.0, 60.0, 10.0, 3.0, 0.0]))
     for _ in range(15):
-        ctl.step([0.0, 0.0, 0.0, 0.0, -0.5, 0.0])  # theta5 towards and through 0
+        ctl.step([0.0, 0.0, 0.0, 0.0, -0.5, 0.0], ref="local")  # theta5 towards and through 0
     labels = set(ctl.log.column("singularity"))
     assert "wrist (S5 = 0)" in labels
 

@@ -57,9 +57,11 @@ def test_correction_is_clipped_part_by_part():
 def test_the_reference_advances_along_the_twist():
     reference = pin.SE3(pin.exp3(np.array([0.3, -0.2, 0.1])), np.array([0.5, 0.1, 0.2]))
     twist = np.array([0.1, 0.0, -0.2, 0.0, 0.5, 0.3])
-    local = advance(reference, twist, 0.01, True)
+    local = advance(reference, twist, 0.01, "local")
     assert np.allclose(pin.log6(reference.actInv(local)).vector, 0.01 * twist, atol=1e-15)
-    base = advance(reference, twist, 0.01, False)
+    world = advance(reference, twist, 0.01, "world")  # the spatial twist at the base origin
+    assert np.allclose(pin.log6(world * reference.inverse()).vector, 0.01 * twist, atol=1e-15)
+    base = advance(reference, twist, 0.01, "world_aligned")
     assert np.allclose(base.translation - reference.translation, 0.01 * twist[:3], atol=1e-15)
     turn = pin.log3(base.rotation @ reference.rotation.T)
     assert np.allclose(turn, 0.01 * twist[3:], atol=1e-15)
@@ -76,7 +78,7 @@ def test_the_followed_fraction_is_the_resolutions_scale(panda_arm):
     seen = set()
     for k in range(150):
         twist = rng.normal(size=6) * (0.05 if k % 3 else 2.0)
-        r = ctl.step(twist).resolution
+        r = ctl.step(twist, ref="local").resolution
         expected = None if r.status in REANCHOR else r.scale
         got = _followed(r)
         seen.add(r.status)

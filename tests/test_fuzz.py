@@ -93,7 +93,7 @@ def cases() -> list[tuple[str, str, Any]]:
         for site in ("solve.ref", "step.ref", "FrameTask.frame", "FrameTask.name",
                      "solve.priority", "JointTask.joint", "RelativeFrameTask.frame_a",
                      "QPOptions.backend"):  # fmt: skip
-            if value is None and site in ("FrameTask.name", "solve.ref"):
+            if value is None and site in ("FrameTask.name", "solve.ref", "step.ref"):
                 continue  # None: the default
             out.append((site, _argument(site), value))
     for value in (0.0, -1.0, 1e-320, 1e-7):
@@ -159,7 +159,7 @@ def call_site(site: str, value: Any, panda: rrc_pin.Robot, resolver: Resolver,
         "Controller.deadman": lambda: Controller(panda, deadman=value),
         "Controller.drift": lambda: Controller(panda, drift=value),
         "Controller.q_set": lambda: setattr(ctl, "q", value),
-        "step.twist": lambda: ctl.step(value),
+        "step.twist": lambda: ctl.step(value, ref="local"),
         "step.ref": lambda: ctl.step(twist, ref=value),
         "reverse.seconds": lambda: ctl.reverse(value),
         "reverse.extra": lambda: ctl.reverse(0.01, extra=value),
@@ -194,7 +194,7 @@ def test_every_bad_input_is_refused_by_name_and_changes_nothing(panda: rrc_pin.R
     ctl = Controller(panda)
     for _ in range(5):  # state worth keeping: warm starts, a record, a reference pose
         resolver.solve(panda.ready(), [3.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-        ctl.step([0.02, 0.0, 0.0, 0.0, 0.0, 0.1])
+        ctl.step([0.02, 0.0, 0.0, 0.0, 0.0, 0.1], ref="local")
     before_resolver = resolver.warm_start_state()
     before_ctl = (ctl.q.copy(), ctl.t, len(ctl.log), ctl.speed, ctl.reference.copy())
     checked = 0

@@ -93,13 +93,13 @@ def test_type_iii_keeps_the_hand_point_on_its_line(arms, name, rng):
 
 
 @pytest.mark.parametrize("name", ARMS)
-def test_type_iv_commands_in_the_global_and_the_hand_frame(arms, name, rng):
+def test_type_iv_commands_in_base_and_hand_axes(arms, name, rng):
     arm = arms[name]
     q0, _ = start_and_goal(arm, rng)
     T0 = arm.fk(q0)
     commands = [
-        Command((0.0, 0.0, 1.0), 0.05, np.radians(-20.0), "global"),
-        Command((1.0, 0.0, 0.0), -0.03, np.radians(10.0), "hand"),
+        Command((0.0, 0.0, 1.0), 0.05, np.radians(-20.0), "world_aligned"),
+        Command((1.0, 0.0, 0.0), -0.03, np.radians(10.0), "local"),
     ]
     k = 10
     paths = operator(arm, q0, commands, k, solver=rrc_pin.Resolver(arm, dt=1.0),
@@ -116,6 +116,29 @@ def test_type_iv_commands_in_the_global_and_the_hand_frame(arms, name, rng):
     )
     np.testing.assert_allclose(paths[1].hand[-1], (second * pin.SE3(T1)).homogeneous, atol=1e-9)
     assert all(within_limits(arm, p.q) for p in paths)
+
+
+def test_a_world_command_turns_about_an_axis_through_the_base_origin(arms):
+    """``world``: the spatial twist at the base origin, as Pinocchio's WORLD frame."""
+    arm = arms["panda"]
+    q0 = arm.ready()
+    (path,) = operator(arm, q0, [Command((0.0, 0.0, 1.0), 0.02, 0.2, "world")], 10,
+                       solver=rrc_pin.Resolver(arm, dt=1.0), correction="newton")  # fmt: skip
+    moved = pin.exp6(pin.Motion(np.r_[0.0, 0.0, 0.02, 0.0, 0.0, 0.2])) * pin.SE3(arm.fk(q0))
+    np.testing.assert_allclose(path.hand[-1], moved.homogeneous, atol=1e-9)
+
+
+def test_the_thesis_frame_names_still_work_for_one_release_with_a_warning():
+    with pytest.warns(DeprecationWarning, match="'global' is deprecated.*'world_aligned'"):
+        old = Command((0.0, 0.0, 1.0), 0.05, 0.1, "global")
+    assert old.ref == "world_aligned"
+    with pytest.warns(DeprecationWarning) as caught:
+        hand = Command((0.0, 0.0, 1.0), 0.05, 0.1, frame="hand")
+    assert [str(w.message).split(" is ")[0] for w in caught] == [
+        "guidance.Command(frame=)", "guidance.Command ref 'hand'"]
+    assert hand.ref == "local" and hand == Command((0.0, 0.0, 1.0), 0.05, 0.1, "local")
+    with pytest.warns(DeprecationWarning, match=r"Command.frame is deprecated"):
+        assert hand.frame == "local"
 
 
 @pytest.mark.parametrize("name", ARMS)
@@ -270,7 +293,7 @@ def test_bad_input_names_the_argument(arms):
         straight_line_points(arm, q0, points, 5, spacing=0.0)
     with pytest.raises(InvalidInput, match="^goal_points:"):
         straight_line_points(arm, q0, [[0, 0, 0], [0, 0, 1], [0, 0, 2]], 5, spacing=0.1)
-    with pytest.raises(InvalidInput, match=r"^commands\[0\]\.frame:"):
+    with pytest.raises(InvalidInput, match=r"^commands\[0\]\.ref:"):
         operator(arm, q0, [Command((0, 0, 1), 0.1, 0.1, "tool")], 5)
     with pytest.raises(InvalidInput, match=r"^commands\[1\]\.axis:"):
         operator(arm, q0, [Command((0, 0, 1), 0.1, 0.1), Command((0, 0, 0), 0.1, 0.1)], 5)

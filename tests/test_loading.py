@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import importlib.util
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -170,11 +173,58 @@ def test_malformed_urdf_gives_path_and_parser_message(tmp_path):
     with pytest.raises(URDFError, match=f"{path}: not XML: .+"):
         rrc_pin.load(path)
     path.write_text('<robot name="x"><link name="a"/><joint name="j" type="revolute"/></robot>')
-    with pytest.raises(URDFError, match=f"{path}: Pinocchio could not parse it: .+"):
+    with pytest.raises(URDFError, match=f"{path}: joint 'j': its parent link has none"):
         rrc_pin.load(path)
     path.write_text("<launch/>")
     with pytest.raises(URDFError, match=f"{path}: not a URDF: the root element is <launch>"):
         rrc_pin.load(path)
+
+
+JOINT = ('<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+         '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>')
+
+
+def urdf(*joints: dict[str, str], links: tuple[str, ...] = ("base", "l1")) -> str:
+    body = "".join(f'<link name="{n}"/>' for n in links)
+    return f'<robot name="x">{body}{"".join(JOINT.format(**j) for j in joints)}</robot>'
+
+
+@pytest.mark.parametrize(
+    ("joints", "said"),
+    [
+        # issue 40: urdfdom printed "child link [nowhere] of joint [j2] not found" on stderr,
+        # the exception said only "does not contain a valid URDF model"
+        ([{"name": "j1", "kind": "revolute", "parent": "base", "child": "l1"},
+          {"name": "j2", "kind": "revolute", "parent": "l1", "child": "nowhere"}],
+         "joint 'j2': its child link 'nowhere' is not a link of the file"),
+        ([{"name": "j1", "kind": "revolute", "parent": "base", "child": "l1"},
+          {"name": "j2", "kind": "revolute", "parent": "base", "child": "l1"}],
+         r"link 'l1' is the child of two joints \('j1' and 'j2'\)"),
+        ([{"name": "j1", "kind": "revolute", "parent": "l1", "child": "base"},
+          {"name": "j2", "kind": "revolute", "parent": "base", "child": "l1"}],
+         "the links hang from 0 roots"),
+        # what only the parser knows: its own words, captured from its stderr
+        ([{"name": "j1", "kind": "revolut", "parent": "base", "child": "l1"}],
+         r"Pinocchio could not parse it: Joint \[j1\] has no known type \[revolut\]"),
+    ],
+)
+def test_a_broken_tree_is_named_in_the_error_and_nothing_is_printed(tmp_path, capfd, joints,
+                                                                     said):
+    path = tmp_path / "broken.urdf"
+    path.write_text(urdf(*joints))
+    with pytest.raises(URDFError, match=f"^URDF {path}: {said}"):
+        rrc_pin.load(path)
+    out, err = capfd.readouterr()
+    assert out == "" and err == ""
+
+
+def test_an_empty_name_or_a_folder_is_named_as_such(tmp_path):
+    """Issue 40: ``load("")`` said "URDF .: cannot read it: Is a directory"."""
+    with pytest.raises(InvalidInput, match=r"^name_or_path: empty \(''\): expected an arm's "
+                       "name .*barker6.*or a URDF file's path"):  # fmt: skip
+        rrc_pin.load("")
+    with pytest.raises(URDFError, match=f"^URDF {tmp_path}: name_or_path is a folder, not a URDF"):
+        rrc_pin.load(tmp_path)
 
 
 def test_unknown_tool_frame():
@@ -280,3 +330,79 @@ def test_ready_poses_come_from_the_srdf_where_it_gives_one():
     barker = rrc_pin.load("barker6")  # a catalogue arm: chosen, stated in its ArmSpec
     np.testing.assert_allclose(barker.ready(), np.deg2rad([0, 0, 90, 0, 45, 0]))
     assert barker.poses["paper_start"].tolist() == [0.0] * 6
+
+
+MJCF = Path(__file__).resolve().parent / "data" / "mjcf"
+"""MJCF files MuJoCo wrote from the committed URDFs (tests/data/mjcf/generate.py)."""
+
+
+def test_the_committed_mjcf_is_what_mujoco_writes_from_the_urdfs():
+    spec = importlib.util.spec_from_file_location("generate", MJCF / "generate.py")
+    generate = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(generate)
+    assert generate.main(check=True) == 0
+    assert sorted(p.stem for p in MJCF.glob("*.xml")) == sorted(CATALOGUE)
+
+
+@pytest.mark.parametrize("name", sorted(CATALOGUE))
+def test_an_mjcf_loads_with_the_urdfs_kinematics_and_mujocos(name):
+    """Same joints, limits to the 6 digits MuJoCo prints, tool frame by the same rule; fk and
+    Jacobians equal MuJoCo's own of the same file (1e-12) and the URDF's (1e-12, but
+    nadkarni_c1: its -70 deg base turn is a quaternion MuJoCo prints to 6 digits, 7e-7)."""
+    import mujoco  # the test extra
+
+    frame = "tool"
+    robot = rrc_pin.load(MJCF / f"{name}.xml", tool_frame=frame)
+    urdf = rrc_pin.load(name, tool_frame=frame)
+    assert robot.name == name and robot.joint_names == urdf.joint_names
+    np.testing.assert_allclose(robot.lower, urdf.lower, atol=5e-6)
+    assert np.isinf(robot.velocity_limit).all()  # MJCF has none: the caller gives them
+    m = mujoco.MjModel.from_xml_path(str(MJCF / f"{name}.xml"))
+    d = mujoco.MjData(m)
+    body = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, frame)
+    tol = 1e-6 if name == "nadkarni_c1" else 1e-12
+    rng = np.random.default_rng(41)
+    for _ in range(50):
+        q = np.clip(urdf.random_q(rng), robot.lower, robot.upper)
+        T, J = robot.fk(q), robot.jacobian(q)
+        assert np.abs(T - urdf.fk(q)).max() < tol and np.abs(J - urdf.jacobian(q)).max() < tol
+        d.qpos[:] = q
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        jp, jr = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+        mujoco.mj_jacBody(m, d, jp, jr, body)
+        assert np.abs(T[:3, 3] - d.xpos[body]).max() < 1e-12
+        assert np.abs(T[:3, :3] - d.xmat[body].reshape(3, 3)).max() < 1e-12
+        assert np.abs(J - np.vstack([jp, jr])).max() < 1e-12
+
+
+def test_an_mjcf_arm_solves_as_its_urdf():
+    robot = rrc_pin.load(MJCF / "rrc_k1607.xml")
+    urdf = rrc_pin.load("rrc_k1607")
+    assert robot.tool_frame == "tool"  # the one end link, as for a URDF
+    with pytest.raises(InvalidInput) as info:
+        rrc_pin.Resolver(robot)  # no velocity limits in MJCF: refused by name
+    assert info.value.argument == "velocity"
+    limits = rrc_pin.JointLimits(velocity=urdf.velocity_limit)
+    mine, theirs = rrc_pin.Resolver(robot, limits=limits), rrc_pin.Resolver(urdf)
+    q, twist = urdf.ready(), [0.1, -0.05, 0.02, 0.1, 0.0, -0.2]
+    for _ in range(50):
+        a, b = mine.solve(q, twist), theirs.solve(q, twist)
+        assert a.status == b.status and np.abs(a.qdot - b.qdot).max() < 1e-9
+        q = q + a.qdot * 0.01
+
+
+def test_an_xml_that_is_neither_urdf_nor_mjcf_is_refused(tmp_path):
+    path = tmp_path / "scene.xml"
+    path.write_text("<sdf version='1.7'/>")
+    with pytest.raises(URDFError) as info:
+        rrc_pin.load(path)
+    assert "MJCF" in str(info.value) and "<sdf>" in str(info.value)
+
+
+def test_a_malformed_mjcf_gives_path_and_parser_message(tmp_path):
+    path = tmp_path / "broken.xml"
+    path.write_text('<mujoco><worldbody><body><joint type="warp"/></body></worldbody></mujoco>')
+    with pytest.raises(URDFError) as info:
+        rrc_pin.load(path)
+    assert str(path) in str(info.value) and "Pinocchio could not parse it" in str(info.value)

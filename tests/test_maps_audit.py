@@ -14,7 +14,7 @@ pytest.importorskip("distributed")
 import rrc_pin
 from rrc_pin import maps
 from rrc_pin.errors import InvalidInput
-from rrc_pin.maps.audit import boundary
+from rrc_pin.maps.audit import AuditReport, boundary
 
 pytestmark = pytest.mark.compiled
 
@@ -27,6 +27,22 @@ def test_audited_voxels_are_reached_by_ik(arm, voxel):
     report = maps.audit(m, robot, 40, seed=4)
     assert report.keys.size == 40 and report.confirmed == 1.0, report.failures
     assert np.all(report.distance == 0.0)
+    assert repr(report).startswith("AuditReport(40 voxels tried, 40 reached (100.0%), failures []")
+
+
+def test_a_reports_repr_is_a_one_line_summary_its_arrays_attributes():
+    n = 1000
+    keys = 3 * np.arange(n, dtype=np.int64)
+    reached = np.ones(n, bool)
+    reached[[7, 500, 501, 502, 503, 504, 999]] = False
+    report = AuditReport(keys, reached, np.arange(n) % 4 + 1, np.full(n, 40), np.zeros(n), 26.0,
+                         41_752)  # fmt: skip
+    text = repr(report)
+    assert "\n" not in text and len(text) < 200
+    assert text == ("AuditReport(1,000 voxels tried, 993 reached (99.3%), failures [21, 1500, "
+                    "1503, 1506, 1509, ...], starts 2.5 mean, 4 most, 41,752 resolver steps, "
+                    "26.0 s)")  # fmt: skip
+    assert report.keys is keys and report.failures.tolist() == keys[~reached].tolist()
 
 
 def test_refine_tries_the_boundary_and_arguments_are_checked():

@@ -214,7 +214,12 @@ def test_every_reached_voxel_has_a_witness_within_limits_in_it(arm):
 
 def test_outputs_summary_and_queries(tmp_path):
     m = maps.capability("panda", 2**15, 0.1, out=tmp_path, seed=1, **QUIET)
-    assert (tmp_path / "map.zarr").is_dir() and (tmp_path / "blocks" / "state.npz").exists()
+    assert (tmp_path / "map.zarr" / "checksums.json").is_file()
+    text = repr(m)  # a summary, the arrays as attributes
+    assert "\n" not in text and len(text) < 200 and "samples=32,768" in text
+    assert f"{int(m.reached.sum()):,} voxels reached" in text
+    assert len(list((tmp_path / "blocks").glob("fold-*.npz"))) == 1
+    assert not list((tmp_path / "blocks").glob("part-*"))
     summary = json.loads((tmp_path / "summary.json").read_text())
     assert summary["samples"] == 2**15 and summary["voxels_reached"] == m.reached.sum()
     assert "| voxels_reached |" in (tmp_path / "summary.md").read_text()

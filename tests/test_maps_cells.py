@@ -38,6 +38,8 @@ def test_cell_map_combines_the_frames(two_pandas, tmp_path):
     points = np.vstack([c.grid.centres([both, only]), [[5.0, 0.0, 0.0]]])
     mid = c.at(points)
     assert mid.arms.tolist() == [2, 1, 0] and mid.coverage.shape == (3, 2)
+    text = repr(c)  # a summary, the arrays as attributes
+    assert "\n" not in text and len(text) < 200 and "left/panda_hand_tcp" in text
     assert mid.combined_coverage[0] > 0 and np.isnan(mid.combined_manipulability[1])
     s = c.summary()
     assert 0 < s["shared_volume_m3"] < s["volume_m3[left/panda_hand_tcp]"]

@@ -1,10 +1,17 @@
 """The Dask driver: bit-identical maps from 1 and 2 workers, any task grouping, an interrupted
 and resumed run, and a dask.distributed cluster of two worker processes on loopback; an
-address with no scheduler fails fast."""
+address with no scheduler fails fast; a default run listens on loopback only and serves no
+dashboard unless asked."""
 
 from __future__ import annotations
 
+import ipaddress
+import json
+import subprocess
+import sys
 import time
+import urllib.error
+import urllib.request
 
 import pytest
 
@@ -13,6 +20,8 @@ distributed = pytest.importorskip("distributed")
 from rrc_pin import maps  # noqa: E402
 from rrc_pin.errors import InvalidInput, SchedulerUnreachable  # noqa: E402
 from rrc_pin.maps import driver  # noqa: E402
+
+psutil = pytest.importorskip("psutil")  # a dependency of distributed
 
 pytestmark = pytest.mark.compiled
 
@@ -119,3 +128,83 @@ def test_scheduler_and_workers_arguments_are_checked(scheduler, workers, argumen
     with pytest.raises(InvalidInput) as err:
         maps.capability("kr5_3r", 1000, 0.1, scheduler, workers=workers, progress=False)
     assert err.value.argument == argument
+
+
+@pytest.mark.parametrize("dashboard", [8787, "", "abc", ":99999", "tcp://host:1", "a b:1"])
+def test_a_bad_dashboard_address_is_refused(dashboard):
+    with pytest.raises(InvalidInput) as err:
+        maps.capability("kr5_3r", 1000, 0.1, dashboard=dashboard, progress=False)
+    assert err.value.argument == "dashboard"
+    with pytest.raises(InvalidInput) as err:
+        maps.capability("kr5_3r", 1000, 0.1, "tcp://127.0.0.1:9", dashboard="8787")
+    assert err.value.argument == "dashboard"
+
+
+def test_dashboard_addresses_default_to_loopback():
+    assert driver.dashboard_address("8787") == "127.0.0.1:8787"
+    assert driver.dashboard_address(":0") == "127.0.0.1:0"
+    assert driver.dashboard_address("0.0.0.0:8787") == "0.0.0.0:8787"  # named: every interface
+
+
+SOCKETS = """
+import json, sys, threading, psutil
+from rrc_pin.cli import main
+seen, done = set(), threading.Event()
+
+def sample():  # this process and its children, every 20 ms while the map runs
+    while not done.is_set():
+        me = psutil.Process()
+        for p in (me, *me.children(recursive=True)):
+            try:
+                for c in p.net_connections(kind="inet"):
+                    seen.add((c.laddr.ip if c.laddr else "", c.status))
+            except psutil.Error:
+                pass
+        done.wait(0.02)
+
+threading.Thread(target=sample, daemon=True).start()
+code = main(["map", "kr5_3r", "--samples", "60000", "--voxel", "0.1", "--out", sys.argv[1]])
+done.set()
+print("SOCKETS " + json.dumps([code, sorted(seen)]))
+"""
+
+
+def test_a_default_map_run_listens_on_loopback_only(tmp_path):
+    """``rrc-pin map`` with no scheduler, in a fresh interpreter: every socket of the process
+    and its children, sampled while the map runs, is on 127.0.0.1 (distributed 2026.8 with
+    ``dashboard_address=None`` listened on 0.0.0.0:8787 and a second port)."""
+    done = subprocess.run([sys.executable, "-c", SOCKETS, str(tmp_path / "m")],
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    line = next(x for x in done.stdout.splitlines() if x.startswith("SOCKETS "))
+    code, seen = json.loads(line.removeprefix("SOCKETS "))
+    assert code == 0
+    listening = [ip for ip, status in seen if status == psutil.CONN_LISTEN]
+    assert len(listening) >= 1  # the servers were seen up
+    assert all(ipaddress.ip_address(ip).is_loopback for ip, _ in seen if ip), seen
+
+
+def _status(port: int, path: str) -> int:
+    try:
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}{path}", timeout=5) as r:
+            return int(r.status)
+    except urllib.error.HTTPError as e:
+        return e.code
+
+
+def test_the_servers_serve_nothing_unless_the_dashboard_is_asked_for():
+    def ports() -> set[int]:
+        return {c.laddr.port for c in psutil.Process().net_connections(kind="inet")
+                if c.status == psutil.CONN_LISTEN}  # fmt: skip
+
+    before = ports()
+    for dashboard, expected in ((None, {404}), (":0", {200, 404})):
+        answers: set[int] = set()
+
+        def probe(_p, answers=answers):
+            for port in ports() - before:
+                answers.add(_status(port, "/health"))
+
+        maps.capability("kr5_3r", 4 * 2**10, 0.1, workers=1, dashboard=dashboard,
+                        progress=probe, block_size=2**10)  # fmt: skip
+        assert answers == expected, dashboard  # 200: the scheduler's routes, once asked

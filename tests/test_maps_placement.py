@@ -29,6 +29,8 @@ def test_placements_are_scored_by_the_shared_dexterous_volume(first):
     assert search.shared_volume[:4].max() > 0
     assert search.best in (0, 1, 2, 3)
     assert "| 1 |" in search.table(3)
+    text = repr(search)
+    assert "\n" not in text and len(text) < 200 and f"6 placements, best #{search.best}" in text
     again = maps.base_placement(first, "kr5_3r", region, T[:2], samples=2**16,
                                 min_coverage=0.05, workers=1)  # fmt: skip
     assert np.array_equal(again.shared_volume, search.shared_volume[:2])

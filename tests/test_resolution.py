@@ -72,6 +72,13 @@ def test_a_command_beyond_the_limits_is_scaled_along_its_direction() -> None:
     assert (r.qdot >= r.box.lb).all() and (r.qdot <= r.box.ub).all()
 
 
+def test_the_old_name_of_the_box_warns_for_one_release() -> None:
+    r = solved(np.array([3.0, 1.0]))
+    with pytest.warns(DeprecationWarning, match=r"Resolution.bounds is deprecated.*\.box"):
+        old = r.bounds
+    assert old is r.box
+
+
 def test_active_rows_by_name() -> None:
     g = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     r = solved(

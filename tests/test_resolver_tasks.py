@@ -247,19 +247,58 @@ def test_a_cell_of_two_arms_is_one_stack() -> None:
         np.testing.assert_allclose(r.qdot[:7], one.qdot, atol=1e-9)
 
 
-def test_status_is_partial_while_a_lower_level_is_far_from_its_command() -> None:
+def test_the_status_is_the_top_levels_and_levels_say_how_the_lower_ones_fared() -> None:
     """Issue 30's case: the grip at the top level, each hand commanded at the level below to
-    move apart (the grip forbids it). The lower level is not met, so no answer is ``exact``;
-    with the hands commanded alike the lower level is met, and the answers are ``exact``."""
+    move apart (the grip forbids it). The top level is met (``exact``, as every two-level
+    answer whose top level is met); ``levels`` says the lower one was traded, and met when the
+    hands are commanded alike. (Until issue 40 the first read ``partial``, like a fault.)"""
     cell = rrc_pin.load("gsfc_dual")
     left, right = cell.tool_frames
     resolver = Resolver(cell)
     q = cell.ready()
     grasp = relative_pose(cell, q, left, right).homogeneous
     grip = RelativeFrameTask(left, right, target=grasp)
-    for apart, expected in ((0.05, "partial"), (0.0, "exact")):
+    for apart, lower in ((0.05, "traded"), (0.0, "met")):
         lead = FrameTask(left, [0.0, apart, 0.02, 0.0, 0.0, 0.0], ref="world")
         follow = FrameTask(right, [0.0, -apart, 0.02, 0.0, 0.0, 0.0], ref="world")
         r = resolver.solve(q, [grip, [lead, follow]], priority="strict")
-        assert r.status == expected, (apart, r.status, r.levels)
-        assert r.levels[0] == "met" and (r.levels[1] == "met") == (expected == "exact")
+        assert r.status == "exact" and r.levels == ("met", lower), (apart, r.status, r.levels)
+        grip_served, *hands = (t.served for t in r.tasks)
+        assert grip_served in ("met", "held") and hands == [lower, lower]  # grip: b ~ 1e-16
+
+
+def test_a_posture_of_another_size_is_refused_where_it_meets_the_robot() -> None:
+    """Issue 40: ``PostureTask(np.zeros(6))`` for a 7-joint arm: the task knows no robot, the
+    resolver refuses it at its first call, naming the task, the sizes and the joints, before
+    any state changes."""
+    panda = rrc_pin.load("panda")
+    resolver = Resolver(panda)
+    posture = PostureTask(np.zeros(6))  # no robot yet: nothing to check against
+    said = (r"^q_ref: the posture task 'posture' holds 6 positions, the robot has 7 joints "
+            r"\(panda_joint1, panda_joint2, panda_joint3, \.\.\., panda_joint7\)")
+    before = resolver.warm_start_state()
+    for call in (lambda: resolver.solve(panda.ready(), [posture]),
+                 lambda: resolver.rows_of(posture, panda.ready())):  # fmt: skip
+        with pytest.raises(rrc_pin.InvalidInput, match=said):
+            call()
+    assert np.array_equal(resolver.warm_start_state()["last_qdot"], before["last_qdot"])
+
+
+def test_a_zero_command_says_it_was_held_or_traded() -> None:
+    """The README's baxter case: the posture at its reference (a zero command) gives way to
+    the hands (traded, scale 0; its scale read 1.0 and its level 'scaled' before); a posture
+    alone at its reference is held still (scale 1)."""
+    baxter = rrc_pin.load("baxter")
+    left, right = baxter.tool_frames
+    resolver = Resolver(baxter)
+    q = baxter.ready()
+    r = resolver.solve(q, [[FrameTask(left, [0.05, 0, 0, 0, 0, 0]),
+                            FrameTask(right, [0, 0.05, 0, 0, 0, 0])],
+                           PostureTask(baxter.ready(), gain=1.0)], priority="strict")  # fmt: skip
+    assert r.status == "exact" and r.levels == ("met", "traded")
+    posture = r.tasks[-1]
+    assert posture.served == "traded" and posture.scale == 0.0 and posture.residual > 0.1
+    assert [t.served for t in r.tasks[:2]] == ["met", "met"]
+    still = resolver.solve(q, [FrameTask(left, np.zeros(6)), PostureTask(q)])
+    assert [t.served for t in still.tasks] == ["held", "held"]
+    assert [t.scale for t in still.tasks] == [1.0, 1.0]

@@ -117,6 +117,18 @@ def test_end_links_are_the_moving_leaves_of_the_tree():
     assert "sonar_ring" not in ends and "pedestal" not in ends  # fixed to the base
 
 
+def test_a_serial_chain_built_in_code_is_called_a_chain():
+    """Issue 40: Pinocchio's sample manipulator (its frames name no link as another's parent)
+    was called "a tree with 9 end links"; its joints make a chain whose last joint carries
+    two links."""
+    model = pin.buildSampleModelManipulator()
+    assert end_links(model) == ["wrist2_body", "effector_body"]
+    with pytest.raises(ToolFrameRequired, match="^tool_frame: sample is a serial chain ending "
+                       "in 2 end links; name one of: wrist2_body, effector_body$"):  # fmt: skip
+        Robot(model, None, name="sample", source="sample")
+    assert Robot(model, "effector_body", name="sample", source="sample").nq == 6
+
+
 def test_shared_robot_gives_every_thread_its_own_answers():
     """Issue 15: threads calling fk and jacobian on one Robot, with another thread churning
     frame_pose, jacobian and to_pinocchio on it, get the single-threaded answers."""

@@ -64,7 +64,7 @@ def test_hysteresis_releases_above_the_band_only():
     for elbow, engaged in [(0.6, False), (0.15, True), (0.35, True), (0.6, False), (0.35, False)]:
         q[2] = elbow
         ctl.q = q.copy()
-        ctl.step([0.0, 0.0, 0.01, 0.0, 0.0, 0.0])
+        ctl.step([0.0, 0.0, 0.01, 0.0, 0.0, 0.0], ref="local")
         assert strategy.engaged is engaged, (elbow, ctl.log.column("sigma_min")[-1])
 
 

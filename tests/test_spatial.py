@@ -7,7 +7,12 @@ import pytest
 
 import rrc_pin
 from rrc_pin.solvers.errors import InvalidInput
-from rrc_pin.solvers.spatial import REFERENCES, check_reference, from_world_aligned
+from rrc_pin.solvers.spatial import (
+    REFERENCES,
+    check_reference,
+    from_world_aligned,
+    to_world_aligned,
+)
 
 
 @pytest.mark.parametrize("ref", REFERENCES)
@@ -28,3 +33,14 @@ def test_conversion_reproduces_pinocchio_frames(rng, ref):
 def test_unknown_reference_lists_the_valid_ones():
     with pytest.raises(InvalidInput, match="^ref: expected one of world_aligned, local, world"):
         check_reference("base")
+
+
+@pytest.mark.parametrize("ref", REFERENCES)
+def test_to_world_aligned_is_the_twist_of_the_same_rates(rng, ref):
+    """A twist of rates expressed in ``ref`` comes back as their world_aligned twist."""
+    arm = rrc_pin.load("panda")
+    for _ in range(50):
+        q, qdot = arm.random_q(rng), rng.normal(size=arm.nv)
+        T = arm.fk(q)
+        twist = to_world_aligned(arm.jacobian(q, ref) @ qdot, T[:3, :3], T[:3, 3], ref)
+        np.testing.assert_allclose(twist, arm.jacobian(q) @ qdot, atol=1e-12)

@@ -17,7 +17,7 @@ def log() -> TrajectoryLog:
     arm = rrc_pin.load("barker6")
     ctl = Controller(arm, q0=np.deg2rad([20.0, 30.0, 60.0, 10.0, 2.0, 0.0]), strategy="slowdown")
     for _ in range(30):
-        ctl.step([0.02, 0.0, -0.01, 0.0, -0.4, 0.1])
+        ctl.step([0.02, 0.0, -0.01, 0.0, -0.4, 0.1], ref="local")
     for _ in range(10):
         ctl.step([5.0, 0.0, 0.0, 0.0, 0.0, 0.0], ref="world_aligned")  # beyond the limits
     ctl.reverse(0.2)
@@ -62,10 +62,10 @@ def test_positions_of_the_last_ticks_need_no_records(log):
     arm = rrc_pin.load("panda")
     ctl = Controller(arm, q0=np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.8, 0.7]))
     for _ in range(5):
-        ctl.step([0.02, 0.0, 0.0, 0.0, 0.0, 0.1])
+        ctl.step([0.02, 0.0, 0.0, 0.0, 0.0, 0.1], ref="local")
     assert len(ctl.log.records) == 5  # derived
     for _ in range(3):
-        ctl.step([0.0, 0.02, 0.0, 0.0, 0.1, 0.0])  # pending
+        ctl.step([0.0, 0.02, 0.0, 0.0, 0.1, 0.0], ref="local")  # pending
     tail = ctl.log.positions(6)
     assert ctl.log._pending == 3  # still pending: nothing derived
     wanted = [r.q for r in ctl.log.records[-6:]]
@@ -81,18 +81,18 @@ def test_the_log_keeps_its_capacity_and_its_memory_stays_flat():
     ctl.log.capacity = 100
     command = [0.01, 0.0, 0.0, 0.0, 0.0, 0.05]
     for _ in range(300):
-        ctl.step(command)
+        ctl.step(command, ref="local")
     assert len(ctl.log) == 100 and ctl.log.dropped == 200
     t = ctl.log.column("t")  # the last 100 ticks, oldest first
     np.testing.assert_allclose(t, 0.01 * np.arange(200, 300), atol=1e-9)
     tracemalloc.start()
     try:
         for _ in range(100):  # the ring refilled with ticks allocated under tracemalloc
-            ctl.step(command)
+            ctl.step(command, ref="local")
         gc.collect()
         before = tracemalloc.get_traced_memory()[0]
         for _ in range(400):
-            ctl.step(command)
+            ctl.step(command, ref="local")
         gc.collect()
         grown = tracemalloc.get_traced_memory()[0] - before
     finally:
@@ -105,7 +105,7 @@ def test_reverse_retraces_within_the_ring():
     ctl = Controller(rrc_pin.load("barker6"))
     ctl.log.capacity = 50
     for _ in range(120):
-        ctl.step([0.02, 0.0, 0.0, 0.0, 0.0, 0.1])
+        ctl.step([0.02, 0.0, 0.0, 0.0, 0.0, 0.1], ref="local")
     start = ctl.log.positions(30)[0]  # the configuration of tick 90
     done = ctl.reverse(0.3)
     assert done.reached and np.abs(ctl.q - start).max() <= 1e-9

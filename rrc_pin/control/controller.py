@@ -1,7 +1,8 @@
 r"""Controller: Barker's operator loop on the resolver, one tick per call.
 
-Every :meth:`Controller.step` takes the operator's twist in the hand frame (Barker eq. (20),
-``ref="local"``) or in base axes (``"world_aligned"``), weights it by the speed override
+Every :meth:`Controller.step` takes the operator's twist in base axes (``ref="world_aligned"``,
+the default), in the hand frame (Barker eq. (20), ``"local"``) or as the spatial twist at the
+base origin (``"world"``), weights it by the speed override
 and the deadman (:class:`~rrc_pin.control.deadman.Deadman`), adds the bounded pull back to
 the commanded pose (:class:`~rrc_pin.control.drift.DriftCorrection`), lets the singularity
 strategy adjust it (:mod:`rrc_pin.control.strategies`), resolves it with the
@@ -18,7 +19,8 @@ recording the tick in a :class:`~rrc_pin.control.trajectory_log.TrajectoryLog`.
 from __future__ import annotations
 
 import math
-from typing import Any, Literal, NamedTuple
+import warnings
+from typing import Any, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -32,20 +34,20 @@ from rrc_pin.control.singularity import SingularityLabel
 from rrc_pin.control.strategies import Situation, Strategy, make_strategy
 from rrc_pin.control.strategies.base import KEEP, to_base_axes
 from rrc_pin.control.trajectory_log import LogRecord, TrajectoryLog
+from rrc_pin.deprecated import warn_renamed
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import JointLimits
 from rrc_pin.loading import cells, load
 from rrc_pin.resolver import QPOptions
-from rrc_pin.robot import Robot
+from rrc_pin.robot import Robot, frame_id
 from rrc_pin.solvers.checks import as_vector, finite_number
+from rrc_pin.solvers.spatial import Reference, check_reference, to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.resolution import Resolution
 
 Array = npt.NDArray[np.float64]
-Frame = Literal["local", "world_aligned"]
 LINEAR = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
-FRAMES: tuple[str, ...] = ("local", "world_aligned")
-REANCHOR = ("damped", "singular", "least_squares", "recovering", "fallback", "partial")
+REANCHOR = ("damped", "singular", "least_squares", "recovering", "fallback")
 """Statuses whose motion departs from the command's direction: the reference pose is reset to
 the reached pose instead of pulling the hand back to a pose it could not follow."""
 NO_ERROR = np.zeros(6)
@@ -163,9 +165,10 @@ class Controller(Loop):
         self._rows = tuple(self.resolver.task.selected)
         self._full = len(self._rows) == 6
         self._data = robot.model.createData()
-        self._frame_id = robot.model.getFrameId(robot.tool_frame)
+        self._frame_id = frame_id(robot.model, robot.tool_frame)  # z1: a joint shares its name
         self._command: Array = np.zeros(6)
-        self._command_frame: Frame = "local"
+        self._command_frame: Reference = "world_aligned"
+        self._default_warned = False
         self._reference = self._pose(self._pinocchio_q(self._q))
         self._reanchor = False
 
@@ -179,14 +182,23 @@ class Controller(Loop):
 
     # -- the loop ---------------------------------------------------------------------------
 
-    def step(self, twist: npt.ArrayLike | None = None, ref: Frame = "local") -> Step:
+    def step(
+        self,
+        twist: npt.ArrayLike | None = None,
+        ref: Reference | None = None,
+        *,
+        frame: Reference | None = None,
+    ) -> Step:
         """Resolve and integrate one tick of the operator's command.
 
         Args:
             twist: Commanded twist [v; w] (6,) [m/s, rad/s] of the tool frame in ``ref``,
                 or None: no new command this tick (the last one ages, see ``deadman``).
-            ref: ``"local"`` (hand axes, Barker eq. (20)) or ``"world_aligned"`` (base
-                axes), as tasks name their frames.
+            ref: The twist's frame, as everywhere in rrc-pin (:mod:`rrc_pin.solvers.spatial`):
+                ``"world_aligned"`` (default: the hand's velocity in base axes), ``"local"``
+                (hand axes, Barker eq. (20)) or ``"world"`` (the spatial twist at the base
+                origin; full twists only). A command keeps its frame while it ages.
+            frame: The old name of ``ref`` (deprecated).
 
         Returns:
             The new configuration and the tick's resolution.
@@ -195,24 +207,24 @@ class Controller(Loop):
             InvalidInput: A bad ``twist`` (shape, NaN, inf) or ``ref``, raised before any
                 state changes.
         """
-        if not isinstance(ref, str) or ref not in FRAMES:
-            raise InvalidInput("ref", f"expected one of {', '.join(FRAMES)}, got {ref!r}")
-        if twist is not None:
-            command = _checked_twist(twist)
-            self._command, self._command_frame, self._command_time = command, ref, self.t
+        self._take(twist, ref, frame)
         weight = self._weight()
-        command = self._command if weight == 1.0 else weight * self._command
-        local = self._command_frame == "local"
+        given = self._command if weight == 1.0 else weight * self._command  # in ``ref``
+        ref = self._command_frame
+        local = ref == "local"
 
         q = self._q
         q_pin = self._pinocchio_q(q)
         pose = self._pose(q_pin)
+        command = given  # served in hand axes (local) or base axes; a world twist turned so:
+        if ref == "world":
+            command = to_world_aligned(given, pose.rotation, pose.translation, "world")
         if self._reanchor:
             self._reference, self._reanchor = pose, False
         error = pose_error(pose, self._reference)  # hand axes
         if not self._full:  # position rows only: the orientation is not commanded
             error[3:] = 0.0
-        # What to serve, in the command's frame: the command plus the correction.
+        # What to serve, in the command's axes: the command plus the correction.
         if self.drift is None or weight == 0.0:  # an arm stopped or let go stands still
             wanted = command
         else:
@@ -227,7 +239,7 @@ class Controller(Loop):
         factor = decision.factor
         if decision.rates is None:
             r = self.resolver.solve(q, wanted if factor == 1.0 else factor * wanted,
-                                    self._command_frame)
+                                    "local" if local else "world_aligned")
         else:
             r = self.resolver.solve(q, [RatesTask(decision.rates)], priority="strict")
         # q itself, not a copy: read-only, replaced at every tick.
@@ -237,13 +249,62 @@ class Controller(Loop):
         if fraction is None:
             self._reanchor = True
         elif self._full:  # the command, for the time it was followed
-            self._reference = advance(self._reference, command, factor * fraction * self.dt,
-                                      local)
+            self._reference = advance(self._reference, given, factor * fraction * self.dt, ref)
         else:  # the commanded position, at the orientation reached
             moved = to_base_axes(pose.rotation, command) if local else command
             self._reference = advance(self._reference, moved * LINEAR,
-                                      factor * fraction * self.dt, False)
+                                      factor * fraction * self.dt, "world_aligned")
         return self._advance(r)
+
+    def _take(
+        self, twist: npt.ArrayLike | None, ref: Reference | None, frame: Reference | None
+    ) -> None:
+        """Keep a new command and its frame, checked (the old keyword ``frame`` mapped).
+
+        Raises:
+            InvalidInput: A bad ``twist`` or ``ref``, or both ``ref`` and ``frame``, before
+                anything is kept.
+        """
+        if frame is not None:
+            warn_renamed("Controller.step(frame=)", "Controller.step(ref=)", stacklevel=4)
+            if ref is not None:
+                raise InvalidInput("frame", "the old name of ref: pass ref alone")
+            ref = frame
+        if twist is None:
+            if ref is not None:
+                self._checked_ref(ref)
+            return
+        command = _checked_twist(twist)
+        self._command_frame = self._checked_ref("world_aligned" if ref is None else ref)
+        self._command, self._command_time = command, self.t
+        if ref is None:
+            self._warn_default()
+
+    def _checked_ref(self, ref: object) -> Reference:
+        """``ref`` if it names a frame this controller's task can be commanded in.
+
+        Raises:
+            InvalidInput: Naming ``ref``: not a frame's name, or ``world`` on an arm whose
+                task has position rows only (a spatial twist needs its angular rows).
+        """
+        checked = check_reference(ref)  # type: ignore[arg-type]
+        if checked == "world" and not self._full:
+            raise InvalidInput(
+                "ref", f"{self.robot.name} is commanded in position only (below six joints); "
+                "a 'world' twist is the spatial twist of the whole hand: use 'world_aligned'",
+            )
+        return checked
+
+    def _warn_default(self) -> None:
+        """Warn once per controller that a twist without ``ref`` is now ``world_aligned``."""
+        if not self._default_warned:
+            self._default_warned = True
+            warnings.warn(
+                "Controller.step(twist) without ref: the twist is in 'world_aligned' (base "
+                "axes), the default of every entry point; before this release the "
+                "controller's default was 'local' (hand axes). Pass ref= to choose and "
+                "silence this", FutureWarning, stacklevel=4,
+            )
 
     # -- what the loop asks of it -----------------------------------------------------------
 

@@ -26,6 +26,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.spatial import Reference
 
 Array = npt.NDArray[np.float64]
 
@@ -87,15 +88,19 @@ def pose_error(pose: pin.SE3, reference: pin.SE3) -> Array:
     return np.concatenate([xyzquat[:3], two * xyzquat[3:6]])
 
 
-def advance(reference: pin.SE3, twist: Array, dt: float, local: bool) -> pin.SE3:
-    """The reference pose moved by a constant ``twist`` (6,) for ``dt`` [s].
+def advance(reference: pin.SE3, twist: Array, dt: float, ref: Reference) -> pin.SE3:
+    """The reference pose moved by a ``twist`` (6,) held constant in frame ``ref`` for ``dt`` [s].
 
-    ``local`` (hand axes): the screw motion ``T exp(twist dt)``; else ``world_aligned``: the
-    origin moves by ``v dt`` and the axes turn by ``exp(w dt)`` about the base axes.
+    ``local`` (hand axes): the screw motion ``T exp(twist dt)``; ``world`` (the spatial twist
+    at the base origin): the screw motion ``exp(twist dt) T``; ``world_aligned``: the origin
+    moves by ``v dt`` and the axes turn by ``exp(w dt)`` about the base axes.
     """
-    if local:
+    if ref == "local":
         moved: pin.SE3 = reference * pin.exp6(twist * dt)
         return moved
+    if ref == "world":
+        turned: pin.SE3 = pin.exp6(twist * dt) * reference
+        return turned
     return pin.SE3(pin.exp3(twist[3:] * dt) @ reference.rotation,
                    reference.translation + twist[:3] * dt)  # fmt: skip
 

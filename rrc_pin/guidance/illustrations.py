@@ -329,8 +329,8 @@ def illustration_6(correction: Correction = "none") -> tuple[list[Row], list[Gui
     arm = chain("nadkarni_c2")
     q0 = start("nadkarni_c2")
     commands = [
-        Command((0.0, 0.0, 1.0), 4.0 * INCH, np.radians(-30.0), "global"),
-        Command((1.0, 0.0, 0.0), -1.0 * INCH, np.radians(15.0), "hand"),
+        Command((0.0, 0.0, 1.0), 4.0 * INCH, np.radians(-30.0), "world_aligned"),
+        Command((1.0, 0.0, 0.0), -1.0 * INCH, np.radians(15.0), "local"),
     ]
     paths = operator(arm, q0, commands, [9, 4], correction=correction)
     q = np.concatenate([paths[0].q, paths[1].q[1:]])

@@ -104,7 +104,7 @@ class JointLimits(Limit):
         if self.acceleration is not None and np.size(self.acceleration) not in (1, n):
             raise InvalidInput("acceleration", f"expected a scalar or shape ({n},), got "
                                f"{np.shape(self.acceleration)}")  # fmt: skip
-        half = 0.5 * (layout.upper - layout.lower)
+        half = 0.5 * layout.upper - 0.5 * layout.lower  # no overflow at a floating base's 1.8e308
         if self.margin > 0.0 and (self.margin >= half).any():
             narrow = [name for name, i in layout.joints.items() if self.margin >= half[i]]
             raise InvalidInput(

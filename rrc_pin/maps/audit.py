@@ -47,11 +47,13 @@ STALL_STEPS = 20
 """A start is abandoned after this many steps without getting :data:`STALL_M` closer."""
 STALL_M = 1e-4
 """[m] Progress that counts."""
+SHOWN = 5
+"""Failures a report's ``repr`` lists (the rest: :attr:`AuditReport.failures`)."""
 
 
-@dataclass
+@dataclass(repr=False)
 class AuditReport:
-    """What IK found for each voxel tried.
+    """What IK found for each voxel tried (its ``repr``, a one-line summary).
 
     Attributes:
         keys: The voxels tried (k,).
@@ -81,6 +83,16 @@ class AuditReport:
         """The voxels IK did not reach."""
         out: npt.NDArray[np.int64] = self.keys[~self.reached]
         return out
+
+    def __repr__(self) -> str:
+        n, failed = int(self.keys.size), self.failures.tolist()
+        shown = ", ".join(map(str, failed[:SHOWN])) + (", ..." if len(failed) > SHOWN else "")
+        starts = f"{self.starts.mean():.1f} mean, {self.starts.max()} most" if n else "none"
+        return (
+            f"AuditReport({n:,} voxels tried, {n - len(failed):,} reached "
+            f"({self.confirmed:.1%}), failures [{shown}], starts {starts}, "
+            f"{self.steps_total:,} resolver steps, {self.seconds:.1f} s)"
+        )
 
 
 def _robot(m: CapabilityMap, robot: Robot) -> tuple[Robot, npt.NDArray[np.int64]]:

@@ -55,6 +55,7 @@ def capability(
     block_size: int = BLOCK,
     blocks_per_task: int | None = None,
     grid: Grid | None = None,
+    dashboard: str | None = None,
 ) -> CapabilityMap:
     """The capability map of ``arm``'s tool frame: reachability, dexterity, singularities.
 
@@ -90,6 +91,10 @@ def capability(
             thread, at most 8 blocks each. Any grouping gives the same map.
         grid: The voxel grid (default: the one holding the chain's reach); used by the cell
             maps to put every arm on one grid.
+        dashboard: Serve Dask's dashboard of the in-process cluster at this address
+            (``"8787"`` or ``":8787"``: on 127.0.0.1; ``"0.0.0.0:8787"``: every interface;
+            needs bokeh); None: no dashboard, and the cluster's HTTP servers listen on
+            127.0.0.1 only, serving nothing. Refused with a ``scheduler``.
 
     Returns:
         The map.
@@ -107,7 +112,7 @@ def capability(
     block_size = _block_size(block_size)
     if blocks_per_task is not None:
         blocks_per_task = _count(blocks_per_task, "blocks_per_task", 1, 64)
-    driver.check_scheduler(scheduler, workers)
+    driver.check_scheduler(scheduler, workers, dashboard)
     if not isinstance(dexterity, bool):
         raise InvalidInput("dexterity", f"expected True or False, got {dexterity!r}")
     report = progress if callable(progress) else None
@@ -134,7 +139,7 @@ def capability(
         store.check()
     job = Job(kin, grid.arrays, plan, seed, dexterity, q, fields)
     bar = ProgressBar(f"map {robot.name}") if progress is True else None
-    with driver.connect(scheduler, workers) as client:
+    with driver.connect(scheduler, workers, dashboard=dashboard) as client:
         stats, run = driver.run(job, grid.size, client, store, report or bar, blocks_per_task)
     meta = {
         **definition,

@@ -54,9 +54,11 @@ def popcount(bits: npt.NDArray[np.uint64]) -> npt.NDArray[np.int64]:
     return out
 
 
-@dataclass
+@dataclass(repr=False)
 class CapabilityMap:
     """Reachability, dexterity and singularity statistics of one tool frame, per voxel.
+
+    Its ``repr`` is a one-line summary (the arrays: :attr:`stats`, :meth:`column`).
 
     Attributes:
         grid: The voxels (aligned on multiples of the voxel edge, base frame).
@@ -70,6 +72,15 @@ class CapabilityMap:
     stats: VoxelStats
     chain: Chain
     meta: dict[str, Any] = field(default_factory=dict)
+
+    def __repr__(self) -> str:
+        shape = "x".join(map(str, self.grid.shape))
+        return (
+            f"CapabilityMap(arm={self.meta.get('arm')!r}, frame={self.meta.get('frame')!r}, "
+            f"samples={int(self.meta.get('samples', 0)):,}, voxel={self.grid.voxel} m, "
+            f"grid {shape}, {int(np.count_nonzero(self.reached)):,} voxels reached, "
+            f"{self.volume():.4g} m^3)"
+        )
 
     @property
     def plan(self) -> Plan:

@@ -57,9 +57,11 @@ class CellQuery(NamedTuple):
     combined_manipulability: Array
 
 
-@dataclass
+@dataclass(repr=False)
 class CellMap:
     """The maps of a cell's tool frames on one grid, and their combination.
+
+    Its ``repr`` is a one-line summary.
 
     Attributes:
         name: The cell (robot) name.
@@ -70,6 +72,14 @@ class CellMap:
     name: str
     frames: tuple[str, ...]
     maps: tuple[CapabilityMap, ...]
+
+    def __repr__(self) -> str:
+        shared = np.count_nonzero(self.shared) * self.grid.voxel**3
+        return (
+            f"CellMap({self.name!r}, frames={list(self.frames)}, "
+            f"samples={int(self.maps[0].meta.get('samples', 0)):,} per frame, "
+            f"voxel={self.grid.voxel} m, shared {shared:.4g} m^3)"
+        )
 
     @property
     def grid(self) -> Grid:
@@ -171,6 +181,7 @@ def cell_map(
     dexterity: bool = True,
     progress: ProgressArg = True,
     block_size: int = BLOCK,
+    dashboard: str | None = None,
 ) -> CellMap:
     """The map of every tool frame of ``cell`` on one grid, and their combination.
 
@@ -184,6 +195,7 @@ def cell_map(
         dexterity: As :func:`~rrc_pin.maps.capability`.
         progress: As :func:`~rrc_pin.maps.capability` (one bar per frame).
         block_size: As :func:`~rrc_pin.maps.capability`.
+        dashboard: As :func:`~rrc_pin.maps.capability`.
         out: Folder: each frame's map in ``<index>_<frame>/`` (resumable each) and the
             cell's ``summary.md``/``.json`` (plots: :func:`~rrc_pin.maps.plot_cell`).
 
@@ -205,7 +217,7 @@ def cell_map(
         maps.append(capability(
             robot, samples, float(voxel), scheduler, seed=seed, out=sub, workers=workers,
             dexterity=dexterity, frame=frame, progress=progress, block_size=block_size,
-            grid=grid,
+            grid=grid, dashboard=dashboard,
         ))  # fmt: skip
     result = CellMap(robot.name, tuple(robot.tool_frames), tuple(maps))
     if folder is not None:

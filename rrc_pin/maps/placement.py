@@ -55,9 +55,9 @@ def placements_grid(
     return np.array(out)
 
 
-@dataclass
+@dataclass(repr=False)
 class PlacementSearch:
-    """Scores of the candidate placements of the second arm.
+    """Scores of the candidate placements of the second arm (its ``repr``, a summary).
 
     Attributes:
         placements: Candidate base poses (K, 4, 4).
@@ -75,6 +75,15 @@ class PlacementSearch:
     region: Grid
     min_coverage: float
     seconds: float = 0.0
+
+    def __repr__(self) -> str:
+        k = self.best
+        x, y, z = self.placements[k][:3, 3]
+        return (
+            f"PlacementSearch({len(self.placements):,} placements, best #{k} at "
+            f"({x:.3f}, {y:.3f}, {z:.3f}) m: {self.shared_volume[k]:.4g} m^3 shared dexterous, "
+            f"{self.seconds:.1f} s)"
+        )
 
     @property
     def best(self) -> int:
@@ -141,6 +150,7 @@ def base_placement(
     workers: int | None = None,
     frame: str | None = None,
     block_size: int = BLOCK,
+    dashboard: str | None = None,
 ) -> PlacementSearch:
     """Score each base pose of ``second`` by the dexterous volume it shares with ``first``.
 
@@ -157,6 +167,7 @@ def base_placement(
         workers: As :func:`~rrc_pin.maps.capability`.
         frame: The second arm's tool frame (default: its own).
         block_size: Samples per block.
+        dashboard: As :func:`~rrc_pin.maps.capability`.
 
     Raises:
         InvalidInput: A bad argument (named).
@@ -175,7 +186,7 @@ def base_placement(
         raise InvalidInput("min_coverage", f"expected (0, 1], got {min_coverage!r}")
     if isinstance(samples, bool) or not isinstance(samples, int) or samples < 1:
         raise InvalidInput("samples", f"expected an int >= 1, got {samples!r}")
-    driver.check_scheduler(scheduler, workers)
+    driver.check_scheduler(scheduler, workers, dashboard)
     grid = region_grid(lo, hi, first.grid.voxel)
     centres = grid.centres(np.arange(grid.size))
     q1 = first.at(centres)
@@ -191,7 +202,7 @@ def base_placement(
         for t in T
     ]  # fmt: skip
     start = time.perf_counter()
-    with driver.connect(scheduler, workers) as client:
+    with driver.connect(scheduler, workers, dashboard=dashboard) as client:
         futures: list[Any] = [
             client.submit(score_placement, job, first_dexterous, first_manip,
                           float(min_coverage), pure=False)

@@ -198,13 +198,22 @@ class VoxelStats:
         self.imin[k] = np.minimum(self.imin[k], part.imin)
         self.outside += part.outside
 
-    def sparse(self) -> Sparse:
-        """The voxels reached, as a :class:`Sparse` (for a compact checkpoint)."""
-        k = np.flatnonzero(self.count)
-        return Sparse(
-            k, self.count[k], self.dirs[k], self.fmax[k], self.isum[k], self.imin[k],
-            self.outside,
-        )  # fmt: skip
+    @classmethod
+    def combine(cls, parts: Sequence[Sparse], fields: Fields) -> Sparse:
+        """Sparse results (each of distinct keys) as one, reduced exactly by :meth:`merge`.
+
+        The statistics of the union of their keys only: memory of the parts, not the grid.
+        """
+        keys, inverse = np.unique(np.concatenate([p.keys for p in parts]), return_inverse=True)
+        union = cls.empty(keys.size, fields)
+        start = 0
+        for p in parts:
+            end = start + p.keys.size
+            union.merge(Sparse(inverse[start:end], p.count, p.dirs, p.fmax, p.isum, p.imin,
+                               p.outside))  # fmt: skip
+            start = end
+        return Sparse(keys, union.count, union.dirs, union.fmax, union.isum, union.imin,
+                      union.outside)  # fmt: skip
 
     def arrays(self) -> dict[str, npt.NDArray[Any]]:
         """Every column by name, (V,) each."""

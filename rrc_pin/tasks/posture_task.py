@@ -19,6 +19,10 @@ class PostureTask(Task):
 
     Continuous joints take the short way round (the difference wrapped into [-pi, pi]).
 
+    The task knows no robot until a resolver meets it: ``q_ref``'s size is checked against the
+    robot's joints there (:meth:`check`, from ``Resolver.solve`` and ``Resolver.rows_of``),
+    before anything is computed, as every task's frames are.
+
     Args:
         q_ref: Reference configuration (nq,) [rad or m].
         gain: k > 0 [1/s]: the fraction of the remaining distance asked per second.
@@ -53,7 +57,12 @@ class PostureTask(Task):
             InvalidInput: ``q_ref`` has the wrong size.
         """
         if self.q_ref.size != layout.nv:
-            raise InvalidInput("q_ref", f"expected shape ({layout.nv},), got ({self.q_ref.size},)")
+            names = list(layout.joints)
+            shown = ", ".join(names[:3] + (["..."] if len(names) > 4 else []) + names[3:][-1:])
+            raise InvalidInput(
+                "q_ref", f"the posture task {self.name!r} holds {self.q_ref.size} positions, the "
+                f"robot has {layout.nv} joints ({shown}): expected shape ({layout.nv},)",
+            )
 
     def rows(self, kin: Kinematics) -> TaskRows:
         """Identity rows and ``gain (q_ref - q)``."""

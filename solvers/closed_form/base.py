@@ -9,7 +9,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.checks import as_array, as_vector
-from rrc_pin.solvers.tick.kernels import kernel
+from rrc_pin.solvers.compiled import kernel
 
 Array = npt.NDArray[np.float64]
 _F64 = np.dtype(np.float64)

@@ -26,7 +26,8 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.closed_form.base import finite
-from rrc_pin.solvers.tick.kernels import cholesky_solve, jacobi_svd, kernel, svd_rates
+from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.tick.kernels import cholesky_solve, jacobi_svd, svd_rates
 
 Array = npt.NDArray[np.float64]
 Vector3 = tuple[float, float, float]

@@ -15,7 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.closed_form.base import finite
-from rrc_pin.solvers.tick.kernels import kernel
+from rrc_pin.solvers.compiled import kernel
 
 Array = npt.NDArray[np.float64]
 Terms = tuple[float, float, float, float, float, float, float]

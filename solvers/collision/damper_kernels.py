@@ -38,7 +38,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.tick.kernels import kernel
+from rrc_pin.solvers.compiled import kernel
 
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]

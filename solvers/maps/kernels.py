@@ -1,7 +1,7 @@
 r"""Compiled kernels of the capability maps.
 
 A serial chain's pose and Jacobian, singular values, voxel and direction bins, and the exact
-accumulation of samples into voxels. Every function is ``@njit(cache=True, nogil=True)``
+accumulation of samples into voxels. Every function is ``@kernel(nogil=True)``
 (numba): arrays in, arrays out, the caller preallocates; no Python object inside. ``nogil``
 lets the threads of a local Dask scheduler run the kernels side by side. The same source runs
 as plain Python under ``NUMBA_DISABLE_JIT=1`` (tests/test_maps_kernels.py checks both against
@@ -38,7 +38,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+
+from rrc_pin.solvers.compiled import kernel
 
 REVOLUTE = 0
 PRISMATIC = 1
@@ -80,7 +81,7 @@ overflow in int64."""
 #   imin: 0 witness (global sample index), 1.. first sample per condition (minima, int64)
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def sincos(x, C, S):
     """Cosines ``C`` and sines ``S`` of the angles ``x`` [rad] (m,), to an ulp or two.
 
@@ -105,7 +106,7 @@ def sincos(x, C, S):
         C[i] = (sr if odd else cr) * (-1.0 if q == 1 or q == 2 else 1.0)
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def chain_tile(rot, trans, kind, Q, lo, m, joints, X, C, S, R, P, Og, Ax):
     """Poses of the samples ``lo .. lo + m - 1`` of ``Q``, one array per entry (a tile).
 
@@ -174,7 +175,7 @@ def chain_tile(rot, trans, kind, Q, lo, m, joints, X, C, S, R, P, Og, Ax):
                     P[i, s] += R[3 * i + 2, s] * X[s]
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def chain_jacobian(Og, Ax, kind, P, m, J):
     """Geometric Jacobians of a tile's samples, rows [v; w], into ``J`` (r, n, T), r = 3 or 6.
 
@@ -200,7 +201,7 @@ def chain_jacobian(Og, Ax, kind, P, m, J):
                     J[3, k, s], J[4, k, s], J[5, k, s] = 0.0, 0.0, 0.0
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def chain_batch(rot, trans, kind, Q, R, P, J):
     """Poses and Jacobians of many configurations (:func:`chain_tile`, :func:`chain_jacobian`).
 
@@ -226,7 +227,7 @@ def chain_batch(rot, trans, kind, Q, R, P, J):
                     J[lo + s, i, k] = Jt[i, k, s]
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def singular_values(W, m, sv):
     """Singular values of a tile's matrices ``W`` (r, n, T), r <= n, into ``sv`` (r, T).
 
@@ -288,7 +289,7 @@ def singular_values(W, m, sv):
             sv[j, s] = value
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def direction_bin(x, y, z):
     """Bin (0..53) of the unit direction ``(x, y, z)`` on the equal-angle cube map.
 
@@ -311,7 +312,7 @@ def direction_bin(x, y, z):
     return (face * FACE_CELLS + iu) * FACE_CELLS + iv
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def voxel_key(x, y, z, start, voxel, shape):
     """Linear index ``(ix ny + iy) nz + iz`` of the voxel holding ``(x, y, z)``, or -1 outside.
 
@@ -326,7 +327,7 @@ def voxel_key(x, y, z, start, voxel, shape):
     return (ix * shape[1] + iy) * shape[2] + iz
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def limit_margin(q, lower, span):
     """Smallest distance to a joint limit relative to the joint's range, in [0, 0.5].
 
@@ -341,7 +342,7 @@ def limit_margin(q, lower, span):
     return out
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def sample_row(
     s, px, py, pz, zx, zy, zz, q, sv, lower, span, start, voxel, shape, dexterity, quanta, first,
     keys, dirs, fmax, isum, imin,
@@ -375,7 +376,7 @@ def sample_row(
         isum[s, 1] = 0
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def chain_rows(
     rot, trans, kind, Q, lower, span, start, voxel, shape, rows, dexterity, quanta, first,
     keys, dirs, fmax, isum, imin,
@@ -420,7 +421,7 @@ def chain_rows(
                        keys, dirs, fmax, isum, imin)  # fmt: skip
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def batch_rows(
     P, Z, J, flags, Q, lower, span, start, voxel, shape, dexterity, quanta, first,
     keys, dirs, fmax, isum, imin,
@@ -469,7 +470,7 @@ def batch_rows(
                 imin[g, 1 + c] = first + g if flags[g, c] else NONE
 
 
-@njit(cache=True, nogil=True)
+@kernel(nogil=True)
 def accumulate(keys, count, dirs, fmax, isum, imin, table, tmax):
     """Add rows into a hash table of voxels, exactly; returns (slots filled, samples outside).
 

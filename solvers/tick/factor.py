@@ -14,8 +14,8 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.solvers.compiled import kernel
 from rrc_pin.solvers.tick import kernels
-from rrc_pin.solvers.tick.kernels import kernel
 
 Array = npt.NDArray[np.float64]
 

@@ -14,15 +14,13 @@ numba caches the machine code in ``__pycache__``); later processes load it in mi
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
-from typing import Any, TypeVar, cast
 
 import numpy as np
 import numpy.typing as npt
-from numba import njit
+
+from rrc_pin.solvers.compiled import kernel
 
 Array = npt.NDArray[np.float64]
-F = TypeVar("F", bound=Callable[..., Any])
 
 ON_LIMIT = 1e-12
 """[rad or m] A start at most this far outside the range counts as on its limit."""
@@ -37,24 +35,6 @@ VELOCITY, POSITION, ACCELERATION = 0, 1, 2
 SWEEPS = 60
 """Most sweeps of the one-sided Jacobi SVD (:func:`jacobi_svd`); it converges quadratically and
 takes five to eight on a 6 x 6 factor, so this cap is only a guard."""
-
-
-def kernel(function: F) -> F:
-    """``numba.njit(cache=True)`` with the function's own signature kept for the type checker."""
-    return cast(F, njit(cache=True)(function))
-
-
-def inlined(function: F) -> F:
-    """``numba.njit(cache=True, inline="always")``: compiled into each compiled caller.
-
-    At numba's IR, not apart: for the compiled tick's glue between its kernels.
-
-    A kernel that calls another links the callee's code into its own and LLVM optimises it
-    again there, so along a chain of compiled wrappers the kernels at its end are optimised
-    once per link. Inlined, the glue is optimised once, in the tick's entry, and each kernel
-    twice: on its own and there (docs/benchmarks.md, "Compiling the tick").
-    """
-    return cast(F, njit(cache=True, inline="always")(function))
 
 
 # -- the step's joint box ---------------------------------------------------------------------

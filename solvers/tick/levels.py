@@ -15,8 +15,8 @@ import numpy as np
 import numpy.typing as npt
 from numba import objmode
 
+from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import backend_calls, factor, kernels
-from rrc_pin.solvers.tick.kernels import inlined, kernel
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
 
 Array = npt.NDArray[np.float64]

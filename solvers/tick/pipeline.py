@@ -70,13 +70,12 @@ then the fallbacks (:mod:`rrc_pin.solvers.tick.fallbacks`)."""
 METHODS: tuple[Method, ...] = ("qp", "scipy", "scaling", "hold")
 
 Status = Literal[
-    "exact", "partial", "scaled", "sliding", "damped", "singular", "least_squares", "recovering",
-    "fallback",
+    "exact", "scaled", "sliding", "damped", "singular", "least_squares", "recovering", "fallback",
 ]
-"""What the answer is (docs/api.md, "Reading a resolution"):
+"""What the answer is for the top level (docs/api.md, "Reading a resolution"); how each lower
+level fared is in ``levels`` (:data:`LevelStatus`):
 
-- ``exact``: every level is met;
-- ``partial``: the top level is met, a lower one only in part (see ``levels``);
+- ``exact``: the top level's command is met;
 - ``scaled``: the top level's direction is kept exactly, its speed reduced (``scale < 1``)
   to the largest the constraints allow;
 - ``sliding``: the exact rates crossed a row the command may slide along (a collision pair):
@@ -99,7 +98,8 @@ Status = Literal[
 LevelStatus = Literal["met", "scaled", "traded", "dropped"]
 """How one priority level was served: ``met`` (its command, to :data:`EXACT_TOL`), ``scaled``
 (its command's direction, slower), ``traded`` (a least-squares optimum within the levels above
-and the constraints), ``dropped`` (its solve failed: the answer of the levels above kept)."""
+and the constraints; a zero command whose rows moved), ``dropped`` (its solve failed: the
+answer of the levels above kept)."""
 
 EXACT_TOL = 1e-9
 """Relative residual under which a command counts as met, and a scale as 1."""
@@ -258,11 +258,8 @@ def _answer(problem: Problem, top: _Top, qdot: Array, method: Method,
     clip = kernels.clip_into(qdot, box.lb, box.ub)  # the kernels' answers to rounding
     qdot, shrink = _within_rows(qdot, box, problem.rows)
     qdot.flags.writeable = False
-    status = top.status
-    if status == "exact" and levels.count("met") < len(levels):
-        status = "partial"
     return Answer(
-        qdot, method, status, tuple(levels), top.scale * shrink, top.veer, top.lambda_sq,
+        qdot, method, top.status, tuple(levels), top.scale * shrink, top.veer, top.lambda_sq,
         work.backend, work.iterations, work.solve_time, tuple(work.attempts), clip,
     )  # fmt: skip
 
@@ -526,13 +523,20 @@ def _level_status(status: Status) -> LevelStatus:
 
 
 def _served(problem: Problem, k: int, qdot: Array) -> LevelStatus:
-    """How level ``k`` was served by ``qdot``: met, scaled along its command, or traded."""
+    """How level ``k`` was served by ``qdot`` (:func:`served`)."""
     A, b = problem.stacked[k]
-    y = A @ qdot
+    return served(A @ qdot, b)
+
+
+def served(y: Array, b: Array) -> LevelStatus:
+    """How rates ``y`` serve the command ``b``: met, scaled along it, or traded.
+
+    A zero command has no direction to scale along: not met, it is traded.
+    """
     if _met(y, b):
         return "met"
     scale, veer = scale_and_veer(y, b)
-    return "scaled" if veer <= 1e-6 and scale > 0.0 else "traded"
+    return "scaled" if veer <= 1e-6 and scale > 0.0 and b.any() else "traded"
 
 
 def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:

@@ -15,6 +15,7 @@ root of its weight, so that metres and radians weigh alike.
 from __future__ import annotations
 
 import math
+import warnings
 from functools import cached_property
 from typing import Literal, NamedTuple, Protocol
 
@@ -22,13 +23,17 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.tick.kernels import ACCELERATION, POSITION, scale_and_veer
-from rrc_pin.solvers.tick.pipeline import Answer, LevelStatus, Method, Status
-from rrc_pin.solvers.tick.problem import Box, Problem, largest_weight, row_factors
+from rrc_pin.solvers.tick.pipeline import Answer, LevelStatus, Method, Status, served
+from rrc_pin.solvers.tick.problem import Box, Problem, TaskRows, largest_weight, row_factors
 
 Array = npt.NDArray[np.float64]
 
 BoundKind = Literal["velocity", "position", "acceleration"]
 """What sets a joint-rate bound."""
+
+Served = Literal["met", "scaled", "traded", "dropped", "held"]
+"""How one task was served: its level's words (:data:`LevelStatus`) for the task's own rows,
+and ``held`` for a zero command whose rows stayed still (one whose rows moved is ``traded``)."""
 
 ACTIVE_TOL = 1e-9
 """[rad/s or m/s, or the row's units] A bound or row closer than this to the answer is active."""
@@ -81,8 +86,11 @@ class TaskReport(NamedTuple):
         achieved: Rates of its rows produced by the answer, ``A qdot`` (m,).
         residual: ``|achieved - commanded|`` (Euclidean, in the task's own units).
         scale: Fraction of the command achieved along it, in [0, 1], in the task's
-            normalised metric (module docstring).
+            normalised metric (module docstring); a zero command has no direction: 1 when
+            ``held``, 0 when ``traded``.
         bound_by: The active joint bounds on joints this task moves.
+        served: How the task was served (:data:`Served`): ``met``, ``scaled``, ``traded``,
+            ``dropped``, or ``held`` (a zero command, its rows still).
     """
 
     name: str
@@ -92,6 +100,7 @@ class TaskReport(NamedTuple):
     residual: float
     scale: float
     bound_by: tuple[ActiveLimit, ...]
+    served: Served
 
 
 class Deferred(Protocol):
@@ -133,16 +142,17 @@ class Resolution(_Record):
 
     Attributes:
         qdot: Joint rates (n,) [rad/s or m/s], finite and within the step's box (read-only).
-        status: What the answer is (:data:`~rrc_pin.solvers.tick.pipeline.Status`; docs/api.md,
-        "Reading
-            a resolution").
+        status: What the answer is for the top level
+            (:data:`~rrc_pin.solvers.tick.pipeline.Status`; docs/api.md, "Reading a
+            resolution"); how each lower level fared is in ``levels``.
         method: How the top level was answered (:data:`~rrc_pin.solvers.tick.pipeline.Method`).
         scale: Fraction in [0, 1] of the top level's command achieved along it (normalised
             metric): the common scale of its tasks when its direction was kept.
         veer: Angle [rad] between the top level's achieved and commanded rates (normalised
             metric): 0 unless damped, singular, least squares or a fallback.
-        levels: How each priority level was served
-        (:data:`~rrc_pin.solvers.tick.pipeline.LevelStatus`).
+        levels: How each priority level was served, the top level's first
+            (:data:`~rrc_pin.solvers.tick.pipeline.LevelStatus`: ``met``, ``scaled``,
+            ``traded``, ``dropped``).
         attempts: ``(method or level, reason)`` of every method that failed.
         backend: Name of the last QP backend that answered, or "" (the exact kernels).
         iterations: Backend iterations (0 without a backend).
@@ -177,6 +187,13 @@ class Resolution(_Record):
         """The step's joint-rate bounds."""
         return self.source.box
 
+    @property
+    def bounds(self) -> Box:
+        """The old name of :attr:`box` (deprecated: goes in the next release)."""
+        warnings.warn("Resolution.bounds is deprecated and goes in the next release: use "
+                      "Resolution.box", DeprecationWarning, stacklevel=2)  # fmt: skip
+        return self.box
+
     @cached_property
     def active(self) -> tuple[ActiveLimit, ...]:
         """Joint bounds the answer touches, by joint then side (:data:`ACTIVE_TOL`)."""
@@ -203,16 +220,11 @@ class Resolution(_Record):
         active = self.active
         for k, level in enumerate(self.problem.levels):
             for t in level:
-                y = t.A @ self.qdot
                 bound_by: tuple[ActiveLimit, ...] = ()
                 if active:
                     moved = (t.A != 0.0).any(axis=0).tolist()
                     bound_by = tuple(a for a in active if moved[a.joint])
-                factor = row_factors(t, largest_weight((t,)), units=True)
-                peak = float(np.abs(t.b).max(initial=0.0)) or 1.0  # no overflow in the metric
-                scale = scale_and_veer(y, t.b)[0] if factor is None else scale_and_veer(
-                    factor * (y / peak), factor * (t.b / peak))[0]  # fmt: skip
-                out.append(TaskReport(t.name, k, t.b, y, _norm(y - t.b), scale, bound_by))
+                out.append(_report(t, k, t.A @ self.qdot, bound_by, self.levels[k] == "dropped"))
         return tuple(out)
 
     @cached_property
@@ -230,6 +242,25 @@ class Resolution(_Record):
             f"scale={self.scale:.6g}, veer={self.veer:.3g}, levels={self.levels}, "
             f"active={len(self.active)}, qdot={np.array2string(self.qdot, precision=4)})"
         )
+
+
+def _report(
+    t: TaskRows, level: int, y: Array, bound_by: tuple[ActiveLimit, ...], dropped: bool
+) -> TaskReport:
+    """How task ``t`` of ``level`` was served by its achieved rates ``y``.
+
+    Scale and verdict in the task's normalised metric (module docstring), both divided by the
+    command's largest entry above 1 so that the metric cannot overflow.
+    """
+    factor = row_factors(t, largest_weight((t,)), units=True)
+    peak = max(1.0, float(np.abs(t.b).max(initial=0.0)))
+    ys, bs = (y, t.b) if factor is None else (factor * (y / peak), factor * (t.b / peak))
+    how: Served = "dropped" if dropped else served(ys, bs)
+    if t.b.any():
+        scale = scale_and_veer(ys, bs)[0]
+    else:  # a zero command: held still, or traded for a level above or a limit
+        how, scale = ("held", 1.0) if how == "met" else (how, 0.0)
+    return TaskReport(t.name, level, t.b, y, _norm(y - t.b), scale, bound_by, how)
 
 
 KIND_NAMES: dict[int, BoundKind] = {POSITION: "position", ACCELERATION: "acceleration"}

@@ -27,7 +27,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.tick.kernels import cholesky, cholesky_solve, kernel, solve_factored
+from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.tick.kernels import cholesky, cholesky_solve, solve_factored
 
 Array = npt.NDArray[np.float64]
 

@@ -28,8 +28,8 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import kernels, top
-from rrc_pin.solvers.tick.kernels import inlined, kernel
 from rrc_pin.solvers.tick.levels import least_squares, row_values
 from rrc_pin.solvers.tick.problem import LARGE, SATURATION, TaskRows
 from rrc_pin.solvers.tick.top import EXACT, FAILED, SCALED, Rows, Top
@@ -104,12 +104,14 @@ def stacked(A: Array, b: Array, weight: Array, unit: Array, normalised: bool, lb
 
 @kernel
 def served(A: Array, b: Array, qdot: Array) -> int:
-    """How a lower level was served by ``qdot``: met, scaled along its command, or traded."""
+    """How a lower level was served by ``qdot``: met, scaled along its command, or traded
+    (:func:`rrc_pin.solvers.tick.pipeline.served`: a zero command not met is traded).
+    """  # noqa: D205
     y = row_values(A, qdot)
     if top.norm(y - b) <= top.EXACT_TOL * (1.0 + top.norm(b)):
         return MET
     scale, veer = kernels.scale_and_veer(y, b)
-    return SCALED_LEVEL if veer <= 1e-6 and scale > 0.0 else TRADED
+    return SCALED_LEVEL if veer <= 1e-6 and scale > 0.0 and b.any() else TRADED
 
 
 @kernel
@@ -224,11 +226,6 @@ def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide
     reals[SCALE] = answer.scale * within_rows(qdot, rows, zero_inside)
     reals[VEER], reals[LAMBDA_SQ] = answer.veer, answer.lambda_sq
     joints[QDOT] = qdot
-    status = answer.status
-    if status == EXACT:
-        for k in range(1, levels):
-            if ints[STARTS + levels + 1 + k] != MET:
-                status = top.PARTIAL
     return status
 
 

@@ -29,16 +29,15 @@ import numpy as np
 import numpy.typing as npt
 from numba import objmode
 
+from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import backend_calls, factor, kernels
 from rrc_pin.solvers.tick.factor import Factor
-from rrc_pin.solvers.tick.kernels import inlined, kernel
 from rrc_pin.solvers.tick.levels import least_squares, row_values
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, damped_optimum, project
 
 Array = npt.NDArray[np.float64]
 
-(EXACT, PARTIAL, SCALED, SLIDING, DAMPED, SINGULAR, LEAST_SQUARES, RECOVERING,
- FALLBACK) = range(9)  # fmt: skip
+EXACT, SCALED, SLIDING, DAMPED, SINGULAR, LEAST_SQUARES, RECOVERING, FALLBACK = range(8)
 """Codes of :data:`~rrc_pin.solvers.tick.pipeline.Status`, in its order."""
 
 FAILED = -1

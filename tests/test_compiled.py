@@ -1,0 +1,258 @@
+"""The compiled kernels' cache cannot break the library: damaged entries (truncated, empty,
+random bytes) of every compiled module are compiled again and written anew; a read-only
+install with a read-only home caches in the user's private temporary folder, or compiles in
+memory; ``import rrc_pin`` and the solves succeed every time, with the same answers.
+
+Each case runs in a fresh interpreter on a copy of the package in a temporary folder (the
+symlinked numerics copied as files), so that the checkout's own cache is never touched.
+Read-only places are simulated by a file where numba expects a directory (``__pycache__``,
+``$HOME/.cache``, the private temporary folder): the tests run as root in CI, and root
+writes through permission bits and read-only mode.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rrc_pin
+from rrc_pin.solvers import compiled
+
+pytestmark = pytest.mark.compiled
+
+PACKAGE = Path(rrc_pin.__file__).resolve().parent
+KERNEL = re.compile(r"^@kernel\b|\bkernel\(", re.MULTILINE)
+
+SOLVE_ALL = """
+import numpy as np
+import rrc_pin
+from rrc_pin import CollisionLimit, CollisionModel, JointLimits, Resolver, maps
+out = {"file": rrc_pin.__file__}
+panda = rrc_pin.load("panda")
+q = panda.ready()
+out["tick"] = Resolver(panda, dt=0.01).solve(q, [0.05, 0, -0.05, 0, 0, 0.1]).qdot.tolist()
+cm = CollisionModel(panda)
+T = np.eye(4)
+T[:3, 3] = (0.5, 0.0, 0.2)
+cm.add_box(T, (0.6, 0.8, 0.04), name="table")
+near = Resolver(panda, dt=0.01, limits=[JointLimits(), CollisionLimit(cm, 0.02, 0.3)])
+for _ in range(60):  # down onto the table: the collision kernels and the sliding stage's
+    q = q + near.solve(q, [0.1, 0, -0.3, 0, 0, 0]).qdot * 0.01
+out["collision"] = q.tolist()
+for name in ("barker6", "rrc_k1607", "kr5_3r"):
+    arm = rrc_pin.load(name)
+    qa = arm.random_q(np.random.default_rng(1))
+    out[name] = arm.closed_form.joint_rates(qa, np.ones(arm.closed_form.task_dim)).tolist()
+m = maps.capability("kr5_3r", 2000, 0.1, workers=1, progress=False, block_size=1024)
+out["maps"] = m.stats.isum.sum(axis=0).tolist()
+from rrc_pin.solvers.closed_form.base import finite  # only kernels call it: its entry read here
+out["finite"] = [bool(finite(np.ones(6), 6))]
+from rrc_pin.solvers.tick import factor, levels, slide_kernels, top  # the tick's, likewise
+x = np.empty(2)
+slide_kernels.project(np.eye(2), 0.0, np.ones(2), -np.ones(2), np.ones(2), np.zeros((0, 2)),
+                      np.zeros(0), 0.0, x)
+out["tick glue"] = [top.norm(np.ones(3)), float(levels.row_values(np.eye(2), x).sum()),
+                    float(factor.qr(np.eye(2)).R.sum())]
+"""
+
+SOLVE_ONE = """
+import rrc_pin
+from rrc_pin import Resolver
+panda = rrc_pin.load("panda")
+out = {"file": rrc_pin.__file__,
+       "tick": Resolver(panda, dt=0.01).solve(panda.ready(), [0.05, 0, -0.05, 0, 0, 0.1])
+       .qdot.tolist()}
+"""
+
+REPORT = """
+import importlib, json
+from numba.core.registry import CPUDispatcher
+out["kernels"] = {}
+for name in MODULES:
+    module = importlib.import_module(name)
+    for attr, f in vars(module).items():
+        if isinstance(f, CPUDispatcher) and f.__module__ == name:
+            s = f.stats
+            out["kernels"][f"{name}.{attr}"] = [s.cache_path, sorted(map(str, s.cache_hits)),
+                                                sorted(map(str, s.cache_misses))]
+print("RESULT " + json.dumps(out))
+"""
+
+
+def compiled_modules(root: Path) -> list[str]:
+    """The modules of the package copy at ``root`` that define compiled kernels."""
+    names = []
+    for path in sorted((root / "rrc_pin").rglob("*.py")):
+        if path.name != "compiled.py" and KERNEL.search(path.read_text()):
+            names.append(".".join(path.relative_to(root).with_suffix("").parts))
+    return names
+
+
+def install(root: Path, caches: bool = False) -> Path:
+    """A copy of the package in ``root``, with the checkout's caches or none; returns ``root``.
+
+    numba's entries are keyed by the source's content, so the copy's load the checkout's.
+    """
+    ignore = None if caches else shutil.ignore_patterns("__pycache__")
+    shutil.copytree(PACKAGE, root / "rrc_pin", symlinks=False, ignore=ignore)
+    return root
+
+
+def run(root: Path, script: str, env: dict[str, str] | None = None) -> dict:
+    """Run ``script`` with the copy at ``root`` first on the path; its result and kernels."""
+    code = (f"import sys; sys.path.insert(0, {str(root)!r})\nMODULES = "
+            f"{compiled_modules(root)!r}\n{script}\n{REPORT}")  # fmt: skip
+    base = {k: v for k, v in os.environ.items() if k not in ("NUMBA_CACHE_DIR", "XDG_CACHE_HOME")}
+    done = subprocess.run([sys.executable, "-c", code], env={**base, **(env or {})},
+                          capture_output=True, text=True, timeout=900, cwd=root)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    line = next(x for x in done.stdout.splitlines() if x.startswith("RESULT "))
+    out = json.loads(line.removeprefix("RESULT "))
+    assert out.pop("file").startswith(str(root))
+    return out
+
+
+def same_answers(a: dict, b: dict) -> None:
+    """Every answer of two runs equal (bit for bit: the same machine code, or its recompile)."""
+    assert a.keys() == b.keys()
+    for key in a:
+        if key != "kernels":
+            assert np.array_equal(a[key], b[key]), key
+
+
+def cache_files(root: Path) -> dict[str, list[Path]]:
+    """numba's cache files under the copy, by module (``rrc_pin.solvers.tick.kernels``...)."""
+    out: dict[str, list[Path]] = {}
+    for path in sorted(root.rglob("__pycache__/*.nb[ic]")):
+        package = path.parent.parent.relative_to(root).parts
+        out.setdefault(".".join((*package, path.name.split(".")[0])), []).append(path)
+    return out
+
+
+def kernel_of(path: Path) -> str:
+    """The kernel a cache file belongs to (numba names it ``module.qualname-line.pyXY...``)."""
+    return path.name.split(".")[1].rsplit("-", 1)[0]
+
+
+def damage(path: Path, kind: str, rng: np.random.Generator) -> None:
+    data = path.read_bytes()
+    if kind == "truncated":
+        path.write_bytes(data[: int(rng.integers(1, len(data)))])
+    elif kind == "empty":
+        path.write_bytes(b"")
+    else:
+        path.write_bytes(rng.bytes(len(data)))
+
+
+def test_damaged_entries_of_every_module_are_compiled_again_and_rewritten(tmp_path):
+    seed = int(np.random.SeedSequence().entropy % 2**63)
+    rng = np.random.default_rng(seed)
+    run(PACKAGE.parent, SOLVE_ALL)  # compiles, if the suite has not yet, in the checkout
+    root = install(tmp_path, caches=True)
+    modules = compiled_modules(root)
+    reference = run(root, SOLVE_ALL)
+    seen = signatures(reference)
+    warm = run(root, SOLVE_ALL)
+    assert not recompiled(warm, seen)
+    seen |= signatures(warm)
+    loaded = {k for k, (_, hits, _) in warm["kernels"].items() if hits}
+    files = {  # the entries a process loads (a kernel called only by kernels is compiled in them)
+        module: [p for p in paths if f"{module}.{kernel_of(p)}" in loaded]
+        for module, paths in cache_files(root).items()
+    }
+    assert {m for m, paths in files.items() if paths} == set(modules)
+    lost: set[str] = set()
+    for kind in ("truncated", "empty", "random bytes"):
+        damaged = set()
+        for module, paths in files.items():  # one kernel's index, or its data (every signature)
+            path = paths[int(rng.integers(len(paths)))]
+            for other in paths:
+                if other.suffix == path.suffix and kernel_of(other) == kernel_of(path):
+                    damage(other, kind, rng)
+            damaged.add(f"{module}.{kernel_of(path)}")
+        lost |= damaged  # entries of signatures only their callers ask for, until asked
+        again = run(root, SOLVE_ALL)
+        same_answers(reference, again)
+        assert damaged <= recompiled(again, seen) <= lost, f"{kind}, seed {seed}"
+        seen |= signatures(again)
+    clean = run(root, SOLVE_ALL)  # every damaged entry was written anew: all loaded
+    same_answers(reference, clean)
+    assert not recompiled(clean, seen), seed
+
+
+def signatures(result: dict) -> set[tuple[str, str]]:
+    """(kernel, signature) of every entry a run loaded or compiled."""
+    return {(k, sig) for k, (_, hits, misses) in result["kernels"].items()
+            for sig in (*hits, *misses)}  # fmt: skip
+
+
+def recompiled(result: dict, seen: set[tuple[str, str]]) -> set[str]:
+    """The kernels a run compiled again for a signature cached before (a signature new to the
+    cache may be compiled for the first time: not every run takes the same paths)."""
+    return {k for k, (_, _, misses) in result["kernels"].items()
+            if any((k, sig) in seen for sig in misses)}  # fmt: skip
+
+
+def read_only_copy(root: Path) -> dict[str, str]:
+    """A copy whose every ``__pycache__`` and whose home's ``.cache`` are files; its env."""
+    install(root / "site")
+    for folder in [root / "site", *(p for p in (root / "site").rglob("*") if p.is_dir())]:
+        (folder / "__pycache__").write_text("not a directory")
+    (root / "home").mkdir()
+    (root / "home" / ".cache").write_text("not a directory")
+    (root / "tmp").mkdir()
+    return {"HOME": str(root / "home"), "TMPDIR": str(root / "tmp"),
+            "PYTHONDONTWRITEBYTECODE": "1"}  # fmt: skip
+
+
+def test_a_read_only_install_and_home_cache_privately_or_compile_in_memory(tmp_path):
+    env = read_only_copy(tmp_path)
+    site = tmp_path / "site"
+    reference = run(PACKAGE.parent, SOLVE_ONE)  # the checkout, its cache
+    first = run(site, SOLVE_ONE, env)  # numba alone: "cannot cache function ...: no locator"
+    same_answers(reference, first)
+    private = tmp_path / "tmp" / private_name()
+    assert private.is_dir() and private.stat().st_mode & 0o777 == 0o700
+    paths = {path for path, _, _ in first["kernels"].values()}
+    assert paths and all(p is not None and p.startswith(str(private)) for p in paths)
+    second = run(site, SOLVE_ONE, env)  # the private cache serves the next process
+    same_answers(reference, second)
+    assert any(hits for _, hits, _ in second["kernels"].values())
+    assert not recompiled(second, signatures(first))
+    shutil.rmtree(private)
+    private.write_text("not a directory")  # no writable place at all: compiled in memory
+    third = run(site, SOLVE_ONE, env)
+    same_answers(reference, third)
+    assert all(path is None for path, _, _ in third["kernels"].values())
+    assert not list(site.rglob("*.nb[ic]"))
+    assert (tmp_path / "home" / ".cache").is_file()
+
+
+def private_name() -> str:
+    return f"{compiled.PRIVATE_PREFIX}{os.getuid() if hasattr(os, 'getuid') else 'user'}"
+
+
+def test_a_private_folder_open_to_others_or_not_owned_is_refused(tmp_path, monkeypatch):
+    monkeypatch.setattr(compiled.tempfile, "gettempdir", lambda: str(tmp_path))
+    compiled.private_folder.cache_clear()
+    try:
+        folder = compiled.private_folder()
+        assert folder == tmp_path / private_name() and folder.stat().st_mode & 0o777 == 0o700
+        compiled.private_folder.cache_clear()
+        folder.chmod(0o777)  # another user could plant pickles here
+        assert compiled.private_folder() is None
+        compiled.private_folder.cache_clear()
+        folder.rmdir()
+        (tmp_path / "elsewhere").mkdir(mode=0o700)
+        folder.symlink_to(tmp_path / "elsewhere")
+        assert compiled.private_folder() is None
+    finally:
+        compiled.private_folder.cache_clear()
