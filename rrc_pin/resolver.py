@@ -174,6 +174,12 @@ class Resolver:
             self._layout, joint[0], self.options, direction_preserving, self.backend,
             self._names)  # fmt: skip
 
+    @property
+    def layout(self) -> Layout:
+        """What its tasks and limits may name on the robot (:meth:`solve_at`'s kinematics are
+        made on it)."""  # noqa: D205, D209
+        return self._layout
+
     def reset(self) -> None:
         """Forget the warm starts and the previous joint rates."""
         with self._lock:
