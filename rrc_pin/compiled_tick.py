@@ -101,10 +101,13 @@ class CompiledTick:
         direction: Whether the top level is the direction problem.
         backend: Its QP backend.
         names: Joint names for the report.
+        general: Compile the general entry now (:func:`rrc_pin.solvers.tick.tick.run`), not
+            only the default tick's: the resolver's ticks will have rows, tasks or a box
+            that may exclude standing still.
     """
 
     def __init__(self, layout: Layout, limit: JointLimits, options: Options, direction: bool,
-                 backend: QPBackend, names: tuple[str, ...]) -> None:  # fmt: skip
+                 backend: QPBackend, names: tuple[str, ...], general: bool) -> None:  # fmt: skip
         velocity = layout.velocity if limit.velocity is None else np.asarray(limit.velocity)
         acceleration = _NO_ACCELERATION if limit.acceleration is None else np.asarray(
             limit.acceleration)  # fmt: skip
@@ -119,6 +122,7 @@ class CompiledTick:
             velocity_tolerance(self.velocity),
         )  # fmt: skip
         self._context = backend_calls.Context(backend, self.velocity)
+        self.workspace.compile(general)
 
     def answers(self, constraints: Sequence[Constraints | None]) -> bool:
         """Whether the compiled tick answers with these limits' constraints: no other box, no

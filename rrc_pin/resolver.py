@@ -170,9 +170,13 @@ class Resolver:
         self._last_qdot: Array = np.zeros(robot.nv)
         self._lock = threading.Lock()
         joint = [limit for limit in self.limits if isinstance(limit, JointLimits)]
+        # the general entry now where ticks will need it; else at the first that does (tasks
+        # given to a one-tool resolver, a start outside the joint limits)
+        general = (len(self.limits) > 1 or self.task is None or not direction_preserving
+                   or (len(joint) == 1 and joint[0].acceleration is not None))  # fmt: skip
         self._compiled = None if len(joint) != 1 else CompiledTick(
             self._layout, joint[0], self.options, direction_preserving, self.backend,
-            self._names)  # fmt: skip
+            self._names, general)  # fmt: skip
 
     @property
     def layout(self) -> Layout:

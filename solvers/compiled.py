@@ -122,7 +122,7 @@ def inlined(function: F) -> F:
     For the compiled tick's glue between its kernels. A kernel that calls another links the
     callee's machine code into its own and LLVM optimises it again there, so along a chain of
     compiled wrappers the kernels at its end are optimised once per link; inlined, the glue is
-    optimised once, in the tick's entry (docs/benchmarks.md, "Compiling the tick"). Called from
+    optimised once, in the tick's entry (docs/api.md, "One compiled pass per tick"). Called from
     Python, it compiles and caches as any kernel.
     """
     dispatcher = njit(inline="always")(function)

@@ -12,12 +12,15 @@ r"""One resolver tick in one compiled call, on a workspace of preallocated array
 5. the **clip** into the box and the rows.
 
 Its arguments are a few packed arrays (numba's call costs grow with the number of arguments:
-docs/benchmarks.md), the rows of which the module constants name; :class:`Workspace` holds them
-for one resolver and reads the answer back. The QPs the kernels do not answer go to the backend
-from inside the call (:mod:`rrc_pin.solvers.tick.backend_calls`); where the top level finds no
-usable answer, :func:`run` returns :data:`~rrc_pin.solvers.tick.top.FAILED` and the fallbacks
-(:mod:`rrc_pin.solvers.tick.fallbacks`) answer. Problems with equality rows (contacts) go to the
-Python pipeline (:func:`rrc_pin.solvers.tick.pipeline.solve`).
+docs/api.md, "One compiled pass per tick"), the rows of which the module constants name;
+:class:`Workspace` holds them for one resolver and reads the answer back. The QPs the kernels do
+not answer go to the backend from inside the call (:mod:`rrc_pin.solvers.tick.backend_calls`);
+where the top level finds no usable answer, :func:`run` returns
+:data:`~rrc_pin.solvers.tick.top.FAILED` and the fallbacks (:mod:`rrc_pin.solvers.tick.fallbacks`)
+answer. Problems with equality rows (contacts) go to the Python pipeline
+(:func:`rrc_pin.solvers.tick.pipeline.solve`). The default tick (one level, the joint box alone)
+has an entry of its own, :func:`run_box`: the same stages without the code it does not reach,
+compiled in a fraction of the general entry's time.
 """
 
 from __future__ import annotations
@@ -56,6 +59,9 @@ BAD_POSITION, BAD_RATE = 1, 2
 
 INVALID_INPUT = -2
 """What :func:`run` returns for a position or commanded rate that is not finite."""
+
+ELSEWHERE = -3
+"""What :func:`run_box` returns for a tick that is not its own (:func:`run` answers it)."""
 
 _EPS = float(np.finfo(np.float64).eps)
 
@@ -189,6 +195,64 @@ def lower_levels(task_rows: Array, rates: Array, ints: Ints, rows: Rows, answer:
     return qdot
 
 
+@inlined
+def box(joints: Array, rates: Array, ints: Ints, reals: Array) -> bool:
+    """Stages 1 and 2: the inputs checked (the code of a bad one in ``ints[INVALID]``, then
+    False), the step's box and what sets each bound into ``joints``, its flags into ``reals``.
+    """  # noqa: D205
+    ints[INVALID] = checked(joints, rates, ints[ROWS])
+    if ints[INVALID]:
+        return False
+    kind = np.empty((2, joints.shape[1]), np.int8)
+    zero_inside, recovering = kernels.joint_box(
+        joints[POSITION], joints[LOWER], joints[UPPER], joints[VELOCITY], reals[MARGIN],
+        reals[GAIN], reals[DT], joints[PREVIOUS], joints[ACCELERATION], joints[LB], joints[UB],
+        kind,
+    )  # fmt: skip
+    joints[KIND], joints[KIND + 1] = kind[0], kind[1]
+    reals[ZERO_INSIDE] = 1.0 if zero_inside else 0.0
+    reals[RECOVERING] = 1.0 if recovering else 0.0
+    return True
+
+
+@inlined
+def report(joints: Array, ints: Ints, reals: Array, rows: Rows, answer: Top, qdot: Array) -> int:
+    """Stage 5: ``qdot`` clipped into the box and shrunk into the rows, and the top level's
+    report, into ``joints`` and ``reals``; the status code.
+    """  # noqa: D205
+    reals[CLIP] = kernels.clip_into(qdot, rows.lb, rows.ub)
+    reals[SCALE] = answer.scale * within_rows(qdot, rows, reals[ZERO_INSIDE] == 1.0)
+    reals[VEER], reals[LAMBDA_SQ] = answer.veer, answer.lambda_sq
+    joints[QDOT] = qdot
+    status = answer.status
+    code = MET if status == EXACT else SCALED_LEVEL if status == SCALED else TRADED
+    ints[STARTS + ints[LEVELS] + 1] = code
+    return status
+
+
+@kernel
+def run_box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Array) -> int:
+    """The default tick: one level in the direction mode, within the joint box alone.
+
+    What :func:`run` does for it, without the code of the rows, the least squares and the
+    lower levels (a fraction of its compile): the status code, :data:`INVALID_INPUT`, or
+    :data:`ELSEWHERE` where the mode is not the direction one (:func:`run` answers then).
+    """
+    if not box(joints, rates, ints, reals):
+        return INVALID_INPUT
+    if reals[ZERO_INSIDE] == 0.0 or ints[WEIGHTED] == 1 or ints[DIRECTION] == 0:
+        return ELSEWHERE
+    n = joints.shape[1]
+    rows = Rows(joints[LB], joints[UB], np.empty((0, n)), np.empty(0), np.empty(0, np.bool_),
+                reals[TOLERANCE])  # fmt: skip
+    # the direction flag, not the literal True: one compiled signature of stacked
+    A, b, rate_factor = level(task_rows, rates, ints, 0, ints[DIRECTION] == 1, rows.lb, rows.ub)
+    answer = top.direction_box(A, b, rows, reals[DT], reals[THRESHOLD], rate_factor)
+    if answer.status == FAILED:
+        return FAILED
+    return report(joints, ints, reals, rows, answer, answer.qdot)
+
+
 @kernel
 def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide: Array,
         ints: Ints, reals: Array) -> int:  # fmt: skip
@@ -198,35 +262,18 @@ def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide
     ``joints``, ``task_rows``, ``rates`` and the constraint rows ``G``, ``h``, ``slide``
     (``ints[CONSTRAINTS]`` of them); writes the box, the rates and the report.
     """
-    m, p = ints[ROWS], ints[CONSTRAINTS]
-    ints[INVALID] = checked(joints, rates, m)
-    if ints[INVALID]:
+    if not box(joints, rates, ints, reals):
         return INVALID_INPUT
-    lb, ub = joints[LB], joints[UB]
-    kind = np.empty((2, lb.size), np.int8)
-    zero_inside, recovering = kernels.joint_box(
-        joints[POSITION], joints[LOWER], joints[UPPER], joints[VELOCITY], reals[MARGIN],
-        reals[GAIN], reals[DT], joints[PREVIOUS], joints[ACCELERATION], lb, ub, kind,
-    )  # fmt: skip
-    joints[KIND], joints[KIND + 1] = kind[0], kind[1]
-    reals[ZERO_INSIDE] = 1.0 if zero_inside else 0.0
-    reals[RECOVERING] = 1.0 if recovering else 0.0
-    rows = Rows(lb, ub, G[:p], h[:p], slide[:p] != 0.0, reals[TOLERANCE])
+    p = ints[CONSTRAINTS]
+    rows = Rows(joints[LB], joints[UB], G[:p], h[:p], slide[:p] != 0.0, reals[TOLERANCE])
+    zero_inside, recovering = reals[ZERO_INSIDE] == 1.0, reals[RECOVERING] == 1.0
     direction = (ints[WEIGHTED] == 0 and ints[DIRECTION] == 1 and zero_inside
                  and not (rows.h < 0.0).any())  # fmt: skip
     answer = top_level(task_rows, rates, ints, reals, rows, direction, recovering)
     if answer.status == FAILED:
         return FAILED
-    levels = ints[LEVELS]
-    status = answer.status
-    ints[STARTS + levels + 1] = MET if status == EXACT else SCALED_LEVEL if status == SCALED else (
-        TRADED)  # fmt: skip
     qdot = lower_levels(task_rows, rates, ints, rows, answer)
-    reals[CLIP] = kernels.clip_into(qdot, lb, ub)
-    reals[SCALE] = answer.scale * within_rows(qdot, rows, zero_inside)
-    reals[VEER], reals[LAMBDA_SQ] = answer.veer, answer.lambda_sq
-    joints[QDOT] = qdot
-    return status
+    return report(joints, ints, reals, rows, answer, qdot)
 
 
 class Workspace:
@@ -315,11 +362,36 @@ class Workspace:
         self.ints[CONSTRAINTS] = p
 
     def run(self, q: Array, previous: Array, dt: float) -> int:
-        """The tick at positions ``q`` (n,) after rates ``previous`` (n,), step ``dt`` [s]."""
+        """The tick at positions ``q`` (n,) after rates ``previous`` (n,), step ``dt`` [s].
+
+        One level without rows goes to :func:`run_box`, and to :func:`run` only where that
+        is not its tick.
+        """
         self.joints[POSITION], self.joints[PREVIOUS] = q, previous
         self.reals[DT] = dt
+        if self.ints[LEVELS] == 1 and self.ints[CONSTRAINTS] == 0:
+            code: int = run_box(self.joints, self.task_rows, self.rates, self.ints, self.reals)
+            if code != ELSEWHERE:
+                return code
         return run(self.joints, self.task_rows, self.rates, self.G, self.h, self.slide,
                    self.ints, self.reals)  # fmt: skip
+
+    def compile(self, general: bool) -> None:
+        """Compile the default tick's entry (:func:`run_box`), and the general one where
+        ``general``, or load them from numba's cache: on a problem without rows whose answer
+        is exact, so that no QP is asked for and nothing is kept.
+        """  # noqa: D205
+        n = self.n
+        ws = Workspace(self.joints[LOWER], self.joints[UPPER], self.joints[VELOCITY],
+                       self.joints[ACCELERATION], 0.0, 1.0, 0.0, True, 1.0)  # fmt: skip
+        one = TaskRows(np.eye(1, n), np.zeros(1), None, "", np.ones(1))
+        ws.load_levels([[one]], False)
+        ws.load_rows(None, None, None)
+        ws.joints[POSITION] = np.clip(np.zeros(n), self.joints[LOWER], self.joints[UPPER])
+        ws.reals[DT] = 0.01
+        run_box(ws.joints, ws.task_rows, ws.rates, ws.ints, ws.reals)
+        if general:
+            run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
 
     def level_codes(self) -> list[int]:
         """How each level was served (:data:`MET`, :data:`SCALED_LEVEL`, :data:`TRADED`)."""

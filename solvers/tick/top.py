@@ -331,6 +331,24 @@ def direction(A: Array, b: Array, rows: Rows, dt: float, threshold: float, rate_
             f, z = factor.least_norm(f, b)
             w = z
             fits = kernels.inside(w, rows.lb, rows.ub)
+    return command_stages(A, b, f, w, z, fits, boxed, u_box, rows, slid, dt, threshold,
+                          rate_factor, need_null)  # fmt: skip
+
+
+@inlined
+def direction_box(A: Array, b: Array, rows: Rows, dt: float, threshold: float,
+                  rate_factor: float) -> Top:  # fmt: skip
+    """The direction mode's one level within the box alone: no row, so no sliding stage."""
+    f, w, fits, boxed, u_box = factor.fitted(A, b, rows.lb, rows.ub)
+    return command_stages(A, b, f, w, w, fits, boxed, u_box, rows, False, dt, threshold,
+                          rate_factor, False)  # fmt: skip
+
+
+@inlined
+def command_stages(A: Array, b: Array, f: Factor, w: Array, z: Array, fits: bool, boxed: Array,
+                   u_box: float, rows: Rows, slid: bool, dt: float, threshold: float,
+                   rate_factor: float, need_null: bool) -> Top:  # fmt: skip
+    """Stages 1 and 3-5 on the command as it stands (``slid``: the sliding stage's)."""
     outside_range = not f.regular and not met(f.J, z, b)
     top = exact(A, b, f, w, fits, rows, slid, outside_range, rate_factor, need_null)
     if top.status == FAILED:
