@@ -177,6 +177,11 @@ class Resolver:
         self._compiled = None if len(joint) != 1 else CompiledTick(
             self._layout, joint[0], self.options, direction_preserving, self.backend,
             self._names, general)  # fmt: skip
+        # solve(q, twist) straight into the compiled tick: the joint box the only limit, the
+        # Jacobian Pinocchio's and its vector q itself
+        self._twists = (self._compiled is not None and self.limits == (joint[0],)
+                        and self.task is not None and closed_form is None
+                        and robot.model.nq == robot.model.nv)  # fmt: skip
 
     @property
     def layout(self) -> Layout:
@@ -233,8 +238,32 @@ class Resolver:
             FrameNotFound: A task names a frame the robot does not have (the error lists
                 them).
         """
+        if (self._twists and type(command) is np.ndarray and type(q) is np.ndarray
+                and ref is None and dt is None and qdot_prev is None and priority == "weighted"):
+            r = self._twist(q, command)
+            if r is not None:
+                return r
         q, dof, q_pin = self.robot.positions(q)
         return self._solve(dof, q_pin, None, command, ref, priority, dt, qdot_prev)
+
+    def _twist(self, q: Array, twist: Array) -> Resolution | None:
+        """``solve(q, twist)`` of the resolver's task in its ref, in the compiled tick alone
+        (:meth:`CompiledTick.twist`), or None where the general path answers: arrays of other
+        shapes or types (it checks them), a task with a target, a box that excludes standing
+        still."""  # noqa: D205, D209
+        task = cast(FrameTask, self.task)
+        if (q.dtype != np.float64 or q.shape != (self.robot.nq,) or twist.dtype != np.float64
+                or twist.shape != (6,) or task.target is not None):  # fmt: skip
+            return None
+        b = twist.copy() if len(task.selected) == 6 else twist[list(task.selected)]
+        with self._lock:
+            start = time.perf_counter()
+            compiled = cast(CompiledTick, self._compiled)
+            r = compiled.twist(self.robot.model, self._data, task, q, b, self._last_qdot,
+                               self.dt, start)  # fmt: skip
+            if r is not None:
+                self._last_qdot = r.qdot
+            return r
 
     def solve_at(
         self,

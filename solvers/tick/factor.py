@@ -54,7 +54,7 @@ def qr(J: Array) -> Factor:
     m, n = J.shape
     Q, R = np.empty((n, n)), np.empty((n, m))
     kernels.householder_qr(J.T, Q, R)
-    return Factor(J, Q, R, False, np.empty((0, 0)), np.empty(0), np.empty((0, 0)), -1)
+    return Factor(J, Q, R, False, Q[:0], Q[0, :0], Q[:0], -1)
 
 
 @kernel
@@ -106,10 +106,11 @@ def fitted(J: Array, b: Array, lb: Array, ub: Array) -> tuple[Factor, Array, boo
         scale u (else u = -1).
     """
     m, n = J.shape
-    Q, R = np.empty((n, n)), np.empty((n, m))
-    w, boxed = np.empty(n), np.empty(n)
+    space = np.empty(n * (n + m + 2))  # one allocation: Q, R, w and the boxed rates
+    Q, R = space[: n * n].reshape(n, n), space[n * n : n * (n + m)].reshape(n, m)
+    w, boxed = space[n * (n + m) : n * (n + m + 1)], space[n * (n + m + 1) :]
     fit, u = kernels.direction_step(J, b, lb, ub, Q, R, w, boxed)
-    f = Factor(J, Q, R, fit > 0, np.empty((0, 0)), np.empty(0), np.empty((0, 0)), -1)
+    f = Factor(J, Q, R, fit > 0, Q[:0], w[:0], Q[:0], -1)
     if fit:
         return f, w, fit == 2, boxed, u
     f = with_svd(f)

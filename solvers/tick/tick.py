@@ -79,9 +79,9 @@ def stacked(A: Array, b: Array, weight: Array, unit: Array, normalised: bool, lb
     top_weight = weight[0]
     for i in range(m):
         top_weight = max(top_weight, weight[i])
-    rows, rates = np.empty((m, n)), np.empty(m)
-    ones = np.ones(m)
-    units = unit if normalised else ones
+    space = np.empty(m * (n + 1))  # one allocation: the rows and rates
+    rows, rates = space[: m * n].reshape(m, n), space[m * n :]
+    units = unit if normalised else np.ones(m)
     peak = kernels.weighted_rows(A, b, weight, top_weight, units, 1.0, rows, rates)
     if normalised:
         if peak <= LARGE:
@@ -209,7 +209,8 @@ def box(joints: Array, rates: Array, ints: Ints, reals: Array) -> bool:
         reals[GAIN], reals[DT], joints[PREVIOUS], joints[ACCELERATION], joints[LB], joints[UB],
         kind,
     )  # fmt: skip
-    joints[KIND], joints[KIND + 1] = kind[0], kind[1]
+    for j in range(kind.shape[1]):
+        joints[KIND, j], joints[KIND + 1, j] = kind[0, j], kind[1, j]
     reals[ZERO_INSIDE] = 1.0 if zero_inside else 0.0
     reals[RECOVERING] = 1.0 if recovering else 0.0
     return True
@@ -242,9 +243,7 @@ def run_box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Ar
         return INVALID_INPUT
     if reals[ZERO_INSIDE] == 0.0 or ints[WEIGHTED] == 1 or ints[DIRECTION] == 0:
         return ELSEWHERE
-    n = joints.shape[1]
-    rows = Rows(joints[LB], joints[UB], np.empty((0, n)), np.empty(0), np.empty(0, np.bool_),
-                reals[TOLERANCE])  # fmt: skip
+    rows = Rows(joints[LB], joints[UB], task_rows[:0], reals[:0], reals[:0], reals[TOLERANCE])
     # the direction flag, not the literal True: one compiled signature of stacked
     A, b, rate_factor = level(task_rows, rates, ints, 0, ints[DIRECTION] == 1, rows.lb, rows.ub)
     answer = top.direction_box(A, b, rows, reals[DT], reals[THRESHOLD], rate_factor)
@@ -265,7 +264,7 @@ def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide
     if not box(joints, rates, ints, reals):
         return INVALID_INPUT
     p = ints[CONSTRAINTS]
-    rows = Rows(joints[LB], joints[UB], G[:p], h[:p], slide[:p] != 0.0, reals[TOLERANCE])
+    rows = Rows(joints[LB], joints[UB], G[:p], h[:p], slide[:p], reals[TOLERANCE])
     zero_inside, recovering = reals[ZERO_INSIDE] == 1.0, reals[RECOVERING] == 1.0
     direction = (ints[WEIGHTED] == 0 and ints[DIRECTION] == 1 and zero_inside
                  and not (rows.h < 0.0).any())  # fmt: skip
@@ -345,6 +344,14 @@ class Workspace:
         rates[WEIGHT, start:end] = 1.0 if t.weight is None else t.weight
         rates[UNIT, start:end] = 1.0 if t.unit is None else t.unit
 
+    def load_twist(self, J: Array, selected: tuple[int, ...], b: Array) -> None:
+        """One task's rows ``J`` (6, n) (the ``selected`` ones) and rates ``b``, over those
+        loaded last (:meth:`load_levels`: the same task, whose weights and units stay).
+        """  # noqa: D205
+        m = b.size
+        self.task_rows[:m] = J if m == 6 else J[list(selected)]
+        self.rates[RATE, :m] = b
+
     def load_rows(
         self, G: Array | None, h: Array | None, slide: npt.NDArray[np.bool_] | None
     ) -> None:
@@ -395,7 +402,9 @@ class Workspace:
 
     def level_codes(self) -> list[int]:
         """How each level was served (:data:`MET`, :data:`SCALED_LEVEL`, :data:`TRADED`)."""
-        levels = int(self.ints[LEVELS])
-        start = STARTS + levels + 1
-        codes: list[int] = self.ints[start : start + levels].tolist()
+        ints = self.ints
+        levels = ints.item(LEVELS)
+        if levels == 1:
+            return [ints.item(STARTS + 2)]
+        codes: list[int] = ints[STARTS + levels + 1 : STARTS + 2 * levels + 1].tolist()
         return codes

@@ -85,7 +85,7 @@ class Rows(NamedTuple):
         ub: Upper bounds (n,).
         G: Rows (p, n), p = 0 for none.
         h: Their bounds (p,).
-        slide: Per row, whether the command may slide along it (p,).
+        slide: Per row, nonzero where the command may slide along it (p,).
         tol: How far a kernel's answer may leave the box and rows
             (:func:`rrc_pin.solvers.qp_backends.qp.tolerance`).
     """
@@ -94,7 +94,7 @@ class Rows(NamedTuple):
     ub: Array
     G: Array
     h: Array
-    slide: npt.NDArray[np.bool_]
+    slide: Array
     tol: float
 
 
@@ -137,7 +137,7 @@ def along_command(A: Array, b: Array, qdot: Array, per_unit: Array, rate_factor:
 def answer(A: Array, b: Array, qdot: Array, status: int, rate_factor: float, null: Array,
            lambda_sq: float) -> Top:  # fmt: skip
     """The top level's answer ``qdot`` with its scale and veer along the command."""
-    scale, veer = along_command(A, b, qdot, np.empty(0), rate_factor)
+    scale, veer = along_command(A, b, qdot, b[:0], rate_factor)
     return Top(qdot, status, scale, veer, lambda_sq, null)
 
 
@@ -278,8 +278,8 @@ def exact(A: Array, b: Array, f: Factor, w: Array, fits: bool, rows: Rows, slid:
           outside_range: bool, rate_factor: float, need_null: bool) -> Top:  # fmt: skip
     """Stage 1: the exact rates where they keep every constraint, else pass on."""
     if not (fits and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
-        return passing(w, np.empty((0, 0)))
-    null = factor.null_basis(f)[1] if need_null else np.empty((0, A.shape[1]))
+        return passing(w, A[:0])
+    null = factor.null_basis(f)[1] if need_null else A[:0]
     if slid:
         return answer(A, b, w, SLIDING, rate_factor, null, 0.0)
     if outside_range:
