@@ -8,13 +8,13 @@ Run from a checkout: ``python benchmarks/bench_cells.py --out DIR`` (``--record`
 
 - **gsfc_dual** (issue 30): the held object commanded by random world-axes twists (0.15 m/s
   and 0.4 rad/s per axis, normal, each held 0.5 s), a default ``CellController`` (deadman,
-  targets fed back, the grip's equality rows, the closed chain's projection, the log), at
+  targets fed back, the grip's equality rows, the closed chain's correction, the log), at
   100 Hz. The controllers take the same commands: joint limits only, and joint limits plus
   a ``CollisionLimit`` on the cell's capsules (every pair between the two arms and the
   kinematic rules' pairs within each; default safety and detection distances). At every
   tick each steps, in an order shuffled per tick (interleaved).
 - **yeh_tripod**: the body commanded by random twists (0.03 m/s, 0.1 rad/s per axis, held
-  0.5 s) over its three feet in support (the contacts' equality rows and projection), the
+  0.5 s) over its three feet in support (the contacts' equality rows and correction), the
   same controllers (the collision model: the three legs' capsules, rows over all 24 rates,
   the floating base's included).
 - A third controller of each cell adds a ball to its collision model (:data:`BALLS`), in the
@@ -39,12 +39,14 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import collections  # noqa: E402
+import json  # noqa: E402
 import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
+import pinocchio as pin  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from script import arguments, make_parser, mark_quick, measure, pyplot, write  # noqa: E402
@@ -52,7 +54,10 @@ from timing import one_core, progress, statistics, us  # noqa: E402
 
 import rrc_pin  # noqa: E402
 from rrc_pin.cells import CellController  # noqa: E402
+from rrc_pin.cells.closure import ClosureBound  # noqa: E402
 from rrc_pin.errors import RrcPinError  # noqa: E402
+from rrc_pin.solvers.tick.damping import Damping  # noqa: E402
+from rrc_pin.solvers.tick.factorization import Factorization  # noqa: E402
 
 DT = 0.01
 TICKS, QUICK_TICKS = 3000, 100
@@ -281,8 +286,154 @@ def plot(results: dict[str, Any], path: Path) -> bool:
     return True
 
 
+# -- the soak (issue 37): the closed chains over long runs, fresh seeds -------------------
+
+SOAK = {"gsfc_dual": (20, 5000), "yeh_tripod": (10, 3000)}
+"""Cell: (fresh seeds, ticks per seed) of ``--soak``; gsfc_dual with damping and without."""
+QUICK_SOAK = {"gsfc_dual": (2, 300), "yeh_tripod": (2, 300)}
+SOAK_SPEED = {"gsfc_dual": 2.0, "yeh_tripod": 1.0}
+"""The soak's commands are the timing's (:data:`SPEEDS`) times this: joint bounds active on
+about a third of gsfc_dual's ticks; the tripod's body driven by its own (0.03 m/s, 0.1 rad/s
+per axis) to where its feet cannot follow on some hundreds of ticks a seed, and near singular
+poses on more (three times faster, it spends most of a run there: damped on 45-75 % of the
+ticks, its body turned off the commanded axis by up to 0.05 rad in 0.5 s)."""
+
+
+def check_tick(
+    ctl: CellController, before: np.ndarray, step: Any, report: dict[str, Any]
+) -> None:
+    """Count what tick ``step`` (from ``before``) broke, into ``report`` (:func:`soak`).
+
+    The rates applied (the resolver's and the closure's correction) inside the tick's box;
+    the joints' change over the tick, ``(q_new - q_old) / dt``, inside it too (to the
+    integration's rounding, 1e-9 relative) and q_new inside the position limits; the closed
+    chains within their bound at every tick reported held; a tick after a lost one moves
+    only when it closes the chain.
+    """
+    cell, r, dt = ctl.cell, step.resolution, ctl.dt
+    box = r.problem.box
+    model = cell.model
+    if not (np.isfinite(step.q).all() and np.isfinite(r.applied).all()):
+        report["nan"] += 1
+        return
+    report["box"] += int(np.any(r.applied < box.lb) or np.any(r.applied > box.ub))
+    moved = pin.difference(model, cell.to_pinocchio(before), cell.to_pinocchio(step.q)) / dt
+    slack = 1e-9 * (1.0 + np.abs(box.lb) + np.abs(box.ub))
+    report["rate"] += int(np.any(moved < box.lb - slack) or np.any(moved > box.ub + slack))
+    report["rate_ratio"] = max(report["rate_ratio"],
+                               float(np.max(np.abs(moved) / cell.velocity_limit)))  # fmt: skip
+    dof = cell.dof_positions(step.q)
+    report["position"] += int(np.any(dof < cell.dof_lower) or np.any(dof > cell.dof_upper))
+    report["active"] += int(np.any((r.qdot <= box.lb + 1e-9) | (r.qdot >= box.ub - 1e-9)))
+    report["statuses"][r.status] += 1
+    position, rotation = ctl.chain_error
+    bound = ctl.closure or ClosureBound()
+    level = max(position / bound.position, rotation / bound.rotation)
+    closing = report.pop("_closing", None)  # the last tick moved while lost: from this level
+    if closing is not None and level >= closing:
+        report["opened_while_lost"] += 1
+    if r.status in ("grip_lost", "contact_lost"):
+        report["lost"] += 1
+        report["episodes"] += int(report["_last"] not in ("grip_lost", "contact_lost"))
+        if r.applied.any():  # moved while lost: it must close the chain
+            report["_closing"] = level
+        elif report["_last"] in ("grip_lost", "contact_lost") and not np.array_equal(
+            before, step.q
+        ):  # fmt: skip
+            report["opened_while_lost"] += 1
+    else:
+        report["held_position"] = max(report["held_position"], position)
+        report["held_rotation"] = max(report["held_rotation"], rotation)
+    report["_last"] = r.status
+
+
+def soak(name: str, seed: int, ticks: int, damping: bool) -> dict[str, Any]:
+    """Random commands on cell ``name`` (the object's twist on gsfc_dual, the body's on
+    yeh_tripod, each held 0.5 s), every tick checked (:func:`check_tick`); the counts.
+
+    On the tripod also: ticks where a body command could not be followed in full far from
+    singularities (the top level's condition number within the damping threshold) that were
+    not ``scaled`` along the command (veer above 1e-6 rad), and the body's largest turn off
+    the commanded axis over a command's 0.5 s.
+    """
+    cell = rrc_pin.load(name)
+    ctl = CellController(cell, DT, damping=Damping() if damping else None)
+    command, speed = SPEEDS[name]
+    speed = speed * SOAK_SPEED[name]
+    rng = np.random.default_rng(seed)
+    report: dict[str, Any] = {
+        "cell": name, "seed": seed, "ticks": ticks, "damping": damping, "nan": 0, "box": 0,
+        "rate": 0, "rate_ratio": 0.0, "position": 0, "active": 0, "lost": 0, "episodes": 0,
+        "opened_while_lost": 0, "held_position": 0.0, "held_rotation": 0.0, "not_scaled": 0,
+        "far_limited": 0, "turn": 0.0, "statuses": collections.Counter(), "_last": "",
+    }  # fmt: skip
+    threshold = Damping().threshold
+    start = cell.fk(ctl.q, "body")[:3, :3] if cell.body else None
+    twist = np.zeros(6)
+    for k in range(ticks):
+        if k % HOLD == 0:
+            if start is not None and k:
+                report["turn"] = max(report["turn"], _turn(cell, ctl.q, start, twist))
+                start = cell.fk(ctl.q, "body")[:3, :3]
+            twist = rng.normal(size=6) * speed
+        before = ctl.q
+        step = ctl.step({command: twist})
+        check_tick(ctl, before, step, report)
+        r = step.resolution
+        if cell.body and r.scale < 1.0 - 1e-9 and r.status not in ("grip_lost", "contact_lost"):
+            A = r.problem.stacked[0][0]
+            null = Factorization(r.problem.equalities[0]).null_basis()
+            sigma = np.linalg.svd(A @ null.T, compute_uv=False)
+            if sigma[0] <= threshold * sigma[-1]:  # far from singularities
+                report["far_limited"] += 1
+                report["not_scaled"] += int(r.status != "scaled" or r.veer > 1e-6)
+    report["statuses"] = dict(report["statuses"])
+    for key in [k for k in report if k.startswith("_")]:
+        del report[key]
+    return report
+
+
+def _turn(cell: rrc_pin.Cell, q: np.ndarray, start: np.ndarray, twist: np.ndarray) -> float:
+    """The body's rotation [rad] since ``start`` (3, 3) off the commanded angular velocity."""
+    theta = pin.log3(cell.fk(q, "body")[:3, :3] @ start.T)
+    w = twist[3:]
+    if np.linalg.norm(w) > 0.0:
+        w = w / np.linalg.norm(w)
+        theta = theta - w * (theta @ w)
+    return float(np.linalg.norm(theta))
+
+
+def run_soak(quick: bool) -> dict[str, Any]:
+    """Every cell's soak (:data:`SOAK`) over fresh seeds, damping on and off on gsfc_dual."""
+    rows = []
+    for name, (seeds, ticks) in (QUICK_SOAK if quick else SOAK).items():
+        for _ in range(seeds):
+            seed = int(np.random.SeedSequence().entropy % 2**63)
+            for damping in (True, False) if name == "gsfc_dual" else (True,):
+                rows.append(soak(name, seed, ticks, damping))
+                row = rows[-1]
+                progress(f"soak {name} seed {seed} damping {damping}: lost {row['lost']} "
+                         f"({row['episodes']} times), held within {row['held_position']:.2e} m "
+                         f"{row['held_rotation']:.2e} rad, rates {row['rate_ratio']:.4f} of "
+                         f"the limits, box {row['box']} rate {row['rate']} nan {row['nan']}, "
+                         f"far and limited {row['far_limited']} (not scaled "
+                         f"{row['not_scaled']}), turn {row['turn']:.2e} rad")  # fmt: skip
+    return {"soak": rows}
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = arguments(make_parser(__doc__, "cells", f"{QUICK_TICKS} ticks per cell"), argv)
+    parser = make_parser(__doc__, "cells", f"{QUICK_TICKS} ticks per cell")
+    parser.add_argument("--soak", action="store_true",
+                        help="the closed chains' soak instead of the timing (never recorded)")
+    args = arguments(parser, argv)
+    if args.soak:
+        if args.record:
+            parser.error("--soak is not recorded")
+        results = measure("cells_soak", args.quick, lambda: run_soak(args.quick))
+        if args.out is not None:
+            args.out.mkdir(parents=True, exist_ok=True)
+            (args.out / "cells_soak.json").write_text(json.dumps(results, indent=2) + "\n")
+        return 0
     results = measure("cells", args.quick, lambda: run(args.quick))
     write(args, "cells", results, lambda path: plot(results, path))
     print(docs_section(results))

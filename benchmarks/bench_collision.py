@@ -5,6 +5,10 @@ Run with the peers' environment from a checkout:
 ``PYTHONPATH=. .venv-peers/bin/python benchmarks/bench_collision.py --out DIR`` (``--record``
 writes ``benchmarks/results/collision.{json,png}``; ``--quick`` a short smoke run).
 
+``--soak`` (rrc-pin alone, any environment) runs the held-out soak of benchmarks/collision_soak.py
+instead: 200 random starts in penetration and each scene's 10-minute sessions (``--quick``: 12
+starts, 10 s), written as ``collision_soak.{json,png}``.
+
 The cell: two pandas facing each other 1.0 m apart (``rrc_pin.combine``), capsule geometry
 (:class:`rrc_pin.CollisionModel`); for mink the same joint tree and capsules written as MJCF
 (:mod:`collision_peers`; MuJoCo's ``mj_geomDistance`` equals coal's distance to 1e-15 on them).
@@ -40,6 +44,7 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 import numpy as np
 import pinocchio as pin
 from collision_peers import mjcf
+from collision_soak import soak
 from script import arguments, make_parser, mark_quick, measure, pyplot, write
 from timing import progress
 
@@ -320,10 +325,48 @@ def plot(results: dict[str, Any], path: Path) -> bool:
     return True
 
 
+def plot_soak(results: dict[str, Any], path: Path) -> bool:
+    """The soak: each start's ticks to leave the safety distance against the command's time,
+    and each session's nearest pair."""
+    plt = pyplot()
+    if plt is None:
+        return False
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4))
+    for kind in sorted({r["kind"] for r in results["starts"]}):
+        rows = [r for r in results["starts"] if r["kind"] == kind and r["exit_ticks"] is not None]
+        ax[0].plot([r["deadline"] * DT for r in rows], [r["exit_ticks"] * DT for r in rows], "o",
+                   ms=3, label=kind)  # fmt: skip
+    top = max([r["deadline"] * DT for r in results["starts"]] + [0.1])
+    ax[0].plot([0, top], [0, top], color="gray", ls="--", label="the command's time")
+    ax[0].set(xlabel="the command's time to leave [s]", ylabel="out of the safety distance [s]")
+    ax[0].legend(fontsize=8)
+    sessions = results["sessions"]
+    labels = [f"{s['scene']}{' (turning)' if s['turning'] else ''}" for s in sessions]
+    ax[1].barh(labels, [s["min_distance_m"] * 1e3 for s in sessions])
+    ax[1].axvline(SAFETY * 1e3, color="gray", ls="--")
+    ax[1].set(xlabel="minimum distance [mm]", xlim=(SAFETY * 1e3 - 2, SAFETY * 1e3 + 1))
+    for k, s in enumerate(sessions):
+        ax[1].text(SAFETY * 1e3 - 1.9, k, f"{s['fallback_ticks']} fallback ticks", va="center",
+                   fontsize=7, color="white")  # fmt: skip
+    mark_quick(fig, results)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = make_parser(__doc__, "collision")
     parser.add_argument("--ticks", type=int, default=None, help="ticks per pair set")
+    parser.add_argument("--soak", action="store_true", help="the held-out soak, not the peers")
     args = arguments(parser, argv)
+    if args.soak:
+        starts, minutes = (12, 10 / 60) if args.quick else (200, 10.0)
+        soaked = measure("collision_soak", args.quick, lambda: soak(starts, minutes, 0, progress),
+                         "coal")  # fmt: skip
+        print(soaked["summary"])
+        write(args, "collision_soak", soaked, lambda p: plot_soak(soaked, p))
+        return
     ticks = args.ticks or (60 if args.quick else 1000)
     results = measure("collision", args.quick, lambda: run(ticks), "mink", "mujoco", "pink",
                       "coal")  # fmt: skip

@@ -26,7 +26,7 @@ from typing import Any
 
 KNOWN = (
     "closed_form", "resolver", "tasks", "study", "scaling", "controller", "control_schemes", "maps",
-    "collision", "cells",
+    "collision", "collision_soak", "cells",
 )
 CELLS = ("gsfc_dual", "yeh_tripod")
 """The cells the cell benchmark times (issue 30)."""
@@ -61,6 +61,7 @@ def problems(results: dict[str, Any]) -> list[str]:
         "control_schemes": _control_schemes,
         "maps": _maps,
         "collision": _collision,
+        "collision_soak": _collision_soak,
         "cells": _cells,
     }[name]
     out += list(check(results))
@@ -278,6 +279,30 @@ def _collision(results: dict[str, Any]) -> Iterator[str]:
                 yield f"{where}.{key}: expected a positive number"
         if not isinstance(r.get("min_distance_m"), (int, float)):
             yield f"{where}.min_distance_m: expected a number"
+
+
+def _collision_soak(results: dict[str, Any]) -> Iterator[str]:
+    """The starts (each with its fallback count) and the sessions (each with its ticks,
+    statuses and fallback ticks), and the summary's counts."""
+    if not results.get("starts"):
+        yield "starts: empty"
+    for k, r in enumerate(results.get("starts") or []):
+        if not (isinstance(r.get("fallbacks"), int) and r["fallbacks"] >= 0):
+            yield f"starts.{k}.fallbacks: expected a count"
+    if not results.get("sessions"):
+        yield "sessions: empty"
+    for s in results.get("sessions") or []:
+        where = f"sessions.{s.get('scene')}.{s.get('turning')}"
+        if not _positive(s.get("ticks")):
+            yield f"{where}.ticks: expected a positive number"
+        if not s.get("statuses"):
+            yield f"{where}.statuses: empty"
+        if not (isinstance(s.get("fallback_ticks"), int) and s["fallback_ticks"] >= 0):
+            yield f"{where}.fallback_ticks: expected a count"
+    summary = results.get("summary") or {}
+    for key in ("starts", "locked", "session_fallback_ticks"):
+        if not (isinstance(summary.get(key), int) and summary[key] >= 0):
+            yield f"summary.{key}: expected a count"
 
 
 def _cells(results: dict[str, Any]) -> Iterator[str]:

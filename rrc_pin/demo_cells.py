@@ -19,12 +19,12 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.cells import Cell, CellController, MasterSlave
+from rrc_pin.demo_figure import draw_cell
 from rrc_pin.loading import load
 
 Array = npt.NDArray[np.float64]
 DT = 0.01  # [s]
 CELLS = ("gsfc_dual", "yeh_tripod")
-GRIP_BOUND = 1e-5  # [m], the largest grip error the dual-arm session may show
 SLIP_BOUND = 1e-6  # [m], the largest slip of a supporting foot the walk may show
 
 
@@ -58,8 +58,25 @@ def dual(quick: bool) -> tuple[CellController, list[tuple[str, str, str]]]:
     return ctl, [
         ("ticks", str(len(ctl.log)), f"{1 / DT:.0f} Hz"),
         ("object moved [mm]", f"{moved * 1e3:.1f}", "from its start"),
-        ("max grip error [m]", f"{grip:.2e}", f"bound {GRIP_BOUND:.0e}"),
-        ("statuses", " ".join(sorted({rec.status for rec in ctl.log})), ""),
+        ("max grip error [m]", f"{grip:.2e}", f"bound {ctl.closure.position:.0e}"
+         if ctl.closure else ""),
+        *_chains(ctl),
+    ]
+
+
+def _chains(ctl: CellController) -> list[tuple[str, str, str]]:
+    """The summary's rows on the closed chains (errors at the ticks' start, lost ticks)."""
+    chain = ctl.log.column("chain")
+    statuses = [rec.status for rec in ctl.log]
+    lost = sum(s in ("grip_lost", "contact_lost") for s in statuses)
+    bound = ctl.closure
+    return [
+        ("max chain error [m]", f"{chain[:, 0].max():.2e}", f"bound {bound.position:.0e}"
+         if bound else ""),
+        ("max chain error [rad]", f"{chain[:, 1].max():.2e}", f"bound {bound.rotation:.0e}"
+         if bound else ""),
+        ("chain lost [ticks]", str(lost), "held still until a command closed it"),
+        ("statuses", " ".join(sorted(set(statuses))), ""),
     ]
 
 
@@ -99,39 +116,8 @@ def tripod(quick: bool) -> tuple[CellController, list[tuple[str, str, str]]]:
         ("ticks", str(len(ctl.log)), f"{1 / DT:.0f} Hz, {cycles} cycles"),
         ("body advance [m]", f"{advance[0]:.6f}", f"planned {cycles * stride:.3f}"),
         ("max foot slip [m]", f"{slip:.2e}", f"bound {SLIP_BOUND:.0e}"),
-        ("statuses", " ".join(sorted({rec.status for rec in ctl.log})), ""),
+        *_chains(ctl),
     ]
-
-
-def draw(ctl: CellController, path: Path) -> bool:
-    """Joint positions and the logged errors over time; False without matplotlib."""
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return False
-    t = np.array([rec.t for rec in ctl.log])
-    q = np.array([rec.q for rec in ctl.log])
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
-    top.plot(t, q, lw=0.8)
-    top.set_ylabel("q")
-    top.set_title(f"{ctl.cell.name}: joint positions")
-    for name in sorted({k for rec in ctl.log for k in rec.grip}):
-        bottom.semilogy(t, [max(rec.grip.get(name, np.nan), 1e-16) for rec in ctl.log],
-                        label=f"grip {name}")  # fmt: skip
-    for name in sorted({k for rec in ctl.log for k in rec.errors}):
-        bottom.semilogy(t, [max(rec.errors.get(name, np.nan), 1e-16) for rec in ctl.log],
-                        lw=0.8, label=f"error {name}")  # fmt: skip
-    bottom.set_ylabel("[m]")
-    bottom.set_xlabel("t [s]")
-    if bottom.get_legend_handles_labels()[0]:
-        bottom.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return True
 
 
 def run_cell_demo(name: str, out: Path | None = None, quick: bool = False) -> int:
@@ -145,7 +131,7 @@ def run_cell_demo(name: str, out: Path | None = None, quick: bool = False) -> in
     for label, value, note in rows:
         print(f"{label:20s} {value:>14s}  {note}".rstrip())
     ctl.save(out / f"{name}.csv")
-    figure = draw(ctl, out / f"{name}.png")
+    figure = draw_cell(ctl, out / f"{name}.png")
     skipped = f"; {name}.png skipped: matplotlib is not installed"
     print(f"\nwritten to {out}: {name}.csv" + (f", {name}.png" if figure else skipped))
     return 0

@@ -67,6 +67,9 @@ class Layout(NamedTuple):
         joints = {n: i for i, n in enumerate(robot.dof_names)}
         frames = frame_index(model)
         reaches = {name: reach(model, fid) for name, fid in frames.items()}
+        if robot.floating:  # every frame at least the longest chain's (:func:`reach`)
+            extent = max(reaches.values())
+            reaches = {name: max(length, extent) for name, length in reaches.items()}
         return cls(
             model.nv, frames, joints, continuous, robot.dof_lower, robot.dof_upper,
             robot.velocity_limit, reaches, closed_form,
@@ -82,6 +85,13 @@ def reach(model: pin.Model, frame: int) -> float:
     scale at which a frame's linear velocity compares with an angular one (1 m/s at this
     distance is 1 rad/s), so that the resolver's metric does not mix metres and radians. At
     least :data:`MIN_REACH`.
+
+    On a floating base (:meth:`Layout.of`) every frame's reach is at least the robot's longest
+    chain: the free-flyer's own chain has no length, so the body's frame would be normalised
+    by :data:`MIN_REACH`, its linear rows 100 times its angular ones (the tripod's body rows
+    over its feet in support read a condition number of 284 at the ready pose, 5-6 in metres,
+    and every body command the contacts limit was damped instead of scaled). A floating body
+    moves by its limbs: 1 rad/s of the body moves their ends at their length.
     """
     f = model.frames[frame]
     length = float(np.linalg.norm(f.placement.translation))

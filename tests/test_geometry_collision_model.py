@@ -43,7 +43,13 @@ def test_obstacles_get_names_and_pair_with_every_moving_body(cm):
     assert cm.bodies[-len(obstacles):] == tuple(obstacles)
     for name in obstacles:
         partners = {a for a, b in cm.pairs if b == name}
-        assert partners == set(moving), name  # not the base (fixed), not another obstacle
+        # not the base (fixed), not another obstacle, not a body no joint moves relative to it:
+        # panda_link1's capsule turns about its own axis (joint 1); link 2's lies along joint
+        # 2's axis, which stays at the shoulder's height (the floor's distance never changes)
+        still = {"panda_link1_0", "panda_link2_0"} if name == "floor" else {"panda_link1_0"}
+        assert partners == set(moving) - still, name
+        assert {a for a, b in cm.invariant if b == name} == still, name
+        assert all(cm.excluded[(a, name)] == "invariant" for a in still), name
         assert cm.excluded[("panda_link0_0", name)] == "rigid"
     floor = cm.scene.names.index("floor")
     np.testing.assert_allclose(cm.scene.normal[floor], (0, 0, 1))  # normalised
@@ -207,3 +213,77 @@ def test_threads_query_with_their_own_data_while_obstacles_change(panda, cm):
     for t in threads:
         t.join()
     assert errors == []
+
+
+SEEDS = (5, int(np.random.SeedSequence().entropy % 2**63))
+"""A fixed seed and one drawn fresh each run (named in every failure)."""
+
+
+def distances_at(cm, robot, rng, count):
+    """Every pair's distance (active and invariant) at ``count`` random configurations."""
+    geometry = pin.GeometryModel()
+    for obj in cm.scene.geometry.geometryObjects:
+        geometry.addGeometryObject(obj)
+    names = list(cm.bodies)
+    pairs = [*cm.pairs, *cm.invariant]
+    for a, b in pairs:
+        geometry.addCollisionPair(pin.CollisionPair(names.index(a), names.index(b)))
+    data, gdata = robot.model.createData(), geometry.createData()
+    out = []
+    for _ in range(count):
+        pin.computeDistances(robot.model, data, geometry, gdata,
+                             robot.to_pinocchio(robot.random_q(rng)))  # fmt: skip
+        out.append([r.min_distance for r in gdata.distanceResults])
+    return pairs, np.array(out)
+
+
+@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "fresh"))
+def test_a_pair_is_invariant_exactly_where_no_joint_changes_its_distance(panda, seed):
+    """Obstacles of every shape at random poses, and shapes held by link 1 on its axis (where
+    turning it moves nothing) or off it, by the hand: the pairs left out as invariant keep
+    their distance (to 1e-5 m) at random configurations, and those a joint moves are rows."""
+    rng = np.random.default_rng(seed)
+    cm = CollisionModel(panda)
+
+    def pose():
+        T = np.eye(4)
+        T[:3, :3] = pin.exp3(rng.normal(size=3))
+        T[:3, 3] = rng.uniform((-0.8, -0.8, -0.2), (0.8, 0.8, 1.0))
+        return T
+
+    cm.add_box(pose(), rng.uniform(0.05, 0.4, 3), name="box")
+    cm.add_sphere(pose(), rng.uniform(0.02, 0.2), name="ball")
+    cm.add_capsule(pose(), 0.05, rng.uniform(0.05, 0.5), name="bar")
+    cm.add_cylinder(pose(), 0.05, rng.uniform(0.05, 0.5), name="post")
+    cm.add_convex(pose(), rng.normal(size=(10, 3)) * 0.1, name="rock")
+    normal = rng.normal(size=3)
+    cm.add_halfspace(normal, float(rng.uniform(-0.5, -0.2)) * np.linalg.norm(normal),
+                     name="plane")  # fmt: skip
+    axis = np.eye(4)
+    axis[2, 3] = rng.uniform(-0.2, 0.0)  # on joint 1's axis, in link 1's frame
+    off = np.eye(4)
+    off[:3, 3] = (0.12, 0.0, -0.1)
+    cm.attach("panda_link1", "sphere", axis, radius=0.03, name="on axis")
+    cm.attach("panda_link1", "sphere", off, radius=0.03, name="off axis")
+    cm.attach("panda_hand", "box", np.eye(4), size=(0.05, 0.05, 0.05), name="held")
+    pairs, d = distances_at(cm, panda, rng, 24)
+    spread = dict(zip(pairs, np.ptp(d, axis=0).tolist(), strict=True))
+    for pair in cm.invariant:
+        assert spread[pair] <= 1e-5, f"seed {seed}: {pair} {spread[pair]}"
+    world = ("box", "ball", "bar", "post", "rock", "plane")
+    for obstacle in world:
+        assert ("on axis", obstacle) in cm.invariant, f"seed {seed}"
+        assert ("off axis", obstacle) in cm.pairs and spread[("off axis", obstacle)] > 1e-3
+        assert ("held", obstacle) in cm.pairs and spread[("held", obstacle)] > 1e-3
+    moved = [p for p in cm.pairs if spread[p] > 1e-5]
+    assert len(moved) >= len(cm.pairs) - 2, f"seed {seed}: {set(cm.pairs) - set(moved)}"
+
+
+def test_a_free_flying_base_moves_every_body_against_the_world():
+    """The tripod's root is a free flyer: no body is invariant against a world obstacle."""
+    tripod = rrc_pin.load("yeh_tripod")
+    cm = CollisionModel(tripod)
+    cm.add_halfspace((0.0, 0.0, 1.0), -1.0, name="floor")
+    assert not [p for p in cm.invariant if "floor" in p]
+    assert all((body, "floor") in cm.pairs for body in cm.bodies[:-1]
+               if cm.scene.joint[cm.bodies.index(body)] != 0)  # fmt: skip

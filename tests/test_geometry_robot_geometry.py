@@ -141,11 +141,18 @@ def test_two_combined_pandas_keep_their_own_pairs_and_pair_every_body_across(fac
     own = {(f"{k}/{a}", f"{k}/{b}") for k in ("left", "right") for a, b in one.pairs}
     across = {(a, b) for a, b in two.pairs if a.split("/")[0] != b.split("/")[0]}
     assert set(two.pairs) == own | across
-    assert len(across) == n * n - 1  # all but the two bases (both fixed to the world)
+    # all but the two bases (both fixed to the world) and the pairs no joint moves: link 1's
+    # capsule turns about its own axis, against the other base or the other link 1
+    assert len(across) == n * n - 4
+    assert set(two.invariant) == {("left/panda_link0_0", "right/panda_link1_0"),
+                                  ("left/panda_link1_0", "right/panda_link0_0"),
+                                  ("left/panda_link1_0", "right/panda_link1_0")}  # fmt: skip
+    assert two.invariant[("left/panda_link1_0", "right/panda_link1_0")] == pytest.approx(
+        1.0 - 2 * 0.09, abs=1e-9)  # the bases 1 m apart, the capsules' radius 0.09 m
     links = {f"panda_link{i}_0" for i in range(1, 8)}
     arm_pairs = {(a, b) for a, b in across
                  if a.split("/")[1] in links and b.split("/")[1] in links}  # fmt: skip
-    assert len(arm_pairs) == 49
+    assert len(arm_pairs) == 48
     assert two.excluded[("left/panda_link0_0", "right/panda_link0_0")] == "rigid"
     # at its base: the right arm's bodies are the left arm's, moved by the placement
     q = panda.ready()
@@ -177,7 +184,10 @@ def test_a_geometry_model_of_ones_own_is_filtered_by_the_kinematic_rules():
     sample = rrc_pin.Robot(model, "effector_body", name="sample", source="built in code")
     cm = CollisionModel(sample, geometry)
     assert cm.variant == "given" and len(cm.bodies) == geometry.ngeoms
-    assert set(cm.excluded.values()) <= {"rigid", "adjacent", "ready"}
+    assert set(cm.excluded.values()) <= {"rigid", "adjacent", "ready", "invariant"}
+    # the shoulder's sphere sits where its three joints' axes meet: the elbow's sphere turns
+    # about its centre, 0.9 m away whatever the joints
+    assert cm.invariant == pytest.approx({("shoulder_object", "elbow_object"): 0.9}, abs=1e-12)
     bad = pin.GeometryModel()
     bad.addGeometryObject(pin.GeometryObject("far", 99, pin.SE3.Identity(), coal.Sphere(0.1)))
     with pytest.raises(InvalidInput, match="joint 99"):

@@ -157,6 +157,29 @@ def test_against_a_halfspace_rows_match_coal(kind):
         assert m @ out["point_b"][0] == pytest.approx(o, abs=TOL)
 
 
+def test_against_a_halfspace_the_pairs_own_row_comes_before_its_other_ends():
+    """With ``ends``, a capsule against a half-space: its first row is the pair's (coal's
+    distance, the lower end), then the other end's, never nearer. (The end written first was
+    the segment's first, whichever was lower: the pair's own row came second half the time.)"""
+    rng = np.random.default_rng(12)
+    second_lower = 0
+    for _ in range(TRIALS):
+        a = body("capsule", rng)
+        poses = np.array([np.eye(4), pose(rotation(rng), rng.normal(size=3) * 0.2), np.eye(4)])
+        m = rng.normal(size=3)
+        m /= np.linalg.norm(m)
+        o = float(m @ poses[1][:3, 3] + rng.uniform(-0.3, 0.3))
+        rows, out = solve([a[0], HALFSPACE], [a[1], np.zeros((2, 3))], [a[2], 0.0], poses, (m, o),
+                          ends=True)  # fmt: skip
+        ref = coal_distance(a[3], poses[1], coal.Halfspace(m, o), np.eye(4))
+        assert out["distance"][0] == pytest.approx(ref.min_distance, abs=TOL)
+        if rows == 2:
+            assert out["distance"][1] >= out["distance"][0] - TOL
+            ends = poses[1][:3, :3] @ a[1].T
+            second_lower += float(m @ ends[:, 1]) < float(m @ ends[:, 0])
+    assert second_lower > TRIALS // 4
+
+
 def test_end_point_rows_are_each_end_against_the_other_segment():
     """With ``ends``: the first row is the pair's; then every end point of a capsule within the
     detection distance of the other body that is not the closest point already, each at the

@@ -405,15 +405,13 @@ def plane_problem(slide: bool | None, b: tuple[float, float, float]) -> Problem:
 def test_a_slide_row_keeps_the_tangential_component_of_a_command_into_it() -> None:
     answer = solve(plane_problem(True, (0.1, 0.05, -0.1)), make_backend("daqp"), Options())
     assert answer.status == "sliding"
-    # to the sliding stage's damping (pipeline.SLIDE_DAMPING, mu = 1e-2 here: A = I): each
-    # direction keeps sigma^2 (sigma^2 + 2 mu) / (sigma^2 + mu)^2 of its command
-    mu = pipeline_module.SLIDE_DAMPING
-    kept = (1.0 + 2.0 * mu) / (1.0 + mu) ** 2
-    # z: the row met with slide_kernels.MARGIN (1e-12 m/s) to spare
-    assert np.allclose(answer.qdot, (0.1 * kept, 0.05 * kept, 0.0), rtol=1e-9, atol=2e-12)
+    # A = I is well conditioned: the sliding stage does not damp it (pipeline._slide), so the
+    # command keeps all of its tangential component; z: the row met with slide_kernels.MARGIN
+    # (1e-12 m/s) to spare
+    assert np.allclose(answer.qdot, (0.1, 0.05, 0.0), rtol=1e-12, atol=2e-12)
     tangential = np.hypot(0.1, 0.05)
     assert answer.veer == pytest.approx(np.arctan2(0.1, tangential), abs=1e-9)
-    assert answer.scale == pytest.approx(kept * tangential**2 / (tangential**2 + 0.01), rel=1e-9)
+    assert answer.scale == pytest.approx(tangential**2 / (tangential**2 + 0.01), rel=1e-9)
 
 
 def test_a_row_without_the_slide_flag_still_scales_the_command_to_a_stop() -> None:
@@ -453,8 +451,9 @@ def test_a_slid_command_met_by_other_joints_is_met_not_scaled() -> None:
     least-norm
     rates of a command down share z between joints 3 and 4 and cross the row; the slide
     meets the command with joint 4 and keeps the row: those rates are the answer (the
-    least-norm rates scaled back to the row would stand still). To the sliding stage's damping
-    (pipeline.SLIDE_DAMPING: 1e-2 of the rows' mean squared singular value): to 1 %."""
+    least-norm rates scaled back to the row would stand still). To the cost of the null space
+    in the sliding stage (pipeline.SLIDE_DAMPING: 1e-2 of the rows' mean squared singular
+    value; 0.66 % of the command along z here): to 1 %."""
     n = 4
     free = np.full(n, 2.0)
     box = Box(-free, free.copy(), np.zeros((2, n), np.int8), True, False, free.copy())

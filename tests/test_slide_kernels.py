@@ -1,14 +1,16 @@
 """rrc_pin.solvers.tick.slide_kernels: the sliding stage's projection against DAQP (1e-8) on random
 problems
 (redundant and square metrics, infinite bounds, rows broken at zero), infeasible data refused,
-never NaN; its damped optimum against the normal equations and bounded through a singularity."""
+never NaN; its metric and target against numpy's SVD (undamped where the rows are well
+conditioned, bounded through a singularity)."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import qpsolvers
 
-from rrc_pin.solvers.tick.slide_kernels import INFEASIBLE, SOLVED, damped_optimum, project
+from rrc_pin.solvers.tick.slide_kernels import INFEASIBLE, SOLVED, project, slide_metric
 
 TRIALS = 1500
 
@@ -71,20 +73,65 @@ def test_project_refuses_a_row_of_zeros_broken_at_w() -> None:
     assert code == INFEASIBLE
 
 
-def test_damped_optimum_minimises_its_cost_and_stays_bounded_at_a_singularity() -> None:
-    rng = np.random.default_rng(3)
-    for _ in range(200):
+SEEDS = (3, int(np.random.SeedSequence().entropy % 2**63))
+"""A fixed seed, and one drawn fresh each run (printed on failure)."""
+
+
+def metric_of(A, b, mu_rel, threshold):
+    """slide_metric's inputs from numpy's SVD, and its M and target written out."""
+    m, n = A.shape
+    U, s, Vt = np.linalg.svd(A)
+    k = min(m, n)
+    rank = int(np.sum(s > 1e-9 * s[0])) if s[0] > 0 else 0
+    mu = mu_rel * np.sum(s**2) / m
+    ratio = s[:rank] * threshold / s[0]  # sigma_i / sigma_on
+    f = mu * np.maximum(1.0 - ratio**2, 0.0)
+    V = Vt.T
+    null = Vt[rank:]
+    root = np.vstack([np.sqrt(f)[:, None] * Vt[:rank], np.sqrt(mu) * null])  # D = root^T root
+    M = A.T @ A + root.T @ root
+    # t, the damped least squares, and argmin |A x - b|^2 + (x - t)^T D (x - t), each as a
+    # least squares of the stacked rows (not the normal equations: M squares the condition)
+    stacked = np.vstack([A, root])
+    t = np.linalg.lstsq(stacked, np.concatenate([b, np.zeros(root.shape[0])]), rcond=None)[0]
+    want = np.linalg.lstsq(stacked, np.concatenate([b, root @ t]), rcond=None)[0]
+    inputs = (U[:, :k] * s[:k], s[:k].copy(), V[:, :k].copy(), rank, null.copy())
+    return inputs, M, want
+
+
+@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "fresh"))
+def test_slide_metric_is_the_damped_metric_and_its_optimum(seed) -> None:
+    rng = np.random.default_rng(seed)
+    for trial in range(300):
         n = int(rng.integers(2, 15))
-        A = rng.normal(size=(int(rng.integers(1, n + 1)), n))
-        b = rng.normal(size=A.shape[0])
-        mu = 1e-2 * np.trace(A.T @ A) / A.shape[0]
-        M = A.T @ A + mu * np.eye(n)
-        t = np.linalg.solve(M, A.T @ b)
-        out = np.empty(n)
-        assert damped_optimum(A, 1e-2, b, out)
-        np.testing.assert_allclose(out, np.linalg.solve(M, A.T @ b + mu * t), rtol=1e-9,
-                                   atol=1e-12)  # fmt: skip
+        m = int(rng.integers(1, n + 1))
+        A = rng.normal(size=(m, n)) * rng.uniform(0.1, 3.0, n)
+        if trial % 3 == 0:  # ill conditioned: some directions past the onset
+            U, s, Vt = np.linalg.svd(A, full_matrices=False)
+            A = U @ np.diag(s * np.logspace(0, -rng.uniform(1, 5), s.size)) @ Vt
+        b = rng.normal(size=m)
+        threshold = float(rng.choice([10.0, 100.0, np.inf]))
+        (US, sigma, right, rank, null), M, want = metric_of(A, b, 1e-2, threshold)
+        B, target = np.empty((m + n, n)), np.empty(n)
+        rows = slide_metric(A, US, sigma, right, rank, null, b, 1e-2, threshold, B, target)
+        scale = np.abs(M).max()
+        np.testing.assert_allclose(B[:rows].T @ B[:rows], M, atol=1e-10 * scale,
+                                   err_msg=f"seed {seed} trial {trial}")  # fmt: skip
+        np.testing.assert_allclose(target, want, rtol=1e-8, atol=1e-9 * np.abs(want).max(),
+                                   err_msg=f"seed {seed} trial {trial}")  # fmt: skip
+
+
+def test_slide_metric_leaves_well_conditioned_rows_undamped_and_a_singularity_bounded() -> None:
+    A = np.array([[1.0, 0.0, 0.0], [0.0, 0.5, 0.0]])  # condition 2: its exact rates, the
+    b = np.array([0.3, -0.2])  # null space (joint 3) at mu
+    (US, sigma, right, rank, null), _, _ = metric_of(A, b, 1e-2, 100.0)
+    B, target = np.empty((5, 3)), np.empty(3)
+    rows = slide_metric(A, US, sigma, right, rank, null, b, 1e-2, 100.0, B, target)
+    np.testing.assert_allclose(target, (0.3, -0.4, 0.0), atol=1e-15)
+    mu = 1e-2 * (1.0 + 0.25) / 2
+    np.testing.assert_allclose(B[:rows].T @ B[:rows], np.diag([1.0, 0.25, mu]), atol=1e-15)
     A = np.array([[1.0, 0.0], [0.0, 1e-9]])  # one direction nearly lost: the exact rates 1e9
-    out = np.empty(2)
-    assert damped_optimum(A, 1e-2, np.array([1.0, 1.0]), out)
-    assert np.isfinite(out).all() and np.abs(out).max() < 2.0
+    (US, sigma, right, rank, null), _, _ = metric_of(A, np.ones(2), 1e-2, 100.0)
+    B, target = np.empty((4, 2)), np.empty(2)
+    slide_metric(A, US, sigma, right, rank, null, np.ones(2), 1e-2, 100.0, B, target)
+    assert np.isfinite(target).all() and np.abs(target).max() < 20.0

@@ -2,9 +2,9 @@ r"""CellController: one tick of a cell, one command per object, body or free han
 
 What each command becomes (the cooperative commands):
 
-- an **object** held by two hands: its frame's twist with a target pose, and the grip (the
-  second hand's pose relative to the first, a :class:`~rrc_pin.tasks.RelativeFrameTask`
-  with the grasp as its target), both in the top level. The top level is the resolver's
+- an **object** held by two hands: its frame's twist with a target pose in the top level,
+  the grip (the second hand's relative twist zero, :class:`~rrc_pin.limits.GripLimit`)
+  equality rows that every level is solved within. The top level is the resolver's
   direction problem, :math:`\max s` with :math:`A\dot q = s\,b`: when an arm meets a limit
   or a singularity, both hands slow together by one common scale along the commanded
   direction and the grip is never stretched. ``coupled=False`` instead resolves each hand on
@@ -24,6 +24,11 @@ drift correction: each advances by the command times the achieved scale, and the
 their pose error back (gain ``gain``). Below the top level a posture task pulls toward the
 ready pose (the redundancy's use).
 
+The closed chains (grips, feet in support) are kept closed inside each tick: the error
+each shows at the tick's configuration and the step's second order are taken out by a
+correction inside the tick's box (:mod:`rrc_pin.cells.closure`), and a chain open beyond its
+bound stops the cell (``grip_lost`` / ``contact_lost``) until a command closes it.
+
 The loop itself is :class:`~rrc_pin.control.loop.Loop`, the one
 :class:`~rrc_pin.control.Controller` is built on: the speed override and the deadman weight
 every command, the configuration is integrated on its manifold, the ticks go to a log ring
@@ -33,27 +38,32 @@ every command, the configuration is integrated on its manifold, the ticks go to 
 
 from __future__ import annotations
 
-import csv
-import math
 import os
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Literal, NamedTuple
+from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.cells.cell import Cell
+from rrc_pin.cells.cell_log import CellLog
+from rrc_pin.cells.cell_resolution import CellResolution
+from rrc_pin.cells.closure import Chains, ClosureBound, close
 from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.loop import Loop, Step
-from rrc_pin.control.trajectory_log import CAPACITY, RecordRing, checked_path, reason
+from rrc_pin.deprecated import warn_renamed
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import ContactLimit, GripLimit, JointLimits, Limit
+from rrc_pin.limits.contact_limit import Closure
 from rrc_pin.loading import load
 from rrc_pin.resolver import QPOptions
+from rrc_pin.robot import frame_index
 from rrc_pin.solvers.checks import as_vector, positive
 from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.kernels import scale_and_veer
+from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.tasks import FrameTask, PostureTask, Task
 
@@ -62,88 +72,26 @@ Ref = Literal["world", "local", "base"]
 REFS: tuple[str, ...] = ("world", "local", "base")
 Command = npt.ArrayLike | tuple[npt.ArrayLike, str]
 """A twist (6,) in the cell's world axes, or ``(twist, ref)``."""
-REANCHOR = ("damped", "singular", "least_squares", "recovering", "fallback")
-"""Statuses whose motion departs from the command's direction: the targets are reset to the
-reached poses instead of pulling back toward poses that could not be followed."""
+REANCHOR = ("singular", "least_squares", "recovering", "fallback")
+"""Statuses whose motion is not the command's (part of it out of reach, or another problem's
+answer): the targets are reset to the reached poses instead of pulling back toward poses
+that could not be followed."""
+HOLD = (5e-3, 5e-3)
+"""[m, rad] How far a ``damped`` tick's target may lead its frame. A damped tick (past the
+damping threshold, near a singular pose) advances its target along the command by what its
+frame made along it, and the motion's veer off the command is fed back up to this distance;
+beyond it the target follows the frame. Reset to the reached pose at every damped tick (the
+former rule), the veer added up (the tripod's body 63 mm off its line, turned 0.45 rad); fed
+back without a bound, the feedback and the damping were at odds near a singular pose
+(gsfc_dual's object held 0.85 m from its target)."""
+Lost = Literal["grip_lost", "contact_lost"]
+LOST: tuple[Lost, ...] = ("grip_lost", "contact_lost")
+"""The statuses of a cell whose closed chain is open beyond its bound (:mod:`.closure`)."""
 
 
 CellStep = Step
-"""One tick's outcome: the configuration after it (nq,) and the resolution."""
-
-
-class CellRecord(NamedTuple):
-    """One tick as the log keeps it.
-
-    Attributes:
-        t: Time at the start of the tick [s].
-        q: Configuration at the start (nq,).
-        qdot: Joint rates (nv,).
-        status: The resolution's status.
-        scale: The top level's common scale.
-        levels: Each level's status, joined by ``/``.
-        errors: Pose error [m] of each commanded frame to its target, by command name.
-        grip: Grip error [m] of each held object (relative position to the grasp).
-        mode: ``"teleop"`` or ``"reverse"``.
-    """
-
-    t: float
-    q: Array
-    qdot: Array
-    status: str
-    scale: float
-    levels: str
-    errors: dict[str, float]
-    grip: dict[str, float]
-    mode: str
-
-
-class CellLog(RecordRing[CellRecord]):
-    """A cell's log: the ring of :class:`CellRecord` every loop keeps, and its CSV.
-
-    Args:
-        nq: Length of the cell's q.
-        nv: Length of its qdot.
-        capacity: Ticks kept (:class:`~rrc_pin.control.trajectory_log.RecordRing`).
-    """
-
-    record_type = CellRecord
-
-    def __init__(self, nq: int, nv: int, capacity: int = CAPACITY) -> None:
-        super().__init__(None, capacity)
-        self.nq, self.nv = nq, nv
-
-    def __iter__(self) -> Iterator[CellRecord]:
-        return iter(self.records)
-
-    def save(self, path: str | os.PathLike[str]) -> Path:
-        """Write the log as CSV (one row per tick, a header) to ``path``; return the path.
-
-        Raises:
-            InvalidInput: Naming ``path``: not a ``.csv`` path, or a file that cannot be
-                written (the system's reason).
-        """
-        out = checked_path(path)
-        if out.suffix != ".csv":
-            raise InvalidInput("path", f"expected a .csv file, got {str(out)!r}")
-        records = self.records
-        names = sorted({k for rec in records for k in rec.errors})
-        grips = sorted({k for rec in records for k in rec.grip})
-        try:
-            with out.open("w", newline="") as f:
-                w = csv.writer(f)
-                w.writerow(["t", "mode", "status", "scale", "levels",
-                            *[f"error:{n}" for n in names], *[f"grip:{n}" for n in grips],
-                            *[f"q{i}" for i in range(self.nq)],
-                            *[f"qdot{i}" for i in range(self.nv)]])  # fmt: skip
-                for rec in records:
-                    w.writerow([f"{rec.t:.6f}", rec.mode, rec.status, f"{rec.scale:.9g}",
-                                rec.levels, *[f"{rec.errors.get(n, math.nan):.9g}" for n in names],
-                                *[f"{rec.grip.get(n, math.nan):.9g}" for n in grips],
-                                *[f"{x:.12g}" for x in rec.q],
-                                *[f"{x:.12g}" for x in rec.qdot]])  # fmt: skip
-        except OSError as exc:
-            raise InvalidInput("path", f"cannot write {str(out)!r}: {reason(exc)}") from exc
-        return out
+"""One tick's outcome: the configuration after it (nq,) and its resolution (a
+:class:`~rrc_pin.cells.cell_resolution.CellResolution`)."""
 
 
 class CellController(Loop):
@@ -152,7 +100,8 @@ class CellController(Loop):
     Args:
         cell: A :class:`~rrc_pin.cells.Cell` or a ready-made cell's name.
         dt: Control period [s].
-        q0: Initial configuration (nq,); default the ready pose.
+        q0: Initial configuration (nq,); default the ready pose. The grips and the feet's
+            anchors are the chains as they are there.
         limits: The resolver's limits: joint limits (default ``JointLimits()``), or a list of
             limits (joint limits, a :class:`~rrc_pin.limits.CollisionLimit` on the cell's
             :class:`~rrc_pin.geometry.CollisionModel`, ...); the support's contacts and the
@@ -161,13 +110,15 @@ class CellController(Loop):
         damping: The resolver's damping, or None.
         deadman: How a command ages (default ``Deadman()``), or None.
         speed: Speed override in [0, 1].
-        gain: Feedback gain [1/s] of the target poses and the grip.
+        gain: Feedback gain [1/s] of the target poses.
         posture_gain: Gain [1/s] of the posture task below the top level.
         coupled: Hold objects as one (the grip in the top level); False: each hand of a held
             object resolved on its own (for comparison).
-        project_contacts: After integrating, move each supporting leg's joints by the
-            Newton step that puts its foot back on its anchor (removes the integration's
-            second-order slip; its size is logged in ``contact_correction``).
+        closure: The bound the closed chains (grips, feet in support) are kept within, each
+            tick's error taken out inside the step (:mod:`rrc_pin.cells.closure`); None: no
+            correction and no bound (for comparison: the integration's remainder then adds
+            up).
+        project_contacts: Deprecated (goes in the next release): False is ``closure=None``.
 
     Raises:
         InvalidInput: A bad argument, named.
@@ -175,9 +126,9 @@ class CellController(Loop):
 
     passing = 1e-5
     """[rad, m] :meth:`reverse` passes a recorded configuration within this distance: the
-    closed chains' projection moved each one off its rates' integral (by 7.5e-7 rad on
-    gsfc_dual at 0.17 rad/s, 7.5e-10 on yeh_tripod), so that retracing it takes a second,
-    ``exact`` tick otherwise. The segment's start is still reached to rounding."""
+    closed chains' correction moved each one off the rates the chains' rows allow (by up to
+    the correction's size), so that retracing it takes a second, ``exact`` tick otherwise.
+    The segment's start is still reached to rounding."""
 
     def __init__(
         self,
@@ -193,12 +144,18 @@ class CellController(Loop):
         gain: float = 10.0,
         posture_gain: float = 0.1,
         coupled: bool = True,
-        project_contacts: bool = True,
+        closure: ClosureBound | None = ClosureBound(),  # noqa: B008 - immutable
+        project_contacts: bool | None = None,
     ) -> None:
+        if project_contacts is not None:  # the former closure step's switch
+            warn_renamed("CellController(project_contacts=)", "CellController(closure=)")
+            closure = closure if project_contacts else None
         if isinstance(cell, str):
             cell = load(cell)  # type: ignore[assignment]
         if not isinstance(cell, Cell):
             raise InvalidInput("cell", f"expected a Cell or a cell's name, got {cell!r}")
+        if closure is not None and not isinstance(closure, ClosureBound):
+            raise InvalidInput("closure", f"expected a ClosureBound or None, got {closure!r}")
         given: list[Limit]
         if limits is None:
             given = [JointLimits()]
@@ -216,14 +173,26 @@ class CellController(Loop):
         self.posture = PostureTask(cell.dof_positions(cell.ready()), gain=posture_gain,
                                    weight=1e-3, name="posture")  # fmt: skip
         self.coupled = bool(coupled)
-        self.project_contacts = bool(project_contacts)
-        self.log: CellLog = CellLog(cell.nq, cell.nv)
-        self.contact_correction = 0.0
+        self.closure = closure
+        commands = [*cell.objects, *([cell.body] if cell.body else []), *cell.arms]
+        self.log: CellLog = CellLog(cell.nq, cell.nv, commands, list(cell.objects))
+        self.chain_error = (0.0, 0.0)
+        """The closed chains' largest position [m] and rotation [rad] error at the last
+        tick's start (zero without chains)."""
+        self.lost: Lost | None = None
+        """``"grip_lost"`` or ``"contact_lost"`` while a chain is open beyond its bound (the
+        cell then holds still until a command closes it), else None."""
         self.support: list[str] = list(cell.tool_frames) if cell.body is not None else []
         self._anchors: dict[str, Array] = {}
+        self._grips: dict[str, Array] = {}
         self._commands: dict[str, Array] = {}
         self._targets: dict[str, Array] = {}
-        self._reanchor()
+        self._tick: tuple[str, bool, dict[str, Array]] = ("teleop", False, {})
+        self._applied = np.zeros(cell.nv)
+        self._correction_size = 0.0
+        self._data = cell.model.createData()  # the closure's second-order pass
+        self._frames = frame_index(cell.model)
+        self._close_at()
 
     # -- settings -------------------------------------------------------------------------
 
@@ -269,8 +238,10 @@ class CellController(Loop):
             raise InvalidInput("leg", f"{leg}'s foot is not in support; in support: "
                                f"{', '.join(self.support) or 'none'}")  # fmt: skip
         self.support.remove(foot)
+        self._anchors.pop(foot)
         self._commands.pop(leg, None)
-        self._reanchor()
+        self._chains()
+        self._retarget()
 
     def land(self, leg: str) -> None:
         """Put leg ``leg``'s foot in support where it is now (a fixed contact).
@@ -282,8 +253,10 @@ class CellController(Loop):
         if foot in self.support:
             raise InvalidInput("leg", f"{leg}'s foot is already in support")
         self.support.append(foot)
+        self._anchors[foot] = self.cell.fk(self._q, foot)
         self._commands.pop(leg, None)
-        self._reanchor()
+        self._chains()
+        self._retarget()
 
     # -- the loop ---------------------------------------------------------------------------
 
@@ -296,6 +269,11 @@ class CellController(Loop):
                 commanded frame's axes) or ``"base"`` (a hand's arm base axes). Names not
                 given are held still; None: no new command (the last ones age, see
                 ``deadman``).
+
+        Returns:
+            The configuration after the tick and its resolution: the rates applied (the
+            closed chains' correction included), and ``grip_lost`` or ``contact_lost``
+            where a chain is open beyond its bound (:attr:`lost`).
 
         Raises:
             InvalidInput: An unknown name (the commandable ones listed), a hand that holds an
@@ -326,46 +304,185 @@ class CellController(Loop):
                 continue
             top.append(FrameTask(self.frame_of(name), twist, target=self._targets[name],
                                  gain=self.gain, name=name))  # fmt: skip
-        self.contact.set_frames(self.support)
-        self.grip.set_pairs([] if not self.coupled else
-                            [g.hands for g in cell.objects.values()])  # fmt: skip
-        levels: list[list[Task]]
         if hands:
             r = self.resolver.solve(self._q, [*top, *hands, self.posture])
         else:
-            levels = [top, [self.posture]] if top else [[self.posture]]
+            levels: list[list[Task]] = [top, [self.posture]] if top else [[self.posture]]
             r = self.resolver.solve(self._q, levels, priority="strict")
-        self._record(r, poses, "teleop")
-        follow = r.scale if hands == [] else 1.0
+        commanded = any(bool(np.any(t != 0.0)) for t in twists.values())
+        self._tick = ("teleop", commanded, poses)
+        out = self._advance(r)
+        r = out.resolution
+        if r.status in LOST and not r.qdot.any():  # held still: the targets wait
+            return out
         if r.status in REANCHOR:
-            out = self._advance(r)
-            self._reanchor()
-        else:
-            for name, twist in twists.items():
-                self._targets[name] = _moved(self._targets[name], twist * (follow * self.dt))
-            out = self._advance(r)
+            self._retarget()
+            return out
+        if r.status == "damped" and not hands:
+            self._held_back(r, twists)
+            return out
+        follow = r.scale if hands == [] else 1.0
+        for name, twist in twists.items():
+            self._targets[name] = _moved(self._targets[name], twist * (follow * self.dt))
         return out
+
+    def _held_back(self, r: Resolution, twists: dict[str, Array]) -> None:
+        """A damped tick's targets, fed back within a bound (:data:`HOLD`).
+
+        Each moves along its command by what its frame made along it, then to at most
+        :data:`HOLD` from the frame.
+        """
+        tasks = {t.name: t for t in r.problem.levels[0]}
+        for name, twist in twists.items():
+            task = tasks[name]
+            factor = None if task.unit is None else 1.0 / task.unit
+            made = scale_and_veer(task.A @ r.qdot, twist, factor)[0] if twist.any() else 0.0
+            target = _moved(self._targets[name], twist * (made * self.dt))
+            pose = self.cell.fk(self._q, self.frame_of(name))
+            error = np.concatenate([target[:3, 3] - pose[:3, 3],
+                                    pin.log3(target[:3, :3] @ pose[:3, :3].T)])  # fmt: skip
+            for part, hold in zip((slice(0, 3), slice(3, 6)), HOLD, strict=True):
+                size = float(np.linalg.norm(error[part]))
+                if size > hold:
+                    error[part] *= hold / size
+            self._targets[name] = _moved(pose, error)
 
     # -- what the loop asks of it ---------------------------------------------------------
 
     def _log_reverse(self, q: Array, r: Resolution) -> None:
-        self._record(r, {}, "reverse")
+        """A reverse tick: logged, closed and integrated by :meth:`_advance` (a command)."""
+        self._tick = ("reverse", True, {})
+
+    def _advance(self, r: Resolution) -> Step:
+        """One tick: the closed chains' correction (:meth:`_closed`), the log, the integration."""
+        closed = self._closed(r)
+        self._record(closed)
+        return super()._advance(closed)
+
+    def _integrate(self, qdot: Array) -> Array:
+        """The loop's integration of the tick's applied rates (:meth:`_closed`).
+
+        The resolver's ``qdot`` and the closed chains' correction (the argument is the first).
+        """
+        return super()._integrate(self._applied)
 
     def _stopped(self) -> None:
         self._commands = {}
-        self._reanchor()
+        self._retarget()
 
     def _configuration_set(self) -> None:
-        """Targets and the feet's anchors at the configuration set.
+        """Targets, grips and the feet's anchors at the configuration set.
 
-        A cell set elsewhere stays there: the targets' feedback and the projection would
-        pull it back to the old poses and anchors.
+        A cell set elsewhere stays there: the targets' feedback and the closure would pull
+        it back to the old poses, grips and anchors.
         """
-        self._reanchor()
+        self._close_at()
 
     def save(self, path: str | os.PathLike[str]) -> Path:
         """Write the log as CSV to ``path`` (:meth:`CellLog.save`); return the path."""
         return self.log.save(path)
+
+    @property
+    def contact_correction(self) -> float:
+        """The former closure step's size (deprecated: goes in the next release).
+
+        The largest rate of the last tick's correction [rad/s or m/s]; each tick's whole
+        correction is its resolution's ``correction`` (:class:`CellResolution`).
+        """
+        warn_renamed("CellController.contact_correction",
+                     "CellController.step(...).resolution.correction", stacklevel=2)  # fmt: skip
+        return self._correction_size
+
+    # -- the closed chains ------------------------------------------------------------------
+
+    def _close_at(self) -> None:
+        """The grips and the feet's anchors as they are at the current q; targets there too."""
+        q, cell = self._q, self.cell
+        self._anchors = {f: cell.fk(q, f) for f in self.support}
+        self._grips = {}
+        if self.coupled:
+            for name, g in cell.objects.items():
+                self._grips[name] = _inverse(cell.fk(q, g.hands[0])) @ cell.fk(q, g.hands[1])
+        self.lost = None
+        self._chains()
+        self._retarget()
+
+    def _chains(self) -> None:
+        """The contact and grip limits set to the support's anchors and the grips."""
+        self.contact.set_frames(self.support, [self._anchors[f] for f in self.support])
+        grasps = [self.cell.objects[n] for n in self._grips]
+        self.grip.set_pairs([g.hands for g in grasps], [self._grips[g.name] for g in grasps])
+
+    def _closed(self, r: Resolution) -> CellResolution:
+        """``r`` with the closed chains' correction, or held still while one is lost.
+
+        The correction (:func:`~rrc_pin.cells.closure.close`) takes the error measured at the
+        tick's configuration (the resolver's kinematics, by the contact and grip limits) and
+        the step's second order out inside the tick's box. A tick that starts with a chain
+        beyond its bound holds still (``grip_lost`` / ``contact_lost``, zero rates), and so
+        does every tick after it until one whose command, with the correction, closes the
+        chain (its predicted error after the step below the error now); the status stays
+        until the chain is back within the bound.
+        """
+        self._applied = r.qdot
+        self._correction_size = 0.0
+        self.chain_error = (0.0, 0.0)
+        hands = self._hands(r)
+        measured: list[tuple[Closure | None, Lost]] = [(self.contact.last, "contact_lost"),
+                                                      (self.grip.last, "grip_lost")]  # fmt: skip
+        parts = [(last, kind) for last, kind in measured if last is not None]
+        if not parts:
+            return CellResolution.of_tick(r, r.qdot.copy(), hands)
+        closure = Closure(*(np.concatenate([c[i] for c, _ in parts]) for i in range(3)))
+        e = closure.error.reshape(-1, 6)
+        self.chain_error = (float(np.linalg.norm(e[:, :3], axis=1).max()),
+                            float(np.linalg.norm(e[:, 3:], axis=1).max()))  # fmt: skip
+        bound = self.closure
+        if bound is None:
+            return CellResolution.of_tick(r, r.qdot.copy(), hands)
+        ids = self._frames
+        chains = Chains(closure, tuple(ids[f] for f in self.contact.frames),
+                        tuple((ids[a], ids[b]) for a, b in self.grip.pairs))  # fmt: skip
+        mode, commanded, _ = self._tick
+        top = r.problem.stacked[0][0] if mode == "teleop" else np.zeros((0, self.cell.nv))
+        box = r.problem.box
+        delta, after = close(self.cell.model, self._data, self._pinocchio_q(self._q), chains,
+                             r.qdot, top, box, r.problem.rows, self.dt)  # fmt: skip
+        level = bound.level(closure.error)
+        if level <= 1.0:
+            self.lost = None
+        elif self.lost is not None and commanded and bound.level(after) < level:
+            r = r._replace(status=self.lost)  # a command that closes the chain: taken
+        else:  # held still
+            if self.lost is None:
+                self.lost = max(parts, key=lambda p: bound.level(p[0].error))[1]
+            still = np.zeros(self.cell.nv)
+            still.flags.writeable = False
+            self._applied = still
+            return CellResolution.of_tick(r._replace(qdot=still, status=self.lost, scale=0.0,
+                                                veer=0.0), still.copy(), hands)  # fmt: skip
+        self._applied = box.clip(r.qdot + delta)  # inside the box as the resolver's rates are
+        self._correction_size = float(np.abs(self._applied - r.qdot).max())
+        return CellResolution.of_tick(r, self._applied, hands)
+
+    def _hands(self, r: Resolution) -> Callable[[], tuple[TaskRows, ...]] | None:
+        """The held objects' hands as rows of the top level, made when read (or None)."""
+        mode, _, poses = self._tick
+        objects = [t for t in r.problem.levels[0] if t.name in self._grips]
+        if mode != "teleop" or not objects:
+            return None
+        cell, q = self.cell, self._q
+
+        def rows() -> tuple[TaskRows, ...]:
+            out = []
+            for task in objects:
+                for hand in cell.objects[task.name].hands:
+                    twist = _transport(task.b, poses[task.name], cell.fk(q, hand))
+                    out.append(TaskRows(cell.jacobian(q, "world_aligned", hand), twist, None,
+                                        hand, task.unit))  # fmt: skip
+            return tuple(out)
+
+        return rows
 
     # -- helpers --------------------------------------------------------------------------
 
@@ -415,68 +532,26 @@ class CellController(Loop):
                 R = self.cell.fk(self._q, self.cell.body)[:3, :3] @ R
         return np.concatenate([R @ twist[:3], R @ twist[3:]])
 
-    def _reanchor(self) -> None:
-        """Targets at the current poses of every commandable frame; anchors of the feet."""
+    def _retarget(self) -> None:
+        """Targets at the current poses of every commandable frame."""
         q = self._q
         self._targets = {n: self.cell.fk(q, self.frame_of(n)) for n in self.commandable()}
-        self._anchors = {f: self.cell.fk(q, f) for f in self.support}
 
-    def _integrate(self, qdot: Array) -> Array:
-        """The loop's integration, then the closed chains closed again (``project_contacts``)."""
-        q = super()._integrate(qdot)
-        if self.project_contacts and (self.support or (self.coupled and self.cell.objects)):
-            q = self._projected(q)
-        return q
-
-    def _projected(self, q: Array) -> Array:
-        """``q`` with the closed chains closed again by a Newton step on every rate.
-
-        A foot in support goes back onto its anchor; the second hand on a held object onto
-        the grip (the first hand's pose times the grasp). One least-norm step over every rate
-        (the body's too), then one more without the joints it pushed past a limit (held
-        there). The step is the integration's second-order remainder (about 1e-8 rad at
-        100 Hz): within rounding of the rates the resolver gave; its largest entry is kept
-        in ``contact_correction``.
-        """
-        cell = self.cell
-        goals = [(f, T) for f, T in self._anchors.items()]
-        if self.coupled:
-            goals += [(g.hands[1], cell.fk(q, g.hands[0]) @ g.grip) for g in cell.objects.values()]
-        free = cell.actuated | ~cell.actuated  # every rate
-        step = np.zeros(cell.nv)
-        for _ in range(2):
-            errors, rows = [], []
-            for frame, goal in goals:
-                pose = cell.fk(q, frame)
-                errors.append(np.concatenate([goal[:3, 3] - pose[:3, 3],
-                                              pin.log3(goal[:3, :3] @ pose[:3, :3].T)]))
-                rows.append(cell.jacobian(q, "world_aligned", frame))
-            J = np.vstack(rows)
-            J[:, ~free] = 0.0
-            step = np.linalg.lstsq(J, np.concatenate(errors), rcond=None)[0]
-            moved = cell.integrate(q, step, 1.0)
-            dof = cell.dof_positions(moved)
-            past = (dof < cell.dof_lower) | (dof > cell.dof_upper)
-            if not past.any():
-                q = moved
-                break
-            free = free & ~past
-        else:
-            q = moved
-            q[~np.isinf(cell.lower)] = np.clip(q, cell.lower, cell.upper)[~np.isinf(cell.lower)]
-        self.contact_correction = float(np.abs(step).max())
-        return q
-
-    def _record(self, r: Resolution, poses: dict[str, Array], mode: str) -> None:
+    def _record(self, r: CellResolution) -> None:
+        """Log the tick: its rates, status, the commands' pose errors, the grips' errors."""
+        mode, _, poses = self._tick
         errors = {n: float(np.linalg.norm(self._targets[n][:3, 3] - T[:3, 3]))
                   for n, T in poses.items()}  # fmt: skip
         grip = {}
-        for name, g in self.cell.objects.items():
-            Ta, Tb = self.cell.fk(self._q, g.hands[0]), self.cell.fk(self._q, g.hands[1])
-            rel = _inverse(Ta) @ Tb
+        measured = self.grip.last
+        for k, (name, g) in enumerate(self.cell.objects.items()):
+            if measured is not None and name in self._grips:  # the tick's, by the grip limit
+                grip[name] = float(np.linalg.norm(measured.error[6 * k : 6 * k + 3]))
+                continue
+            rel = _inverse(self.cell.fk(self._q, g.hands[0])) @ self.cell.fk(self._q, g.hands[1])
             grip[name] = float(np.linalg.norm(rel[:3, 3] - g.grip[:3, 3]))
-        self.log.append(CellRecord(self.t, self._q, np.array(r.qdot), r.status, r.scale,
-                                   "/".join(r.levels), errors, grip, mode))  # fmt: skip
+        self.log.add(self.t, self._q, r.applied, r.status, r.scale, r.levels, errors, grip,
+                     self.chain_error, mode)  # fmt: skip
 
 
 def _inverse(T: Array) -> Array:

@@ -12,7 +12,7 @@
 
 Every change (an obstacle added, moved, attached or removed) builds a new frozen
 :class:`~rrc_pin.geometry.scene.Scene` and swaps it in at once, so queries in other threads are
-never torn; a change is not meant for every tick (it costs about a millisecond, see
+never torn; a change is not meant for every tick (it costs a millisecond or two, see
 docs/api.md). Bad input raises :class:`~rrc_pin.errors.InvalidInput` naming the argument,
 before anything changes.
 """
@@ -28,7 +28,7 @@ import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.geometry import shapes
-from rrc_pin.geometry.pairs import Reason
+from rrc_pin.geometry.pairs import Reason, invariant
 from rrc_pin.geometry.proximity import CollisionData, Proximity, Select, query
 from rrc_pin.geometry.robot_geometry import VARIANTS, filtered_pairs, robot_geometry
 from rrc_pin.geometry.scene import Extra, Scene, build_scene
@@ -94,11 +94,16 @@ class CollisionModel:
             )  # fmt: skip
         self.robot = robot
         self._objects = objects
-        self._robot_pairs = pairs
-        self._robot_excluded: dict[tuple[str, str], Reason] = excluded
+        still = invariant(robot.model, objects, pairs)
+        names = [str(o.name) for o in objects.geometryObjects]
+        self._robot_invariant = {(names[a], names[b]): d for (a, b), d in still.items()}
+        self._robot_pairs = [p for p in pairs if p not in still]
+        self._robot_excluded: dict[tuple[str, str], Reason] = {
+            **excluded, **dict.fromkeys(self._robot_invariant, "invariant")}
         self._frames = frame_index(robot.model)
         self._tree = tree_of(robot.model, robot.random_q(0))
         self._extras: dict[str, Extra] = {}
+        self._decided: dict[tuple[str, str], float | None] = {}  # the extras' pairs: invariant?
         self._walls: dict[str, tuple[Wall, ...]] = {}
         self._lock = threading.Lock()
         self._local = threading.local()
@@ -118,6 +123,15 @@ class CollisionModel:
     def excluded(self) -> dict[tuple[str, str], Reason]:
         """The pairs left out, by body names, with their reasons (a new dict)."""
         return dict(self._scene.excluded)
+
+    @property
+    def invariant(self) -> dict[tuple[str, str], float]:
+        """The pairs left out because no joint changes their distance, with that distance.
+
+        By body names, the distance [m] signed (a new dict;
+        :func:`~rrc_pin.geometry.pairs.invariant`).
+        """
+        return dict(self._scene.invariant)
 
     @property
     def bodies(self) -> tuple[str, ...]:
@@ -254,6 +268,7 @@ class CollisionModel:
         with self._lock:
             if name in self._extras:
                 extras = {k: v for k, v in self._extras.items() if k != name}
+                self._decided = {p: d for p, d in self._decided.items() if name not in p}
                 scene = self._build(extras)
                 self._extras, self._scene = extras, scene
             elif name in self._walls:
@@ -368,7 +383,8 @@ class CollisionModel:
 
     def _build(self, extras: dict[str, Extra]) -> Scene:
         return build_scene(self.robot.model, self._objects, self._robot_pairs,
-                           self._robot_excluded, list(extras.values()), self._tree)  # fmt: skip
+                           self._robot_excluded, list(extras.values()), self._tree,
+                           self._robot_invariant, self._decided)  # fmt: skip
 
     def _add_world(self, kind: str, shape: object, pose: pin.SE3, name: str | None) -> str:
         label = self._new_name(kind, name)

@@ -20,7 +20,7 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
-from rrc_pin.geometry.pairs import Pair, Reason
+from rrc_pin.geometry.pairs import Pair, Reason, invariant
 from rrc_pin.geometry.shapes import bounding_sphere
 from rrc_pin.geometry.tree import KinematicTree
 from rrc_pin.solvers.collision.narrow_kernels import BOX, CAPSULE, HALFSPACE, OTHER, SPHERE
@@ -78,6 +78,8 @@ class Scene:
         labels: ``"name_a|name_b"`` of each active pair (a constraint row's name).
         every: True for every pair (npairs,): the query's default selection.
         excluded: The pairs left out, by names, with their reasons.
+        invariant: The pairs left out because no joint changes their distance
+            (:func:`~rrc_pin.geometry.pairs.invariant`), by names, with that distance [m].
         njoints: Number of joints of the model (including the world, 0).
         tree: The model's joints for the compiled forward kinematics, or None (a query reads
             Pinocchio's placements).
@@ -101,6 +103,7 @@ class Scene:
     labels: tuple[str, ...]
     every: npt.NDArray[np.bool_]
     excluded: dict[tuple[str, str], Reason]
+    invariant: dict[tuple[str, str], float]
     njoints: int
     tree: KinematicTree | None
 
@@ -112,12 +115,18 @@ def build_scene(
     excluded: dict[tuple[str, str], Reason],
     extras: list[Extra],
     tree: KinematicTree | None,
+    robot_invariant: dict[tuple[str, str], float],
+    decided: dict[tuple[str, str], float | None],
 ) -> Scene:
     """The scene of ``robot``'s bodies (active pairs ``robot_pairs``) and the ``extras``.
 
     An extra is paired with every robot body and every other extra, except bodies on its
-    own joint (``rigid``: a held object and its hand, an obstacle and the robot's base) and
-    two world obstacles (neither moves).
+    own joint (``rigid``: a held object and its hand, an obstacle and the robot's base), two
+    world obstacles (neither moves) and pairs whose distance no joint changes (``invariant``:
+    :func:`~rrc_pin.geometry.pairs.invariant`, decided here for the extras' pairs; the
+    robot's own are decided once, ``robot_invariant`` by names with their distance [m]).
+    ``decided`` holds the extras' pairs decided before, by names (their distance, None for a
+    pair a joint moves): only new pairs are measured, and added to it.
     """
     held = [e for e in extras if e.joint != 0]
     world = [e for e in extras if e.joint == 0]
@@ -133,13 +142,26 @@ def build_scene(
     joint = np.array([o.parentJoint for o in objects], dtype=np.int64)
     n_robot = robot.ngeoms
     excluded = dict(excluded)
-    pairs = list(robot_pairs)
+    added = []
     for b in range(n_robot, len(objects)):
         for a in range(b):
             if joint[a] == joint[b]:
                 excluded[(names[a], names[b])] = "rigid"
             else:
-                pairs.append((a, b))
+                added.append((a, b))
+    new = [(a, b) for a, b in added if (names[a], names[b]) not in decided]
+    found = invariant(model, geometry, new)
+    for a, b in new:
+        decided[(names[a], names[b])] = found.get((a, b))
+    fixed = dict(robot_invariant)
+    pairs = list(robot_pairs)
+    for a, b in added:
+        distance = decided[(names[a], names[b])]
+        if distance is None:
+            pairs.append((a, b))
+        else:
+            excluded[(names[a], names[b])] = "invariant"
+            fixed[(names[a], names[b])] = distance
     pairs.sort()
     for a, b in pairs:
         geometry.addCollisionPair(pin.CollisionPair(a, b))
@@ -178,6 +200,6 @@ def build_scene(
         second=second,
         pair_names=tuple((names[a], names[b]) for a, b in pairs),
         labels=tuple(f"{names[a]}|{names[b]}" for a, b in pairs),
-        every=np.ones(len(pairs), dtype=np.bool_), excluded=excluded,
+        every=np.ones(len(pairs), dtype=np.bool_), excluded=excluded, invariant=fixed,
         njoints=model.njoints, tree=tree,
     )  # fmt: skip

@@ -1,6 +1,6 @@
 """Limits of a resolution, one per module: each gives a box and named constraint rows a tick."""
 
-from rrc_pin.limits.collision import CollisionLimit
+from rrc_pin.limits.collision import CollisionLimit, InvariantPairWarning
 from rrc_pin.limits.contact_limit import ContactLimit
 from rrc_pin.limits.grip_limit import GripLimit
 from rrc_pin.limits.joint_limits import JointLimits
@@ -12,6 +12,7 @@ __all__ = [
     "CollisionLimit",
     "ContactLimit",
     "GripLimit",
+    "InvariantPairWarning",
     "JointLimits",
     "Limit",
     "SingularityLimit",

@@ -10,13 +10,16 @@ may lose :data:`END` of its margin a step, a pair's own row the damper's share):
 
 .. math:: -n^T (J_b - J_a)\,\dot q \le \xi \frac{d - d_s}{d_i - d_s}
 
-``d`` the pair's signed distance (negative in penetration, where the normal still points
-from A to B: the row then asks the pair to separate, never to stay: mink's PR 105), ``n`` the
-unit normal from A to B, ``J_a``, ``J_b`` the witness points' linear Jacobians, ``d_s`` the
+``d`` the pair's signed distance (negative in penetration), ``n`` the unit normal from A to B
+(kept in penetration), ``J_a``, ``J_b`` the witness points' linear Jacobians, ``d_s`` the
 safety distance, ``d_i`` the detection distance and :math:`\xi` [m/s] the approach speed
 allowed at ``d_i`` (the row is not felt there by a slower approach: activation is smooth).
-Below ``d_s`` the pair separates, restoring :data:`RECOVERY` of the shortfall a step (at most
-at :math:`\xi`).
+Below ``d_s``, in penetration too, the row asks only that the distance not decrease
+(:mod:`rrc_pin.solvers.collision.damper_kernels`): standing still is always allowed, so a start
+inside never locks the arm, and a command that moves the pair apart is met as it is (the
+distance then grows at the command's pace). A pair at most :data:`BAND` below ``d_s`` (what
+one step's linearisation loses) is pushed back out, restoring :data:`RECOVERY` of its shortfall
+a step, less and less deeper down, nothing from twice :data:`BAND` on.
 Linearised over one step of ``dt``, the distance after the step is at least
 :math:`d_s + (d - d_s)(1 - \xi\,dt / (d_i - d_s))`, so :math:`\xi` is capped at
 :math:`(d_i - d_s)/dt` (never crossing :math:`d_s` in one step). The true distance differs
@@ -38,6 +41,7 @@ that bound the answer and how close they are.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -49,7 +53,7 @@ from rrc_pin.geometry import CollisionModel, Wall
 from rrc_pin.geometry.proximity import gather
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import finite_number
-from rrc_pin.solvers.collision.damper_kernels import damper_rows
+from rrc_pin.solvers.collision.damper_kernels import damper_bound, damper_rows
 from rrc_pin.solvers.tick.problem import Constraints
 
 if TYPE_CHECKING:
@@ -68,9 +72,15 @@ DETECTION = 0.10
 GAIN = 0.5
 """[m/s] Default approach speed xi allowed at the detection distance."""
 
+BAND = 1e-3
+"""[m] The shortfall below d_s that a pair's row pushes back out (the one-step linearisation's
+tolerance, docs/api.md); deeper, the push falls linearly to nothing at twice this: a start the
+user chose inside is left to the command
+(:func:`~rrc_pin.solvers.collision.damper_kernels.damper_bound`)."""
+
 RECOVERY = 0.5
-"""Fraction of a shortfall below the safety distance restored per step (at most at the gain):
-:mod:`rrc_pin.solvers.collision.damper_kernels`."""
+"""Fraction of a shortfall within :data:`BAND` below d_s restored per step (at most at the
+gain)."""
 
 END = 0.5
 """Fraction of its margin above d_s an end-point row may lose in one step (its xi is
@@ -87,9 +97,14 @@ end and was taken (the far end may approach faster), the closest end then swappe
 hands held against each other had their wrists flip back and forth at 0.3-0.6 rad/s a tick."""
 
 STILL = 1e-9
-"""[m/s per rad/s] A row whose every entry is below this is dropped: no joint changes the
-pair's distance (a base link turning about its own axis over the floor), so the row cannot
-be met if it asks for separation, and constrains nothing otherwise."""
+"""[m/s per rad/s] A row whose every entry is below this is dropped: at this configuration no
+joint changes the pair's distance to first order (a pair no joint ever moves is left out of the
+model's pairs: :func:`~rrc_pin.geometry.pairs.invariant`), so the row constrains nothing, and
+could not be met where it asks the pair out."""
+
+
+class InvariantPairWarning(UserWarning):
+    """A pair that no joint can move is inside the safety distance: it is no constraint."""
 
 
 class CollisionLimit(Limit):
@@ -151,6 +166,8 @@ class CollisionLimit(Limit):
                 support[j, start : start + robot.joints[i].nv] = True
         self._support = support
         self._kept: tuple[Scene | None, npt.NDArray[np.bool_]] = (None, np.zeros(0, np.bool_))
+        self._seen: Scene | None = None
+        self._warn_invariant(model.scene)
 
     def check(self, layout: Layout) -> None:
         """Refuse a resolver whose robot is not the model's.
@@ -169,6 +186,8 @@ class CollisionLimit(Limit):
         select = None if self.pairs is None else self._keep
         prox = self.model.proximity(kin, self._data, self.detection, True, select)
         scene = self._data.scene
+        if scene is not self._seen:  # an obstacle added since: its pairs no joint moves
+            self._warn_invariant(scene)
         self.last = prox
         walls = self.model.walls()
         k = len(prox.names)
@@ -187,7 +206,7 @@ class CollisionLimit(Limit):
             unmoved = damper_rows(kin.data.J, self._support, prox.joint_a, prox.joint_b,
                                   prox.point_a, prox.point_b, prox.normal, prox.distance,
                                   prox.pair, self.safety, self.detection, xi, END * span / dt,
-                                  BLEND, RECOVERY / dt, STILL, G, h, moved)  # fmt: skip
+                                  BLEND, BAND, RECOVERY / dt, STILL, G, h, moved)  # fmt: skip
         if walls:
             G, h, distance = self._walls(kin, walls, G, h, names, distance, dt)
             moved = np.abs(G).max(axis=1) > STILL
@@ -214,10 +233,23 @@ class CollisionLimit(Limit):
                 continue
             J = kin.jacobian(wall.frame, "world_aligned")[:3]
             rows.append((wall.normal @ J)[None, :])
-            bounds.append(np.array([xi * gap / self.detection]))
+            bounds.append(np.array([damper_bound(gap, self.detection, xi, BAND, RECOVERY / dt)]))
             gaps.append(np.array([gap]))
             names.append(f"{wall.frame}|{wall.name}")
         return np.vstack(rows), np.concatenate(bounds), np.concatenate(gaps)
+
+    def _warn_invariant(self, scene: Scene) -> None:
+        """Warn of the pairs of ``scene`` that no joint moves and that are inside d_s."""
+        self._seen = scene
+        inside = [f"{a}|{b} ({d * 1e3:.1f} mm)" for (a, b), d in scene.invariant.items()
+                  if d < self.safety and (self.pairs is None or (a, b) in self.pairs)]  # fmt: skip
+        if inside:
+            warnings.warn(
+                f"{self.name}: {', '.join(inside)} inside the safety distance "
+                f"{self.safety * 1e3:.1f} mm, and no joint changes their distance: not "
+                "constrained (the robot cannot move them apart)", InvariantPairWarning,
+                stacklevel=3,
+            )  # fmt: skip
 
     def _keep(self, scene: Scene) -> npt.NDArray[np.bool_]:
         """Whether each pair of ``scene`` is one of :attr:`pairs` (kept per scene)."""

@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits.limit import Limit
+from rrc_pin.solvers.checks import rigid_transform
 from rrc_pin.solvers.tick.problem import Constraints
+from rrc_pin.tasks.frame_task import FrameTask
 
 if TYPE_CHECKING:
     from rrc_pin.kinematics import Kinematics, Layout
@@ -20,34 +22,66 @@ Array = npt.NDArray[np.float64]
 AXES = ("vx", "vy", "vz", "wx", "wy", "wz")
 
 
+class Closure(NamedTuple):
+    r"""Closed chains at one tick's configuration: their rows and how far each is open.
+
+    Attributes:
+        C: The chains' equality rows (6 k, nv), ``C qdot = 0``.
+        error: Each chain's pose error to its goal (6 k,) [m, rad], ``[p* - p; log(R* R^T)]``
+            in the rows' axes: a step of rates :math:`\dot q` changes it by
+            :math:`-C\dot q\,\Delta t` to first order.
+        unit: Each row's unit (6 k,): the chain's reach [m] for its position rows, 1 for its
+            rotation rows (the resolver's metric, :class:`~rrc_pin.solvers.tick.problem.TaskRows`).
+    """
+
+    C: Array
+    error: Array
+    unit: Array
+
+
 class ContactLimit(Limit):
     r"""Fixed contacts: the full twist of each frame is zero, :math:`J_c\,\dot q = 0`.
 
     Six equality rows per frame (its world_aligned Jacobian: the contact point does not
     slide, the foot does not turn), kept at every answer: the resolver's levels are solved
     within them, so that a body command that would need a foot to slip is scaled, never
-    obeyed by slipping.
+    obeyed by slipping. With anchors (each frame's pose in support), every tick also measures
+    how far each frame is from its anchor (:attr:`last`): what a cell's controller closes
+    inside the step (:mod:`rrc_pin.cells.closure`).
 
     Args:
         frames: The frames in contact (e.g. the feet in support).
         name: Name in the report; rows are named ``name:frame:axis``.
+        anchors: Each frame's pose in support (4, 4) [m], in ``frames``' order, or None.
 
     Raises:
-        InvalidInput: ``frames`` not distinct frame names, or ``name`` not a string.
+        InvalidInput: ``frames`` not distinct frame names, ``name`` not a string, or anchors
+            that are not one rigid transform per frame.
     """
 
-    def __init__(self, frames: Sequence[str], name: str = "contact") -> None:
+    def __init__(
+        self, frames: Sequence[str], name: str = "contact",
+        anchors: Sequence[npt.ArrayLike] | None = None,
+    ) -> None:  # fmt: skip
         if not isinstance(name, str):
             raise InvalidInput("name", f"expected a string, got {name!r}")
         self.name = name
         self._layout: Layout | None = None
-        self.set_frames(frames)
+        self.set_frames(frames, anchors)
 
-    def set_frames(self, frames: Sequence[str]) -> None:
-        """The frames in contact from now on (a foot lifted or landed); checked.
+    def set_frames(
+        self, frames: Sequence[str], anchors: Sequence[npt.ArrayLike] | None = None
+    ) -> None:
+        """The frames in contact from now on (a foot lifted or landed), and their anchors.
+
+        Args:
+            frames: The frames in contact.
+            anchors: Each frame's pose in support (4, 4) [m], in ``frames``' order, or None
+                (no error measured).
 
         Raises:
-            InvalidInput: Not distinct frame names; the limit is then unchanged.
+            InvalidInput: Not distinct frame names, or not one anchor per frame; the limit is
+                then unchanged.
             FrameNotFound: A frame the robot (of the resolver holding it) does not have.
         """
         items = (frames,) if isinstance(frames, str) else tuple(frames)
@@ -57,9 +91,19 @@ class ContactLimit(Limit):
             for frame in items:
                 if frame not in self._layout.frames:
                     raise FrameNotFound(frame, sorted(self._layout.frames), "frames")
+        goals = None
+        if anchors is not None:
+            if len(anchors) != len(items):
+                raise InvalidInput("anchors", f"expected {len(items)} poses, got {len(anchors)}")
+            goals = tuple(FrameTask(f, target=rigid_transform(T, f"anchors[{i}]"))
+                          for i, (f, T) in enumerate(zip(items, anchors, strict=True)))  # fmt: skip
         self.frames: tuple[str, ...] = items
+        self._goals = goals
         self._names = tuple(f"{self.name}:{f}:{a}" for f in items for a in AXES)
         self._zero = np.zeros(6 * len(items))
+        self.last: Closure | None = None
+        """The rows and the anchors' errors at the last configuration the limit saw (None
+        without anchors or frames)."""
 
     def check(self, layout: Layout) -> None:
         """Refuse frames the robot does not have.
@@ -77,4 +121,8 @@ class ContactLimit(Limit):
         if not self.frames:
             return Constraints()
         C = np.vstack([kin.jacobian(f) for f in self.frames])
+        if self._goals is not None:
+            error = np.concatenate([g.error(kin.pose(g.frame)) for g in self._goals])
+            unit = np.concatenate([[kin.layout.reach[f]] * 3 + [1.0] * 3 for f in self.frames])
+            self.last = Closure(C, error, unit)
         return Constraints(C=C, d=self._zero, names=self._names)

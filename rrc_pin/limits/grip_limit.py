@@ -9,8 +9,9 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import FrameNotFound, InvalidInput
-from rrc_pin.limits.contact_limit import AXES
+from rrc_pin.limits.contact_limit import AXES, Closure
 from rrc_pin.limits.limit import Limit
+from rrc_pin.solvers.checks import rigid_transform
 from rrc_pin.solvers.tick.problem import Constraints
 from rrc_pin.tasks.relative_frame_task import RelativeFrameTask
 
@@ -25,30 +26,43 @@ class GripLimit(Limit):
 
     The rows are :class:`~rrc_pin.tasks.RelativeFrameTask`'s (its class docstring), held
     exactly at every answer, whatever the levels do (scaled, damped, traded): two hands on
-    one object keep their grip to first order; the controller of a cell removes the
-    integration's second-order remainder by a projection
-    (:class:`~rrc_pin.cells.controller.CellController`).
+    one object keep their grip to first order. With grips (b's pose in a to keep), every tick
+    also measures how far each pair is from its grip (:attr:`last`, in a's axes): the
+    integration's second-order remainder, which a cell's controller closes inside the step
+    (:mod:`rrc_pin.cells.closure`).
 
     Args:
         pairs: ``(frame_a, frame_b)`` pairs.
         name: Name in the report; rows are named ``name:frame_b/frame_a:axis``.
+        grips: Each pair's grip, b's pose in a (4, 4) [m], in ``pairs``' order, or None.
 
     Raises:
-        InvalidInput: Not pairs of two different frame names.
+        InvalidInput: Not pairs of two different frame names, or grips that are not one
+            rigid transform per pair.
     """
 
-    def __init__(self, pairs: Sequence[tuple[str, str]] = (), name: str = "grip") -> None:
+    def __init__(
+        self, pairs: Sequence[tuple[str, str]] = (), name: str = "grip",
+        grips: Sequence[npt.ArrayLike] | None = None,
+    ) -> None:  # fmt: skip
         if not isinstance(name, str):
             raise InvalidInput("name", f"expected a string, got {name!r}")
         self.name = name
         self._layout: Layout | None = None
-        self.set_pairs(pairs)
+        self.set_pairs(pairs, grips)
 
-    def set_pairs(self, pairs: Sequence[tuple[str, str]]) -> None:
-        """The pairs held from now on (an object grasped or released); checked.
+    def set_pairs(
+        self, pairs: Sequence[tuple[str, str]], grips: Sequence[npt.ArrayLike] | None = None
+    ) -> None:
+        """The pairs held from now on (an object grasped or released), and their grips.
+
+        Args:
+            pairs: ``(frame_a, frame_b)`` pairs.
+            grips: Each pair's grip, b's pose in a (4, 4) [m], or None (no error measured).
 
         Raises:
-            InvalidInput: Not pairs of two different frame names; the limit is unchanged.
+            InvalidInput: Not pairs of two different frame names, or not one grip per pair;
+                the limit is unchanged.
             FrameNotFound: A frame the robot (of the resolver holding it) does not have.
         """
         items = tuple(tuple(p) for p in pairs)
@@ -59,10 +73,20 @@ class GripLimit(Limit):
                 for frame in p:
                     if frame not in self._layout.frames:
                         raise FrameNotFound(frame, sorted(self._layout.frames), "pairs")
+        if grips is not None and len(grips) != len(items):
+            raise InvalidInput("grips", f"expected {len(items)} poses, got {len(grips)}")
+        targets = [None] * len(items) if grips is None else [
+            rigid_transform(T, f"grips[{i}]") for i, T in enumerate(grips)]  # fmt: skip
         self.pairs: tuple[tuple[str, str], ...] = items  # type: ignore[assignment]
-        self._tasks = tuple(RelativeFrameTask(a, b) for a, b in self.pairs)
+        # gain 1: the rows' rates are then the grip's error itself (RelativeFrameTask.rows)
+        self._tasks = tuple(RelativeFrameTask(a, b, target=T, gain=1.0)
+                            for (a, b), T in zip(self.pairs, targets, strict=True))  # fmt: skip
+        self._measured = grips is not None and bool(items)
         self._names = tuple(f"{self.name}:{b}/{a}:{x}" for a, b in self.pairs for x in AXES)
         self._zero = np.zeros(6 * len(items))
+        self.last: Closure | None = None
+        """The rows and the grips' errors at the last configuration the limit saw (None
+        without grips or pairs)."""
 
     def check(self, layout: Layout) -> None:
         """Refuse frames the robot does not have.
@@ -80,5 +104,9 @@ class GripLimit(Limit):
         """The grip rows ``C qdot = 0`` (C: (6 k, nv))."""
         if not self.pairs:
             return Constraints()
-        C = np.vstack([t.rows(kin).A for t in self._tasks])
+        rows = [t.rows(kin) for t in self._tasks]
+        C = np.vstack([r.A for r in rows])
+        if self._measured:
+            unit = np.concatenate([np.ones(6) if r.unit is None else r.unit for r in rows])
+            self.last = Closure(C, np.concatenate([r.b for r in rows]), unit)
         return Constraints(C=C, d=self._zero, names=self._names)

@@ -11,16 +11,25 @@ witness points' velocities :math:`v = J_p \dot q`. The damper keeps
    \iff -n^T (J_b - J_a)\,\dot q \le \xi \frac{d - d_s}{d_i - d_s}
 
 with :math:`d_s` the safety distance, :math:`d_i` the detection distance and :math:`\xi`
-[m/s] the approach speed allowed at :math:`d_i`. Below :math:`d_s` (and in penetration) the
-bound is negative: the pair must separate, at
+[m/s] the approach speed allowed at :math:`d_i`. Below :math:`d_s` (in penetration too) the
+row asks that the distance not decrease, :math:`\dot d \ge -\epsilon` (:data:`SLACK`), so that
+standing still meets it and the problem stays feasible whatever the start: any motion that does
+not bring the pair closer is free, and a command away from it is met as it is. Asked to
+separate at a rate instead (mink's rows in penetration), a start the user did not choose locked
+the arm: the rate could not be met within the joints' velocity limits, or two pairs asked for
+opposite motions (100 of 119 starting placements of panda against obstacles held, every tick,
+even commanded away). A pair just below :math:`d_s`, at most ``band`` (the one-step
+linearisation's error: the witness points' second-order motion over the step), is pushed back
+out, at
 
-.. math:: \dot d \ge \min\left(\rho \frac{d_s - d}{\Delta t}, \xi\right)
+.. math:: \dot d \ge \rho \min(d_s - d,\ 2\beta - (d_s - d)) / \Delta t
 
-restoring the fraction :math:`\rho` of the shortfall per step (at most at :math:`\xi`). The
-damper's own rate there, :math:`\xi/(d_i - d_s)` (6 %/step at its defaults), would let a
-second-order loss of a fraction of a millimetre a step (two capsules near parallel, whose
-witness points jump from end to end as they turn) settle millimetres below :math:`d_s`; at
-:math:`\rho` it settles at about that loss divided by :math:`\rho`.
+(:func:`damper_bound`, at most :math:`\xi`): the fraction :math:`\rho` of its shortfall a step
+up to :math:`\beta`, falling linearly to nothing at :math:`2\beta` (continuous in the
+distance). Without it, the second-order losses of a pair sliding at :math:`d_s` add up tick
+after tick (baxter's fingers 0.4 mm below it in 8 s). Where no rates restore every such pair
+(:mod:`rrc_pin.solvers.tick.pipeline`, ``_damped_within``), their rows ask only that they not
+approach.
 
 A point's linear Jacobian from its joint's Jacobian in Pinocchio's WORLD convention (the
 spatial velocity at the world origin, :math:`[v_O; \omega]`, what
@@ -43,17 +52,39 @@ from rrc_pin.solvers.compiled import kernel
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.int64]
 
-HELD = 1e-6
-"""[m] A pair less than this below d_s is held (h = 0), not recovered: the damper brings pairs
-to d_s exponentially, and rounding leaves them a hair below it (h of -1e-18 would turn every
-such tick into a recovery, the whole problem a least-squares one)."""
-
 SLACK = 1e-9
-"""[m/s] The least bound of a row not recovering: a pair held at d_s (bound 0) met by rates
-that cross it by rounding (1e-17) had the whole answer shrunk to zero by the pipeline's last
-step (``rrc_pin.solvers.tick.pipeline._within_rows`` scales the rates back into every row, and 0 /
-1e-17 is
-0): two hands held side by side stopped sliding. 1e-9 m/s is 6e-7 m in ten minutes."""
+"""[m/s] The least bound of a row not pushing its pair out (module docstring): a pair held at
+d_s (bound 0) met by rates that cross it by rounding (1e-17) had the whole answer shrunk to zero by
+the pipeline's last step (``rrc_pin.solvers.tick.pipeline._within_rows`` scales the rates back
+into every row, and 0 / 1e-17 is 0): two hands held side by side stopped sliding. 1e-9 m/s is
+6e-7 m in ten minutes."""
+
+
+HELD = 1e-6
+"""[m] A pair less than this below d_s is held (the bound :data:`SLACK`), not pushed back: the
+damper brings pairs to d_s exponentially, and rounding leaves them a hair below it (a bound of
+-1e-18 would turn every such tick into a recovery, the whole problem a least-squares one)."""
+
+
+@kernel
+def damper_bound(
+    gap: float, span: float, gain: float, band: float, recovery: float
+) -> float:  # fmt: skip
+    r"""The bound [m/s] of a pair's row at ``gap`` = :math:`d - d_s` [m] (module docstring).
+
+    Args:
+        gap: The pair's distance less the safety distance [m].
+        span: :math:`d_i - d_s` [m], > 0.
+        gain: :math:`\xi` [m/s], the approach speed allowed at ``span``.
+        band: :math:`\beta` [m] >= 0, the shortfall below d_s pushed back out.
+        recovery: :math:`\rho / \Delta t` [1/s].
+    """
+    if gap > -HELD:
+        return max(gain * gap / span, SLACK)
+    shortfall = min(-gap, 2.0 * band + gap)
+    if shortfall <= 0.0:
+        return SLACK
+    return max(-recovery * shortfall, -gain)
 
 
 @kernel
@@ -72,6 +103,7 @@ def damper_rows(
     xi: float,
     xi_end: float,
     blend: float,
+    band: float,
     recovery: float,
     still: float,
     G: Array,
@@ -96,7 +128,8 @@ def damper_rows(
         xi_end: That of an end point's row ``blend`` [m] farther than its pair's own row, >=
             ``xi``; an end point's row as close as its pair's has ``xi``, linearly between.
         blend: See xi_end, > 0.
-        recovery: rho / dt [1/s], the rate restoring a shortfall below d_s.
+        band: beta [m], the shortfall below d_s pushed back out (:func:`damper_bound`).
+        recovery: rho / dt [1/s], the rate of that push.
         still: A row whose every entry is at most this in size is not ``moved``.
         G: Out (k, nv).
         h: Out (k,) [m/s].
@@ -139,9 +172,5 @@ def damper_rows(
         moved[r] = largest > still
         if not moved[r]:
             unmoved += 1
-        gap = distance[r] - safety
-        if gap > -HELD:
-            h[r] = max(gain * gap / span, SLACK)
-        else:
-            h[r] = max(recovery * gap, -gain)
+        h[r] = damper_bound(distance[r] - safety, span, gain, band, recovery)
     return unmoved

@@ -203,7 +203,7 @@ def narrow_phase(
                 plane[h, 0] * seg[0, 1, 0] + plane[h, 1] * seg[0, 1, 1] + plane[h, 2] * seg[0, 1, 2]
             )
             lowest = 0 if height0 <= height1 else 1
-            for e in range(2):
+            for e in (lowest, 1 - lowest):  # the pair's own row (its lowest end) first
                 if e != lowest and not ends:
                     continue
                 height = (height0 if e == 0 else height1) - offset[h]

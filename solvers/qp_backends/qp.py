@@ -160,8 +160,9 @@ class Work:
 
 
 def solve_within(
-    qp: QP, decoding: Decoding, box: Box, rows: Rows | None, backend: QPBackend, work: Work
-) -> Array:
+    qp: QP, decoding: Decoding, box: Box, rows: Rows | None, backend: QPBackend, work: Work,
+    clip: bool = True,
+) -> Array:  # fmt: skip
     """The backend's answer to ``qp``, within the box and rows to :data:`FEASIBILITY_TOL`.
 
     Args:
@@ -171,6 +172,9 @@ def solve_within(
         rows: Constraint rows, or None.
         backend: The backend.
         work: Where its work is counted.
+        clip: Clip the answer into the box; False: the answer as decoded (within the
+            tolerance of the box; a direction answer keeps its direction, which a clip of each
+            joint on its own turns: the caller's final clip is reported).
 
     Raises:
         NumericalFailure: No usable answer (the backend's fault, time-out or infeasibility, a
@@ -181,7 +185,7 @@ def solve_within(
     work.iterations += solved.iterations
     work.solve_time += solved.solve_time
     x: Array = solved.x.copy()
-    size = kernels.clip_into(x, box.lb, box.ub)
+    size = kernels.clip_into(x if clip else x.copy(), box.lb, box.ub)
     tol = tolerance(box)
     if not (size <= tol and (rows is None or kernels.rows_hold(rows.G, x, rows.h, tol))):
         raise NumericalFailure(f"{solved.backend}: answer outside the constraints by {size:.3g}")

@@ -21,9 +21,9 @@ The top level of the ``direction`` mode (:mod:`rrc_pin.solvers.tick.direction`,
 Before 2, where the exact rates cross a constraint row marked ``slide`` (a collision pair, which
 the command should slide along rather than stop at), the command is first projected onto what
 the slide rows and the box allow, :math:`b' = A\dot q^*` with :math:`\dot q^*` the least
-squares of :math:`A\dot q \approx b` within them, damped by :data:`SLIDE_DAMPING`
-(:func:`_slide`, :mod:`rrc_pin.solvers.tick.slide_kernels`: one answer, continuous in the data),
-and 1-2
+squares of :math:`A\dot q \approx b` within them, damped on A's null space and past the damping
+threshold only (:data:`SLIDE_DAMPING`, :func:`_slide`,
+:mod:`rrc_pin.solvers.tick.slide_kernels`: one answer, continuous in the data), and 1-2
 run on :math:`b'` (``sliding``, the veer from :math:`b` reported). Without a crossed slide row
 nothing changes: exact answers stay exact (0 veer).
 
@@ -59,7 +59,7 @@ from rrc_pin.solvers.tick.factorization import Factorization
 from rrc_pin.solvers.tick.kernels import scale_and_veer
 from rrc_pin.solvers.tick.least_squares import Subspace, least_squares
 from rrc_pin.solvers.tick.problem import Box, Problem, Rows
-from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, damped_optimum, project
+from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
 
 Array = npt.NDArray[np.float64]
 
@@ -71,6 +71,7 @@ METHODS: tuple[Method, ...] = ("qp", "scipy", "scaling", "hold")
 
 Status = Literal[
     "exact", "scaled", "sliding", "damped", "singular", "least_squares", "recovering", "fallback",
+    "grip_lost", "contact_lost",
 ]
 """What the answer is for the top level (docs/api.md, "Reading a resolution"); how each lower
 level fared is in ``levels`` (:data:`LevelStatus`):
@@ -92,7 +93,10 @@ level fared is in ``levels`` (:data:`LevelStatus`):
 - ``recovering``: a joint outside its range, or a constraint row broken at the start, must
   be restored: the least-squares optimum within the constraints;
 - ``fallback``: the pipeline found no usable answer for the top level; a fallback did
-  (``attempts`` says why).
+  (``attempts`` says why);
+- ``grip_lost``, ``contact_lost``: never the pipeline's; a cell's controller
+  (``rrc_pin.cells``) found a closed chain (two hands' grip, a foot in support) open beyond
+  its bound: the cell holds still (zero rates) until a command closes it.
 """
 
 LevelStatus = Literal["met", "scaled", "traded", "dropped"]
@@ -105,8 +109,11 @@ EXACT_TOL = 1e-9
 """Relative residual under which a command counts as met, and a scale as 1."""
 
 DIRECTION_TOL = 1e-7
-"""[rad] A backend's answer to the direction problem may veer from the command by this much
-(its null basis' rounding times its size) before it is refused."""
+"""A backend's answer to the direction problem may have task rates off the command's direction
+up to this much times the largest its size can give (``|A| |qdot|``: the null basis' rounding
+times the answer's size) before it is refused. As an angle instead (1e-7 rad), the rounding
+of an answer at a small scale along the command was refused (a few 1e-11 off the direction
+at a scale of 1e-3, 448 fallback ticks in 30,000 of baxter's hands commanded in full)."""
 
 DEFAULT_FALLBACKS: tuple[Method, ...] = ("scipy", "scaling")
 """The fallbacks tried after the pipeline by default; ``hold`` ends every chain."""
@@ -273,7 +280,8 @@ def _top(
     if problem.mode != "direction":
         last = len(problem.levels) == 1
         if space.N is None and rows is not None and rows.sliding is not None:
-            qdot, null = _damped_within(A, b, box, rows, backend, work, not last)
+            qdot, null = _damped_within(A, b, box, rows, backend, work, not last,
+                                        options.damping)  # fmt: skip
         else:
             qdot, null = least_squares(A, b, space, box, rows, backend, work, "least_squares",
                                        not last)  # fmt: skip
@@ -297,7 +305,7 @@ def _top(
         # the exact rates cross a row the command may slide along: the command becomes what
         # the slide rows and the box let it keep (the rest of the pipeline is unchanged)
         try:
-            kept = _slide(A, b, space, box, slide, backend, work)
+            kept = _slide(A, b, space, box, slide, backend, work, factor, options.damping)
         except (NumericalFailure, np.linalg.LinAlgError) as exc:
             work.attempts.append(("slide", f"{exc}; the command kept as given"))
         else:
@@ -343,37 +351,38 @@ def _top(
 
 SLIDE_DAMPING = 1e-2
 r"""Weight :math:`\mu` of the sliding stage's damping, relative to the mean squared singular
-value of the top level's rows (:func:`_slide`). Two facing pandas' hands driven into each other
-(36 pairs, 600 ticks, with rrc_pin.limits.collision.BLEND): the largest joint-rate change
-between two ticks 0.19 rad/s at 1e-3, 0.086 at 1e-2 (2.4 at 1e-4, 2.35 with the former
-least-squares tie-break alone). A direction of singular value :math:`\sigma` keeps
-:math:`\sigma^2(\sigma^2 + 2\mu)/(\sigma^2 + \mu)^2` of its command where no constraint
-binds: 0.99990 at :math:`\sigma^2` the mean."""
+value of the top level's rows (:func:`_slide`): the cost of a rate in their null space, and of
+a direction past the damping threshold (toward :math:`\mu` at a singularity). Two facing
+pandas' hands driven into each other (36 pairs, 600 ticks, with
+rrc_pin.limits.collision.BLEND): the largest joint-rate change between two ticks 0.19 rad/s at
+1e-3, 0.086 at 1e-2 (2.4 at 1e-4, 2.35 with the former least-squares tie-break alone)."""
 
 
 def _slide(
-    A: Array, b: Array, space: Subspace, box: Box, slide: Rows, backend: QPBackend, work: Work
-) -> Array:
-    r"""What the slide rows and the box let the command keep, damped.
+    A: Array, b: Array, space: Subspace, box: Box, slide: Rows, backend: QPBackend, work: Work,
+    factor: Factorization, damping: Damping | None,
+) -> Array:  # fmt: skip
+    r"""What the slide rows and the box let the command keep.
 
-    .. math:: \min_{\dot q}\ \|A\dot q - b\|^2 + \mu\|\dot q - t\|^2
+    .. math:: \min_{\dot q}\ \|A\dot q - b\|^2 + (\dot q - t)^TD(\dot q - t)
        \quad\text{s.t. the box and the slide rows}
 
-    with ``t`` the damped least squares :math:`(A^TA + \mu I)^{-1}A^Tb` and :math:`\mu` =
-    :data:`SLIDE_DAMPING` times the mean squared singular value of A: the projection of its
-    unconstrained optimum (:func:`rrc_pin.solvers.tick.slide_kernels.damped_optimum`) onto the
-    constraints
-    in the metric :math:`A^TA + \mu I` (:func:`rrc_pin.solvers.tick.slide_kernels.project`).
-    Without the
-    damping (the least squares alone, with a least-norm tie-break 1e-6 of the trace) the
+    with ``t`` the damped least squares :math:`(A^TA + D)^{-1}A^Tb` and D
+    (:func:`rrc_pin.solvers.tick.slide_kernels.slide_metric`) :data:`SLIDE_DAMPING` times the
+    mean squared singular value of A on A's null space, the same on the directions past the
+    damping threshold (the top level's onset, smoothly from zero there), zero on the others:
+    a direction A moves well keeps all of what the constraints allow of its command, as the
+    LP over the same rows would (with D = :math:`\mu I`, 0.93 of the tangential speed of a
+    hand sliding down a wall was kept where an LP kept all of it). The problem is the
+    projection of its unconstrained optimum onto the constraints in the metric
+    :math:`A^TA + D` (:func:`rrc_pin.solvers.tick.slide_kernels.project`). Without D on the
+    null space (the least squares alone, with a least-norm tie-break 1e-6 of the trace) the
     optimal rates formed a set along A's null space, and the answer moved anywhere in it from
     one tick to the next as rows entered and left (2.35 rad/s between two sliding ticks); with
-    it the answer is one point, Lipschitz in the data (rates in A's null space cost
-    :math:`\mu` each). Pulled toward ``t`` rather than toward zero, a direction A moves well
-    keeps its command to second order in :math:`\mu/\sigma^2`; rather than toward the exact
-    rates, it stays bounded through a singularity (pulled toward the exact rates, which grow
-    without bound there, a stretched panda's shoulder, elbow and wrist flipped between
-    opposite rate limits every tick).
+    it the answer is one point, Lipschitz in the data. Pulled toward ``t`` rather than toward
+    the exact rates, it stays bounded through a singularity (pulled toward the exact rates,
+    which grow without bound there, a stretched panda's shoulder, elbow and wrist flipped
+    between opposite rate limits every tick).
 
     The backend answers the same QP where the kernel refuses; within the equality rows' null
     space, the least squares alone (:func:`~rrc_pin.solvers.tick.least_squares.least_squares`).
@@ -384,16 +393,19 @@ def _slide(
     if space.N is not None:
         kept, _ = least_squares(A, b, space, box, slide, backend, work, "slide", False)
         return kept
-    n = A.shape[1]
-    x, target = np.empty(n), np.empty(n)
-    A = np.ascontiguousarray(A)  # one compiled signature (see least_squares._projected)
-    if not damped_optimum(A, SLIDE_DAMPING, b, target):
-        raise NumericalFailure("the sliding stage's metric is not definite")
-    if project(A, SLIDE_DAMPING, target, box.lb, box.ub, slide.G, slide.h, MARGIN, x) == SOLVED:
+    m, n = A.shape
+    US, sigma, right, rank = factor.svd
+    B, target = np.empty((m + n, n)), np.empty(n)
+    threshold = math.inf if damping is None else float(damping.threshold)
+    rows = slide_metric(np.ascontiguousarray(A), US, sigma, right, rank,
+                        np.ascontiguousarray(factor.null_basis()), b, SLIDE_DAMPING, threshold,
+                        B, target)  # fmt: skip
+    B = B[:rows]
+    x = np.empty(n)
+    if project(B, 0.0, target, box.lb, box.ub, slide.G, slide.h, MARGIN, x) == SOLVED:
         kernels.clip_into(x, box.lb, box.ub)  # by the kernel's rounding at most (1e-9)
         return x
-    M = A.T @ A
-    M.flat[:: n + 1] += SLIDE_DAMPING * max(float(M.trace()) / max(A.shape[0], 1), _TINY)
+    M = B.T @ B
     size = max(float(np.abs(M).max()), _TINY)
     qp = QP(M / size, -(M @ target) / size, slide.G, np.full(slide.h.size, -np.inf), slide.h,
             box.lb, box.ub, f"slide:{n}")  # fmt: skip
@@ -401,17 +413,22 @@ def _slide(
 
 
 def _damped_within(
-    A: Array, b: Array, box: Box, rows: Rows, backend: QPBackend, work: Work, need_null: bool
-) -> tuple[Array, Array | None]:
+    A: Array, b: Array, box: Box, rows: Rows, backend: QPBackend, work: Work, need_null: bool,
+    damping: Damping | None,
+) -> tuple[Array, Array | None]:  # fmt: skip
     """A least-squares top level with slide rows: its exact optimum where that holds every
-    constraint, else the sliding stage's damped least squares within them all (:func:`_slide`).
+    constraint, else the sliding stage's least squares within them all (:func:`_slide`).
 
-    Most such problems are a collision pair below its safety distance (``recovering``: a row
-    asks the pair to separate, so standing still is not feasible and the problem is not a
-    direction one). The least squares alone there, undamped, drove baxter's wrists at their
-    4 rad/s limits for a pair 2 um below the safety distance, and the step's second-order error
-    took the pair 1.03 mm below it over four ticks (a 10-minute session); and a recovering tick
-    between two sliding ones changed the rates by 2.9 rad/s and back.
+    Most such problems are a collision pair just below its safety distance, its row asking it
+    back out (``recovering``: standing still is not feasible and the problem is not a direction
+    one). The least squares alone there, undamped, drove baxter's wrists at their 4 rad/s
+    limits for a pair 2 um below the safety distance, and the step's second-order error took
+    the pair 1.03 mm below it over four ticks (a 10-minute session); and a recovering tick
+    between two sliding ones changed the rates by 2.9 rad/s and back. Where no rates meet every
+    constraint, the slide rows that ask to move apart (a bound below zero) ask only not to
+    approach (bound zero), and the least squares is solved again: a pair is pushed out where
+    that is possible, and never holds the arm where it is not (two pairs asking for opposite
+    motions; a joint at its limit).
 
     Returns:
         The rates (n,), and A's null space (d, n) for the next level (None when not needed).
@@ -419,8 +436,25 @@ def _damped_within(
     factor = Factorization(A)
     w = factor.least_norm(b)
     if not (kernels.inside(w, box.lb, box.ub) and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
-        w = _slide(A, b, Subspace(None, None), box, rows, backend, work)
+        try:
+            w = _slide(A, b, Subspace(None, None), box, rows, backend, work, factor, damping)
+        except (NumericalFailure, np.linalg.LinAlgError) as exc:
+            relaxed = _not_approaching(rows)
+            if relaxed is None:
+                raise
+            work.attempts.append(("slide", f"{exc}; the pairs asked apart only kept apart"))
+            w = _slide(A, b, Subspace(None, None), box, relaxed, backend, work, factor, damping)
     return w, factor.null_basis() if need_null else None
+
+
+def _not_approaching(rows: Rows) -> Rows | None:
+    """``rows`` with every slide row's bound below zero raised to zero, or None if none is."""
+    if rows.slide is None:
+        return None
+    pushed = rows.slide & (rows.h < 0.0)
+    if not pushed.any():
+        return None
+    return rows._replace(h=np.where(pushed, 0.0, rows.h))
 
 
 def _damping(
@@ -460,9 +494,9 @@ def _clamped(factor: Factorization, w: Array, box: Box, dt: float) -> Factorizat
 
 STILL_SCALE = 1e-9
 """A direction answer scaled below this stands still along the command: its task rates are the
-rounding of a zero, and their angle to the command (what :data:`DIRECTION_TOL` checks) is
-noise. Two facing pandas' hands held against each other answered scale 7.6e-14 at veers of
-0.47-3.1 rad, refused: 100 fallback ticks in a 10-minute session."""
+rounding of a zero, and their direction (what :data:`DIRECTION_TOL` checks) is noise. Two
+facing pandas' hands held against each other answered scale 7.6e-14 at veers of 0.47-3.1 rad,
+refused: 100 fallback ticks in a 10-minute session."""
 
 
 def _scaled(
@@ -472,7 +506,10 @@ def _scaled(
 
     A backend's answer is decoded from the null space and w, so its task rates are a multiple
     of ``A w`` up to the null basis' rounding times the answer's size; its scale is read from
-    them, and an answer that veers from them by more than :data:`DIRECTION_TOL` is refused.
+    them, and an answer off their direction by more than :data:`DIRECTION_TOL` of that size is
+    refused. The answer is taken as decoded, not clipped into the box joint by joint (within
+    the backend's tolerance of it: the pipeline's final clip, reported): a clip turns the
+    direction, by 1e-11 relative to the rates' size, an angle of 1e-7 rad at a scale of 1e-3.
 
     Raises:
         NumericalFailure: The backend found no usable answer.
@@ -481,9 +518,11 @@ def _scaled(
     if answer is not None:
         return answer
     qp, decoding = direction_qp(w, null, box, rows)
-    qdot = solve_within(qp, decoding, box, rows, backend, work)
-    scale, veer = scale_and_veer(A @ qdot, A @ w)
-    if veer > DIRECTION_TOL and scale > STILL_SCALE:
+    qdot = solve_within(qp, decoding, box, rows, backend, work, clip=False)
+    y = A @ qdot
+    scale, veer = scale_and_veer(y, A @ w)
+    off = _norm(y) * math.sin(min(veer, 0.5 * math.pi))  # the task rates off the direction
+    if off > DIRECTION_TOL * _norm(A.ravel()) * _norm(qdot) and scale > STILL_SCALE:
         raise NumericalFailure(f"{work.backend}: answer veers by {veer:.3g} rad from the command")
     return Along(qdot, scale)
 

@@ -3,7 +3,9 @@ r"""The sliding stage's QP, solved by hand: a projection in a definite metric on
 .. math:: \min_{\dot q}\ (\dot q - w)^T M (\dot q - w) \quad \text{s.t.}\quad
    lb \le \dot q \le ub,\ G\dot q \le h
 
-with :math:`M = A^TA + \mu I` (n of a few tens at most, a few tens of rows). With
+with :math:`M = B^TB` definite, B the rows of the metric (:func:`slide_metric`: :math:`A^TA`
+damped on A's null space and past the damping threshold; n of a few tens at most, a few tens
+of rows). With
 :math:`M = LL^T` and :math:`y = L^T(\dot q - w)` it is the least-distance problem
 :math:`\min \|y\|` s.t. :math:`E^T y \ge f` (Lawson & Hanson 1974, chapter 23), whose answer
 comes from the non-negative least squares :math:`\min_{u \ge 0} \|[E; f^T] u - e_{n+1}\|`
@@ -28,7 +30,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.tick.kernels import cholesky, cholesky_solve, solve_factored
+from rrc_pin.solvers.tick.kernels import cholesky, solve_factored
 
 Array = npt.NDArray[np.float64]
 
@@ -304,35 +306,79 @@ def _least_distance(E: Array, m: int, n: int, L: Array, w: Array, x: Array) -> i
 
 
 @kernel
-def damped_optimum(A: Array, damping: float, b: Array, out: Array) -> bool:
-    r"""``out`` the minimiser of :math:`\|A\dot q - b\|^2 + \mu\|\dot q - t\|^2`, t the damped
-    least squares :math:`(A^TA + \mu I)^{-1}A^Tb`: :math:`t + \mu M^{-1} t`, M and
-    :math:`\mu` as :func:`project`'s.
+def slide_metric(
+    A: Array, US: Array, sigma: Array, right: Array, rank: int, null: Array, b: Array,
+    damping: float, threshold: float, B: Array, target: Array,
+) -> int:  # fmt: skip
+    r"""The sliding stage's metric as rows B (:math:`M = B^TB`) and the point it pulls toward.
 
-    Along a right singular vector of A of singular value :math:`\sigma`, with
-    :math:`\beta` the command's part :math:`u^Tb`, that is
-    :math:`\beta\sigma(\sigma^2 + 2\mu)/(\sigma^2 + \mu)^2`: the exact
-    :math:`\beta/\sigma` to second order in :math:`\mu/\sigma^2` where A is well
-    conditioned, at most :math:`2\beta/\sqrt{\mu}`-ish and smooth through a singularity
-    (where the exact rates grow without bound).
+    .. math:: M = A^TA + \sum_{i<r} f_i v_iv_i^T + \mu N^TN, \qquad
+       f_i = \mu\,\max\big(0,\ 1 - (\sigma_i/\sigma_{on})^2\big)
+
+    with :math:`A = U\Sigma V^T` of rank r, N (d, n) orthonormal rows spanning its null space,
+    :math:`\mu` = ``damping`` times the mean squared singular value
+    :math:`\operatorname{tr}(A^TA)/m` (at least the smallest normal double) and the onset
+    :math:`\sigma_{on} = \sigma_1/\kappa` of the top level's damping
+    (:mod:`rrc_pin.solvers.tick.damping`, ``threshold`` :math:`\kappa`; inf: none). A direction
+    A moves well (:math:`\sigma_i \ge \sigma_{on}`) is not damped; one below the onset is,
+    smoothly from zero at the onset (Maciejewski & Klein 1988's onset) to :math:`\mu` at a
+    singularity; the null space costs :math:`\mu`, which makes the answer one point.
+
+    The target minimises :math:`\|A\dot q - b\|^2 + (\dot q - t)^TD(\dot q - t)` (D the
+    damping terms of M, t :math:`= M^{-1}A^Tb` the damped least squares): along
+    :math:`v_i`, :math:`\beta_i\sigma_i(\sigma_i^2 + 2f_i)/(\sigma_i^2 + f_i)^2` with
+    :math:`\beta_i = u_i^Tb`, the exact :math:`\beta_i/\sigma_i` where undamped, bounded
+    through a singularity; zero in the null space (t has none).
+
+    Args:
+        A: The rows (m, n).
+        US: :math:`U\Sigma` (m, k) of A's SVD, k = min(m, n).
+        sigma: Singular values (k,), descending.
+        right: Right singular vectors (n, k).
+        rank: How many singular values count.
+        null: Orthonormal rows (d, n), d = n - rank, spanning A's null space.
+        b: The command (m,).
+        damping: See :math:`\mu`, > 0.
+        threshold: :math:`\kappa` >= 1, or inf for no damping of A's range.
+        B: Out: the metric's rows, the first returned count of its (m + n, n) written.
+        target: Out (n,).
 
     Returns:
-        False where M is not numerically definite (``out`` not set).
-    """  # noqa: D205
-    rows, n = A.shape
-    M, mu = _damped_gram(A, damping)
-    g = np.empty(n)
-    for i in range(n):
-        t = 0.0
-        for r in range(rows):
-            t += A[r, i] * b[r]
-        g[i] = t
-    first = np.empty(n)
-    if not cholesky_solve(M, g, first):
-        return False
-    second = np.empty(n)
-    if not cholesky_solve(M, first, second):
-        return False
-    for i in range(n):
-        out[i] = first[i] + mu * second[i]
-    return True
+        The number of rows of B written: m, the damped directions, then d.
+    """
+    m, n = A.shape
+    trace = 0.0
+    for i in range(sigma.size):
+        trace += sigma[i] * sigma[i]
+    mu = max(damping * trace / max(m, 1), _TINY)
+    onset = sigma[0] / threshold if sigma.size and rank > 0 else 0.0
+    for i in range(m):
+        for j in range(n):
+            B[i, j] = A[i, j]
+    rows: int = m
+    for j in range(n):
+        target[j] = 0.0
+    for i in range(rank):
+        s = sigma[i]
+        f = 0.0
+        if s < onset:
+            ratio = s / onset
+            f = mu * (1.0 - ratio * ratio)
+        beta = 0.0
+        for r in range(m):
+            beta += US[r, i] * b[r]
+        beta /= s  # u_i^T b
+        coefficient = beta * s * (s * s + 2.0 * f) / ((s * s + f) * (s * s + f))
+        root = math.sqrt(f)
+        for j in range(n):
+            target[j] += coefficient * right[j, i]
+            if f > 0.0:
+                B[rows, j] = root * right[j, i]
+        if f > 0.0:
+            rows += 1
+    root = math.sqrt(mu)
+    for i in range(null.shape[0]):
+        for j in range(n):
+            B[rows, j] = root * null[i, j]
+        rows += 1
+    return rows

@@ -1,0 +1,96 @@
+"""CellLog: a cell's ticks as packed rows, their memory, the ring, the records and the CSV."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import rrc_pin
+from rrc_pin.cells import CellController, CellLog, CellRecord
+from rrc_pin.control.trajectory_log import CAPACITY
+from rrc_pin.errors import InvalidInput
+
+LIMIT = 32e6
+"""[bytes] What a cell's log may hold at its default capacity."""
+
+
+@pytest.mark.parametrize(("name", "row"), [("gsfc_dual", 294), ("yeh_tripod", 462)])
+def test_a_full_log_at_the_default_capacity_holds_under_32_mb(name, row):
+    """60,000 ticks (10 minutes at 100 Hz) of the ready-made cells, filled: the array's bytes
+    are the row's size times the ticks, under 32 MB, nothing else kept per tick."""
+    ctl = CellController(name, 0.01)
+    log = ctl.log
+    assert log.capacity == CAPACITY == 60_000
+    assert log.dtype.itemsize == row
+    ctl.step()  # one real tick, then the rest packed as it would be
+    rec = log[-1]
+    for _ in range(CAPACITY - 1):
+        log.add(rec.t, rec.q, rec.qdot, rec.status, rec.scale, rec.levels.split("/"),
+                rec.errors, rec.grip, (rec.chain_position, rec.chain_rotation), rec.mode)
+    assert len(log) == CAPACITY and log.dropped == 0
+    assert log.nbytes == row * CAPACITY < LIMIT, log.nbytes
+    log.add(rec.t, rec.q, rec.qdot, rec.status, rec.scale, [], {}, {}, (0.0, 0.0), "teleop")
+    assert len(log) == CAPACITY and log.dropped == 1 and log.nbytes == row * CAPACITY
+
+
+def test_records_come_back_as_they_were_logged():
+    log = CellLog(3, 2, ["object", "left"], ["object"], capacity=4)
+    rows = []
+    for k in range(6):
+        rec = CellRecord(0.01 * k, np.arange(3.0) + k, np.array([k, -k], float),
+                         ("exact", "scaled", "grip_lost")[k % 3], 0.5 + k / 10,
+                         "met/traded" if k % 2 else "scaled", {"object": 1e-3 * k},
+                         {"object": 1e-9},
+                         1e-9 * k, 2e-9 * k, ("teleop", "reverse")[k % 2])  # fmt: skip
+        log.append(rec)
+        rows.append(rec)
+    assert len(log) == 4 and log.dropped == 2
+    for got, want in zip(log.records, rows[2:], strict=True):
+        assert got.t == want.t and got.status == want.status and got.mode == want.mode
+        assert got.levels == want.levels and got.scale == want.scale
+        assert got.errors == want.errors and got.grip == want.grip  # "left" not commanded
+        np.testing.assert_array_equal(got.q, want.q)
+        np.testing.assert_array_equal(got.qdot, want.qdot)
+        assert got.chain_position == want.chain_position
+        assert got.chain_rotation == want.chain_rotation
+    assert log[-1].t == rows[-1].t and log[0].t == rows[2].t
+    np.testing.assert_array_equal(log.positions(2)[0], rows[4].q)
+    np.testing.assert_array_equal(log.column("q")[:, 0], [2.0, 3.0, 4.0, 5.0])
+    with pytest.raises(IndexError):
+        log[4]
+    log.capacity = 2  # the oldest forgotten at once
+    assert len(log) == 2 and log.dropped == 4 and log[0].t == rows[4].t
+    log.clear()
+    assert len(log) == 0 and log.positions(3) == []
+
+
+def test_bad_input_is_named():
+    log = CellLog(2, 2)
+    with pytest.raises(InvalidInput, match="record"):
+        log.append(("not", "a", "record"))  # type: ignore[arg-type]
+    with pytest.raises(InvalidInput, match="name: no column 'x'"):
+        log.column("x")
+    with pytest.raises(InvalidInput, match="capacity"):
+        log.capacity = 0
+    with pytest.raises(InvalidInput, match="tick"):
+        log.append_tick((0.0, np.zeros(2)))
+    with pytest.raises(InvalidInput, match="n: "):
+        log.positions(-1)
+
+
+def test_the_csv_has_a_row_per_tick_with_the_chains_errors(tmp_path):
+    ctl = CellController(rrc_pin.load("gsfc_dual"), 0.01)
+    for _ in range(3):
+        ctl.step({"object": [0.01, 0, 0, 0, 0, 0]})
+    text = ctl.save(tmp_path / "cell.csv").read_text().splitlines()
+    header = text[0].split(",")
+    assert len(text) == 4 and header[:5] == ["t", "mode", "status", "scale", "levels"]
+    assert "grip:object" in header and "chain_position" in header and "qdot13" in header
+    row = dict(zip(header, text[2].split(","), strict=True))
+    assert row["status"] == "exact" and row["levels"] == "met/traded"
+    assert float(row["error:object"]) < 1e-6
+    assert float(row["chain_position"]) < 1e-8
+    with pytest.raises(InvalidInput, match="path: expected a .csv"):
+        ctl.save(tmp_path / "cell.npz")
+    with pytest.raises(InvalidInput, match="path: cannot write"):
+        ctl.save(tmp_path / "missing" / "cell.csv")
