@@ -3,12 +3,12 @@
 The kernels answer most of a tick; the direction problem with constraint rows or several null
 directions, a least-squares level whose metric is semidefinite or whose projection the kernel
 refuses, and the sliding stage's QP where its projection refuses, go to the resolver's QP
-backend (DAQP by default), exactly as :mod:`rrc_pin.solvers.tick.pipeline` builds and checks
-them (:func:`~rrc_pin.solvers.tick.direction.direction_qp`,
-:func:`~rrc_pin.solvers.tick.least_squares.least_squares`,
-:func:`~rrc_pin.solvers.qp_backends.qp.solve_within`). The tick's backend and its record of work
-and failures are this thread's :class:`Context` (:func:`enter`); a failure is recorded there as
-the pipeline records it, and the compiled caller reads an empty answer.
+backend (DAQP by default) through the pipeline's own functions, which build and check them
+(:func:`~rrc_pin.solvers.tick.pipeline.backend_along`,
+:func:`~rrc_pin.solvers.tick.pipeline.backend_slide`,
+:func:`~rrc_pin.solvers.tick.least_squares.least_squares`). The tick's backend and its record of
+work and failures are this thread's :class:`Context` (:func:`enter`); a failure is recorded there
+as the pipeline records it, and the compiled caller reads an empty answer.
 """
 
 from __future__ import annotations
@@ -20,25 +20,17 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.errors import NumericalFailure
 from rrc_pin.solvers.qp_backends.base import QPBackend
-from rrc_pin.solvers.qp_backends.qp import QP, Decoding, Work, solve_within
-from rrc_pin.solvers.tick.direction import direction_qp
-from rrc_pin.solvers.tick.kernels import scale_and_veer
+from rrc_pin.solvers.qp_backends.qp import Work
 from rrc_pin.solvers.tick.least_squares import Subspace, least_squares
+from rrc_pin.solvers.tick.pipeline import backend_along, backend_slide
 from rrc_pin.solvers.tick.problem import Box, Rows
 
 Array = npt.NDArray[np.float64]
 
-TOP, SLIDE = 0, -1
-"""Where a QP is asked for: the top level, the sliding stage; k > 0 is lower level k."""
+TOP, SLIDE, SLIDE_RELAXING = 0, -1, -2
+"""Where a QP is asked for: the top level, the direction mode's sliding stage, a least-squares
+top level's sliding stage that relaxes its rows where it fails; k > 0 is lower level k."""
 
-DIRECTION_TOL = 1e-7
-"""[rad] A backend's answer to the direction problem may veer from the command by this much
-(:data:`rrc_pin.solvers.tick.pipeline.DIRECTION_TOL`)."""
-
-STILL_SCALE = 1e-9
-"""(:data:`rrc_pin.solvers.tick.pipeline.STILL_SCALE`)."""
-
-_TINY = float(np.finfo(np.float64).tiny)
 _NO_KIND = np.zeros((2, 0), np.int8)
 _EMPTY = np.empty(0)
 
@@ -95,6 +87,8 @@ def _failed(where: int, exc: Exception) -> Array:
     reason = str(exc)
     if where == SLIDE:
         label, reason = "slide", f"{reason}; the command kept as given"
+    elif where == SLIDE_RELAXING:
+        label, reason = "slide", f"{reason}; the pairs asked apart only kept apart"
     elif where == TOP:
         label = "qp"
     else:
@@ -103,29 +97,18 @@ def _failed(where: int, exc: Exception) -> Array:
     return _EMPTY
 
 
-def not_definite(where: int) -> None:
-    """Record the sliding stage's metric not definite, where the pipeline records it."""
-    _failed(where, NumericalFailure("the sliding stage's metric is not definite"))
-
-
 def direction(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array, h: Array
               ) -> tuple[Array, float]:  # fmt: skip
-    """The direction problem along ``w`` by the backend: its rates (n,) and their scale along
-    the command, read from the task rates (:func:`rrc_pin.solvers.tick.pipeline._scaled`);
-    empty rates where it fails.
+    """The direction problem along ``w`` by the backend
+    (:func:`rrc_pin.solvers.tick.pipeline.backend_along`): its rates (n,) and their scale
+    along the command; empty rates where it fails.
     """  # noqa: D205
     context = _LOCAL.context
-    box, rows = _box(lb, ub), _rows(G, h)
-    qp, decoding = direction_qp(w, null, box, rows)
     try:
-        qdot = solve_within(qp, decoding, box, rows, context.backend, _work())
-        scale, veer = scale_and_veer(A @ qdot, A @ w)
-        if veer > DIRECTION_TOL and scale > STILL_SCALE:
-            raise NumericalFailure(f"{_work().backend}: answer veers by {veer:.3g} rad "
-                                   "from the command")  # fmt: skip
+        along = backend_along(A, w, null, _box(lb, ub), _rows(G, h), context.backend, _work())
     except NumericalFailure as exc:
         return _failed(TOP, exc), -1.0
-    return np.ascontiguousarray(qdot), float(scale)
+    return np.ascontiguousarray(along.qdot), float(along.u)
 
 
 def level(where: int, A: Array, b: Array, x: Array, N: Array, lb: Array, ub: Array, G: Array,
@@ -148,23 +131,15 @@ def level(where: int, A: Array, b: Array, x: Array, N: Array, lb: Array, ub: Arr
     return np.ascontiguousarray(qdot), none if null is None else np.ascontiguousarray(null)
 
 
-def slide(where: int, metric: Array, mu: float, target: Array, lb: Array, ub: Array, G: Array,
-          h: Array) -> Array:  # fmt: skip
+def slide(where: int, B: Array, target: Array, lb: Array, ub: Array, G: Array, h: Array
+          ) -> Array:  # fmt: skip
     r"""The sliding stage's QP by the backend where its projection refused
-    (:func:`rrc_pin.solvers.tick.pipeline._slide`): the rates, empty where it fails.
-
-    The metric is :math:`A^TA + \mu I` of rows A = ``metric``.
+    (:func:`rrc_pin.solvers.tick.pipeline.backend_slide`, the metric :math:`B^TB`): the rates,
+    empty where it fails.
     """  # noqa: D205
     context = _LOCAL.context
-    n = target.size
-    M = metric.T @ metric
-    M.flat[:: n + 1] += mu
-    size = max(float(np.abs(M).max()), _TINY)
-    box, rows = _box(lb, ub), Rows(G, h, ())
-    qp = QP(M / size, -(M @ target) / size, G, np.full(h.size, -np.inf), h, lb, ub,
-            f"slide:{n}")  # fmt: skip
     try:
-        qdot = solve_within(qp, Decoding(None, None), box, rows, context.backend, _work())
+        qdot = backend_slide(B, target, _box(lb, ub), Rows(G, h, ()), context.backend, _work())
     except NumericalFailure as exc:
         return _failed(where, exc)
     return np.ascontiguousarray(qdot)

@@ -405,6 +405,19 @@ def _slide(
     if project(B, 0.0, target, box.lb, box.ub, slide.G, slide.h, MARGIN, x) == SOLVED:
         kernels.clip_into(x, box.lb, box.ub)  # by the kernel's rounding at most (1e-9)
         return x
+    return backend_slide(B, target, box, slide, backend, work)
+
+
+def backend_slide(
+    B: Array, target: Array, box: Box, slide: Rows, backend: QPBackend, work: Work
+) -> Array:
+    r"""The sliding stage's QP by the backend: the point of the box and slide rows nearest
+    ``target`` in the metric :math:`B^TB` (where :func:`_slide`'s projection refuses).
+
+    Raises:
+        NumericalFailure: The backend found no usable answer.
+    """  # noqa: D205
+    n = target.size
     M = B.T @ B
     size = max(float(np.abs(M).max()), _TINY)
     qp = QP(M / size, -(M @ target) / size, slide.G, np.full(slide.h.size, -np.inf), slide.h,
@@ -517,6 +530,17 @@ def _scaled(
     answer = along(w, null, box, rows)
     if answer is not None:
         return answer
+    return backend_along(A, w, null, box, rows, backend, work)
+
+
+def backend_along(
+    A: Array, w: Array, null: Array, box: Box, rows: Rows | None, backend: QPBackend, work: Work
+) -> Along:
+    """The direction problem along ``w`` by the backend, its answer checked (:func:`_scaled`).
+
+    Raises:
+        NumericalFailure: The backend found no usable answer.
+    """
     qp, decoding = direction_qp(w, null, box, rows)
     qdot = solve_within(qp, decoding, box, rows, backend, work, clip=False)
     y = A @ qdot

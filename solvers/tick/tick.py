@@ -169,7 +169,8 @@ def top_level(task_rows: Array, rates: Array, ints: Ints, reals: Array, rows: Ro
     if direction:
         return top.direction(A, b, rows, reals[DT], reals[THRESHOLD], rate_factor, need_null)
     per_unit = 1.0 / rates[UNIT][: ints[STARTS + 1]] if ints[UNITS] else np.empty(0)
-    return top.least_squares_top(A, b, per_unit, rows, recovering, rate_factor, need_null)
+    return top.least_squares_top(A, b, per_unit, rows, recovering, rate_factor, need_null,
+                                 reals[THRESHOLD])  # fmt: skip
 
 
 @inlined

@@ -33,7 +33,7 @@ from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import backend_calls, factor, kernels
 from rrc_pin.solvers.tick.factor import Factor
 from rrc_pin.solvers.tick.levels import least_squares, row_values
-from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, damped_optimum, project
+from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
 
 Array = npt.NDArray[np.float64]
 
@@ -148,20 +148,11 @@ def passing(w: Array, null: Array) -> Top:
 
 
 @kernel
-def not_definite(where: int) -> None:
-    """Record the sliding stage's metric not definite
-    (:func:`rrc_pin.solvers.tick.backend_calls.not_definite`).
-    """  # noqa: D205
-    with objmode():
-        backend_calls.not_definite(where)
-
-
-@kernel
-def backend_slide(where: int, A: Array, mu: float, target: Array, lb: Array, ub: Array,
-                  G: Array, h: Array) -> Array:  # fmt: skip
+def backend_slide(where: int, B: Array, target: Array, lb: Array, ub: Array, G: Array,
+                  h: Array) -> Array:  # fmt: skip
     """The sliding stage's QP by the backend (:func:`rrc_pin.solvers.tick.backend_calls.slide`)."""
     with objmode(x="float64[::1]"):
-        x = backend_calls.slide(where, A, mu, target, lb, ub, G, h)
+        x = backend_calls.slide(where, B, target, lb, ub, G, h)
     return x
 
 
@@ -188,33 +179,34 @@ def slide_rows(rows: Rows) -> tuple[Array, Array]:
 
 
 @kernel
-def slid_command(where: int, A: Array, b: Array, G: Array, h: Array, rows: Rows
-                 ) -> tuple[int, Array]:  # fmt: skip
-    r"""What the slide rows and the box let the command keep, damped (the sliding stage).
+def slid_command(where: int, A: Array, b: Array, G: Array, h: Array, rows: Rows, f: Factor,
+                 threshold: float) -> tuple[int, Array, Factor]:  # fmt: skip
+    r"""What the slide rows ``G``, ``h`` and the box let the command keep (the sliding stage).
 
-    :math:`\min \|A\dot q - b\|^2 + \mu\|\dot q - t\|^2` within them, t the damped least
-    squares (:func:`rrc_pin.solvers.tick.pipeline._slide`): the projection of its optimum
+    :math:`\min \|A\dot q - b\|^2 + (\dot q - t)^TD(\dot q - t)` within them, D damping A's
+    null space and its directions past the damping ``threshold`` (0: none)
+    (:func:`rrc_pin.solvers.tick.pipeline._slide`,
+    :func:`~rrc_pin.solvers.tick.slide_kernels.slide_metric`): the projection of its optimum
     (:func:`~rrc_pin.solvers.tick.slide_kernels.project`), else the backend's QP.
 
     Returns:
-        ``(code, rates)``: 0 and the rates (n,), or :data:`FAILED` (the metric is not
-        definite, or the backend failed: recorded as ``where``'s failure).
+        ``(code, rates, f)``: 0 and the rates (n,), or :data:`FAILED` (the backend failed:
+        recorded as ``where``'s failure); and A's factorisation with its SVD.
     """
     m, n = A.shape
-    target, x = np.empty(n), np.empty(n)
-    if not damped_optimum(A, SLIDE_DAMPING, b, target):
-        not_definite(where)
-        return FAILED, target
-    if project(A, SLIDE_DAMPING, target, rows.lb, rows.ub, G, h, MARGIN, x) == SOLVED:
+    f = factor.with_svd(f)
+    f, null = factor.null_basis(f)
+    B, target = np.empty((m + n, n)), np.empty(n)
+    kappa = threshold if threshold > 0.0 else np.inf
+    count = slide_metric(A, f.US, f.sigma, f.right, f.rank, null, b, SLIDE_DAMPING, kappa, B,
+                         target)  # fmt: skip
+    B = B[:count]
+    x = np.empty(n)
+    if project(B, 0.0, target, rows.lb, rows.ub, G, h, MARGIN, x) == SOLVED:
         kernels.clip_into(x, rows.lb, rows.ub)  # by the kernel's rounding at most
-        return 0, x
-    trace = 0.0
-    for i in range(n):
-        for r in range(m):
-            trace += A[r, i] * A[r, i]
-    mu = SLIDE_DAMPING * max(trace / max(m, 1), _TINY)
-    x = backend_slide(where, A, mu, target, rows.lb, rows.ub, G, h)
-    return (0, x) if x.size else (FAILED, x)
+        return 0, x, f
+    x = backend_slide(where, B, target, rows.lb, rows.ub, G, h)
+    return (0 if x.size else FAILED), x, f
 
 
 @kernel
@@ -274,30 +266,34 @@ def damping(f: Factor, b: Array, w: Array, u: float, rows: Rows, dt: float, thre
 
 
 @inlined
-def exact(A: Array, b: Array, f: Factor, w: Array, fits: bool, rows: Rows, slid: bool,
+def exact(A: Array, command: Array, f: Factor, w: Array, fits: bool, rows: Rows, slid: bool,
           outside_range: bool, rate_factor: float, need_null: bool) -> Top:  # fmt: skip
-    """Stage 1: the exact rates where they keep every constraint, else pass on."""
+    """Stage 1: the exact rates where they keep every constraint, else pass on (the scale and
+    veer reported along ``command``, the top level's as given).
+    """  # noqa: D205
     if not (fits and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
         return passing(w, A[:0])
     null = factor.null_basis(f)[1] if need_null else A[:0]
     if slid:
-        return answer(A, b, w, SLIDING, rate_factor, null, 0.0)
+        return answer(A, command, w, SLIDING, rate_factor, null, 0.0)
     if outside_range:
-        return answer(A, b, w, SINGULAR, rate_factor, null, 0.0)
+        return answer(A, command, w, SINGULAR, rate_factor, null, 0.0)
     return Top(w, EXACT, 1.0, 0.0, 0.0, null)
 
 
 @inlined
-def scaled(A: Array, b: Array, f: Factor, w: Array, boxed: Array, u_box: float, rows: Rows,
-           slid: bool, outside_range: bool, dt: float, threshold: float, rate_factor: float
-           ) -> Top:  # fmt: skip
-    """Stages 3-5, where w does not keep the constraints: scaled, damped, singular."""
+def scaled(A: Array, command: Array, b: Array, f: Factor, w: Array, boxed: Array, u_box: float,
+           rows: Rows, slid: bool, outside_range: bool, dt: float, threshold: float,
+           rate_factor: float) -> Top:  # fmt: skip
+    """Stages 3-5, where w does not keep the constraints: scaled, damped, singular (``b`` the
+    command served, ``command`` the one reported along).
+    """  # noqa: D205
     f, null = factor.null_basis(f)
     qdot, u = (boxed, u_box) if u_box >= 0.0 else scaled_along(A, w, null, rows)
     if u < 0.0:
         return passing(w, null)
     if slid:
-        return answer(A, b, qdot, SLIDING, rate_factor, null, 0.0)
+        return answer(A, command, qdot, SLIDING, rate_factor, null, 0.0)
     if not outside_range and u >= 1.0 - EXACT_TOL:
         return Top(qdot, EXACT, 1.0, 0.0, 0.0, null)
     usable, lam = damping(f, b, w, u, rows, dt, threshold)
@@ -306,9 +302,10 @@ def scaled(A: Array, b: Array, f: Factor, w: Array, boxed: Array, u_box: float, 
         if damped_u < 0.0:
             return passing(w, null)
         if u_box < 0.0 or not damped_u <= STILL_SCALE < u:
-            return answer(A, b, damped_qdot, DAMPED, rate_factor, null, float(np.max(lam)))
+            return answer(A, command, damped_qdot, DAMPED, rate_factor, null,
+                          float(np.max(lam)))  # fmt: skip
     if outside_range:
-        return answer(A, b, qdot, SINGULAR, rate_factor, null, 0.0)
+        return answer(A, command, qdot, SINGULAR, rate_factor, null, 0.0)
     return Top(qdot, SCALED, u * rate_factor, 0.0, 0.0, null)
 
 
@@ -319,10 +316,10 @@ def direction(A: Array, b: Array, rows: Rows, dt: float, threshold: float, rate_
     f, w, fits, boxed, u_box = factor.fitted(A, b, rows.lb, rows.ub)
     if rows.h.size:
         u_box = -1.0
-    z, slid = w, False
+    command, z, slid = b, w, False
     G, h = slide_rows(rows)
     if h.size and not kernels.rows_hold(G, w, h, 0.0):  # stage 2 changes the command
-        code, kept = slid_command(backend_calls.SLIDE, A, b, G, h, rows)
+        code, kept, f = slid_command(backend_calls.SLIDE, A, b, G, h, rows, f, threshold)
         if code == 0:
             if rows.slide.all() or kernels.rows_hold(rows.G, kept, rows.h, rows.tol):
                 null = factor.null_basis(f)[1] if need_null else np.empty((0, A.shape[1]))
@@ -331,7 +328,7 @@ def direction(A: Array, b: Array, rows: Rows, dt: float, threshold: float, rate_
             f, z = factor.least_norm(f, b)
             w = z
             fits = kernels.inside(w, rows.lb, rows.ub)
-    return command_stages(A, b, f, w, z, fits, boxed, u_box, rows, slid, dt, threshold,
+    return command_stages(A, command, b, f, w, z, fits, boxed, u_box, rows, slid, dt, threshold,
                           rate_factor, need_null)  # fmt: skip
 
 
@@ -340,26 +337,28 @@ def direction_box(A: Array, b: Array, rows: Rows, dt: float, threshold: float,
                   rate_factor: float) -> Top:  # fmt: skip
     """The direction mode's one level within the box alone: no row, so no sliding stage."""
     f, w, fits, boxed, u_box = factor.fitted(A, b, rows.lb, rows.ub)
-    return command_stages(A, b, f, w, w, fits, boxed, u_box, rows, False, dt, threshold,
+    return command_stages(A, b, b, f, w, w, fits, boxed, u_box, rows, False, dt, threshold,
                           rate_factor, False)  # fmt: skip
 
 
 @inlined
-def command_stages(A: Array, b: Array, f: Factor, w: Array, z: Array, fits: bool, boxed: Array,
-                   u_box: float, rows: Rows, slid: bool, dt: float, threshold: float,
-                   rate_factor: float, need_null: bool) -> Top:  # fmt: skip
-    """Stages 1 and 3-5 on the command as it stands (``slid``: the sliding stage's)."""
+def command_stages(A: Array, command: Array, b: Array, f: Factor, w: Array, z: Array,
+                   fits: bool, boxed: Array, u_box: float, rows: Rows, slid: bool, dt: float,
+                   threshold: float, rate_factor: float, need_null: bool) -> Top:  # fmt: skip
+    """Stages 1 and 3-5 on the command ``b`` as it stands (``slid``: the sliding stage's; the
+    report along ``command``, the one given).
+    """  # noqa: D205
     outside_range = not f.regular and not met(f.J, z, b)
-    top = exact(A, b, f, w, fits, rows, slid, outside_range, rate_factor, need_null)
+    top = exact(A, command, f, w, fits, rows, slid, outside_range, rate_factor, need_null)
     if top.status == FAILED:
-        top = scaled(A, b, f, w, boxed, u_box, rows, slid, outside_range, dt, threshold,
-                     rate_factor)  # fmt: skip
+        top = scaled(A, command, b, f, w, boxed, u_box, rows, slid, outside_range, dt,
+                     threshold, rate_factor)  # fmt: skip
     return top
 
 
 @inlined
 def least_squares_top(A: Array, b: Array, per_unit: Array, rows: Rows, recovering: bool,
-                      rate_factor: float, need_null: bool) -> Top:  # fmt: skip
+                      rate_factor: float, need_null: bool, threshold: float) -> Top:  # fmt: skip
     """The top level of the tracking and weighted modes: its least squares within the
     constraints (with slide rows: damped where the optimum breaks them, as the sliding stage;
     ``recovering`` where a joint or row must be restored).
@@ -368,7 +367,15 @@ def least_squares_top(A: Array, b: Array, per_unit: Array, rows: Rows, recoverin
     if rows.slide.any():
         f, w = factor.least_norm(factor.qr(A), b)
         if not (kernels.inside(w, rows.lb, rows.ub) and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
-            code, w = slid_command(backend_calls.TOP, A, b, rows.G, rows.h, rows)
+            # where no rates meet them all, the pairs asked apart are only kept apart
+            # (rrc_pin.solvers.tick.pipeline._damped_within)
+            relaxed = np.where((rows.slide != 0.0) & (rows.h < 0.0), 0.0, rows.h)
+            relaxes = (relaxed != rows.h).any()
+            where = backend_calls.SLIDE_RELAXING if relaxes else backend_calls.TOP
+            code, w, f = slid_command(where, A, b, rows.G, rows.h, rows, f, threshold)
+            if code != 0 and relaxes:
+                code, w, f = slid_command(backend_calls.TOP, A, b, rows.G, relaxed, rows, f,
+                                          threshold)  # fmt: skip
             if code != 0:
                 return passing(w, np.empty((0, n)))
         null = factor.null_basis(f)[1] if need_null else np.empty((0, n))
