@@ -41,7 +41,15 @@ import numpy as np
 import numpy.typing as npt
 
 import rrc_pin
-from rrc_pin import CollisionLimit, CollisionModel, FrameTask, JointLimits, PostureTask, Resolver
+from rrc_pin import (
+    CollisionLimit,
+    CollisionModel,
+    FrameTask,
+    JointLimits,
+    PostureTask,
+    QPOptions,
+    Resolver,
+)
 
 Array = npt.NDArray[np.float64]
 
@@ -52,6 +60,9 @@ SIZES = (1.0, 1.0, 1.0, 1e-3, 10.0, 300.0)
 """Factors on a segment's commands, drawn uniformly."""
 STILL = 1e-9
 """A scale below this stands still along the command: its veer is not compared."""
+UNHURRIED = QPOptions(time_limit=10.0)
+"""The backend's time cap: far beyond any answer, so that the machine's load (which the default
+cap of 50 ms turns into a fallback on a slow call) does not change the answers."""
 SEED = 20261206
 """The recording's seed (every case draws from ``(SEED, its index)``)."""
 
@@ -89,7 +100,7 @@ def _twist_case(robot: rrc_pin.Robot, mode: str) -> Callable[[], Solve]:
             options["damping"] = None
         elif mode == "limits":
             options["limits"] = JointLimits(margin=0.01, acceleration=40.0)
-        resolver = Resolver(robot, DT, **options)
+        resolver = Resolver(robot, DT, qp=UNHURRIED, **options)
         if mode == "limits":
             return lambda q, x, prev: resolver.solve(q, x, qdot_prev=prev)
         return lambda q, x, prev: resolver.solve(q, x)
@@ -101,7 +112,7 @@ def _tasks_case(robot: rrc_pin.Robot, frames: tuple[str, ...], mode: str) -> Cal
     rows = "full" if robot.nv >= 6 else "position"
 
     def make() -> Solve:
-        resolver = Resolver(robot, DT)
+        resolver = Resolver(robot, DT, qp=UNHURRIED)
         hands = [FrameTask(f, rows=rows) for f in frames]
         posture = PostureTask(robot.neutral(), gain=1.0, weight=0.01)
 
@@ -127,7 +138,8 @@ def _table() -> Case:
     cm.add_box(T, (0.6, 0.8, 0.04), name="table")
 
     def make() -> Solve:
-        resolver = Resolver(panda, DT, limits=[JointLimits(), CollisionLimit(cm, 0.02, 0.1)],
+        resolver = Resolver(panda, DT, qp=UNHURRIED,
+                            limits=[JointLimits(), CollisionLimit(cm, 0.02, 0.1)],
                             task=FrameTask(panda.tool_frame, rows="position"))  # fmt: skip
         return lambda q, x, prev: resolver.solve(q, x)
 
@@ -144,7 +156,8 @@ def _facing() -> Case:
     cm = CollisionModel(robot, "capsules")
 
     def make() -> Solve:
-        resolver = Resolver(robot, DT, limits=[JointLimits(), CollisionLimit(cm, 0.02, 0.1)])
+        resolver = Resolver(robot, DT, qp=UNHURRIED,
+                            limits=[JointLimits(), CollisionLimit(cm, 0.02, 0.1)])
         hands = [FrameTask(f, rows="position") for f in robot.tool_frames]
 
         def solve(q: Array, x: Array, prev: Array) -> Any:
@@ -257,6 +270,7 @@ def _answers(resolutions: list[Any]) -> dict[str, Any]:
         "status": np.array([r.status for r in resolutions]),
         "method": np.array([r.method for r in resolutions]),
         "levels": np.array([",".join(r.levels) for r in resolutions]),
+        "backend": np.array([r.backend for r in resolutions]),
         "scale": np.array([r.scale for r in resolutions]),
         "veer": np.array([r.veer for r in resolutions]),
         "lambda_sq": np.array([r.lambda_sq for r in resolutions]),
@@ -294,10 +308,11 @@ def replay(data: Any, case: Case, first: int | None = None) -> dict[str, Any]:
 def differences(data: Any, name: str, now: dict[str, Any]) -> dict[str, Any]:
     """The largest differences between the recorded answers of case ``name`` and ``now``."""
     k = len(now["qdot"])
-    old = {key: data[f"{name}/{key}"][:k] for key in now}
+    old = {key: data[f"{name}/{key}"][:k] for key in now if f"{name}/{key}" in data}
     scale = np.maximum(1.0, np.abs(old["qdot"]).max(axis=1))
     rates = np.abs(now["qdot"] - old["qdot"]).max(axis=1) / scale
     same = {key: old[key] == now[key] for key in ("status", "method", "levels")}
+    kernels = old["backend"] == "" if "backend" in old else np.ones(k, dtype=bool)
     moving = np.maximum(old["scale"], now["scale"]) > STILL
     # the angle of rates standing still along the command is the rounding of a zero's
     return {
@@ -309,6 +324,7 @@ def differences(data: Any, name: str, now: dict[str, Any]) -> dict[str, Any]:
         "differ": {key: np.flatnonzero(~s).tolist() for key, s in same.items() if not s.all()},
         "status": old["status"],
         "per_tick": rates,
+        "kernels": kernels,
     }
 
 
@@ -317,11 +333,16 @@ def compare(path: Path, first: int | None, tolerance: float) -> int:
     data = np.load(path)
     known = {case.name: case for case in cases()}
     failures, worst, total = 0, 0.0, 0
+    by_source = {"kernels": [0, 0.0], "backend": [0, 0.0]}  # ticks, largest difference
     by_status: dict[str, float] = {}
     for name in data["cases"].tolist():
         found = differences(data, name, replay(data, known[name], first))
         total += found["ticks"]
         worst = max(worst, found["rates"])
+        for source, mask in (("kernels", found["kernels"]), ("backend", ~found["kernels"])):
+            by_source[source][0] += int(mask.sum())
+            by_source[source][1] = max(by_source[source][1],
+                                       float(found["per_tick"][mask].max(initial=0.0)))  # fmt: skip
         for status, d in zip(found["status"].tolist(), found["per_tick"].tolist(), strict=True):
             by_status[status] = max(by_status.get(status, 0.0), d)
         bad = found["rates"] > tolerance or found["differ"]
@@ -335,6 +356,8 @@ def compare(path: Path, first: int | None, tolerance: float) -> int:
         f"{total} ticks, largest relative rate difference {worst:.3g}; per status "
         + ", ".join(f"{k} {v:.3g}" for k, v in sorted(by_status.items()))
     )
+    print("the old tick's answers from " + ", ".join(
+        f"its {k}: {n} ticks, largest {d:.3g}" for k, (n, d) in by_source.items()))
     print(f"{failures} cases beyond {tolerance:g} or with another status, method or levels")
     return 1 if failures else 0
 
