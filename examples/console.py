@@ -1,13 +1,13 @@
 """The operator's console in the browser, and the same console driven from Python.
 
-Shows: ``rrc_pin.console.Console`` serving barker6 on a local port (open the printed address in
-a browser: the arm in 3-D, the sliders, the deadman, the readouts). A page's controls only post
-commands to the console's mailbox, which its control loop reads at every tick; this script
-posts the same commands itself, as a page would: latch the deadman, command the hand along its
-own z axis, record, stop, retrace the record (Barker's evacuation), and reads back where the
-hand went and how regularly the loop ticked. Then it serves the page until Ctrl-C. Needs the
-console extra: ``pip install -e ".[console]"`` (``pip install -e .`` and viser); without viser
-it says so.
+Shows: ``rrc_pin.console.Console`` serving barker6 on a local port (open the printed address,
+its token included, in a browser: the arm in 3-D, the sliders, the deadman, the readouts). A
+page's controls only post commands to the console's mailbox, which its control loop reads at
+every tick; this script posts the same commands itself, as a page would: latch the deadman,
+command the hand along its own z axis, record, stop, retrace the record (Barker's evacuation),
+and reads back where the hand went and how regularly the loop ticked. Then it serves the page
+until Ctrl-C. Needs the console extra: ``pip install -e ".[console]"`` (``pip install -e .``
+and viser); without viser it says so.
 
 Run: ``python examples/console.py``
 """

@@ -188,7 +188,18 @@ def parser() -> argparse.ArgumentParser:
     robot.add_argument("--cell", default=None, metavar="NAME", help="a cell of several arms")
     console.add_argument("--port", type=int, default=8080, help="port (the next free one if taken)")
     console.add_argument(
-        "--host", default="127.0.0.1", help="interface to serve on (default: this machine only)"
+        "--host",
+        default="127.0.0.1",
+        help="interface to serve on (default: this machine only; any other needs a token of your "
+        "own, and the traffic is plain HTTP: prefer an SSH tunnel)",
+    )
+    console.add_argument(
+        "--token",
+        default=None,
+        metavar="SECRET",
+        help="the secret every page must show (16 characters or more of letters, digits and "
+        "-_.~); default: $RRC_PIN_CONSOLE_TOKEN, else a new one at each start, printed with "
+        "the address; prefer the variable: a command line is visible to every user",
     )
     console.add_argument("--rate", type=float, default=100.0, help="control loop rate [Hz]")
     console.add_argument(
@@ -260,11 +271,14 @@ def console_command(args: argparse.Namespace) -> int:
     if not _installed("viser"):
         print('rrc-pin console: viser not installed: pip install -e ".[console]"', file=sys.stderr)
         return 2
-    from rrc_pin.console import Console, console_robot
+    from rrc_pin.console import Access, Console, console_robot
+    from rrc_pin.console.access import TOKEN_ENV
 
+    token = args.token or os.environ.get(TOKEN_ENV) or None
+    Access(args.host, token)  # a bad token, or none for the network: said before loading
     robot = console_robot(args.arm, args.cell)
     console = Console(robot, host=args.host, port=args.port, rate=args.rate, out=args.out,
-                      realtime=args.realtime)  # fmt: skip
+                      realtime=args.realtime, token=token)  # fmt: skip
     console.serve_forever()
     return 0
 

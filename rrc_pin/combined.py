@@ -124,12 +124,19 @@ def _entry(key: object, value: object) -> tuple[Robot, pin.SE3]:
 
 
 def prefixed(model: pin.Model, prefix: str) -> pin.Model:
-    """A copy of ``model`` with every joint and frame name but the universe's prefixed."""
+    """A copy of ``model`` with every joint and frame name but the universe's prefixed.
+
+    A fixed joint's frame that shares its name with a body's (a URDF may name a fixed joint
+    after its child link, as z1's ``gripperStator``) is named ``<name>_joint``: appending a
+    model refuses a frame name it cannot tell apart without its type.
+    """
     out = pin.Model(model)
     for j in range(1, out.njoints):
         out.names[j] = prefix + out.names[j]
+    bodies = {f.name for f in model.frames if f.type == pin.FrameType.BODY}
     for i in range(1, len(out.frames)):
         frame = out.frames[i]  # a copy: rename it, then store it back
-        frame.name = prefix + frame.name
+        clash = frame.type == pin.FrameType.FIXED_JOINT and frame.name in bodies
+        frame.name = prefix + frame.name + ("_joint" if clash else "")
         out.frames[i] = frame
     return out

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import importlib
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -335,6 +336,8 @@ def test_a_swinging_leg_moves_while_two_feet_carry_the_body(tripod):
         ({"object": [0, 0, np.nan, 0, 0, 0]}, r"commands\['object'\]"),
         ({"object": np.zeros(5)}, r"commands\['object'\]"),
         ({"object": (np.zeros(6), "hand")}, r"commands\['object'\]: ref 'hand'"),
+        ({"object": (np.zeros(6), "base")},
+         r"commands\['object'\]: ref 'base' is a hand's arm base axes; 'object' is an object"),
     ],
 )
 def test_bad_commands_raise_naming_the_argument_and_change_nothing(dual, commands, match):
@@ -354,20 +357,57 @@ def test_a_foot_in_support_cannot_be_commanded(tripod):
         ctl.step({"leg2": np.zeros(6)})
 
 
-def test_free_hands_take_world_local_and_base_axes(dual):
-    """With no object held, each hand follows its own command in the frame named."""
+def test_free_hands_take_every_frame_and_their_base_axes(dual):
+    """With no object held, each hand follows its own command in the frame named: its
+    velocity in base axes (also a plain twist), hand axes, its arm's base axes, or the
+    spatial twist at the base origin (the hand's velocity ``v + w x p``)."""
     cell = rrc_pin.cells.make_cell(
         {k: (a.robot, a.base) for k, a in dual.arms.items()}, name="free",
         ready={k: dual.ready()[a.q] for k, a in dual.arms.items()},
     )  # fmt: skip
     twist = np.array([0.02, -0.01, 0.03, 0.0, 0.1, 0.0])
-    for ref in ("world", "local", "base"):
+    T0 = cell.fk(cell.ready(), "left/tool")
+    R = {"world_aligned": np.eye(3), "local": T0[:3, :3], "base": cell.arms["left"].base[:3, :3]}
+    for ref in (None, "world_aligned", "local", "base", "world"):
         ctl = CellController(cell, 0.01, q0=cell.ready())
-        T0 = cell.fk(ctl.q, "left/tool")
-        r = ctl.step({"left": (twist, ref), "right": np.zeros(6)}).resolution
-        R = {"world": np.eye(3), "local": T0[:3, :3], "base": cell.arms["left"].base[:3, :3]}[ref]
+        command = twist if ref is None else (twist, ref)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FutureWarning)  # "world"'s (tested below)
+            r = ctl.step({"left": command, "right": np.zeros(6)}).resolution
         achieved = cell.jacobian(ctl.log[-1].q, "world_aligned", "left/tool") @ r.qdot
-        np.testing.assert_allclose(achieved, np.r_[R @ twist[:3], R @ twist[3:]], atol=1e-9)
+        if ref == "world":
+            want = np.r_[twist[:3] + np.cross(twist[3:], T0[:3, 3]), twist[3:]]
+        else:
+            axes = R[ref or "world_aligned"]
+            want = np.r_[axes @ twist[:3], axes @ twist[3:]]
+        np.testing.assert_allclose(achieved, want, atol=1e-9)
+
+
+def test_a_world_command_warns_once_that_it_meant_world_aligned(dual, tripod):
+    """'world' meant world_aligned before this release (it is Pinocchio's WORLD now): one
+    FutureWarning per controller, naming the old meaning; the other frames never warn."""
+    ctl = CellController(dual, 0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ctl.step({"object": [0.01, 0, 0, 0, 0, 0]})
+        ctl.step({"object": ([0.01, 0, 0, 0, 0, 0], "world_aligned")})
+        ctl.step({"object": ([0.01, 0, 0, 0, 0, 0], "local")})
+    with pytest.warns(FutureWarning, match="before this release it meant 'world_aligned'") as w:
+        ctl.step({"object": ([0.01, 0, 0, 0, 0, 0], "world")})
+    assert len(w) == 1 and w[0].filename == __file__  # blamed on the caller's line
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ctl.step({"object": ([0.01, 0, 0, 0, 0, 0], "world")})  # once per controller
+    with pytest.warns(FutureWarning, match="spatial twist at the cell's base origin"):
+        CellController(tripod, 0.01).step({"body": (np.zeros(6), "world")})
+
+
+def test_base_axes_are_a_hands_only(tripod):
+    ctl = CellController(tripod, 0.01)
+    with pytest.raises(InvalidInput, match="ref 'base' is a hand's arm base axes; 'body' is the "
+                       "body: expected world_aligned, local or world"):  # fmt: skip
+        ctl.step({"body": (np.zeros(6), "base")})
+    assert ctl.t == 0.0
 
 
 @pytest.mark.parametrize(("name", "command"), [("object", [0.05, 0.0, 0.02, 0.0, 0.0, 0.1]),

@@ -109,13 +109,28 @@ def run_console_script(*args: str, close_stdout: bool = False) -> subprocess.Com
          "rrc-pin console: --cell: 'no_such_cell' does not load as a cell"),
         (["console", "--rate", "0"], "rrc-pin console: rate: expected a finite number > 0"),
         (["console", "--port", "70000"], "rrc-pin console: port: expected a port number"),
+        (["console", "--host", "0.0.0.0"],
+         "rrc-pin console: token: serving on '0.0.0.0' lets every machine that reaches it"),
+        (["console", "--token", "short"], "rrc-pin console: token: expected a secret of at least"),
     ],
 )
-def test_errors_are_one_line_and_exit_code_2(args, message, capsys):
+def test_errors_are_one_line_and_exit_code_2(args, message, capsys, monkeypatch):
     """Issue 7 item 7, issue 18 item 12: a traceback, or a check of nothing that passed."""
+    monkeypatch.delenv("RRC_PIN_CONSOLE_TOKEN", raising=False)
     assert main(args) == 2
     err = capsys.readouterr().err.splitlines()
     assert len(err) == 1 and err[0].startswith(message), err
+
+
+def test_the_console_takes_its_token_from_the_environment(capsys, monkeypatch):
+    from rrc_pin.console.access import TOKEN_ENV
+
+    monkeypatch.setenv(TOKEN_ENV, "too short")
+    assert main(["console", "--host", "0.0.0.0"]) == 2
+    assert "token: expected a secret of at least 16 characters" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["console", "--help"])
+    assert f"${TOKEN_ENV}" in capsys.readouterr().out  # the help names the variable read
 
 
 def test_errors_are_one_line_from_the_console_script_too():

@@ -152,3 +152,15 @@ def test_the_result_keeps_its_arms_and_their_placements(cell):
     for part, (arm, T) in zip(robot.parts, arms.values(), strict=True):
         assert part.robot is arm
         np.testing.assert_allclose(part.T_base, T, atol=1e-15)
+
+
+def test_a_fixed_joint_named_after_its_link_joins_a_cell(rng):
+    """z1's URDF names a fixed joint after its child link (two frames ``gripperStator``, a
+    fixed joint's and a body's): the joint's frame is ``<name>_joint`` in the cell, the arm's
+    kinematics unchanged."""
+    z1 = rrc_pin.load("z1")
+    pair = combine({"a": (z1, np.eye(4)), "b": (z1, placement(rng))})
+    names = [f.name for f in pair.model.frames]
+    assert names.count("a/gripperStator") == 1 and "a/gripperStator_joint" in names
+    q = z1.random_q(rng)
+    assert np.allclose(pair.fk(np.concatenate([q, q]), pair.tool_frames[0]), z1.fk(q), atol=1e-12)

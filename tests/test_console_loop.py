@@ -60,13 +60,17 @@ def test_the_hand_moves_along_the_commanded_axis(name, request):
 
 def test_released_deadman_fades_the_command_and_stop_is_immediate(barker6):
     loop = ControlLoop(barker6, rate=100.0)
+    assert loop.halted == -1
     moved(loop, 20, cmd.Latch(True), cmd.Velocity(np.array([0.04, 0, 0, 0, 0, 0])))
     d = moved(loop, 100, cmd.Latch(False))  # the controller's deadman: 0.2 s, then a 0.3 s fade
     assert 0.004 < np.linalg.norm(d) < 0.02
     assert np.linalg.norm(moved(loop, 10)) < 1e-9 and not loop.snapshot.enabled
     moved(loop, 20, cmd.Latch(True), cmd.Velocity(np.array([0.04, 0, 0, 0, 0, 0])))
+    loop.clock.tick()
+    loop.mailbox.post(cmd.Latch(True))  # before the STOP in the same tick: the STOP wins
     loop.mailbox.post(cmd.Stop())
     loop.tick(10.0)  # a zero command at once: only the drift correction's pull remains
+    assert loop.halted == loop.clock.ticks == 1
     assert (
         np.linalg.norm(loop.ctl.robot.jacobian(loop.ctl.q)[:3] @ loop.snapshot.resolution.qdot)
         < 1e-3

@@ -7,7 +7,7 @@ import threading
 import pytest
 
 from rrc_pin.console import commands as cmd
-from rrc_pin.console.mailbox import Mailbox
+from rrc_pin.console.mailbox import Mailbox, urgent
 from rrc_pin.errors import InvalidInput
 
 
@@ -27,6 +27,25 @@ def test_a_full_mailbox_drops_the_oldest_and_counts():
     assert [c.value for c in box.drain()] == [0.2, 0.3, 0.4]
     assert box.dropped == 2
     assert box.posted == 5
+
+
+def test_a_full_mailbox_never_drops_a_stop_or_a_release_for_another_command():
+    box = Mailbox(capacity=3)
+    box.post(cmd.Stop())
+    for k in range(5):
+        box.post(cmd.Speed(k / 10))
+    box.post(cmd.Latch(False))
+    assert box.drain() == [cmd.Stop(), cmd.Speed(0.4), cmd.Latch(False)]
+    assert box.dropped == 4
+    full = Mailbox(capacity=2)
+    full.post(cmd.Released())
+    full.post(cmd.Stop())
+    full.post(cmd.Latch(True))  # not urgent, and no room: this one goes
+    full.post(cmd.Latch(False))  # urgent: the oldest urgent one goes
+    assert full.drain() == [cmd.Stop(), cmd.Latch(False)]
+    assert (full.dropped, full.posted) == (2, 4)
+    kinds = (cmd.Stop(), cmd.Released(), cmd.Latch(False), cmd.Latch(True), cmd.Hold())
+    assert [urgent(c) for c in kinds] == [True, True, True, False, False]
 
 
 def test_posting_threads_and_a_draining_reader_lose_nothing_but_the_dropped():

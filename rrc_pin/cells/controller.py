@@ -14,15 +14,17 @@ What each command becomes (the cooperative commands):
   support as fixed contacts (:class:`~rrc_pin.limits.ContactLimit`, equality rows that every
   level is solved within); a leg lifted with :meth:`CellController.swing` is commanded like
   a free hand, and :meth:`CellController.land` puts it back in support;
-- a **free hand**: its twist with a target pose, in the cell's world axes, its own hand
-  axes or its arm's base axes.
+- a **free hand**: its twist with a target pose, in any of the frames below or its arm's
+  base axes.
 
-Every command is a twist [v; w] (6,) [m/s, rad/s] of the commanded frame's origin, in the
-frame named by its ref (``"world"``: the cell's base axes; ``"local"``: the commanded
-frame's own axes; ``"base"``: the arm's base axes, for a hand). The target poses are the
-drift correction: each advances by the command times the achieved scale, and the tasks feed
-their pose error back (gain ``gain``). Below the top level a posture task pulls toward the
-ready pose (the redundancy's use).
+Every command is a twist [v; w] (6,) [m/s, rad/s] in the frame named by its ref, the words of
+every entry point (:mod:`rrc_pin.solvers.spatial`, Pinocchio's ``ReferenceFrame``):
+``"world_aligned"`` (the default: the commanded frame's velocity in the cell's base axes),
+``"local"`` (the same in the commanded frame's own axes) or ``"world"`` (the spatial twist at
+the cell's base origin); a hand also takes ``"base"`` (its velocity in its arm's base axes).
+The target poses are the drift correction: each advances by the command times the achieved
+scale, and the tasks feed their pose error back (gain ``gain``). Below the top level a
+posture task pulls toward the ready pose (the redundancy's use).
 
 The closed chains (grips, feet in support) are kept closed inside each tick: the error
 each shows at the tick's configuration and the step's second order are taken out by a
@@ -39,6 +41,7 @@ every command, the configuration is integrated on its manifold, the ticks go to 
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Literal
@@ -61,6 +64,7 @@ from rrc_pin.loading import load
 from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import frame_index
 from rrc_pin.solvers.checks import as_vector, positive
+from rrc_pin.solvers.spatial import to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.kernels import scale_and_veer
 from rrc_pin.solvers.tick.problem import TaskRows
@@ -68,10 +72,11 @@ from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.tasks import FrameTask, PostureTask, Task
 
 Array = npt.NDArray[np.float64]
-Ref = Literal["world", "local", "base"]
-REFS: tuple[str, ...] = ("world", "local", "base")
+Ref = Literal["world_aligned", "local", "world", "base"]
+REFS: tuple[Ref, ...] = ("world_aligned", "local", "world", "base")
+"""The frames a command's twist may be given in: every entry point's, and a hand's ``base``."""
 Command = npt.ArrayLike | tuple[npt.ArrayLike, str]
-"""A twist (6,) in the cell's world axes, or ``(twist, ref)``."""
+"""A twist (6,) in ``world_aligned``, or ``(twist, ref)``."""
 REANCHOR = ("singular", "least_squares", "recovering", "fallback")
 """Statuses whose motion is not the command's (part of it out of reach, or another problem's
 answer): the targets are reset to the reached poses instead of pulling back toward poses
@@ -186,6 +191,7 @@ class CellController(Loop):
         self._anchors: dict[str, Array] = {}
         self._grips: dict[str, Array] = {}
         self._commands: dict[str, Array] = {}
+        self._world_warned = False
         self._targets: dict[str, Array] = {}
         self._tick: tuple[str, bool, dict[str, Array]] = ("teleop", False, {})
         self._applied = np.zeros(cell.nv)
@@ -264,11 +270,12 @@ class CellController(Loop):
         """Resolve and integrate one tick.
 
         Args:
-            commands: Name (:meth:`commandable`) -> twist (6,) [m/s, rad/s] in the cell's
-                world axes, or ``(twist, ref)`` with ref ``"world"``, ``"local"`` (the
-                commanded frame's axes) or ``"base"`` (a hand's arm base axes). Names not
-                given are held still; None: no new command (the last ones age, see
-                ``deadman``).
+            commands: Name (:meth:`commandable`) -> twist (6,) [m/s, rad/s] of the
+                commanded frame in ``world_aligned``, or ``(twist, ref)`` with ref
+                ``"world_aligned"``, ``"local"``, ``"world"`` (module docstring; ``"world"``
+                meant ``"world_aligned"`` before this release and warns once) or, for a hand,
+                ``"base"`` (its arm's base axes). Names not given are held still; None: no
+                new command (the last ones age, in their frames, see ``deadman``).
 
         Returns:
             The configuration after the tick and its resolution: the rates applied (the
@@ -286,7 +293,7 @@ class CellController(Loop):
         weight = self._weight()
         cell = self.cell
         poses = {name: cell.fk(self._q, self.frame_of(name)) for name in self._targets}
-        twists = {name: weight * self._in_world(name, poses[name], self._commands[name])
+        twists = {name: weight * self._world_aligned(name, poses[name], self._commands[name])
                   if name in self._commands else np.zeros(6) for name in self._targets}  # fmt: skip
         top: list[Task] = []
         hands: list[Task] = []
@@ -508,29 +515,44 @@ class CellController(Loop):
         for name, value in commands.items():
             label = f"commands[{name!r}]"
             self._check_name(name, "commands")
-            ref = "world"
+            ref = "world_aligned"
             if isinstance(value, tuple) and len(value) == 2 and isinstance(value[1], str):
                 value, ref = value
-            if ref not in REFS or (ref == "base" and name not in self.cell.arms):
-                raise InvalidInput(label, f"ref {ref!r}: expected world, local, or base (for a "
-                                   "hand)")  # fmt: skip
+            if ref not in REFS:
+                raise InvalidInput(label, f"ref {ref!r}: expected world_aligned, local, world, "
+                                   "or base (a hand's arm base axes)")  # fmt: skip
+            if ref == "base" and name not in self.cell.arms:
+                raise InvalidInput(label, f"ref 'base' is a hand's arm base axes; {name!r} is "
+                                   f"{'the body' if name == self.cell.body else 'an object'}: "
+                                   "expected world_aligned, local or world")  # fmt: skip
             twist = as_vector(value, label, 6)
             out[name] = np.concatenate([twist, [REFS.index(ref)]])
+        if any(c[6] == REFS.index("world") for c in out.values()):
+            self._warn_world()
         return out
 
-    def _in_world(self, name: str, pose: Array, command: Array) -> Array:
-        """A checked command (twist and its ref's index) as a twist in world axes."""
+    def _warn_world(self) -> None:
+        """Warn once per controller that a ``"world"`` command now means Pinocchio's WORLD."""
+        if not self._world_warned:
+            self._world_warned = True
+            warnings.warn(
+                "CellController.step: ref 'world' is the spatial twist at the cell's base "
+                "origin, as at every entry point; before this release it meant 'world_aligned' "
+                "(the commanded frame's velocity in base axes, the default): pass "
+                "'world_aligned' or a plain twist for that motion",
+                FutureWarning,
+                stacklevel=4,
+            )
+
+    def _world_aligned(self, name: str, pose: Array, command: Array) -> Array:
+        """A checked command (twist and its ref's index) in ``world_aligned`` at ``pose`` (4, 4)."""
         twist, ref = command[:6], REFS[int(command[6])]
-        if ref == "world":
-            return twist
-        if ref == "local":
-            R = pose[:3, :3]
-        else:  # the arm's base axes: the body's pose times the base placement
-            arm = self.cell.arms[name]
-            R = arm.base[:3, :3]
-            if self.cell.body is not None:
-                R = self.cell.fk(self._q, self.cell.body)[:3, :3] @ R
-        return np.concatenate([R @ twist[:3], R @ twist[3:]])
+        if ref != "base":
+            return to_world_aligned(twist, pose[:3, :3], pose[:3, 3], ref)
+        R = self.cell.arms[name].base[:3, :3]  # the arm's base axes: on the body, if any
+        if self.cell.body is not None:
+            R = self.cell.fk(self._q, self.cell.body)[:3, :3] @ R
+        return to_world_aligned(twist, R, pose[:3, 3], "local")  # the hand's velocity in axes R
 
     def _retarget(self) -> None:
         """Targets at the current poses of every commandable frame."""

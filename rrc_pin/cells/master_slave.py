@@ -3,7 +3,7 @@ r"""MasterSlave: a 6-DOF hand controller's pose increments as a slave frame's tw
 Nguyen & Zhou's testbed drives each slave arm from a 6-DOF Kraft mini-master. Each tick the
 master's pose change :math:`(\Delta p, \Delta R)` over the period :math:`\Delta t`, in the
 master's base axes, becomes a twist of the slave frame (a hand or a held object) in the
-cell's world axes:
+cell's base axes (``world_aligned``, a plain command of ``CellController.step``):
 
 .. math:: v = \frac{k_p\, R_{ms}\, \Delta p}{\Delta t}, \qquad
           \omega = \frac{R_{ms} \log(\Delta R)}{\Delta t}
@@ -56,7 +56,7 @@ class MasterSlave:
         return self._last is not None
 
     def update(self, master: npt.ArrayLike, clutch: bool) -> Array:
-        """The slave's twist (6,) [m/s, rad/s] in world axes for the master's pose now.
+        """The slave's twist (6,) [m/s, rad/s], ``world_aligned``, for the master's pose now.
 
         Args:
             master: The master's pose (4, 4) in its base frame [m].

@@ -8,7 +8,9 @@ thread at its own rate; the page only posts :mod:`~rrc_pin.console.commands` to 
 :class:`Mailbox`. viser is imported when a console starts, so this package imports without it.
 """
 
+from rrc_pin.console.access import Access
 from rrc_pin.console.app import Console, console_robot
+from rrc_pin.console.intake import Intake, TokenBucket
 from rrc_pin.console.loop import ControlLoop, Notice, start_pose
 from rrc_pin.console.mailbox import Mailbox
 from rrc_pin.console.operator import Operator, OperatorSettings
@@ -17,8 +19,10 @@ from rrc_pin.console.snapshot import Snapshot
 from rrc_pin.console.visuals import Visuals, visuals_of
 
 __all__ = [
+    "Access",
     "Console",
     "ControlLoop",
+    "Intake",
     "Mailbox",
     "Notice",
     "Operator",
@@ -27,6 +31,7 @@ __all__ = [
     "Rate",
     "Snapshot",
     "TickClock",
+    "TokenBucket",
     "Visuals",
     "console_robot",
     "start_pose",

@@ -4,8 +4,10 @@ Threads, from the robot outward:
 
 1. the control loop (:class:`~rrc_pin.console.loop.ControlLoop`): owns the controller, ticks
    at ``rate`` (100 Hz by default), reads the mailbox at every tick;
-2. viser's event loop and its thread pool: receive the pages' messages and run the panel's
-   callbacks, which only post commands to the mailbox;
+2. viser's event loop: checks every request and message (:mod:`~rrc_pin.console.guard`),
+   receives the pages' messages and runs the panel's callbacks in the order the messages
+   came, which only post commands to the mailbox; it asks for the loop's scheduling, a step
+   below (a STOP travels through it);
 3. the view (:class:`~rrc_pin.console.view.View`): reads the loop's latest snapshot at a lower
    rate and sends the scene and the readouts to the pages.
 
@@ -14,6 +16,7 @@ The loop never waits for a page or for the renderer; a page never touches the co
 
 from __future__ import annotations
 
+import logging
 import sys
 import threading
 from pathlib import Path
@@ -21,8 +24,10 @@ from typing import Any
 
 import numpy.typing as npt
 
+from rrc_pin.console.access import Access
 from rrc_pin.console.commands import Released, Target
-from rrc_pin.console.loop import ControlLoop
+from rrc_pin.console.intake import Intake
+from rrc_pin.console.loop import LOOP_NICE, REALTIME_PRIORITY, ControlLoop, schedule
 from rrc_pin.console.mailbox import Mailbox
 from rrc_pin.console.operator import OperatorSettings
 from rrc_pin.console.panel import Panel
@@ -33,6 +38,9 @@ from rrc_pin.errors import InvalidInput, RrcPinError
 from rrc_pin.loading import load
 from rrc_pin.robot import Robot
 
+LOG = logging.getLogger("rrc_pin.console")
+IO_PRIORITY = REALTIME_PRIORITY - 1
+"""Real-time priority of viser's event loop thread under ``realtime`` (below the loop's)."""
 SWITCH_INTERVAL = 2e-4
 """The interpreter's thread switch interval [s] while a console runs (default 5e-3): a thread
 holding the GIL (the view, a page's callback) gives it up to the waking loop this soon."""
@@ -43,7 +51,7 @@ class Console:
 
     Args:
         robot: The robot, or a name :func:`rrc_pin.load` takes.
-        host: Interface to serve on (default loopback only).
+        host: Interface to serve on (default loopback only); any other needs ``token``.
         port: Port; 0 takes a free one (see :attr:`url`).
         rate: Control loop rate [1/s].
         view_rate: Scene updates per second (the readouts 5 per second).
@@ -55,9 +63,18 @@ class Console:
         settings: Limits of the operator's controls.
         realtime: Run the control loop under real-time scheduling where permitted
             (:class:`~rrc_pin.console.loop.ControlLoop`).
+        token: The secret every page and websocket must show, at least 16 characters of
+            letters, digits and ``-_.~``; None makes one at each start (loopback only).
+        intake: What each connection may send (size, shape and rate of its messages).
+
+    Attributes:
+        access: Who may connect (:class:`~rrc_pin.console.access.Access`: its ``token``).
+        io_scheduling: How viser's event loop thread is scheduled (as the loop's
+            ``scheduling``, one real-time priority below it).
+        guard: The checks on viser's server once started (:class:`~rrc_pin.console.guard.Guard`).
 
     Raises:
-        InvalidInput: A bad argument, named.
+        InvalidInput: A bad argument, named; no ``token`` for a ``host`` beyond this machine.
         UnknownArm, URDFError: ``robot`` is a name that does not load.
     """
 
@@ -75,7 +92,13 @@ class Console:
         backend: str = "daqp",
         settings: OperatorSettings | None = None,
         realtime: bool = False,
+        token: str | None = None,
+        intake: Intake | None = None,
     ) -> None:
+        self.access = Access(host, token)
+        if intake is not None and not isinstance(intake, Intake):
+            raise InvalidInput("intake", f"expected a console.Intake, got {intake!r}")
+        self.intake = intake or Intake()
         self.robot = load(robot) if isinstance(robot, str) else robot
         if not isinstance(self.robot, Robot):
             raise InvalidInput("robot", f"expected a rrc_pin.Robot or a name, got {robot!r}")
@@ -87,6 +110,8 @@ class Console:
                                 settings=settings, strategy=strategy, backend=backend,
                                 realtime=realtime)  # fmt: skip
         self.server: Any = None
+        self.guard: Any = None
+        self.io_scheduling = "not started"
         self.scene: Scene | None = None
         self.panel: Panel | None = None
         self.view: View | None = None
@@ -95,10 +120,21 @@ class Console:
     def start(self) -> Console:
         """Serve the page, start the loop and the view; returns the console."""
         import viser
+        import viser.infra
+
+        from rrc_pin.console.guard import Guard
 
         visuals = visuals_of(self.robot)
-        self.server = viser.ViserServer(host=self.host, port=self.port, verbose=False)
-        server = self.server
+        self.server = server = viser.ViserServer(host=self.host, port=self.port, verbose=False)
+        self.guard = Guard(server, self.access, self.intake, viser.infra.Message.deserialize)
+        try:
+            self.guard.install()
+        except BaseException:
+            self.stop()
+            raise
+        if not self.access.loopback:
+            LOG.warning(exposed(self.host, self.server.get_port()))
+        server.get_event_loop().call_soon_threadsafe(self._schedule_io)
         server.gui.set_panel_label(f"rrc-pin console: {self.robot.name}")
         mailbox = self.loop.mailbox
         limits = self.loop.operator.settings
@@ -106,9 +142,10 @@ class Console:
                            on_target=lambda pose: mailbox.post(Target(pose)),
                            full=(limits.max_linear, limits.max_angular))  # fmt: skip
         self.panel = Panel(server, self.loop, self.out)
+        self.guard.urgent = self.panel.urgent
         self.view = View(server, self.loop, self.scene, self.panel, rate=self.view_rate)
 
-        def closed(client: Any) -> None:
+        async def closed(client: Any) -> None:  # on viser's event loop: at once
             if not server.get_clients():  # the last page went away: let go of the arm
                 mailbox.post(Released())
 
@@ -121,12 +158,22 @@ class Console:
         self.view.start()
         return self
 
+    def _schedule_io(self) -> None:
+        """Schedule viser's event loop thread (it runs there): the loop's way, a step below.
+
+        The thread that reads the pages, and carries STOP, asks for the loop's scheduling one
+        real-time priority below it (where the OS allows it): it does not wait for a core
+        behind other processes.
+        """
+        self.io_scheduling = schedule(self.loop.realtime, IO_PRIORITY, LOOP_NICE)[0]
+
     @property
     def url(self) -> str:
-        """The page's address (after :meth:`start`)."""
+        """The page's address with its token (after :meth:`start`): what the operator opens."""
         if self.server is None:
             raise InvalidInput("console", "not started")
-        return f"http://{self.host}:{self.server.get_port()}/"
+        host = f"[{self.host}]" if ":" in self.host else self.host
+        return f"http://{host}:{self.server.get_port()}/?token={self.access.token}"
 
     def stop(self) -> None:
         """Stop the view, the loop and the server."""
@@ -141,6 +188,9 @@ class Console:
     def serve_forever(self) -> None:
         """Start, print the address, and serve until interrupted (Ctrl-C)."""
         self.start()
+        if not self.access.loopback:
+            print(f"\n{'!' * 79}\n{exposed(self.host, self.server.get_port())}\n{'!' * 79}\n",
+                  file=sys.stderr, flush=True)  # fmt: skip
         print(f"rrc-pin console: {self.robot.name} at {self.url} (loop {self.loop.rate:g} Hz; "
               "Ctrl-C to stop)", flush=True)  # fmt: skip
         try:
@@ -155,6 +205,14 @@ class Console:
 
     def __exit__(self, *exc: object) -> None:
         self.stop()
+
+
+def exposed(host: str, port: int) -> str:
+    """The warning of a console served beyond this machine."""
+    return (f"rrc-pin console: serving on {host}, port {port}: every machine that reaches it and "
+            "holds the token drives the arm. The traffic (the token included) is plain HTTP, "
+            "readable on the network: serve 127.0.0.1 and reach it through an SSH tunnel "
+            "where the network is not yours alone.")  # fmt: skip
 
 
 def console_robot(arm: str | None, cell: str | None) -> Robot:

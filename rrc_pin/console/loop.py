@@ -27,7 +27,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.console import commands as cmd
-from rrc_pin.console.mailbox import Mailbox
+from rrc_pin.console.mailbox import Mailbox, urgent
 from rrc_pin.console.operator import Operator, OperatorSettings
 from rrc_pin.console.rate import Rate, TickClock
 from rrc_pin.console.snapshot import Mode, Snapshot
@@ -109,6 +109,8 @@ class ControlLoop:
         clock: The ticks' periods and work times (:class:`~rrc_pin.console.rate.TickClock`).
         skipped: Deadlines given up after a stall of more than a period.
         errors: Ticks that raised (each reported as a notice; the arm stopped).
+        halted: The tick (``clock.ticks``) that applied the last STOP or release of the arm
+            (:func:`~rrc_pin.console.mailbox.urgent`), or -1.
 
     Raises:
         InvalidInput: A bad argument, named (a strategy the arm cannot take included).
@@ -154,6 +156,7 @@ class ControlLoop:
         self.notices: collections.deque[Notice] = collections.deque(maxlen=50)
         self.errors = 0
         self.skipped = 0
+        self.halted = -1
         self._notice_id = 0
         self._job: _Job | None = None
         self._held_q: Array = self.ctl.q
@@ -208,14 +211,10 @@ class ControlLoop:
 
     def _schedule(self) -> str:
         """Ask the OS to schedule this (the loop's) thread as configured; say how it is."""
-        if self.realtime:
-            try:
-                os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(REALTIME_PRIORITY))
-                return f"SCHED_FIFO {REALTIME_PRIORITY}"
-            except (OSError, AttributeError) as exc:
-                self.notice("error", f"real-time scheduling refused ({exc}): a nice loop instead")
-        nice = set_nice(self.priority) if self.priority is not None else None
-        return "normal" if nice is None else f"nice {nice}"
+        how, refused = schedule(self.realtime, REALTIME_PRIORITY, self.priority)
+        if refused is not None:
+            self.notice("error", f"real-time scheduling refused ({refused}): a nice loop instead")
+        return how
 
     # -- one tick -----------------------------------------------------------------------------
 
@@ -230,6 +229,8 @@ class ControlLoop:
         """
         now = time.perf_counter() if now is None else now
         for command in self.mailbox.drain():
+            if urgent(command):
+                self.halted = self.clock.ticks
             try:
                 self._apply(command, now)
             except RrcPinError as exc:
@@ -507,6 +508,27 @@ REALTIME_PRIORITY = 10
 """``SCHED_FIFO`` priority of a real-time loop (1 to 99; kernel threads sit at 50)."""
 MIN_SLEEP = 5e-5
 """Shortest sleep [s] of a real-time loop's tick: an overrunning loop still yields its core."""
+
+
+def schedule(realtime: bool, priority: int, nice: int | None) -> tuple[str, str | None]:
+    """Ask the OS to schedule the calling thread as the console's threads are scheduled.
+
+    ``SCHED_FIFO`` at ``priority`` if ``realtime`` and permitted (Linux, root or
+    CAP_SYS_NICE), else at ``nice`` (if not None).
+
+    Returns:
+        How the thread is scheduled (``"SCHED_FIFO 10"``, ``"nice -10"``, ``"normal"``), and
+        why real-time scheduling was refused (None if it was not asked or was granted).
+    """
+    refused = None
+    if realtime:
+        try:
+            os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+            return f"SCHED_FIFO {priority}", None
+        except (OSError, AttributeError) as exc:
+            refused = str(exc)
+    value = set_nice(nice) if nice is not None else None
+    return ("normal" if value is None else f"nice {value}"), refused
 
 
 def set_nice(value: int) -> int | None:

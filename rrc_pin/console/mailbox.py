@@ -5,17 +5,24 @@ from __future__ import annotations
 import threading
 from collections import deque
 
-from rrc_pin.console.commands import Command
+from rrc_pin.console.commands import Command, Latch, Released, Stop
 from rrc_pin.errors import InvalidInput
+
+
+def urgent(command: Command) -> bool:
+    """Whether ``command`` stops or releases the arm: STOP, the latch let go, no page left."""
+    return isinstance(command, (Stop, Released)) or (isinstance(command, Latch) and not command.on)
 
 
 class Mailbox:
     """A bounded, thread-safe queue of commands: many posters, one reader (the loop).
 
-    The page's callbacks run in viser's threads and only :meth:`post`; the loop
-    :meth:`drain` s it once per tick and applies the commands in order. When more than
-    ``capacity`` commands wait (a page flooding the server), the oldest are dropped and
-    counted: the loop's memory and its time per tick stay bounded whatever the page sends.
+    The page's callbacks :meth:`post`; the loop :meth:`drain` s it once per tick and applies
+    the commands in order, all before it steps: a STOP takes effect at the next tick whatever
+    came before it. When more than ``capacity`` commands wait (a loop stalled, a program
+    posting faster than the loop ticks), the oldest are dropped and counted, but never one
+    that stops or releases the arm (:func:`urgent`) while another can go: the loop's memory
+    and its time per tick stay bounded whatever is posted.
 
     Args:
         capacity: Most commands kept waiting, >= 1.
@@ -34,13 +41,26 @@ class Mailbox:
         self._posted = 0
 
     def post(self, command: Command) -> None:
-        """Queue ``command`` (any thread); the oldest waiting one is dropped when full."""
+        """Queue ``command`` (any thread); when full, the oldest that is not urgent is dropped."""
         with self._lock:
-            if len(self._queue) >= self.capacity:
-                self._queue.popleft()
-                self._dropped += 1
-            self._queue.append(command)
             self._posted += 1
+            if len(self._queue) >= self.capacity and not self._dropped_one(urgent(command)):
+                self._dropped += 1  # full of urgent ones, and this one is not
+                return
+            self._queue.append(command)
+
+    def _dropped_one(self, for_urgent: bool) -> bool:
+        """Drop the oldest command that is not urgent (or, for an urgent one, the oldest)."""
+        for i, waiting in enumerate(self._queue):
+            if not urgent(waiting):
+                del self._queue[i]
+                break
+        else:
+            if not for_urgent:
+                return False
+            self._queue.popleft()  # a later urgent command stops or releases the arm as well
+        self._dropped += 1
+        return True
 
     def drain(self) -> list[Command]:
         """Every waiting command, oldest first, removed from the queue (the loop's call)."""

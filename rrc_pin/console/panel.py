@@ -1,8 +1,13 @@
 """Panel: the console's controls; every event becomes one command posted to the mailbox.
 
-The callbacks run in viser's threads. They build a command (checked when made: a NaN, a
-string or a value beyond its slider's range from a page is refused there, the page told
-why and the control put back) and post it; they never touch the controller.
+The callbacks are coroutines: viser runs them on its event loop as each message arrives, in
+the order the messages came (a synchronous callback would wait in viser's thread pool, where
+a STOP queued behind a page's flood and a latch could overtake the STOP after it). They build
+a command (checked when made: a NaN, a string or a value beyond its slider's range from a
+page is refused there, the page told why and the control put back) and post it; they never
+touch the controller. Commands that make the loop build a new resolver or controller
+(backend, hand, home, load) pass at most :data:`REBUILDS_PER_SECOND` a second, the others
+refused to the page that sent them.
 
 Controls (folder by folder):
 
@@ -24,12 +29,13 @@ from __future__ import annotations
 
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Awaitable, Callable
 from pathlib import Path
 from typing import Any
 
 from rrc_pin.console import commands as cmd
 from rrc_pin.console.commands import AXES, FRAMES
+from rrc_pin.console.intake import TokenBucket
 from rrc_pin.console.loop import ControlLoop
 from rrc_pin.console.snapshot import Snapshot
 from rrc_pin.errors import InvalidInput, RrcPinError
@@ -40,6 +46,26 @@ KEYS: dict[str, tuple[int, int]] = {
 """Hotkey -> (linear axis, sign) of its jog; with Shift, the rotation about that axis."""
 HOLD_HZ = 20.0
 """Heartbeats per second of the hold-to-move button."""
+REBUILDS_PER_SECOND = 4.0
+"""Most backend, hand, home and load commands a second, all pages together (each costs the
+loop about a millisecond: a new resolver or controller)."""
+REBUILDS = (cmd.Backend, cmd.Hand, cmd.Home, cmd.Load)
+
+Callback = Callable[[Any], Awaitable[None]]
+
+
+def _now(action: Callable[[], None]) -> Callback:
+    """A callback doing ``action`` on viser's event loop, as its message arrives."""
+
+    async def callback(event: Any) -> None:
+        action()
+
+    return callback
+
+
+def _id(handle: Any) -> str | None:
+    """A viser element's id as its messages carry it (viser keeps it private), or None."""
+    return getattr(getattr(handle, "_impl", None), "uuid", None)
 
 
 def _jog(axis: int, sign: int) -> Callable[[Any], cmd.Jog]:
@@ -59,6 +85,7 @@ class Panel:
         sliders: The six velocity sliders, [vx, vy, vz, wx, wy, wz].
         joints, status: The readouts' HTML blocks (written by the view).
         errors: Refused page events (bad values) so far.
+        stop_button: The STOP button.
     """
 
     def __init__(self, server: Any, loop: ControlLoop, out: Path) -> None:
@@ -68,6 +95,7 @@ class Panel:
         self.out = out
         self.errors = 0
         self._stops = loop.operator.stops
+        self._rebuilds = TokenBucket(REBUILDS_PER_SECOND, 2, time.monotonic())
         s = loop.operator.settings
         gui = server.gui
         gui.configure_theme(control_width="large", dark_mode=False, show_logo=False)
@@ -89,19 +117,19 @@ class Panel:
                 slider.on_update(self._guard(self._velocity, reset=self._reset_sliders))
             self.frame.on_update(self._guard(self._velocity, reset=self._reset_sliders))
             zero = gui.add_button("zero the sliders")
-            zero.on_click(lambda e: self._zero())
+            zero.on_click(_now(self._zero))
             self.hold = gui.add_button("hold to move (deadman)", color="green")
             self.hold.on_hold(self._guard(lambda e: cmd.Hold()), callback_hz=HOLD_HZ)
             self.latch = gui.add_checkbox("deadman latched", False,
                                           hint="move without holding; released when the last "
                                                "page closes and at STOP")  # fmt: skip
             self.latch.on_update(self._guard(lambda e: cmd.Latch(bool(self.latch.value))))
-            stop = gui.add_button("STOP (space)", color="red")
-            stop.on_click(lambda e: self.stop())
+            self.stop_button = gui.add_button("STOP (space)", color="red")
+            self.stop_button.on_click(_now(self.stop))
             self.speed = gui.add_slider("speed override [%]", min=0, max=100, step=5,
                                         initial_value=100)  # fmt: skip
             self.speed.on_update(self._guard(lambda e: cmd.Speed(self.speed.value / 100.0),
-                                             reset=lambda: self._put(self.speed, 100)))  # fmt: skip
+                                             reset=self._reset_speed))  # fmt: skip
             drop = gui.add_button("drop the target")
             drop.on_click(self._guard(lambda e: cmd.Target(None)))
         with gui.add_folder("Readouts"):
@@ -110,10 +138,12 @@ class Panel:
         with gui.add_folder("Resolution", expand_by_default=False):
             self.strategy = gui.add_dropdown("strategy", loop.strategies,
                                              initial_value=loop.snapshot.strategy)  # fmt: skip
-            self.strategy.on_update(self._guard(lambda e: cmd.Strategy(self.strategy.value)))
+            self.strategy.on_update(self._guard(lambda e: cmd.Strategy(
+                cmd.one_of(self.strategy.value, "strategy", loop.strategies))))
             self.backend = gui.add_dropdown("backend", loop.backends,
                                             initial_value=loop.snapshot.backend)  # fmt: skip
-            self.backend.on_update(self._guard(lambda e: cmd.Backend(self.backend.value)))
+            self.backend.on_update(self._guard(lambda e: cmd.Backend(
+                cmd.one_of(self.backend.value, "backend", loop.backends))))
         with gui.add_folder("Trajectory", expand_by_default=False):
             self.record = gui.add_checkbox("record", False)
             self.record.on_update(self._guard(lambda e: cmd.Record(bool(self.record.value))))
@@ -135,18 +165,50 @@ class Panel:
                                           modifier="shift" if shift else None)  # fmt: skip
                 command.on_trigger(self._guard(_jog(which, sign)))
         space = gui.add_command("STOP", hotkey="space")
-        space.on_trigger(lambda e: self.stop())
+        space.on_trigger(_now(self.stop))
+        # Taken as their message arrives (urgent): viser keeps its elements' ids private, and
+        # without one of them that control's message goes the way of the others.
+        self._urgent = {uuid: how for uuid, how in (
+            (_id(self.stop_button), ("GuiUpdateMessage", True, self.stop)),
+            (_id(space), ("CommandTriggerMessage", None, self.stop)),
+            (_id(self.latch), ("GuiUpdateMessage", False, self._let_go)),
+        ) if uuid is not None}  # fmt: skip
 
     # -- events -------------------------------------------------------------------------------
 
+    def urgent(self, message: Any) -> Callable[[], None] | None:
+        """What to do at once for a page's message that stops or releases the arm, or None.
+
+        Those messages: the STOP button, the space key, the latch unchecked. The guard calls
+        it for every message as it arrives, ahead of the page's budget and of viser's dispatch
+        (:class:`~rrc_pin.console.guard.Guard`), which never sees the message: the action does
+        what the control's callback would.
+        """
+        how = self._urgent.get(str(getattr(message, "uuid", "")))
+        if how is None or type(message).__name__ != how[0]:
+            return None
+        if how[1] is not None and getattr(message, "updates", None) != {"value": how[1]}:
+            return None
+        return how[2]
+
+    def _let_go(self) -> None:
+        """The latch unchecked on a page: on every page, and to the loop."""
+        self._put(self.latch, False)
+        self.mailbox.post(cmd.Latch(False))
+
     def _guard(
         self, make: Callable[[Any], cmd.Command | None], reset: Callable[[], None] | None = None
-    ) -> Callable[[Any], None]:
+    ) -> Callback:
         """A callback posting ``make(event)``; a refused value is told to the page instead."""
 
-        def callback(event: Any) -> None:
+        async def callback(event: Any) -> None:
+            if getattr(event, "client", None) is None:
+                return  # a value the server set (viser calls back for those too): no request
             try:
                 command = make(event)
+                if isinstance(command, REBUILDS) and not self._rebuilds.take(time.monotonic()):
+                    raise InvalidInput("command", f"at most {REBUILDS_PER_SECOND:g} backend, hand,"
+                                       " home or load commands a second: try again")  # fmt: skip
             except (RrcPinError, TypeError, ValueError, OverflowError) as exc:
                 self.errors += 1
                 self._tell(event, " ".join(str(exc).split()))
@@ -169,6 +231,10 @@ class Panel:
         for slider, value in zip(self.sliders, twist, strict=True):
             self._put(slider, float(value))
         self._put(self.frame, self.loop.operator.frame)
+
+    def _reset_speed(self) -> None:
+        """Put back the speed override the loop has (after a refused value)."""
+        self._put(self.speed, round(100 * self.loop.ctl.speed))
 
     def _zero(self) -> None:
         for slider in self.sliders:
@@ -228,7 +294,7 @@ class Panel:
             client.add_notification("refused", text, color="red", auto_close_seconds=6.0)
 
     def _put(self, handle: Any, value: object) -> None:
-        """Set a control's value from the server (no callback runs)."""
+        """Set a control's value from the server (its callback skips it: no page sent it)."""
         if handle.value != value:
             handle.value = value
 

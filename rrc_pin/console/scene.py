@@ -75,7 +75,8 @@ class Scene:
         server: A ``viser.ViserServer``.
         robot: The robot.
         visuals: Its shapes.
-        on_target: Called with the gizmo's pose (4, 4) when the operator drags it.
+        on_target: Called with the gizmo's pose (4, 4) when the operator drags it, on viser's
+            event loop as the page's message arrives (it must not block).
         full: The sliders' full values [m/s, rad/s], drawn :data:`ARROW` of the reach long.
 
     Attributes:
@@ -144,7 +145,7 @@ class Scene:
         if on_target is not None:
             callback = on_target
 
-            def dragged(event: Any) -> None:
+            async def dragged(event: Any) -> None:  # on viser's event loop, in order
                 self._dragged = time.perf_counter()
                 pose = pose_of(self.gizmo.position, self.gizmo.wxyz)
                 if pose is None:  # a page sent a position or rotation that is not one

@@ -15,7 +15,7 @@ import threading
 import time
 from typing import Any
 
-from rrc_pin.console.loop import ControlLoop
+from rrc_pin.console.loop import LOOP_NICE, ControlLoop, set_nice
 from rrc_pin.console.panel import Panel
 from rrc_pin.console.readouts import Reader, joints_html, status_html
 from rrc_pin.console.scene import Scene
@@ -77,6 +77,7 @@ class View:
             self._thread.join(timeout)
 
     def _run(self) -> None:
+        set_nice(LOOP_NICE)
         while not self._stop.is_set():
             start = time.perf_counter()
             try:

@@ -38,7 +38,7 @@ k = 10), plus up to one device period of sample hold.
 Integration with a controller (the intended hook): each tick, ``twist = stream.twist(t,
 hand_pose)`` with the tick's time and the hand's pose from the tick's kinematics, then
 ``ctl.step(twist, ref="world_aligned")`` (a :class:`~rrc_pin.cells.CellController`: one
-stream per commandable name, ``{name: (twist, "world")}``); the device's thread calls
+stream per commandable name, ``{name: (twist, "world_aligned")}``); the device's thread calls
 :meth:`PoseStream.push` (a stream is locked: push and twist may run in different threads).
 """
 
