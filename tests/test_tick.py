@@ -23,6 +23,14 @@ STATUS_NAMES = get_args(Status)
 SEEDS = [20261206, int(np.random.SeedSequence().entropy % 2**63)]
 N, DT = 7, 0.01
 LEVELS = ("met", "scaled", "traded", "dropped")
+RATE_TOL = 1e-9
+"""Rates' difference relative to their size, and scales' difference, where the kernels
+answered."""
+BACKEND_TOL = 1e-5
+"""Where the backend (DAQP) answered a stage: its answer moves with the last bits of its data,
+which the compiled tick forms in its own loops. On a scaled two-level problem with three rows the
+pipeline's own rates moved by 9.6e-7 (its scale by 4.1e-7) when its task or constraint rows were
+moved by one ulp, as far as the compiled tick's differ from it there."""
 
 
 def limits(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -102,8 +110,9 @@ def test_random_problems_answered_as_the_pipeline(seed: int) -> None:
         qdot = ws.joints[tick.QDOT]
         assert status == want.status
         assert tuple(LEVELS[c] for c in ws.level_codes()) == want.levels
-        assert np.abs(qdot - want.qdot).max() <= 1e-9 * (1.0 + np.abs(want.qdot).max())
-        assert ws.reals[tick.SCALE] == pytest.approx(want.scale, abs=1e-9)
+        tol = RATE_TOL if want.backend == "" else BACKEND_TOL
+        assert np.abs(qdot - want.qdot).max() <= tol * (1.0 + np.abs(want.qdot).max()), seed
+        assert ws.reals[tick.SCALE] == pytest.approx(want.scale, abs=tol), seed
         if max(want.scale, ws.reals[tick.SCALE]) > 1e-9:
             assert ws.reals[tick.VEER] == pytest.approx(want.veer, abs=1e-7)
     assert {"exact", "scaled", "least_squares"} <= set(kinds), kinds
