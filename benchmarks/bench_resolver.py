@@ -59,7 +59,16 @@ from comparison import plot as comparison_plot  # noqa: E402
 from machine import load_average, machine_info, source_state  # noqa: E402
 from script import make_parser, write  # noqa: E402
 from stage_profile import profile_steps, profile_table  # noqa: E402
-from timing import MODE_TITLES, MODES, REPEATS, Contender, progress, run_mode, us  # noqa: E402
+from timing import (  # noqa: E402
+    MODE_TITLES,
+    MODES,
+    REPEATS,
+    Contender,
+    progress,
+    run_mode,
+    statistics,
+    us,
+)
 
 import rrc_pin  # noqa: E402
 
@@ -160,9 +169,30 @@ def bench_arm(
         "kinematics_gaps": gaps,
         "modes": modes,
         "quality": judged,
+        "damped": damped_ticks(first),
         "rrc_pin": rrc_statistics(first[RRC].kept),
         "profile": profile_default(arm, Q, X),
     }
+
+
+def damped_ticks(first: dict[str, Any]) -> dict[str, Any]:
+    """The steps rrc-pin answered ``damped`` (near a singularity, its costliest ticks) alone,
+    from the first tight round: per contender the median and the CPU time's p99 [us] there,
+    and the ratios to PlaCo's on the same steps."""
+    mask = np.array([r.status == "damped" for r in first[RRC].kept])
+    out: dict[str, Any] = {"steps": int(mask.sum()), "contenders": {}}
+    if not mask.any():
+        return out
+    for label, run in first.items():
+        answered = mask & ~run.failed
+        if answered.any():
+            out["contenders"][label] = statistics(run.seconds[answered], run.cpu[answered])
+    placo = out["contenders"].get(PLACO)
+    for row in out["contenders"].values():
+        if placo is not None:
+            row["vs_placo_median"] = placo["median_us"] / row["median_us"]
+            row["vs_placo_cpu_p99"] = placo["cpu_p99_us"] / row["cpu_p99_us"]
+    return out
 
 
 def profile_default(arm: Any, Q: Array, X: Array) -> dict[str, Any]:

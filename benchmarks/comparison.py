@@ -79,13 +79,15 @@ def time_workload(
 
 
 def add_placo_ratios(rows: dict[str, dict[str, Any]], placo_of: dict[str, str]) -> None:
-    """``vs_placo_median`` / ``_p99``: the PlaCo row's median (p99) over each row's, in place,
-    for the rows whose PlaCo row ran."""
+    """``vs_placo_median`` / ``_p99`` (and ``_cpu_p99``, of the calls' CPU times): the PlaCo
+    row's median (p99) over each row's, in place, for the rows whose PlaCo row ran."""
     for label, row in rows.items():
         base = rows.get(placo_of.get(label, ""))
         if base is not None:
             row["vs_placo_median"] = base["median_us"] / row["median_us"]
             row["vs_placo_p99"] = base["p99_us"] / row["p99_us"]
+            if "cpu_p99_us" in base and "cpu_p99_us" in row:
+                row["vs_placo_cpu_p99"] = base["cpu_p99_us"] / row["cpu_p99_us"]
 
 
 def spread(row: dict[str, Any], key: str = "median_us") -> str:

@@ -120,6 +120,8 @@ class Run:
 
     Attributes:
         seconds: Time of each step's call (steps,) [s].
+        cpu: The calling thread's CPU time of each step's call (steps,) [s]: the wall time
+            less the time the scheduler gave the core to another process.
         rates: Joint rates of each step (steps, n) [rad/s] (zero where it failed).
         failed: Steps where the call raised (steps,).
         kept: What the calls returned, if the contender keeps it.
@@ -129,6 +131,7 @@ class Run:
     seconds: Array
     rates: Array
     failed: npt.NDArray[np.bool_]
+    cpu: Array = field(default_factory=lambda: np.empty(0))
     kept: list[Any] = field(default_factory=list)
     first_error: str = ""
 
@@ -154,7 +157,9 @@ def run_mode(
     """
     steps, n = Q.shape
     runs = {
-        c.label: Run(np.empty(steps), np.zeros((steps, n)), np.zeros(steps, dtype=bool))
+        c.label: Run(
+            np.empty(steps), np.zeros((steps, n)), np.zeros(steps, dtype=bool), np.empty(steps)
+        )
         for c in contenders
     }
     for c in contenders:  # one untimed call: imports, workspaces, first-call set-up
@@ -181,19 +186,24 @@ def run_mode(
     return runs
 
 
-def _step(c: Contender, q: Array, x: Array) -> tuple[Any, float, str]:
-    """One call of ``c``: (what it returned, seconds, the error or "" when it answered)."""
-    clock = time.perf_counter
-    t0 = clock()
+def _step(c: Contender, q: Array, x: Array) -> tuple[Any, float, float, str]:
+    """One call of ``c``: (what it returned, seconds, CPU seconds, the error or "")."""
+    clock, cpu = time.perf_counter, time.thread_time
+    c0, t0 = cpu(), clock()
     try:
         out = c.call(q, x)
     except Exception as exc:  # a peer raising (pink's NoSolutionFound...) is a failed step
-        return None, clock() - t0, f"{type(exc).__name__}: {exc}"[:300]
-    return out, clock() - t0, ""
+        t1, c1 = clock(), cpu()
+        return None, t1 - t0, c1 - c0, f"{type(exc).__name__}: {exc}"[:300]
+    t1, c1 = clock(), cpu()
+    return out, t1 - t0, c1 - c0, ""
 
 
-def _record(run: Run, c: Contender, k: int, out: Any, seconds: float, error: str) -> None:
+def _record(
+    run: Run, c: Contender, k: int, out: Any, seconds: float, cpu: float, error: str
+) -> None:
     run.seconds[k] = seconds
+    run.cpu[k] = cpu
     if error:
         run.failed[k] = True
         run.first_error = run.first_error or error
@@ -224,11 +234,13 @@ def record_trajectory(
     return Q, X
 
 
-def statistics(seconds: Array) -> dict[str, float]:
-    """Median, 10th, 90th and 99th percentiles, mean and maximum of step times [us]."""
+def statistics(seconds: Array, cpu: Array | None = None) -> dict[str, float]:
+    """Median, 10th, 90th and 99th percentiles, mean and maximum of step times [us]; with the
+    calls' CPU times, their median and 99th percentile too (``cpu_median_us``, ``cpu_p99_us``:
+    a call that lost its core to another process counts only its own work)."""
     us = np.asarray(seconds) * 1e6
     p10, p50, p90, p99 = np.percentile(us, [10, 50, 90, 99])
-    return {
+    out = {
         "median_us": float(p50),
         "p10_us": float(p10),
         "p90_us": float(p90),
@@ -236,6 +248,10 @@ def statistics(seconds: Array) -> dict[str, float]:
         "mean_us": float(us.mean()),
         "max_us": float(us.max()),
     }
+    if cpu is not None and len(cpu):
+        c50, c99 = np.percentile(np.asarray(cpu) * 1e6, [50, 99])
+        out.update({"cpu_median_us": float(c50), "cpu_p99_us": float(c99)})
+    return out
 
 
 def compliance(
@@ -257,7 +273,7 @@ def summarise(
     lower, upper, velocity = limits
     out: dict[str, dict[str, Any]] = {}
     for label, run in runs.items():
-        row: dict[str, Any] = statistics(run.seconds)
+        row: dict[str, Any] = statistics(run.seconds, run.cpu)
         row.update(compliance(Q, run.rates, lower, upper, velocity, dt))
         row["failures"] = int(run.failed.sum())
         if run.first_error:

@@ -121,7 +121,8 @@ class Kinematics:
         layout: The robot's layout.
     """
 
-    __slots__ = ("_data", "_first", "_model", "_whole", "layout", "q", "q_pin")
+    __slots__ = ("_data", "_first", "_jacobians", "_model", "_placed", "_whole", "layout", "q",
+                 "q_pin")  # fmt: skip
 
     def __init__(
         self, model: pin.Model, data: pin.Data, layout: Layout, q: Array, q_pin: Array
@@ -130,6 +131,9 @@ class Kinematics:
         self._model, self._data = model, data
         self._first: str | None = None  # the one frame whose Jacobian computeFrameJacobian gave
         self._whole = False  # every joint's Jacobian and every frame's pose computed
+        self._placed = False  # the joints supporting _first placed (a world_aligned or world
+        # Jacobian of it: Pinocchio's local one does not place them)
+        self._jacobians: dict[tuple[str, str], Array] = {}
 
     @property
     def model(self) -> pin.Model:
@@ -143,7 +147,16 @@ class Kinematics:
         return self._data
 
     def jacobian(self, frame: str, ref: Reference = "world_aligned") -> Array:
-        """Geometric Jacobian (6, nv) of ``frame``, rows [v; w], in frame ``ref``."""
+        """Geometric Jacobian (6, nv) of ``frame``, rows [v; w], in frame ``ref``.
+
+        Computed once per frame and ref, then shared by every reader of this tick (read only).
+        """
+        J = self._jacobians.get((frame, ref))
+        if J is None:
+            J = self._jacobians[frame, ref] = self._computed(frame, ref)
+        return J
+
+    def _computed(self, frame: str, ref: Reference) -> Array:
         layout = self.layout
         if frame == layout.tool_frame and ref == "world_aligned":
             return np.asarray(layout.closed_form.jacobian(self.q), dtype=np.float64)
@@ -151,6 +164,7 @@ class Kinematics:
         J: Array
         if not self._whole and (self._first is None or self._first == frame):
             self._first = frame
+            self._placed = self._placed or ref != "local"
             J = pin.computeFrameJacobian(
                 self._model, self._data, self.q_pin, fid, PIN_REFERENCE[ref]
             )
@@ -165,8 +179,21 @@ class Kinematics:
 
     def pose(self, frame: str) -> Array:
         """Pose (4, 4) of ``frame`` in the base frame [m] (a copy)."""
-        self._compute_whole()
-        return np.array(self._data.oMf[self.layout.frames[frame]].homogeneous)
+        return np.array(self.placement(frame).homogeneous)
+
+    def placement(self, frame: str) -> pin.SE3:
+        """Pose of ``frame`` in the base frame (a copy).
+
+        Where the frame's world_aligned Jacobian was computed alone (``computeFrameJacobian``),
+        its parent joint is placed already: the pose is that placement times the frame's
+        (Pinocchio's ``updateFramePlacement``, the same floats as a forward pass), without a
+        second pass.
+        """
+        fid = self.layout.frames[frame]
+        if frame != self._first or not self._placed or self._whole:
+            self._compute_whole()
+            return pin.SE3(self._data.oMf[fid])
+        return pin.SE3(pin.updateFramePlacement(self._model, self._data, fid))
 
     def _compute_whole(self) -> None:
         if not self._whole:

@@ -34,6 +34,7 @@ from typing import Any, Literal, cast
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.compiled_tick import CompiledTick
 from rrc_pin.errors import InvalidInput, UnknownBackend
 from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.limits import JointLimits, Limit
@@ -44,7 +45,7 @@ from rrc_pin.solvers.qp_backends import make_backend
 from rrc_pin.solvers.spatial import Reference
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.pipeline import DEFAULT_FALLBACKS, Method, Options, solve
-from rrc_pin.solvers.tick.problem import TaskRows, build
+from rrc_pin.solvers.tick.problem import Constraints, TaskRows, build
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.tasks import FrameTask, Task
 
@@ -169,6 +170,25 @@ class Resolver:
         self._names = robot.dof_names
         self._last_qdot: Array = np.zeros(robot.nv)
         self._lock = threading.Lock()
+        joint = [limit for limit in self.limits if isinstance(limit, JointLimits)]
+        # the general entry now where ticks will need it; else at the first that does (tasks
+        # given to a one-tool resolver, a start outside the joint limits)
+        general = (len(self.limits) > 1 or self.task is None or not direction_preserving
+                   or (len(joint) == 1 and joint[0].acceleration is not None))  # fmt: skip
+        self._compiled = None if len(joint) != 1 else CompiledTick(
+            self._layout, joint[0], self.options, direction_preserving, self.backend,
+            self._names, general)  # fmt: skip
+        # solve(q, twist) straight into the compiled tick: the joint box the only limit, the
+        # Jacobian Pinocchio's and its vector q itself
+        self._twists = (self._compiled is not None and self.limits == (joint[0],)
+                        and self.task is not None and closed_form is None
+                        and robot.model.nq == robot.model.nv)  # fmt: skip
+
+    @property
+    def layout(self) -> Layout:
+        """What its tasks and limits may name on the robot (:meth:`solve_at`'s kinematics are
+        made on it)."""  # noqa: D205, D209
+        return self._layout
 
     def reset(self) -> None:
         """Forget the warm starts and the previous joint rates."""
@@ -219,10 +239,68 @@ class Resolver:
             FrameNotFound: A task names a frame the robot does not have (the error lists
                 them).
         """
+        if (self._twists and type(command) is np.ndarray and type(q) is np.ndarray
+                and ref is None and dt is None and qdot_prev is None and priority == "weighted"):
+            r = self._twist(q, command)
+            if r is not None:
+                return r
         q, dof, q_pin = self.robot.positions(q)
+        return self._solve(dof, q_pin, None, command, ref, priority, dt, qdot_prev)
+
+    def _twist(self, q: Array, twist: Array) -> Resolution | None:
+        """``solve(q, twist)`` of the resolver's task in its ref, in the compiled tick alone
+        (:meth:`CompiledTick.twist`), or None where the general path answers: arrays of other
+        shapes or types (it checks them), a task with a target, a box that excludes standing
+        still."""  # noqa: D205, D209
+        task = cast(FrameTask, self.task)
+        if (q.dtype != np.float64 or q.shape != (self.robot.nq,) or twist.dtype != np.float64
+                or twist.shape != (6,) or task.target is not None):  # fmt: skip
+            return None
+        b = twist.copy() if len(task.selected) == 6 else twist[list(task.selected)]
+        with self._lock:
+            start = time.perf_counter()
+            compiled = cast(CompiledTick, self._compiled)
+            r = compiled.twist(self.robot.model, self._data, task, q, b, self._last_qdot,
+                               self.dt, start)  # fmt: skip
+            if r is not None:
+                self._last_qdot = r.qdot
+            return r
+
+    def solve_at(
+        self,
+        kinematics: Kinematics,
+        command: npt.ArrayLike | TaskCommand,
+        ref: Reference | None = None,
+        *,
+        priority: Priority = "weighted",
+        dt: float | None = None,
+        qdot_prev: npt.ArrayLike | None = None,
+    ) -> Resolution:
+        """:meth:`solve` at the configuration of ``kinematics``, read instead of computed.
+
+        For a loop that computes one :class:`~rrc_pin.kinematics.Kinematics` per tick and
+        shares it (a controller's drift correction, strategy, resolver and log read the same
+        one); it must be of this resolver's robot, its ``q`` checked by its maker.
+
+        Raises:
+            InvalidInput: As :meth:`solve`, and ``kinematics`` of another robot.
+        """
+        if not isinstance(kinematics, Kinematics) or kinematics.layout.nv != self.robot.nv:
+            raise InvalidInput("kinematics", f"expected a Kinematics of {self.robot.name}, got "
+                               f"{kinematics!r}")  # fmt: skip
+        return self._solve(kinematics.q, kinematics.q_pin, kinematics, command, ref, priority,
+                           dt, qdot_prev)  # fmt: skip
+
+    def _solve(
+        self, dof: Array, q_pin: Array, kin: Kinematics | None,
+        command: npt.ArrayLike | TaskCommand, ref: Reference | None, priority: Priority,
+        dt: float | None, qdot_prev: npt.ArrayLike | None,
+    ) -> Resolution:  # fmt: skip
+        """The tick (:meth:`solve`) once q is checked: the other arguments checked, then the
+        kinematics, the tasks' rows, the limits, the answer."""  # noqa: D205, D209
         step = self.dt if dt is None else _dt(dt)
         previous = None if qdot_prev is None else as_vector(qdot_prev, "qdot_prev", self.robot.nv)
-        if isinstance(command, Task) or _is_tasks(command):
+        if type(command) is not np.ndarray and (isinstance(command, Task) or _is_tasks(command)):
             if ref is not None:
                 raise InvalidInput("ref", "tasks carry their own ref; pass ref to FrameTask")
             levels, weighted = self._levels(cast(TaskCommand, command), priority)
@@ -237,19 +315,35 @@ class Resolver:
             ref = task.ref if ref is None else task.check_ref(ref)
         with self._lock:
             start = time.perf_counter()
-            kin = Kinematics(self.robot.model, self._data, self._layout, dof, q_pin)
+            if kin is None:
+                kin = Kinematics(self.robot.model, self._data, self._layout, dof, q_pin)
             if twist is None:
                 rows = [[t.rows(kin) for t in level] for level in levels]
             else:
                 rows = [[cast(FrameTask, levels[0][0]).rows_at(kin, twist, cast(Reference, ref))]]
             _check_rows(rows)
             before = self._last_qdot if previous is None else previous
-            constraints = [limit.constraints(kin, step, before) for limit in self.limits]
-            problem = build(rows, constraints, self.robot.nv, step, weighted=weighted,
-                            direction=self.direction_preserving)
-            answer = solve(problem, self.backend, self.options)
-            self._last_qdot = answer.qdot
-            return Resolution.of(problem, answer, time.perf_counter() - start, self._names)
+            r = self._tick(kin, rows, weighted, step, before, start)
+            self._last_qdot = r.qdot
+            return r
+
+    def _tick(self, kin: Kinematics, rows: list[list[TaskRows]], weighted: bool, step: float,
+              before: Array, start: float) -> Resolution:  # fmt: skip
+        """The tick of ``rows`` within the limits: compiled where it can be, else the Python
+        pipeline (equality rows, a joint box that is not one JointLimits)."""  # noqa: D205, D209
+        compiled = self._compiled
+        joint = None if compiled is None else compiled.limit
+        constraints = [None if limit is joint else limit.constraints(kin, step, before)
+                       for limit in self.limits]  # fmt: skip
+        if compiled is not None and compiled.answers(constraints):
+            return compiled.tasks(kin, rows, weighted, constraints, before, step, start)
+        if joint is not None:
+            constraints = [joint.constraints(kin, step, before) if c is None else c
+                           for c in constraints]  # fmt: skip
+        problem = build(rows, cast(list[Constraints], constraints), self.robot.nv, step,
+                        weighted=weighted, direction=self.direction_preserving)  # fmt: skip
+        answer = solve(problem, self.backend, self.options)
+        return Resolution.of(problem, answer, time.perf_counter() - start, self._names)
 
     def rows_of(self, task: Task, q: npt.ArrayLike) -> TaskRows:
         """The rows ``A qdot ~= b`` that ``task`` gives at ``q`` (what ``solve`` stacks).

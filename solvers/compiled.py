@@ -165,6 +165,23 @@ def kernel(function: Callable[..., Any] | None = None, /, *, nogil: bool = False
     return compile_ if function is None else compile_(function)
 
 
+def inlined(function: F) -> F:
+    """A kernel compiled into each compiled caller, at numba's IR (``inline="always"``).
+
+    For the compiled tick's glue between its kernels. A kernel that calls another links the
+    callee's machine code into its own and LLVM optimises it again there, so along a chain of
+    compiled wrappers the kernels at its end are optimised once per link; inlined, the glue is
+    optimised once, in the tick's entry (docs/api.md, "One compiled pass per tick"). Called from
+    Python, it compiles and caches as any kernel.
+    """
+    dispatcher = njit(inline="always")(function)
+    if not numba_config.DISABLE_JIT:
+        cache = function_cache(function)
+        if cache is not None:
+            dispatcher._cache = cache
+    return cast(F, dispatcher)
+
+
 def function_cache(f: Callable[..., Any]) -> GuardedCache | None:
     """The cache of ``f`` in the first writable place (module docstring), or None."""
     with _SETTING:

@@ -76,4 +76,4 @@ class CellResolution(Resolution):
             return resolved.tasks
         problem = self.problem
         levels = ((*problem.levels[0], *hands()), *problem.levels[1:])
-        return resolved._replace(problem=problem._replace(levels=levels)).tasks
+        return resolved._replace(source=problem._replace(levels=levels)).tasks

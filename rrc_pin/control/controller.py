@@ -37,10 +37,11 @@ from rrc_pin.control.strategies.base import KEEP, to_base_axes
 from rrc_pin.control.trajectory_log import LogRecord, TrajectoryLog
 from rrc_pin.deprecated import warn_renamed
 from rrc_pin.errors import InvalidInput
+from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits import JointLimits
 from rrc_pin.loading import cells, loaded
 from rrc_pin.resolver import QPOptions
-from rrc_pin.robot import Robot, frame_id
+from rrc_pin.robot import Robot
 from rrc_pin.solvers.checks import as_vector, finite_number
 from rrc_pin.solvers.spatial import Reference, check_reference, to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
@@ -207,11 +208,11 @@ class Controller(Loop):
         self._rows = tuple(self.resolver.task.selected)
         self._full = len(self._rows) == 6
         self._data = robot.model.createData()
-        self._frame_id = frame_id(robot.model, robot.tool_frame)  # z1: a joint shares its name
+        self._tool: str = robot.tool_frame
         self._command: Array = np.zeros(6)
         self._command_frame: Reference = "world_aligned"
         self._default_warned = False
-        self._reference = self._pose(self._pinocchio_q(self._q))
+        self._reference = self._kinematics(self._q).placement(self._tool)
         self._reanchor = False
 
     # -- settings ---------------------------------------------------------------------------
@@ -256,8 +257,9 @@ class Controller(Loop):
         local = ref == "local"
 
         q = self._q
-        q_pin = self._pinocchio_q(q)
-        pose = self._pose(q_pin)
+        kin = self._kinematics(q)  # the tick's one: pose, strategy, resolver and log read it
+        kin.jacobian(self._tool, "world_aligned")  # first: it places the hand too
+        pose = kin.placement(self._tool)
         command = given  # served in hand axes (local) or base axes; a world twist turned so:
         if ref == "world":
             command = to_world_aligned(given, pose.rotation, pose.translation, "world")
@@ -278,13 +280,13 @@ class Controller(Loop):
         else:  # (a command beyond LARGE divided down along itself: no rates overflow)
             down = _within_large(wanted)
             decision = self.strategy.decide(Situation(
-                self.robot, q, wanted * down, self.dt, command * down, self._rows, hand))
+                self.robot, q, wanted * down, self.dt, command * down, self._rows, hand, kin))
         factor = decision.factor
         if decision.rates is None:
-            r = self.resolver.solve(q, wanted if factor == 1.0 else factor * wanted,
-                                    "local" if local else "world_aligned")
+            r = self.resolver.solve_at(kin, wanted if factor == 1.0 else factor * wanted,
+                                       "local" if local else "world_aligned")  # fmt: skip
         else:
-            r = self.resolver.solve(q, [RatesTask(decision.rates)], priority="strict")
+            r = self.resolver.solve_at(kin, [RatesTask(decision.rates)], priority="strict")
         # q itself, not a copy: read-only, replaced at every tick.
         self.log.append_tick(RawTick(self.t, q, r, command, hand, factor, error, "teleop",
                                      decision.note))
@@ -361,12 +363,10 @@ class Controller(Loop):
 
     # -- helpers ----------------------------------------------------------------------------
 
-    def _pose(self, q_pin: Array) -> pin.SE3:
-        """Tool pose at ``q_pin``, Pinocchio's configuration (one FK pass, own data)."""
-        model, data = self.robot.model, self._data
-        pin.forwardKinematics(model, data, q_pin)
-        pose: pin.SE3 = pin.updateFramePlacement(model, data, self._frame_id)
-        return pose
+    def _kinematics(self, q: Array) -> Kinematics:
+        """The kinematics of the loop's own ``q`` (valid: not checked again), on own data."""
+        return Kinematics(self.robot.model, self._data, self.resolver.layout,
+                          self.robot.dof_positions(q), self._pinocchio_q(q))  # fmt: skip
 
     def _compact(self, ticks: list[RawTick]) -> Tick:
         """Ticks as the log keeps them, a row each (vectorised over the batch).

@@ -256,4 +256,9 @@ def tolerance(box: Box) -> float:
 
     :data:`FEASIBILITY_TOL` times (1 + the norm of the velocity limits).
     """
-    return FEASIBILITY_TOL * (1.0 + math.hypot(*np.minimum(box.velocity, 1e300).tolist()))
+    return velocity_tolerance(box.velocity)
+
+
+def velocity_tolerance(velocity: Array) -> float:
+    """:func:`tolerance` of a box of velocity limits ``velocity`` (n,)."""
+    return FEASIBILITY_TOL * (1.0 + math.hypot(*np.minimum(velocity, 1e300).tolist()))

@@ -212,7 +212,6 @@ def solve(problem: Problem, backend: QPBackend, options: Options) -> Answer:
     """
     work = Work()
     box, rows = problem.box, problem.rows
-    method: Method = "qp"
     top: _Top | None = None
     try:
         space = _equality_space(problem)
@@ -220,23 +219,12 @@ def solve(problem: Problem, backend: QPBackend, options: Options) -> Answer:
     except (NumericalFailure, np.linalg.LinAlgError) as exc:
         work.attempts.append(("qp", str(exc)))
     if top is None:
-        from rrc_pin.solvers.tick.fallbacks import fallback
-
-        for name in options.fallbacks:
-            try:
-                qdot = fallback(name, problem, work)
-            except (NumericalFailure, np.linalg.LinAlgError) as exc:
-                work.attempts.append((name, str(exc)))
-                continue
-            method = name
-            top = _Top(qdot, "fallback", *_along_command(problem, qdot), 0.0, None)
-            break
-    assert top is not None  # "hold" always answers
+        return fallback_answer(problem, options, work)
     qdot, levels = top.qdot, ["met" if top.status == "exact" else _level_status(top.status)]
     null = top.null
     for k in range(1, len(problem.levels)):
-        if method != "qp" or null is None or null.shape[0] == 0:
-            levels.append("dropped" if method != "qp" else _served(problem, k, qdot))
+        if null is None or null.shape[0] == 0:
+            levels.append(_served(problem, k, qdot))
             continue
         A, b = problem.stacked[k]
         try:
@@ -248,8 +236,34 @@ def solve(problem: Problem, backend: QPBackend, options: Options) -> Answer:
             null = None
             continue
         levels.append(_served(problem, k, qdot))
+    return _answer(problem, top, qdot, "qp", levels, work)
+
+
+def fallback_answer(problem: Problem, options: Options, work: Work) -> Answer:
+    """The answer of the fallbacks, where the pipeline found no usable answer for the top
+    level (``work`` holds why); the lower levels dropped.
+    """  # noqa: D205
+    from rrc_pin.solvers.tick.fallbacks import fallback
+
+    for name in options.fallbacks:
+        try:
+            qdot = fallback(name, problem, work)
+        except (NumericalFailure, np.linalg.LinAlgError) as exc:
+            work.attempts.append((name, str(exc)))
+            continue
+        top = _Top(qdot, "fallback", *_along_command(problem, qdot), 0.0, None)
+        levels = [_level_status(top.status)] + ["dropped"] * (len(problem.levels) - 1)
+        return _answer(problem, top, qdot, name, levels, work)
+    raise AssertionError("'hold' always answers")  # the chain ends with it (Options)
+
+
+def _answer(problem: Problem, top: _Top, qdot: Array, method: Method,
+            levels: list[LevelStatus], work: Work) -> Answer:  # fmt: skip
+    """The answer: the rates ``qdot`` of every level, clipped into the box and rows, and
+    ``top``'s report."""  # noqa: D205, D209
+    box = problem.box
     clip = kernels.clip_into(qdot, box.lb, box.ub)  # the kernels' answers to rounding
-    qdot, shrink = _within_rows(qdot, box, rows)
+    qdot, shrink = _within_rows(qdot, box, problem.rows)
     qdot.flags.writeable = False
     return Answer(
         qdot, method, top.status, tuple(levels), top.scale * shrink, top.veer, top.lambda_sq,
@@ -401,6 +415,19 @@ def _slide(
     if project(B, 0.0, target, box.lb, box.ub, slide.G, slide.h, MARGIN, x) == SOLVED:
         kernels.clip_into(x, box.lb, box.ub)  # by the kernel's rounding at most (1e-9)
         return x
+    return backend_slide(B, target, box, slide, backend, work)
+
+
+def backend_slide(
+    B: Array, target: Array, box: Box, slide: Rows, backend: QPBackend, work: Work
+) -> Array:
+    r"""The sliding stage's QP by the backend: the point of the box and slide rows nearest
+    ``target`` in the metric :math:`B^TB` (where :func:`_slide`'s projection refuses).
+
+    Raises:
+        NumericalFailure: The backend found no usable answer.
+    """  # noqa: D205
+    n = target.size
     M = B.T @ B
     size = max(float(np.abs(M).max()), _TINY)
     qp = QP(M / size, -(M @ target) / size, slide.G, np.full(slide.h.size, -np.inf), slide.h,
@@ -513,6 +540,17 @@ def _scaled(
     answer = along(w, null, box, rows)
     if answer is not None:
         return answer
+    return backend_along(A, w, null, box, rows, backend, work)
+
+
+def backend_along(
+    A: Array, w: Array, null: Array, box: Box, rows: Rows | None, backend: QPBackend, work: Work
+) -> Along:
+    """The direction problem along ``w`` by the backend, its answer checked (:func:`_scaled`).
+
+    Raises:
+        NumericalFailure: The backend found no usable answer.
+    """
     qp, decoding = direction_qp(w, null, box, rows)
     qdot = solve_within(qp, decoding, box, rows, backend, work, clip=False)
     y = A @ qdot

@@ -216,7 +216,7 @@ def build(
         The :class:`Problem`.
     """
     box = _box(constraints, n)
-    rows = _rows(constraints)
+    rows = merged_rows(constraints)
     equalities, equality_names = _equalities(constraints)
     if weighted:
         mode: Mode = "weighted"
@@ -352,7 +352,8 @@ def _box(constraints: Sequence[Constraints], n: int) -> Box:
     return box
 
 
-def _rows(constraints: Sequence[Constraints]) -> Rows | None:
+def merged_rows(constraints: Sequence[Constraints]) -> Rows | None:
+    """The constraints' rows stacked, named, with their slide masks and distances, or None."""
     Gs: list[Array] = []
     hs: list[Array] = []
     names: list[str] = []

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 import warnings
 from functools import cached_property
-from typing import Literal, NamedTuple
+from typing import Literal, NamedTuple, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -103,6 +103,17 @@ class TaskReport(NamedTuple):
     served: Served
 
 
+class Deferred(Protocol):
+    """A problem built only where a resolution's report reads it (the compiled tick's)."""
+
+    @property
+    def box(self) -> Box:
+        """The step's joint-rate bounds."""
+
+    def problem(self) -> Problem:
+        """The problem the tick answered."""
+
+
 class _Record(NamedTuple):
     qdot: Array
     status: Status
@@ -117,7 +128,7 @@ class _Record(NamedTuple):
     lambda_sq: float
     build_time: float
     solve_time: float
-    problem: Problem
+    source: Problem | Deferred
     joint_names: tuple[str, ...] | None = None
 
 
@@ -126,7 +137,8 @@ class Resolution(_Record):
 
     An immutable record: the problem it answered holds the rows and commands it reports on
     (copies where the caller's arrays could change). A named tuple with a cache for the
-    fields computed on access.
+    fields computed on access: the compiled tick builds its problem only where the report
+    reads it (``source`` then defers it, :class:`Deferred`).
 
     Attributes:
         qdot: Joint rates (n,) [rad/s or m/s], finite and within the step's box (read-only).
@@ -148,7 +160,8 @@ class Resolution(_Record):
         lambda_sq: Largest squared damping applied (normalised units), 0 when undamped.
         build_time: Time outside the backend [s].
         solve_time: Time inside the backend [s].
-        problem: The problem it answers (tasks' rows, box, constraint rows).
+        problem: The problem it answers (tasks' rows, box, constraint rows), built on first
+            access where it was deferred.
         joint_names: Joint names for :attr:`ActiveLimit.name`, or None.
     """
 
@@ -163,22 +176,28 @@ class Resolution(_Record):
             elapsed - answer.solve_time, answer.solve_time, problem, names,
         )  # fmt: skip
 
-    @property
+    @cached_property
+    def problem(self) -> Problem:
+        """The problem it answers (tasks' rows, box, constraint rows)."""
+        source = self.source
+        return source if isinstance(source, Problem) else source.problem()
+
+    @cached_property
     def box(self) -> Box:
         """The step's joint-rate bounds."""
-        return self.problem.box
+        return self.source.box
 
     @property
     def bounds(self) -> Box:
         """The old name of :attr:`box` (deprecated: goes in the next release)."""
         warnings.warn("Resolution.bounds is deprecated and goes in the next release: use "
                       "Resolution.box", DeprecationWarning, stacklevel=2)  # fmt: skip
-        return self.problem.box
+        return self.box
 
     @cached_property
     def active(self) -> tuple[ActiveLimit, ...]:
         """Joint bounds the answer touches, by joint then side (:data:`ACTIVE_TOL`)."""
-        return active_limits(self.qdot, self.problem.box, self.joint_names)
+        return active_limits(self.qdot, self.box, self.joint_names)
 
     @cached_property
     def active_rows(self) -> tuple[ActiveRow, ...]:

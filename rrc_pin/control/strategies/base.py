@@ -10,6 +10,7 @@ import numpy as np
 import numpy.typing as npt
 import pinocchio as pin
 
+from rrc_pin.kinematics import Kinematics
 from rrc_pin.robot import Robot
 
 Array = npt.NDArray[np.float64]
@@ -33,6 +34,8 @@ class Situation:
         rows: The task rows of the tool Jacobian: all six, or the three linear ones for an
             arm of fewer than six joints.
         hand: The tool's pose when ``twist`` is in hand axes, else None.
+        kinematics: The tick's kinematics at ``q`` (the controller's, shared), or None: the
+            Jacobian is then computed here.
 
     Attributes:
         robot, q, dt, command, rows: As given.
@@ -40,10 +43,10 @@ class Situation:
 
     def __init__(
         self, robot: Robot, q: Array, twist: Array, dt: float, command: Array,
-        rows: tuple[int, ...], hand: pin.SE3 | None = None,
+        rows: tuple[int, ...], hand: pin.SE3 | None = None, kinematics: Kinematics | None = None,
     ) -> None:  # fmt: skip
         self.robot, self.q, self.dt, self.command, self.rows = robot, q, dt, command, rows
-        self._twist, self._hand = twist, hand
+        self._twist, self._hand, self._kinematics = twist, hand, kinematics
 
     @cached_property
     def twist(self) -> Array:
@@ -55,7 +58,11 @@ class Situation:
     @cached_property
     def jacobian(self) -> Array:
         """The task rows of the tool Jacobian at ``q``, ``world_aligned`` (m, nq)."""
-        J = self.robot.jacobian(self.q)
+        kin, frame = self._kinematics, self.robot.tool_frame
+        if kin is None or frame is None:
+            J = self.robot.jacobian(self.q)
+        else:
+            J = kin.jacobian(frame, "world_aligned")
         out: Array = J if len(self.rows) == 6 else J[list(self.rows)]
         return out
 

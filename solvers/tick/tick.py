@@ -1,0 +1,411 @@
+r"""One resolver tick in one compiled call, on a workspace of preallocated arrays.
+
+:func:`run` goes down the stages of docs/api.md ("One tick, one pipeline") once:
+
+1. the inputs' **checks** (every position and commanded rate finite);
+2. the step's **box** (:func:`~rrc_pin.solvers.tick.kernels.joint_box`);
+3. the **problem**: the mode, and each level's rows in the metric it is solved in
+   (:func:`stacked`: :func:`rrc_pin.solvers.tick.problem.build`'s);
+4. the **top level** (:func:`rrc_pin.solvers.tick.top.direction`, or a least squares), then each
+   **lower level** within the optimal set of those above
+   (:func:`rrc_pin.solvers.tick.levels.least_squares`);
+5. the **clip** into the box and the rows.
+
+Its arguments are a few packed arrays (numba's call costs grow with the number of arguments:
+docs/api.md, "One compiled pass per tick"), the rows of which the module constants name;
+:class:`Workspace` holds them for one resolver and reads the answer back. The QPs the kernels do
+not answer go to the backend from inside the call (:mod:`rrc_pin.solvers.tick.backend_calls`);
+where the top level finds no usable answer, :func:`run` returns
+:data:`~rrc_pin.solvers.tick.top.FAILED` and the fallbacks (:mod:`rrc_pin.solvers.tick.fallbacks`)
+answer. Problems with equality rows (contacts) go to the Python pipeline
+(:func:`rrc_pin.solvers.tick.pipeline.solve`). The default tick (one level, the joint box alone)
+has an entry of its own, :func:`run_box`: the same stages without the code it does not reach,
+compiled in a fraction of the general entry's time.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.solvers.compiled import inlined, kernel
+from rrc_pin.solvers.tick import kernels, top
+from rrc_pin.solvers.tick.levels import least_squares, row_values
+from rrc_pin.solvers.tick.problem import LARGE, SATURATION, TaskRows
+from rrc_pin.solvers.tick.top import EXACT, FAILED, SCALED, Rows, Top
+
+Array = npt.NDArray[np.float64]
+Ints = npt.NDArray[np.int64]
+
+# Rows of ``joints`` (k, n): the inputs, then the outputs.
+POSITION, LOWER, UPPER, VELOCITY, ACCELERATION, PREVIOUS, LB, UB, QDOT, KIND = range(10)
+JOINT_ROWS = 11  # KIND takes two rows: the lower bounds', then the upper ones'
+# Rows of ``rates`` (k, m): each task row's commanded rate, weight and unit.
+RATE, WEIGHT, UNIT = range(3)
+# Entries of ``ints``: sizes and flags in, codes out, then the levels' row offsets and codes.
+LEVELS, ROWS, CONSTRAINTS, WEIGHTED, DIRECTION, UNITS, INVALID, STARTS = range(8)
+# Entries of ``reals``: the step and the limits' settings in, the report out.
+(DT, MARGIN, GAIN, THRESHOLD, TOLERANCE, SCALE, VEER, LAMBDA_SQ, CLIP, ZERO_INSIDE,
+ RECOVERING, REAL_SIZE) = range(12)  # fmt: skip
+
+MET, SCALED_LEVEL, TRADED, DROPPED = range(4)
+"""Codes of how a level was served (:data:`~rrc_pin.solvers.tick.pipeline.LevelStatus`)."""
+
+BAD_POSITION, BAD_RATE = 1, 2
+"""Codes of ``ints[INVALID]``: a position, or a commanded rate, not finite."""
+
+INVALID_INPUT = -2
+"""What :func:`run` returns for a position or commanded rate that is not finite."""
+
+ELSEWHERE = -3
+"""What :func:`run_box` returns for a tick that is not its own (:func:`run` answers it)."""
+
+_EPS = float(np.finfo(np.float64).eps)
+
+
+@kernel
+def stacked(A: Array, b: Array, weight: Array, unit: Array, normalised: bool, lb: Array,
+            ub: Array) -> tuple[Array, Array, float]:  # fmt: skip
+    """A level's rows and rates in its metric, and the factor its rates were multiplied by.
+
+    Each row times the square root of its weight over the level's largest, and in the
+    normalised metric divided by its unit; the rates capped
+    (:func:`rrc_pin.solvers.tick.problem._stack`).
+    """
+    m, n = A.shape
+    top_weight = weight[0]
+    for i in range(m):
+        top_weight = max(top_weight, weight[i])
+    space = np.empty(m * (n + 1))  # one allocation: the rows and rates
+    rows, rates = space[: m * n].reshape(m, n), space[m * n :]
+    units = unit if normalised else np.ones(m)
+    peak = kernels.weighted_rows(A, b, weight, top_weight, units, 1.0, rows, rates)
+    if normalised:
+        if peak <= LARGE:
+            return rows, rates, 1.0
+        scale = 0.0
+        for i in range(m):
+            scale = max(scale, abs(b[i]))
+        kernels.weighted_rows(A, b, weight, top_weight, units, 1.0 / scale, rows, rates)
+        return rows, rates, 1.0 / scale
+    if peak <= SATURATION:
+        return rows, rates, 1.0
+    sides = 0.0
+    for j in range(n):
+        side = max(-lb[j], ub[j])
+        if math.isfinite(side):
+            sides += side
+    largest = 0.0
+    for i in range(m):
+        for j in range(n):
+            largest = max(largest, abs(rows[i, j]))
+    cap = SATURATION * (1.0 + largest * sides)
+    if peak <= cap:
+        return rows, rates, 1.0
+    return rows, rates * (cap / peak), cap / peak
+
+
+@kernel
+def served(A: Array, b: Array, qdot: Array) -> int:
+    """How a lower level was served by ``qdot``: met, scaled along its command, or traded
+    (:func:`rrc_pin.solvers.tick.pipeline.served`: a zero command not met is traded).
+    """  # noqa: D205
+    y = row_values(A, qdot)
+    if top.norm(y - b) <= top.EXACT_TOL * (1.0 + top.norm(b)):
+        return MET
+    scale, veer = kernels.scale_and_veer(y, b)
+    return SCALED_LEVEL if veer <= 1e-6 and scale > 0.0 and b.any() else TRADED
+
+
+@kernel
+def within_rows(x: Array, rows: Rows, zero_inside: bool) -> float:
+    """``x`` shrunk toward zero in place until the rows hold exactly; the factor (1: kept).
+
+    (:func:`rrc_pin.solvers.tick.pipeline._within_rows`: standing still must be allowed).
+    """
+    if rows.h.size == 0 or not zero_inside or (rows.h < 0.0).any():
+        return 1.0
+    values = row_values(rows.G, x)
+    factor = np.inf
+    for i in range(values.size):
+        if values[i] > rows.h[i]:
+            factor = min(factor, rows.h[i] / values[i])
+    if factor == np.inf:
+        return 1.0
+    factor *= 1.0 - 4.0 * _EPS
+    for i in range(x.size):
+        x[i] *= factor
+    return factor
+
+
+@inlined
+def checked(joints: Array, rates: Array, m: int) -> int:
+    """0 where every position and commanded rate is finite, else the code of the first bad."""
+    if not kernels.all_finite(joints[POSITION]):
+        return BAD_POSITION
+    if not kernels.all_finite(rates[RATE][:m]):
+        return BAD_RATE
+    return 0
+
+
+@inlined
+def level(task_rows: Array, rates: Array, ints: Ints, k: int, normalised: bool, lb: Array,
+          ub: Array) -> tuple[Array, Array, float]:  # fmt: skip
+    """Level ``k``'s rows and rates in its metric (:func:`stacked`)."""
+    start, end = ints[STARTS + k], ints[STARTS + k + 1]
+    return stacked(task_rows[start:end], rates[RATE][start:end], rates[WEIGHT][start:end],
+                   rates[UNIT][start:end], normalised, lb, ub)  # fmt: skip
+
+
+@inlined
+def top_level(task_rows: Array, rates: Array, ints: Ints, reals: Array, rows: Rows,
+              direction: bool, recovering: bool) -> Top:  # fmt: skip
+    """The top level's answer: the direction problem's stages or a least squares."""
+    A, b, rate_factor = level(task_rows, rates, ints, 0, direction, rows.lb, rows.ub)
+    need_null = ints[LEVELS] > 1
+    if direction:
+        return top.direction(A, b, rows, reals[DT], reals[THRESHOLD], rate_factor, need_null)
+    per_unit = 1.0 / rates[UNIT][: ints[STARTS + 1]] if ints[UNITS] else np.empty(0)
+    return top.least_squares_top(A, b, per_unit, rows, recovering, rate_factor, need_null,
+                                 reals[THRESHOLD])  # fmt: skip
+
+
+@inlined
+def lower_levels(task_rows: Array, rates: Array, ints: Ints, rows: Rows, answer: Top
+                 ) -> Array:  # fmt: skip
+    """Each level below the top within the optimal set of those above, its code in ``ints``:
+    the rates (a level whose QP the backend fails is dropped, those above kept).
+    """  # noqa: D205
+    qdot, null = answer.qdot, answer.null
+    codes = STARTS + ints[LEVELS] + 1
+    for k in range(1, ints[LEVELS]):
+        A, b, _ = level(task_rows, rates, ints, k, k == 0, rows.lb, rows.ub)
+        if null.shape[0] == 0:
+            ints[codes + k] = served(A, b, qdot)
+            continue
+        kept, null = least_squares(k, A, b, qdot, null, rows.lb, rows.ub, rows.G, rows.h,
+                                   rows.tol, k < ints[LEVELS] - 1)  # fmt: skip
+        if kept.size == 0:  # the backend failed: the levels above kept
+            ints[codes + k] = DROPPED
+            continue
+        qdot = kept
+        ints[codes + k] = served(A, b, qdot)
+    return qdot
+
+
+@inlined
+def box(joints: Array, rates: Array, ints: Ints, reals: Array) -> bool:
+    """Stages 1 and 2: the inputs checked (the code of a bad one in ``ints[INVALID]``, then
+    False), the step's box and what sets each bound into ``joints``, its flags into ``reals``.
+    """  # noqa: D205
+    ints[INVALID] = checked(joints, rates, ints[ROWS])
+    if ints[INVALID]:
+        return False
+    kind = np.empty((2, joints.shape[1]), np.int8)
+    zero_inside, recovering = kernels.joint_box(
+        joints[POSITION], joints[LOWER], joints[UPPER], joints[VELOCITY], reals[MARGIN],
+        reals[GAIN], reals[DT], joints[PREVIOUS], joints[ACCELERATION], joints[LB], joints[UB],
+        kind,
+    )  # fmt: skip
+    for j in range(kind.shape[1]):
+        joints[KIND, j], joints[KIND + 1, j] = kind[0, j], kind[1, j]
+    reals[ZERO_INSIDE] = 1.0 if zero_inside else 0.0
+    reals[RECOVERING] = 1.0 if recovering else 0.0
+    return True
+
+
+@inlined
+def report(joints: Array, ints: Ints, reals: Array, rows: Rows, answer: Top, qdot: Array) -> int:
+    """Stage 5: ``qdot`` clipped into the box and shrunk into the rows, and the top level's
+    report, into ``joints`` and ``reals``; the status code.
+    """  # noqa: D205
+    reals[CLIP] = kernels.clip_into(qdot, rows.lb, rows.ub)
+    reals[SCALE] = answer.scale * within_rows(qdot, rows, reals[ZERO_INSIDE] == 1.0)
+    reals[VEER], reals[LAMBDA_SQ] = answer.veer, answer.lambda_sq
+    joints[QDOT] = qdot
+    status = answer.status
+    code = MET if status == EXACT else SCALED_LEVEL if status == SCALED else TRADED
+    ints[STARTS + ints[LEVELS] + 1] = code
+    return status
+
+
+@kernel
+def run_box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Array) -> int:
+    """The default tick: one level in the direction mode, within the joint box alone.
+
+    What :func:`run` does for it, without the code of the rows, the least squares and the
+    lower levels (a fraction of its compile): the status code, :data:`INVALID_INPUT`, or
+    :data:`ELSEWHERE` where the mode is not the direction one (:func:`run` answers then).
+    """
+    if not box(joints, rates, ints, reals):
+        return INVALID_INPUT
+    if reals[ZERO_INSIDE] == 0.0 or ints[WEIGHTED] == 1 or ints[DIRECTION] == 0:
+        return ELSEWHERE
+    rows = Rows(joints[LB], joints[UB], task_rows[:0], reals[:0], reals[:0], reals[TOLERANCE])
+    # the direction flag, not the literal True: one compiled signature of stacked
+    A, b, rate_factor = level(task_rows, rates, ints, 0, ints[DIRECTION] == 1, rows.lb, rows.ub)
+    answer = top.direction_box(A, b, rows, reals[DT], reals[THRESHOLD], rate_factor)
+    if answer.status == FAILED:
+        return FAILED
+    return report(joints, ints, reals, rows, answer, answer.qdot)
+
+
+@kernel
+def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide: Array,
+        ints: Ints, reals: Array) -> int:  # fmt: skip
+    """One tick: its status code, :data:`FAILED` (the fallbacks answer) or :data:`INVALID_INPUT`.
+
+    Reads the sizes, flags and settings in ``ints`` and ``reals`` and the inputs' rows of
+    ``joints``, ``task_rows``, ``rates`` and the constraint rows ``G``, ``h``, ``slide``
+    (``ints[CONSTRAINTS]`` of them); writes the box, the rates and the report.
+    """
+    if not box(joints, rates, ints, reals):
+        return INVALID_INPUT
+    p = ints[CONSTRAINTS]
+    rows = Rows(joints[LB], joints[UB], G[:p], h[:p], slide[:p], reals[TOLERANCE])
+    zero_inside, recovering = reals[ZERO_INSIDE] == 1.0, reals[RECOVERING] == 1.0
+    direction = (ints[WEIGHTED] == 0 and ints[DIRECTION] == 1 and zero_inside
+                 and not (rows.h < 0.0).any())  # fmt: skip
+    answer = top_level(task_rows, rates, ints, reals, rows, direction, recovering)
+    if answer.status == FAILED:
+        return FAILED
+    qdot = lower_levels(task_rows, rates, ints, rows, answer)
+    return report(joints, ints, reals, rows, answer, qdot)
+
+
+class Workspace:
+    """The preallocated arrays of one resolver's ticks, and the compiled tick on them.
+
+    Args:
+        lower: Lower position limits (n,) [rad or m] of the step's box.
+        upper: Upper position limits (n,).
+        velocity: Velocity limits (n,) [rad/s or m/s].
+        acceleration: Acceleration limits (n,) or (1,) [rad/s^2 or m/s^2], inf for none.
+        margin: The box's margin from the position limits [rad or m].
+        gain: Its position gain in (0, 1].
+        threshold: The damping threshold, or 0 for no damping.
+        direction: Whether the top level is the direction problem where standing still is
+            allowed.
+        tolerance: How far a kernel's answer may leave the box and rows before it is refused.
+    """
+
+    def __init__(self, lower: Array, upper: Array, velocity: Array, acceleration: Array,
+                 margin: float, gain: float, threshold: float, direction: bool,
+                 tolerance: float) -> None:  # fmt: skip
+        n = lower.size
+        self.n = n
+        self.joints = np.zeros((JOINT_ROWS, n))
+        self.joints[LOWER], self.joints[UPPER], self.joints[VELOCITY] = lower, upper, velocity
+        self.joints[ACCELERATION] = np.broadcast_to(acceleration, (n,))
+        self.reals = np.zeros(REAL_SIZE)
+        self.reals[MARGIN], self.reals[GAIN], self.reals[THRESHOLD] = margin, gain, threshold
+        self.reals[TOLERANCE] = tolerance
+        self.ints = np.zeros(STARTS + 8, np.int64)
+        self.ints[DIRECTION] = int(direction)
+        self.task_rows, self.rates = np.zeros((6, n)), np.ones((3, 6))
+        self.G, self.h, self.slide = np.zeros((0, n)), np.zeros(0), np.zeros(0)
+
+    def load_levels(self, levels: Sequence[Sequence[TaskRows]], weighted: bool) -> None:
+        """The tasks' rows and rates, by level (highest first)."""
+        ints = self.ints
+        if len(levels) == 1 and len(levels[0]) == 1:  # one task: the default tick's
+            t = levels[0][0]
+            m = t.b.size
+            self._fit(m, 1)
+            ints[STARTS], ints[STARTS + 1] = 0, m
+            self._load(t, 0, m)
+        else:
+            m = sum(t.b.size for level in levels for t in level)
+            self._fit(m, len(levels))
+            r = 0
+            for k, tasks in enumerate(levels):
+                ints[STARTS + k] = r
+                for t in tasks:
+                    self._load(t, r, r + t.b.size)
+                    r += t.b.size
+            ints[STARTS + len(levels)] = r
+        ints[LEVELS], ints[ROWS], ints[WEIGHTED] = len(levels), m, weighted
+        ints[UNITS] = any(t.unit is not None for t in levels[0])
+
+    def _fit(self, m: int, levels: int) -> None:
+        """Room for ``m`` task rows and ``levels`` levels."""
+        if m > self.rates.shape[1]:
+            self.task_rows, self.rates = np.zeros((m, self.n)), np.ones((3, m))
+        if self.ints.size < STARTS + 2 * levels + 2:
+            self.ints = np.concatenate([self.ints, np.zeros(2 * levels + 2, np.int64)])
+
+    def _load(self, t: TaskRows, start: int, end: int) -> None:
+        """Task ``t``'s rows, rates, weights and units as rows ``start:end``."""
+        self.task_rows[start:end] = t.A
+        rates = self.rates
+        rates[RATE, start:end] = t.b
+        rates[WEIGHT, start:end] = 1.0 if t.weight is None else t.weight
+        rates[UNIT, start:end] = 1.0 if t.unit is None else t.unit
+
+    def load_twist(self, J: Array, selected: tuple[int, ...], b: Array) -> None:
+        """One task's rows ``J`` (6, n) (the ``selected`` ones) and rates ``b``, over those
+        loaded last (:meth:`load_levels`: the same task, whose weights and units stay).
+        """  # noqa: D205
+        m = b.size
+        self.task_rows[:m] = J if m == 6 else J[list(selected)]
+        self.rates[RATE, :m] = b
+
+    def load_rows(
+        self, G: Array | None, h: Array | None, slide: npt.NDArray[np.bool_] | None
+    ) -> None:
+        """The constraint rows ``G qdot <= h`` (None: none) and which the command may slide
+        along (None: none).
+        """  # noqa: D205
+        if h is None or G is None:
+            self.ints[CONSTRAINTS] = 0
+            return
+        p = h.size
+        if p > self.h.size:
+            self.G, self.h, self.slide = np.zeros((p, self.n)), np.zeros(p), np.zeros(p)
+        self.G[:p], self.h[:p] = G, h
+        self.slide[:p] = 0.0 if slide is None else slide
+        self.ints[CONSTRAINTS] = p
+
+    def run(self, q: Array, previous: Array, dt: float) -> int:
+        """The tick at positions ``q`` (n,) after rates ``previous`` (n,), step ``dt`` [s].
+
+        One level without rows goes to :func:`run_box`, and to :func:`run` only where that
+        is not its tick.
+        """
+        self.joints[POSITION], self.joints[PREVIOUS] = q, previous
+        self.reals[DT] = dt
+        if self.ints[LEVELS] == 1 and self.ints[CONSTRAINTS] == 0:
+            code: int = run_box(self.joints, self.task_rows, self.rates, self.ints, self.reals)
+            if code != ELSEWHERE:
+                return code
+        return run(self.joints, self.task_rows, self.rates, self.G, self.h, self.slide,
+                   self.ints, self.reals)  # fmt: skip
+
+    def compile(self, general: bool) -> None:
+        """Compile the default tick's entry (:func:`run_box`), and the general one where
+        ``general``, or load them from numba's cache: on a problem without rows whose answer
+        is exact, so that no QP is asked for and nothing is kept.
+        """  # noqa: D205
+        n = self.n
+        ws = Workspace(self.joints[LOWER], self.joints[UPPER], self.joints[VELOCITY],
+                       self.joints[ACCELERATION], 0.0, 1.0, 0.0, True, 1.0)  # fmt: skip
+        one = TaskRows(np.eye(1, n), np.zeros(1), None, "", np.ones(1))
+        ws.load_levels([[one]], False)
+        ws.load_rows(None, None, None)
+        ws.joints[POSITION] = np.clip(np.zeros(n), self.joints[LOWER], self.joints[UPPER])
+        ws.reals[DT] = 0.01
+        run_box(ws.joints, ws.task_rows, ws.rates, ws.ints, ws.reals)
+        if general:
+            run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
+
+    def level_codes(self) -> list[int]:
+        """How each level was served (:data:`MET`, :data:`SCALED_LEVEL`, :data:`TRADED`)."""
+        ints = self.ints
+        levels = ints.item(LEVELS)
+        if levels == 1:
+            return [ints.item(STARTS + 2)]
+        codes: list[int] = ints[STARTS + levels + 1 : STARTS + 2 * levels + 1].tolist()
+        return codes

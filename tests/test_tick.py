@@ -1,0 +1,188 @@
+"""One tick in one compiled call (solvers/tick/tick.py) against the Python pipeline it takes the
+place of (solvers/tick/pipeline.py, its reference): random problems of every mode (direction,
+tracking, weighted; one level, strict levels; the joint box alone or with constraint rows, some
+of them slide rows), the same rates to 1e-9 of their size, the same statuses, levels, scales and
+veers; its pieces against numpy; bad inputs coded before anything is written."""
+
+from __future__ import annotations
+
+from typing import get_args
+
+import numpy as np
+import pytest
+
+from rrc_pin.solvers.qp_backends import make_backend
+from rrc_pin.solvers.qp_backends.qp import velocity_tolerance
+from rrc_pin.solvers.tick import backend_calls, kernels, tick
+from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.pipeline import Options, Status, served, solve
+from rrc_pin.solvers.tick.problem import Box, Constraints, TaskRows, build
+
+STATUS_NAMES = get_args(Status)
+
+SEEDS = [20261206, int(np.random.SeedSequence().entropy % 2**63)]
+N, DT = 7, 0.01
+LEVELS = ("met", "scaled", "traded", "dropped")
+RATE_TOL = 1e-9
+"""Rates' difference relative to their size, and scales' difference, where the kernels
+answered."""
+BACKEND_TOL = 1e-5
+"""Where the backend (DAQP) answered a stage: its answer moves with the last bits of its data,
+which the compiled tick forms in its own loops. On a scaled two-level problem with three rows the
+pipeline's own rates moved by 9.6e-7 (its scale by 4.1e-7) when its task or constraint rows were
+moved by one ulp, as far as the compiled tick's differ from it there."""
+
+
+def limits(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    lower = -rng.uniform(1.0, 3.0, N)
+    return lower, -lower * rng.uniform(0.5, 1.5, N), rng.uniform(0.5, 2.0, N)
+
+
+def tasks(rng: np.random.Generator, weighted: bool) -> list[list[TaskRows]]:
+    """One to three levels of one or two tasks, weights and units at random."""
+    count = 1 if weighted else int(rng.integers(1, 4))
+    out = []
+    for k in range(count):
+        level = []
+        for t in range(int(rng.integers(1, 3))):
+            m = int(rng.integers(1, 5))
+            weight = None if rng.random() < 0.5 else rng.uniform(0.1, 2.0, m)
+            unit = None if rng.random() < 0.5 else rng.uniform(0.3, 1.5, m)
+            b = rng.normal(size=m) * rng.choice([0.05, 0.5, 5.0])
+            level.append(TaskRows(rng.normal(size=(m, N)), b, weight, f"t{k}{t}", unit))
+        out.append(level)
+    return out
+
+
+def case(rng: np.random.Generator) -> tuple:
+    lower, upper, velocity = limits(rng)
+    q = rng.uniform(lower, upper)
+    if rng.random() < 0.1:  # a start outside the range: the box excludes standing still
+        q[0] = upper[0] + 0.1
+    weighted = rng.random() < 0.3
+    levels = tasks(rng, weighted)
+    p = int(rng.integers(0, 4)) if rng.random() < 0.5 else 0
+    G, h = rng.normal(size=(p, N)), rng.uniform(0.0, 0.5, p)
+    slide = rng.random(p) < 0.5
+    return q, lower, upper, velocity, levels, weighted, G, h, slide, rng.random() < 0.8
+
+
+def pipeline_answer(q, lower, upper, velocity, levels, weighted, G, h, slide, direction):
+    lb, ub, kind = np.empty(N), np.empty(N), np.empty((2, N), np.int8)
+    zero, recovering = kernels.joint_box(q, lower, upper, velocity, 0.0, 1.0, DT, np.zeros(N),
+                                         np.array([np.inf]), lb, ub, kind)  # fmt: skip
+    box = Box(lb, ub, kind, zero, recovering, velocity)
+    names = tuple(f"row{i}" for i in range(h.size))
+    limits_ = [Constraints(box), Constraints(G=G, h=h, names=names, slide=slide)]
+    problem = build(levels, limits_, N, DT, weighted=weighted, direction=direction)
+    return solve(problem, make_backend("daqp"), Options(Damping()))
+
+
+def compiled_answer(q, lower, upper, velocity, levels, weighted, G, h, slide, direction):
+    ws = tick.Workspace(lower, upper, velocity, np.array([np.inf]), 0.0, 1.0, 100.0, direction,
+                        velocity_tolerance(velocity))  # fmt: skip
+    ws.load_levels(levels, weighted)
+    if h.size:
+        ws.load_rows(G, h, slide)
+    else:
+        ws.load_rows(None, None, None)
+    backend_calls.enter(backend_calls.Context(make_backend("daqp"), velocity))
+    try:
+        code = ws.run(q, np.zeros(N), DT)
+    finally:
+        backend_calls.leave()
+    return code, ws
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_random_problems_answered_as_the_pipeline(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    kinds: dict[str, int] = {}
+    for _ in range(400):
+        args = case(rng)
+        want = pipeline_answer(*args)
+        code, ws = compiled_answer(*args)
+        if code == tick.FAILED:  # the fallbacks' answer: not the compiled call's
+            assert want.method != "qp"
+            continue
+        status = STATUS_NAMES[code]
+        kinds[status] = kinds.get(status, 0) + 1
+        qdot = ws.joints[tick.QDOT]
+        assert status == want.status
+        assert tuple(LEVELS[c] for c in ws.level_codes()) == want.levels
+        tol = RATE_TOL if want.backend == "" else BACKEND_TOL
+        assert np.abs(qdot - want.qdot).max() <= tol * (1.0 + np.abs(want.qdot).max()), seed
+        assert ws.reals[tick.SCALE] == pytest.approx(want.scale, abs=tol), seed
+        if max(want.scale, ws.reals[tick.SCALE]) > 1e-9:
+            assert ws.reals[tick.VEER] == pytest.approx(want.veer, abs=1e-7)
+    assert {"exact", "scaled", "least_squares"} <= set(kinds), kinds
+
+
+def test_stacked_rows_are_the_problems(rng: np.random.Generator) -> None:
+    velocity = limits(rng)[2]
+    lb, ub = -velocity, velocity
+    for _ in range(100):
+        (level,) = tasks(rng, weighted=True)
+        normalised = bool(rng.random() < 0.5)
+        A = np.vstack([t.A for t in level])
+        b = np.concatenate([t.b for t in level])
+        weight = np.concatenate([np.ones(t.b.size) if t.weight is None else t.weight
+                                 for t in level])  # fmt: skip
+        unit = np.concatenate([np.ones(t.b.size) if t.unit is None else t.unit for t in level])
+        rows, rates, factor = tick.stacked(A, b, weight, unit, normalised, lb, ub)
+        box = Box(lb, ub, np.zeros((2, N), np.int8), True, False, velocity)
+        problem = build([level], [Constraints(box)], N, DT, direction=normalised)
+        want_A, want_b = problem.stacked[0]
+        np.testing.assert_allclose(rows, want_A, atol=1e-15)
+        np.testing.assert_allclose(rates, want_b, atol=1e-15)
+        assert factor == problem.rate_factor
+
+
+def test_served_and_the_shrink_into_rows_against_the_pipelines(rng: np.random.Generator) -> None:
+    for _ in range(200):
+        A = rng.normal(size=(3, N))
+        b = rng.normal(size=3) * (rng.random() < 0.9)
+        qdot = rng.normal(size=N)
+        for x in (qdot, np.linalg.pinv(A) @ b, 0.5 * np.linalg.pinv(A) @ b):
+            assert LEVELS[tick.served(A, b, x)] == served(A @ x, b)
+
+
+@pytest.mark.parametrize("bad", ["position", "rate"])
+def test_bad_inputs_are_coded_before_anything_is_written(bad: str) -> None:
+    rng = np.random.default_rng(4)
+    lower, upper, velocity = limits(rng)
+    ws = tick.Workspace(lower, upper, velocity, np.array([np.inf]), 0.0, 1.0, 100.0, True, 1e-6)
+    level = [[TaskRows(rng.normal(size=(6, N)), rng.normal(size=6), None, "t")]]
+    ws.load_levels(level, False)
+    ws.load_rows(None, None, None)
+    q = np.zeros(N)
+    if bad == "position":
+        q[2] = np.nan
+    else:
+        ws.rates[tick.RATE, 1] = np.inf
+    before = ws.joints[tick.QDOT].copy()
+    assert ws.run(q, np.zeros(N), DT) == tick.INVALID_INPUT
+    assert ws.ints[tick.INVALID] == (tick.BAD_POSITION if bad == "position" else tick.BAD_RATE)
+    assert np.array_equal(ws.joints[tick.QDOT], before)
+
+
+def test_the_default_tick_passes_a_box_without_standing_still_on() -> None:
+    """run_box answers one level in the direction mode; a start outside the range (the box
+    excludes zero: the least-squares mode) is run's."""
+    rng = np.random.default_rng(5)
+    lower, upper, velocity = limits(rng)
+    ws = tick.Workspace(lower, upper, velocity, np.array([np.inf]), 0.0, 1.0, 100.0, True, 1e-6)
+    ws.load_levels([[TaskRows(rng.normal(size=(6, N)), rng.normal(size=6), None, "t")]], False)
+    ws.load_rows(None, None, None)
+    q = np.zeros(N)
+    ws.joints[tick.POSITION], ws.reals[tick.DT] = q, DT
+    args = (ws.joints, ws.task_rows, ws.rates, ws.ints, ws.reals)
+    assert tick.run_box(*args) >= 0
+    q[0] = upper[0] + 0.5
+    ws.joints[tick.POSITION] = q
+    assert tick.run_box(*args) == tick.ELSEWHERE
+    backend_calls.enter(backend_calls.Context(make_backend("daqp"), velocity))
+    try:
+        assert ws.run(q, np.zeros(N), DT) == STATUS_NAMES.index("recovering")
+    finally:
+        backend_calls.leave()

@@ -1,0 +1,68 @@
+"""The compiled tick's top level (solvers/tick/top.py): its status codes are the pipeline's, its
+small pieces against numpy; its stages against the pipeline's run in tests/test_tick.py and
+tests/test_tick_answers.py."""
+
+from __future__ import annotations
+
+from typing import get_args
+
+import numpy as np
+import pytest
+
+from rrc_pin.solvers.tick import top
+from rrc_pin.solvers.tick.direction import along
+from rrc_pin.solvers.tick.kernels import scale_and_veer
+from rrc_pin.solvers.tick.pipeline import Status
+from rrc_pin.solvers.tick.problem import Box
+
+SEEDS = [20261206, int(np.random.SeedSequence().entropy % 2**63)]
+
+
+def test_status_codes_index_the_pipelines_statuses() -> None:
+    names = get_args(Status)
+    codes = {"exact": top.EXACT, "scaled": top.SCALED, "sliding": top.SLIDING,
+             "damped": top.DAMPED, "singular": top.SINGULAR, "least_squares": top.LEAST_SQUARES,
+             "recovering": top.RECOVERING, "fallback": top.FALLBACK}  # fmt: skip
+    for name, code in codes.items():
+        assert names[code] == name
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_norm_scale_and_veer_against_numpy(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    for _ in range(200):
+        x = rng.normal(size=int(rng.integers(1, 9))) * 10.0 ** rng.integers(-200, 200)
+        peak = float(np.abs(x).max())  # numpy's squares overflow beyond 1e154
+        assert top.norm(x) == pytest.approx(peak * float(np.linalg.norm(x / peak)), rel=1e-14)
+        A = rng.normal(size=(3, 5))
+        b, qdot = rng.normal(size=3), rng.normal(size=5)
+        per_unit = rng.uniform(0.5, 2.0, 3)
+        scale, veer = scale_and_veer(A @ qdot, b, per_unit)
+        got = top.along_command(A, b, qdot, per_unit, 0.5)
+        assert got == pytest.approx((0.5 * scale, veer), abs=1e-12)
+    assert top.norm(np.zeros(3)) == 0.0
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_the_box_scale_of_no_or_one_null_direction_is_the_pipelines(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n = 6
+    lb, ub = -rng.uniform(0.1, 1.0, n), rng.uniform(0.1, 1.0, n)
+    rows = top.Rows(lb, ub, np.zeros((0, n)), np.zeros(0), np.zeros(0), 1e-6)
+    box = Box(lb, ub, np.zeros((2, n), np.int8), True, False, np.ones(n))
+    for d in (0, 1):
+        for _ in range(100):
+            w = rng.normal(size=n) * 3.0
+            null = np.linalg.qr(rng.normal(size=(n, n)))[0][:, :d].T.copy()
+            qdot, u = top.scaled_along(np.eye(n), w, null, rows)
+            want = along(w, null, box, None)
+            assert want is not None and u == want.u
+            np.testing.assert_allclose(qdot, want.qdot, atol=1e-15)
+
+
+def test_slide_rows_are_the_marked_ones() -> None:
+    G, h = np.arange(12.0).reshape(4, 3), np.arange(4.0)
+    rows = top.Rows(np.zeros(3), np.ones(3), G, h, np.array([1.0, 0.0, 1.0, 0.0]), 1e-6)
+    Gs, hs = top.slide_rows(rows)
+    np.testing.assert_array_equal(Gs, G[[0, 2]])
+    np.testing.assert_array_equal(hs, h[[0, 2]])
