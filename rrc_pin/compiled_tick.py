@@ -119,7 +119,7 @@ class CompiledTick:
 
     def __init__(self, layout: Layout, limit: JointLimits, options: Options, direction: bool,
                  backend: QPBackend, names: tuple[str, ...], general: bool) -> None:  # fmt: skip
-        velocity = layout.velocity if limit.velocity is None else np.asarray(limit.velocity)
+        velocity = limit.velocities(layout)
         acceleration = _NO_ACCELERATION if limit.acceleration is None else np.asarray(
             limit.acceleration)  # fmt: skip
         damping = options.damping

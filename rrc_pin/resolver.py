@@ -240,7 +240,8 @@ class Resolver:
                 them).
         """
         if (self._twists and type(command) is np.ndarray and type(q) is np.ndarray
-                and ref is None and dt is None and qdot_prev is None and priority == "weighted"):
+                and ref is None and dt is None and qdot_prev is None and type(priority) is str
+                and priority == "weighted"):
             r = self._twist(q, command)
             if r is not None:
                 return r

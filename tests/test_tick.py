@@ -144,7 +144,7 @@ def test_served_and_the_shrink_into_rows_against_the_pipelines(rng: np.random.Ge
         b = rng.normal(size=3) * (rng.random() < 0.9)
         qdot = rng.normal(size=N)
         for x in (qdot, np.linalg.pinv(A) @ b, 0.5 * np.linalg.pinv(A) @ b):
-            assert LEVELS[tick.served(A, b, x)] == served(A @ x, b)
+            assert LEVELS[tick.served(A, b, x, 1.0)] == served(A @ x, b)
 
 
 @pytest.mark.parametrize("bad", ["position", "rate"])

@@ -114,13 +114,21 @@ class JointLimits(Limit):
                 f"ranges: {np.round(half[[layout.joints[n] for n in narrow]], 4).tolist()})",
             )  # fmt: skip
 
+    def velocities(self, layout: Layout) -> Array:
+        """The velocity limits this box keeps on ``layout``'s joints (nv,) [rad/s or m/s]: the
+        robot's, or the override's within what mimic joints put on the joints they follow."""  # noqa: D205, D209
+        if self.velocity is None:
+            return layout.velocity
+        velocity: Array = np.asarray(self.velocity)
+        if layout.mimic_velocity is not None:
+            velocity = np.minimum(velocity, layout.mimic_velocity)
+        return velocity
+
     def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
         """The step's box (:func:`rrc_pin.solvers.tick.kernels.joint_box`)."""
         layout = kin.layout
         n = layout.nv
-        velocity: Array = layout.velocity if self.velocity is None else np.asarray(self.velocity)
-        if self.velocity is not None and layout.mimic_velocity is not None:
-            velocity = np.minimum(velocity, layout.mimic_velocity)
+        velocity = self.velocities(layout)
         acceleration = _NO_ACCELERATION if self.acceleration is None else np.asarray(
             self.acceleration
         )

@@ -83,16 +83,17 @@ def stacked(A: Array, b: Array, weight: Array, unit: Array, normalised: bool, lb
     rows, rates = space[: m * n].reshape(m, n), space[m * n :]
     units = unit if normalised else np.ones(m)
     peak = kernels.weighted_rows(A, b, weight, top_weight, units, 1.0, rows, rates)
-    if normalised:
-        if peak <= LARGE:
-            return rows, rates, 1.0
-        scale = 0.0
+    factor = 1.0
+    if normalised and peak > LARGE:  # the direction first: b over its largest entry, before
+        # the rows' factors could overflow
+        b_max = 0.0
         for i in range(m):
-            scale = max(scale, abs(b[i]))
-        kernels.weighted_rows(A, b, weight, top_weight, units, 1.0 / scale, rows, rates)
-        return rows, rates, 1.0 / scale
-    if peak <= SATURATION:
-        return rows, rates, 1.0
+            b_max = max(b_max, abs(b[i]))
+        factor = 1.0 / b_max
+        peak = kernels.weighted_rows(A, b, weight, top_weight, units, factor, rows, rates)
+    command = peak / factor  # the command's own magnitude (inf beyond the float range)
+    if command <= (LARGE if normalised else SATURATION):
+        return rows, rates, factor
     sides = 0.0
     for j in range(n):
         side = max(-lb[j], ub[j])
@@ -103,19 +104,22 @@ def stacked(A: Array, b: Array, weight: Array, unit: Array, normalised: bool, lb
         for j in range(n):
             largest = max(largest, abs(rows[i, j]))
     cap = SATURATION * (1.0 + largest * sides)
-    if peak <= cap:
-        return rows, rates, 1.0
-    return rows, rates * (cap / peak), cap / peak
+    if normalised:
+        cap = min(cap, LARGE)
+    if command <= cap:
+        return rows, rates, factor
+    return rows, rates * (cap / peak), factor * (cap / peak)
 
 
 @kernel
-def served(A: Array, b: Array, qdot: Array) -> int:
+def served(A: Array, b: Array, qdot: Array, rate_factor: float) -> int:
     """How a lower level was served by ``qdot``: met, scaled along its command, or traded
-    (:func:`rrc_pin.solvers.tick.pipeline.served`: a zero command not met is traded).
+    (:func:`rrc_pin.solvers.tick.pipeline.served`: a zero command not met is traded; a
+    command divided down by ``rate_factor`` and met is scaled).
     """  # noqa: D205
     y = row_values(A, qdot)
     if top.norm(y - b) <= top.EXACT_TOL * (1.0 + top.norm(b)):
-        return MET
+        return MET if rate_factor == 1.0 else SCALED_LEVEL
     scale, veer = kernels.scale_and_veer(y, b)
     return SCALED_LEVEL if veer <= 1e-6 and scale > 0.0 and b.any() else TRADED
 
@@ -182,9 +186,9 @@ def lower_levels(task_rows: Array, rates: Array, ints: Ints, rows: Rows, answer:
     qdot, null = answer.qdot, answer.null
     codes = STARTS + ints[LEVELS] + 1
     for k in range(1, ints[LEVELS]):
-        A, b, _ = level(task_rows, rates, ints, k, k == 0, rows.lb, rows.ub)
+        A, b, rate_factor = level(task_rows, rates, ints, k, k == 0, rows.lb, rows.ub)
         if null.shape[0] == 0:
-            ints[codes + k] = served(A, b, qdot)
+            ints[codes + k] = served(A, b, qdot, rate_factor)
             continue
         kept, null = least_squares(k, A, b, qdot, null, rows.lb, rows.ub, rows.G, rows.h,
                                    rows.tol, k < ints[LEVELS] - 1)  # fmt: skip
@@ -192,7 +196,7 @@ def lower_levels(task_rows: Array, rates: Array, ints: Ints, rows: Rows, answer:
             ints[codes + k] = DROPPED
             continue
         qdot = kept
-        ints[codes + k] = served(A, b, qdot)
+        ints[codes + k] = served(A, b, qdot, rate_factor)
     return qdot
 
 

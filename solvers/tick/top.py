@@ -142,6 +142,15 @@ def answer(A: Array, b: Array, qdot: Array, status: int, rate_factor: float, nul
 
 
 @kernel
+def met_top(qdot: Array, rate_factor: float, null: Array) -> Top:
+    """The top level's stacked command met: exact where that is the command itself, else (a
+    command divided down, :mod:`rrc_pin.solvers.tick.problem`) scaled by its factor."""  # noqa: D205, D209
+    if rate_factor == 1.0:
+        return Top(qdot, EXACT, 1.0, 0.0, 0.0, null)
+    return Top(qdot, SCALED, rate_factor, 0.0, 0.0, null)
+
+
+@kernel
 def passing(w: Array, null: Array) -> Top:
     """A stage's "not mine": the next stage answers."""
     return Top(w, FAILED, 0.0, 0.0, 0.0, null)
@@ -278,7 +287,7 @@ def exact(A: Array, command: Array, f: Factor, w: Array, fits: bool, rows: Rows,
         return answer(A, command, w, SLIDING, rate_factor, null, 0.0)
     if outside_range:
         return answer(A, command, w, SINGULAR, rate_factor, null, 0.0)
-    return Top(w, EXACT, 1.0, 0.0, 0.0, null)
+    return met_top(w, rate_factor, null)
 
 
 @inlined
@@ -295,7 +304,7 @@ def scaled(A: Array, command: Array, b: Array, f: Factor, w: Array, boxed: Array
     if slid:
         return answer(A, command, qdot, SLIDING, rate_factor, null, 0.0)
     if not outside_range and u >= 1.0 - EXACT_TOL:
-        return Top(qdot, EXACT, 1.0, 0.0, 0.0, null)
+        return met_top(qdot, rate_factor, null)
     usable, lam = damping(f, b, w, u, rows, dt, threshold)
     if lam.size:
         damped_qdot, damped_u = scaled_along(A, factor.rates(usable, b, lam), null, rows)
@@ -390,6 +399,6 @@ def least_squares_top(A: Array, b: Array, per_unit: Array, rows: Rows, recoverin
     if recovering or (rows.h < 0.0).any():
         status = RECOVERING
     else:
-        status = EXACT if met(A, qdot, b) else LEAST_SQUARES
+        status = EXACT if met(A, qdot, b) and rate_factor == 1.0 else LEAST_SQUARES
     scale, veer = along_command(A, b, qdot, per_unit, rate_factor)
     return Top(qdot, status, scale, veer, 0.0, null)
