@@ -103,7 +103,7 @@ class CellLog(RecordRing[CellRecord]):
             ("errors", "f8", (len(self.commands),)), ("grip", "f8", (len(self.objects),)),
             ("chain", "f8", (2,)), ("status", "u1"), ("mode", "u1"), ("levels", "u1", (LEVELS,)),
         ])  # fmt: skip
-        self._table = np.zeros(0, self.dtype)
+        self._table: npt.NDArray[Any] = np.zeros(0, self.dtype)
         self._start = 0  # the oldest row's index in the ring
         self._count = 0
 
@@ -170,7 +170,8 @@ class CellLog(RecordRing[CellRecord]):
     def table(self) -> npt.NDArray[Any]:
         """The ticks kept, oldest first, as a structured array (a copy; :attr:`dtype`)."""
         index = (self._start + np.arange(self._count)) % max(self._table.size, 1)
-        return self._table[index]
+        kept: npt.NDArray[Any] = self._table[index]
+        return kept
 
     def column(self, name: str) -> npt.NDArray[Any]:
         """One field over the ticks kept, oldest first: (N,) or (N, k) (a copy).

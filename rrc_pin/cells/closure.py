@@ -170,11 +170,13 @@ def close(
     trust = TRUST * box.velocity
     low = np.minimum(np.maximum(box.lb - qdot, -trust), 0.0)  # zero always inside
     high = np.maximum(np.minimum(box.ub - qdot, trust), 0.0)
+    G: Array
+    h: Array
     if rows is None:
         G, h = np.zeros((0, n)), np.zeros(0)
     else:
         G, h = np.ascontiguousarray(rows.G), np.maximum(rows.h - rows.G @ qdot, 0.0)
-    delta = np.zeros(n)
+    delta: Array = np.zeros(n)
     for _ in range(PASSES):
         second = second_order(model, data, q, qdot + delta, chains.contacts, chains.grips)
         delta = solve((closure.error - 0.5 * dt * dt * second) / (dt * closure.unit))

@@ -197,7 +197,7 @@ class CellController(Loop):
         self._world_warned = False
         self._targets: dict[str, Array] = {}
         self._tick: tuple[str, bool, dict[str, Array]] = ("teleop", False, {})
-        self._applied = np.zeros(cell.nv)
+        self._applied: Array = np.zeros(cell.nv)
         self._correction_size = 0.0
         self._data = cell.model.createData()  # the closure's second-order pass
         self._frames = frame_index(cell.model)

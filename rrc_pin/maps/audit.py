@@ -90,7 +90,7 @@ class AuditReport:
     def __repr__(self) -> str:
         n, failed = int(self.keys.size), self.failures.tolist()
         shown = ", ".join(map(str, failed[:SHOWN])) + (", ..." if len(failed) > SHOWN else "")
-        starts = f"{self.starts.mean():.1f} mean, {self.starts.max()} most" if n else "none"
+        starts = f"{self.starts.mean():.1f} mean, {np.max(self.starts)} most" if n else "none"
         return (
             f"AuditReport({n:,} voxels tried, {n - len(failed):,} reached "
             f"({self.confirmed:.1%}), failures [{shown}], starts {starts}, "

@@ -72,5 +72,6 @@ class LookAtTask(AxisAlignTask):
             return pose[:3, :3] @ self.axis, np.zeros((3, kin.q.size))
         d = offset / rho
         Jv = kin.jacobian(self.frame, "world_aligned")[:3]
-        return d, -np.cross(d[:, None], Jv, axis=0) / rho
+        rows: Array = np.asarray(-np.cross(d[:, None], Jv, axis=0) / rho, np.float64)
+        return d, rows
 

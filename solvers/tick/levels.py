@@ -112,6 +112,7 @@ def projected(B: Array, z: Array, x: Array, N: Array, whole: bool, lb: Array, ub
     """  # noqa: D205
     d = z.size
     out = np.empty(d)
+    qdot: Array
     if whole:
         Gz, hz = one_sided(G, np.full(h.size, -np.inf), h)
         code = project(B, 0.0, z, lb, ub, Gz, hz, MARGIN, out)

@@ -405,7 +405,8 @@ def _slide(
         return kept
     m, n = A.shape
     US, sigma, right, rank = factor.svd
-    B, target = np.empty((m + n, n)), np.empty(n)
+    B: Array = np.empty((m + n, n))
+    target = np.empty(n)
     threshold = math.inf if damping is None else float(damping.threshold)
     rows = slide_metric(np.ascontiguousarray(A), US, sigma, right, rank,
                         np.ascontiguousarray(factor.null_basis()), b, SLIDE_DAMPING, threshold,

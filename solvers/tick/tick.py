@@ -307,7 +307,7 @@ class Workspace:
         self.reals = np.zeros(REAL_SIZE)
         self.reals[MARGIN], self.reals[GAIN], self.reals[THRESHOLD] = margin, gain, threshold
         self.reals[TOLERANCE] = tolerance
-        self.ints = np.zeros(STARTS + 8, np.int64)
+        self.ints: npt.NDArray[np.int64] = np.zeros(STARTS + 8, np.int64)
         self.ints[DIRECTION] = int(direction)
         self.task_rows, self.rates = np.zeros((6, n)), np.ones((3, 6))
         self.G, self.h, self.slide = np.zeros((0, n)), np.zeros(0), np.zeros(0)

@@ -205,12 +205,13 @@ def slid_command(where: int, A: Array, b: Array, G: Array, h: Array, rows: Rows,
     m, n = A.shape
     f = factor.with_svd(f)
     f, null = factor.null_basis(f)
-    B, target = np.empty((m + n, n)), np.empty(n)
+    B: Array = np.empty((m + n, n))
+    target = np.empty(n)
     kappa = threshold if threshold > 0.0 else np.inf
     count = slide_metric(A, f.US, f.sigma, f.right, f.rank, null, b, SLIDE_DAMPING, kappa, B,
                          target)  # fmt: skip
     B = B[:count]
-    x = np.empty(n)
+    x: Array = np.empty(n)
     if project(B, 0.0, target, rows.lb, rows.ub, G, h, MARGIN, x) == SOLVED:
         kernels.clip_into(x, rows.lb, rows.ub)  # by the kernel's rounding at most
         return 0, x, f
@@ -391,7 +392,7 @@ def least_squares_top(A: Array, b: Array, per_unit: Array, rows: Rows, recoverin
         qdot = w
     else:
         # np.int64: not a literal, so one compiled signature serves every level
-        qdot, null = least_squares(np.int64(backend_calls.TOP), A, b, np.zeros(n),
+        qdot, null = least_squares(np.int64(backend_calls.TOP), A, b, np.zeros(n),  # type: ignore[arg-type, unused-ignore]
                                    np.empty((0, n)), rows.lb, rows.ub, rows.G, rows.h, rows.tol,
                                    need_null)  # fmt: skip
         if qdot.size == 0:
