@@ -219,7 +219,9 @@ def test_a_command_above_1e100_is_never_reported_exact(seed: int, arms: dict) ->
     """Before, 1,498 of 51,000 soak steps said ``exact``, scale 1, for commands above 1e100
     while the hand moved at the command divided by its largest entry. Now such a command is
     ``scaled`` (or damped, singular: never exact), the hand moving along it at ``scale`` times
-    it, the same motion as for the same direction at 1e99 (the largest the box allows)."""
+    it, the same motion as for the same direction at 1e99 (the largest the box allows) where
+    that one is scaled too: near a singular pose the 1e99 command is damped, the divided one
+    scaled along itself to the box (barker6, a fresh seed: the two differ there)."""
     rng = np.random.default_rng(seed)
     for name in ("kr5_3r", "barker6", "panda"):
         arm = arms[name]
@@ -236,7 +238,8 @@ def test_a_command_above_1e100_is_never_reported_exact(seed: int, arms: dict) ->
                 np.testing.assert_allclose(J @ r.qdot / size, r.scale * rows,
                                            atol=1e-7 * r.scale * np.abs(rows).max())  # fmt: skip
                 slower = resolver.solve(q, direction * 1e99)
-                np.testing.assert_allclose(r.qdot, slower.qdot, atol=1e-9)
+                if slower.status == "scaled":  # (near a singular pose the 1e99 one is damped)
+                    np.testing.assert_allclose(r.qdot, slower.qdot, atol=1e-9)
 
 
 def test_a_subnormal_command_from_outside_the_limits_has_a_finite_report(arms: dict) -> None:
