@@ -4,7 +4,8 @@ A capsule (segment :math:`a_0 a_1`, radius :math:`r`) against a box (centre :mat
 :math:`R_c`, half sides :math:`h_c`) overlaps it exactly when no axis separates them. The
 separation along a unit axis :math:`m` pointing from the box towards the capsule is
 
-.. math:: F(m) = \min(m \cdot a_0,\ m \cdot a_1) - r - \Big(m \cdot t + \sum_c h_c |m \cdot R_c|\Big)
+.. math:: F(m) = \min(m \cdot a_0,\ m \cdot a_1) - r
+          - \Big(m \cdot t + \sum_c h_c |m \cdot R_c|\Big)
 
 and, in penetration, the signed distance is its largest value over the twelve face normals of
 the Minkowski difference of the segment and the box: the six box faces :math:`\pm R_c` and

@@ -200,8 +200,7 @@ def _apart(poses: Array, bodies: Records, world: Array, a: int, b: int) -> float
 
 @kernel
 def _write(found: Records, row: int, k: int, end: int, measured: Row) -> int:
-    """Write ``measured`` as row ``row`` of pair ``k`` (``end``: 1 for an end point's row,
-    :data:`FEATURE` for a box feature's)."""
+    """Write ``measured`` as row ``row`` of pair ``k`` (``end``: 1, :data:`FEATURE`)."""
     d, pa, pb, n = measured
     record = found[row]
     record["pair"] = k
@@ -329,9 +328,11 @@ def _box_ends(
     poses: Array, bodies: Records, a: int, b: int, k: int, detection: float, found: Records,
     rows: int,
 ) -> int:  # fmt: skip
-    """Append the end-point rows of capsule ``a`` against box ``b`` (module docstring), and
-    inside the box the rows of the features of its deepest axis
-    (:func:`~rrc_pin.solvers.collision.box_kernels.inside_rows`) that no end-point row repeats.
+    """Append the end-point rows of capsule ``a`` against box ``b``, then its features'.
+
+    The features (module docstring): with the segment inside the box, those of its deepest axis
+    (:func:`~rrc_pin.solvers.collision.box_kernels.inside_rows`), else the nearest edges
+    (:func:`_box_edges`); those that no end-point row repeats.
 
     Returns:
         The number of rows now written.
