@@ -36,8 +36,8 @@ along a face or an edge) its row follows that point while another comes closer, 
 order. So the features that may take over within the step get rows too: with the segment
 inside the box, those of its deepest separating axis
 (:func:`~rrc_pin.solvers.collision.box_kernels.inside_rows`); outside, the three box edges
-nearest the segment (the distance of a segment to a box is the least of its ends' and of the
-box's edges' to it): the three nearest, edges meeting at the nearest corner counted once.
+nearest the segment, those meeting at its nearest corner counted once (the distance of a
+segment to a box is the least of its ends' and of the box's edges' to it).
 
 Pairs of other shapes (cylinders, convex hulls, meshes) are returned for coal, only where they
 may be within the detection distance: besides the broad phase's bounding spheres, a sphere or
