@@ -36,9 +36,9 @@ DECREASE = 2.5e-4
 commanded at random: the rows keep the distance to first order (rounding 1e-11 m a tick), a
 capsule against a box with the rows of the box's features that may take over within the step
 (:mod:`rrc_pin.solvers.collision.box_kernels`); the rest is the step's second-order motion and
-coal's penetration depths of cylinders. The most over 3,800 starts of the soak, 40 ticks each:
+coal's penetration depths of cylinders. The most over 5,600 starts of the soak, 40 ticks each:
 0.154 mm (a cylinder), 0.106 mm for boxes (0.46 mm without the features' rows; a capsule
-sliding along a box, quadratic in the step), 0.053 mm for two pandas' capsules."""
+sliding along a box, quadratic in the step), 0.116 mm for two pandas' capsules (quadratic)."""
 
 MAKERS = {"panda": soak.panda_start, "held box": soak.held_box_start,
           "two pandas": soak.two_pandas_start}  # fmt: skip
