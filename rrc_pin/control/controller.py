@@ -17,8 +17,9 @@ A device's poses may command the tool frame, and any other frame of the robot (b
 second hand), instead of twists (:meth:`~rrc_pin.control.loop.Loop.stream`): each tick the
 stream's bounded twist toward its target is the frame's command (the tool's through the same
 path as a twist in base axes; another frame's as a :class:`~rrc_pin.tasks.FrameTask` in the
-top level beside the tool's, one common scale). The optional jerk stage
-(``smoothing=``) runs after the resolver.
+top level beside the tool's, one common scale; a strategy that chooses the joint rates
+itself, Barker's on barker6, moves the arm alone and the other frames wait). The optional
+jerk stage (``smoothing=``) runs after the resolver.
 :meth:`Controller.reverse` retraces the recorded joint positions back in time (Barker's
 "speedy and effortless evacuation of the robot hand from a congested workspace").
 """
