@@ -323,8 +323,10 @@ def test_a_recorded_stream_drives_the_hand_through_its_faults(panda):
     with pytest.raises(rrc_pin.InvalidInput, match="twist: panda_hand_tcp follows its pose"):
         ctl.step([0.01, 0, 0, 0, 0, 0], ref="world_aligned")
     ctl.close_stream()
-    held = ctl.step(np.zeros(6), ref="world_aligned").resolution  # twists again: it holds
+    held = ctl.step().resolution  # the stream's last twist does not age on: it holds
     assert np.abs(held.qdot).max() < 1e-9 and ctl.streams == {}
+    moved = ctl.step([0.01, 0, 0, 0, 0, 0], ref="world_aligned").resolution  # twists again
+    assert moved.status == "exact" and np.abs(moved.qdot).max() > 1e-3
     with pytest.raises(rrc_pin.InvalidInput, match="name: 'panda_hand_tcp' has no stream"):
         ctl.close_stream()
     with pytest.raises(rrc_pin.InvalidInput, match="name: expected a frame of panda"):

@@ -32,9 +32,9 @@ correction inside the tick's box (:mod:`rrc_pin.cells.closure`), and a chain ope
 bound stops the cell (``grip_lost`` / ``contact_lost``) until a command closes it.
 
 A command's name may follow a device's poses instead (:meth:`~rrc_pin.control.loop.Loop.stream`:
-its twist each tick the stream's, its target the pose reached), and the jerk stage
-(``smoothing=``) may run after the resolver, before the closed chains' correction (which
-keeps them closed whatever the stage changed). The loop itself is
+its twist each tick the stream's, its target the pose reached), and a cell of free hands
+may have the jerk stage after its resolver (``smoothing=``; bounding each joint apart would
+open a grip or a foot's contact). The loop itself is
 :class:`~rrc_pin.control.loop.Loop`, the one
 :class:`~rrc_pin.control.Controller` is built on: the speed override and the deadman weight
 every command, the configuration is integrated on its manifold, the ticks go to a log ring

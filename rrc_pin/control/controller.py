@@ -12,6 +12,8 @@ period (Barker eq. (21)) on the configuration manifold:
 .. math:: q_{k+1} = q_k \oplus \dot q_k\, \Delta t \quad (\texttt{pinocchio.integrate}),
 
 recording the tick in a :class:`~rrc_pin.control.trajectory_log.TrajectoryLog`.
+:meth:`Controller.reverse` retraces the recorded joint positions back in time (Barker's
+"speedy and effortless evacuation of the robot hand from a congested workspace").
 
 A device's poses may command the tool frame, and any other frame of the robot (baxter's
 second hand), instead of twists (:meth:`~rrc_pin.control.loop.Loop.stream`): each tick the
@@ -20,8 +22,6 @@ path as a twist in base axes; another frame's as a :class:`~rrc_pin.tasks.FrameT
 top level beside the tool's, one common scale; a strategy that chooses the joint rates
 itself, Barker's on barker6, moves the arm alone and the other frames wait). The optional
 jerk stage (``smoothing=``) runs after the resolver.
-:meth:`Controller.reverse` retraces the recorded joint positions back in time (Barker's
-"speedy and effortless evacuation of the robot hand from a congested workspace").
 """
 
 from __future__ import annotations
@@ -402,6 +402,16 @@ class Controller(Loop):
     def _stopped(self) -> None:
         self._command = np.zeros(6)
         self._reanchor = True
+
+    def close_stream(self, name: str | None = None) -> None:
+        """End ``name``'s stream (default: the tool frame's); the tool frame then holds.
+
+        Raises:
+            InvalidInput: ``name`` has no stream (the streamed ones listed).
+        """
+        super().close_stream(name)
+        if name is None or name == self._tool:  # its last twist does not age on
+            self._stopped()
 
     def _stream_name(self, name: str | None) -> str:
         if name is None:
