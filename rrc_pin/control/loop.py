@@ -244,7 +244,8 @@ class Loop:
         (:meth:`PoseStream.twist`, base axes, times the speed override) at every tick, toward
         the target the device's samples give: push them with :meth:`PoseStream.push` (times on
         this loop's clock, :attr:`t`) and press the clutch with :meth:`PoseStream.clutch`,
-        from any thread. The stream starts anchored at the frame's pose now.
+        from any thread (open and close streams between ticks, in the loop's own). The stream
+        starts anchored at the frame's pose now.
 
         Args:
             name: A frame of the robot (``Controller``: default its tool frame) or a command's
