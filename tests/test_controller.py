@@ -304,20 +304,23 @@ def replayed(ctl: Controller, replays: dict[str, Replay]) -> list[rrc_pin.contro
     return steps
 
 
-def test_a_recorded_stream_drives_the_hand_through_its_faults(panda):
+@pytest.mark.parametrize("seed", [1, "fresh"])
+def test_a_recorded_stream_drives_the_hand_through_its_faults(panda, seed):
     """ctl.stream() on panda: a 90 Hz recording (0.5 mm and 2 mrad noise, dropouts of 0.15 and
     0.4 s, a three-sample glitch 0.25 m off, the tracker's frame moved by (0, 0.2, 0.05) m, the
     clutch pressed 1 s) into a 100 Hz Controller.step(): the hand follows the clean target
     0.10 s behind (1/k) within 3 mm (RMS 1.5 mm) outside 0.5 s after each fault, both jumps
     rejected, the moved frame and the clutch's release re-anchored with no step in the target
-    or the hand's motion (measured 0.10 s, 2.1 mm, RMS 0.92 mm)."""
+    or the hand's motion (measured 0.10 s, 2.1 mm, RMS 0.92 mm; at most 2.4 mm over 20 other
+    noise seeds)."""
+    seed = int(np.random.SeedSequence().entropy % 2**63) if seed == "fresh" else seed
     ctl = Controller(panda, dt=DT)
     stream = ctl.stream()
     assert ctl.streams == {panda.tool_frame: stream}
-    replay = Replay(stream, seed=1)
+    replay = Replay(stream, seed=seed)
     steps = replayed(ctl, {panda.tool_frame: replay})
     lag, worst, rms = replay.lag_and_error()
-    assert 0.05 <= lag <= 0.12 and worst < 3e-3 and rms < 1.5e-3, (lag, worst, rms)
+    assert 0.05 <= lag <= 0.12 and worst < 3e-3 and rms < 1.5e-3, (seed, lag, worst, rms)
     replay.check_faults()
     assert all(s.resolution.status == "exact" for s in steps)
     with pytest.raises(rrc_pin.InvalidInput, match="twist: panda_hand_tcp follows its pose"):
