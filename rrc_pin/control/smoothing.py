@@ -46,6 +46,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.solvers.checks import as_vector, finite_number, flag, integer, real_array
+from rrc_pin.solvers.smoothing_kernels import braked, jerk_step
 from rrc_pin.solvers.tick.problem import Box
 
 if TYPE_CHECKING:
@@ -161,6 +162,8 @@ class JerkLimiter:
         margin = finite_number(margin, "margin", 0.0)
         self._lower = None if lower is None else _limits(lower, "lower", n) + margin
         self._upper = None if upper is None else _limits(upper, "upper", n) - margin
+        self._brake: Array = BRAKE * self.a_max
+        self._lead: Array = self.a_max / self.j_max + 2.0 * self.dt
         self.rates: Array = np.zeros(n)
         self._acceleration: Array = np.zeros(n)
         self._stopping = False
@@ -199,16 +202,13 @@ class JerkLimiter:
         if not isinstance(box, Box) or box.lb.shape != (self.n,):
             raise InvalidInput("box", f"expected the tick's Box of {self.n} joints, got {box!r}")
         where = None if position is None else as_vector(position, "position", self.n)
-        dt, a_max, j_max = self.dt, self.a_max, self.j_max
-        v, a = self.rates, self._acceleration
+        v = self.rates
         target = np.zeros(self.n) if self._stopping else self._braked(command, where)
-        e = target - v
-        wanted = np.sign(e) * j_max * (np.sqrt(dt * dt + 2.0 * np.abs(e) / j_max) - dt)
-        step = np.clip(np.clip(wanted, a - j_max * dt, a + j_max * dt), -a_max, a_max)
-        smoothed = v + step * dt
+        smoothed = np.empty(self.n)
+        jerk_step(v, self._acceleration, target, self.dt, self.a_max, self.j_max, smoothed)
         out = box.clip(smoothed)
         clipped = out != smoothed
-        change = (out - v) / dt
+        change = (out - v) / self.dt
         self.rates, self._acceleration = out, change
         return Smoothed(out.copy(), change, clipped, np.abs(out - command) > SAME)
 
@@ -216,12 +216,8 @@ class JerkLimiter:
         """``command`` slowed where a position limit is near (module docstring)."""
         if position is None or self._lower is None or self._upper is None:
             return command
-        a, lead = BRAKE * self.a_max, self.a_max / self.j_max + 2.0 * self.dt
-        out: Array = command.copy()
-        for distance, sign in ((self._upper - position, 1.0), (position - self._lower, -1.0)):
-            d = np.maximum(distance, 0.0)
-            fastest = -a * lead + np.sqrt((a * lead) ** 2 + 2.0 * a * d)
-            out = np.minimum(out, fastest) if sign > 0 else np.maximum(out, -fastest)
+        out: Array = np.empty(self.n)
+        braked(command, position, self._lower, self._upper, self._brake, self._lead, out)
         return out
 
 
