@@ -58,6 +58,7 @@ from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.loop import Loop, Step
 from rrc_pin.deprecated import warn_renamed
 from rrc_pin.errors import InvalidInput
+from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits import ContactLimit, GripLimit, JointLimits, Limit
 from rrc_pin.limits.contact_limit import Closure
 from rrc_pin.loading import loaded
@@ -200,6 +201,9 @@ class CellController(Loop):
         self._applied: Array = np.zeros(cell.nv)
         self._correction_size = 0.0
         self._data = cell.model.createData()  # the closure's second-order pass
+        self._kin_data = cell.model.createData()  # the tick's kinematics (:meth:`_kinematics`)
+        self._kin: Kinematics | None = None
+        self._frame_tasks: dict[str, FrameTask] = {}
         self._frames = frame_index(cell.model)
         self._close_at()
 
@@ -301,7 +305,8 @@ class CellController(Loop):
             self._command_time = self.t
         weight = self._weight()
         cell = self.cell
-        poses = {name: cell.fk(self._q, self.frame_of(name)) for name in self._targets}
+        kin = self._kinematics()
+        poses = {name: kin.pose(self.frame_of(name)) for name in self._targets}
         twists = {name: weight * self._world_aligned(name, poses[name], self._commands[name])
                   if name in self._commands else np.zeros(6) for name in self._targets}  # fmt: skip
         top: list[Task] = []
@@ -318,13 +323,12 @@ class CellController(Loop):
                     hands.append(FrameTask(hand, _transport(twist, poses[name], T),
                                            target=target, gain=self.gain))  # fmt: skip
                 continue
-            top.append(FrameTask(self.frame_of(name), twist, target=self._targets[name],
-                                 gain=self.gain, name=name))  # fmt: skip
+            top.append(self._task(name, twist))
         if hands:
-            r = self.resolver.solve(self._q, [*top, *hands, self.posture])
+            r = self.resolver.solve_at(kin, [*top, *hands, self.posture])
         else:
             levels: list[list[Task]] = [top, [self.posture]] if top else [[self.posture]]
-            r = self.resolver.solve(self._q, levels, priority="strict")
+            r = self.resolver.solve_at(kin, levels, priority="strict")
         commanded = any(bool(np.any(t != 0.0)) for t in twists.values())
         self._tick = ("teleop", commanded, poses)
         out = self._advance(r)
@@ -341,6 +345,32 @@ class CellController(Loop):
         for name, twist in twists.items():
             self._targets[name] = _moved(self._targets[name], twist * (follow * self.dt))
         return out
+
+    def _kinematics(self) -> Kinematics:
+        """The tick's one :class:`~rrc_pin.kinematics.Kinematics` at the current q.
+
+        Read by the commands' poses, the resolver's tasks and limits (the closed chains' rows
+        and errors) and the closure's correction; on the controller's own Data, so that it
+        holds until the next tick.
+        """
+        _, dof, q_pin = self.cell.positions(self._q)
+        self._kin = Kinematics(self.cell.model, self._kin_data, self.resolver.layout, dof, q_pin)
+        return self._kin
+
+    def _task(self, name: str, twist: Array) -> FrameTask:
+        """Command ``name``'s frame task of this tick: ``twist`` (6,) toward its target.
+
+        One task per command, kept across ticks: its twist and target are the controller's
+        own, checked already (the target a rigid transform it moved), so set without a
+        second check.
+        """
+        task = self._frame_tasks.get(name)
+        if task is None:
+            task = self._frame_tasks[name] = FrameTask(self.frame_of(name), gain=self.gain,
+                                                       name=name)  # fmt: skip
+        task.twist = twist
+        task.target = self._targets[name]
+        return task
 
     def _held_back(self, r: Resolution, twists: dict[str, Array]) -> None:
         """A damped tick's targets, fed back within a bound (:data:`HOLD`).
