@@ -53,7 +53,7 @@ import pinocchio as pin
 from rrc_pin.cells.cell import Cell
 from rrc_pin.cells.cell_log import CellLog
 from rrc_pin.cells.cell_resolution import CellResolution
-from rrc_pin.cells.closure import Chains, ClosureBound, close
+from rrc_pin.cells.closure import ChainFrames, ClosureBound, close, compile_correction
 from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.loop import Loop, Step
 from rrc_pin.deprecated import warn_renamed
@@ -200,11 +200,13 @@ class CellController(Loop):
         self._tick: tuple[str, bool, dict[str, Array]] = ("teleop", False, {})
         self._applied: Array = np.zeros(cell.nv)
         self._correction_size = 0.0
-        self._data = cell.model.createData()  # the closure's second-order pass
         self._kin_data = cell.model.createData()  # the tick's kinematics (:meth:`_kinematics`)
         self._kin: Kinematics | None = None
         self._frame_tasks: dict[str, FrameTask] = {}
         self._frames = frame_index(cell.model)
+        self._chain_frames = ChainFrames.of(cell.model, (), ())
+        if closure is not None:
+            compile_correction(cell.nv)
         self._close_at()
 
     # -- settings -------------------------------------------------------------------------
@@ -398,11 +400,13 @@ class CellController(Loop):
     def _log_reverse(self, q: Array, r: Resolution) -> None:
         """A reverse tick: logged, closed and integrated by :meth:`_advance` (a command)."""
         self._tick = ("reverse", True, {})
+        self._kin = None  # the resolver made its own: the closure makes the tick's
 
     def _advance(self, r: Resolution) -> Step:
         """One tick: the closed chains' correction (:meth:`_closed`), the log, the integration."""
         closed = self._closed(r)
         self._record(closed)
+        self._kin = None  # of this tick's q only
         return super()._advance(closed)
 
     def _integrate(self, qdot: Array) -> Array:
@@ -458,6 +462,10 @@ class CellController(Loop):
         self.contact.set_frames(self.support, [self._anchors[f] for f in self.support])
         grasps = [self.cell.objects[n] for n in self._grips]
         self.grip.set_pairs([g.hands for g in grasps], [self._grips[g.name] for g in grasps])
+        ids = self._frames
+        self._chain_frames = ChainFrames.of(self.cell.model,
+                                            tuple(ids[f] for f in self.contact.frames),
+                                            tuple((ids[a], ids[b]) for a, b in self.grip.pairs))
 
     def _closed(self, r: Resolution) -> CellResolution:
         """``r`` with the closed chains' correction, or held still while one is lost.
@@ -486,14 +494,12 @@ class CellController(Loop):
         bound = self.closure
         if bound is None:
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
-        ids = self._frames
-        chains = Chains(closure, tuple(ids[f] for f in self.contact.frames),
-                        tuple((ids[a], ids[b]) for a, b in self.grip.pairs))  # fmt: skip
         mode, commanded, _ = self._tick
         top = r.problem.stacked[0][0] if mode == "teleop" else np.zeros((0, self.cell.nv))
         box = r.problem.box
-        delta, after = close(self.cell.model, self._data, self._pinocchio_q(self._q), chains,
-                             r.qdot, top, box, r.problem.rows, self.dt)  # fmt: skip
+        kin = self._kin if self._kin is not None else self._kinematics()
+        delta, after = close(kin, self._chain_frames, closure, r.qdot, top, box, r.problem.rows,
+                             self.dt)  # fmt: skip
         level = bound.level(closure.error)
         if level <= 1.0:
             self.lost = None
