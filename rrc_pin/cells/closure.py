@@ -63,7 +63,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.cells import closure_kernels
-from rrc_pin.cells.closure_kernels import DAMPING, KEEP, PASSES
+from rrc_pin.cells.closure_kernels import DAMPING, KEEP, PASSES, TRUST
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits.contact_limit import Closure
 from rrc_pin.solvers.checks import finite_number
@@ -72,11 +72,7 @@ from rrc_pin.solvers.tick.problem import Box, Rows
 Array = npt.NDArray[np.float64]
 
 __all__ = ["DAMPING", "KEEP", "PASSES", "TRUST", "ChainFrames", "ClosureBound", "close",
-           "compile_correction"]
-
-TRUST = 0.1
-"""The trust region: the correction moves each joint by at most this fraction of its velocity
-limit [rad/s or m/s]."""
+           "compile_correction", "largest"]
 
 
 @dataclass(frozen=True)
@@ -100,12 +96,17 @@ class ClosureBound:
 
     def level(self, error: Array) -> float:
         """The largest error of chains ``error`` (6 k,) relative to the bound (<= 1: held)."""
-        e = error.reshape(-1, 6)
-        if not e.size:
-            return 0.0
-        position = float(np.max(np.linalg.norm(e[:, :3], axis=1))) / self.position
-        rotation = float(np.max(np.linalg.norm(e[:, 3:], axis=1))) / self.rotation
-        return max(position, rotation)
+        position, rotation = largest(error)
+        return max(position / self.position, rotation / self.rotation)
+
+
+def largest(error: Array) -> tuple[float, float]:
+    """The largest position [m] and rotation [rad] error of chains ``error`` (6 k,) (0 for none)."""
+    e = error.reshape(-1, 6)
+    if not e.size:
+        return 0.0, 0.0
+    return (float(np.max(np.linalg.norm(e[:, :3], axis=1))),
+            float(np.max(np.linalg.norm(e[:, 3:], axis=1))))  # fmt: skip
 
 
 class ChainFrames(NamedTuple):
@@ -179,22 +180,14 @@ def close(
     """
     n = qdot.size
     data = kin.data
-    J = np.ascontiguousarray(data.J)
     poses = np.array([data.oMf[f].homogeneous for f in frames.frames]).reshape(-1, 4, 4)
-    trust = TRUST * box.velocity
-    low = np.minimum(np.maximum(box.lb - qdot, -trust), 0.0)  # zero always inside
-    high = np.maximum(np.minimum(box.ub - qdot, trust), 0.0)
-    G: Array
-    h: Array
-    if rows is None:
-        G, h = np.zeros((0, n)), np.zeros(0)
-    else:
-        G, h = np.ascontiguousarray(rows.G), np.maximum(rows.h - rows.G @ qdot, 0.0)
+    G, h = (np.zeros((0, n)), np.zeros(0)) if rows is None else (rows.G, np.array(rows.h))
     delta, after = np.empty(n), np.empty(closure.error.size)
     closure_kernels.correction(
-        J, frames.support, frames.joint, poses, frames.contacts, frames.grips,
-        np.ascontiguousarray(closure.C), closure.error, closure.unit, np.ascontiguousarray(top),
-        qdot, low, high, G, h, dt, delta, after,
+        np.ascontiguousarray(data.J), frames.support, frames.joint, poses, frames.contacts,
+        frames.grips, np.ascontiguousarray(closure.C), closure.error, closure.unit,
+        np.ascontiguousarray(top), qdot, np.array([box.lb, box.ub, box.velocity]),
+        np.ascontiguousarray(G), h, dt, delta, after,
     )  # fmt: skip
     return delta, after
 
@@ -212,5 +205,5 @@ def compile_correction(nv: int) -> None:
     closure_kernels.correction(
         np.zeros((6, nv)), np.zeros((0, nv), dtype=bool), np.zeros(nv, dtype=np.int64),
         np.zeros((0, 4, 4)), ints, ints.reshape(0, 2), rows, empty, empty, rows, qdot,
-        np.zeros(nv), np.zeros(nv), rows, empty, 0.01, np.empty(nv), np.empty(0),
+        np.zeros((3, nv)), rows, empty, 0.01, np.empty(nv), np.empty(0),
     )  # fmt: skip

@@ -56,6 +56,10 @@ first)."""
 PASSES = 2
 """Passes of the correction in a tick (:func:`correction`)."""
 
+TRUST = 0.1
+"""The trust region: the correction moves each joint by at most this fraction of its velocity
+limit [rad/s or m/s]."""
+
 _TINY = float(np.finfo(np.float64).tiny)
 
 
@@ -226,8 +230,8 @@ def lexicographic(C: Array, top: Array, null: Array, keep: Array, r: Array, out:
 @kernel
 def correction(
     J: Array, support: npt.NDArray[np.bool_], joint: Ints, poses: Array, contacts: Ints,
-    grips: Ints, C: Array, error: Array, unit: Array, top: Array, qdot: Array, low: Array,
-    high: Array, G: Array, h: Array, dt: float, delta: Array, after: Array,
+    grips: Ints, C: Array, error: Array, unit: Array, top: Array, qdot: Array, box: Array,
+    G: Array, h: Array, dt: float, delta: Array, after: Array,
 ) -> None:  # fmt: skip
     r"""The correction that closes the chains within the step, and their error after it.
 
@@ -246,11 +250,11 @@ def correction(
         unit: Their units (6 k,) (the resolver's metric).
         top: The top level's rows (t, nv) in their metric.
         qdot: The resolver's rates (nv,).
-        low: The correction's lower bounds (nv,): the box less the rates, within the trust
-            region, at most zero.
-        high: Its upper bounds (nv,), at least zero.
-        G: The constraint rows (p, nv), or (0, nv).
-        h: Their room ``max(h - G qdot, 0)`` (p,).
+        box: (3, nv) the tick's box: its lower and upper bounds and the velocity limits
+            (the correction's bounds are the box less the rates, within the trust region
+            :data:`TRUST` times the velocity limits, and zero).
+        G: The constraint rows ``G qdot <= h`` (p, nv), or (0, nv).
+        h: Their bounds (p,) (the correction's room: ``max(h - G qdot, 0)``).
         dt: The step [s].
         delta: Out: the correction (nv,).
         after: Out: the chains' error after the step (6 k,), to second order.
@@ -265,6 +269,10 @@ def correction(
         householder_qr(np.ascontiguousarray(Cm.T), Q, R)
         null = np.ascontiguousarray(Q[:, m:].T)
         keep = top @ null.T
+    trust = TRUST * box[2]
+    low = np.minimum(np.maximum(box[0] - qdot, -trust), 0.0)  # zero always inside
+    high = np.maximum(np.minimum(box[1] - qdot, trust), 0.0)
+    room = np.maximum(h - G @ qdot, 0.0)
     M = np.empty((m + top.shape[0], n))
     M[:m] = Cm
     M[m:] = KEEP * top
@@ -275,8 +283,8 @@ def correction(
         second_order(J, support, joint, poses, contacts, grips, u, second)
         r[:] = (error - 0.5 * dt * dt * second) / (dt * unit)
         lexicographic(Cm, top, null, keep, r, delta)
-        if not (inside(delta, low, high) and rows_hold(G, delta, h, 0.0)):
-            if project(M, DAMPING, delta, low, high, G, h, MARGIN, x) != SOLVED:
+        if not (inside(delta, low, high) and rows_hold(G, delta, room, 0.0)):
+            if project(M, DAMPING, delta, low, high, G, room, MARGIN, x) != SOLVED:
                 x[:] = 0.0
             clip_into(x, low, high)
             delta[:] = x

@@ -40,6 +40,7 @@ every command, the configuration is integrated on its manifold, the ticks go to 
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -53,7 +54,7 @@ import pinocchio as pin
 from rrc_pin.cells.cell import Cell
 from rrc_pin.cells.cell_log import CellLog
 from rrc_pin.cells.cell_resolution import CellResolution
-from rrc_pin.cells.closure import ChainFrames, ClosureBound, close, compile_correction
+from rrc_pin.cells.closure import ChainFrames, ClosureBound, close, compile_correction, largest
 from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.loop import Loop, Step
 from rrc_pin.deprecated import warn_renamed
@@ -487,10 +488,9 @@ class CellController(Loop):
         parts = [(last, kind) for last, kind in measured if last is not None]
         if not parts:
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
-        closure = Closure(*(np.concatenate([c[i] for c, _ in parts]) for i in range(3)))
-        e = closure.error.reshape(-1, 6)
-        self.chain_error = (float(np.max(np.linalg.norm(e[:, :3], axis=1))),
-                            float(np.max(np.linalg.norm(e[:, 3:], axis=1))))  # fmt: skip
+        closure = parts[0][0] if len(parts) == 1 else Closure(
+            *(np.concatenate([c[i] for c, _ in parts]) for i in range(3)))  # fmt: skip
+        self.chain_error = largest(closure.error)
         bound = self.closure
         if bound is None:
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
@@ -500,7 +500,7 @@ class CellController(Loop):
         kin = self._kin if self._kin is not None else self._kinematics()
         delta, after = close(kin, self._chain_frames, closure, r.qdot, top, box, r.problem.rows,
                              self.dt)  # fmt: skip
-        level = bound.level(closure.error)
+        level = max(self.chain_error[0] / bound.position, self.chain_error[1] / bound.rotation)
         if level <= 1.0:
             self.lost = None
         elif self.lost is not None and commanded and bound.level(after) < level:
@@ -607,18 +607,22 @@ class CellController(Loop):
     def _record(self, r: CellResolution) -> None:
         """Log the tick: its rates, status, the commands' pose errors, the grips' errors."""
         mode, _, poses = self._tick
-        errors = {n: float(np.linalg.norm(self._targets[n][:3, 3] - T[:3, 3]))
-                  for n, T in poses.items()}  # fmt: skip
+        errors = {n: _length(self._targets[n][:3, 3] - T[:3, 3]) for n, T in poses.items()}
         grip = {}
         measured = self.grip.last
         for k, (name, g) in enumerate(self.cell.objects.items()):
             if measured is not None and name in self._grips:  # the tick's, by the grip limit
-                grip[name] = float(np.linalg.norm(measured.error[6 * k : 6 * k + 3]))
+                grip[name] = _length(measured.error[6 * k : 6 * k + 3])
                 continue
             rel = _inverse(self.cell.fk(self._q, g.hands[0])) @ self.cell.fk(self._q, g.hands[1])
             grip[name] = float(np.linalg.norm(rel[:3, 3] - g.grip[:3, 3]))
         self.log.add(self.t, self._q, r.applied, r.status, r.scale, r.levels, errors, grip,
                      self.chain_error, mode)  # fmt: skip
+
+
+def _length(v: Array) -> float:
+    """The Euclidean length of ``v`` (1-D): ``numpy.linalg.norm``'s floats, one call."""
+    return math.sqrt(float(v @ v))
 
 
 def _inverse(T: Array) -> Array:
