@@ -200,3 +200,18 @@ def test_the_correction_is_the_numpy_reference(cell, seed):
                                    err_msg=f"seed {seed}, case {k}")  # fmt: skip
         np.testing.assert_allclose(after, want_after, rtol=0.0, atol=1e-15,
                                    err_msg=f"seed {seed}, case {k}")  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", [FIXED, None])
+def test_largest_is_numpys_norms(seed):
+    """Each chain's position and rotation lengths, the largest: numpy's floats, bit for bit."""
+    seed = fresh() if seed is None else seed
+    rng = np.random.default_rng(seed)
+    assert ck.largest(np.zeros(0)) == (0.0, 0.0)
+    for k in (1, 2, 3, 5):
+        for _ in range(50):
+            error = rng.normal(size=6 * k) * 10.0 ** rng.uniform(-9, 1)
+            e = error.reshape(-1, 6)
+            want = (float(np.max(np.linalg.norm(e[:, :3], axis=1))),
+                    float(np.max(np.linalg.norm(e[:, 3:], axis=1))))  # fmt: skip
+            assert ck.largest(error) == want, f"seed {seed}"

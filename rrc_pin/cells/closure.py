@@ -63,7 +63,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.cells import closure_kernels
-from rrc_pin.cells.closure_kernels import DAMPING, KEEP, PASSES, TRUST
+from rrc_pin.cells.closure_kernels import DAMPING, KEEP, PASSES, TRUST, largest
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits.contact_limit import Closure
 from rrc_pin.solvers.checks import finite_number
@@ -98,15 +98,6 @@ class ClosureBound:
         """The largest error of chains ``error`` (6 k,) relative to the bound (<= 1: held)."""
         position, rotation = largest(error)
         return max(position / self.position, rotation / self.rotation)
-
-
-def largest(error: Array) -> tuple[float, float]:
-    """The largest position [m] and rotation [rad] error of chains ``error`` (6 k,) (0 for none)."""
-    e = error.reshape(-1, 6)
-    if not e.size:
-        return 0.0, 0.0
-    return (float(np.max(np.linalg.norm(e[:, :3], axis=1))),
-            float(np.max(np.linalg.norm(e[:, 3:], axis=1))))  # fmt: skip
 
 
 class ChainFrames(NamedTuple):
@@ -193,7 +184,7 @@ def close(
 
 
 def compile_correction(nv: int) -> None:
-    """Compile the correction's kernel now (or load it from the cache), for a cell of ``nv`` rates.
+    """Compile the correction's kernels now (or load them from the cache), for ``nv`` rates.
 
     With the arrays' types a tick passes (the resolver's rates read-only), so that a
     controller's first tick does not compile it.
@@ -207,3 +198,4 @@ def compile_correction(nv: int) -> None:
         np.zeros((0, 4, 4)), ints, ints.reshape(0, 2), rows, empty, empty, rows, qdot,
         np.zeros((3, nv)), rows, empty, 0.01, np.empty(nv), np.empty(0),
     )  # fmt: skip
+    largest(np.zeros(0))

@@ -26,6 +26,8 @@ with :math:`\ddot q = 0`.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import numpy.typing as npt
 
@@ -69,6 +71,20 @@ def _cross(a: Array, b: Array, out: Array) -> None:
     out[0] = a[1] * b[2] - a[2] * b[1]
     out[1] = a[2] * b[0] - a[0] * b[2]
     out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@kernel
+def largest(error: Array) -> tuple[float, float]:
+    """The largest position [m] and rotation [rad] error of chains ``error`` (6 k,) (0 for none).
+
+    Each chain's lengths summed in numpy's order (``numpy.linalg.norm``'s floats).
+    """
+    position = rotation = 0.0
+    for i in range(error.size // 6):
+        e = error[6 * i : 6 * i + 6]
+        position = max(position, math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]))
+        rotation = max(rotation, math.sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5]))
+    return position, rotation
 
 
 @kernel
