@@ -250,8 +250,7 @@ class CellLog(RecordRing[CellRecord]):
         return out
 
     def _next(self) -> int:
-        """The index of the row the next tick goes in (the array grown, or the oldest row
-        reused)."""  # noqa: D205, D209
+        """The index of the next tick's row (the array grown, or the oldest row reused)."""
         size = self._table.size
         if self._count < size:
             index = (self._start + self._count) % size

@@ -363,16 +363,14 @@ class CellController(Loop):
     def _task(self, name: str, twist: Array) -> FrameTask:
         """Command ``name``'s frame task of this tick: ``twist`` (6,) toward its target.
 
-        One task per command, kept across ticks: its twist and target are the controller's
-        own, checked already (the target a rigid transform it moved), so set without a
-        second check.
+        One task per command, kept across ticks: its twist, target and gain are the
+        controller's own, checked already (the target a rigid transform it moved), so set
+        without a second check.
         """
         task = self._frame_tasks.get(name)
         if task is None:
-            task = self._frame_tasks[name] = FrameTask(self.frame_of(name), gain=self.gain,
-                                                       name=name)  # fmt: skip
-        task.twist = twist
-        task.target = self._targets[name]
+            task = self._frame_tasks[name] = FrameTask(self.frame_of(name), name=name)
+        task.twist, task.target, task.gain = twist, self._targets[name], self.gain
         return task
 
     def _held_back(self, r: Resolution, twists: dict[str, Array]) -> None:
