@@ -208,6 +208,7 @@ class CellController(Loop):
         self._chain_frames = ChainFrames.of(cell.model, (), ())
         if closure is not None:
             compile_correction(cell.nv)
+        scale_and_veer(np.zeros(6), np.zeros(6), np.ones(6))  # compiled now: damped ticks use it
         self._close_at()
 
     # -- settings -------------------------------------------------------------------------
