@@ -53,6 +53,8 @@ for name in ("barker6", "rrc_k1607", "kr5_3r"):
     out[name] = arm.closed_form.joint_rates(qa, np.ones(arm.closed_form.task_dim)).tolist()
 m = maps.capability("kr5_3r", 2000, 0.1, workers=1, progress=False, block_size=1024)
 out["maps"] = m.stats.isum.sum(axis=0).tolist()
+cell = rrc_pin.Controller("gsfc_dual", 0.01)  # a CellController: the closed chains' correction
+out["cell"] = cell.step({"object": np.array([0.05, 0.0, 0.0, 0.0, 0.0, 0.1])}).q.tolist()
 # only kernels call these: their own entries read here
 from rrc_pin.solvers.closed_form.base import finite
 from rrc_pin.solvers.collision.box_kernels import turned
