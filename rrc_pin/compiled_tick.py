@@ -37,10 +37,10 @@ from rrc_pin.tasks import FrameTask
 Array = npt.NDArray[np.float64]
 
 STATUSES: tuple[Status, ...] = get_args(Status)
-"""The statuses by their compiled codes (:mod:`rrc_pin.solvers.tick.top`)."""
+"""The statuses by their compiled codes (:mod:`rrc_pin.solvers.tick.statuses`)."""
 
-LEVELS: tuple[LevelStatus, ...] = ("met", "scaled", "traded", "dropped")
-"""How a level was served, by its compiled code (:data:`rrc_pin.solvers.tick.tick.MET`...)."""
+LEVELS: tuple[LevelStatus, ...] = get_args(LevelStatus)
+"""How a level was served, by its compiled code (:data:`rrc_pin.solvers.tick.statuses.MET`...)."""
 
 ONE_LEVEL: tuple[tuple[LevelStatus], ...] = tuple((s,) for s in LEVELS)
 """The levels of a one-level tick, by its code."""

@@ -22,7 +22,6 @@ where the backend fails, the top level fails (:data:`FAILED`) and the fallbacks 
 
 from __future__ import annotations
 
-import math
 from typing import NamedTuple
 
 import numpy as np
@@ -30,21 +29,25 @@ import numpy.typing as npt
 from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import backend_calls, factor, kernels
+from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses
 from rrc_pin.solvers.tick.factor import Factor
 from rrc_pin.solvers.tick.levels import least_squares, row_values
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
+from rrc_pin.solvers.tick.statuses import (
+    DAMPED,
+    EXACT,
+    EXACT_TOL,
+    LEAST_SQUARES,
+    RECOVERING,
+    SCALED,
+    SINGULAR,
+    SLIDING,
+)
 
 Array = npt.NDArray[np.float64]
 
-EXACT, SCALED, SLIDING, DAMPED, SINGULAR, LEAST_SQUARES, RECOVERING, FALLBACK = range(8)
-"""Codes of :data:`~rrc_pin.solvers.tick.pipeline.Status`, in its order."""
-
 FAILED = -1
 """The top level found no usable answer (the backend failed): the fallbacks answer."""
-
-EXACT_TOL = 1e-9
-"""Relative residual under which a command counts as met, and a scale as 1."""
 
 STILL_SCALE = 1e-9
 """A direction answer scaled below this stands still along the command
@@ -53,9 +56,6 @@ STILL_SCALE = 1e-9
 SLIDE_DAMPING = 1e-2
 r"""Weight :math:`\mu` of the sliding stage's damping
 (:data:`rrc_pin.solvers.tick.pipeline.SLIDE_DAMPING`)."""
-
-_TINY = float(np.finfo(np.float64).tiny)
-
 
 class Top(NamedTuple):
     """The top level's answer and its report.
@@ -99,23 +99,9 @@ class Rows(NamedTuple):
 
 
 @kernel
-def norm(x: Array) -> float:
-    """Euclidean norm without overflow or underflow."""
-    top = 0.0
-    for i in range(x.size):
-        top = max(top, abs(x[i]))
-    if top == 0.0 or not math.isfinite(top):
-        return top
-    s = 0.0
-    for i in range(x.size):
-        s += (x[i] / top) ** 2
-    return top * math.sqrt(s)
-
-
-@kernel
 def met(A: Array, x: Array, b: Array) -> bool:
-    """Whether ``A x`` meets ``b`` to :data:`EXACT_TOL` (relative)."""
-    return norm(row_values(A, x) - b) <= EXACT_TOL * (1.0 + norm(b))
+    """Whether ``A x`` meets ``b`` (:func:`rrc_pin.solvers.tick.statuses.met`)."""
+    return statuses.met(row_values(A, x), b)
 
 
 @kernel
@@ -143,11 +129,8 @@ def answer(A: Array, b: Array, qdot: Array, status: int, rate_factor: float, nul
 
 @kernel
 def met_top(qdot: Array, rate_factor: float, null: Array) -> Top:
-    """The top level's stacked command met: exact where that is the command itself, else (a
-    command divided down, :mod:`rrc_pin.solvers.tick.problem`) scaled by its factor."""  # noqa: D205, D209
-    if rate_factor == 1.0:
-        return Top(qdot, EXACT, 1.0, 0.0, 0.0, null)
-    return Top(qdot, SCALED, rate_factor, 0.0, 0.0, null)
+    """The top level's stacked command met (:func:`rrc_pin.solvers.tick.statuses.met_top`)."""
+    return Top(qdot, statuses.met_top(rate_factor), rate_factor, 0.0, 0.0, null)
 
 
 @kernel
