@@ -219,19 +219,39 @@ def scaled_along(A: Array, w: Array, null: Array, rows: Rows) -> tuple[Array, fl
     return u * w + y * null[0], u
 
 
+@kernel
+def columns_used(J: Array) -> int:
+    """How many columns of ``J`` have a nonzero entry (its rank is at most that)."""
+    count = 0
+    for j in range(J.shape[1]):
+        for i in range(J.shape[0]):
+            if J[i, j] != 0.0:
+                count += 1
+                break
+    return count
+
+
 @inlined
-def clamped(f: Factor, w: Array, rows: Rows, dt: float) -> Factor:
+def clamped(f: Factor, w: Array, rows: Rows, dt: float, threshold: float
+            ) -> tuple[Factor, bool]:  # fmt: skip
     """The rows without the joints ``w`` pushes against a bound that holds them, where they
-    keep their rank (:func:`rrc_pin.solvers.tick.pipeline._clamped`), else ``f``.
+    keep their rank (:func:`rrc_pin.solvers.tick.pipeline._clamped`), else ``f``; and whether
+    their condition number is surely within ``threshold`` (:func:`factor.surely_conditioned`:
+    where it is, the SVDs would choose the same rows).
     """  # noqa: D205
     J = np.empty_like(f.J)
     if not kernels.clamp_pushed(f.J, w, rows.lb, rows.ub, kernels.ON_LIMIT / dt, J):
-        return f
-    c = factor.with_svd(factor.qr(J))
+        return f, factor.surely_conditioned(f, threshold)
+    if columns_used(J) < J.shape[0] and factor.surely_conditioned(f, threshold):
+        return f, True  # the clamped rows are short of rank, f has it
+    c = factor.qr(J)
+    if factor.surely_conditioned(c, threshold):  # of full rank
+        return c, True
+    c = factor.with_svd(c)
     if c.rank == min(J.shape[0], J.shape[1]):
-        return c
+        return c, False
     f = factor.with_svd(f)
-    return c if c.rank >= f.rank else f
+    return (c if c.rank >= f.rank else f), False
 
 
 @kernel
@@ -242,7 +262,10 @@ def damping(f: Factor, b: Array, w: Array, u: float, rows: Rows, dt: float, thre
     """  # noqa: D205
     if threshold <= 0.0:
         return f, np.empty(0)
-    usable = factor.with_svd(clamped(f, w, rows, dt))
+    usable, conditioned = clamped(f, w, rows, dt, threshold)
+    if conditioned:
+        return usable, np.empty(0)
+    usable = factor.with_svd(usable)
     if factor.condition(usable) <= threshold:
         return usable, np.empty(0)
     m, k = usable.US.shape
