@@ -347,7 +347,7 @@ def _top(
         # up to 19 %; a backend's inexact answer is not taken for the command's direction)
     if outside_range:
         return _Top(u_w.qdot, "singular", *_along_command(problem, u_w.qdot), 0.0, null)
-    return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
+    return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, u_w.veer, 0.0, null)
 
 
 def _met_top(problem: Problem, qdot: Array, null: Array | None) -> _Top:
@@ -556,7 +556,7 @@ def backend_along(
     off = statuses.norm(y) * math.sin(min(veer, 0.5 * math.pi))  # the task rates off the direction
     if off > DIRECTION_TOL * statuses.norm(A.ravel()) * statuses.norm(qdot) and scale > STILL_SCALE:
         raise NumericalFailure(f"{work.backend}: answer veers by {veer:.3g} rad from the command")
-    return Along(qdot, scale)
+    return Along(qdot, scale, veer)
 
 
 def _null(factor: Factorization, space: Subspace) -> Array:

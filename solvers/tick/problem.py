@@ -37,7 +37,9 @@ from typing import Literal, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.solvers.checks import all_finite
 from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.errors import InvalidInput
 from rrc_pin.solvers.tick import kernels
 
 Array = npt.NDArray[np.float64]
@@ -327,6 +329,18 @@ def _ones(m: int) -> Array:
     ones = np.ones(m)
     ones.flags.writeable = False
     return ones
+
+
+def finite_rows(levels: Sequence[Sequence[TaskRows]]) -> None:
+    """Refuse a task whose rows are not finite (a user's task, or a command that overflowed).
+
+    Raises:
+        InvalidInput: Naming ``command`` and the task.
+    """
+    for level in levels:
+        for t in level:
+            if not (all_finite(t.b) and all_finite(t.A)):
+                raise InvalidInput("command", f"task {t.name!r} gave rows that are not finite")
 
 
 def largest_weight(tasks: Sequence[TaskRows]) -> float:

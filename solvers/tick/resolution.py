@@ -150,7 +150,8 @@ class Resolution(_Record):
         scale: Fraction in [0, 1] of the top level's command achieved along it (normalised
             metric): the common scale of its tasks when its direction was kept.
         veer: Angle [rad] between the top level's achieved and commanded rates (normalised
-            metric): 0 unless damped, singular, least squares or a fallback.
+            metric): 0 unless damped, singular, least squares, a fallback, or scaled by the
+            QP backend (its answer's angle as measured).
         levels: How each priority level was served, the top level's first
             (:data:`~rrc_pin.solvers.tick.pipeline.LevelStatus`: ``met``, ``scaled``,
             ``traded``, ``dropped``).

@@ -51,8 +51,8 @@ LEVELS, ROWS, CONSTRAINTS, WEIGHTED, DIRECTION, UNITS, INVALID, STARTS = range(8
 (DT, MARGIN, GAIN, THRESHOLD, TOLERANCE, SCALE, VEER, LAMBDA_SQ, CLIP, ZERO_INSIDE,
  RECOVERING, REAL_SIZE) = range(12)  # fmt: skip
 
-BAD_POSITION, BAD_RATE = 1, 2
-"""Codes of ``ints[INVALID]``: a position, or a commanded rate, not finite."""
+BAD_POSITION, BAD_RATE, BAD_ROWS = 1, 2, 3
+"""Codes of ``ints[INVALID]``: a position, a commanded rate, or a task row not finite."""
 
 INVALID_INPUT = -2
 """What :func:`run` returns for a position or commanded rate that is not finite."""
@@ -120,12 +120,17 @@ def within_rows(x: Array, rows: Rows, zero_inside: bool) -> float:
 
 
 @inlined
-def checked(joints: Array, rates: Array, m: int) -> int:
-    """0 where every position and commanded rate is finite, else the code of the first bad."""
+def checked(joints: Array, task_rows: Array, rates: Array, m: int) -> int:
+    """0 where every position, commanded rate and task row is finite, else the code of the
+    first bad.
+    """  # noqa: D205
     if not kernels.all_finite(joints[POSITION]):
         return BAD_POSITION
     if not kernels.all_finite(rates[RATE][:m]):
         return BAD_RATE
+    for i in range(m):
+        if not kernels.all_finite(task_rows[i]):
+            return BAD_ROWS
     return 0
 
 
@@ -175,11 +180,11 @@ def lower_levels(task_rows: Array, rates: Array, ints: Ints, rows: Rows, answer:
 
 
 @inlined
-def box(joints: Array, rates: Array, ints: Ints, reals: Array) -> bool:
+def box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Array) -> bool:
     """Stages 1 and 2: the inputs checked (the code of a bad one in ``ints[INVALID]``, then
     False), the step's box and what sets each bound into ``joints``, its flags into ``reals``.
     """  # noqa: D205
-    ints[INVALID] = checked(joints, rates, ints[ROWS])
+    ints[INVALID] = checked(joints, task_rows, rates, ints[ROWS])
     if ints[INVALID]:
         return False
     kind = np.empty((2, joints.shape[1]), np.int8)
@@ -218,7 +223,7 @@ def run_box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Ar
     lower levels (a fraction of its compile): the status code, :data:`INVALID_INPUT`, or
     :data:`ELSEWHERE` where the mode is not the direction one (:func:`run` answers then).
     """
-    if not box(joints, rates, ints, reals):
+    if not box(joints, task_rows, rates, ints, reals):
         return INVALID_INPUT
     if reals[ZERO_INSIDE] == 0.0 or ints[WEIGHTED] == 1 or ints[DIRECTION] == 0:
         return ELSEWHERE
@@ -240,7 +245,7 @@ def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide
     ``joints``, ``task_rows``, ``rates`` and the constraint rows ``G``, ``h``, ``slide``
     (``ints[CONSTRAINTS]`` of them); writes the box, the rates and the report.
     """
-    if not box(joints, rates, ints, reals):
+    if not box(joints, task_rows, rates, ints, reals):
         return INVALID_INPUT
     p = ints[CONSTRAINTS]
     rows = Rows(joints[LB], joints[UB], G[:p], h[:p], slide[:p], reals[TOLERANCE])

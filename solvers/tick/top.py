@@ -150,13 +150,13 @@ def backend_slide(where: int, B: Array, target: Array, lb: Array, ub: Array, G: 
 
 @kernel
 def backend_direction(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array,
-                      h: Array) -> tuple[Array, float]:  # fmt: skip
+                      h: Array) -> tuple[Array, float, float]:  # fmt: skip
     """The direction problem by the backend
     (:func:`rrc_pin.solvers.tick.backend_calls.direction`).
     """  # noqa: D205
-    with objmode(qdot="float64[::1]", u="float64"):
-        qdot, u = backend_calls.direction(A, w, null, lb, ub, G, h)
-    return qdot, u
+    with objmode(qdot="float64[::1]", u="float64", veer="float64"):
+        qdot, u, veer = backend_calls.direction(A, w, null, lb, ub, G, h)
+    return qdot, u, veer
 
 
 @kernel
@@ -203,8 +203,10 @@ def slid_command(where: int, A: Array, b: Array, G: Array, h: Array, rows: Rows,
 
 
 @kernel
-def scaled_along(A: Array, w: Array, null: Array, rows: Rows) -> tuple[Array, float]:
-    """The direction problem along ``w``: its rates and scale u (u < 0: the backend failed).
+def scaled_along(A: Array, w: Array, null: Array, rows: Rows) -> tuple[Array, float, float]:
+    """The direction problem along ``w``: its rates, scale u (u < 0: the backend failed), veer.
+
+    The veer [rad] is measured where the backend answered, else 0 (along w by construction).
 
     Without rows: the uniform scale (no null space) or the exact line scale (one null
     direction) (:func:`rrc_pin.solvers.tick.direction.along`); else the backend's QP
@@ -214,9 +216,9 @@ def scaled_along(A: Array, w: Array, null: Array, rows: Rows) -> tuple[Array, fl
         return backend_direction(A, w, null, rows.lb, rows.ub, rows.G, rows.h)
     if null.shape[0] == 0:
         u = kernels.uniform_scale(w, rows.lb, rows.ub)
-        return u * w, u
+        return u * w, u, 0.0
     u, y = kernels.line_scale(w, null[0], rows.lb, rows.ub)
-    return u * w + y * null[0], u
+    return u * w + y * null[0], u, 0.0
 
 
 @kernel
@@ -305,7 +307,7 @@ def scaled(A: Array, command: Array, b: Array, f: Factor, w: Array, boxed: Array
     command served, ``command`` the one reported along).
     """  # noqa: D205
     f, null = factor.null_basis(f)
-    qdot, u = (boxed, u_box) if u_box >= 0.0 else scaled_along(A, w, null, rows)
+    qdot, u, veer = (boxed, u_box, 0.0) if u_box >= 0.0 else scaled_along(A, w, null, rows)
     if u < 0.0:
         return passing(w, null)
     if slid:
@@ -314,7 +316,7 @@ def scaled(A: Array, command: Array, b: Array, f: Factor, w: Array, boxed: Array
         return met_top(qdot, rate_factor, null)
     usable, lam = damping(f, b, w, u, rows, dt, threshold)
     if lam.size:
-        damped_qdot, damped_u = scaled_along(A, factor.rates(usable, b, lam), null, rows)
+        damped_qdot, damped_u, _ = scaled_along(A, factor.rates(usable, b, lam), null, rows)
         if damped_u < 0.0:
             return passing(w, null)
         if u_box < 0.0 or not damped_u <= STILL_SCALE < u:
@@ -322,7 +324,7 @@ def scaled(A: Array, command: Array, b: Array, f: Factor, w: Array, boxed: Array
                           float(np.max(lam)))  # fmt: skip
     if outside_range:
         return answer(A, command, qdot, SINGULAR, rate_factor, null, 0.0)
-    return Top(qdot, SCALED, u * rate_factor, 0.0, 0.0, null)
+    return Top(qdot, SCALED, u * rate_factor, veer, 0.0, null)
 
 
 @inlined
