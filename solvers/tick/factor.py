@@ -162,15 +162,19 @@ def surely_conditioned(f: Factor, threshold: float) -> bool:
     if m > n:
         return False
     R = f.R
+    bound = min(threshold, 1.0 / RANK_TOL) * (1.0 - 1e-9)
+    low, high = np.inf, 0.0
+    for i in range(m):
+        low, high = min(low, abs(R[i, i])), max(high, abs(R[i, i]))
+    if not (low > 0.0 and high <= bound * low):  # the pivots' ratio is at most the condition
+        return False
     size = 0.0
     pivots = np.empty(m)  # the triangle's inverse diagonal
     for i in range(m):
-        if R[i, i] == 0.0:
-            return False
         pivots[i] = 1.0 / R[i, i]
         for j in range(i, m):
             size += R[i, j] ** 2
-    limit = (min(threshold, 1.0 / RANK_TOL) * (1.0 - 1e-9)) ** 2
+    limit = bound**2
     x = np.empty(m)
     inverse = 0.0
     for k in range(m):  # column k of the inverse: R_1 x = e_k by back substitution (x_i = 0, i > k)

@@ -128,9 +128,8 @@ def checked(joints: Array, task_rows: Array, rates: Array, m: int) -> int:
         return BAD_POSITION
     if not kernels.all_finite(rates[RATE][:m]):
         return BAD_RATE
-    for i in range(m):
-        if not kernels.all_finite(task_rows[i]):
-            return BAD_ROWS
+    if not kernels.all_finite(task_rows.ravel()[: m * task_rows.shape[1]]):  # a view: C order
+        return BAD_ROWS
     return 0
 
 
