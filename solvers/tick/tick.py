@@ -55,7 +55,7 @@ BAD_POSITION, BAD_RATE, BAD_ROWS = 1, 2, 3
 """Codes of ``ints[INVALID]``: a position, a commanded rate, or a task row not finite."""
 
 INVALID_INPUT = -2
-"""What :func:`run` returns for a position or commanded rate that is not finite."""
+"""What :func:`run` returns for a position, commanded rate or task row that is not finite."""
 
 ELSEWHERE = -3
 """What :func:`run_box` returns for a tick that is not its own (:func:`run` answers it)."""
