@@ -223,6 +223,7 @@ class CellController(Loop):
             compile_correction(cell.nv)
         scale_and_veer(np.zeros(6), np.zeros(6), np.ones(6))  # compiled now: damped ticks use it
         self._close_at()
+        self._compile_tick()
 
     # -- settings -------------------------------------------------------------------------
 
@@ -367,6 +368,36 @@ class CellController(Loop):
         for name, twist in twists.items():
             self._targets[name] = _moved(self._targets[name], twist * (follow * self.dt))
         return out
+
+    def _compile_tick(self) -> None:
+        """Run the resolver's stages once now, on this cell's tasks and limits, so that no tick
+        compiles a kernel (or loads it from numba's cache); the resolver then reset.
+
+        The ticks: exact, one after it (the previous rates read-only), a command too fast to
+        meet (scaled), a posture level the box cuts (the projected least squares), and a
+        command whose rows are weighted past the damping threshold (damped,
+        :class:`~rrc_pin.solvers.tick.damping.Damping`).
+        """
+        kin, names = self._kinematics(), list(self._targets)
+        far = PostureTask(self.posture.q_ref + 1.0, gain=1e6, name="compiling")
+
+        def commands(speed: float) -> Callable[[], list[Task]]:
+            return lambda: [self._task(name, np.full(6, speed)) for name in names]
+
+        ticks = [(commands(0.0), self.posture), (commands(0.0), self.posture),
+                 (commands(1e6), self.posture), (commands(0.0), far)]  # fmt: skip
+        damping = self.resolver.options.damping
+        if damping is not None:  # one row of each command's weighted past the threshold
+            weight = np.ones(6)
+            weight[-1] = (0.1 / damping.threshold) ** 2
+            ticks.append((lambda: [FrameTask(self.frame_of(name), np.full(6, 1e6),
+                                             weight=weight) for name in names], self.posture))
+        for tasks, lower in ticks:
+            top = tasks()
+            self.resolver.solve_at(kin, [top, [lower]] if top else [[lower]], priority="strict",
+                                   qdot_prev=self._previous_rates())  # fmt: skip
+        self.resolver.reset()
+        self._kin = None
 
     def _kinematics(self) -> Kinematics:
         """The tick's one :class:`~rrc_pin.kinematics.Kinematics` at the current q.
