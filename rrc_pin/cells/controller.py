@@ -370,30 +370,29 @@ class CellController(Loop):
         return out
 
     def _compile_tick(self) -> None:
-        """Run the resolver's stages once now, on this cell's tasks and limits, so that no tick
-        compiles a kernel (or loads it from numba's cache); the resolver then reset.
+        """Run the resolver's stages once now: no tick compiles a kernel or loads it.
 
-        The ticks: exact, one after it (the previous rates read-only), a command too fast to
-        meet (scaled), a posture level the box cuts (the projected least squares), and a
-        command whose rows are weighted past the damping threshold (damped,
-        :class:`~rrc_pin.solvers.tick.damping.Damping`).
+        On this cell's tasks and limits, from numba's cache or compiled: an exact tick, one
+        after it (the previous rates read-only), a command too fast to meet (scaled), a
+        posture level the box cuts (the projected least squares), and a command one of whose
+        rows is weighted past the damping threshold (damped,
+        :class:`~rrc_pin.solvers.tick.damping.Damping`); the resolver then reset.
         """
         kin, names = self._kinematics(), list(self._targets)
         far = PostureTask(self.posture.q_ref + 1.0, gain=1e6, name="compiling")
-
-        def commands(speed: float) -> Callable[[], list[Task]]:
-            return lambda: [self._task(name, np.full(6, speed)) for name in names]
-
-        ticks = [(commands(0.0), self.posture), (commands(0.0), self.posture),
-                 (commands(1e6), self.posture), (commands(0.0), far)]  # fmt: skip
+        ticks: list[tuple[float | None, Task]] = [(0.0, self.posture), (0.0, self.posture),
+                                                  (1e6, self.posture), (0.0, far)]  # fmt: skip
         damping = self.resolver.options.damping
-        if damping is not None:  # one row of each command's weighted past the threshold
-            weight = np.ones(6)
+        weight = np.ones(6)
+        if damping is not None:
             weight[-1] = (0.1 / damping.threshold) ** 2
-            ticks.append((lambda: [FrameTask(self.frame_of(name), np.full(6, 1e6),
-                                             weight=weight) for name in names], self.posture))
-        for tasks, lower in ticks:
-            top = tasks()
+            ticks.append((None, self.posture))
+        for speed, lower in ticks:
+            top: list[Task] = (
+                [self._task(name, np.full(6, speed)) for name in names] if speed is not None
+                else [FrameTask(self.frame_of(name), np.full(6, 1e6), weight=weight)
+                      for name in names]
+            )  # fmt: skip
             self.resolver.solve_at(kin, [top, [lower]] if top else [[lower]], priority="strict",
                                    qdot_prev=self._previous_rates())  # fmt: skip
         self.resolver.reset()

@@ -23,8 +23,9 @@ Array = npt.NDArray[np.float64]
 
 
 def barker_closed_form(robot: Robot, strategy: str) -> BarkerClosedForm:
-    """The robot's :class:`BarkerClosedForm` (``barker6`` and its variants), its kernels
-    compiled (:func:`compile_closed_form`).
+    """The robot's :class:`BarkerClosedForm` (``barker6`` and its variants), compiled.
+
+    Its kernels compiled or loaded from numba's cache now (:func:`compile_closed_form`).
 
     Raises:
         InvalidInput: Naming ``strategy``, for an arm without Barker's closed form.
