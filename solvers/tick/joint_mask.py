@@ -27,6 +27,10 @@ from rrc_pin.solvers.tick.problem import Box, Constraints, Problem, TaskRows
 Array = npt.NDArray[np.float64]
 Index = npt.NDArray[np.intp]
 
+STILL = 1e-9
+"""[the row's units per rad/s] An inequality row whose free joints' entries are all within
+this, and whose masked joints' are not, leaves the problem (:func:`free_columns`)."""
+
 
 def free_columns(
     levels: Sequence[Sequence[TaskRows]], constraints: Sequence[Constraints], free: Index
@@ -39,15 +43,51 @@ def free_columns(
         free: Indices of the joints that may move (ascending).
 
     Returns:
-        ``(levels, constraints)`` over ``free.size`` columns; rows and names unchanged.
+        ``(levels, constraints)`` over ``free.size`` columns, less the rows only masked joints
+        move (:func:`_free_rows`, :func:`_free_constraints`).
     """
-    rows = [[t._replace(A=t.A[:, free]) for t in level] for level in levels]
-    kept = [c._replace(
-        box=None if c.box is None else _free_box(c.box, free),
-        G=None if c.G is None else c.G[:, free],
-        C=None if c.C is None else c.C[:, free],
-    ) for c in constraints]  # fmt: skip
+    rows = [[_free_rows(t, free) for t in level] for level in levels]
+    kept = [_free_constraints(c, free) for c in constraints]
     return rows, kept
+
+
+def _free_constraints(c: Constraints, free: Index) -> Constraints:
+    """The constraints ``c`` on the columns ``free``, without the inequality rows that only
+    masked joints move (beyond :data:`STILL`).
+
+    Such a row bounds what no free joint can change: a limit gives none for a pair no joint
+    moves (:class:`~rrc_pin.limits.CollisionLimit`), and the reduced model gives none.
+    Equality rows are all kept.
+    """  # noqa: D205
+    box = None if c.box is None else _free_box(c.box, free)
+    C = None if c.C is None else c.C[:, free]
+    if c.G is None or c.h is None:
+        return c._replace(box=box, C=C)
+    G = c.G[:, free]
+    moved = np.abs(G).max(axis=1, initial=0.0) > STILL
+    kept = moved | ~(np.abs(c.G).max(axis=1, initial=0.0) > STILL)
+    if kept.all():
+        return c._replace(box=box, G=G, C=C)
+    p = c.h.size
+    names = tuple(n for n, k in zip(c.names[:p], kept.tolist(), strict=True) if k)
+    return Constraints(box, G[kept], c.h[kept], C, c.d, names + tuple(c.names[p:]),
+                       None if c.slide is None else c.slide[kept],
+                       None if c.distance is None else c.distance[kept])  # fmt: skip
+
+
+def _free_rows(t: TaskRows, free: Index) -> TaskRows:
+    """The rows of ``t`` on the columns ``free``, without those only masked joints move.
+
+    A row whose every nonzero entry is a masked joint's (a joint or posture task's row of that
+    joint, or a frame's direction that only masked joints move) leaves the task: no rate
+    serves it, and a direction level would otherwise stop along it.
+    """
+    A = t.A[:, free]
+    kept = (A != 0.0).any(axis=1) | ~(t.A != 0.0).any(axis=1)
+    if kept.all():
+        return t._replace(A=A)
+    return TaskRows(A[kept], t.b[kept], None if t.weight is None else t.weight[kept], t.name,
+                    None if t.unit is None else t.unit[kept])  # fmt: skip
 
 
 def _free_box(box: Box, free: Index) -> Box:
