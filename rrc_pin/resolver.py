@@ -236,7 +236,7 @@ class Resolver:
         robot = self.robot
         items = [joints] if isinstance(joints, str) else joints
         try:
-            names = list(cast(Iterable[str], items))
+            names = list(items)
         except TypeError:
             raise InvalidInput("joints", f"expected joint names, got {joints!r}") from None
         known = {*robot.joint_names, *([robot.base_joint] if robot.base_joint else [])}
@@ -314,9 +314,9 @@ class Resolver:
             FrameNotFound: A task names a frame the robot does not have (the error lists
                 them).
         """
-        if (self._twists and self._free is None and type(command) is np.ndarray and type(q) is np.ndarray
-                and ref is None and dt is None and qdot_prev is None and type(priority) is str
-                and priority == "weighted"):
+        if (self._twists and self._free is None and type(command) is np.ndarray
+                and type(q) is np.ndarray and ref is None and dt is None and qdot_prev is None
+                and type(priority) is str and priority == "weighted"):
             r = self._twist(q, command)
             if r is not None:
                 return r
@@ -399,14 +399,15 @@ class Resolver:
                 rows = [[cast(FrameTask, levels[0][0]).rows_at(kin, twist, cast(Reference, ref))]]
             _check_rows(rows)
             before = self._last_qdot if previous is None else previous
-            r = self._tick(kin, rows, weighted, step, before, start)
+            r = self._tick(kin, rows, weighted, step, before, start, levels)
             self._last_qdot = r.qdot
             return r
 
     def _tick(self, kin: Kinematics, rows: list[list[TaskRows]], weighted: bool, step: float,
-              before: Array, start: float) -> Resolution:  # fmt: skip
-        """The tick of ``rows`` within the limits: compiled where it can be, else the Python
-        pipeline (equality rows, a joint box that is not one JointLimits)."""  # noqa: D205, D209
+              before: Array, start: float, tasks: list[list[Task]]) -> Resolution:  # fmt: skip
+        """The tick of ``rows`` (those of ``tasks``) within the limits: compiled where it can be,
+        else the Python pipeline (equality rows, a joint box that is not one JointLimits, a
+        joint mask)."""  # noqa: D205, D209
         compiled = self._compiled if self._free is None else None
         joint = None if compiled is None else compiled.limit
         constraints = [None if limit is joint else limit.constraints(kin, step, before)
@@ -417,20 +418,22 @@ class Resolver:
             constraints = [joint.constraints(kin, step, before) if c is None else c
                            for c in constraints]  # fmt: skip
         if self._free is not None:
-            return self._masked_tick(rows, cast(list[Constraints], constraints), weighted, step,
-                                     start)  # fmt: skip
+            joint_rows = [[t.joint_rows for t in level] for level in tasks]
+            return self._masked_tick(rows, joint_rows, cast(list[Constraints], constraints),
+                                     weighted, step, start)  # fmt: skip
         problem = build(rows, cast(list[Constraints], constraints), self.robot.nv, step,
                         weighted=weighted, direction=self.direction_preserving)  # fmt: skip
         answer = solve(problem, self.backend, self.options)
         return Resolution.of(problem, answer, time.perf_counter() - start, self._names)
 
-    def _masked_tick(self, rows: list[list[TaskRows]], constraints: list[Constraints],
-                     weighted: bool, step: float, start: float) -> Resolution:  # fmt: skip
+    def _masked_tick(self, rows: list[list[TaskRows]], joint_rows: list[list[bool]],
+                     constraints: list[Constraints], weighted: bool, step: float,
+                     start: float) -> Resolution:  # fmt: skip
         """The tick on the free joints' columns (:mod:`rrc_pin.solvers.tick.joint_mask`), its
         answer and problem written back over every joint."""  # noqa: D205, D209
         free = cast(npt.NDArray[np.intp], self._free)
         nv = self.robot.nv
-        levels, kept = free_columns(rows, constraints, free)
+        levels, kept = free_columns(rows, joint_rows, constraints, free)
         problem = build(levels, kept, free.size, step, weighted=weighted,
                         direction=self.direction_preserving)  # fmt: skip
         answer = solve(problem, self.backend, self.options)

@@ -534,7 +534,7 @@ def test_the_former_closure_keywords_warn_and_still_work(dual):
 def test_a_mask_holds_its_joints_still_through_the_closure(dual, seed):
     """gsfc_dual carrying its object under random twists, a mask of one to three joints
     changed every 50 ticks (CellController.mask): the masked joints exactly where they were
-    (the resolver's rates and the closure's applied rates 0.0), the grip within its bound."""  # noqa: D205, D209
+    (the resolver's rates and the closure's applied rates 0.0), the grip within its bound."""
     seed = fresh() if seed is None else seed
     rng = np.random.default_rng(seed)
     ctl = CellController(dual, 0.01)

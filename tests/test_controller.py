@@ -292,7 +292,7 @@ def test_the_default_start_is_the_ready_pose():
 def test_a_mask_holds_its_joints_through_the_loop_and_unmask_releases_them() -> None:
     """Controller.mask between ticks: the masked joints exactly still through the drift
     correction and the integration, the hand still served by the others; a bad name refused
-    by name with the mask unchanged; unmask lets them move again."""  # noqa: D205, D209
+    by name with the mask unchanged; unmask lets them move again."""
     ctl = Controller("panda", 0.01)
     ctl.mask(["panda_joint1", "panda_joint4"])
     with pytest.raises(rrc_pin.InvalidInput, match="joints"):

@@ -13,7 +13,7 @@ the head's collision rows move, up to 6.3e-8 apart at a rate of 1e-7): there the
 model's pipeline, given the masked problem's numbers, answers the masked rates to 1e-15, so
 the gap is the problem's conditioning, not the mask; such ticks are at most a tenth.
 Fresh seeds at every run (printed on failure), beside fixed ones.
-"""  # noqa: D205
+"""
 
 from __future__ import annotations
 
@@ -25,11 +25,11 @@ import pytest
 import rrc_pin
 from rrc_pin import CollisionLimit, CollisionModel, FrameTask, JointLimits, PostureTask, Resolver
 from rrc_pin.geometry.robot_geometry import robot_geometry
+from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import Robot
+from rrc_pin.solvers.qp_backends import make_backend
 from rrc_pin.solvers.tick.joint_mask import free_columns, scattered, widened_rates
 from rrc_pin.solvers.tick.kernels import VELOCITY
-from rrc_pin.resolver import QPOptions
-from rrc_pin.solvers.qp_backends import make_backend
 from rrc_pin.solvers.tick.pipeline import Options, solve
 from rrc_pin.solvers.tick.problem import Box, Constraints, Problem, TaskRows, build
 
@@ -48,7 +48,7 @@ ARMS = {  # the run's robot, and whether it has capsules for its own collision p
 
 def test_the_free_columns_and_back() -> None:
     """Every row block keeps its free columns, the box its free entries; written back with
-    zero columns and a zero box (the plain numpy of the module docstring)."""  # noqa: D205, D209
+    zero columns and a zero box (the plain numpy of the module docstring)."""
     rng = np.random.default_rng(SEEDS[0])
     n, free = 5, np.array([0, 2, 3])
     A, G, C = rng.normal(size=(4, n)), rng.normal(size=(3, n)), rng.normal(size=(1, n))
@@ -56,15 +56,18 @@ def test_the_free_columns_and_back() -> None:
     lb[1] = 0.2  # a masked joint whose box excludes zero: out of range, it stays
     box = Box(lb, ub, np.zeros((2, n), np.int8), False, True, ub.copy())
     limits = [Constraints(box, G, np.ones(3), C, np.zeros(1), ("g0", "g1", "g2", "c0"))]
-    levels, kept = free_columns([[TaskRows(A, np.ones(4), None, "t")]], limits, free)
+    posture = TaskRows(np.eye(n), np.arange(n, dtype=float), None, "posture")
+    levels, kept = free_columns([[TaskRows(A, np.ones(4), None, "t"), posture]],
+                                [[False, True]], limits, free)  # fmt: skip
     assert np.array_equal(levels[0][0].A, A[:, free])
+    assert np.array_equal(levels[0][1].A, np.eye(3)) and np.array_equal(levels[0][1].b, free)
     small = kept[0]
     assert small.box is not None and small.G is not None and small.C is not None
     assert np.array_equal(small.G, G[:, free]) and np.array_equal(small.C, C[:, free])
     assert np.array_equal(small.box.lb, lb[free]) and np.array_equal(small.box.ub, ub[free])
     assert small.box.contains_zero and not small.box.recovering  # the joint out of range is held
     reduced = build(levels, kept, free.size, DT)
-    report = scattered(reduced, [[TaskRows(A, np.ones(4), None, "t")]], free, n)
+    report = scattered(reduced, [[TaskRows(A, np.ones(4), None, "t"), posture]], free, n)
     assert np.array_equal(report.box.lb[[1, 4]], [0.0, 0.0])
     assert np.array_equal(report.box.ub[[1, 4]], [0.0, 0.0])
     assert np.array_equal(report.box.kind[:, [1, 4]], np.full((2, 2), VELOCITY))
@@ -112,7 +115,7 @@ def test_a_mask_changed_every_50_ticks_solves_as_the_reduced_model(
     name: str, strict: bool, seed: int
 ) -> None:
     """Masked joints at exactly 0.0, the free ones as the reduced model's resolver within
-    TOL, at every tick of a closed-loop run."""  # noqa: D205, D209
+    TOL, at every tick of a closed-loop run."""
     rng = np.random.default_rng(seed)
     robot = rrc_pin.load(name)
     collision = ARMS[name]
@@ -167,7 +170,7 @@ def test_a_mask_changed_every_50_ticks_solves_as_the_reduced_model(
 
 def _gap(masked: Problem, reduced: Problem, free: npt.NDArray[np.intp]) -> float:
     """The largest difference between the masked resolver's problem on the joints ``free``
-    and the reduced model's: rows, rates, constraint rows and box."""  # noqa: D205, D209
+    and the reduced model's: rows, rates, constraint rows and box."""
     gaps = [0.0]
     for (A, b), (A_r, b_r) in zip(masked.stacked, reduced.stacked, strict=True):
         assert not A[:, np.setdiff1d(np.arange(A.shape[1]), free)].any()
@@ -186,7 +189,7 @@ def _gap(masked: Problem, reduced: Problem, free: npt.NDArray[np.intp]) -> float
 def _answer_to_masked_data(masked: Problem, reduced: Problem,
                            free: npt.NDArray[np.intp]) -> npt.NDArray[np.float64]:  # fmt: skip
     """The pipeline's answer to the reduced model's problem with the masked problem's numbers
-    (they differ by the two models' roundoff, at most DATA_TOL)."""  # noqa: D205, D209
+    (they differ by the two models' roundoff, at most DATA_TOL)."""
     rows = None if reduced.rows is None or masked.rows is None else reduced.rows._replace(
         G=np.ascontiguousarray(masked.rows.G[:, free]), h=masked.rows.h)  # fmt: skip
     problem = reduced._replace(

@@ -747,7 +747,7 @@ def test_an_arm_that_cannot_stop_in_one_step_is_not_recovering(arms: dict) -> No
 
 def test_a_mask_holds_its_joints_and_unmask_gives_the_unmasked_answer_back() -> None:
     """Masked rates exactly 0.0, named in the resolution and never ``active``; the twist's
-    compiled path is left while a mask is set and is the same answer once unmasked."""  # noqa: D205, D209
+    compiled path is left while a mask is set and is the same answer once unmasked."""
     arm = rrc_pin.load("panda")
     q = arm.ready()
     twist = np.array([0.3, -0.2, 0.1, 0.4, 0.2, -0.3])
@@ -806,7 +806,7 @@ def test_masking_a_primary_holds_its_mimics_and_a_mimic_is_refused(tmp_path) -> 
 
 def test_a_floating_base_is_masked_as_one_joint() -> None:
     """yeh_tripod's body_joint: its six rates 0.0, each leg alone serving its flange (Pinocchio's
-    buildReducedModel does not lock a free-flyer: no reduced model to compare with)."""  # noqa: D205, D209
+    buildReducedModel does not lock a free-flyer: no reduced model to compare with)."""
     robot = rrc_pin.load("yeh_tripod")
     q = robot.ready()
     tasks = [FrameTask(f, np.array([0.01, 0.0, 0.02, 0.0, 0.0, 0.05]), rows="full")

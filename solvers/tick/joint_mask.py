@@ -33,20 +33,26 @@ this, and whose masked joints' are not, leaves the problem (:func:`free_columns`
 
 
 def free_columns(
-    levels: Sequence[Sequence[TaskRows]], constraints: Sequence[Constraints], free: Index
-) -> tuple[list[list[TaskRows]], list[Constraints]]:
+    levels: Sequence[Sequence[TaskRows]], joint_rows: Sequence[Sequence[bool]],
+    constraints: Sequence[Constraints], free: Index,
+) -> tuple[list[list[TaskRows]], list[Constraints]]:  # fmt: skip
     """The tasks' rows and the limits' constraints on the columns ``free`` alone.
 
     Args:
         levels: Task rows per priority level, over every joint (n columns).
+        joint_rows: Per task of ``levels``, whether its rows are joints' own rates (rows of
+            the identity: a joint, posture, damping or rates task).
         constraints: What each limit contributes, over every joint.
         free: Indices of the joints that may move (ascending).
 
     Returns:
-        ``(levels, constraints)`` over ``free.size`` columns, less the rows only masked joints
-        move (:func:`_free_rows`, :func:`_free_constraints`).
+        ``(levels, constraints)`` over ``free.size`` columns, less the masked joints' own
+        rows of joint-space tasks (:func:`_free_rows`) and the inequality rows only masked
+        joints move (:func:`_free_constraints`).
     """
-    rows = [[_free_rows(t, free) for t in level] for level in levels]
+    rows = [[_free_rows(t, free) if joint else t._replace(A=t.A[:, free])
+             for t, joint in zip(level, flags, strict=True)]
+            for level, flags in zip(levels, joint_rows, strict=True)]  # fmt: skip
     kept = [_free_constraints(c, free) for c in constraints]
     return rows, kept
 
@@ -76,11 +82,11 @@ def _free_constraints(c: Constraints, free: Index) -> Constraints:
 
 
 def _free_rows(t: TaskRows, free: Index) -> TaskRows:
-    """The rows of ``t`` on the columns ``free``, without those only masked joints move.
+    """The joint-space rows of ``t`` on the columns ``free``, without the masked joints' own.
 
-    A row whose every nonzero entry is a masked joint's (a joint or posture task's row of that
-    joint, or a frame's direction that only masked joints move) leaves the task: no rate
-    serves it, and a direction level would otherwise stop along it.
+    A model without the masked joints has no row for them; any other task (a frame's) keeps
+    every row, a direction only masked joints move then a zero row, as in that model (its
+    command unmet, and reported so).
     """
     A = t.A[:, free]
     kept = (A != 0.0).any(axis=1) | ~(t.A != 0.0).any(axis=1)
