@@ -41,7 +41,7 @@ SAME = 1e-12  # [rad/s] the masked rates against the pipeline's answer to their 
 PERIOD = 50  # ticks between mask changes
 TICKS = 150
 DT = 0.01
-ARMS = {  # the run's robot, and whether it has capsules for its own collision pairs
+ARMS = {  # the run's robot, and whether its collision pairs are limits too
     "panda": True,
     "rrc_k1607": False,
     "baxter": True,
@@ -94,7 +94,7 @@ def _reduced(robot: Robot, masked: tuple[str, ...], q: npt.NDArray[np.float64],
 
 
 def _limits(cm: CollisionModel | None, pairs: list[tuple[str, str]]) -> list[object]:
-    """Joint limits (and acceleration), and the collision pairs ``pairs`` with an obstacle."""
+    """Joint limits (and an acceleration bound), and collision rows of the pairs ``pairs``."""
     joint = JointLimits(acceleration=40.0)
     if cm is None:
         return [joint]
@@ -136,7 +136,7 @@ def test_a_mask_changed_every_50_ticks_solves_as_the_reduced_model(
                 masked = tuple(rng.choice(robot.joint_names, count, replace=False).tolist())
                 small, small_cm = _reduced(robot, masked, q, collision)
                 pairs = [] if cm is None else sorted(set(cm.pairs) & set(small_cm.pairs))
-                if resolver is None or collision:  # the collision pairs common to both
+                if resolver is None or collision:  # the pairs both models keep: a new limit
                     resolver = Resolver(robot, DT, limits=_limits(cm, pairs))
                     resolver.mask(masked)
                 else:
@@ -157,9 +157,10 @@ def test_a_mask_changed_every_50_ticks_solves_as_the_reduced_model(
                                      priority=priority, qdot_prev=qdot[free])  # fmt: skip
             held = np.setdiff1d(np.arange(robot.nv), free)
             assert (r.qdot[held] == 0.0).all()
-            assert r.status == expected.status and r.masked == resolver.masked
+            assert r.masked == resolver.masked
             assert _gap(r.problem, expected.problem, free) <= DATA_TOL
             gap = np.abs(r.qdot[free] - expected.qdot).max()
+            assert gap > TOL or r.status == expected.status, (r, expected)
             if gap > TOL:  # each the pipeline's answer to its numbers, DATA_TOL apart
                 mine = _answer(_numbers_of(r.problem, expected.problem, free))
                 assert np.abs(mine - r.qdot[free]).max() <= SAME, (gap, r, expected)
