@@ -744,6 +744,20 @@ def test_an_arm_that_cannot_stop_in_one_step_is_not_recovering(arms: dict) -> No
 
 # -- the joint mask (Resolver.mask; the exactness against a reduced model: test_joint_mask) --
 
+MIMIC_CHAIN = """<robot name="mimic">
+  <link name="base"/><link name="l0"/><link name="l1"/><link name="l2"/><link name="tool"/>
+  <joint name="j0" type="revolute"><parent link="base"/><child link="l0"/><axis xyz="0 0 1"/>
+    <limit lower="-2.5" upper="2.5" velocity="1.5" effort="1"/></joint>
+  <joint name="j1" type="revolute"><parent link="l0"/><child link="l1"/><origin xyz="0 0 0.3"/>
+    <axis xyz="0 1 0"/><limit lower="-2" upper="2" velocity="1" effort="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.4"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" velocity="1" effort="1"/>
+    <mimic joint="j1" multiplier="0.5" offset="0.1"/></joint>
+  <joint name="tool_joint" type="fixed"><parent link="l2"/><child link="tool"/>
+    <origin xyz="0 0 0.3"/></joint>
+</robot>"""
+"""A chain whose j2 follows j1."""
+
 
 def test_a_mask_holds_its_joints_and_unmask_gives_the_unmasked_answer_back() -> None:
     """Masked rates exactly 0.0, named in the resolution and never ``active``; the twist's
@@ -784,9 +798,9 @@ def test_bad_mask_names_are_refused_by_name_changing_nothing(joints: object) -> 
 
 def test_masking_a_primary_holds_its_mimics_and_a_mimic_is_refused(tmp_path) -> None:
     """A mimic follows its primary: masked with it; named alone, refused naming its primary."""
-    from tests.test_mimic import chain  # the chain whose j2 follows j1
-
-    arm = chain(tmp_path, k=0.5)
+    path = tmp_path / "mimic.urdf"
+    path.write_text(MIMIC_CHAIN)
+    arm = rrc_pin.load(path)
     resolver = Resolver(arm, task=FrameTask("tool", rows="position"))
     with pytest.raises(InvalidInput, match="'j2' is a mimic joint: it follows 'j1'"):
         resolver.mask("j2")
