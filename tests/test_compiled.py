@@ -55,13 +55,15 @@ m = maps.capability("kr5_3r", 2000, 0.1, workers=1, progress=False, block_size=1
 out["maps"] = m.stats.isum.sum(axis=0).tolist()
 # only kernels call these: their own entries read here
 from rrc_pin.solvers.closed_form.base import finite
+from rrc_pin.solvers.collision.box_kernels import turned
 from rrc_pin.solvers.collision.damper_kernels import damper_bound
 from rrc_pin.solvers.collision.narrow_kernels import segment_closest
 from rrc_pin.solvers.collision.vectors import dot
 out["finite"] = [bool(finite(np.ones(6), 6))]
 out["callees"] = [damper_bound(0.01, 0.1, 0.5, 1e-3, 50.0), dot((1.0, 2.0, 3.0), (4.0, 5.0, 6.0)),
                   *segment_closest((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.5, 1.0, 0.0),
-                                   (0.0, 0.0, 1.0))]
+                                   (0.0, 0.0, 1.0)),
+                  *turned(((0.0, 1.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 0.0, 1.0)), (1.0, 2.0, 3.0))]
 from rrc_pin.solvers.tick import factor, levels, slide_kernels, top  # the tick's, likewise
 x = np.empty(2)
 slide_kernels.project(np.eye(2), 0.0, np.ones(2), -np.ones(2), np.ones(2), np.zeros((0, 2)),

@@ -248,9 +248,10 @@ def test_capsule_end_points_against_a_box_match_coal():
         rows, others, out, other = run(bodies, poses, True, FAR)
         assert others == 1 and other[0] == 0  # the closest points: coal's
         ends = a[1] @ poses[1][:3, :3].T + poses[1][:3, 3]
-        assert rows == (1 if not (a[1][1] - a[1][0]).any() else 2)
-        assert (out["end"][:rows] == 1).all()
-        for r in range(rows):
+        count = 1 if not (a[1][1] - a[1][0]).any() else 2  # then the features' rows
+        assert rows >= count
+        assert (out["end"][:count] == 1).all() and (out["end"][count:rows] == 2).all()
+        for r in range(count):
             ref = coal_distance(coal.Sphere(a[2]), pose(np.eye(3), ends[r]),
                                 coal.Box(*(2 * half)), poses[2] @ placement)  # fmt: skip
             d, n = out["distance"][r], out["normal"][r]
@@ -304,3 +305,60 @@ def test_coal_gets_a_pair_unless_its_bound_is_beyond_the_detection_distance(kind
         skipped += others == 0
         measured += d < detection
     assert skipped > TRIALS // 10 and measured > TRIALS // 10, f"seed {seed}: {skipped}, {measured}"
+
+
+def segment_to_segment(p0, p1, q0, q1, samples=4001):
+    """The least distance of two segments, by sampling the first (the distance to a point of
+    it is convex along it): within 1e-6 m here."""
+    s = np.linspace(0.0, 1.0, samples)[:, None]
+    points = p0 + s * (p1 - p0)
+    v = q1 - q0
+    t = np.clip((points - q0) @ v / (v @ v), 0.0, 1.0)
+    return float(np.linalg.norm(points - (q0 + t[:, None] * v), axis=1).min())
+
+
+@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "fresh"))
+def test_capsule_outside_a_box_gets_the_rows_of_its_nearest_edges(seed):
+    """A capsule whose segment is outside a box: after its end points' rows, the rows of the
+    box's edges nearest the segment (those of the nearest corner once, none an end's row
+    repeats), against the distances of the twelve edges to the segment by sampling (1e-6 m);
+    the least of all its rows is coal's distance of the segment to the box less the radius."""
+    rng = np.random.default_rng(seed)
+    checked = 0
+    for _ in range(200):
+        a = body("capsule", rng)
+        if not (a[1][1] - a[1][0]).any():
+            continue
+        half = rng.uniform(0.03, 0.3, 3)
+        poses = np.array([np.eye(4), pose(rotation(rng), rng.normal(size=3) * 0.25),
+                          pose(rotation(rng), np.zeros(3))])  # fmt: skip
+        bodies = records([a[0], BOX], [a[1], np.zeros((2, 3))], [a[2], 0.0], [1, 2])
+        bodies["box"][1], bodies["half"][1] = np.eye(4)[:3], half
+        segment = a[1] @ poses[1][:3, :3].T + poses[1][:3, 3]
+        apart = coal_distance(coal.Capsule(0.0, float(np.linalg.norm(a[1][1] - a[1][0]))),
+                              poses[1], coal.Box(*(2 * half)), poses[2]).min_distance
+        if apart <= 1e-3:  # the segment inside the box, or touching it
+            continue
+        rows, _, out, _ = run(bodies, poses, True, FAR)
+        R = poses[2][:3, :3]
+        edges = []
+        for c in range(3):
+            for s1 in (-1, 1):
+                for s2 in (-1, 1):
+                    k1, k2 = (c + 1) % 3, (c + 2) % 3
+                    mid = s1 * half[k1] * R[:, k1] + s2 * half[k2] * R[:, k2]
+                    ends = (mid - half[c] * R[:, c], mid + half[c] * R[:, c])
+                    edges.append(segment_to_segment(*segment, *ends) - a[2])
+        features = out[2:rows]  # less those an end point's row repeats
+        assert 3 <= rows <= 5, f"seed {seed}"
+        nearest = sorted(edges)
+        least = min(nearest[0], *out["distance"][:2])
+        assert out["distance"][:rows].min() == pytest.approx(least, abs=1e-6), f"seed {seed}"
+        assert least == pytest.approx(apart - a[2], abs=1e-6), f"seed {seed}"
+        for d in features["distance"]:  # each an edge's distance, and none below the nearest
+            assert min(abs(d - e) for e in edges) <= 1e-6, f"seed {seed}"
+        assert features["distance"].min() >= nearest[0] - 1e-6, f"seed {seed}"
+        np.testing.assert_allclose(features["point_b"] - features["point_a"],
+                                   features["distance"][:, None] * features["normal"], atol=TOL)
+        checked += 1
+    assert checked >= 50, f"seed {seed}: {checked}"

@@ -45,8 +45,10 @@ T = TypeVar("T")
 Select = Callable[[Scene], npt.NDArray[np.bool_]]
 """Gives the pairs of a scene to answer for, as a mask (npairs,) over its pairs."""
 
-ROWS = 5
-"""Most rows of one pair: its closest points and four end points."""
+ROWS = 6
+"""Most rows of one pair: its closest points and four end points (two capsules); a capsule
+against a box, its two end points and up to three features' rows
+(:mod:`rrc_pin.solvers.collision.box_kernels`)."""
 
 REPEAT = 1e-6
 """[m] An end point's row whose witness points are both within this of its pair's own row
@@ -257,7 +259,7 @@ def _coal(scene: Scene, model: pin.Model, data: pin.Data, cdata: CollisionData,
                 if end_result.min_distance < detection:
                     rows = _coal_row(scene, cdata, k, end_result, 1, rows)
     found = cdata.found
-    order = np.argsort(2 * found["pair"][:rows] + found["end"][:rows], kind="stable")
+    order = np.argsort(3 * found["pair"][:rows] + found["end"][:rows], kind="stable")
     order = order[_distinct(found[order])]
     found[: order.size] = found[order]
     return int(order.size)
@@ -282,7 +284,7 @@ def _distinct(rows: Records) -> npt.NDArray[np.bool_]:
     An end point's row that repeats its pair's own (coal's closest points at a capsule's end
     against a box, within :data:`REPEAT`) is left out.
     """
-    end = rows["end"] == 1
+    end = rows["end"] != 0
     keep = np.ones(rows.size, dtype=np.bool_)
     if not end.any():
         return keep

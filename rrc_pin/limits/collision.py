@@ -5,7 +5,9 @@ One velocity-damper row per pair closer than the detection distance (Kanehiro et
 other body
 (:mod:`rrc_pin.solvers.collision.narrow_kernels`: near-parallel capsules' closest points jump from
 end to end,
-and the end about to become the closest is then already constrained; an end-point row
+and the end about to become the closest is then already constrained; a capsule against a
+box also gets rows for the box's features that may take over within the step,
+:mod:`rrc_pin.solvers.collision.box_kernels`; an end-point row
 may lose :data:`END` of its margin a step, a pair's own row the damper's share):
 
 .. math:: -n^T (J_b - J_a)\,\dot q \le \xi \frac{d - d_s}{d_i - d_s}

@@ -21,8 +21,8 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.collision.damper_kernels import damper_rows
-from rrc_pin.solvers.collision.narrow_kernels import narrow_phase
+from rrc_pin.solvers.collision.damper_kernels import SLACK, damper_rows
+from rrc_pin.solvers.collision.narrow_kernels import FEATURE, narrow_phase
 from rrc_pin.solvers.collision.proximity_kernels import (
     joint_jacobians,
     joint_poses,
@@ -72,9 +72,9 @@ def collision_pass(
         world: Out (ng, 3): bounding-sphere centres in the world [m].
         candidates: Out (npairs,): the broad phase's pairs.
         other: Out (npairs,): the pairs left for coal.
-        found: Out (5 npairs,) :data:`~rrc_pin.solvers.collision.records.FOUND` rows.
-        G: Out (5 npairs, nv): each found row's damper row (with ``rows``, nothing for coal).
-        h: Out (5 npairs,) [m/s]: its bound.
+        found: Out (6 npairs,) :data:`~rrc_pin.solvers.collision.records.FOUND` rows.
+        G: Out (6 npairs, nv): each found row's damper row (with ``rows``, nothing for coal).
+        h: Out (6 npairs,) [m/s]: its bound.
 
     Returns:
         rows: The number of rows found; ``others``: the number of pairs left for coal;
@@ -114,7 +114,9 @@ def pair_rows(
     """The damper rows ``G qdot <= h`` of the first ``rows`` found rows.
 
     Writes each row's joints (``joint_a``, ``joint_b``) and ``moved``; the damper's parameters
-    from ``settings`` (:func:`~rrc_pin.solvers.collision.damper_kernels.damper_rows`).
+    from ``settings`` (:func:`~rrc_pin.solvers.collision.damper_kernels.damper_rows`). A box
+    feature's row farther than its pair's own is never pushed out (at least ``SLACK``): the
+    push restores the pair's distance, which is its own row's.
 
     Returns:
         The number of rows no joint moves.
@@ -125,8 +127,16 @@ def pair_rows(
         joint_a[r] = joint[first[pair[r]]]
         joint_b[r] = joint[second[pair[r]]]
     s = settings[0]
-    return damper_rows(J, support, joint_a[:rows], joint_b[:rows], found["point_a"][:rows],
-                       found["point_b"][:rows], found["normal"][:rows], found["distance"][:rows],
-                       pair[:rows], s["safety"], s["detection"], s["xi"], s["xi_end"], s["blend"],
-                       s["band"], s["recovery"], s["still"], G[:rows], h[:rows],
-                       found["moved"][:rows])  # fmt: skip
+    distance = found["distance"]
+    unmoved = damper_rows(J, support, joint_a[:rows], joint_b[:rows], found["point_a"][:rows],
+                          found["point_b"][:rows], found["normal"][:rows], distance[:rows],
+                          pair[:rows], s["safety"], s["detection"], s["xi"], s["xi_end"],
+                          s["blend"], s["band"], s["recovery"], s["still"], G[:rows], h[:rows],
+                          found["moved"][:rows])  # fmt: skip
+    own = 0.0
+    for r in range(rows):
+        if found["end"][r] == 0:
+            own = distance[r]
+        elif found["end"][r] == FEATURE and distance[r] > own:
+            h[r] = max(h[r], SLACK)  # a feature's row holds or damps, never pushes out
+    return unmoved

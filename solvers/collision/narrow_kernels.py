@@ -30,7 +30,14 @@ become the minimum over one step is then constrained (the ends, and the current 
 
 A capsule against a box (body B) goes to coal for its closest points; its end-point rows are
 each end against the box: in the box's frame the end point clamped to the box is the nearest
-box point outside it; inside, the nearest face (the signed distance to a convex set).
+box point outside it; inside, the nearest face (the signed distance to a convex set). coal's
+witness is one point of the contact, and where the contact is a line or a patch (the segment
+along a face or an edge) its row follows that point while another comes closer, at first
+order. So the features that may take over within the step get rows too: with the segment
+inside the box, those of its deepest separating axis
+(:func:`~rrc_pin.solvers.collision.box_kernels.inside_rows`); outside, the three box edges
+nearest the segment, those meeting at its nearest corner counted once (the distance of a
+segment to a box is the least of its ends' and of the box's edges' to it).
 
 Pairs of other shapes (cylinders, convex hulls, meshes) are returned for coal, only where they
 may be within the detection distance: besides the broad phase's bounding spheres, a sphere or
@@ -49,6 +56,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.solvers.collision.box_kernels import box_pose, inside_rows, turned
 from rrc_pin.solvers.collision.vectors import Vector, along, dot, norm, placed, sub
 from rrc_pin.solvers.compiled import kernel
 
@@ -61,6 +69,9 @@ Row = tuple[float, Vector, Vector, Vector]
 OTHER, SPHERE, CAPSULE, HALFSPACE, BOX = 0, 1, 2, 3, 4
 """Codes of a body's shape (:data:`~rrc_pin.solvers.collision.records.BODY`'s ``shape``); OTHER
 and BOX go to coal (a capsule against a box gets its end-point rows here)."""
+
+FEATURE = 2
+"""``end`` of a box feature's row (:data:`~rrc_pin.solvers.collision.records.FOUND`)."""
 
 SAME = 1e-9
 """[m] An end-point row whose two points are both within this of the pair's closest points is
@@ -189,7 +200,7 @@ def _apart(poses: Array, bodies: Records, world: Array, a: int, b: int) -> float
 
 @kernel
 def _write(found: Records, row: int, k: int, end: int, measured: Row) -> int:
-    """Write ``measured`` as row ``row`` of pair ``k`` (``end``: 1 for an end point's row)."""
+    """Write ``measured`` as row ``row`` of pair ``k`` (``end``: 1, :data:`FEATURE`)."""
     d, pa, pb, n = measured
     record = found[row]
     record["pair"] = k
@@ -317,16 +328,21 @@ def _box_ends(
     poses: Array, bodies: Records, a: int, b: int, k: int, detection: float, found: Records,
     rows: int,
 ) -> int:  # fmt: skip
-    """Append the end-point rows of capsule ``a`` against box ``b`` (module docstring).
+    """Append the end-point rows of capsule ``a`` against box ``b``, then its features'.
+
+    The features (module docstring): with the segment inside the box, those of its deepest axis
+    (:func:`~rrc_pin.solvers.collision.box_kernels.inside_rows`), else the nearest edges
+    (:func:`_box_edges`); those that no end-point row repeats.
 
     Returns:
         The number of rows now written.
     """
-    R, t = _box_pose(poses, bodies, b)
+    R, t = box_pose(poses, bodies, b)
     half = (bodies["half"][b, 0], bodies["half"][b, 1], bodies["half"][b, 2])
     ra = bodies["radius"][a]
     start, end = _segment(poses, bodies, a)
     count = 1 if start == end else 2  # a sphere: one point
+    begin = rows
     for e in range(count):
         p = start if e == 0 else end
         rel = sub(p, t)
@@ -353,43 +369,87 @@ def _box_ends(
         d = sd - ra
         if d >= detection:
             continue
-        normal = _turned(R, n)
+        normal = turned(R, n)
         point_b = (t[0] + R[0][0] * near[0] + R[1][0] * near[1] + R[2][0] * near[2],
                    t[1] + R[0][1] * near[0] + R[1][1] * near[1] + R[2][1] * near[2],
                    t[2] + R[0][2] * near[0] + R[1][2] * near[1] + R[2][2] * near[2])  # fmt: skip
         rows = _write(found, rows, k, 1, (d, along(p, ra, normal), point_b, normal))
+    inside, first, second, third = inside_rows(start, end, ra, R, t, half)
+    if inside == 0:  # outside: the box's edges nearest the segment
+        inside, first, second, third = _box_edges(start, end, ra, R, t, half)
+    for i in range(inside):
+        row = first if i == 0 else second if i == 1 else third
+        if row[0] < detection and not _repeats(found, begin, rows, row):
+            rows = _write(found, rows, k, FEATURE, row)
     return rows
 
 
 @kernel
-def _box_pose(
-    poses: Array, bodies: Records, b: int
-) -> tuple[tuple[Vector, Vector, Vector], Vector]:  # fmt: skip
-    """Box ``b``'s rotation, by its columns (each a box axis in the world), and centre [m]."""
-    box = bodies["box"]
-    j = bodies["joint"][b]
-    M = _columns(poses, j)
-    R = (_turned(M, (box[b, 0, 0], box[b, 1, 0], box[b, 2, 0])),
-         _turned(M, (box[b, 0, 1], box[b, 1, 1], box[b, 2, 1])),
-         _turned(M, (box[b, 0, 2], box[b, 1, 2], box[b, 2, 2])))  # fmt: skip
-    x, y, z = box[b, 0, 3], box[b, 1, 3], box[b, 2, 3]
-    centre = (poses[j, 0, 3] + poses[j, 0, 0] * x + poses[j, 0, 1] * y + poses[j, 0, 2] * z,
-              poses[j, 1, 3] + poses[j, 1, 0] * x + poses[j, 1, 1] * y + poses[j, 1, 2] * z,
-              poses[j, 2, 3] + poses[j, 2, 0] * x + poses[j, 2, 1] * y + poses[j, 2, 2] * z)
-    return R, centre
+def _box_edges(a0: Vector, a1: Vector, r: float, R: tuple[Vector, Vector, Vector], t: Vector,
+               half: Vector) -> tuple[int, Row, Row, Row]:  # fmt: skip
+    """The rows of the three box edges nearest a segment outside the box (module docstring).
+
+    Edges whose closest points are those of a nearer one (the edges of a corner closest to the
+    segment) are one row.
+
+    Args:
+        a0: The segment's first end [m], world frame.
+        a1: Its other end [m].
+        r: The capsule's radius [m].
+        R: The box's axes by columns (world frame).
+        t: The box's centre [m].
+        half: Its half sides [m].
+
+    Returns:
+        count: 0 where an edge meets the segment, else 3; the rows of the nearest edges,
+        nearest first (distance [m], point on the capsule, point on the box, unit normal from
+        the capsule to the box; an infinite distance where the box has fewer).
+    """
+    u = sub(a1, a0)
+    first = second = third = (math.inf, a0, a0, ZERO)
+    for c in range(3):
+        k1, k2 = (c + 1) % 3, (c + 2) % 3
+        e = along(ZERO, 2.0 * half[c], R[c])
+        for corner in range(4):
+            v0 = along(along(along(t, -half[c], R[c]), (1.0 if corner & 1 else -1.0) * half[k1],
+                             R[k1]), (1.0 if corner & 2 else -1.0) * half[k2], R[k2])  # fmt: skip
+            s, edge = segment_closest(a0, u, v0, e)
+            ca, cb = along(a0, s, u), along(v0, edge, e)
+            gap = sub(cb, ca)
+            length = norm(gap)
+            if length <= MET:
+                return 0, first, second, third
+            n = (gap[0] / length, gap[1] / length, gap[2] / length)
+            row = (length - r, along(ca, r, n), cb, n)
+            if _same(row, first) or _same(row, second) or _same(row, third):
+                continue
+            if row[0] < first[0]:
+                first, second, third = row, first, second
+            elif row[0] < second[0]:
+                second, third = row, second
+            elif row[0] < third[0]:
+                third = row
+    return 3, first, second, third
 
 
 @kernel
-def _columns(poses: Array, j: int) -> tuple[Vector, Vector, Vector]:
-    """The rotation of placement ``j`` of ``poses`` (n, 4, 4), by its columns."""
-    return ((poses[j, 0, 0], poses[j, 1, 0], poses[j, 2, 0]),
-            (poses[j, 0, 1], poses[j, 1, 1], poses[j, 2, 1]),
-            (poses[j, 0, 2], poses[j, 1, 2], poses[j, 2, 2]))  # fmt: skip
+def _same(row: Row, other: Row) -> bool:
+    """Whether the witness points of two rows are both within :data:`SAME` of each other."""
+    _, pa, pb, _ = row
+    _, qa, qb, _ = other
+    return max(abs(pa[0] - qa[0]), abs(pa[1] - qa[1]), abs(pa[2] - qa[2]), abs(pb[0] - qb[0]),
+               abs(pb[1] - qb[1]), abs(pb[2] - qb[2])) <= SAME  # fmt: skip
 
 
 @kernel
-def _turned(R: tuple[Vector, Vector, Vector], x: Vector) -> Vector:
-    r""":math:`R\,x` for ``R`` given by its columns."""
-    return (R[0][0] * x[0] + R[1][0] * x[1] + R[2][0] * x[2],
-            R[0][1] * x[0] + R[1][1] * x[1] + R[2][1] * x[2],
-            R[0][2] * x[0] + R[1][2] * x[1] + R[2][2] * x[2])  # fmt: skip
+def _repeats(found: Records, begin: int, rows: int, row: Row) -> bool:
+    """Whether ``row``'s witness points are both within :data:`SAME` of those of one of the
+    rows ``begin`` to ``rows`` of ``found``."""  # noqa: D205, D209
+    for r in range(begin, rows):
+        record = found[r]
+        point_a, point_b = record["point_a"], record["point_b"]
+        written = (record["distance"], (point_a[0], point_a[1], point_a[2]),
+                   (point_b[0], point_b[1], point_b[2]), ZERO)  # fmt: skip
+        if _same(row, written):
+            return True
+    return False

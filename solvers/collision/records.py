@@ -53,11 +53,11 @@ FOUND = np.dtype([
     ("normal", np.float64, (3,)),
     ("moved", np.bool_),
 ])  # fmt: skip
-"""A row of a proximity query: its pair's index, 1 for a capsule end point's row (0 for the
-pair's closest points), the joints bodies A and B move with, the signed distance [m], the
-witness points on A and B and the unit normal from A to B (world frame, ``p_b - p_a = d n``),
-and whether some joint rate changes the distance (its damper row has an entry above ``still``,
-:data:`SETTINGS`)."""
+"""A row of a proximity query: its pair's index, 1 for a capsule end point's row, 2 for a box
+feature's (:mod:`~rrc_pin.solvers.collision.narrow_kernels`; 0 for the pair's closest points),
+the joints bodies A and B move with, the signed distance [m], the witness points on A and B and
+the unit normal from A to B (world frame, ``p_b - p_a = d n``), and whether some joint rate
+changes the distance (its damper row has an entry above ``still``, :data:`SETTINGS`)."""
 
 SETTINGS = np.dtype([
     ("detection", np.float64),

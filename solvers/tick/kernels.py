@@ -139,7 +139,9 @@ def householder_qr(At: Array, Q: Array, R: Array) -> None:
         R: Out: upper triangular (n, m).
     """
     n, m = At.shape
-    R[:, :] = At
+    for i in range(n):  # element by element: an array copy compiles numba's shape error too
+        for j in range(m):
+            R[i, j] = At[i, j]
     Q[:, :] = 0.0
     for i in range(n):
         Q[i, i] = 1.0
@@ -595,8 +597,9 @@ def scale_and_veer(y: Array, b: Array, factor: Array | None = None) -> tuple[flo
     m = b.size
     ys, bs = np.empty(m), np.empty(m)
     if factor is None:
-        ys[:] = y
-        bs[:] = b
+        for i in range(m):
+            ys[i] = y[i]
+            bs[i] = b[i]
     else:
         peak = 1.0
         for i in range(m):

@@ -229,7 +229,8 @@ def report(joints: Array, ints: Ints, reals: Array, rows: Rows, answer: Top, qdo
     reals[CLIP] = kernels.clip_into(qdot, rows.lb, rows.ub)
     reals[SCALE] = answer.scale * within_rows(qdot, rows, reals[ZERO_INSIDE] == 1.0)
     reals[VEER], reals[LAMBDA_SQ] = answer.veer, answer.lambda_sq
-    joints[QDOT] = qdot
+    for c in range(qdot.size):  # element by element: an array copy compiles numba's shape error
+        joints[QDOT, c] = qdot[c]
     status = answer.status
     code = MET if status == EXACT else SCALED_LEVEL if status == SCALED else TRADED
     ints[STARTS + ints[LEVELS] + 1] = code
