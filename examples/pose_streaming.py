@@ -1,11 +1,14 @@
 """Streamed pose targets: a 90 Hz tracker with its faults driving hands at 100 Hz.
 
 Shows: a recorded device stream (synthesised, seeded: 0.5 mm noise, two dropouts, a
-three-sample glitch and a tracker whose frame moved) replayed into
-``rrc_pin.Controller.step`` on panda through a ``rrc_pin.PoseStream`` (its twists in base
-axes), with the hand's clutch pressed for a second; then baxter's two hands, each on its own
-stream, through one ``Resolver`` with two ``FrameTask``. Prints how far behind the device the
-hand is, the jumps rejected and the re-anchorings. Needs only ``pip install -e .``.
+three-sample glitch and a tracker whose frame moved) replayed into ``rrc_pin.Controller``
+through its own stream (``ctl.stream()``: push the device's poses, press the clutch, and
+``ctl.step()`` follows), with the clutch pressed for half a second; the same with the jerk
+stage on (``smoothing=SmoothingOptions(...)``); baxter's two hands in one ``Controller``
+(the left the tool frame, the right a second streamed frame); gsfc_dual's two free hands in
+one ``CellController``. Prints how far behind the device each hand is, the jumps rejected,
+the re-anchorings, and how far the smoothed hand is from the raw one.
+Needs only ``pip install -e .``.
 
 Run: ``python examples/pose_streaming.py``
 """
@@ -17,6 +20,9 @@ import os
 import numpy as np
 
 import rrc_pin
+from rrc_pin.cells import CellController
+from rrc_pin.control.pose_stream import PoseStream
+from rrc_pin.control.smoothing import SmoothingOptions
 from rrc_pin.control.synthetic_stream import Jump, device_pose, synthetic_stream
 
 QUICK = os.environ.get("RRC_PIN_EXAMPLES_QUICK") == "1"
@@ -28,27 +34,31 @@ FAULTS = {"dropouts": [(1.5, 1.65), (3.0, 3.4) if QUICK else (6.0, 6.4)],
 CLUTCH = (5.0, 5.5) if QUICK else (10.5, 11.5)
 
 
-class Hand:
-    """One hand's stream fed from its recording as the loop's clock passes the samples."""
+class Device:
+    """One tracker's recording, pushed into a controller's stream as the loop's clock passes.
 
-    def __init__(self, pose: np.ndarray, seed: int, phase: float = 0.0) -> None:
+    In a real loop the device's thread calls ``stream.push`` as its samples come.
+    """
+
+    def __init__(self, stream: PoseStream, seed: int, phase: float = 0.0) -> None:
         self.recording = synthetic_stream(SECONDS, 90.0, seed=seed, phase=phase, **FAULTS)
-        self.stream = rrc_pin.PoseStream(pose)
-        self.phase, self.next, self.errors = phase, 0, []
+        self.stream, self.phase, self.next, self.errors = stream, phase, 0, []
 
-    def twist(self, t: float, pose: np.ndarray) -> np.ndarray:
-        """Push the samples due by ``t`` [s]; the hand's twist for its ``pose``."""
+    def feed(self, t: float, hand: np.ndarray) -> None:
+        """Push the samples due by ``t`` [s], set the clutch, note the hand's distance.
+
+        The distance to the clean device's pose 0.1 s before (the stream's lag, 1 / gain).
+        """
         rec = self.recording
-        while self.next < len(rec.times) and rec.times[self.next] <= t:
+        while self.next < len(rec.times) and rec.times[self.next] <= t + 1e-9:
             self.stream.push(rec.times[self.next], rec.poses[self.next])
             self.next += 1
         self.stream.clutch(CLUTCH[0] <= t < CLUTCH[1], t)
-        clean = device_pose(max(t - 0.1, 0.0), phase=self.phase)  # 0.1 s ago, no noise
+        clean = device_pose(max(t - 0.1, 0.0), phase=self.phase)
         if t - 0.1 >= MOVED.start:
             clean[:3, 3] += MOVED.offset
         if self.stream.state == "tracking":
-            self.errors.append(np.linalg.norm(self.stream.target_for(clean)[:3, 3] - pose[:3, 3]))
-        return self.stream.twist(t, pose)
+            self.errors.append(np.linalg.norm(self.stream.target_for(clean)[:3, 3] - hand[:3, 3]))
 
     def summary(self) -> str:
         """How the hand followed, in words."""
@@ -58,26 +68,49 @@ class Hand:
                 f"re-anchored at {', '.join(f'{a:.2f} s' for a in s.anchors)}")
 
 
-def main() -> None:
-    """Panda through Controller.step, then baxter's two hands through one Resolver."""
-    panda = rrc_pin.load("panda")
-    ctl = rrc_pin.Controller(panda, dt=DT)
-    hand = Hand(panda.fk(ctl.q), seed=1)
+def replay(ctl: rrc_pin.control.Loop, devices: dict[str, Device]) -> np.ndarray:
+    """Step ``ctl`` for SECONDS with its devices fed; the first frame's positions."""
+    frames = {n: ctl.frame_of(n) if isinstance(ctl, CellController) else n for n in devices}
+    path = []
     for k in range(round(SECONDS / DT)):
-        ctl.step(hand.twist(k * DT, panda.fk(ctl.q)), ref="world_aligned")
-    print(f"panda, {SECONDS:.0f} s of a 90 Hz stream at 100 Hz: {hand.summary()}")
+        for name, device in devices.items():
+            device.feed(k * DT, ctl.robot.fk(ctl.q, frames[name]))
+        ctl.step()
+        path.append(ctl.robot.fk(ctl.q, frames[next(iter(devices))])[:3, 3])
+    return np.array(path)
 
-    baxter = rrc_pin.load("baxter")
-    resolver = rrc_pin.Resolver(baxter, dt=DT)
-    q = baxter.ready()
-    posture = rrc_pin.PostureTask(baxter.ready(), gain=0.5, weight=1e-3)
-    hands = {f: Hand(baxter.fk(q, f), seed=2 + i, phase=float(i))
-             for i, f in enumerate(baxter.tool_frames)}  # fmt: skip
-    for k in range(round(SECONDS / DT)):
-        tasks = [rrc_pin.FrameTask(f, h.twist(k * DT, baxter.fk(q, f))) for f, h in hands.items()]
-        q = baxter.integrate(q, resolver.solve(q, [tasks, [posture]], priority="strict").qdot, DT)
-    for frame, h in hands.items():
-        print(f"baxter {frame}: {h.summary()}")
+
+def main() -> None:
+    """Panda raw and jerk-limited, baxter's two hands, gsfc_dual's two free hands."""
+    panda = rrc_pin.load("panda")
+    paths = {}
+    for label, smoothing in (("raw", None), ("jerk-limited", SmoothingOptions(20.0, 500.0))):
+        ctl = rrc_pin.Controller(panda, dt=DT, smoothing=smoothing)
+        device = Device(ctl.stream(), seed=1)
+        paths[label] = replay(ctl, {panda.tool_frame: device})
+        print(f"panda {label}, {SECONDS:.0f} s of a 90 Hz stream at 100 Hz: {device.summary()}")
+    apart = np.linalg.norm(paths["raw"] - paths["jerk-limited"], axis=1)
+    print(f"panda jerk-limited hand from the raw one: largest {1e3 * apart.max():.1f} mm, "
+          f"median {1e3 * np.median(apart):.2f} mm")
+
+    baxter = rrc_pin.load("baxter", tool_frame="left_gripper")
+    ctl = rrc_pin.Controller(baxter, dt=DT)
+    devices = {"left_gripper": Device(ctl.stream(), seed=2),
+               "right_gripper": Device(ctl.stream("right_gripper"), seed=3, phase=1.0)}  # fmt: skip
+    replay(ctl, devices)
+    for frame, device in devices.items():
+        print(f"baxter {frame}: {device.summary()}")
+
+    dual = rrc_pin.load("gsfc_dual")
+    free = rrc_pin.cells.make_cell({k: (a.robot, a.base) for k, a in dual.arms.items()},
+                                   name="free", ready={k: dual.ready()[a.q]
+                                                       for k, a in dual.arms.items()})  # fmt: skip
+    cell = CellController(free, DT)
+    devices = {"left": Device(cell.stream("left"), seed=4),
+               "right": Device(cell.stream("right"), seed=5, phase=1.0)}  # fmt: skip
+    replay(cell, devices)
+    for name, device in devices.items():
+        print(f"gsfc_dual {name} hand: {device.summary()}")
 
 
 if __name__ == "__main__":

@@ -19,7 +19,7 @@ if TYPE_CHECKING:
     from rrc_pin.combined import combine
     from rrc_pin.control import Controller, Deadman, DriftCorrection, TrajectoryLog
     from rrc_pin.control.pose_stream import PoseStream, StreamOptions
-    from rrc_pin.control.smoothing import JerkLimiter
+    from rrc_pin.control.smoothing import JerkLimiter, SmoothingOptions
     from rrc_pin.errors import (
         FrameNotFound,
         InvalidInput,
@@ -95,6 +95,7 @@ __all__ = [
     "Robot",
     "RrcPinError",
     "SingularityLimit",
+    "SmoothingOptions",
     "StreamOptions",
     "SupportPolygonLimit",
     "Task",
@@ -147,6 +148,7 @@ _HOME: dict[str, str] = {
     "Robot": "rrc_pin.robot",
     "RrcPinError": "rrc_pin.errors",
     "SingularityLimit": "rrc_pin.limits",
+    "SmoothingOptions": "rrc_pin.control.smoothing",
     "StreamOptions": "rrc_pin.control.pose_stream",
     "SupportPolygonLimit": "rrc_pin.limits",
     "Task": "rrc_pin.tasks",

@@ -265,8 +265,13 @@ def _controller(w: World) -> list[Site]:
         Site("Controller", lambda: rrc_pin.Controller, {
             "robot": w.panda, "dt": 0.01, "q0": None, "strategy": None, "limits": None,
             "qp": None, "damping": Damping(), "deadman": rrc_pin.Deadman(),
-            "drift": rrc_pin.DriftCorrection(), "speed": 1.0, "near": 0.05}),
+            "drift": rrc_pin.DriftCorrection(), "speed": 1.0, "near": 0.05, "smoothing": None}),
         Site("Controller.step", lambda: w.controller().step, {"twist": w.twist, "ref": "local"}),
+        Site("Controller.stream", lambda: w.controller().stream, {"name": None, "options": None}),
+        Site("Controller.close_stream", lambda: _streaming(w.controller()).close_stream,
+             {"name": None}),
+        Site("SmoothingOptions", lambda: rrc_pin.SmoothingOptions,
+             {"acceleration": 20.0, "jerk": 500.0}),
         Site("Controller.reverse", lambda: w.controller().reverse,
              {"seconds": 0.01, "extra": 1.0}),
         Site("Controller.mask", lambda: w.controller().mask, {"joints": "panda_joint4"}),
@@ -284,6 +289,12 @@ def _controller(w: World) -> list[Site]:
         Site("TrajectoryLog.positions", lambda: w.controller().log.positions, {"n": 1}),
         Site("TrajectoryLog.header", lambda: w.controller().log.header, {}),
     ]
+
+
+def _streaming(ctl: Any) -> Any:
+    """``ctl`` with its tool frame streamed."""
+    ctl.stream()
+    return ctl
 
 
 def _cells(w: World) -> list[Site]:
@@ -306,6 +317,8 @@ def _cells(w: World) -> list[Site]:
         Site("CellController.step", lambda: w.cell_controller().step,
              {"commands": {"object": np.array([0.01, 0, 0, 0, 0, 0])}}),
         Site("CellController.target", lambda: w.cell_controller().target, {"name": "object"}),
+        Site("CellController.stream", lambda: w.cell_controller().stream,
+             {"name": "object", "options": None}),
         Site("CellController.frame_of", lambda: w.cell_controller().frame_of,
              {"name": "object"}),
         Site("CellController.save", lambda: w.cell_controller().save,
@@ -454,6 +467,7 @@ def _teleoperation(w: World) -> list[Site]:
         Site("PoseStream.target_for", lambda: rrc_pin.PoseStream(w.T).target_for,
              {"device": w.T}),
         Site("PoseStream.twist", lambda: rrc_pin.PoseStream(w.T).twist, {"t": 0.0, "hand": w.T}),
+        Site("PoseStream.reset", lambda: rrc_pin.PoseStream(w.T).reset, {"hand": w.T}),
         Site("JerkLimiter", lambda: rrc_pin.JerkLimiter, {
             "n": 7, "dt": 0.01, "acceleration": 10.0, "jerk": 100.0, "lower": None,
             "upper": None, "margin": 0.0}, aliases={"upper": ("lower",)}),

@@ -70,6 +70,10 @@ slide_kernels.project(np.eye(2), 0.0, np.ones(2), -np.ones(2), np.ones(2), np.ze
                       np.zeros(0), 0.0, x)
 out["tick glue"] = [top.norm(np.ones(3)), float(levels.row_values(np.eye(2), x).sum()),
                     float(factor.qr(np.eye(2)).R.sum())]
+stage = rrc_pin.JerkLimiter(panda.nv, 0.01, 20.0, 500.0, lower=panda.dof_lower,
+                            upper=panda.dof_upper)  # the jerk stage's kernels
+box = Resolver(panda, dt=0.01).solve(panda.ready(), np.zeros(6)).problem.box
+out["jerk stage"] = stage.step(np.ones(panda.nv), box, panda.ready()).qdot.tolist()
 """
 
 SOLVE_ONE = """

@@ -92,3 +92,26 @@ def test_names_and_paths_are_checked():
         cmd.Latch("yes")  # type: ignore[arg-type]
     with pytest.raises(InvalidInput, match="seconds"):
         cmd.Reverse(0.0)
+
+
+def test_a_device_pose_from_the_page_is_seven_or_eight_numbers_with_a_unit_quaternion():
+    """``x y z qw qx qy qz [clutch]``: a quarter turn about z at (0.1, 0, 0.2), the clutch
+    pressed; a quaternion within 1e-3 of unit length normalised; empty ends the stream."""
+    c = cmd.pose_from_page("0.1 0 0.2 0.70710678 0 0 0.70710678 1")
+    want = np.array([[0.0, -1.0, 0.0, 0.1], [1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.2],
+                     [0.0, 0.0, 0.0, 1.0]])  # fmt: skip
+    np.testing.assert_allclose(c.pose, want, atol=1e-8)
+    assert c.clutch and not c.pose.flags.writeable
+    loose = cmd.pose_from_page("0, 0, 0, 1.0005, 0, 0, 0")
+    np.testing.assert_allclose(loose.pose, np.eye(4), atol=1e-12)
+    assert not loose.clutch
+    assert cmd.pose_from_page("  ").pose is None
+    for text, name in (("1 2 3", "pose"), ("0 0 0 1 0 0 0 2", "pose"), ("0 0 nan 1 0 0 0", "pose"),
+                       ("0 0 0 1 0 0 x", "pose"), ("0 0 0 2 0 0 0", "quaternion"),
+                       (None, "pose")):  # fmt: skip
+        with pytest.raises(InvalidInput, match=name):
+            cmd.pose_from_page(text)  # type: ignore[arg-type]
+    with pytest.raises(InvalidInput, match="clutch"):
+        cmd.Pose(np.eye(4), clutch=1)  # type: ignore[arg-type]
+    with pytest.raises(InvalidInput, match="pose"):
+        cmd.Pose(-np.eye(4))

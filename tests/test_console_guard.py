@@ -350,3 +350,34 @@ def test_a_flood_of_four_sockets_costs_the_loop_nothing_and_stop_comes_next_tick
         assert not [r for r in caplog.records if r.levelno >= logging.ERROR]
     finally:
         c.stop()
+
+
+def test_a_program_streams_device_poses_through_the_same_door_and_stop_jumps_its_queue(console):
+    """A program on the console's websocket (the token in its address, as any page's): its
+    device poses, the panel's device field updated 90 times a second, reach the loop as a
+    pose stream through the guard's checks and its budget, and the hand follows; a STOP from
+    the same socket is taken as it arrives (urgent), ends the stream and stops the arm. The
+    door is the twists': no token, no socket."""
+    pin = pytest.importorskip("pinocchio")
+    from rrc_pin.control.synthetic_stream import synthetic_stream
+
+    assert refused_status(ws_url(console, token=False)) == 403
+    loop, ws = console.loop, page_socket(console)
+    device = console.panel.device._impl.uuid  # viser keeps its ids private
+    loop.mailbox.post(cmd.Latch(True))
+    start = loop.robot_pose()[:3, 3]
+    recording = synthetic_stream(2.0, 90.0, seed=3)
+    for pose in recording.poses:
+        q = pin.Quaternion(pose[:3, :3])
+        text = " ".join(f"{v:.9f}" for v in (*pose[:3, 3], q.w, q.x, q.y, q.z))
+        ws.send(encode("GuiUpdateMessage", uuid=device, updates={"value": text}))
+        time.sleep(1.0 / 90.0)
+    wait_for(lambda: np.linalg.norm(loop.robot_pose()[:3, 3] - start) > 0.02, "the hand moved")
+    assert loop.snapshot.mode == "stream" and loop.ctl.streams
+    urgents = console.guard.urgents
+    ws.send(encode("GuiUpdateMessage", uuid=console.panel.stop_button._impl.uuid,
+                   updates={"value": True}))  # fmt: skip
+    wait_for(lambda: not loop.ctl.streams and loop.snapshot.stops >= 1, "the STOP applied")
+    assert console.guard.urgents == urgents + 1 and console.guard.closed == {}
+    assert loop.alive and loop.errors == 0, [n.text for n in loop.notices]
+    ws.close()

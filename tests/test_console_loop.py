@@ -10,6 +10,7 @@ import pytest
 import rrc_pin
 from rrc_pin.console import commands as cmd
 from rrc_pin.console.loop import ControlLoop, start_pose
+from rrc_pin.control.synthetic_stream import device_pose, synthetic_stream
 from rrc_pin.errors import InvalidInput
 
 
@@ -282,3 +283,55 @@ def test_a_record_is_full_at_the_logs_capacity_too(barker6):
     loop.mailbox.post(cmd.Record(True))
     moved(loop, 15, cmd.Latch(True), cmd.Velocity(np.array([0.02, 0, 0, 0, 0, 0])))
     assert loop.snapshot.mode == "held" and "record full (0.1 s)" in loop.notices[-1].text
+
+
+def stream_into(loop: ControlLoop, recording, ticks: int, t0: float, clutch=lambda t: False):
+    """Post the recording's samples due by each tick as Pose commands, then tick; the hand's
+    positions and the stream's targets of the clean device 0.1 s before (NaN: no stream)."""
+    hands, expected, k = [], [], int(np.searchsorted(recording.times, t0))
+    for i in range(ticks):
+        t = t0 + i * loop.dt
+        while k < len(recording.times) and recording.times[k] <= t + 1e-9:
+            loop.mailbox.post(cmd.Pose(recording.poses[k], clutch(t)))
+            k += 1
+        loop.tick(t)
+        stream = loop.ctl.streams.get(loop.snapshot.hand)
+        hands.append(loop.robot_pose()[:3, 3])
+        clean = device_pose(max(t - 0.1, 0.0))
+        expected.append(np.full(3, np.nan) if stream is None else stream.target_for(clean)[:3, 3])
+    return np.array(hands), np.array(expected)
+
+
+def test_a_device_pose_stream_drives_the_hand_behind_the_deadman_and_stop(panda):
+    """Pose commands at 90 Hz (0.5 mm noise) into the 100 Hz loop, the deadman latched: the
+    hand follows the device 0.1 s behind within 3 mm (measured 1.6 mm); the deadman released
+    holds it (clutched: still to 1e-4 m once it has reached its target) and latched again it
+    follows on with no step; the device's clutch holds it likewise; STOP ends the stream and
+    stops the arm, and the next sample opens a new stream where the hand is (no jump); an
+    empty pose ends it."""
+    loop = ControlLoop(panda, rate=100.0)
+    recording = synthetic_stream(8.0, 90.0, seed=3)
+    loop.mailbox.post(cmd.Latch(True))
+    hands, expected = stream_into(loop, recording, 200, 0.0)
+    error = np.linalg.norm(hands - expected, axis=1)[50:]
+    assert error.max() < 3e-3 and loop.snapshot.mode == "stream" and loop.snapshot.enabled
+    loop.mailbox.post(cmd.Latch(False))
+    hands, _ = stream_into(loop, recording, 100, 2.0)
+    assert np.ptp(hands[50:], axis=0).max() < 1e-4 and not loop.snapshot.enabled
+    loop.mailbox.post(cmd.Latch(True))
+    hands, _ = stream_into(loop, recording, 100, 3.0)
+    steps = np.linalg.norm(np.diff(hands, axis=0), axis=1)
+    assert steps.max() < 0.5 * loop.dt  # under 0.5 m/s (the stream's clamp): no jump
+    hands, _ = stream_into(loop, recording, 100, 4.0, clutch=lambda t: t >= 4.0)
+    assert np.ptp(hands[50:], axis=0).max() < 1e-4
+    loop.mailbox.post(cmd.Stop())
+    loop.tick(5.0)
+    assert loop.ctl.streams == {} and loop.snapshot.stops == 1
+    held = loop.robot_pose()[:3, 3]
+    loop.mailbox.post(cmd.Latch(True))
+    hands, _ = stream_into(loop, recording, 50, 5.01)
+    assert np.linalg.norm(hands[0] - held) < 1e-9  # from where it stopped, with no jump
+    assert np.linalg.norm(np.diff(hands, axis=0), axis=1).max() < 0.5 * loop.dt
+    loop.mailbox.post(cmd.Pose(None))
+    loop.tick(5.6)
+    assert loop.ctl.streams == {} and loop.snapshot.mode == "teleop"

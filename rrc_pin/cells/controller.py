@@ -31,7 +31,11 @@ each shows at the tick's configuration and the step's second order are taken out
 correction inside the tick's box (:mod:`rrc_pin.cells.closure`), and a chain open beyond its
 bound stops the cell (``grip_lost`` / ``contact_lost``) until a command closes it.
 
-The loop itself is :class:`~rrc_pin.control.loop.Loop`, the one
+A command's name may follow a device's poses instead (:meth:`~rrc_pin.control.loop.Loop.stream`:
+its twist each tick the stream's, its target the pose reached), and a cell of free hands
+may have the jerk stage after its resolver (``smoothing=``; bounding each joint apart would
+open a grip or a foot's contact). The loop itself is
+:class:`~rrc_pin.control.loop.Loop`, the one
 :class:`~rrc_pin.control.Controller` is built on: the speed override and the deadman weight
 every command, the configuration is integrated on its manifold, the ticks go to a log ring
 (:class:`CellLog`) and :meth:`~rrc_pin.control.loop.Loop.reverse` retraces them.
@@ -56,6 +60,7 @@ from rrc_pin.cells.cell_resolution import CellResolution
 from rrc_pin.cells.closure import Chains, ClosureBound, close
 from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.loop import Loop, Step
+from rrc_pin.control.smoothing import SmoothingOptions
 from rrc_pin.deprecated import warn_renamed
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import ContactLimit, GripLimit, JointLimits, Limit
@@ -124,6 +129,8 @@ class CellController(Loop):
             correction and no bound (for comparison: the integration's remainder then adds
             up).
         project_contacts: Deprecated (goes in the next release): False is ``closure=None``.
+        smoothing: Bounds of the jerk stage after the resolver, or None (no stage); a cell of
+            free hands only (bounding each joint apart opens a grip or a foot's contact).
 
     Raises:
         InvalidInput: A bad argument, named.
@@ -151,6 +158,7 @@ class CellController(Loop):
         coupled: bool = True,
         closure: ClosureBound | None = ClosureBound(),  # noqa: B008 - immutable
         project_contacts: bool | None = None,
+        smoothing: SmoothingOptions | None = None,
     ) -> None:
         if project_contacts is not None:  # the former closure step's switch
             project_contacts = flag(project_contacts, "project_contacts")
@@ -172,10 +180,15 @@ class CellController(Loop):
         gain = positive(gain, "gain")
         posture_gain = positive(posture_gain, "posture_gain")
         coupled = flag(coupled, "coupled")
+        if smoothing is not None and (cell.body is not None or (cell.objects and coupled)):
+            raise InvalidInput("smoothing", f"{cell.name} has closed chains (a held object, feet "
+                               "in support) that a jerk stage bounding each joint apart would "
+                               "open: a cell of free hands only")  # fmt: skip
         self.contact = ContactLimit((), name="contact")
         self.grip = GripLimit((), name="grip")
         super().__init__(cell, dt, q0, limits=[*given, self.contact, self.grip], qp=qp,
-                         damping=damping, deadman=deadman, speed=speed)  # fmt: skip
+                         damping=damping, deadman=deadman, speed=speed,
+                         smoothing=smoothing)  # fmt: skip
         self.cell = cell
         self.gain = gain
         self.posture = PostureTask(cell.dof_positions(cell.ready()), gain=posture_gain,
@@ -284,7 +297,8 @@ class CellController(Loop):
                 ``"world_aligned"``, ``"local"``, ``"world"`` (module docstring; ``"world"``
                 meant ``"world_aligned"`` before this release and warns once) or, for a hand,
                 ``"base"`` (its arm's base axes). Names not given are held still; None: no
-                new command (the last ones age, in their frames, see ``deadman``).
+                new command (the last ones age, in their frames, see ``deadman``). A
+                streamed name (:meth:`stream`) follows its stream whatever is given here.
 
         Returns:
             The configuration after the tick and its resolution: the rates applied (the
@@ -304,6 +318,8 @@ class CellController(Loop):
         poses = {name: cell.fk(self._q, self.frame_of(name)) for name in self._targets}
         twists = {name: weight * self._world_aligned(name, poses[name], self._commands[name])
                   if name in self._commands else np.zeros(6) for name in self._targets}  # fmt: skip
+        for name, twist in self._streamed(poses).items():  # the stream's target: the reference
+            twists[name], self._targets[name] = self.speed * twist, poses[name]
         top: list[Task] = []
         hands: list[Task] = []
         for name, twist in twists.items():
@@ -320,11 +336,13 @@ class CellController(Loop):
                 continue
             top.append(FrameTask(self.frame_of(name), twist, target=self._targets[name],
                                  gain=self.gain, name=name))  # fmt: skip
+        before = self._previous_rates()
         if hands:
-            r = self.resolver.solve(self._q, [*top, *hands, self.posture])
+            r = self.resolver.solve(self._q, [*top, *hands, self.posture], qdot_prev=before)
         else:
             levels: list[list[Task]] = [top, [self.posture]] if top else [[self.posture]]
-            r = self.resolver.solve(self._q, levels, priority="strict")
+            r = self.resolver.solve(self._q, levels, priority="strict", qdot_prev=before)
+        r = self._smooth(r)
         commanded = any(bool(np.any(t != 0.0)) for t in twists.values())
         self._tick = ("teleop", commanded, poses)
         out = self._advance(r)
@@ -385,6 +403,12 @@ class CellController(Loop):
     def _stopped(self) -> None:
         self._commands = {}
         self._retarget()
+
+    def _stream_name(self, name: str | None) -> str:
+        return self._check_name(name, "name")
+
+    def _pose_of(self, name: str) -> Array:
+        return self.cell.fk(self._q, self.frame_of(name))
 
     def _configuration_set(self) -> None:
         """Targets, grips and the feet's anchors at the configuration set.

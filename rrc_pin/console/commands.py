@@ -20,6 +20,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.solvers.checks import as_array, as_vector
+from rrc_pin.solvers.closed_form.quaternion import matrix_from_quaternion
 
 Array = npt.NDArray[np.float64]
 Frame = Literal["local", "world_aligned"]
@@ -189,15 +190,47 @@ class Target:
     pose: Array | None = None
 
     def __post_init__(self) -> None:
-        if self.pose is None:
-            return
-        pose = as_array(self.pose, "pose", (4, 4)).copy()
-        R = pose[:3, :3]
-        if not (np.allclose(R @ R.T, np.eye(3), atol=1e-6) and np.allclose(pose[3], [0, 0, 0, 1])
-                and np.linalg.det(R) > 0.0):  # fmt: skip
-            raise InvalidInput("pose", "expected a rigid transform (4, 4)")
-        pose.flags.writeable = False
-        object.__setattr__(self, "pose", pose)
+        if self.pose is not None:
+            object.__setattr__(self, "pose", _rigid(self.pose))
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A device's pose for the commanded hand's stream (a VR controller, a tracker, a master).
+
+    The first sample opens the hand's stream anchored where the hand is
+    (``Controller.stream``); each moves the hand's target by the device's motion since, at the
+    loop's tick; ``pose`` None ends the stream.
+
+    Attributes:
+        pose: The device's pose (4, 4) in its own world [m] (a rigid transform), or None.
+        clutch: Whether the device's clutch is pressed: the hand holds while the device moves,
+            and is re-anchored on release.
+    """
+
+    pose: Array | None = None
+    clutch: bool = False
+
+    def __post_init__(self) -> None:
+        if self.pose is not None:
+            object.__setattr__(self, "pose", _rigid(self.pose))
+        if not isinstance(self.clutch, bool):
+            raise InvalidInput("clutch", f"expected True or False, got {self.clutch!r}")
+
+
+def _rigid(value: object) -> Array:
+    """``value`` as a read-only rigid transform (4, 4).
+
+    Raises:
+        InvalidInput: Naming ``pose``: not a finite (4, 4) rigid transform.
+    """
+    pose: Array = np.array(as_array(value, "pose", (4, 4)), dtype=np.float64)  # type: ignore[arg-type]
+    R = pose[:3, :3]
+    if not (np.allclose(R @ R.T, np.eye(3), atol=1e-6) and np.allclose(pose[3], [0, 0, 0, 1])
+            and np.linalg.det(R) > 0.0):  # fmt: skip
+        raise InvalidInput("pose", "expected a rigid transform (4, 4)")
+    pose.flags.writeable = False
+    return pose
 
 
 @dataclass(frozen=True)
@@ -273,8 +306,8 @@ class Released:
 
 
 Command = (
-    Velocity | Jog | Hold | Latch | Stop | Speed | Strategy | Backend | Hand | Target | Record
-    | Reverse | Save | Load | Home | Released
+    Velocity | Jog | Hold | Latch | Stop | Speed | Strategy | Backend | Hand | Target | Pose
+    | Record | Reverse | Save | Load | Home | Released
 )
 """Every request the loop takes."""
 
@@ -302,3 +335,37 @@ def velocity_from_page(
         for i, v in enumerate(values)
     ]  # fmt: skip
     return Velocity(np.array(twist), one_of(frame, "frame", FRAMES))  # type: ignore[arg-type]
+
+
+def pose_from_page(text: object) -> Pose:
+    """A :class:`Pose` from the page's device field: ``"x y z qw qx qy qz [clutch]"``.
+
+    The position [m] and the orientation's unit quaternion (scalar first; one within 1e-3 of
+    unit length is normalised: a device's single-precision floats), then 1 or 0 for the
+    clutch (default 0); an empty text ends the stream.
+
+    Raises:
+        InvalidInput: Naming ``pose`` (not seven or eight numbers, not finite, the clutch not
+            0 or 1) or ``quaternion`` (not of unit length).
+    """
+    if not isinstance(text, str):
+        raise InvalidInput("pose", f"expected the device's pose as text, got {text!r}")
+    if not text.strip():
+        return Pose(None)
+    try:
+        values = [float(v) for v in text.replace(",", " ").split()]
+    except ValueError:
+        raise InvalidInput("pose", f"expected numbers: x y z qw qx qy qz [clutch], got {text!r}") \
+            from None
+    if len(values) not in (7, 8) or not all(math.isfinite(v) for v in values):
+        raise InvalidInput("pose", f"expected seven or eight finite numbers, got {text!r}")
+    if len(values) == 8 and values[7] not in (0.0, 1.0):
+        raise InvalidInput("pose", f"expected the clutch 0 or 1, got {values[7]}")
+    quaternion = np.array(values[3:7])
+    size = float(np.linalg.norm(quaternion))
+    if abs(size - 1.0) > 1e-3:
+        raise InvalidInput("quaternion", f"expected a unit quaternion, got |q| = {size:.6g}")
+    pose = np.eye(4)
+    pose[:3, :3] = matrix_from_quaternion(quaternion)  # (normalised there)
+    pose[:3, 3] = values[:3]
+    return Pose(pose, len(values) == 8 and values[7] == 1.0)

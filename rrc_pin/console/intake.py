@@ -27,7 +27,8 @@ class Intake:
 
     Attributes:
         rate: Messages a second a connection may send on average, > 0 (a page sends up to
-            about 40: the hold button's heartbeats, a dragged slider, the camera, keys).
+            about 40: the hold button's heartbeats, a dragged slider, the camera, keys; a
+            device streaming its poses 90 to 120 more).
         burst: Messages it may send at once beyond the rate, >= 1.
         patience: How long [s] a connection may keep its budget spent (every message waiting
             for its token) before it is closed, > 0.
@@ -41,7 +42,7 @@ class Intake:
         InvalidInput: A limit out of its range, named.
     """
 
-    rate: float = 100.0
+    rate: float = 200.0
     burst: int = 10
     patience: float = 2.0
     max_bytes: int = 2**20 + 2**16

@@ -2,9 +2,11 @@
 
 One thread owns the :class:`~rrc_pin.Controller`. Every tick it drains the
 :class:`~rrc_pin.console.mailbox.Mailbox` (the page's commands, checked when they were made),
-applies them, asks the :class:`~rrc_pin.console.operator.Operator` for the twist, steps the
-controller once and publishes a :class:`~rrc_pin.console.snapshot.Snapshot` (one reference
-assignment: a reader gets the old one or the new one). Nothing else touches the controller,
+applies them, asks the :class:`~rrc_pin.console.operator.Operator` for the twist (or, while
+a device streams poses, lets the controller follow the hand's stream: ``Controller.stream``,
+clutched while the deadman is released), steps the controller once and publishes a
+:class:`~rrc_pin.console.snapshot.Snapshot` (one reference assignment: a reader gets the old
+one or the new one). Nothing else touches the controller,
 except a worker thread the loop starts for a long job (reverse, save, load) while it holds the
 arm still and keeps ticking.
 
@@ -163,6 +165,7 @@ class ControlLoop:
         self._playback: collections.deque[Array] = collections.deque()
         self._replay: collections.deque[Array] = collections.deque()
         self._stop_now = False
+        self._clutch = False
         self._full = False
         self._thread: threading.Thread | None = None
         self._stop = threading.Event()
@@ -248,6 +251,7 @@ class ControlLoop:
         if self._stop_now:
             self._stop_now = False
             self._replay.clear()
+            self._end_stream()
             return self._publish(*self._step(np.zeros(6), "local"), "teleop")
         if self._replay:
             twist = self._replay.popleft()
@@ -256,6 +260,11 @@ class ControlLoop:
             return self._publish(*self._step(twist, "world_aligned"), "replay")
         if self._full:
             return self._publish(None, None, "held")
+        stream = self.ctl.streams.get(self._hand)
+        if stream is not None:  # the device's: held (clutched) while the deadman is released
+            enabled = self.operator.enabled(now)
+            stream.clutch(self._clutch or not enabled, self.ctl.t)
+            return self._publish(self.ctl.step().resolution, None, "stream", enabled)
         pose = self.robot_pose() if self.operator.needs_pose() else None
         wanted = self.operator.twist(now, pose)
         mode: Mode = "target" if wanted is not None and pose is not None else "teleop"
@@ -268,7 +277,8 @@ class ControlLoop:
         step = self.ctl.step(twist, ref=frame)
         return step.resolution, twist
 
-    def _publish(self, resolution: Resolution | None, twist: Array | None, mode: Mode) -> Snapshot:
+    def _publish(self, resolution: Resolution | None, twist: Array | None, mode: Mode,
+                 enabled: bool | None = None) -> Snapshot:  # fmt: skip
         log = self.ctl.log
         if not self.recording:
             log.clear()  # nothing kept: the log stays empty between records
@@ -280,7 +290,8 @@ class ControlLoop:
                 "error",
                 f"record full ({len(log) * self.dt:g} s): the arm holds; save it or stop recording",
             )
-        enabled = twist is not None and mode in ("teleop", "target")
+        if enabled is None:
+            enabled = twist is not None and mode in ("teleop", "target")
         self._snapshot = self._snap(resolution, twist, mode, enabled)
         return self._snapshot
 
@@ -323,6 +334,8 @@ class ControlLoop:
         """Apply one command (raises RrcPinError to refuse it; nothing changed then)."""
         if isinstance(c, (cmd.Velocity, cmd.Jog, cmd.Hold, cmd.Latch, cmd.Target)):
             self.operator.apply(c, now)  # busy or not: the controls' state, read when stepping
+        elif isinstance(c, cmd.Pose):
+            self._device(c)
         elif isinstance(c, (cmd.Stop, cmd.Released)):
             self.operator.stop()
             self._stop_now = True
@@ -349,6 +362,25 @@ class ControlLoop:
             self._save(c)
         else:
             self._load(c.path)
+
+    def _device(self, c: cmd.Pose) -> None:
+        """A device's sample into the hand's stream (the first opens it); None ends it.
+
+        Samples are timed at the tick that takes them (the controller's clock); while the arm
+        is busy (reverse, load, replay) they are dropped.
+        """
+        if c.pose is None:
+            self._end_stream()
+            return
+        if self._busy() or self._replay or self._full:
+            return
+        stream = self.ctl.streams.get(self._hand) or self.ctl.stream()
+        self._clutch = c.clutch
+        stream.push(self.ctl.t, c.pose)
+
+    def _end_stream(self) -> None:
+        if self._hand in self.ctl.streams:
+            self.ctl.close_stream()
 
     def _busy(self) -> bool:
         return self._job is not None or bool(self._playback)

@@ -14,7 +14,10 @@ Controls (folder by folder):
 - **Command**: hand (robots with several tool frames), frame (hand or base axes), six
   velocity sliders, zero; the deadman (a *hold to move* button whose heartbeats keep it held
   for :attr:`~rrc_pin.console.operator.OperatorSettings.hold_timeout`, and a latch), STOP,
-  speed override, drop target (the gizmo).
+  speed override, drop target (the gizmo), the device's pose (a stream of
+  ``x y z qw qx qy qz [clutch]`` values, each a :class:`~rrc_pin.console.commands.Pose`: a
+  page's script or a program on the console's websocket, behind the same token, Origin and
+  intake as every control; the deadman still gates it and STOP still jumps its queue).
 - **Resolution**: singularity strategy (those the arm takes), QP backend (those installed).
 - **Trajectory**: record, reverse (seconds), save CSV / NPZ (written on the console's machine
   and offered to the page as a download), load (upload a record: it is replayed from its
@@ -132,6 +135,10 @@ class Panel:
                                              reset=self._reset_speed))  # fmt: skip
             drop = gui.add_button("drop the target")
             drop.on_click(self._guard(lambda e: cmd.Target(None)))
+            self.device = gui.add_text("device pose", "", hint="a device's pose stream: x y z "
+                                       "qw qx qy qz [clutch 0/1] in metres, from a page or a "
+                                       "program (empty: the stream ends)")  # fmt: skip
+            self.device.on_update(self._guard(lambda e: cmd.pose_from_page(self.device.value)))
         with gui.add_folder("Readouts"):
             self.joints = gui.add_html("")
             self.status = gui.add_html("")

@@ -11,8 +11,9 @@ from rrc_pin.console.commands import Frame
 from rrc_pin.solvers.tick.resolution import Resolution
 
 Array = npt.NDArray[np.float64]
-Mode = Literal["teleop", "target", "reverse", "replay", "held"]
-"""What the loop did at the tick: the operator's twist, the servo to the target, playing back
+Mode = Literal["teleop", "target", "stream", "reverse", "replay", "held"]
+"""What the loop did at the tick: the operator's twist, the servo to the target, following a
+device's pose stream, playing back
 a retrace, replaying a loaded trajectory, or holding the arm still (a worker has the
 controller: reversing, saving, loading; or the record is full)."""
 

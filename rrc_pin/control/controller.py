@@ -14,6 +14,14 @@ period (Barker eq. (21)) on the configuration manifold:
 recording the tick in a :class:`~rrc_pin.control.trajectory_log.TrajectoryLog`.
 :meth:`Controller.reverse` retraces the recorded joint positions back in time (Barker's
 "speedy and effortless evacuation of the robot hand from a congested workspace").
+
+A device's poses may command the tool frame, and any other frame of the robot (baxter's
+second hand), instead of twists (:meth:`~rrc_pin.control.loop.Loop.stream`): each tick the
+stream's bounded twist toward its target is the frame's command (the tool's through the same
+path as a twist in base axes; another frame's as a :class:`~rrc_pin.tasks.FrameTask` in the
+top level beside the tool's, one common scale; a strategy that chooses the joint rates
+itself, Barker's on barker6, moves the arm alone and the other frames wait). The optional
+jerk stage (``smoothing=``) runs after the resolver.
 """
 
 from __future__ import annotations
@@ -32,6 +40,7 @@ from rrc_pin.control.loop import Loop, Step
 from rrc_pin.control.rates_task import RatesTask
 from rrc_pin.control.record_ring import SHARED_TEXTS
 from rrc_pin.control.singularity import SingularityLabel
+from rrc_pin.control.smoothing import SmoothingOptions
 from rrc_pin.control.strategies import Situation, Strategy, make_strategy
 from rrc_pin.control.strategies.base import KEEP, to_base_axes
 from rrc_pin.control.trajectory_log import LogRecord, TrajectoryLog
@@ -47,6 +56,7 @@ from rrc_pin.solvers.spatial import Reference, check_reference, to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.problem import LARGE
 from rrc_pin.solvers.tick.resolution import ACTIVE_TOL, Resolution
+from rrc_pin.tasks import FrameTask
 
 Array = npt.NDArray[np.float64]
 LINEAR = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
@@ -148,6 +158,8 @@ class Controller(Loop):
         speed: Speed override in [0, 1] (a teach pendant's percentage), settable.
         near: Width of the neighbourhood in which singularities are named in the log
             (:class:`~rrc_pin.control.singularity.SingularityLabel`).
+        smoothing: Bounds of the jerk stage after the resolver
+            (:class:`~rrc_pin.control.smoothing.SmoothingOptions`), or None (no stage).
 
     Raises:
         InvalidInput: A bad argument, named; a robot with several tool frames that is not a
@@ -185,6 +197,7 @@ class Controller(Loop):
         drift: DriftCorrection | None = DriftCorrection(),  # noqa: B008 - immutable
         speed: float = 1.0,
         near: float = 0.05,
+        smoothing: SmoothingOptions | None = None,
     ) -> None:
         robot = _loaded(robot)
         if robot.tool_frame is None:
@@ -196,7 +209,7 @@ class Controller(Loop):
         if drift is not None and not isinstance(drift, DriftCorrection):
             raise InvalidInput("drift", f"expected a DriftCorrection or None, got {drift!r}")
         super().__init__(robot, dt, q0, limits=limits, qp=qp, damping=damping, deadman=deadman,
-                         speed=speed)  # fmt: skip
+                         speed=speed, smoothing=smoothing)  # fmt: skip
         self.strategy = make_strategy(strategy)
         self.strategy.check(robot)
         self.drift = drift
@@ -236,7 +249,8 @@ class Controller(Loop):
 
         Args:
             twist: Commanded twist [v; w] (6,) [m/s, rad/s] of the tool frame in ``ref``,
-                or None: no new command this tick (the last one ages, see ``deadman``).
+                or None: no new command this tick (the last one ages, see ``deadman``; a
+                streamed tool frame follows its stream, and takes no twist).
             ref: The twist's frame, as everywhere in rrc-pin (:mod:`rrc_pin.solvers.spatial`):
                 ``"world_aligned"`` (default: the hand's velocity in base axes), ``"local"``
                 (hand axes, Barker eq. (20)) or ``"world"`` (the spatial twist at the base
@@ -244,22 +258,27 @@ class Controller(Loop):
             frame: The old name of ``ref`` (deprecated).
 
         Returns:
-            The new configuration and the tick's resolution.
+            The new configuration and the tick's resolution (its ``qdot`` the rates
+            integrated: the jerk stage's where there is one, :attr:`smoothed` saying where
+            it changed the resolver's).
 
         Raises:
-            InvalidInput: A bad ``twist`` (shape, NaN, inf) or ``ref``, raised before any
-                state changes.
+            InvalidInput: A bad ``twist`` (shape, NaN, inf) or ``ref``, or a twist for a
+                streamed tool frame, raised before any state changes.
         """
+        if twist is not None and self._tool in self.streams:
+            raise InvalidInput("twist", f"{self._tool} follows its pose stream: give no twist, "
+                               "or close_stream() first")  # fmt: skip
         self._take(twist, ref, frame)
-        weight = self._weight()
-        given = self._command if weight == 1.0 else weight * self._command  # in ``ref``
-        ref = self._command_frame
-        local = ref == "local"
-
         q = self._q
         kin = self._kinematics(q)  # the tick's one: pose, strategy, resolver and log read it
         kin.jacobian(self._tool, "world_aligned")  # first: it places the hand too
         pose = kin.placement(self._tool)
+        others = self._follow_streams(kin, pose) if self.streams else []
+        weight = self._weight()
+        given = self._command if weight == 1.0 else weight * self._command  # in ``ref``
+        ref = self._command_frame
+        local = ref == "local"
         command = given  # served in hand axes (local) or base axes; a world twist turned so:
         if ref == "world":
             command = to_world_aligned(given, pose.rotation, pose.translation, "world")
@@ -282,16 +301,24 @@ class Controller(Loop):
             decision = self.strategy.decide(Situation(
                 self.robot, q, wanted * down, self.dt, command * down, self._rows, hand, kin))
         factor = decision.factor
-        if decision.rates is None:
-            r = self.resolver.solve_at(kin, wanted if factor == 1.0 else factor * wanted,
-                                       "local" if local else "world_aligned")  # fmt: skip
+        before = self._previous_rates()
+        if decision.rates is not None:
+            r = self.resolver.solve_at(kin, [RatesTask(decision.rates)], priority="strict",
+                                       qdot_prev=before)  # fmt: skip
         else:
-            r = self.resolver.solve_at(kin, [RatesTask(decision.rates)], priority="strict")
+            served = wanted if factor == 1.0 else factor * wanted
+            frame_ref: Reference = "local" if local else "world_aligned"
+            if others:  # the tool and the streamed frames: one level, one common scale
+                top = [FrameTask(self._tool, served, ref=frame_ref, rows=self._rows), *others]
+                r = self.resolver.solve_at(kin, [top], priority="strict", qdot_prev=before)
+            else:
+                r = self.resolver.solve_at(kin, served, frame_ref, qdot_prev=before)
+        r = self._smooth(r)
         # q itself, not a copy: read-only, replaced at every tick.
         self.log.append_tick(RawTick(self.t, q, r, command, hand, factor, error, "teleop",
                                      decision.note))
         fraction = None if decision.rates is not None else _followed(r)
-        if fraction is None:
+        if fraction is None or self._tool in self.streams:  # (a stream's target: the reference)
             self._reanchor = True
         elif self._full:  # the command, for the time it was followed
             self._reference = advance(self._reference, given, factor * fraction * self.dt, ref)
@@ -300,6 +327,21 @@ class Controller(Loop):
             self._reference = advance(self._reference, moved * LINEAR,
                                       factor * fraction * self.dt, "world_aligned")
         return self._advance(r)
+
+    def _follow_streams(self, kin: Kinematics, pose: pin.SE3) -> list[FrameTask]:
+        """The streamed commands of this tick: the tool's taken as its command, others' tasks.
+
+        A streamed tool frame's command is its stream's twist (base axes), new every tick
+        (the deadman does not age it: the stream fades its own dropouts), and its reference
+        is the pose reached at every tick (the stream's target is the reference).
+        """
+        poses = {f: pose.homogeneous if f == self._tool else kin.pose(f) for f in self.streams}
+        twists = self._streamed(poses)
+        tool = twists.pop(self._tool, None)
+        if tool is not None:
+            self._command, self._command_frame = tool, "world_aligned"
+            self._command_time = self.t
+        return [FrameTask(f, self.speed * twist, name=f) for f, twist in twists.items()]
 
     def _take(
         self, twist: npt.ArrayLike | None, ref: Reference | None, frame: Reference | None
@@ -360,6 +402,27 @@ class Controller(Loop):
     def _stopped(self) -> None:
         self._command = np.zeros(6)
         self._reanchor = True
+
+    def close_stream(self, name: str | None = None) -> None:
+        """End ``name``'s stream (default: the tool frame's); the tool frame then holds.
+
+        Raises:
+            InvalidInput: ``name`` has no stream (the streamed ones listed).
+        """
+        super().close_stream(name)
+        if name is None or name == self._tool:  # its last twist does not age on
+            self._stopped()
+
+    def _stream_name(self, name: str | None) -> str:
+        if name is None:
+            return self._tool
+        if not isinstance(name, str) or name not in self.resolver.layout.frames:
+            raise InvalidInput("name", f"expected a frame of {self.robot.name} (the tool frame "
+                               f"{self._tool!r} by default), got {name!r}")  # fmt: skip
+        return name
+
+    def _pose_of(self, name: str) -> Array:
+        return self._kinematics(self._q).pose(name)
 
     # -- helpers ----------------------------------------------------------------------------
 

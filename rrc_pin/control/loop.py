@@ -12,7 +12,13 @@ configuration, the resolver and the clock, and owns:
   .. math:: q_{k+1} = q_k \oplus \dot q_k\, \Delta t \quad (\texttt{pinocchio.integrate});
 
 - the **log** (a :class:`~rrc_pin.control.trajectory_log.RecordRing`) and **reverse**, which
-  retraces the recorded configurations back in time.
+  retraces the recorded configurations back in time;
+- the **pose streams** (:meth:`Loop.stream`): a device's poses for a frame (a hand, a held
+  object, a body), each a :class:`~rrc_pin.control.pose_stream.PoseStream` turned into that
+  frame's bounded twist at every tick;
+- the optional **jerk stage** after the resolver (:attr:`Loop.smoothing`, a
+  :class:`~rrc_pin.control.smoothing.JerkLimiter`): the rates integrated are the resolver's
+  with each joint's acceleration and jerk bounded, inside the tick's box.
 
 What a subclass adds: how a tick's command becomes tasks (its ``step``), how a tick and a
 reverse tick are logged (:meth:`Loop._log_reverse`), and what reverse resets
@@ -30,10 +36,12 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.control.deadman import Deadman
+from rrc_pin.control.pose_stream import PoseStream, StreamOptions
 from rrc_pin.control.rates_task import RatesTask
+from rrc_pin.control.smoothing import JerkLimiter, Smoothed, SmoothingOptions
 from rrc_pin.control.trajectory_log import RecordRing
 from rrc_pin.errors import InvalidInput
-from rrc_pin.limits import Limit
+from rrc_pin.limits import JointLimits, Limit
 from rrc_pin.resolver import QPOptions, Resolver
 from rrc_pin.robot import Robot
 from rrc_pin.solvers.checks import finite_number
@@ -82,6 +90,13 @@ class Loop:
         damping: The resolver's damping near singularities, or None.
         deadman: How a command ages, or None: a command stays in force until the next.
         speed: Speed override in [0, 1], settable.
+        smoothing: The jerk stage's bounds, or None: the resolver's rates as they are.
+
+    Attributes:
+        smoothing: The jerk stage (its ``stop()``, ``stop_time()``, ``rates``), or None.
+        smoothed: What the stage did at the last tick (:class:`Smoothed`: its ``changed``
+            mask says where it changed the resolver's rates), or None.
+        streams: The pose streams by the name they command (:meth:`stream`).
 
     Raises:
         InvalidInput: A bad argument, named; nothing is built.
@@ -104,9 +119,12 @@ class Loop:
         damping: Damping | None,
         deadman: Deadman | None,
         speed: float,
+        smoothing: SmoothingOptions | None = None,
     ) -> None:
         if deadman is not None and not isinstance(deadman, Deadman):
             raise InvalidInput("deadman", f"expected a Deadman or None, got {deadman!r}")
+        if smoothing is not None and not isinstance(smoothing, SmoothingOptions):
+            raise InvalidInput("smoothing", f"expected SmoothingOptions or None, got {smoothing!r}")
         self.robot = robot
         self.resolver = Resolver(robot, dt, limits=limits, qp=qp, damping=damping)
         self.dt = self.resolver.dt
@@ -118,6 +136,13 @@ class Loop:
         # Continuous joints as (cos, sin) or a floating base: q is not Pinocchio's q.
         self._manifold = robot.model.nq != robot.model.nv
         self._floating = robot.nq != robot.nv
+        margin = max((lim.margin for lim in self.resolver.limits if isinstance(lim, JointLimits)),
+                     default=0.0)  # fmt: skip
+        self.smoothing: JerkLimiter | None = (None if smoothing is None else
+                                              smoothing.limiter(robot, self.dt, margin))
+        self.smoothed: Smoothed | None = None
+        self.streams: dict[str, PoseStream] = {}
+        self._rates: Array = np.zeros(robot.nv)  # the rates of the last tick integrated
 
     # -- settings ---------------------------------------------------------------------------
 
@@ -130,6 +155,7 @@ class Loop:
     def q(self, value: npt.ArrayLike) -> None:
         self._q = self._checked_q(value, "q")
         self._configuration_set()
+        self._hold_streams()
 
     def _checked_q(self, value: npt.ArrayLike, name: str) -> Array:
         """``value`` as a read-only copy of a valid configuration (nq,).
@@ -222,10 +248,84 @@ class Loop:
                     break
         self._command_time = -math.inf
         self._stopped()
+        if self.smoothing is not None:  # retraced unsmoothed: the stage goes on from there
+            self.smoothing.reset(self._rates)
+        self._hold_streams()
         error = float(np.max(np.abs(self._difference(self.q, targets[-1]))))
         return Retrace(steps, error <= 1e-9 and steps <= budget, error)
 
+    # -- pose streams -----------------------------------------------------------------------
+
+    def stream(self, name: str | None = None, options: StreamOptions | None = None) -> PoseStream:
+        """Stream a device's poses to ``name``'s frame; the stream (a new one each call).
+
+        From the next :meth:`step` on, that frame's twist is the stream's
+        (:meth:`PoseStream.twist`, base axes, times the speed override) at every tick, toward
+        the target the device's samples give: push them with :meth:`PoseStream.push` (times on
+        this loop's clock, :attr:`t`) and press the clutch with :meth:`PoseStream.clutch`,
+        from any thread (open and close streams between ticks, in the loop's own). The stream
+        starts anchored at the frame's pose now.
+
+        Args:
+            name: A frame of the robot (``Controller``: default its tool frame) or a command's
+                name (``CellController``: an object, the body, a free hand).
+            options: How it maps, bounds and judges the poses (default ``StreamOptions()``).
+
+        Raises:
+            InvalidInput: A name that cannot be streamed (the choices listed), bad options.
+        """
+        name = self._stream_name(name)
+        made = PoseStream(self._pose_of(name), options)
+        self.streams[name] = made
+        return made
+
+    def close_stream(self, name: str | None = None) -> None:
+        """End ``name``'s stream (default: the tool frame's); its frame is commanded again.
+
+        Raises:
+            InvalidInput: ``name`` has no stream (the streamed ones listed).
+        """
+        name = self._stream_name(name)
+        if name not in self.streams:
+            raise InvalidInput("name", f"{name!r} has no stream; streamed: "
+                               f"{', '.join(self.streams) or 'none'}")  # fmt: skip
+        del self.streams[name]
+
+    def _streamed(self, poses: dict[str, Array]) -> dict[str, Array]:
+        """The streamed frames' twists (6,) in base axes at their ``poses`` (4, 4), this tick
+        (before the speed override)."""  # noqa: D205, D209
+        return {name: s.twist(self.t, poses[name])
+                for name, s in self.streams.items() if name in poses}  # fmt: skip
+
+    def _hold_streams(self) -> None:
+        """Every stream's hand held where its frame is (the robot moved otherwise)."""
+        for name, s in self.streams.items():
+            s.reset(self._pose_of(name))
+
+    # -- the jerk stage ----------------------------------------------------------------------
+
+    def _previous_rates(self) -> Array | None:
+        """The rates the joints have (the stage's) for the resolver, or None (its own)."""
+        return None if self.smoothing is None else self.smoothing.rates
+
+    def _smooth(self, r: Resolution) -> Resolution:
+        """``r`` with the jerk stage's rates (inside its box), if there is a stage."""
+        stage = self.smoothing
+        if stage is None:
+            return r
+        self.smoothed = out = stage.step(r.qdot, r.box, self.robot.dof_positions(self._q))
+        out.qdot.flags.writeable = False
+        return r._replace(qdot=out.qdot)
+
     # -- what subclasses provide ---------------------------------------------------------
+
+    def _stream_name(self, name: str | None) -> str:
+        """``name`` checked as a streamable name (or the default for None)."""
+        raise NotImplementedError
+
+    def _pose_of(self, name: str) -> Array:
+        """The pose (4, 4) in the base frame of the frame ``name`` commands, now."""
+        raise NotImplementedError
 
     def _log_reverse(self, q: Array, r: Resolution) -> None:
         """Record one reverse tick from ``q`` (before it is integrated)."""
@@ -275,6 +375,7 @@ class Loop:
         A new array (Barker eq. (21), ``pinocchio.integrate``).
         """
         q = self._q
+        self._rates = qdot
         if not self._manifold:
             out: Array = pin.integrate(self.robot.model, q, qdot * self.dt)
             return out

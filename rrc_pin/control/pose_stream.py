@@ -35,11 +35,12 @@ own rate (:meth:`PoseStream.push`); the control loop asks a twist at its own
 Following a device moving at speed v, the hand lags by about :math:`1/k` seconds (0.1 s at
 k = 10), plus up to one device period of sample hold.
 
-Integration with a controller (the intended hook): each tick, ``twist = stream.twist(t,
-hand_pose)`` with the tick's time and the hand's pose from the tick's kinematics, then
-``ctl.step(twist, ref="world_aligned")`` (a :class:`~rrc_pin.cells.CellController`: one
-stream per commandable name, ``{name: (twist, "world_aligned")}``); the device's thread calls
-:meth:`PoseStream.push` (a stream is locked: push and twist may run in different threads).
+In a controller: ``stream = ctl.stream(frame, options)`` (:meth:`Loop.stream
+<rrc_pin.control.loop.Loop.stream>`; a :class:`~rrc_pin.cells.CellController`: a command's
+name) makes one anchored at the frame's pose and turns it into the frame's twist at every
+``ctl.step()``; the device's thread calls :meth:`PoseStream.push` with times on the
+controller's clock (``ctl.t``) and :meth:`PoseStream.clutch` (a stream is locked: push and
+twist may run in different threads).
 """
 
 from __future__ import annotations
@@ -175,7 +176,7 @@ class PoseStream:
             InvalidInput: ``t`` not finite or earlier than the last sample's, ``device`` not
                 a rigid transform; nothing changes.
         """
-        pose = rigid_transform(device, "device")
+        pose = rigid_transform(device, "device").copy()  # kept: a caller may reuse its array
         t = finite_number(t, "t")
         with self._lock:
             if self._last is not None and t < self._last[0]:
@@ -224,6 +225,22 @@ class PoseStream:
             if was and not pressed and self._last is not None:
                 self._anchor(self._last[0] if t is None else t, self._last[1])
                 self.state = "tracking" if self.state == "clutched" else self.state
+
+    def reset(self, hand: npt.ArrayLike) -> None:
+        """Hold the hand where it is: its target and anchor ``hand`` (4, 4), base frame [m].
+
+        The device is anchored at its last sample: the next samples move the hand from
+        ``hand`` (no step). A controller calls it when it moved the hand otherwise (reverse,
+        a configuration set).
+
+        Raises:
+            InvalidInput: ``hand`` not a rigid transform; nothing changes.
+        """
+        pose = rigid_transform(hand, "hand").copy()
+        with self._lock:
+            self._target, self._hand_anchor = pose, pose.copy()
+            if self._last is not None:
+                self._device_anchor = self._last[1]
 
     def target_for(self, device: npt.ArrayLike) -> Array:
         """The hand's target (4, 4) that a device pose would give now (its anchors, its box).

@@ -26,7 +26,10 @@ of :math:`a_{max}`): the resolver's box shows a position limit only within one s
 accelerations within the bounds the joints stand still (below 1e-9) within
 :meth:`JerkLimiter.stop_time` :math:`= \max|v|/a_{max} + 3 a_{max}/j_{max} + 2\Delta t`.
 
-Integration with a controller (the intended hook): after ``r = resolver.solve(q, ...,
+In a controller: ``Controller(..., smoothing=SmoothingOptions(acceleration, jerk))`` (and
+``CellController``) runs the stage after its resolver every tick (:attr:`Loop.smoothing
+<rrc_pin.control.loop.Loop.smoothing>`, the tick's report :attr:`Loop.smoothed
+<rrc_pin.control.loop.Loop.smoothed>`). By hand: after ``r = resolver.solve(q, ...,
 qdot_prev=stage.rates)``, ``out = stage.step(r.qdot, r.problem.box,
 robot.dof_positions(q))`` and integrate ``out.qdot``; passing the stage's rates as
 ``qdot_prev`` keeps the resolver's own acceleration limits (if any) relative to what the
@@ -35,14 +38,19 @@ joints do.
 
 from __future__ import annotations
 
-from typing import NamedTuple
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.solvers.checks import as_vector, finite_number, flag, integer, real_array
+from rrc_pin.solvers.smoothing_kernels import braked, jerk_step
 from rrc_pin.solvers.tick.problem import Box
+
+if TYPE_CHECKING:
+    from rrc_pin.robot import Robot
 
 MAX_JOINTS = 100_000
 """The most joints a limiter takes (``n``): more than any robot has."""
@@ -58,6 +66,12 @@ filter's reserve to follow its own target down (planned with all of it, the rate
 the braking curve and the box won for two ticks in one session of 40)."""
 
 
+SAME = 1e-6
+"""[rad/s or m/s] A rate within this of the resolver's is the resolver's (:attr:`Smoothed.changed`):
+the filter's own remainder when it follows a rate that changes by e a tick is about
+e^2 / (2 j_max dt^2), 1e-7 for e = 1e-4 at the default bounds."""
+
+
 class Smoothed(NamedTuple):
     """One tick of the stage.
 
@@ -66,11 +80,46 @@ class Smoothed(NamedTuple):
         acceleration: Their change per tick over dt (n,) [rad/s^2 or m/s^2].
         clipped: Mask (n,) of the joints whose smoothed rate the box moved (their bounds were
             broken for the box's sake).
+        changed: Mask (n,) of the joints whose rate differs by more than :data:`SAME` from the
+            one the stage was given (the resolver's): where the stage changed the rates.
     """
 
     qdot: Array
     acceleration: Array
     clipped: npt.NDArray[np.bool_]
+    changed: npt.NDArray[np.bool_]
+
+
+@dataclass(frozen=True)
+class SmoothingOptions:
+    """The bounds of a controller's jerk stage (``Controller(..., smoothing=...)``).
+
+    Attributes:
+        acceleration: a_max > 0 [rad/s^2 or m/s^2], a scalar or one per rate (nv,).
+        jerk: j_max > 0 [rad/s^3 or m/s^3], a scalar or one per rate (nv,).
+
+    Raises:
+        InvalidInput: A bound that is not finite and > 0 (named); its length is checked
+            against the robot's rates when a controller builds its stage.
+    """
+
+    acceleration: float | npt.ArrayLike = 20.0
+    jerk: float | npt.ArrayLike = 500.0
+
+    def __post_init__(self) -> None:
+        for name in ("acceleration", "jerk"):
+            value = getattr(self, name)
+            _positive(value, name, int(np.size(real_array(value, name))))
+
+    def limiter(self, robot: Robot, dt: float, margin: float = 0.0) -> JerkLimiter:
+        """The stage for ``robot``'s rates at period ``dt`` [s], braking ``margin`` [rad or m]
+        before its position limits (the resolver's ``JointLimits.margin``).
+
+        Raises:
+            InvalidInput: A bound of another length than the robot's rates, naming it.
+        """  # noqa: D205
+        return JerkLimiter(robot.nv, dt, self.acceleration, self.jerk, lower=robot.dof_lower,
+                           upper=robot.dof_upper, margin=margin)  # fmt: skip
 
 
 class JerkLimiter:
@@ -113,6 +162,8 @@ class JerkLimiter:
         margin = finite_number(margin, "margin", 0.0)
         self._lower = None if lower is None else _limits(lower, "lower", n) + margin
         self._upper = None if upper is None else _limits(upper, "upper", n) - margin
+        self._brake: Array = BRAKE * self.a_max
+        self._lead: Array = self.a_max / self.j_max + 2.0 * self.dt
         self.rates: Array = np.zeros(n)
         self._acceleration: Array = np.zeros(n)
         self._stopping = False
@@ -151,29 +202,22 @@ class JerkLimiter:
         if not isinstance(box, Box) or box.lb.shape != (self.n,):
             raise InvalidInput("box", f"expected the tick's Box of {self.n} joints, got {box!r}")
         where = None if position is None else as_vector(position, "position", self.n)
-        dt, a_max, j_max = self.dt, self.a_max, self.j_max
-        v, a = self.rates, self._acceleration
+        v = self.rates
         target = np.zeros(self.n) if self._stopping else self._braked(command, where)
-        e = target - v
-        wanted = np.sign(e) * j_max * (np.sqrt(dt * dt + 2.0 * np.abs(e) / j_max) - dt)
-        step = np.clip(np.clip(wanted, a - j_max * dt, a + j_max * dt), -a_max, a_max)
-        smoothed = v + step * dt
+        smoothed = np.empty(self.n)
+        jerk_step(v, self._acceleration, target, self.dt, self.a_max, self.j_max, smoothed)
         out = box.clip(smoothed)
         clipped = out != smoothed
-        change = (out - v) / dt
+        change = (out - v) / self.dt
         self.rates, self._acceleration = out, change
-        return Smoothed(out.copy(), change, clipped)
+        return Smoothed(out.copy(), change, clipped, np.abs(out - command) > SAME)
 
     def _braked(self, command: Array, position: Array | None) -> Array:
         """``command`` slowed where a position limit is near (module docstring)."""
         if position is None or self._lower is None or self._upper is None:
             return command
-        a, lead = BRAKE * self.a_max, self.a_max / self.j_max + 2.0 * self.dt
-        out: Array = command.copy()
-        for distance, sign in ((self._upper - position, 1.0), (position - self._lower, -1.0)):
-            d = np.maximum(distance, 0.0)
-            fastest = -a * lead + np.sqrt((a * lead) ** 2 + 2.0 * a * d)
-            out = np.minimum(out, fastest) if sign > 0 else np.maximum(out, -fastest)
+        out: Array = np.empty(self.n)
+        braked(command, position, self._lower, self._upper, self._brake, self._lead, out)
         return out
 
 
