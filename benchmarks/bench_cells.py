@@ -347,9 +347,10 @@ def check_tick(
     report["_last"] = r.status
 
 
-def soak(name: str, seed: int, ticks: int, damping: bool) -> dict[str, Any]:
+def soak(name: str, seed: int, ticks: int, damping: bool, dt: float = DT) -> dict[str, Any]:
     """Random commands on cell ``name`` (the object's twist on gsfc_dual, the body's on
-    yeh_tripod, each held 0.5 s), every tick checked (:func:`check_tick`); the counts.
+    yeh_tripod, each held :data:`HOLD` ticks), every tick checked (:func:`check_tick`), at
+    period ``dt`` [s]; the counts.
 
     On the tripod also: ticks where a body command could not be followed in full far from
     singularities (the top level's condition number within the damping threshold) that were
@@ -357,7 +358,7 @@ def soak(name: str, seed: int, ticks: int, damping: bool) -> dict[str, Any]:
     the commanded axis over a command's 0.5 s.
     """
     cell = rrc_pin.load(name)
-    ctl = CellController(cell, DT, damping=Damping() if damping else None)
+    ctl = CellController(cell, dt, damping=Damping() if damping else None)
     command, speed = SPEEDS[name]
     speed = speed * SOAK_SPEED[name]
     rng = np.random.default_rng(seed)

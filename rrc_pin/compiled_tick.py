@@ -29,7 +29,15 @@ from rrc_pin.solvers.qp_backends.base import QPBackend
 from rrc_pin.solvers.qp_backends.qp import Work, velocity_tolerance
 from rrc_pin.solvers.tick import backend_calls, tick
 from rrc_pin.solvers.tick.pipeline import LevelStatus, Options, Status, fallback_answer
-from rrc_pin.solvers.tick.problem import Box, Constraints, Problem, TaskRows, build, merged_rows
+from rrc_pin.solvers.tick.problem import (
+    Box,
+    Constraints,
+    Problem,
+    TaskRows,
+    build,
+    finite_rows,
+    merged_rows,
+)
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.solvers.tick.top import FAILED
 from rrc_pin.tasks import FrameTask
@@ -37,10 +45,10 @@ from rrc_pin.tasks import FrameTask
 Array = npt.NDArray[np.float64]
 
 STATUSES: tuple[Status, ...] = get_args(Status)
-"""The statuses by their compiled codes (:mod:`rrc_pin.solvers.tick.top`)."""
+"""The statuses by their compiled codes (:mod:`rrc_pin.solvers.tick.statuses`)."""
 
-LEVELS: tuple[LevelStatus, ...] = ("met", "scaled", "traded", "dropped")
-"""How a level was served, by its compiled code (:data:`rrc_pin.solvers.tick.tick.MET`...)."""
+LEVELS: tuple[LevelStatus, ...] = get_args(LevelStatus)
+"""How a level was served, by its compiled code (:data:`rrc_pin.solvers.tick.statuses.MET`...)."""
 
 ONE_LEVEL: tuple[tuple[LevelStatus], ...] = tuple((s,) for s in LEVELS)
 """The levels of a one-level tick, by its code."""
@@ -156,10 +164,10 @@ class CompiledTick:
         J = pin.computeFrameJacobian(model, data, q, layout.frames[task.frame],
                                      PIN_REFERENCE[task.ref])  # fmt: skip
         ws.load_twist(J, task.selected, b)
-        code = self._run(q, previous, dt, b)
+        twist = (task, J, b, layout.reach[task.frame])
+        code = self._run(q, previous, dt, twist)
         if code == tick.ELSEWHERE:
             return None
-        twist = (task, J, b, layout.reach[task.frame])
         return self._answer(code, twist, [None], dt, False, start)
 
     def answers(self, constraints: Sequence[Constraints | None]) -> bool:
@@ -181,15 +189,18 @@ class CompiledTick:
         else:
             ws.load_rows(rows.G, rows.h, rows.slide)
         self._loaded = None
-        code = self._run(kin.q, previous, dt, ws.rates[tick.RATE, : ws.ints[tick.ROWS]])
+        code = self._run(kin.q, previous, dt, levels)
         return self._answer(code, levels, constraints, dt, weighted, start)
 
-    def _run(self, q: Array, previous: Array, dt: float, rates: Array) -> int:
+    def _run(
+        self, q: Array, previous: Array, dt: float,
+        levels: list[list[TaskRows]] | tuple[FrameTask, Array, Array, float],
+    ) -> int:  # fmt: skip
         """The loaded tick at ``q`` after ``previous`` [rad/s], its QPs handed to the backend.
 
         Raises:
-            InvalidInput: A position (``q``) or commanded rate (``twist``, of ``rates``) not
-                finite, with the message the checks give.
+            InvalidInput: A position (``q``), twist or task row (of ``levels``, as
+                :meth:`_answer` takes them) not finite, with the message the checks give.
         """
         backend_calls.enter(self._context)
         try:
@@ -197,8 +208,15 @@ class CompiledTick:
         finally:
             backend_calls.leave()
         if code == tick.INVALID_INPUT:
-            bad = self.workspace.ints[tick.INVALID] == tick.BAD_POSITION
-            as_vector(q, "q", q.size) if bad else as_vector(rates, "twist", rates.size)
+            bad = self.workspace.ints[tick.INVALID]
+            if bad == tick.BAD_POSITION:
+                as_vector(q, "q", q.size)
+            if isinstance(levels, tuple):
+                task, J, b, reach = levels
+                if bad == tick.BAD_RATE:
+                    as_vector(b, "twist", b.size)
+                levels = [[task.rows_from(J, b, reach)]]
+            finite_rows(levels)
         return code
 
     def _answer(

@@ -40,13 +40,13 @@ from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.limits import JointLimits, Limit
 from rrc_pin.loading import loaded
 from rrc_pin.robot import Robot
-from rrc_pin.solvers.checks import all_finite, as_vector, finite_number, positive
+from rrc_pin.solvers.checks import as_vector, finite_number, positive
 from rrc_pin.solvers.qp_backends import make_backend
 from rrc_pin.solvers.spatial import Reference
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.joint_mask import free_columns, scattered, widened_rates
 from rrc_pin.solvers.tick.pipeline import DEFAULT_FALLBACKS, Method, Options, solve
-from rrc_pin.solvers.tick.problem import Constraints, TaskRows, build
+from rrc_pin.solvers.tick.problem import Constraints, TaskRows, build, finite_rows
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.tasks import FrameTask, Task
 
@@ -183,8 +183,8 @@ class Resolver:
             self._names, general)  # fmt: skip
         # solve(q, twist) straight into the compiled tick: the joint box the only limit, the
         # Jacobian Pinocchio's and its vector q itself
-        self._twists = (self._compiled is not None and self.limits == (joint[0],)
-                        and self.task is not None and closed_form is None
+        self._box_only = self._compiled is not None and self.limits == (joint[0],)
+        self._twists = (self._box_only and self.task is not None and closed_form is None
                         and robot.model.nq == robot.model.nv)  # fmt: skip
 
     @property
@@ -397,7 +397,6 @@ class Resolver:
                 rows = [[t.rows(kin) for t in level] for level in levels]
             else:
                 rows = [[cast(FrameTask, levels[0][0]).rows_at(kin, twist, cast(Reference, ref))]]
-            _check_rows(rows)
             before = self._last_qdot if previous is None else previous
             r = self._tick(kin, rows, weighted, step, before, start, levels)
             self._last_qdot = r.qdot
@@ -409,6 +408,9 @@ class Resolver:
         else the Python pipeline (equality rows, a joint box that is not one JointLimits, a
         joint mask)."""  # noqa: D205, D209
         compiled = self._compiled if self._free is None else None
+        if self._box_only and compiled is not None:  # its compiled call checks the rows first
+            return compiled.tasks(kin, rows, weighted, [None], before, step, start)
+        finite_rows(rows)  # before any limit computes its rows
         joint = None if compiled is None else compiled.limit
         constraints = [None if limit is joint else limit.constraints(kin, step, before)
                        for limit in self.limits]  # fmt: skip
@@ -522,18 +524,6 @@ class Resolver:
                 "task", f"the closed form has {cf.task_dim} rows; rows {task.selected} asked"
             )
         return cf
-
-
-def _check_rows(levels: list[list[TaskRows]]) -> None:
-    """Refuse a task whose rows are not finite (a user's task, or a command that overflowed).
-
-    Raises:
-        InvalidInput: Naming ``command`` and the task.
-    """
-    for level in levels:
-        for t in level:
-            if not (all_finite(t.b) and all_finite(t.A)):
-                raise InvalidInput("command", f"task {t.name!r} gave rows that are not finite")
 
 
 def _dt(dt: float) -> float:

@@ -39,12 +39,12 @@ def test_the_direction_problem_is_the_pipelines(rng: np.random.Generator) -> Non
         A, w, null, lb, ub, G, h = problem(rng)
         backend_calls.enter(backend_calls.Context(make_backend("daqp"), np.ones(N)))
         try:
-            qdot, u = backend_calls.direction(A, w, null, lb, ub, G, h)
+            qdot, u, veer = backend_calls.direction(A, w, null, lb, ub, G, h)
         finally:
             backend_calls.leave()
         box = Box(lb, ub, np.zeros((2, 0), np.int8), True, False, np.ones(N))
         want = backend_along(A, w, null, box, Rows(G, h, ()), make_backend("daqp"), Work())
-        assert u == want.u
+        assert u == want.u and veer == want.veer
         np.testing.assert_array_equal(qdot, want.qdot)
 
 
@@ -60,7 +60,7 @@ def test_a_failure_is_recorded_where_the_pipeline_records_it(where, label, tail)
     backend_calls.enter(context)
     try:
         if where == backend_calls.TOP:
-            qdot, u = backend_calls.direction(A, w, null, lb, ub, G, h)
+            qdot, u, _ = backend_calls.direction(A, w, null, lb, ub, G, h)
             assert u < 0.0
         elif where > 0:
             qdot, _ = backend_calls.level(where, A, rng.normal(size=3), np.zeros(N), null, lb,

@@ -7,8 +7,10 @@ import pinocchio as pin
 import pytest
 
 import rrc_pin
-from rrc_pin.cells.closure import DAMPING, Chains, ClosureBound, _damped, close, second_order
+from rrc_pin.cells import closure_kernels
+from rrc_pin.cells.closure import ChainFrames, ClosureBound, close
 from rrc_pin.errors import InvalidInput
+from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.limits.contact_limit import Closure
 from rrc_pin.robot import frame_index
 from rrc_pin.solvers.tick.problem import Box
@@ -28,6 +30,25 @@ def dual():
 @pytest.fixture(scope="module")
 def tripod():
     return rrc_pin.load("yeh_tripod")
+
+
+def kinematics(cell, q):
+    """The kinematics of a tick at ``q`` (a controller's: its own Data)."""
+    _, dof, q_pin = cell.positions(q)
+    return Kinematics(cell.model, cell.model.createData(), Layout.of(cell), dof, q_pin)
+
+
+def second_order(cell, q, qdot, contacts, grips):
+    """The compiled second order of the chains (frame names) at ``q`` along ``qdot``."""
+    ids = frame_index(cell.model)
+    frames = ChainFrames.of(cell.model, tuple(ids[f] for f in contacts),
+                            tuple((ids[a], ids[b]) for a, b in grips))  # fmt: skip
+    data = kinematics(cell, q).data
+    poses = np.array([data.oMf[f].homogeneous for f in frames.frames]).reshape(-1, 4, 4)
+    out = np.empty(6 * (len(contacts) + len(grips)))
+    closure_kernels.second_order(np.ascontiguousarray(data.J), frames.support, frames.joint,
+                                 poses, frames.contacts, frames.grips, qdot, out)  # fmt: skip
+    return out
 
 
 def _chain_errors(cell, q, contacts, grips):
@@ -51,10 +72,8 @@ def test_second_order_is_the_chains_second_derivative_along_the_step(dual, tripo
     seed = fresh() if seed is None else seed
     rng = np.random.default_rng(seed)
     cell = dual if name == "gsfc_dual" else tripod
-    ids = frame_index(cell.model)
     contacts = list(cell.tool_frames) if cell.body else []
     grips = [g.hands for g in cell.objects.values()]
-    data = cell.model.createData()
     h = 1e-4
     for _ in range(5):
         q = cell.random_q(rng)
@@ -64,8 +83,7 @@ def test_second_order_is_the_chains_second_derivative_along_the_step(dual, tripo
         numeric = (at[0] - 2.0 * at[1] + at[2]) / h**2
         # rotation vectors: their second difference is the angular acceleration near zero
         # only, so compare rotations as the rotation rate's derivative in the rows' axes
-        got = second_order(cell.model, data, cell.to_pinocchio(q), qdot,
-                           [ids[f] for f in contacts], [(ids[a], ids[b]) for a, b in grips])
+        got = second_order(cell, q, qdot, contacts, grips)
         for k in range(len(contacts) + len(grips)):
             np.testing.assert_allclose(got[6 * k : 6 * k + 3], numeric[6 * k : 6 * k + 3],
                                        atol=2e-5 * (1 + np.abs(numeric).max()),
@@ -80,10 +98,8 @@ def test_second_order_rotations_against_a_finite_difference_of_the_rates(dual, t
     rng = np.random.default_rng(seed)
     h = 1e-6
     for cell in (dual, tripod):
-        ids = frame_index(cell.model)
         contacts = list(cell.tool_frames) if cell.body else []
         grips = [g.hands for g in cell.objects.values()]
-        data = cell.model.createData()
         q, qdot = cell.random_q(rng), rng.normal(size=cell.nv)
 
         def rates(t, cell=cell, q=q, qdot=qdot, contacts=contacts, grips=grips):
@@ -98,8 +114,7 @@ def test_second_order_rotations_against_a_finite_difference_of_the_rates(dual, t
             return np.concatenate(out)
 
         numeric = (rates(h) - rates(-h)) / (2 * h)
-        got = second_order(cell.model, data, cell.to_pinocchio(q), qdot,
-                           [ids[f] for f in contacts], [(ids[a], ids[b]) for a, b in grips])
+        got = second_order(cell, q, qdot, contacts, grips)
         for k in range(len(contacts) + len(grips)):
             np.testing.assert_allclose(got[6 * k + 3 : 6 * k + 6], numeric[3 * k : 3 * k + 3],
                                        atol=1e-6 * (1 + np.abs(numeric).max()),
@@ -107,19 +122,21 @@ def test_second_order_rotations_against_a_finite_difference_of_the_rates(dual, t
 
 
 def _problem(cell, rng, box_scale=1.0):
-    """A grip or contact closure at a random configuration: rows, a small error, a box."""
+    """A grip or contact closure at a random configuration: rows, a small error, a box.
+
+    Returns q, the chains' rows and errors, their frames, the box, rates inside it."""
     q = cell.random_q(rng)
     ids = frame_index(cell.model)
     if cell.body:
         frames = list(cell.tool_frames)
         C = np.vstack([cell.jacobian(q, "world_aligned", f) for f in frames])
-        chains = (tuple(ids[f] for f in frames), ())
+        chains = ChainFrames.of(cell.model, tuple(ids[f] for f in frames), ())
         unit = np.tile([1.99] * 3 + [1.0] * 3, len(frames))
     else:
         a, b = cell.objects["object"].hands
         task = rrc_pin.tasks.RelativeFrameTask(a, b)
         C = rrc_pin.Resolver(cell, 0.01).rows_of(task, q).A
-        chains = ((), ((ids[a], ids[b]),))
+        chains = ChainFrames.of(cell.model, (), ((ids[a], ids[b]),))
         unit = np.array([1.5] * 3 + [1.0] * 3)
     error = rng.normal(size=C.shape[0]) * 1e-5
     n = cell.nv
@@ -127,7 +144,7 @@ def _problem(cell, rng, box_scale=1.0):
     ub = cell.velocity_limit * box_scale * rng.uniform(0.0, 1.0, n)
     box = Box(lb, ub, np.zeros((2, n), np.int8), True, False, cell.velocity_limit.copy())
     qdot = box.clip(rng.normal(size=n) * 0.3)
-    return q, Chains(Closure(C, error, unit), *chains), box, qdot
+    return q, Closure(C, error, unit), chains, box, qdot
 
 
 @pytest.mark.parametrize("seed", [FIXED, None])
@@ -135,12 +152,10 @@ def test_the_correction_stays_in_the_box_left_and_its_trust_region(dual, tripod,
     seed = fresh() if seed is None else seed
     rng = np.random.default_rng(seed)
     for cell in (dual, tripod):
-        data = cell.model.createData()
         for _ in range(20):
-            q, chains, box, qdot = _problem(cell, rng)
+            q, closure, chains, box, qdot = _problem(cell, rng)
             top = rng.normal(size=(6, cell.nv))
-            delta, _ = close(cell.model, data, cell.to_pinocchio(q), chains, qdot, top, box,
-                             None, 0.01)  # fmt: skip
+            delta, _ = close(kinematics(cell, q), chains, closure, qdot, top, box, None, 0.01)
             assert np.all(np.isfinite(delta)), seed
             applied = qdot + delta
             assert np.all(applied >= box.lb - 1e-12) and np.all(applied <= box.ub + 1e-12), seed
@@ -154,11 +169,10 @@ def test_an_unbounded_correction_closes_the_chains_and_keeps_the_top_level(dual,
     correction in their null space), both to the damping's second order."""
     seed = fresh() if seed is None else seed
     rng = np.random.default_rng(seed)
-    data = dual.model.createData()
     checked = 0
     while checked < 10:
-        q, chains, box, _ = _problem(dual, rng, box_scale=1e3)
-        C = chains.closure.C
+        q, closure, chains, box, _ = _problem(dual, rng, box_scale=1e3)
+        C = closure.C
         null = np.linalg.svd(C)[2][6:]
         qdot = null.T @ rng.normal(size=null.shape[0]) * 0.3  # the grip's rows kept, C qdot = 0
         top = dual.jacobian(q, "world_aligned", "object")
@@ -167,9 +181,8 @@ def test_an_unbounded_correction_closes_the_chains_and_keeps_the_top_level(dual,
         if sigma[0] > 10 * sigma[-1] or np.linalg.svd(C, compute_uv=False)[-1] < 0.1:
             continue  # nearer a singular configuration: the damping takes its share
         box = box._replace(velocity=box.velocity * 1e3)
-        delta, after = close(dual.model, data, dual.to_pinocchio(q), chains, qdot, top, box,
-                             None, 0.01)  # fmt: skip
-        size = np.abs(chains.closure.error).max()  # what the chains' rows must take out
+        delta, after = close(kinematics(dual, q), chains, closure, qdot, top, box, None, 0.01)
+        size = np.abs(closure.error).max()  # what the chains' rows must take out
         # exact to second order in the damping (1e-4 of the rows' mean squared singular value)
         np.testing.assert_allclose(top @ delta, 0.0, atol=1e-3 * size / 0.01,
                                    err_msg=f"seed {seed}")  # fmt: skip
@@ -188,14 +201,14 @@ def test_a_singular_chain_is_corrected_by_bounded_rates(dual):
     sigma = np.linalg.svd(C, compute_uv=False)
     assert 1e-12 < sigma[-1] < 1e-3 * sigma[0]  # nearly singular
     ids = frame_index(dual.model)
+    chains = ChainFrames.of(dual.model, (), ((ids[a], ids[b]),))
     for _ in range(10):
         error = rng.normal(size=6) * 1e-5
-        chains = Chains(Closure(C, error, np.array([1.5] * 3 + [1.0] * 3)), (),
-                        ((ids[a], ids[b]),))  # fmt: skip
+        closure = Closure(C, error, np.array([1.5] * 3 + [1.0] * 3))
         wide = np.full(dual.nv, 1e3)
         box = Box(-wide, wide, np.zeros((2, dual.nv), np.int8), True, False, wide)
-        delta, _ = close(dual.model, dual.model.createData(), dual.to_pinocchio(q), chains,
-                         np.zeros(dual.nv), np.zeros((0, dual.nv)), box, None, 0.01)  # fmt: skip
+        delta, _ = close(kinematics(dual, q), chains, closure, np.zeros(dual.nv),
+                         np.zeros((0, dual.nv)), box, None, 0.01)  # fmt: skip
         assert np.all(np.isfinite(delta))
         assert np.abs(delta).max() < 0.1, np.abs(delta).max()
 
@@ -209,22 +222,3 @@ def test_the_bound_is_checked_and_reads_each_chain(dual):
     for bad in ({"position": 0.0}, {"rotation": -1.0}, {"position": np.nan}):
         with pytest.raises(InvalidInput, match=next(iter(bad))):
             ClosureBound(**bad)
-
-
-@pytest.mark.parametrize("seed", [FIXED, None])
-def test_the_damped_least_squares_is_its_formula(seed):
-    """``_damped`` against numpy: t = (J^T J + mu I)^-1 J^T b, then t + mu (J^T J + mu I)^-1 t,
-    mu = 1e-4 tr(J^T J) / m; its residual within the two damped steps' bound."""
-    seed = fresh() if seed is None else seed
-    rng = np.random.default_rng(seed)
-    for m, n in ((6, 14), (18, 24), (6, 6)):
-        J, b = rng.normal(size=(m, n)), rng.normal(size=m)
-        M = J.T @ J + DAMPING * np.trace(J.T @ J) / m * np.eye(n)
-        t = np.linalg.solve(M, J.T @ b)
-        want = t + DAMPING * np.trace(J.T @ J) / m * np.linalg.solve(M, t)
-        np.testing.assert_allclose(_damped(J, b), want, rtol=1e-9, atol=1e-12,
-                                   err_msg=f"seed {seed}")  # fmt: skip
-        # Two damped steps leave (mu / (sigma^2 + mu))^2 of b along each singular direction.
-        mu, sigma = DAMPING * np.trace(J.T @ J) / m, np.linalg.svd(J, compute_uv=False)[-1]
-        left = (mu / (sigma**2 + mu)) ** 2 * np.linalg.norm(b)
-        assert np.linalg.norm(J @ _damped(J, b) - b) <= 1.01 * left + 1e-12, f"seed {seed}"

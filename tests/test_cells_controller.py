@@ -99,6 +99,22 @@ def test_the_grip_holds_within_its_bound_and_no_joint_leaves_its_box(soak, seed,
     assert report["rate_ratio"] <= 1.0 + 1e-9, (seed, report)
 
 
+@pytest.mark.parametrize("name", ["gsfc_dual", "yeh_tripod"])
+@pytest.mark.parametrize("seed", [FIXED[0], None])
+def test_a_cell_runs_at_1_khz(soak, name, seed):
+    """The console's fast loop on a cell: a period of 1 ms, random commands (the soak's):
+    every tick inside its box and the position limits, the joints' change over each tick
+    too, the chains within their bound at every tick (none lost), no NaN."""
+    seed = fresh() if seed is None else seed
+    report = soak.soak(name, seed, 1500, True, dt=0.001)
+    bound = ClosureBound()
+    for key in ("nan", "box", "rate", "position", "lost", "opened_while_lost"):
+        assert report[key] == 0, (seed, key, report)
+    assert report["held_position"] <= bound.position, (seed, report)
+    assert report["held_rotation"] <= bound.rotation, (seed, report)
+    assert report["rate_ratio"] <= 1.0 + 1e-9, (seed, report)
+
+
 @pytest.mark.parametrize("seed", [*FIXED, None])
 def test_the_tripod_scales_body_commands_far_from_singularities(soak, seed):
     """yeh_tripod, random body twists: the feet within the bound; a command the limits or

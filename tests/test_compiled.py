@@ -53,6 +53,8 @@ for name in ("barker6", "rrc_k1607", "kr5_3r"):
     out[name] = arm.closed_form.joint_rates(qa, np.ones(arm.closed_form.task_dim)).tolist()
 m = maps.capability("kr5_3r", 2000, 0.1, workers=1, progress=False, block_size=1024)
 out["maps"] = m.stats.isum.sum(axis=0).tolist()
+cell = rrc_pin.Controller("gsfc_dual", 0.01)  # a CellController: the closed chains' correction
+out["cell"] = cell.step({"object": np.array([0.05, 0.0, 0.0, 0.0, 0.0, 0.1])}).q.tolist()
 # only kernels call these: their own entries read here
 from rrc_pin.solvers.closed_form.base import finite
 from rrc_pin.solvers.collision.box_kernels import turned
@@ -64,12 +66,15 @@ out["callees"] = [damper_bound(0.01, 0.1, 0.5, 1e-3, 50.0), dot((1.0, 2.0, 3.0),
                   *segment_closest((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.5, 1.0, 0.0),
                                    (0.0, 0.0, 1.0)),
                   *turned(((0.0, 1.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 0.0, 1.0)), (1.0, 2.0, 3.0))]
-from rrc_pin.solvers.tick import factor, levels, slide_kernels, top  # the tick's, likewise
+# the tick's, likewise
+from rrc_pin.solvers.tick import factor, levels, problem, slide_kernels, statuses, top
 x = np.empty(2)
 slide_kernels.project(np.eye(2), 0.0, np.ones(2), -np.ones(2), np.ones(2), np.zeros((0, 2)),
                       np.zeros(0), 0.0, x)
-out["tick glue"] = [top.norm(np.ones(3)), float(levels.row_values(np.eye(2), x).sum()),
-                    float(factor.qr(np.eye(2)).R.sum())]
+out["tick glue"] = [statuses.norm(np.ones(3)), float(levels.row_values(np.eye(2), x).sum()),
+                    float(factor.qr(np.eye(2)).R.sum()),
+                    problem.cap(np.eye(2), 1e200, 1.0, True, -np.ones(2), np.ones(2)),
+                    *top.along_command(np.eye(2), np.ones(2), x, np.zeros(0), 1.0)]
 stage = rrc_pin.JerkLimiter(panda.nv, 0.01, 20.0, 500.0, lower=panda.dof_lower,
                             upper=panda.dof_upper)  # the jerk stage's kernels
 box = Resolver(panda, dt=0.01).solve(panda.ready(), np.zeros(6)).problem.box

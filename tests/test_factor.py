@@ -64,3 +64,25 @@ def test_the_record_gives_the_class_floats(seed: int) -> None:
         assert np.array_equal(null, g.null_basis())
         lam = rng.uniform(0.0, 1.0, min(m, n))
         assert np.array_equal(factor.rates(factor.with_svd(f), b, lam), g.rates(b, lam))
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_surely_conditioned_only_where_numpys_condition_is_below(seed: int) -> None:
+    """True only for full row rank and numpy's condition number at most the threshold; and
+    true for rows well below it (the Frobenius bound is at most m times the condition)."""
+    rng = np.random.default_rng(seed)
+    said = 0
+    for _ in range(400):
+        J = rows(rng) * 10.0 ** rng.uniform(-3, 3)
+        m, n = J.shape
+        f = factor.qr(J)
+        sigma = np.linalg.svd(J, compute_uv=False)
+        full = m <= n and sigma[-1] > RANK_TOL * sigma[0]
+        kappa = float(sigma[0] / sigma[-1]) if full else np.inf
+        threshold = float(10.0 ** rng.uniform(0, 3))
+        sure = factor.surely_conditioned(f, threshold)
+        assert not sure or kappa <= threshold, (seed, kappa, threshold)
+        if kappa * m <= threshold * (1 - 1e-8):
+            assert sure, (seed, kappa, threshold)
+        said += sure
+    assert said > 20, seed

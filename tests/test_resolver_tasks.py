@@ -188,6 +188,7 @@ def test_weights_and_damping_task(baxter: rrc_pin.Robot) -> None:
     assert heavy.tasks[0].residual < light.tasks[0].residual
 
 
+@pytest.mark.filterwarnings("ignore:overflow encountered in multiply:RuntimeWarning")
 def test_bad_tasks_are_refused_before_any_state_change(baxter: rrc_pin.Robot) -> None:
     resolver = Resolver(baxter)
     q = baxter.neutral()
@@ -211,6 +212,8 @@ def test_bad_tasks_are_refused_before_any_state_change(baxter: rrc_pin.Robot) ->
         (lambda: resolver.solve(q, [FrameTask(left)], ref="local"), InvalidInput, "ref"),
         (lambda: resolver.solve(q, [[FrameTask(left)], [FrameTask(left)]]), InvalidInput,
          "command"),  # levels need priority="strict"
+        (lambda: resolver.solve(q, [FrameTask(left), PostureTask(q + 3.0, gain=1e308)]),
+         InvalidInput, "command"),  # its rows overflow: refused by the compiled call's checks
     ]  # fmt: skip
     for call, error, argument in cases:
         with pytest.raises(error) as info:

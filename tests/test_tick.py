@@ -147,7 +147,7 @@ def test_served_and_the_shrink_into_rows_against_the_pipelines(rng: np.random.Ge
             assert LEVELS[tick.served(A, b, x, 1.0)] == served(A @ x, b)
 
 
-@pytest.mark.parametrize("bad", ["position", "rate"])
+@pytest.mark.parametrize("bad", ["position", "rate", "row"])
 def test_bad_inputs_are_coded_before_anything_is_written(bad: str) -> None:
     rng = np.random.default_rng(4)
     lower, upper, velocity = limits(rng)
@@ -158,11 +158,14 @@ def test_bad_inputs_are_coded_before_anything_is_written(bad: str) -> None:
     q = np.zeros(N)
     if bad == "position":
         q[2] = np.nan
-    else:
+    elif bad == "rate":
         ws.rates[tick.RATE, 1] = np.inf
+    else:
+        ws.task_rows[5, 3] = -np.inf
     before = ws.joints[tick.QDOT].copy()
     assert ws.run(q, np.zeros(N), DT) == tick.INVALID_INPUT
-    assert ws.ints[tick.INVALID] == (tick.BAD_POSITION if bad == "position" else tick.BAD_RATE)
+    codes = {"position": tick.BAD_POSITION, "rate": tick.BAD_RATE, "row": tick.BAD_ROWS}
+    assert ws.ints[tick.INVALID] == codes[bad]
     assert np.array_equal(ws.joints[tick.QDOT], before)
 
 

@@ -137,15 +137,18 @@ class CellLog(RecordRing[CellRecord]):
         levels: Sequence[str], errors: dict[str, float], grip: dict[str, float],
         chain: tuple[float, float], mode: str,
     ) -> None:  # fmt: skip
-        """Append one tick (the oldest forgotten when the log is full); no object kept."""
-        row = self._next()
-        row["t"], row["q"], row["qdot"], row["scale"] = t, q, qdot, scale
-        row["errors"] = [errors.get(n, math.nan) for n in self.commands]
-        row["grip"] = [grip.get(n, math.nan) for n in self.objects]
-        row["chain"] = chain
-        row["status"], row["mode"] = STATUSES.index(status), MODES.index(mode)
+        """Append one tick (the oldest forgotten when the log is full); no object kept.
+
+        The row is written in one assignment (a tuple of :attr:`dtype`'s fields).
+        """
         codes = [LEVEL_STATUSES.index(s) for s in levels[:LEVELS]]
-        row["levels"] = codes + [NONE] * (LEVELS - len(codes))
+        row = (
+            t, q, qdot, scale, [errors.get(n, math.nan) for n in self.commands],
+            [grip.get(n, math.nan) for n in self.objects], chain, STATUSES.index(status),
+            MODES.index(mode), codes + [NONE] * (LEVELS - len(codes)),
+        )  # fmt: skip
+        index = self._next()  # may grow the table: read it after
+        self._table[index] = row
 
     def append(self, record: CellRecord) -> None:
         """Append one tick's record (packed into a row).
@@ -246,8 +249,8 @@ class CellLog(RecordRing[CellRecord]):
             raise InvalidInput("path", f"cannot write {str(out)!r}: {reason(exc)}") from exc
         return out
 
-    def _next(self) -> Any:
-        """The row the next tick goes in (the array grown, or the oldest row reused)."""
+    def _next(self) -> int:
+        """The index of the next tick's row (the array grown, or the oldest row reused)."""
         size = self._table.size
         if self._count < size:
             index = (self._start + self._count) % size
@@ -261,7 +264,7 @@ class CellLog(RecordRing[CellRecord]):
             index = self._start
             self._start = (self._start + 1) % size
             self._dropped += 1
-        return self._table[index]
+        return int(index)
 
     def _record(self, row: Any) -> CellRecord:
         errors = {n: float(e) for n, e in zip(self.commands, row["errors"], strict=True)

@@ -44,6 +44,7 @@ every command, the configuration is integrated on its manifold, the ticks go to 
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -57,12 +58,13 @@ import pinocchio as pin
 from rrc_pin.cells.cell import Cell
 from rrc_pin.cells.cell_log import CellLog
 from rrc_pin.cells.cell_resolution import CellResolution
-from rrc_pin.cells.closure import Chains, ClosureBound, close
+from rrc_pin.cells.closure import ChainFrames, ClosureBound, close, compile_correction, largest
 from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.loop import Loop, Step
 from rrc_pin.control.smoothing import SmoothingOptions
 from rrc_pin.deprecated import warn_renamed
 from rrc_pin.errors import InvalidInput
+from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits import ContactLimit, GripLimit, JointLimits, Limit
 from rrc_pin.limits.contact_limit import Closure
 from rrc_pin.loading import loaded
@@ -212,8 +214,14 @@ class CellController(Loop):
         self._tick: tuple[str, bool, dict[str, Array]] = ("teleop", False, {})
         self._applied: Array = np.zeros(cell.nv)
         self._correction_size = 0.0
-        self._data = cell.model.createData()  # the closure's second-order pass
+        self._kin_data = cell.model.createData()  # the tick's kinematics (:meth:`_kinematics`)
+        self._kin: Kinematics | None = None
+        self._frame_tasks: dict[str, FrameTask] = {}
         self._frames = frame_index(cell.model)
+        self._chain_frames = ChainFrames.of(cell.model, (), ())
+        if closure is not None:
+            compile_correction(cell.nv)
+        scale_and_veer(np.zeros(6), np.zeros(6), np.ones(6))  # compiled now: damped ticks use it
         self._close_at()
 
     # -- settings -------------------------------------------------------------------------
@@ -315,7 +323,8 @@ class CellController(Loop):
             self._command_time = self.t
         weight = self._weight()
         cell = self.cell
-        poses = {name: cell.fk(self._q, self.frame_of(name)) for name in self._targets}
+        kin = self._kinematics()
+        poses = {name: kin.pose(self.frame_of(name)) for name in self._targets}
         twists = {name: weight * self._world_aligned(name, poses[name], self._commands[name])
                   if name in self._commands else np.zeros(6) for name in self._targets}  # fmt: skip
         for name, twist in self._streamed(poses).items():  # the stream's target: the reference
@@ -334,14 +343,13 @@ class CellController(Loop):
                     hands.append(FrameTask(hand, _transport(twist, poses[name], T),
                                            target=target, gain=self.gain))  # fmt: skip
                 continue
-            top.append(FrameTask(self.frame_of(name), twist, target=self._targets[name],
-                                 gain=self.gain, name=name))  # fmt: skip
+            top.append(self._task(name, twist))
         before = self._previous_rates()
         if hands:
-            r = self.resolver.solve(self._q, [*top, *hands, self.posture], qdot_prev=before)
+            r = self.resolver.solve_at(kin, [*top, *hands, self.posture], qdot_prev=before)
         else:
             levels: list[list[Task]] = [top, [self.posture]] if top else [[self.posture]]
-            r = self.resolver.solve(self._q, levels, priority="strict", qdot_prev=before)
+            r = self.resolver.solve_at(kin, levels, priority="strict", qdot_prev=before)
         r = self._smooth(r)
         commanded = any(bool(np.any(t != 0.0)) for t in twists.values())
         self._tick = ("teleop", commanded, poses)
@@ -359,6 +367,30 @@ class CellController(Loop):
         for name, twist in twists.items():
             self._targets[name] = _moved(self._targets[name], twist * (follow * self.dt))
         return out
+
+    def _kinematics(self) -> Kinematics:
+        """The tick's one :class:`~rrc_pin.kinematics.Kinematics` at the current q.
+
+        Read by the commands' poses, the resolver's tasks and limits (the closed chains' rows
+        and errors) and the closure's correction; on the controller's own Data, so that it
+        holds until the next tick.
+        """
+        _, dof, q_pin = self.cell.positions(self._q)
+        self._kin = Kinematics(self.cell.model, self._kin_data, self.resolver.layout, dof, q_pin)
+        return self._kin
+
+    def _task(self, name: str, twist: Array) -> FrameTask:
+        """Command ``name``'s frame task of this tick: ``twist`` (6,) toward its target.
+
+        One task per command, kept across ticks: its twist, target and gain are the
+        controller's own, checked already (the target a rigid transform it moved), so set
+        without a second check.
+        """
+        task = self._frame_tasks.get(name)
+        if task is None:
+            task = self._frame_tasks[name] = FrameTask(self.frame_of(name), name=name)
+        task.twist, task.target, task.gain = twist, self._targets[name], self.gain
+        return task
 
     def _held_back(self, r: Resolution, twists: dict[str, Array]) -> None:
         """A damped tick's targets, fed back within a bound (:data:`HOLD`).
@@ -386,11 +418,13 @@ class CellController(Loop):
     def _log_reverse(self, q: Array, r: Resolution) -> None:
         """A reverse tick: logged, closed and integrated by :meth:`_advance` (a command)."""
         self._tick = ("reverse", True, {})
+        self._kin = None  # the resolver made its own: the closure makes the tick's
 
     def _advance(self, r: Resolution) -> Step:
         """One tick: the closed chains' correction (:meth:`_closed`), the log, the integration."""
         closed = self._closed(r)
         self._record(closed)
+        self._kin = None  # of this tick's q only
         return super()._advance(closed)
 
     def _integrate(self, qdot: Array) -> Array:
@@ -452,6 +486,10 @@ class CellController(Loop):
         self.contact.set_frames(self.support, [self._anchors[f] for f in self.support])
         grasps = [self.cell.objects[n] for n in self._grips]
         self.grip.set_pairs([g.hands for g in grasps], [self._grips[g.name] for g in grasps])
+        ids = self._frames
+        self._chain_frames = ChainFrames.of(self.cell.model,
+                                            tuple(ids[f] for f in self.contact.frames),
+                                            tuple((ids[a], ids[b]) for a, b in self.grip.pairs))
 
     def _closed(self, r: Resolution) -> CellResolution:
         """``r`` with the closed chains' correction, or held still while one is lost.
@@ -473,22 +511,19 @@ class CellController(Loop):
         parts = [(last, kind) for last, kind in measured if last is not None]
         if not parts:
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
-        closure = Closure(*(np.concatenate([c[i] for c, _ in parts]) for i in range(3)))
-        e = closure.error.reshape(-1, 6)
-        self.chain_error = (float(np.max(np.linalg.norm(e[:, :3], axis=1))),
-                            float(np.max(np.linalg.norm(e[:, 3:], axis=1))))  # fmt: skip
+        closure = parts[0][0] if len(parts) == 1 else Closure(
+            *(np.concatenate([c[i] for c, _ in parts]) for i in range(3)))  # fmt: skip
+        self.chain_error = largest(closure.error)
         bound = self.closure
         if bound is None:
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
-        ids = self._frames
-        chains = Chains(closure, tuple(ids[f] for f in self.contact.frames),
-                        tuple((ids[a], ids[b]) for a, b in self.grip.pairs))  # fmt: skip
         mode, commanded, _ = self._tick
         top = r.problem.stacked[0][0] if mode == "teleop" else np.zeros((0, self.cell.nv))
         box = r.problem.box
-        delta, after = close(self.cell.model, self._data, self._pinocchio_q(self._q), chains,
-                             r.qdot, top, box, r.problem.rows, self.dt)  # fmt: skip
-        level = bound.level(closure.error)
+        kin = self._kin if self._kin is not None else self._kinematics()
+        delta, after = close(kin, self._chain_frames, closure, r.qdot, top, box, r.problem.rows,
+                             self.dt)  # fmt: skip
+        level = max(self.chain_error[0] / bound.position, self.chain_error[1] / bound.rotation)
         if level <= 1.0:
             self.lost = None
         elif self.lost is not None and commanded and bound.level(after) < level:
@@ -595,18 +630,22 @@ class CellController(Loop):
     def _record(self, r: CellResolution) -> None:
         """Log the tick: its rates, status, the commands' pose errors, the grips' errors."""
         mode, _, poses = self._tick
-        errors = {n: float(np.linalg.norm(self._targets[n][:3, 3] - T[:3, 3]))
-                  for n, T in poses.items()}  # fmt: skip
+        errors = {n: _length(self._targets[n][:3, 3] - T[:3, 3]) for n, T in poses.items()}
         grip = {}
         measured = self.grip.last
         for k, (name, g) in enumerate(self.cell.objects.items()):
             if measured is not None and name in self._grips:  # the tick's, by the grip limit
-                grip[name] = float(np.linalg.norm(measured.error[6 * k : 6 * k + 3]))
+                grip[name] = _length(measured.error[6 * k : 6 * k + 3])
                 continue
             rel = _inverse(self.cell.fk(self._q, g.hands[0])) @ self.cell.fk(self._q, g.hands[1])
             grip[name] = float(np.linalg.norm(rel[:3, 3] - g.grip[:3, 3]))
         self.log.add(self.t, self._q, r.applied, r.status, r.scale, r.levels, errors, grip,
                      self.chain_error, mode)  # fmt: skip
+
+
+def _length(v: Array) -> float:
+    """The Euclidean length of ``v`` (1-D): ``numpy.linalg.norm``'s floats, one call."""
+    return math.sqrt(float(v @ v))
 
 
 def _inverse(T: Array) -> Array:

@@ -60,10 +60,14 @@ class Along(NamedTuple):
     Attributes:
         qdot: The rates (n,), ``u w + V_n^T y``.
         u: The scale along the command, in [0, 1].
+        veer: The angle [rad] of the rates' task rates off the command's, measured where a
+            backend answered (:func:`rrc_pin.solvers.tick.pipeline.backend_along`); 0 for the
+            kernels' answers, along the command by construction.
     """
 
     qdot: Array
     u: float
+    veer: float = 0.0
 
 
 def along(w: Array, null: Array, box: Box, rows: Rows | None) -> Along | None:

@@ -145,3 +145,45 @@ def condition(f: Factor) -> float:
     if f.rank < k or f.rank == 0:
         return np.inf
     return float(f.sigma[0] / f.sigma[f.rank - 1])
+
+
+@kernel
+def surely_conditioned(f: Factor, threshold: float) -> bool:
+    r"""Whether J (m <= n) surely has full rank and a condition number at most ``threshold``,
+    without the SVD.
+
+    :math:`\kappa_2(J) = \kappa_2(R_1) \le \|R_1\|_F\,\|R_1^{-1}\|_F` (R_1 the leading m x m
+    triangle of R; Golub & Van Loan 2013, section 2.3.2: the 2-norm at most the Frobenius
+    one): that bound at most ``threshold`` and below ``1 / RANK_TOL`` (less a rounding
+    margin), :func:`condition` is at most ``threshold`` and the rank m. False where unsure
+    (a singular triangle, or a bound beyond the float range; the SVD decides then).
+    """  # noqa: D205
+    m, n = f.J.shape
+    if m > n:
+        return False
+    R = f.R
+    bound = min(threshold, 1.0 / RANK_TOL) * (1.0 - 1e-9)
+    low, high = np.inf, 0.0
+    for i in range(m):
+        low, high = min(low, abs(R[i, i])), max(high, abs(R[i, i]))
+    if not (low > 0.0 and high <= bound * low):  # the pivots' ratio is at most the condition
+        return False
+    size = 0.0
+    pivots = np.empty(m)  # the triangle's inverse diagonal
+    for i in range(m):
+        pivots[i] = 1.0 / R[i, i]
+        for j in range(i, m):
+            size += R[i, j] ** 2
+    limit = bound**2
+    x = np.empty(m)
+    inverse = 0.0
+    for k in range(m):  # column k of the inverse: R_1 x = e_k by back substitution (x_i = 0, i > k)
+        for i in range(k, -1, -1):
+            s = 1.0 if i == k else 0.0
+            for j in range(i + 1, k + 1):
+                s -= R[i, j] * x[j]
+            x[i] = s * pivots[i]
+            inverse += x[i] ** 2
+        if not size * inverse <= limit:  # the bound only grows
+            return False
+    return True

@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Literal, NamedTuple
+from typing import Literal, NamedTuple, get_args
 
 import numpy as np
 import numpy.typing as npt
@@ -52,7 +52,7 @@ import numpy.typing as npt
 from rrc_pin.solvers.errors import InvalidInput, NumericalFailure
 from rrc_pin.solvers.qp_backends.base import QPBackend
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding, Work, solve_within, tolerance
-from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick import kernels, statuses
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.direction import Along, along, direction_qp
 from rrc_pin.solvers.tick.factorization import Factorization
@@ -60,6 +60,7 @@ from rrc_pin.solvers.tick.kernels import scale_and_veer
 from rrc_pin.solvers.tick.least_squares import Subspace, least_squares
 from rrc_pin.solvers.tick.problem import Box, Problem, Rows
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
+from rrc_pin.solvers.tick.statuses import EXACT_TOL
 
 Array = npt.NDArray[np.float64]
 
@@ -105,8 +106,8 @@ LevelStatus = Literal["met", "scaled", "traded", "dropped"]
 and the constraints; a zero command whose rows moved), ``dropped`` (its solve failed: the
 answer of the levels above kept)."""
 
-EXACT_TOL = 1e-9
-"""Relative residual under which a command counts as met, and a scale as 1."""
+_STATUSES: tuple[Status, ...] = get_args(Status)
+_LEVEL_STATUSES: tuple[LevelStatus, ...] = get_args(LevelStatus)
 
 DIRECTION_TOL = 1e-7
 """A backend's answer to the direction problem may have task rates off the command's direction
@@ -285,7 +286,7 @@ def _top(
         else:
             qdot, null = least_squares(A, b, space, box, rows, backend, work, "least_squares",
                                        not last)  # fmt: skip
-        met = _met(A @ qdot, b) and problem.rate_factor == 1.0
+        met = statuses.met(A @ qdot, b) and problem.rate_factor == 1.0
         status: Status = "recovering" if box.recovering or _broken(rows) else (
             "exact" if met else "least_squares")  # fmt: skip
         return _Top(qdot, status, *_along_command(problem, qdot), 0.0, null)
@@ -320,7 +321,7 @@ def _top(
             z = factor.least_norm(b)
             w = z if space.N is None else z @ space.N
             fits = kernels.inside(w, box.lb, box.ub)
-    outside_range = not factor.regular and not _met(factor.J @ z, b)
+    outside_range = not factor.regular and not statuses.met(factor.J @ z, b)
     if fits and (rows is None or kernels.rows_hold(rows.G, w, rows.h, 0.0)):
         null = _null(factor, space) if len(problem.levels) > 1 else None
         if slid:
@@ -346,17 +347,13 @@ def _top(
         # up to 19 %; a backend's inexact answer is not taken for the command's direction)
     if outside_range:
         return _Top(u_w.qdot, "singular", *_along_command(problem, u_w.qdot), 0.0, null)
-    return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, 0.0, 0.0, null)
+    return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, u_w.veer, 0.0, null)
 
 
 def _met_top(problem: Problem, qdot: Array, null: Array | None) -> _Top:
-    """The top level's stacked command met: ``exact`` where that is the command itself.
-
-    Else (a command divided down, :mod:`rrc_pin.solvers.tick.problem`) ``scaled`` by its factor.
-    """
-    if problem.rate_factor == 1.0:
-        return _Top(qdot, "exact", 1.0, 0.0, 0.0, null)
-    return _Top(qdot, "scaled", problem.rate_factor, 0.0, 0.0, null)
+    """The top level's stacked command met (:func:`rrc_pin.solvers.tick.statuses.met_top`)."""
+    status = _STATUSES[statuses.met_top(problem.rate_factor)]
+    return _Top(qdot, status, problem.rate_factor, 0.0, 0.0, null)
 
 
 SLIDE_DAMPING = 1e-2
@@ -556,10 +553,10 @@ def backend_along(
     qdot = solve_within(qp, decoding, box, rows, backend, work, clip=False)
     y = A @ qdot
     scale, veer = scale_and_veer(y, A @ w)
-    off = _norm(y) * math.sin(min(veer, 0.5 * math.pi))  # the task rates off the direction
-    if off > DIRECTION_TOL * _norm(A.ravel()) * _norm(qdot) and scale > STILL_SCALE:
+    off = statuses.norm(y) * math.sin(min(veer, 0.5 * math.pi))  # the task rates off the direction
+    if off > DIRECTION_TOL * statuses.norm(A.ravel()) * statuses.norm(qdot) and scale > STILL_SCALE:
         raise NumericalFailure(f"{work.backend}: answer veers by {veer:.3g} rad from the command")
-    return Along(qdot, scale)
+    return Along(qdot, scale, veer)
 
 
 def _null(factor: Factorization, space: Subspace) -> Array:
@@ -575,7 +572,7 @@ def _equality_space(problem: Problem) -> Subspace:
     C, d = problem.equalities
     factor = Factorization(C)
     x0 = factor.least_norm(d)
-    if not _met(C @ x0, d):
+    if not statuses.met(C @ x0, d):
         raise NumericalFailure("the equality rows contradict each other")
     return Subspace(x0, factor.null_basis())
 
@@ -588,30 +585,21 @@ def _broken(rows: Rows | None) -> bool:
     return rows is not None and bool((rows.h < 0.0).any())
 
 
-def _met(y: Array, b: Array) -> bool:
-    return _norm(y - b) <= EXACT_TOL * (1.0 + _norm(b))
-
-
 def _level_status(status: Status) -> LevelStatus:
     return "scaled" if status == "scaled" else "traded"
 
 
 def _served(problem: Problem, k: int, qdot: Array) -> LevelStatus:
-    """How level ``k`` was served by ``qdot`` (:func:`served`)."""
+    """How level ``k`` was served by ``qdot`` (:func:`rrc_pin.solvers.tick.statuses.served`)."""
     A, b = problem.stacked[k]
-    status = served(A @ qdot, b)  # a command divided down (Problem.factors) met is scaled
-    return "scaled" if status == "met" and problem.factors[k] != 1.0 else status
+    return _LEVEL_STATUSES[statuses.served(A @ qdot, b, problem.factors[k])]
 
 
 def served(y: Array, b: Array) -> LevelStatus:
-    """How rates ``y`` serve the command ``b``: met, scaled along it, or traded.
-
-    A zero command has no direction to scale along: not met, it is traded.
-    """
-    if _met(y, b):
-        return "met"
-    scale, veer = scale_and_veer(y, b)
-    return "scaled" if veer <= 1e-6 and scale > 0.0 and b.any() else "traded"
+    """How rates ``y`` serve the command ``b``: met, scaled along it, or traded
+    (:func:`rrc_pin.solvers.tick.statuses.served`).
+    """  # noqa: D205
+    return _LEVEL_STATUSES[statuses.served(y, b, 1.0)]
 
 
 def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
@@ -648,8 +636,3 @@ def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:
 
 _EPS = float(np.finfo(np.float64).eps)
 _TINY = float(np.finfo(np.float64).tiny)
-
-
-def _norm(x: Array) -> float:
-    """Euclidean norm without overflow or underflow."""
-    return math.hypot(*x.tolist())

@@ -37,6 +37,9 @@ from typing import Literal, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.solvers.checks import all_finite
+from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.errors import InvalidInput
 from rrc_pin.solvers.tick import kernels
 
 Array = npt.NDArray[np.float64]
@@ -283,26 +286,41 @@ def _weighted(
 def _capped(
     A: Array, b: Array, peak: float, normalised: bool, box: Box, factor: float = 1.0
 ) -> tuple[Array, Array, float]:
-    """``(A, b, factor)``: b as :func:`_stack` gives it (unchanged mostly), and its factor.
+    """``(A, b, factor)``: b as :func:`_stack` gives it (capped by :func:`cap`), and its factor."""
+    c = cap(A, peak, factor, normalised, box.lb, box.ub)
+    return (A, b, factor) if c == 1.0 else (A, b * c, factor * c)
+
+
+@kernel
+def cap(A: Array, peak: float, factor: float, normalised: bool, lb: Array, ub: Array) -> float:
+    """What a level's rates are multiplied by to cap a huge command (module docstring; 1: kept).
 
     Args:
-        A: The level's stacked rows.
-        b: Its rates, the command's times ``factor``, their largest magnitude ``peak``.
-        peak: That magnitude.
+        A: The level's stacked rows (m, n).
+        peak: Its rates' largest magnitude, the command's times ``factor``.
+        factor: What the command's rates were already multiplied by (> 0).
         normalised: The direction level (capped beyond :data:`LARGE`), else a least-squares
             one (beyond :data:`SATURATION`).
-        box: The step's bounds, whose finite sides give the rows' reach.
-        factor: What the command's rates were already multiplied by (> 0).
+        lb: The step's lower bounds (n,), whose finite sides give the rows' reach.
+        ub: Its upper bounds (n,).
     """
     command = peak / factor  # the command's own magnitude (inf beyond the float range)
     if command <= (LARGE if normalised else SATURATION):
-        return A, b, factor
-    sides = np.maximum(-box.lb, box.ub)
-    reach = 1.0 + float(np.abs(A).max(initial=0.0)) * float(sides[np.isfinite(sides)].sum())
-    cap = min(SATURATION * reach, LARGE) if normalised else SATURATION * reach
-    if command <= cap:
-        return A, b, factor
-    return A, b * (cap / peak), factor * (cap / peak)
+        return 1.0
+    m, n = A.shape
+    sides = 0.0
+    for j in range(n):
+        side = max(-lb[j], ub[j])
+        if math.isfinite(side):
+            sides += side
+    largest = 0.0
+    for i in range(m):
+        for j in range(n):
+            largest = max(largest, abs(A[i, j]))
+    limit = SATURATION * (1.0 + largest * sides)
+    if normalised:
+        limit = min(limit, LARGE)
+    return 1.0 if command <= limit else limit / peak
 
 
 @functools.cache
@@ -311,6 +329,18 @@ def _ones(m: int) -> Array:
     ones = np.ones(m)
     ones.flags.writeable = False
     return ones
+
+
+def finite_rows(levels: Sequence[Sequence[TaskRows]]) -> None:
+    """Refuse a task whose rows are not finite (a user's task, or a command that overflowed).
+
+    Raises:
+        InvalidInput: Naming ``command`` and the task.
+    """
+    for level in levels:
+        for t in level:
+            if not (all_finite(t.b) and all_finite(t.A)):
+                raise InvalidInput("command", f"task {t.name!r} gave rows that are not finite")
 
 
 def largest_weight(tasks: Sequence[TaskRows]) -> float:

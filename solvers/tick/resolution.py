@@ -25,6 +25,7 @@ import numpy.typing as npt
 from rrc_pin.solvers.tick.kernels import ACCELERATION, POSITION, scale_and_veer
 from rrc_pin.solvers.tick.pipeline import Answer, LevelStatus, Method, Status, served
 from rrc_pin.solvers.tick.problem import Box, Problem, TaskRows, largest_weight, row_factors
+from rrc_pin.solvers.tick.statuses import norm
 
 Array = npt.NDArray[np.float64]
 
@@ -150,7 +151,8 @@ class Resolution(_Record):
         scale: Fraction in [0, 1] of the top level's command achieved along it (normalised
             metric): the common scale of its tasks when its direction was kept.
         veer: Angle [rad] between the top level's achieved and commanded rates (normalised
-            metric): 0 unless damped, singular, least squares or a fallback.
+            metric): 0 unless damped, singular, least squares, a fallback, or scaled by the
+            QP backend (its answer's angle as measured).
         levels: How each priority level was served, the top level's first
             (:data:`~rrc_pin.solvers.tick.pipeline.LevelStatus`: ``met``, ``scaled``,
             ``traded``, ``dropped``).
@@ -237,7 +239,7 @@ class Resolution(_Record):
     def residual(self) -> float:
         r"""The top level's task error :math:`\|A\dot q - b\|_2` (its tasks' own units, mixed)."""
         level = self.problem.levels[0]
-        return math.hypot(*(_norm(t.A @ self.qdot - t.b) for t in level))
+        return math.hypot(*(norm(t.A @ self.qdot - t.b) for t in level))
 
     def __setattr__(self, name: str, value: object) -> None:
         raise AttributeError(f"a Resolution is immutable: {name!r} cannot be set")
@@ -266,7 +268,7 @@ def _report(
         scale = scale_and_veer(ys, bs)[0]
     else:  # a zero command: held still, or traded for a level above or a limit
         how, scale = ("held", 1.0) if how == "met" else (how, 0.0)
-    return TaskReport(t.name, level, t.b, y, _norm(y - t.b), scale, bound_by, how)
+    return TaskReport(t.name, level, t.b, y, norm(y - t.b), scale, bound_by, how)
 
 
 KIND_NAMES: dict[int, BoundKind] = {POSITION: "position", ACCELERATION: "acceleration"}
@@ -298,8 +300,3 @@ def active_limits(
             kind = KIND_NAMES.get(kinds[1], "velocity")
             out.append(ActiveLimit(j, "upper", kind, float(box.ub[j]), name))
     return tuple(out)
-
-
-def _norm(x: Array) -> float:
-    """Euclidean norm without overflow or underflow."""
-    return math.hypot(*x.tolist())

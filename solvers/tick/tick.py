@@ -25,17 +25,17 @@ compiled in a fraction of the general entry's time.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import kernels, top
+from rrc_pin.solvers.tick import kernels, statuses, top
 from rrc_pin.solvers.tick.levels import least_squares, row_values
-from rrc_pin.solvers.tick.problem import LARGE, SATURATION, TaskRows
-from rrc_pin.solvers.tick.top import EXACT, FAILED, SCALED, Rows, Top
+from rrc_pin.solvers.tick.problem import LARGE, TaskRows, cap
+from rrc_pin.solvers.tick.statuses import DROPPED, EXACT, MET, SCALED, SCALED_LEVEL, TRADED
+from rrc_pin.solvers.tick.top import FAILED, Rows, Top
 
 Array = npt.NDArray[np.float64]
 Ints = npt.NDArray[np.int64]
@@ -51,14 +51,11 @@ LEVELS, ROWS, CONSTRAINTS, WEIGHTED, DIRECTION, UNITS, INVALID, STARTS = range(8
 (DT, MARGIN, GAIN, THRESHOLD, TOLERANCE, SCALE, VEER, LAMBDA_SQ, CLIP, ZERO_INSIDE,
  RECOVERING, REAL_SIZE) = range(12)  # fmt: skip
 
-MET, SCALED_LEVEL, TRADED, DROPPED = range(4)
-"""Codes of how a level was served (:data:`~rrc_pin.solvers.tick.pipeline.LevelStatus`)."""
-
-BAD_POSITION, BAD_RATE = 1, 2
-"""Codes of ``ints[INVALID]``: a position, or a commanded rate, not finite."""
+BAD_POSITION, BAD_RATE, BAD_ROWS = 1, 2, 3
+"""Codes of ``ints[INVALID]``: a position, a commanded rate, or a task row not finite."""
 
 INVALID_INPUT = -2
-"""What :func:`run` returns for a position or commanded rate that is not finite."""
+"""What :func:`run` returns for a position, commanded rate or task row that is not finite."""
 
 ELSEWHERE = -3
 """What :func:`run_box` returns for a tick that is not its own (:func:`run` answers it)."""
@@ -91,37 +88,14 @@ def stacked(A: Array, b: Array, weight: Array, unit: Array, normalised: bool, lb
             b_max = max(b_max, abs(b[i]))
         factor = 1.0 / b_max
         peak = kernels.weighted_rows(A, b, weight, top_weight, units, factor, rows, rates)
-    command = peak / factor  # the command's own magnitude (inf beyond the float range)
-    if command <= (LARGE if normalised else SATURATION):
-        return rows, rates, factor
-    sides = 0.0
-    for j in range(n):
-        side = max(-lb[j], ub[j])
-        if math.isfinite(side):
-            sides += side
-    largest = 0.0
-    for i in range(m):
-        for j in range(n):
-            largest = max(largest, abs(rows[i, j]))
-    cap = SATURATION * (1.0 + largest * sides)
-    if normalised:
-        cap = min(cap, LARGE)
-    if command <= cap:
-        return rows, rates, factor
-    return rows, rates * (cap / peak), factor * (cap / peak)
+    c = cap(rows, peak, factor, normalised, lb, ub)
+    return (rows, rates, factor) if c == 1.0 else (rows, rates * c, factor * c)
 
 
-@kernel
+@inlined
 def served(A: Array, b: Array, qdot: Array, rate_factor: float) -> int:
-    """How a lower level was served by ``qdot``: met, scaled along its command, or traded
-    (:func:`rrc_pin.solvers.tick.pipeline.served`: a zero command not met is traded; a
-    command divided down by ``rate_factor`` and met is scaled).
-    """  # noqa: D205
-    y = row_values(A, qdot)
-    if top.norm(y - b) <= top.EXACT_TOL * (1.0 + top.norm(b)):
-        return MET if rate_factor == 1.0 else SCALED_LEVEL
-    scale, veer = kernels.scale_and_veer(y, b)
-    return SCALED_LEVEL if veer <= 1e-6 and scale > 0.0 and b.any() else TRADED
+    """How a lower level was served by ``qdot`` (:func:`rrc_pin.solvers.tick.statuses.served`)."""
+    return statuses.served(row_values(A, qdot), b, rate_factor)
 
 
 @kernel
@@ -146,12 +120,16 @@ def within_rows(x: Array, rows: Rows, zero_inside: bool) -> float:
 
 
 @inlined
-def checked(joints: Array, rates: Array, m: int) -> int:
-    """0 where every position and commanded rate is finite, else the code of the first bad."""
+def checked(joints: Array, task_rows: Array, rates: Array, m: int) -> int:
+    """0 where every position, commanded rate and task row is finite, else the code of the
+    first bad.
+    """  # noqa: D205
     if not kernels.all_finite(joints[POSITION]):
         return BAD_POSITION
     if not kernels.all_finite(rates[RATE][:m]):
         return BAD_RATE
+    if not kernels.all_finite(task_rows.ravel()[: m * task_rows.shape[1]]):  # a view: C order
+        return BAD_ROWS
     return 0
 
 
@@ -201,11 +179,11 @@ def lower_levels(task_rows: Array, rates: Array, ints: Ints, rows: Rows, answer:
 
 
 @inlined
-def box(joints: Array, rates: Array, ints: Ints, reals: Array) -> bool:
+def box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Array) -> bool:
     """Stages 1 and 2: the inputs checked (the code of a bad one in ``ints[INVALID]``, then
     False), the step's box and what sets each bound into ``joints``, its flags into ``reals``.
     """  # noqa: D205
-    ints[INVALID] = checked(joints, rates, ints[ROWS])
+    ints[INVALID] = checked(joints, task_rows, rates, ints[ROWS])
     if ints[INVALID]:
         return False
     kind = np.empty((2, joints.shape[1]), np.int8)
@@ -245,7 +223,7 @@ def run_box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Ar
     lower levels (a fraction of its compile): the status code, :data:`INVALID_INPUT`, or
     :data:`ELSEWHERE` where the mode is not the direction one (:func:`run` answers then).
     """
-    if not box(joints, rates, ints, reals):
+    if not box(joints, task_rows, rates, ints, reals):
         return INVALID_INPUT
     if reals[ZERO_INSIDE] == 0.0 or ints[WEIGHTED] == 1 or ints[DIRECTION] == 0:
         return ELSEWHERE
@@ -267,7 +245,7 @@ def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide
     ``joints``, ``task_rows``, ``rates`` and the constraint rows ``G``, ``h``, ``slide``
     (``ints[CONSTRAINTS]`` of them); writes the box, the rates and the report.
     """
-    if not box(joints, rates, ints, reals):
+    if not box(joints, task_rows, rates, ints, reals):
         return INVALID_INPUT
     p = ints[CONSTRAINTS]
     rows = Rows(joints[LB], joints[UB], G[:p], h[:p], slide[:p], reals[TOLERANCE])

@@ -22,7 +22,6 @@ where the backend fails, the top level fails (:data:`FAILED`) and the fallbacks 
 
 from __future__ import annotations
 
-import math
 from typing import NamedTuple
 
 import numpy as np
@@ -30,21 +29,25 @@ import numpy.typing as npt
 from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import backend_calls, factor, kernels
+from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses
 from rrc_pin.solvers.tick.factor import Factor
 from rrc_pin.solvers.tick.levels import least_squares, row_values
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
+from rrc_pin.solvers.tick.statuses import (
+    DAMPED,
+    EXACT,
+    EXACT_TOL,
+    LEAST_SQUARES,
+    RECOVERING,
+    SCALED,
+    SINGULAR,
+    SLIDING,
+)
 
 Array = npt.NDArray[np.float64]
 
-EXACT, SCALED, SLIDING, DAMPED, SINGULAR, LEAST_SQUARES, RECOVERING, FALLBACK = range(8)
-"""Codes of :data:`~rrc_pin.solvers.tick.pipeline.Status`, in its order."""
-
 FAILED = -1
 """The top level found no usable answer (the backend failed): the fallbacks answer."""
-
-EXACT_TOL = 1e-9
-"""Relative residual under which a command counts as met, and a scale as 1."""
 
 STILL_SCALE = 1e-9
 """A direction answer scaled below this stands still along the command
@@ -53,9 +56,6 @@ STILL_SCALE = 1e-9
 SLIDE_DAMPING = 1e-2
 r"""Weight :math:`\mu` of the sliding stage's damping
 (:data:`rrc_pin.solvers.tick.pipeline.SLIDE_DAMPING`)."""
-
-_TINY = float(np.finfo(np.float64).tiny)
-
 
 class Top(NamedTuple):
     """The top level's answer and its report.
@@ -99,23 +99,9 @@ class Rows(NamedTuple):
 
 
 @kernel
-def norm(x: Array) -> float:
-    """Euclidean norm without overflow or underflow."""
-    top = 0.0
-    for i in range(x.size):
-        top = max(top, abs(x[i]))
-    if top == 0.0 or not math.isfinite(top):
-        return top
-    s = 0.0
-    for i in range(x.size):
-        s += (x[i] / top) ** 2
-    return top * math.sqrt(s)
-
-
-@kernel
 def met(A: Array, x: Array, b: Array) -> bool:
-    """Whether ``A x`` meets ``b`` to :data:`EXACT_TOL` (relative)."""
-    return norm(row_values(A, x) - b) <= EXACT_TOL * (1.0 + norm(b))
+    """Whether ``A x`` meets ``b`` (:func:`rrc_pin.solvers.tick.statuses.met`)."""
+    return statuses.met(row_values(A, x), b)
 
 
 @kernel
@@ -143,11 +129,8 @@ def answer(A: Array, b: Array, qdot: Array, status: int, rate_factor: float, nul
 
 @kernel
 def met_top(qdot: Array, rate_factor: float, null: Array) -> Top:
-    """The top level's stacked command met: exact where that is the command itself, else (a
-    command divided down, :mod:`rrc_pin.solvers.tick.problem`) scaled by its factor."""  # noqa: D205, D209
-    if rate_factor == 1.0:
-        return Top(qdot, EXACT, 1.0, 0.0, 0.0, null)
-    return Top(qdot, SCALED, rate_factor, 0.0, 0.0, null)
+    """The top level's stacked command met (:func:`rrc_pin.solvers.tick.statuses.met_top`)."""
+    return Top(qdot, statuses.met_top(rate_factor), rate_factor, 0.0, 0.0, null)
 
 
 @kernel
@@ -167,13 +150,13 @@ def backend_slide(where: int, B: Array, target: Array, lb: Array, ub: Array, G: 
 
 @kernel
 def backend_direction(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array,
-                      h: Array) -> tuple[Array, float]:  # fmt: skip
+                      h: Array) -> tuple[Array, float, float]:  # fmt: skip
     """The direction problem by the backend
     (:func:`rrc_pin.solvers.tick.backend_calls.direction`).
     """  # noqa: D205
-    with objmode(qdot="float64[::1]", u="float64"):
-        qdot, u = backend_calls.direction(A, w, null, lb, ub, G, h)
-    return qdot, u
+    with objmode(qdot="float64[::1]", u="float64", veer="float64"):
+        qdot, u, veer = backend_calls.direction(A, w, null, lb, ub, G, h)
+    return qdot, u, veer
 
 
 @kernel
@@ -220,8 +203,10 @@ def slid_command(where: int, A: Array, b: Array, G: Array, h: Array, rows: Rows,
 
 
 @kernel
-def scaled_along(A: Array, w: Array, null: Array, rows: Rows) -> tuple[Array, float]:
-    """The direction problem along ``w``: its rates and scale u (u < 0: the backend failed).
+def scaled_along(A: Array, w: Array, null: Array, rows: Rows) -> tuple[Array, float, float]:
+    """The direction problem along ``w``: its rates, scale u (u < 0: the backend failed), veer.
+
+    The veer [rad] is measured where the backend answered, else 0 (along w by construction).
 
     Without rows: the uniform scale (no null space) or the exact line scale (one null
     direction) (:func:`rrc_pin.solvers.tick.direction.along`); else the backend's QP
@@ -231,24 +216,44 @@ def scaled_along(A: Array, w: Array, null: Array, rows: Rows) -> tuple[Array, fl
         return backend_direction(A, w, null, rows.lb, rows.ub, rows.G, rows.h)
     if null.shape[0] == 0:
         u = kernels.uniform_scale(w, rows.lb, rows.ub)
-        return u * w, u
+        return u * w, u, 0.0
     u, y = kernels.line_scale(w, null[0], rows.lb, rows.ub)
-    return u * w + y * null[0], u
+    return u * w + y * null[0], u, 0.0
+
+
+@kernel
+def columns_used(J: Array) -> int:
+    """How many columns of ``J`` have a nonzero entry (its rank is at most that)."""
+    count = 0
+    for j in range(J.shape[1]):
+        for i in range(J.shape[0]):
+            if J[i, j] != 0.0:
+                count += 1
+                break
+    return count
 
 
 @inlined
-def clamped(f: Factor, w: Array, rows: Rows, dt: float) -> Factor:
+def clamped(f: Factor, w: Array, rows: Rows, dt: float, threshold: float
+            ) -> tuple[Factor, bool]:  # fmt: skip
     """The rows without the joints ``w`` pushes against a bound that holds them, where they
-    keep their rank (:func:`rrc_pin.solvers.tick.pipeline._clamped`), else ``f``.
+    keep their rank (:func:`rrc_pin.solvers.tick.pipeline._clamped`), else ``f``; and whether
+    their condition number is surely within ``threshold`` (:func:`factor.surely_conditioned`:
+    where it is, the SVDs would choose the same rows).
     """  # noqa: D205
     J = np.empty_like(f.J)
     if not kernels.clamp_pushed(f.J, w, rows.lb, rows.ub, kernels.ON_LIMIT / dt, J):
-        return f
-    c = factor.with_svd(factor.qr(J))
+        return f, factor.surely_conditioned(f, threshold)
+    if columns_used(J) < J.shape[0] and factor.surely_conditioned(f, threshold):
+        return f, True  # the clamped rows are short of rank, f has it
+    c = factor.qr(J)
+    if factor.surely_conditioned(c, threshold):  # of full rank
+        return c, True
+    c = factor.with_svd(c)
     if c.rank == min(J.shape[0], J.shape[1]):
-        return c
+        return c, False
     f = factor.with_svd(f)
-    return c if c.rank >= f.rank else f
+    return (c if c.rank >= f.rank else f), False
 
 
 @kernel
@@ -259,7 +264,10 @@ def damping(f: Factor, b: Array, w: Array, u: float, rows: Rows, dt: float, thre
     """  # noqa: D205
     if threshold <= 0.0:
         return f, np.empty(0)
-    usable = factor.with_svd(clamped(f, w, rows, dt))
+    usable, conditioned = clamped(f, w, rows, dt, threshold)
+    if conditioned:
+        return usable, np.empty(0)
+    usable = factor.with_svd(usable)
     if factor.condition(usable) <= threshold:
         return usable, np.empty(0)
     m, k = usable.US.shape
@@ -299,7 +307,7 @@ def scaled(A: Array, command: Array, b: Array, f: Factor, w: Array, boxed: Array
     command served, ``command`` the one reported along).
     """  # noqa: D205
     f, null = factor.null_basis(f)
-    qdot, u = (boxed, u_box) if u_box >= 0.0 else scaled_along(A, w, null, rows)
+    qdot, u, veer = (boxed, u_box, 0.0) if u_box >= 0.0 else scaled_along(A, w, null, rows)
     if u < 0.0:
         return passing(w, null)
     if slid:
@@ -308,7 +316,7 @@ def scaled(A: Array, command: Array, b: Array, f: Factor, w: Array, boxed: Array
         return met_top(qdot, rate_factor, null)
     usable, lam = damping(f, b, w, u, rows, dt, threshold)
     if lam.size:
-        damped_qdot, damped_u = scaled_along(A, factor.rates(usable, b, lam), null, rows)
+        damped_qdot, damped_u, _ = scaled_along(A, factor.rates(usable, b, lam), null, rows)
         if damped_u < 0.0:
             return passing(w, null)
         if u_box < 0.0 or not damped_u <= STILL_SCALE < u:
@@ -316,7 +324,7 @@ def scaled(A: Array, command: Array, b: Array, f: Factor, w: Array, boxed: Array
                           float(np.max(lam)))  # fmt: skip
     if outside_range:
         return answer(A, command, qdot, SINGULAR, rate_factor, null, 0.0)
-    return Top(qdot, SCALED, u * rate_factor, 0.0, 0.0, null)
+    return Top(qdot, SCALED, u * rate_factor, veer, 0.0, null)
 
 
 @inlined

@@ -1,0 +1,308 @@
+r"""The closed chains' correction of one tick, compiled (:mod:`rrc_pin.cells.closure`'s math).
+
+One call, :func:`correction`, makes a tick's whole correction from the tick's kinematics: the
+chains' second order along the step (:func:`chain_motion` and :func:`second_order`, from the
+world Jacobian's columns instead of a second forward pass), the lexicographic damped least
+squares (:func:`lexicographic`, :func:`damped`) and, where that leaves the box or breaks a row,
+the projection (:func:`~rrc_pin.solvers.tick.slide_kernels.project`), :data:`PASSES` times.
+
+The second order. With :math:`S_c` the world Jacobian's column c (the joint's motion as a
+spatial twist at the base origin, Pinocchio's ``computeJointJacobians``) and :math:`u_c` its
+rate, a joint j moves its body by :math:`\nu_j = \sum_{c \in j} S_c u_c`, and at
+:math:`\ddot q = 0` its column turns with the body it sits on (Featherstone, "Rigid Body
+Dynamics Algorithms", eq. 5.20 with no joint bias: revolute, prismatic and free-flyer joints),
+so that the spatial velocity and acceleration of the frame's body are
+
+.. math::
+
+    V = \sum_j \nu_j, \qquad A = \sum_j V_{<j} \times \nu_j
+
+(:math:`V_{<j}` the sum over the joints before j on the chain, :math:`\times` the motion
+cross product). The frame's origin p then moves at :math:`v_p = v + \omega \times p` with the
+classical acceleration :math:`a + \alpha \times p + \omega \times v_p`, the same values as
+Pinocchio's ``getFrameClassicalAcceleration`` in ``LOCAL_WORLD_ALIGNED`` after a forward pass
+with :math:`\ddot q = 0`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.tick.kernels import (
+    cholesky,
+    clip_into,
+    householder_qr,
+    inside,
+    rows_hold,
+    solve_factored,
+)
+from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
+
+Array = npt.NDArray[np.float64]
+Ints = npt.NDArray[np.int64]
+
+DAMPING = 1e-4
+r"""The correction's damping, relative to its rows' mean squared singular value: a direction of
+singular value :math:`\sigma` keeps :math:`\sigma^2(\sigma^2 + 2\mu)/(\sigma^2 + \mu)^2` of
+its correction: all but 1e-8 at the mean, at least three quarters at a hundredth of the
+largest."""
+
+KEEP = 1e-2
+"""Where the box binds, the weight of the top level's rows against the chains' (the chains
+first)."""
+
+PASSES = 2
+"""Passes of the correction in a tick (:func:`correction`)."""
+
+TRUST = 0.1
+"""The trust region: the correction moves each joint by at most this fraction of its velocity
+limit [rad/s or m/s]."""
+
+_TINY = float(np.finfo(np.float64).tiny)
+
+
+@kernel
+def _cross(a: Array, b: Array, out: Array) -> None:
+    """``out = a x b`` (3,)."""
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@kernel
+def largest(error: Array) -> tuple[float, float]:
+    """The largest position [m] and rotation [rad] error of chains ``error`` (6 k,) (0 for none).
+
+    Each chain's lengths summed in numpy's order (``numpy.linalg.norm``'s floats).
+    """
+    position = rotation = 0.0
+    for i in range(error.size // 6):
+        e = error[6 * i : 6 * i + 6]
+        position = max(position, math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]))
+        rotation = max(rotation, math.sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5]))
+    return position, rotation
+
+
+@kernel
+def chain_motion(
+    J: Array, support: npt.NDArray[np.bool_], joint: Ints, P: Array, u: Array, v: Array, a: Array
+) -> None:
+    """Each frame's velocity and classical acceleration at rates ``u`` and no joint acceleration.
+
+    Args:
+        J: The world Jacobian (6, nv) of every joint (Pinocchio's ``data.J`` after
+            ``computeJointJacobians``: spatial twists [v; w] at the base origin).
+        support: (k, nv) True where column c moves frame i (its chain's joints).
+        joint: (nv,) the joint each column belongs to (columns of one joint side by side).
+        P: (k, 3) the frames' origins in the base frame [m].
+        u: The rates (nv,).
+        v: Out: (k, 6) each frame's velocity [m/s, rad/s] in ``local_world_aligned``.
+        a: Out: (k, 6) each frame's classical acceleration [m/s^2, rad/s^2], the same axes.
+    """
+    k, n = support.shape
+    V, A, nu, t = np.empty(6), np.empty(6), np.empty(6), np.empty(3)
+    for i in range(k):
+        V[:] = 0.0
+        A[:] = 0.0
+        c = 0
+        while c < n:
+            if not support[i, c]:
+                c += 1
+                continue
+            j = joint[c]
+            nu[:] = 0.0
+            while c < n and support[i, c] and joint[c] == j:
+                for r in range(6):
+                    nu[r] += J[r, c] * u[c]
+                c += 1
+            # A += V x nu: (w x nu_v + v x nu_w, w x nu_w)
+            _cross(V[3:], nu[:3], t)
+            A[:3] += t
+            _cross(V[:3], nu[3:], t)
+            A[:3] += t
+            _cross(V[3:], nu[3:], t)
+            A[3:] += t
+            V += nu
+        _cross(V[3:], P[i], t)
+        v[i, :3] = V[:3] + t
+        v[i, 3:] = V[3:]
+        _cross(A[3:], P[i], t)
+        a[i, :3] = A[:3] + t
+        _cross(V[3:], v[i, :3], t)
+        a[i, :3] += t
+        a[i, 3:] = A[3:]
+
+
+@kernel
+def second_order(
+    J: Array, support: npt.NDArray[np.bool_], joint: Ints, poses: Array, contacts: Ints,
+    grips: Ints, u: Array, out: Array,
+) -> None:  # fmt: skip
+    r"""Each chain's second derivative along a step of rates ``u``, as its error's.
+
+    The step :math:`q \oplus u\,t` (constant rates: a floating base on its screw, as
+    ``pinocchio.integrate``) moves a contact frame by :math:`v t + \tfrac12 a t^2`: a contact's
+    is its frame's classical acceleration (world axes); a grip's (b in a,
+    :math:`d = p_b - p_a`) is :math:`R_a^T(\ddot d - \dot\omega_a \times d - \omega_a \times
+    (2\dot d - \omega_a \times d))` and :math:`R_a^T(\dot\omega_b - \dot\omega_a - \omega_a
+    \times \omega_b)`.
+
+    Args:
+        J: The world Jacobian (6, nv) of every joint (:func:`chain_motion`).
+        support: (k, nv) the chains' frames' joint rates (:func:`chain_motion`).
+        joint: (nv,) the joint of each rate.
+        poses: (k, 4, 4) the frames' poses in the base frame [m].
+        contacts: The contacts' frames (rows of ``support``).
+        grips: (g, 2) each grip's frames a and b (rows of ``support``).
+        u: The rates (nv,).
+        out: Out: (6 (contacts + grips),), contacts first.
+    """
+    k = support.shape[0]
+    v, a = np.empty((k, 6)), np.empty((k, 6))
+    P = np.ascontiguousarray(poses[:, :3, 3])
+    chain_motion(J, support, joint, P, u, v, a)
+    for i in range(contacts.size):
+        out[6 * i : 6 * i + 6] = a[contacts[i]]
+    s = 6 * contacts.size
+    lin, ang, d, dd, t = np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3)
+    for g in range(grips.shape[0]):
+        fa, fb = grips[g, 0], grips[g, 1]
+        wa = v[fa, 3:]
+        d[:] = P[fb] - P[fa]
+        _cross(wa, d, t)
+        dd[:] = 2.0 * (v[fb, :3] - v[fa, :3]) - t
+        lin[:] = a[fb, :3] - a[fa, :3]
+        _cross(a[fa, 3:], d, t)
+        lin -= t
+        _cross(wa, dd, t)
+        lin -= t
+        _cross(wa, v[fb, 3:], t)
+        ang[:] = a[fb, 3:] - a[fa, 3:] - t
+        for r in range(3):
+            x = y = 0.0
+            for c in range(3):
+                x += poses[fa, c, r] * lin[c]
+                y += poses[fa, c, r] * ang[c]
+            out[s + 6 * g + r] = x
+            out[s + 6 * g + 3 + r] = y
+
+
+@kernel
+def damped(J: Array, b: Array, out: Array) -> None:
+    r"""``out``: the damped least squares of ``J x = b`` pulled toward itself (zero where not
+    definite).
+
+    With :math:`M = J^TJ + \mu I` (:math:`\mu` = :data:`DAMPING` times the mean squared
+    singular value :math:`\operatorname{tr}(J^TJ)/m`) and :math:`t = M^{-1}J^Tb`, the
+    minimiser of :math:`\|Jx - b\|^2 + \mu\|x - t\|^2`, :math:`t + \mu M^{-1}t`: along a
+    right singular vector of singular value :math:`\sigma`,
+    :math:`\beta\sigma(\sigma^2 + 2\mu)/(\sigma^2 + \mu)^2` of the exact
+    :math:`\beta/\sigma`, bounded through a singularity. One Cholesky factorisation, two
+    triangular solves.
+    """  # noqa: D205
+    m, n = J.shape
+    M = J.T @ J
+    trace = 0.0
+    for i in range(n):
+        trace += M[i, i]
+    mu = max(DAMPING * trace / max(m, 1), _TINY)
+    for i in range(n):
+        M[i, i] += mu
+    L = np.zeros((n, n))
+    if not cholesky(M, 1e-12, L):
+        out[:] = 0.0
+        return
+    t, s = np.empty(n), np.empty(n)
+    solve_factored(L, J.T @ b, t)
+    solve_factored(L, t, s)
+    out[:] = t + mu * s
+
+
+@kernel
+def lexicographic(C: Array, top: Array, null: Array, keep: Array, r: Array, out: Array) -> None:
+    """``out``: the chains' rates ``C x = r`` first, then, among the corrections with those
+    rates, the one that keeps the top level's (``top x`` nearest zero), each :func:`damped`.
+
+    Args:
+        C: The chains' rows (m, n), in their metric.
+        top: The top level's rows (t, n) (t = 0: none kept).
+        null: (n - m, n) a basis of C's null space (rows), or (0, n): none.
+        keep: ``top @ null.T`` (t, n - m).
+        r: The chains' rates (m,).
+        out: Out: (n,).
+    """  # noqa: D205
+    damped(C, r, out)
+    if null.shape[0] == 0 or top.shape[0] == 0:
+        return
+    y = np.empty(null.shape[0])
+    damped(keep, -(top @ out), y)
+    out += y @ null
+
+
+@kernel
+def correction(
+    J: Array, support: npt.NDArray[np.bool_], joint: Ints, poses: Array, contacts: Ints,
+    grips: Ints, C: Array, error: Array, unit: Array, top: Array, qdot: Array, box: Array,
+    G: Array, h: Array, dt: float, delta: Array, after: Array,
+) -> None:  # fmt: skip
+    r"""The correction that closes the chains within the step, and their error after it.
+
+    :func:`rrc_pin.cells.closure.close` (its docstring: the least squares, the box, the
+    passes), on the tick's kinematics.
+
+    Args:
+        J: The world Jacobian (6, nv) of every joint (:func:`second_order`).
+        support: (k, nv) the chains' frames' joint rates.
+        joint: (nv,) the joint of each rate.
+        poses: (k, 4, 4) the frames' poses in the base frame [m].
+        contacts: The contacts' frames (rows of ``support``).
+        grips: (g, 2) each grip's frames a and b.
+        C: The chains' rows (6 k, nv).
+        error: Their errors (6 k,) [m, rad].
+        unit: Their units (6 k,) (the resolver's metric).
+        top: The top level's rows (t, nv) in their metric.
+        qdot: The resolver's rates (nv,).
+        box: (3, nv) the tick's box: its lower and upper bounds and the velocity limits
+            (the correction's bounds are the box less the rates, within the trust region
+            :data:`TRUST` times the velocity limits, and zero).
+        G: The constraint rows ``G qdot <= h`` (p, nv), or (0, nv).
+        h: Their bounds (p,) (the correction's room: ``max(h - G qdot, 0)``).
+        dt: The step [s].
+        delta: Out: the correction (nv,).
+        after: Out: the chains' error after the step (6 k,), to second order.
+    """
+    m, n = C.shape[0], qdot.size
+    Cm = np.empty((m, n))  # the resolver's metric: metres per reach
+    for i in range(m):
+        Cm[i] = C[i] / unit[i]
+    null, keep = np.zeros((0, n)), np.zeros((top.shape[0], 0))
+    if top.shape[0] > 0 and m < n:
+        Q, R = np.empty((n, n)), np.empty((n, m))
+        householder_qr(np.ascontiguousarray(Cm.T), Q, R)
+        null = np.ascontiguousarray(Q[:, m:].T)
+        keep = top @ null.T
+    trust = TRUST * box[2]
+    low = np.minimum(np.maximum(box[0] - qdot, -trust), 0.0)  # zero always inside
+    high = np.maximum(np.minimum(box[1] - qdot, trust), 0.0)
+    room = np.maximum(h - G @ qdot, 0.0)
+    M = np.empty((m + top.shape[0], n))
+    M[:m] = Cm
+    M[m:] = KEEP * top
+    second, r, u, x = np.empty(m), np.empty(m), np.empty(n), np.empty(n)
+    delta[:] = 0.0
+    for _ in range(PASSES):
+        u[:] = qdot + delta
+        second_order(J, support, joint, poses, contacts, grips, u, second)
+        r[:] = (error - 0.5 * dt * dt * second) / (dt * unit)
+        lexicographic(Cm, top, null, keep, r, delta)
+        if not (inside(delta, low, high) and rows_hold(G, delta, room, 0.0)):
+            if project(M, DAMPING, delta, low, high, G, room, MARGIN, x) != SOLVED:
+                x[:] = 0.0
+            clip_into(x, low, high)
+            delta[:] = x
+    u[:] = qdot + delta
+    after[:] = error - (C @ u + 0.5 * dt * second) * dt

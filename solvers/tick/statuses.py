@@ -1,0 +1,80 @@
+"""How a tick reports a level served: the rules the compiled tick and the Python pipeline share.
+
+Each rule is one kernel, called from the compiled tick (:mod:`rrc_pin.solvers.tick.top`,
+:mod:`rrc_pin.solvers.tick.tick`) and from plain Python
+(:mod:`rrc_pin.solvers.tick.pipeline`), which names the codes by
+:data:`~rrc_pin.solvers.tick.pipeline.Status` and
+:data:`~rrc_pin.solvers.tick.pipeline.LevelStatus`:
+
+- a command is **met** where the residual is within :data:`EXACT_TOL` of it (:func:`met`);
+- a top level whose stacked command is met is ``exact`` where that is the command itself, else
+  (a command divided down, :mod:`rrc_pin.solvers.tick.problem`) ``scaled`` by its factor
+  (:func:`met_top`);
+- a lower level is ``met``, ``scaled`` along its command or ``traded`` (:func:`served`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.tick import kernels
+
+Array = npt.NDArray[np.float64]
+
+EXACT, SCALED, SLIDING, DAMPED, SINGULAR, LEAST_SQUARES, RECOVERING, FALLBACK = range(8)
+"""Codes of :data:`~rrc_pin.solvers.tick.pipeline.Status`, in its order."""
+
+MET, SCALED_LEVEL, TRADED, DROPPED = range(4)
+"""Codes of :data:`~rrc_pin.solvers.tick.pipeline.LevelStatus`, in its order."""
+
+EXACT_TOL = 1e-9
+"""Relative residual under which a command counts as met, and a scale as 1."""
+
+VEER_TOL = 1e-6
+"""The angle [rad] off its command under which a lower level's rates are its command scaled."""
+
+
+@kernel
+def norm(x: Array) -> float:
+    """Euclidean norm without overflow or underflow."""
+    top = 0.0
+    for i in range(x.size):
+        top = max(top, abs(x[i]))
+    if top == 0.0 or not math.isfinite(top):
+        return top
+    s = 0.0
+    for i in range(x.size):
+        s += (x[i] / top) ** 2
+    return top * math.sqrt(s)
+
+
+@kernel
+def met(y: Array, b: Array) -> bool:
+    """Whether the rows' rates ``y`` (m,) meet the command ``b`` (m,) to :data:`EXACT_TOL`."""
+    return norm(y - b) <= EXACT_TOL * (1.0 + norm(b))
+
+
+@kernel
+def met_top(rate_factor: float) -> int:
+    """The status code of a top level whose stacked command is met: :data:`EXACT` where
+    ``rate_factor`` is 1, else :data:`SCALED` (by ``rate_factor``, its scale either way).
+    """  # noqa: D205
+    return EXACT if rate_factor == 1.0 else SCALED
+
+
+@kernel
+def served(y: Array, b: Array, rate_factor: float) -> int:
+    """How rates ``y`` (m,) serve a level's command ``b`` (m,) (its rates times
+    ``rate_factor``): a code of :data:`MET`, :data:`SCALED_LEVEL`, :data:`TRADED`.
+
+    A command divided down and met is scaled; a zero command has no direction to scale along:
+    not met, it is traded.
+    """  # noqa: D205
+    if met(y, b):
+        return MET if rate_factor == 1.0 else SCALED_LEVEL
+    scale, veer = kernels.scale_and_veer(y, b)
+    return SCALED_LEVEL if veer <= VEER_TOL and scale > 0.0 and b.any() else TRADED
