@@ -60,7 +60,7 @@ from rrc_pin.solvers.tick.kernels import scale_and_veer
 from rrc_pin.solvers.tick.least_squares import Subspace, least_squares
 from rrc_pin.solvers.tick.problem import Box, Problem, Rows
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
-from rrc_pin.solvers.tick.statuses import EXACT_TOL
+from rrc_pin.solvers.tick.statuses import EXACT_TOL, STILL_SCALE
 
 Array = npt.NDArray[np.float64]
 
@@ -513,11 +513,6 @@ def _clamped(factor: Factorization, w: Array, box: Box, dt: float) -> Factorizat
     return clamped if rank == min(J.shape) or rank >= factor.svd[3] else factor
 
 
-STILL_SCALE = 1e-9
-"""A direction answer scaled below this stands still along the command: its task rates are the
-rounding of a zero, and their direction (what :data:`DIRECTION_TOL` checks) is noise. Two
-facing pandas' hands held against each other answered scale 7.6e-14 at veers of 0.47-3.1 rad,
-refused: 100 fallback ticks in a 10-minute session."""
 
 
 def _scaled(

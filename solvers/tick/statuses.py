@@ -37,6 +37,10 @@ EXACT_TOL = 1e-9
 VEER_TOL = 1e-6
 """The angle [rad] off its command under which a lower level's rates are its command scaled."""
 
+STILL_SCALE = 1e-9
+"""A direction answer scaled below this stands still along the command: its task rates are the
+rounding of a zero, and their direction is noise (not checked against the command's)."""
+
 
 @kernel
 def norm(x: Array) -> float:

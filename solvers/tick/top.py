@@ -42,16 +42,13 @@ from rrc_pin.solvers.tick.statuses import (
     SCALED,
     SINGULAR,
     SLIDING,
+    STILL_SCALE,
 )
 
 Array = npt.NDArray[np.float64]
 
 FAILED = -1
 """The top level found no usable answer (the backend failed): the fallbacks answer."""
-
-STILL_SCALE = 1e-9
-"""A direction answer scaled below this stands still along the command
-(:data:`rrc_pin.solvers.tick.pipeline.STILL_SCALE`)."""
 
 SLIDE_DAMPING = 1e-2
 r"""Weight :math:`\mu` of the sliding stage's damping
