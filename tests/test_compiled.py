@@ -345,3 +345,96 @@ def test_a_kernels_stamp_is_that_of_every_module_of_the_package_it_reaches():
             "rrc_pin.solvers.collision.proximity_kernels"} <= set(names)  # fmt: skip
     assert not any(n.startswith(("numpy", "numba", "rrc_pin.geometry")) for n in names)
     assert collision_pass.collision_pass._cache._cache_file._source_stamp == stamp
+
+
+# -- no kernel compiled or loaded inside a control loop ---------------------------------------
+
+LOOP = """
+import gc, json, sys
+from collections import Counter
+import numpy as np
+from numba.core.dispatcher import Dispatcher
+import rrc_pin
+from rrc_pin import CollisionLimit, CollisionModel, Controller, JointLimits
+
+def signatures():
+    out = {}
+    for f in gc.get_objects():
+        if isinstance(f, Dispatcher) and f.py_func.__module__.startswith("rrc_pin"):
+            name = f"{f.py_func.__module__}.{f.py_func.__qualname__}"
+            out.setdefault(name, set()).update(map(str, f.overloads))
+    return out
+
+rng = np.random.default_rng(SEED)
+out = {}
+
+def session(label, controller, command, ticks=300):
+    before = signatures()
+    statuses = Counter()
+    for k in range(ticks):
+        statuses[controller.step(*command(controller, k)).resolution.status] += 1
+    controller.log.column("status")  # the log's rows made of the ticks it holds
+    new = {name: sorted(s - before.get(name, set())) for name, s in signatures().items()}
+    out[label] = {"statuses": dict(statuses), "kernels": len(before),
+                  "new": {name: s for name, s in new.items() if s}}
+
+def arm_command(controller, k):
+    # 50 ticks each: slow, fast (scaled), outward along the hand's position (a stretched
+    # arm: damped; the joints at their limits), in the hand's axes
+    if k % 50 == 0:
+        speed = (0.05, 5.0, 1.0, 0.5)[k // 50 % 4]
+        arm_command.twist = rng.normal(size=6) * speed
+        if k // 50 % 4 == 2:
+            p = controller.reference[:3, 3]
+            arm_command.twist = np.concatenate([p / np.linalg.norm(p), np.zeros(3)])
+    return arm_command.twist, ("local" if k // 50 % 4 == 3 else "world_aligned")
+
+panda = rrc_pin.load("panda")
+stretched = panda.ready().copy()
+stretched[3] = -0.12
+session("panda", Controller(panda, 0.01, stretched), arm_command)
+cm = CollisionModel(panda)
+table = np.eye(4)
+table[:3, 3] = (0.5, 0.0, 0.2)
+cm.add_box(table, (0.6, 0.8, 0.04), name="table")
+session("panda with a table", Controller(panda, 0.01, limits=[JointLimits(),
+        CollisionLimit(cm, 0.02, 0.3)]), arm_command)
+from rrc_pin.control import STRATEGIES
+for strategy in STRATEGIES:
+    session(f"barker6 {strategy}", Controller("barker6", 0.01, strategy=strategy), arm_command)
+session("rrc_k1607", Controller("rrc_k1607", 0.01), arm_command)
+
+def cell_command(controller, k):
+    if k % 40 == 0:
+        speed = (0.05, 3.0, 0.3)[k // 40 % 3]
+        cell_command.twists = {name: rng.normal(size=6) * speed
+                               for name in controller.commandable()}
+    return (cell_command.twists,)
+
+for name in ("gsfc_dual", "yeh_tripod"):
+    session(name, Controller(name, 0.01), cell_command)
+tripod = rrc_pin.load("yeh_tripod")
+session("yeh_tripod with its capsules", Controller(tripod, 0.01, limits=[JointLimits(),
+        CollisionLimit(CollisionModel(tripod, "capsules"))]), cell_command)
+print("RESULT " + json.dumps(out))
+"""
+
+
+@pytest.mark.parametrize("seed", [20261206, int(np.random.SeedSequence().entropy % 2**63)],
+                         ids=["fixed", "fresh"])  # fmt: skip
+def test_no_kernel_is_compiled_or_loaded_inside_a_control_loop(seed):
+    """Each kind of controller, built, then run 300 ticks (exact, scaled, damped and at joint
+    limits; strict levels on the cells; collision rows where cheap) in a fresh interpreter:
+    no compiled kernel of the package gains a signature during the ticks (compiled, or loaded
+    from numba's cache), each one that does named with it."""
+    code = LOOP.replace("SEED", str(seed))
+    done = subprocess.run([sys.executable, "-W", "ignore", "-c", code], capture_output=True,
+                          text=True, timeout=900)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-3000:]
+    line = next(x for x in done.stdout.splitlines() if x.startswith("RESULT "))
+    sessions = json.loads(line.removeprefix("RESULT "))
+    for label, s in sessions.items():
+        assert s["kernels"] > 50, (seed, label, s["kernels"])  # the compiled kernels seen
+        assert not s["new"], f"seed {seed}, {label}: compiled in the loop: {sorted(s['new'])}"
+    seen = {status for s in sessions.values() for status in s["statuses"]}
+    assert {"exact", "scaled", "damped", "sliding"} <= seen, (seed, seen)

@@ -223,6 +223,7 @@ class CellController(Loop):
             compile_correction(cell.nv)
         scale_and_veer(np.zeros(6), np.zeros(6), np.ones(6))  # compiled now: damped ticks use it
         self._close_at()
+        self._compile_tick()
 
     # -- settings -------------------------------------------------------------------------
 
@@ -367,6 +368,35 @@ class CellController(Loop):
         for name, twist in twists.items():
             self._targets[name] = _moved(self._targets[name], twist * (follow * self.dt))
         return out
+
+    def _compile_tick(self) -> None:
+        """Run the resolver's stages once now: no tick compiles a kernel or loads it.
+
+        On this cell's tasks and limits, from numba's cache or compiled: an exact tick, one
+        after it (the previous rates read-only), a command too fast to meet (scaled), a
+        posture level the box cuts (the projected least squares), and a command one of whose
+        rows is weighted past the damping threshold (damped,
+        :class:`~rrc_pin.solvers.tick.damping.Damping`); the resolver then reset.
+        """
+        kin, names = self._kinematics(), list(self._targets)
+        far = PostureTask(self.posture.q_ref + 1.0, gain=1e6, name="compiling")
+        ticks: list[tuple[float | None, Task]] = [(0.0, self.posture), (0.0, self.posture),
+                                                  (1e6, self.posture), (0.0, far)]  # fmt: skip
+        damping = self.resolver.options.damping
+        weight = np.ones(6)
+        if damping is not None:
+            weight[-1] = (0.1 / damping.threshold) ** 2
+            ticks.append((None, self.posture))
+        for speed, lower in ticks:
+            top: list[Task] = (
+                [self._task(name, np.full(6, speed)) for name in names] if speed is not None
+                else [FrameTask(self.frame_of(name), np.full(6, 1e6), weight=weight)
+                      for name in names]
+            )  # fmt: skip
+            self.resolver.solve_at(kin, [top, [lower]] if top else [[lower]], priority="strict",
+                                   qdot_prev=self._previous_rates())  # fmt: skip
+        self.resolver.reset()
+        self._kin = None
 
     def _kinematics(self) -> Kinematics:
         """The tick's one :class:`~rrc_pin.kinematics.Kinematics` at the current q.

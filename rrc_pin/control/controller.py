@@ -447,7 +447,7 @@ class Controller(Loop):
             rotations = np.array([ticks[k].hand.rotation for k in local])  # type: ignore[union-attr]
             commanded[local] = to_base_axes(rotations, commanded[local])
         error = np.array([tick.error for tick in ticks])
-        boxes = [r.problem.box for r in rs]
+        boxes = [r.box for r in rs]
         lb, ub = np.array([b.lb for b in boxes]), np.array([b.ub for b in boxes])
         kind = np.array([b.kind for b in boxes]).astype(np.int8)  # (n, 2, nv)
         low = (qdot - lb <= ACTIVE_TOL).astype(np.int8)

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.control.strategies.barker_arm import nearness
+from rrc_pin.control.strategies.barker_arm import compile_closed_form, nearness
 from rrc_pin.robot import Robot
 from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
 
@@ -39,6 +39,8 @@ class SingularityLabel:
         self.near = near
         cf = robot.closed_form
         self.barker = cf if isinstance(cf, BarkerClosedForm) else None
+        if self.barker is not None:  # its kernels now, not at a tick
+            compile_closed_form(self.barker)
 
     def __call__(self, q: Array, jacobian: Array, singular_values: Array) -> str:
         """The label at ``q`` ("" when no singularity is near).

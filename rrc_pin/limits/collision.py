@@ -54,15 +54,17 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput
 from rrc_pin.geometry import CollisionModel, Wall
 from rrc_pin.geometry.proximity import Proximity, gather, measure, proximity_of
+from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.collision.collision_pass import pair_rows
 from rrc_pin.solvers.collision.damper_kernels import damper_bound
 from rrc_pin.solvers.collision.records import SETTINGS
 from rrc_pin.solvers.tick.problem import Constraints
 
 if TYPE_CHECKING:
     from rrc_pin.geometry.scene import Scene
-    from rrc_pin.kinematics import Kinematics, Layout
+    from rrc_pin.kinematics import Layout
 
 Array = npt.NDArray[np.float64]
 
@@ -178,6 +180,24 @@ class CollisionLimit(Limit):
             raise InvalidInput("model", f"a collision model of {robot.name} (rates "
                                f"{list(robot.dof_names)}), not of this robot's rates "
                                f"{list(layout.joints)}")  # fmt: skip
+        self._compile(layout)
+
+    def _compile(self, layout: Layout) -> None:
+        """Run the collision pass once now: no tick compiles it or loads it.
+
+        From numba's cache or compiled, on the arrays a tick passes (its q read-only or not);
+        nothing is kept.
+        """
+        robot, scene = self.model.robot, self.model.scene
+        _, dof, q_pin = robot.positions(robot.ready())
+        cdata, settings = self.model.create_data(), self._damper(1.0)
+        kin = Kinematics(robot.model, robot.model.createData(), layout, dof, q_pin)
+        for writeable in (True, False):
+            q = np.array(dof)
+            q.flags.writeable = writeable
+            measure(scene, robot.model, q, lambda: kin.data, cdata, settings, scene.every)
+        pair_rows(cdata.J, scene.support, scene.bodies, scene.first, scene.second, settings,
+                  cdata.found, 0, cdata.G, cdata.h)  # fmt: skip
 
     @property
     def last(self) -> Proximity | None:

@@ -67,6 +67,21 @@ def leave() -> None:
     _LOCAL.context = None
 
 
+def compile_direction(context: Context) -> None:
+    """Run :func:`direction` once now on a small problem of the context's rates: the kernels
+    it calls are compiled (or loaded from numba's cache) before a tick hands one over; the
+    backend's warm starts then forgotten.
+    """  # noqa: D205
+    n = context.velocity.size
+    enter(context)
+    try:
+        direction(np.eye(n), np.full(n, 0.1), np.zeros((0, n)), np.full(n, -1.0), np.ones(n),
+                  np.zeros((1, n)), np.ones(1))  # fmt: skip
+    finally:
+        leave()
+        context.backend.reset()
+
+
 def _work() -> Work:
     context: Context = _LOCAL.context
     if context.work is None:

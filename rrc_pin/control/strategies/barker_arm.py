@@ -11,13 +11,21 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput
 from rrc_pin.robot import Robot
 from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
-from rrc_pin.solvers.closed_form.barker_equations import eq33, f_terms, joint_trig
+from rrc_pin.solvers.closed_form.barker_equations import (
+    eq33,
+    f_terms,
+    joint_trig,
+    turn1,
+    wrist_equations,
+)
 
 Array = npt.NDArray[np.float64]
 
 
 def barker_closed_form(robot: Robot, strategy: str) -> BarkerClosedForm:
-    """The robot's :class:`BarkerClosedForm` (``barker6`` and its variants).
+    """The robot's :class:`BarkerClosedForm` (``barker6`` and its variants), compiled.
+
+    Its kernels compiled or loaded from numba's cache now (:func:`compile_closed_form`).
 
     Raises:
         InvalidInput: Naming ``strategy``, for an arm without Barker's closed form.
@@ -28,7 +36,29 @@ def barker_closed_form(robot: Robot, strategy: str) -> BarkerClosedForm:
             "strategy", f"{strategy!r} needs Barker's closed form (barker6 and its variants); "
             f"{robot.name} has none: use 'slowdown' or 'resolver'",
         )  # fmt: skip
+    compile_closed_form(cf)
     return cf
+
+
+def compile_closed_form(cf: BarkerClosedForm) -> None:
+    """Compile the kernels Barker's strategies call (or load them from numba's cache) now.
+
+    Each called as a controller's tick calls it: its ``q`` read-only, the twist writable and
+    its halves views, ``nearness`` also on a writable ``q``; so that no tick compiles.
+    """
+    q = np.full(6, 0.3)
+    q.flags.writeable = False
+    twist = np.full(6, 0.1)
+    for exact in (False, True):
+        cf.joint_rates(q, twist, exact=exact)
+    arm = cf.arm_rates(q, twist[:3])
+    cf.wrist_rates(q, cf.rvel_tilde(q, arm, twist[3:]))
+    cf.tvel_frame2(q, twist[:3])
+    for at in (q, q + twist):
+        nearness(cf, at)
+        t = joint_trig(at)
+        turn1(t, 0.1, 0.1)
+        wrist_equations(cf.geometry, t, 0.1, 0.1, 0.1)
 
 
 class Nearness(NamedTuple):
