@@ -81,4 +81,5 @@ class PostureTask(Task):
             wrapped = np.remainder(error + np.pi, 2.0 * np.pi) - np.pi
             error = np.where(kin.layout.continuous, wrapped, error)
         n = error.size
-        return TaskRows(identity(n), self.gain * error, self._row_weights(n), self.name)
+        error *= self.gain
+        return TaskRows(identity(n), error, self._row_weights(n), self.name)
