@@ -320,6 +320,7 @@ class Workspace:
                 m += t.b.size
         self._fit(m, len(levels))
         held, task_rows, rates, r = self._held, self.task_rows, self.rates, 0
+        rate = rates[RATE]
         for k, tasks in enumerate(levels):
             ints[STARTS + k] = r
             for t in tasks:
@@ -338,7 +339,7 @@ class Workspace:
                 if was[3] is not unit:
                     rates[UNIT, r:end] = 1.0 if unit is None else unit
                     was[3] = _constant(unit)
-                rates[RATE, r:end] = t.b
+                rate[r:end] = t.b
                 r = end
         ints[STARTS + len(levels)] = m
         ints[LEVELS], ints[ROWS], ints[WEIGHTED] = len(levels), m, weighted
