@@ -185,7 +185,8 @@ class CompiledTick:
         ``start`` [s] when the tick began (``time.perf_counter``)."""  # noqa: D205, D209
         ws = self.workspace
         ws.load_levels(levels, weighted)
-        rows = merged_rows([c for c in constraints if c is not None])
+        present = [c for c in constraints if c is not None]
+        rows = merged_rows(present) if present else None
         if rows is None:
             ws.load_rows(None, None, None)
         else:

@@ -133,15 +133,7 @@ def finite_number(
             finite, or out of bounds; the message
             states the expected range (``>= 0``, ``> 0``, ``in (0, 1)``, ``in [0, 0.5)``).
     """
-    real = (int, float, np.integer, np.floating)  # not complex numbers (np.number)
-    if isinstance(value, (bool, np.bool_, np.timedelta64)) or not isinstance(value, real):
-        raise InvalidInput(name, f"expected {_wanted(lower, inclusive, upper)}, got {value!r}")
-    try:
-        out = float(value)
-    except OverflowError:  # an int beyond the float range
-        got = f"an int of {len(str(value))} digits"
-        wanted = _wanted(lower, inclusive, upper)
-        raise InvalidInput(name, f"expected {wanted}, got {got}") from None
+    out = value if type(value) is float else _real_number(value, name, lower, inclusive, upper)
     if (
         not isfinite(out)
         or (lower is not None and (out < lower or (out == lower and not inclusive)))
@@ -149,6 +141,22 @@ def finite_number(
     ):
         raise InvalidInput(name, f"expected {_wanted(lower, inclusive, upper)}, got {out}")
     return out
+
+
+def _real_number(
+    value: object, name: str, lower: float | None, inclusive: bool, upper: float | None
+) -> float:
+    """``value`` as a float if it is a real number (:func:`finite_number`'s bounds for the
+    message)."""  # noqa: D205, D209
+    real = (int, float, np.integer, np.floating)  # not complex numbers (np.number)
+    if isinstance(value, (bool, np.bool_, np.timedelta64)) or not isinstance(value, real):
+        raise InvalidInput(name, f"expected {_wanted(lower, inclusive, upper)}, got {value!r}")
+    try:
+        return float(value)
+    except OverflowError:  # an int beyond the float range
+        got = f"an int of {len(str(value))} digits"
+        wanted = _wanted(lower, inclusive, upper)
+        raise InvalidInput(name, f"expected {wanted}, got {got}") from None
 
 
 def integer(value: object, name: str, lower: int | None = None, upper: int | None = None) -> int:

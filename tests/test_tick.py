@@ -189,3 +189,51 @@ def test_the_default_tick_passes_a_box_without_standing_still_on() -> None:
         assert ws.run(q, np.zeros(N), DT) == STATUS_NAMES.index("recovering")
     finally:
         backend_calls.leave()
+
+
+def _constant_rows(rng: np.random.Generator) -> list[TaskRows]:
+    """Tasks whose rows, weights or units are read-only arrays owning their values (loaded once
+    while they come at the same rows), beside writable ones, None and read-only views."""
+    out = []
+    for k in range(4):
+        m = int(rng.integers(1, 5))
+        A, weight, unit = rng.normal(size=(m, N)), rng.uniform(0.1, 2, m), rng.uniform(0.3, 1.5, m)
+        for part in (A, weight, unit):
+            part.flags.writeable = rng.random() < 0.3
+        view = rng.uniform(0.1, 2.0, 2 * m)[::2]
+        view.flags.writeable = False  # a view of values that may change: loaded every tick
+        weight_or = (None, weight, view)[int(rng.integers(0, 3))]
+        out.append(TaskRows(A, rng.normal(size=m), weight_or,
+                            f"t{k}", None if rng.random() < 0.3 else unit))  # fmt: skip
+    return out
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_loaded_rows_are_a_fresh_workspaces_after_any_sequence(seed: int) -> None:
+    """Levels of the same tasks in other orders, places and numbers, a twist over them, a
+    view's values changed: after each load the workspace holds what a fresh one loads."""
+    rng = np.random.default_rng(seed)
+    lower, upper, velocity = limits(rng)
+
+    def workspace() -> tick.Workspace:
+        return tick.Workspace(lower, upper, velocity, np.array([np.inf]), 0.0, 1.0, 100.0,
+                              True, 1e-6)  # fmt: skip
+
+    pool, ws = _constant_rows(rng), workspace()
+    for step in range(200):
+        picked = [pool[int(i)] for i in rng.integers(0, len(pool), int(rng.integers(1, 5)))]
+        cut = int(rng.integers(0, len(picked)))
+        levels = [picked] if cut == 0 else [picked[:cut], picked[cut:]]
+        view = pool[int(rng.integers(0, len(pool)))].weight
+        if view is not None and view.base is not None:
+            view.base[:] = rng.uniform(0.1, 2.0, view.base.size)
+        ws.load_levels(levels, len(levels) == 1)
+        fresh = workspace()
+        fresh.load_levels(levels, len(levels) == 1)
+        m = int(fresh.ints[tick.ROWS])
+        assert np.array_equal(ws.task_rows[:m], fresh.task_rows[:m]), (seed, step)
+        assert np.array_equal(ws.rates[:, :m], fresh.rates[:, :m]), (seed, step)
+        used = tick.STARTS + len(levels) + 1
+        assert np.array_equal(ws.ints[:used], fresh.ints[:used]), (seed, step)
+        if rng.random() < 0.2:  # the default tick's twist over the rows loaded last
+            ws.load_twist(rng.normal(size=(6, N)), (0, 1, 2, 3, 4, 5), rng.normal(size=6))

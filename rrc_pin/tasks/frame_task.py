@@ -114,6 +114,9 @@ class FrameTask(Task):
             InvalidInput: Wrong shape or a non-finite entry.
         """
         m = len(self.selected)
+        if type(twist) is np.ndarray and twist.dtype == np.float64 and twist.shape == (m,):
+            checked: Array = as_vector(twist, "twist", m).copy()  # the common case
+            return checked
         twist = real_array(twist, "twist", "expected a real (6,) twist")
         size = twist.shape
         if size == (6,) and m != 6:

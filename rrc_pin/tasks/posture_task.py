@@ -47,6 +47,16 @@ class PostureTask(Task):
         self.gain = positive(gain, "gain")
         self.weight = check_weight(weight, self.q_ref.size)
         self.name = task_name(name)
+        self._continuous: tuple[npt.NDArray[np.bool_] | None, bool] = (None, False)
+
+    def _wraps(self, continuous: npt.NDArray[np.bool_]) -> bool:
+        """Whether the mask ``continuous`` (a robot's layout's) has a continuous joint: found
+        once per layout."""  # noqa: D205, D209
+        mask, wraps = self._continuous
+        if mask is not continuous:
+            wraps = bool(continuous.any())
+            self._continuous = (continuous, wraps)
+        return wraps
 
     def frames(self) -> tuple[str, ...]:
         """None."""
@@ -69,8 +79,9 @@ class PostureTask(Task):
     def rows(self, kin: Kinematics) -> TaskRows:
         """Identity rows and ``gain (q_ref - q)``."""
         error = self.q_ref - kin.q
-        if kin.layout.continuous.any():
+        if self._wraps(kin.layout.continuous):
             wrapped = np.remainder(error + np.pi, 2.0 * np.pi) - np.pi
             error = np.where(kin.layout.continuous, wrapped, error)
         n = error.size
-        return TaskRows(identity(n), self.gain * error, self._row_weights(n), self.name)
+        error *= self.gain
+        return TaskRows(identity(n), error, self._row_weights(n), self.name)

@@ -53,9 +53,12 @@ class Task(ABC):
                 raise FrameNotFound(frame, sorted(layout.frames), "frame")
 
     def _row_weights(self, m: int) -> Array | None:
-        """The weight as (m,) row weights, or None when it is 1 everywhere."""
+        """The weight as (m,) row weights, or None when it is 1 everywhere.
+
+        A scalar weight's rows are read-only and shared (:func:`row_weights`).
+        """
         if isinstance(self.weight, float):  # check_weight gives a float or an (m,) array
-            return None if self.weight == 1.0 else np.full(m, self.weight)
+            return None if self.weight == 1.0 else row_weights(self.weight, m)
         return None if (self.weight == 1.0).all() else self.weight
 
 
@@ -65,6 +68,14 @@ def identity(n: int) -> Array:
     eye = np.eye(n)
     eye.flags.writeable = False
     return eye
+
+
+@functools.lru_cache(maxsize=256)
+def row_weights(weight: float, m: int) -> Array:
+    """The rows (m,) of a scalar weight, read-only, made once per weight and size."""
+    rows = np.full(m, weight)
+    rows.flags.writeable = False
+    return rows
 
 
 def check_weight(weight: float | npt.ArrayLike, size: int | None = None) -> float | Array:

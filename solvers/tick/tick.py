@@ -26,6 +26,7 @@ compiled in a fraction of the general entry's time.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -39,6 +40,12 @@ from rrc_pin.solvers.tick.top import FAILED, Rows, Top
 
 Array = npt.NDArray[np.float64]
 Ints = npt.NDArray[np.int64]
+Held = list[Any]
+"""What rows from a start row hold: the end row, then the task's rows, weights and units where
+they are constants (:func:`_constant`), else :data:`_LOADED`."""
+
+_LOADED = object()
+"""A part of a task loaded that is not a constant: never the same as the next tick's."""
 
 # Rows of ``joints`` (k, n): the inputs, then the outputs.
 POSITION, LOWER, UPPER, VELOCITY, ACCELERATION, PREVIOUS, LB, UB, QDOT, KIND = range(10)
@@ -61,6 +68,14 @@ ELSEWHERE = -3
 """What :func:`run_box` returns for a tick that is not its own (:func:`run` answers it)."""
 
 _EPS = float(np.finfo(np.float64).eps)
+
+
+def _constant(part: Array | None) -> object:
+    """``part`` of a task's rows (A, weights or units) if it cannot change: None, or read-only
+    owning its values; else :data:`_LOADED`."""  # noqa: D205, D209
+    if part is None or (part.base is None and not part.flags.writeable):
+        return part
+    return _LOADED
 
 
 @kernel
@@ -290,43 +305,63 @@ class Workspace:
         self.ints[DIRECTION] = int(direction)
         self.task_rows, self.rates = np.zeros((6, n)), np.ones((3, 6))
         self.G, self.h, self.slide = np.zeros((0, n)), np.zeros(0), np.zeros(0)
+        self._held: dict[int, Held] = {}
 
     def load_levels(self, levels: Sequence[Sequence[TaskRows]], weighted: bool) -> None:
-        """The tasks' rows and rates, by level (highest first)."""
-        ints = self.ints
-        if len(levels) == 1 and len(levels[0]) == 1:  # one task: the default tick's
-            t = levels[0][0]
-            m = t.b.size
-            self._fit(m, 1)
-            ints[STARTS], ints[STARTS + 1] = 0, m
-            self._load(t, 0, m)
-        else:
-            m = sum(t.b.size for level in levels for t in level)
-            self._fit(m, len(levels))
-            r = 0
-            for k, tasks in enumerate(levels):
-                ints[STARTS + k] = r
-                for t in tasks:
-                    self._load(t, r, r + t.b.size)
-                    r += t.b.size
-            ints[STARTS + len(levels)] = r
+        """The tasks' rows and rates, by level (highest first).
+
+        A task's rows, weights and units that are None or read-only arrays owning their
+        values (constants: a joint-space task's identity rows, cached units and weights) are
+        loaded once while the same arrays come at the same rows (``_held``).
+        """
+        ints, m = self.ints, 0
+        for tasks in levels:
+            for t in tasks:
+                m += t.b.size
+        self._fit(m, len(levels))
+        held, task_rows, rates, r = self._held, self.task_rows, self.rates, 0
+        rate = rates[RATE]
+        for k, tasks in enumerate(levels):
+            ints[STARTS + k] = r
+            for t in tasks:
+                end = r + t.b.size
+                was = held.get(r)
+                if was is None or was[0] != end:  # other rows here: every part loaded
+                    self._overwrite(r, end)
+                    was = held[r] = [end, _LOADED, _LOADED, _LOADED]
+                A, weight, unit = t.A, t.weight, t.unit
+                if was[1] is not A:
+                    task_rows[r:end] = A
+                    was[1] = _constant(A)
+                if was[2] is not weight:
+                    rates[WEIGHT, r:end] = 1.0 if weight is None else weight
+                    was[2] = _constant(weight)
+                if was[3] is not unit:
+                    rates[UNIT, r:end] = 1.0 if unit is None else unit
+                    was[3] = _constant(unit)
+                rate[r:end] = t.b
+                r = end
+        ints[STARTS + len(levels)] = m
         ints[LEVELS], ints[ROWS], ints[WEIGHTED] = len(levels), m, weighted
-        ints[UNITS] = any(t.unit is not None for t in levels[0])
+        units = False
+        for t in levels[0]:
+            units = units or t.unit is not None
+        ints[UNITS] = units
 
     def _fit(self, m: int, levels: int) -> None:
         """Room for ``m`` task rows and ``levels`` levels."""
         if m > self.rates.shape[1]:
             self.task_rows, self.rates = np.zeros((m, self.n)), np.ones((3, m))
+            self._held.clear()
         if self.ints.size < STARTS + 2 * levels + 2:
             self.ints = np.concatenate([self.ints, np.zeros(2 * levels + 2, np.int64)])
 
-    def _load(self, t: TaskRows, start: int, end: int) -> None:
-        """Task ``t``'s rows, rates, weights and units as rows ``start:end``."""
-        self.task_rows[start:end] = t.A
-        rates = self.rates
-        rates[RATE, start:end] = t.b
-        rates[WEIGHT, start:end] = 1.0 if t.weight is None else t.weight
-        rates[UNIT, start:end] = 1.0 if t.unit is None else t.unit
+    def _overwrite(self, start: int, end: int) -> None:
+        """Forget what ``_held`` says rows ``start:end`` hold (they are being written)."""
+        held = self._held
+        if held:
+            for s in [s for s, was in held.items() if s < end and start < was[0]]:
+                del held[s]
 
     def load_twist(self, J: Array, selected: tuple[int, ...], b: Array) -> None:
         """One task's rows ``J`` (6, n) (the ``selected`` ones) and rates ``b``, over those
@@ -335,6 +370,7 @@ class Workspace:
         m = b.size
         self.task_rows[:m] = J if m == 6 else J[list(selected)]
         self.rates[RATE, :m] = b
+        self._overwrite(0, m)
 
     def load_rows(
         self, G: Array | None, h: Array | None, slide: npt.NDArray[np.bool_] | None
