@@ -251,3 +251,47 @@ def test_backend_switch_and_home_keep_the_cells_controller(dual):
     loop.mailbox.post(cmd.Home())
     watch.run(1)
     np.testing.assert_allclose(loop.ctl.q, loop.start_q, atol=1e-12)
+
+
+def test_a_cell_of_free_hands_switches_the_commanded_name_and_holds_the_other():
+    """Two free pandas: the controls move arm a's hand; switched to b (between ticks), a is
+    held still from the next tick (under 1 um per tick) while b moves."""
+    from rrc_pin.cells import make_cell
+
+    panda = rrc_pin.load("panda")
+    T = np.eye(4)
+    T[1, 3] = 1.0
+    loop = CellLoop(make_cell({"a": (panda, np.eye(4)), "b": (panda, T)}, name="pair"),
+                    rate=RATE)  # fmt: skip
+    assert loop.hands == ("a", "b")
+    watch = Watch(loop)
+    loop.mailbox.post(cmd.Latch(True))
+    loop.mailbox.post(cmd.Velocity(UP, "world_aligned"))
+    watch.run(100)
+    hand_a = loop.robot.fk(loop.ctl.q, loop.cell_ctl.frame_of("a"))[:3, 3]
+    loop.mailbox.post(cmd.Hand("b"))
+    loop.mailbox.post(cmd.Latch(True))
+    loop.mailbox.post(cmd.Velocity(UP, "world_aligned"))
+    start_b = loop.robot.fk(loop.ctl.q, loop.cell_ctl.frame_of("b"))
+    assert loop.snapshot.name == "a"
+    watch.run(1)
+    assert loop.snapshot.name == "b" and loop.snapshot.hand == loop.cell_ctl.frame_of("b")
+    for _ in range(100):
+        before = loop.robot.fk(loop.ctl.q, loop.cell_ctl.frame_of("a"))[:3, 3]
+        watch.run(1)
+        after = loop.robot.fk(loop.ctl.q, loop.cell_ctl.frame_of("a"))[:3, 3]
+        assert np.linalg.norm(after - before) < 1e-6
+    assert np.linalg.norm(after - hand_a) < 1e-4
+    assert watch.pose()[2, 3] - start_b[2, 3] == pytest.approx(0.002, rel=0.1)
+
+
+def test_the_target_gizmo_servoes_the_object(dual):
+    loop = CellLoop(dual, rate=RATE)
+    watch = Watch(loop)
+    goal = watch.pose().copy()
+    goal[2, 3] += 0.005
+    loop.mailbox.post(cmd.Latch(True))
+    loop.mailbox.post(cmd.Target(goal))
+    watch.run(3000)  # 2/s: e^-6 of 5 mm left after 3 s
+    assert loop.snapshot.mode == "target"
+    assert np.linalg.norm(watch.pose()[:3, 3] - goal[:3, 3]) < 5e-5
