@@ -8,9 +8,10 @@ names at a time (:meth:`CellController.commandable`: each held object, the body,
 hand; :class:`~rrc_pin.console.commands.Hand` switches among them), every other name is held
 still, and the closed chains (grips, feet in support) stay closed inside each tick.
 
-A tick whose closed chain opened beyond its bound (``grip_lost`` / ``contact_lost``) holds the
-cell: the loop releases the operator's deadman, says so in a notice and shows the status in the
-snapshot (:attr:`~rrc_pin.console.snapshot.Snapshot.lost`) until a command closes the chain.
+A tick whose closed chain opened beyond its bound (``grip_lost`` / ``contact_lost``) stops the
+cell as STOP does (the operator's deadman released, a zero command from the next tick), says so
+in a notice and shows the status in the snapshot
+(:attr:`~rrc_pin.console.snapshot.Snapshot.lost`) until a command closes the chain.
 
 What a cell's controller does not take is refused by name: a singularity strategy (a cell is
 resolved by its damped resolver) and replaying a loaded record (a cell's record is saved and
@@ -113,11 +114,16 @@ class CellLoop(ControlLoop):
                            f"singularity strategy (its resolver damps), got {name!r}")  # fmt: skip
 
     def _set_hand(self, frame: str) -> None:
-        """Command another name of the cell (the old one held still); no new controller."""
+        """Command another name of the cell (the old one held still).
+
+        The same controller goes on (its targets, chains and record): no jump, so allowed
+        while recording.
+        """
         cmd.one_of(frame, "hand", self.hands)
         if frame == self._hand:
             return
-        self._no_jump("switch what is commanded")
+        if self._busy():
+            raise InvalidInput("command", "cannot switch what is commanded: the cell is busy")
         self.operator.stop()
         self._end_stream()
         self._hand = frame
