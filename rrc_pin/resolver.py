@@ -27,7 +27,7 @@ from __future__ import annotations
 import os
 import threading
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal, cast
 
@@ -44,6 +44,7 @@ from rrc_pin.solvers.checks import as_vector, finite_number, positive
 from rrc_pin.solvers.qp_backends import make_backend
 from rrc_pin.solvers.spatial import Reference
 from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.joint_mask import free_columns, scattered, widened_rates
 from rrc_pin.solvers.tick.pipeline import DEFAULT_FALLBACKS, Method, Options, solve
 from rrc_pin.solvers.tick.problem import Constraints, TaskRows, build, finite_rows
 from rrc_pin.solvers.tick.resolution import Resolution
@@ -170,6 +171,8 @@ class Resolver:
         self._names = robot.dof_names
         self._last_qdot: Array = np.zeros(robot.nv)
         self._lock = threading.Lock()
+        self._masked: tuple[str, ...] = ()  # joint names, in the model's order
+        self._free: npt.NDArray[np.intp] | None = None  # the rates that may move, or None: all
         joint = [limit for limit in self.limits if isinstance(limit, JointLimits)]
         # the general entry now where ticks will need it; else at the first that does (tasks
         # given to a one-tool resolver, a start outside the joint limits)
@@ -189,6 +192,78 @@ class Resolver:
         """What its tasks and limits may name on the robot (:meth:`solve_at`'s kinematics are
         made on it)."""  # noqa: D205, D209
         return self._layout
+
+    @property
+    def masked(self) -> tuple[str, ...]:
+        """The joints held still by the mask (:meth:`mask`), in the robot's order."""
+        return self._masked
+
+    def mask(self, joints: str | Iterable[str]) -> None:
+        """Hold ``joints`` still from the next tick on, beside those masked already.
+
+        A masked joint's rate is exactly zero, and its column leaves every task's rows and
+        every limit's (the box loses its entry): the other joints solve as the model reduced
+        by ``pinocchio.buildReducedModel``, the masked joints locked where they are, would
+        (the same rows, limits and options; the task rows' units stay the full robot's). A
+        floating base's joint (``robot.base_joint``) masks its six rates; a joint's mimics
+        (:mod:`rrc_pin.mimic`) follow it, so are still too. Ticks with a mask take the
+        general path (not the compiled tick).
+
+        Args:
+            joints: A joint name or several (``robot.joint_names``, or ``robot.base_joint``).
+
+        Raises:
+            InvalidInput: ``joints`` is not names of the robot's joints, or names a mimic
+                joint (mask the joint it follows); the mask is then unchanged.
+        """
+        names = self._joint_names(joints)
+        with self._lock:
+            self._set_mask({*self._masked, *names})
+
+    def unmask(self, joints: str | Iterable[str] | None = None) -> None:
+        """Let ``joints`` move again from the next tick on (default every masked joint).
+
+        Raises:
+            InvalidInput: ``joints`` is not names of the robot's joints (as :meth:`mask`);
+                the mask is then unchanged. A joint that is not masked is left as it is.
+        """
+        names = set(self._masked) if joints is None else set(self._joint_names(joints))
+        with self._lock:
+            self._set_mask(set(self._masked) - names)
+
+    def _joint_names(self, joints: str | Iterable[str]) -> list[str]:
+        """``joints`` as a list of names that a mask takes, checked."""
+        robot = self.robot
+        items = [joints] if isinstance(joints, str) else joints
+        try:
+            names = list(items)
+        except TypeError:
+            raise InvalidInput("joints", f"expected joint names, got {joints!r}") from None
+        known = {*robot.joint_names, *([robot.base_joint] if robot.base_joint else [])}
+        followed = {m.name: m.primary for m in robot.mimics}
+        for name in names:
+            if isinstance(name, str) and name in followed:
+                raise InvalidInput("joints", f"{name!r} is a mimic joint: it follows "
+                                   f"{followed[name]!r}; mask that joint (its mimics are then "
+                                   "still too)")  # fmt: skip
+            if not isinstance(name, str) or name not in known:
+                raise InvalidInput("joints", f"{name!r} is not a joint of {robot.name} (its "
+                                   f"joints: {', '.join(sorted(known))})")  # fmt: skip
+        return names
+
+    def _set_mask(self, names: set[str]) -> None:
+        """The mask of the joints ``names`` (checked), for the ticks that follow."""
+        robot = self.robot
+        dofs = self._layout.joints
+        held = np.zeros(robot.nv, dtype=bool)
+        for name in names:
+            if name == robot.base_joint:
+                held[:6] = True
+            else:
+                held[dofs[name]] = True
+        order = [*([robot.base_joint] if robot.base_joint else []), *robot.joint_names]
+        self._masked = tuple(n for n in order if n in names)
+        self._free = np.flatnonzero(~held) if held.any() else None
 
     def reset(self) -> None:
         """Forget the warm starts and the previous joint rates."""
@@ -239,9 +314,9 @@ class Resolver:
             FrameNotFound: A task names a frame the robot does not have (the error lists
                 them).
         """
-        if (self._twists and type(command) is np.ndarray and type(q) is np.ndarray
-                and ref is None and dt is None and qdot_prev is None and type(priority) is str
-                and priority == "weighted"):
+        if (self._twists and self._free is None and type(command) is np.ndarray
+                and type(q) is np.ndarray and ref is None and dt is None and qdot_prev is None
+                and type(priority) is str and priority == "weighted"):
             r = self._twist(q, command)
             if r is not None:
                 return r
@@ -323,18 +398,18 @@ class Resolver:
             else:
                 rows = [[cast(FrameTask, levels[0][0]).rows_at(kin, twist, cast(Reference, ref))]]
             before = self._last_qdot if previous is None else previous
-            r = self._tick(kin, rows, weighted, step, before, start)
+            r = self._tick(kin, rows, weighted, step, before, start, levels)
             self._last_qdot = r.qdot
             return r
 
     def _tick(self, kin: Kinematics, rows: list[list[TaskRows]], weighted: bool, step: float,
-              before: Array, start: float) -> Resolution:  # fmt: skip
-        """The tick of ``rows`` within the limits: compiled where it can be, else the Python
-        pipeline (equality rows, a joint box that is not one JointLimits)."""  # noqa: D205, D209
-        compiled = self._compiled
-        if self._box_only:  # its compiled call checks the rows before anything is computed
-            return cast(CompiledTick, compiled).tasks(kin, rows, weighted, [None], before, step,
-                                                      start)  # fmt: skip
+              before: Array, start: float, tasks: list[list[Task]]) -> Resolution:  # fmt: skip
+        """The tick of ``rows`` (those of ``tasks``) within the limits: compiled where it can be,
+        else the Python pipeline (equality rows, a joint box that is not one JointLimits, a
+        joint mask)."""  # noqa: D205, D209
+        compiled = self._compiled if self._free is None else None
+        if self._box_only and compiled is not None:  # its compiled call checks the rows first
+            return compiled.tasks(kin, rows, weighted, [None], before, step, start)
         finite_rows(rows)  # before any limit computes its rows
         joint = None if compiled is None else compiled.limit
         constraints = [None if limit is joint else limit.constraints(kin, step, before)
@@ -344,10 +419,32 @@ class Resolver:
         if joint is not None:
             constraints = [joint.constraints(kin, step, before) if c is None else c
                            for c in constraints]  # fmt: skip
+        if self._free is not None:
+            joint_rows = [[t.joint_rows for t in level] for level in tasks]
+            return self._masked_tick(rows, joint_rows, cast(list[Constraints], constraints),
+                                     weighted, step, start)  # fmt: skip
         problem = build(rows, cast(list[Constraints], constraints), self.robot.nv, step,
                         weighted=weighted, direction=self.direction_preserving)  # fmt: skip
         answer = solve(problem, self.backend, self.options)
         return Resolution.of(problem, answer, time.perf_counter() - start, self._names)
+
+    def _masked_tick(self, rows: list[list[TaskRows]], joint_rows: list[list[bool]],
+                     constraints: list[Constraints], weighted: bool, step: float,
+                     start: float) -> Resolution:  # fmt: skip
+        """The tick on the free joints' columns (:mod:`rrc_pin.solvers.tick.joint_mask`), its
+        answer and problem written back over every joint."""  # noqa: D205, D209
+        free = cast(npt.NDArray[np.intp], self._free)
+        nv = self.robot.nv
+        levels, kept = free_columns(rows, joint_rows, constraints, free)
+        problem = build(levels, kept, free.size, step, weighted=weighted,
+                        direction=self.direction_preserving)  # fmt: skip
+        answer = solve(problem, self.backend, self.options)
+        qdot = widened_rates(answer.qdot, free, nv)
+        qdot.flags.writeable = False
+        report = scattered(problem, rows, free, nv)
+        masked = tuple(self._names[i] for i in np.setdiff1d(np.arange(nv), free).tolist())
+        return Resolution.of(report, answer._replace(qdot=qdot), time.perf_counter() - start,
+                             self._names)._replace(masked=masked)  # fmt: skip
 
     def rows_of(self, task: Task, q: npt.ArrayLike) -> TaskRows:
         """The rows ``A qdot ~= b`` that ``task`` gives at ``q`` (what ``solve`` stacks).

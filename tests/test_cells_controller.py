@@ -548,6 +548,31 @@ def test_the_former_closure_keywords_warn_and_still_work(dual):
     assert size == pytest.approx(np.abs(step.resolution.correction).max()) and size > 0.0
 
 
+@pytest.mark.parametrize("seed", [*FIXED, None])
+def test_a_mask_holds_its_joints_still_through_the_closure(dual, seed):
+    """gsfc_dual carrying its object under random twists, a mask of one to three joints
+    changed every 50 ticks (CellController.mask): the masked joints exactly where they were
+    (the resolver's rates and the closure's applied rates 0.0), the grip within its bound."""
+    seed = fresh() if seed is None else seed
+    rng = np.random.default_rng(seed)
+    ctl = CellController(dual, 0.01)
+    bound = ClosureBound()
+    names = ctl.robot.joint_names
+    for k in range(300):
+        if k % 50 == 0:
+            twist = rng.normal(size=6) * SPEED
+            ctl.unmask()
+            ctl.mask(rng.choice(names, int(rng.integers(1, 4)), replace=False).tolist())
+            held = [names.index(j) for j in ctl.masked]
+            start = ctl.q[held].copy()
+        r = ctl.step({"object": twist}).resolution
+        assert r.masked == ctl.masked, (seed, k)
+        assert (r.qdot[held] == 0.0).all() and (r.applied[held] == 0.0).all(), (seed, k)
+        assert np.array_equal(ctl.q[held], start), (seed, k)
+        assert ctl.chain_error[0] <= bound.position and ctl.chain_error[1] <= bound.rotation, (
+            seed, k, ctl.chain_error)  # fmt: skip
+
+
 # -- pose streams and the jerk stage (issue 41) ------------------------------------------------
 
 

@@ -291,6 +291,28 @@ def test_the_default_start_is_the_ready_pose():
         assert r.status == "exact"
 
 
+def test_a_mask_holds_its_joints_through_the_loop_and_unmask_releases_them() -> None:
+    """Controller.mask between ticks: the masked joints exactly still through the drift
+    correction and the integration, the hand still served by the others; a bad name refused
+    by name with the mask unchanged; unmask lets them move again."""
+    ctl = Controller("panda", 0.01)
+    ctl.mask(["panda_joint1", "panda_joint4"])
+    with pytest.raises(rrc_pin.InvalidInput, match="joints"):
+        ctl.mask("panda_joint8")
+    assert ctl.masked == ("panda_joint1", "panda_joint4")
+    start = ctl.q.copy()
+    for _ in range(60):
+        step = ctl.step([0.0, 0.0, 0.05, 0.0, 0.0, 0.0], ref="world_aligned")
+        assert step.resolution.masked == ctl.masked
+        assert ctl.q[0] == start[0] and ctl.q[3] == start[3]
+    assert np.abs(ctl.q - start).max() > 0.01
+    ctl.unmask()
+    assert ctl.masked == ()
+    before = ctl.q.copy()
+    ctl.step([0.0, 0.0, 0.05, 0.0, 0.0, 0.0], ref="world_aligned")
+    assert ctl.q[0] != before[0] or ctl.q[3] != before[3]
+
+
 # -- pose streams and the jerk stage (issue 41) ------------------------------------------------
 
 

@@ -9,6 +9,7 @@ import warnings
 import zlib
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -739,3 +740,97 @@ def test_an_arm_that_cannot_stop_in_one_step_is_not_recovering(arms: dict) -> No
     assert r.status != "recovering" and r.method == "qp"
     outside = arm.upper + 0.1
     assert Resolver(arm).solve(outside, np.zeros(6)).status == "recovering"
+
+
+# -- the joint mask (Resolver.mask; the exactness against a reduced model: test_joint_mask) --
+
+MIMIC_CHAIN = """<robot name="mimic">
+  <link name="base"/><link name="l0"/><link name="l1"/><link name="l2"/><link name="tool"/>
+  <joint name="j0" type="revolute"><parent link="base"/><child link="l0"/><axis xyz="0 0 1"/>
+    <limit lower="-2.5" upper="2.5" velocity="1.5" effort="1"/></joint>
+  <joint name="j1" type="revolute"><parent link="l0"/><child link="l1"/><origin xyz="0 0 0.3"/>
+    <axis xyz="0 1 0"/><limit lower="-2" upper="2" velocity="1" effort="1"/></joint>
+  <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="0 0 0.4"/>
+    <axis xyz="0 1 0"/><limit lower="-1" upper="1" velocity="1" effort="1"/>
+    <mimic joint="j1" multiplier="0.5" offset="0.1"/></joint>
+  <joint name="tool_joint" type="fixed"><parent link="l2"/><child link="tool"/>
+    <origin xyz="0 0 0.3"/></joint>
+</robot>"""
+"""A chain whose j2 follows j1."""
+
+
+def test_a_mask_holds_its_joints_and_unmask_gives_the_unmasked_answer_back() -> None:
+    """Masked rates exactly 0.0, named in the resolution and never ``active``; the twist's
+    compiled path is left while a mask is set and is the same answer once unmasked."""
+    arm = rrc_pin.load("panda")
+    q = arm.ready()
+    twist = np.array([0.3, -0.2, 0.1, 0.4, 0.2, -0.3])
+    resolver, plain = Resolver(arm), Resolver(arm)
+    resolver.mask("panda_joint3")
+    resolver.mask(["panda_joint5", "panda_joint3"])  # added to the mask, no duplicate
+    assert resolver.masked == ("panda_joint3", "panda_joint5")
+    r = resolver.solve(q, twist)
+    assert r.qdot[2] == 0.0 and r.qdot[4] == 0.0 and np.abs(r.qdot).max() > 0.1
+    assert r.masked == ("panda_joint3", "panda_joint5")
+    assert r.box.lb[2] == r.box.ub[2] == 0.0
+    assert all(a.joint not in (2, 4) for a in r.active)
+    assert r.tasks[0].commanded.shape == (6,) and r.problem.levels[0][0].A.shape == (6, 7)
+    resolver.unmask("panda_joint3")
+    assert resolver.masked == ("panda_joint5",)
+    resolver.unmask()
+    assert resolver.masked == ()
+    resolver.reset()
+    again = resolver.solve(q, twist)
+    assert again.masked == () and np.array_equal(again.qdot, plain.solve(q, twist).qdot)
+
+
+@pytest.mark.parametrize("joints", ["panda_joint9", ["panda_joint1", "nope"], 3, [None], "",
+                                    ["panda_joint1", 2.0]])  # fmt: skip
+def test_bad_mask_names_are_refused_by_name_changing_nothing(joints: object) -> None:
+    resolver = Resolver(rrc_pin.load("panda"))
+    resolver.mask("panda_joint2")
+    for call in (resolver.mask, resolver.unmask):
+        with pytest.raises(InvalidInput, match="joints") as info:
+            call(joints)  # type: ignore[operator]
+        assert isinstance(info.value, RrcPinError) and info.value.argument == "joints"
+        assert resolver.masked == ("panda_joint2",)
+
+
+def test_masking_a_primary_holds_its_mimics_and_a_mimic_is_refused(tmp_path) -> None:
+    """A mimic follows its primary: masked with it; named alone, refused naming its primary."""
+    path = tmp_path / "mimic.urdf"
+    path.write_text(MIMIC_CHAIN)
+    arm = rrc_pin.load(path)
+    resolver = Resolver(arm, task=FrameTask("tool", rows="position"))
+    with pytest.raises(InvalidInput, match="'j2' is a mimic joint: it follows 'j1'"):
+        resolver.mask("j2")
+    assert resolver.masked == ()
+    resolver.mask("j1")
+    q = np.zeros(arm.nq)
+    r = resolver.solve(q, np.array([0.05, 0.05, 0.0, 0.0, 0.0, 0.0]))
+    assert r.qdot[arm.joint_names.index("j1")] == 0.0 and np.abs(r.qdot).max() > 1e-3
+    model, j2 = arm.model, arm.model.getJointId("j2")
+    placements = []
+    for config in (q, arm.integrate(q, r.qdot, 0.01)):  # the mimic's own placement: still
+        data = model.createData()
+        pin.forwardKinematics(model, data, arm.to_pinocchio(config))
+        placements.append(data.liMi[j2].homogeneous)
+    assert np.array_equal(placements[0], placements[1])
+
+
+def test_a_floating_base_is_masked_as_one_joint() -> None:
+    """yeh_tripod's body_joint: its six rates 0.0, each leg alone serving its flange (Pinocchio's
+    buildReducedModel does not lock a free-flyer: no reduced model to compare with)."""
+    robot = rrc_pin.load("yeh_tripod")
+    q = robot.ready()
+    tasks = [FrameTask(f, np.array([0.01, 0.0, 0.02, 0.0, 0.0, 0.05]), rows="full")
+             for f in robot.tool_frames]  # fmt: skip
+    resolver = Resolver(robot)
+    resolver.mask("body_joint")
+    r = resolver.solve(q, tasks)
+    assert (r.qdot[:6] == 0.0).all() and np.abs(r.qdot[6:]).max() > 1e-3
+    assert r.masked == tuple(f"body_joint:{a}" for a in ("vx", "vy", "vz", "wx", "wy", "wz"))
+    assert r.status == "exact"
+    for task in tasks:
+        J = robot.jacobian(q, frame=task.frame)
+        assert np.abs(J[:, 6:] @ r.qdot[6:] - task.twist).max() <= 1e-9

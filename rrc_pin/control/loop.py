@@ -28,7 +28,7 @@ reverse tick are logged (:meth:`Loop._log_reverse`), and what reverse resets
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -178,6 +178,25 @@ class Loop:
         if value > 1.0:
             raise InvalidInput("speed", f"expected a finite number in [0, 1], got {value}")
         self._speed = value
+
+    @property
+    def masked(self) -> tuple[str, ...]:
+        """The joints held still by the mask (:meth:`mask`), in the robot's order."""
+        return self.resolver.masked
+
+    def mask(self, joints: str | Iterable[str]) -> None:
+        """Hold ``joints`` still from the next tick on (:meth:`~rrc_pin.resolver.Resolver.mask`).
+
+        Raises:
+            InvalidInput: ``joints`` is not names of the robot's joints, or names a mimic
+                joint; the mask is then unchanged.
+        """
+        self.resolver.mask(joints)
+
+    def unmask(self, joints: str | Iterable[str] | None = None) -> None:
+        """Let ``joints`` move again from the next tick on, default every masked joint
+        (:meth:`~rrc_pin.resolver.Resolver.unmask`)."""  # noqa: D205, D209
+        self.resolver.unmask(joints)
 
     # -- reverse ----------------------------------------------------------------------------
 

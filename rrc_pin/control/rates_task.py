@@ -23,6 +23,8 @@ class RatesTask(Task):
         name: Name in the resolution's report.
     """
 
+    joint_rows = True
+
     def __init__(self, rates: Array, name: str = "rates") -> None:
         self.rates = rates
         self.weight = 1.0

@@ -24,6 +24,8 @@ class DampingTask(Task):
         InvalidInput: A weight not > 0.
     """
 
+    joint_rows = True
+
     def __init__(self, weight: float = 1e-3, *, name: str = "damping") -> None:
         self.weight = check_weight(weight)
         self.name = task_name(name)

@@ -24,6 +24,8 @@ class JointTask(Task):
         InvalidInput: A bad joint name type, rate or weight.
     """
 
+    joint_rows = True
+
     def __init__(
         self, joint: str, rate: float = 0.0, *, weight: float = 1.0, name: str | None = None
     ) -> None:

@@ -33,6 +33,8 @@ class PostureTask(Task):
         InvalidInput: A bad q_ref, gain or weight.
     """
 
+    joint_rows = True
+
     def __init__(
         self,
         q_ref: npt.ArrayLike,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import functools
 from abc import ABC, abstractmethod
+from typing import ClassVar
 
 import numpy as np
 import numpy.typing as npt
@@ -23,10 +24,14 @@ class Task(ABC):
         name: Name in the resolution's report.
         weight: Cost of the task's squared residual (weighted priorities) and its rows' weight
             within a strict level; > 0, scalar or one per row.
+        joint_rows: Whether each row is one joint's own rate (a row of the identity): a joint
+            mask (``Resolver.mask``) drops the rows of the joints it holds, as a model without
+            them would have none; other tasks keep every row.
     """
 
     name: str
     weight: float | Array
+    joint_rows: ClassVar[bool] = False
 
     @abstractmethod
     def frames(self) -> tuple[str, ...]:

@@ -131,6 +131,7 @@ class _Record(NamedTuple):
     solve_time: float
     source: Problem | Deferred
     joint_names: tuple[str, ...] | None = None
+    masked: tuple[str, ...] = ()
 
 
 class Resolution(_Record):
@@ -165,6 +166,8 @@ class Resolution(_Record):
         problem: The problem it answers (tasks' rows, box, constraint rows), built on first
             access where it was deferred.
         joint_names: Joint names for :attr:`ActiveLimit.name`, or None.
+        masked: The names (``joint_names``) of the rates a joint mask held at exactly zero
+            (``Resolver.mask``): out of every task and limit, so never in :attr:`active`.
     """
 
     @classmethod
@@ -199,7 +202,10 @@ class Resolution(_Record):
     @cached_property
     def active(self) -> tuple[ActiveLimit, ...]:
         """Joint bounds the answer touches, by joint then side (:data:`ACTIVE_TOL`)."""
-        return active_limits(self.qdot, self.box, self.joint_names)
+        active = active_limits(self.qdot, self.box, self.joint_names)
+        if self.masked:  # held at a zero box by the mask, not by a limit
+            active = tuple(a for a in active if a.name not in self.masked)
+        return active
 
     @cached_property
     def active_rows(self) -> tuple[ActiveRow, ...]:
