@@ -450,3 +450,41 @@ def test_the_last_page_closing_releases_the_deadman(console, page):
     )
     assert "no page connected" in loop.notices[-1].text
     assert loop.alive
+
+
+def test_a_cells_console_at_1_khz_drives_the_object_and_a_pages_stop_holds_it(browser, tmp_path):
+    """gsfc_dual served at 1 kHz: the page shows the cell and names its held object; latched,
+    the object goes up (20 mm/s) with the grip held; the page's STOP is taken out of band
+    (the guard's urgents) and the cell then holds still to 1e-6 m over 100 more ticks."""
+    c = Console("gsfc_dual", port=0, rate=1000.0, out=tmp_path)
+    c.start()
+    context = browser.new_context(viewport={"width": 1000, "height": 700})
+    context.set_default_timeout(1000 * PATIENCE)
+    try:
+        page = context.new_page()
+        page.goto(c.url)
+        page.get_by_text("hold to move").wait_for()
+        loop = c.loop
+        assert loop.hands == ("object",) and loop.dt == pytest.approx(1e-3, abs=1e-15)
+        wait_for(lambda: c.panel.status.content.count('data-field="hand" style="color:inherit">'
+                                                      "object<") == 1, what="the object named")
+        start = loop.robot_pose()
+        loop.mailbox.post(Latch(True))
+        loop.mailbox.post(Velocity(np.array([0.0, 0.0, 0.02, 0.0, 0.0, 0.0]), "world_aligned"))
+        wait_for(lambda: moved(loop, start) > 0.005, what="the object 5 mm up")
+        d = loop.robot_pose()[:3, 3] - start[:3, 3]
+        assert np.linalg.norm(d[:2]) < 1e-3 * np.linalg.norm(d) + 1e-6
+        page.evaluate("document.activeElement && document.activeElement.blur()")
+        page.keyboard.press(" ")  # STOP
+        wait_for(lambda: not loop.operator.latched and loop.snapshot.stops == 1, what="STOP")
+        assert c.guard.urgents == 1
+        wait_for(lambda: not loop.snapshot.enabled, what="released")
+        held, ticks = loop.robot_pose(), loop.clock.ticks
+        wait_for(lambda: loop.clock.ticks > ticks + 100, what="100 more ticks")
+        assert moved(loop, held) < 1e-6
+        position, rotation = loop.cell_ctl.chain_error
+        assert loop.snapshot.lost is None and max(position, rotation) <= 2e-5
+        assert loop.errors == 0 and c.view.errors == 0, c.view.last_error
+    finally:
+        context.close()
+        c.stop()

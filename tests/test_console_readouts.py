@@ -85,3 +85,25 @@ def test_status_block_names_every_field():
     assert fields["singularity"] == "none" and fields["active"] == "none"
     assert fields["loop"] == "100 Hz: period median 10.00 ms, p99 12.00 ms"
     assert fields["notice"] == "saved x.csv"
+    assert "lost" not in fields and fields["hand"] == arm.tool_frames[0]
+
+
+def test_a_cells_status_names_what_is_commanded_and_a_lost_chain_in_red():
+    """gsfc_dual: the hand field names the held object, the readings are its frame's (the
+    commanded 20 mm/s up achieved within 1e-5 m/s); a lost grip is a red field."""
+    from rrc_pin.console.cell_loop import CellLoop
+
+    cell = rrc_pin.load("gsfc_dual")
+    loop = CellLoop(cell, rate=1000.0)
+    loop.mailbox.post(cmd.Latch(True))
+    loop.mailbox.post(cmd.Velocity(np.array([0, 0, 0.02, 0, 0, 0]), "world_aligned"))
+    for k in range(5):
+        snap = loop.tick(k * loop.dt)
+    readings = Reader(cell).read(snap, loop.robot_pose())
+    np.testing.assert_allclose(readings.achieved[:3], [0, 0, 0.02], atol=1e-5)
+    stats = PeriodStats(10, 0.001, 0.0012, 0.002)
+    fields = dict(re.findall(r'data-field="(\w+)"[^>]*>([^<]*)<',
+                             status_html(snap, readings, stats, 1000.0)))  # fmt: skip
+    assert fields["hand"] == "object" and "lost" not in fields and fields["strategy"] == "none"
+    out = status_html(snap._replace(lost="grip_lost"), readings, stats, 1000.0)
+    assert f'data-field="lost" style="color:{RED}">grip_lost<' in out

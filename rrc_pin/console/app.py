@@ -2,8 +2,9 @@
 
 Threads, from the robot outward:
 
-1. the control loop (:class:`~rrc_pin.console.loop.ControlLoop`): owns the controller, ticks
-   at ``rate`` (100 Hz by default), reads the mailbox at every tick;
+1. the control loop (:class:`~rrc_pin.console.loop.ControlLoop`; for a cell its
+   :class:`~rrc_pin.console.cell_loop.CellLoop`): owns the controller, ticks at ``rate``
+   (100 Hz by default; 1000 for 1 kHz, a cell's included), reads the mailbox at every tick;
 2. viser's event loop: checks every request and message (:mod:`~rrc_pin.console.guard`),
    receives the pages' messages and runs the panel's callbacks in the order the messages
    came, which only post commands to the mailbox; it asks for the loop's scheduling, a step
@@ -25,9 +26,10 @@ from typing import Any
 import numpy.typing as npt
 
 from rrc_pin.console.access import Access
+from rrc_pin.console.cell_loop import loop_of
 from rrc_pin.console.commands import Released, Target
 from rrc_pin.console.intake import Intake
-from rrc_pin.console.loop import LOOP_NICE, REALTIME_PRIORITY, ControlLoop, schedule
+from rrc_pin.console.loop import LOOP_NICE, REALTIME_PRIORITY, schedule
 from rrc_pin.console.mailbox import Mailbox
 from rrc_pin.console.operator import OperatorSettings
 from rrc_pin.console.panel import Panel
@@ -106,9 +108,8 @@ class Console:
             raise InvalidInput("port", f"expected a port number 0 to 65535, got {port!r}")
         self.host, self.port, self.view_rate = host, port, view_rate
         self.out = Path(out)
-        self.loop = ControlLoop(self.robot, rate=rate, q0=q0, mailbox=Mailbox(),
-                                settings=settings, strategy=strategy, backend=backend,
-                                realtime=realtime)  # fmt: skip
+        self.loop = loop_of(self.robot, rate=rate, q0=q0, mailbox=Mailbox(), settings=settings,
+                            strategy=strategy, backend=backend, realtime=realtime)  # fmt: skip
         self.server: Any = None
         self.guard: Any = None
         self.io_scheduling = "not started"

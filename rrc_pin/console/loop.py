@@ -28,12 +28,14 @@ from typing import Literal, NamedTuple, cast
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.cells.cell_log import CellLog
 from rrc_pin.console import commands as cmd
 from rrc_pin.console.mailbox import Mailbox, urgent
 from rrc_pin.console.operator import Operator, OperatorSettings
 from rrc_pin.console.rate import Rate, TickClock
 from rrc_pin.console.snapshot import Mode, Snapshot
 from rrc_pin.control import STRATEGIES, Controller, TrajectoryLog, make_strategy
+from rrc_pin.control.loop import Loop
 from rrc_pin.errors import InvalidInput, RrcPinError
 from rrc_pin.limits import JointLimits
 from rrc_pin.resolver import QPOptions, Resolver
@@ -153,7 +155,9 @@ class ControlLoop:
         cmd.one_of(backend, "backend", self.backends)
         cmd.one_of(strategy, "strategy", tuple(STRATEGIES))
         self._strategy, self._backend, self._hand = strategy, backend, self.hands[0]
-        self.ctl = self._controller(self.start_q, self._hand)
+        self.ctl: Loop = self._controller(self.start_q, self._hand)
+        self.hands = self._commandable()
+        self._hand = self.hands[0]
         self.recording = False
         self.notices: collections.deque[Notice] = collections.deque(maxlen=50)
         self.errors = 0
@@ -252,7 +256,7 @@ class ControlLoop:
             self._stop_now = False
             self._replay.clear()
             self._end_stream()
-            return self._publish(*self._step(np.zeros(6), "local"), "teleop")
+            return self._publish(*self._step(np.zeros(6), "local"), "teleop", False)
         if self._replay:
             twist = self._replay.popleft()
             if not self._replay:
@@ -264,7 +268,7 @@ class ControlLoop:
         if stream is not None:  # the device's: held (clutched) while the deadman is released
             enabled = self.operator.enabled(now)
             stream.clutch(self._clutch or not enabled, self.ctl.t)
-            return self._publish(self.ctl.step().resolution, None, "stream", enabled)
+            return self._publish(self._step(None, "local")[0], None, "stream", enabled)
         pose = self.robot_pose() if self.operator.needs_pose() else None
         wanted = self.operator.twist(now, pose)
         mode: Mode = "target" if wanted is not None and pose is not None else "teleop"
@@ -273,9 +277,13 @@ class ControlLoop:
         return self._publish(*self._step(*wanted), mode)
 
     def _step(self, twist: Array | None, frame: cmd.Frame) -> tuple[Resolution, Array | None]:
-        """The one call of ``Controller.step``."""
-        step = self.ctl.step(twist, ref=frame)
+        """The one call of ``Controller.step``: ``twist`` (None: no new command) to the hand."""
+        step = self._arm().step(twist, ref=frame)
         return step.resolution, twist
+
+    def _arm(self) -> Controller:
+        """The controller, an arm's (:class:`~rrc_pin.console.cell_loop.CellLoop` a cell's)."""
+        return cast(Controller, self.ctl)
 
     def _publish(self, resolution: Resolution | None, twist: Array | None, mode: Mode,
                  enabled: bool | None = None) -> Snapshot:  # fmt: skip
@@ -316,7 +324,12 @@ class ControlLoop:
             target=self.operator.target,
             latched=self.operator.latched,
             stops=self.operator.stops,
+            name=self._hand,
         )
+
+    def _commandable(self) -> tuple[str, ...]:
+        """The names the controls command (:class:`~rrc_pin.console.commands.Hand`): tool frames."""
+        return self.robot.tool_frames
 
     def robot_pose(self) -> Array:
         """The commanded hand's pose (4, 4) at the controller's q (base frame) [m]."""
@@ -374,13 +387,13 @@ class ControlLoop:
             return
         if self._busy() or self._replay or self._full:
             return
-        stream = self.ctl.streams.get(self._hand) or self.ctl.stream()
+        stream = self.ctl.streams.get(self._hand) or self.ctl.stream(self._hand)
         self._clutch = c.clutch
         stream.push(self.ctl.t, c.pose)
 
     def _end_stream(self) -> None:
         if self._hand in self.ctl.streams:
-            self.ctl.close_stream()
+            self.ctl.close_stream(self._hand)
 
     def _busy(self) -> bool:
         return self._job is not None or bool(self._playback)
@@ -398,16 +411,16 @@ class ControlLoop:
             )
         strategy = make_strategy(name)
         strategy.check(self.ctl.robot)
-        self.ctl.strategy = strategy
+        self._arm().strategy = strategy
         self._strategy = name
 
     def _set_backend(self, name: str) -> None:
         cmd.one_of(name, "backend", self.backends)
         # A resolver of the same robot, period and limits (its default task: the controller's
         # task rows are unchanged); the controller keeps its q, log and reference pose.
-        self.ctl.resolver = Resolver(
-            self.ctl.robot, self.dt, limits=self.ctl.resolver.limits, qp=QPOptions(backend=name)
-        )
+        self.ctl.resolver = Resolver(self.ctl.robot, self.dt, limits=self.ctl.resolver.limits,
+                                     qp=QPOptions(backend=name),
+                                     damping=self.ctl.resolver.options.damping)  # fmt: skip
         self._backend = name
 
     def _set_hand(self, frame: str) -> None:
@@ -451,7 +464,7 @@ class ControlLoop:
             raise InvalidInput("command", "the arm is busy")
         if not self.recording or len(self.ctl.log) == 0:
             raise InvalidInput("path", "nothing recorded: start recording first")
-        log = self.ctl.log
+        log = cast("TrajectoryLog | CellLog", self.ctl.log)  # (an arm's or a cell's: both save)
 
         def work() -> Path:
             try:
@@ -516,7 +529,7 @@ class ControlLoop:
             self.notice("info", f"replaying {len(twists)} ticks from the record's start")
         return True
 
-    def _controller(self, q: Array, hand: str, speed: float = 1.0) -> Controller:
+    def _controller(self, q: Array, hand: str, speed: float = 1.0) -> Loop:
         """A new controller of ``hand`` at ``q`` with the loop's settings (an empty log).
 
         A new one rather than setting ``q``: the controller's reference pose (its drift

@@ -143,10 +143,12 @@ class Panel:
             self.joints = gui.add_html("")
             self.status = gui.add_html("")
         with gui.add_folder("Resolution", expand_by_default=False):
-            self.strategy = gui.add_dropdown("strategy", loop.strategies,
-                                             initial_value=loop.snapshot.strategy)  # fmt: skip
-            self.strategy.on_update(self._guard(lambda e: cmd.Strategy(
-                cmd.one_of(self.strategy.value, "strategy", loop.strategies))))
+            self.strategy = None
+            if loop.strategies:  # (a cell's controller takes none)
+                self.strategy = gui.add_dropdown("strategy", loop.strategies,
+                                                 initial_value=loop.snapshot.strategy)  # fmt: skip
+                self.strategy.on_update(self._guard(lambda e: cmd.Strategy(cmd.one_of(
+                    self.strategy.value, "strategy", loop.strategies))))  # type: ignore[union-attr]
             self.backend = gui.add_dropdown("backend", loop.backends,
                                             initial_value=loop.snapshot.backend)  # fmt: skip
             self.backend.on_update(self._guard(lambda e: cmd.Backend(

@@ -8,7 +8,9 @@ near singularities; the console shows, at the view's rate:
 - the smallest singular value of the commanded hand's task Jacobian and the singularity near
   (:class:`~rrc_pin.control.singularity.SingularityLabel`: Barker's named conditions on
   ``barker6``, the weak joint and direction elsewhere);
-- the resolver's status, method and scale, and the active limits by name.
+- the resolver's status, method and scale, and the active limits by name;
+- a cell's commanded name (its object, its body, a free hand) and, while a closed chain is
+  open beyond its bound, ``grip_lost`` or ``contact_lost`` in red (the cell holds).
 
 The numbers come from :func:`read` (the kinematics at the snapshot's q, in the caller's thread:
 the loop does not pay for them); the HTML from :func:`joints_html` and :func:`status_html`.
@@ -160,7 +162,8 @@ def status_html(snapshot: Snapshot, readings: Readings, stats: PeriodStats, rate
     fields = [
         ("deadman", "held" if snapshot.enabled else "released"),
         ("mode", snapshot.mode),
-        ("hand", snapshot.hand),
+        ("hand", snapshot.name or snapshot.hand),
+        *([("lost", snapshot.lost)] if snapshot.lost is not None else []),
         ("status", "-" if r is None else r.status),
         ("method", "-" if r is None else r.method),
         ("scale", "-" if r is None else f"{r.scale:.3f}"),
@@ -177,7 +180,7 @@ def status_html(snapshot: Snapshot, readings: Readings, stats: PeriodStats, rate
         ("notice", note or "-"),
     ]  # fmt: skip
     alert = {"singularity": bool(readings.singularity), "active": bool(active_names(snapshot)),
-             "deadman": not snapshot.enabled}  # fmt: skip
+             "deadman": not snapshot.enabled, "lost": True}  # fmt: skip
     rows = [
         f'<div style="font:11px monospace;margin:1px 0"><b>{k}</b>: '
         f'<span data-field="{k}" style="color:{RED if alert.get(k) else "inherit"}">'

@@ -40,6 +40,10 @@ class Snapshot(NamedTuple):
         target: The pose (4, 4) the hand servoes to, or None.
         latched: Whether the deadman is latched.
         stops: The operator's stop count (every stop, from the page or from the loop).
+        name: What the controls command: the hand's tool frame (an arm), or a cell's
+            commanded name (an object, the body, a free hand's arm: ``hand`` its frame).
+        lost: ``"grip_lost"`` or ``"contact_lost"`` while a cell's closed chain is open
+            beyond its bound (the cell holds), else None.
     """
 
     tick: int
@@ -59,3 +63,5 @@ class Snapshot(NamedTuple):
     target: Array | None
     latched: bool
     stops: int
+    name: str = ""
+    lost: str | None = None
