@@ -1,4 +1,4 @@
-"""Shared fixtures: seeded generators and two facing pandas."""
+"""Shared fixtures: seeded generators, two facing pandas, the catalogue's cells."""
 
 from __future__ import annotations
 
@@ -9,11 +9,28 @@ import numpy as np
 import pytest
 
 import rrc_pin
+from rrc_pin.cells import Cell
 
 
 @pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(20261122)
+
+
+@pytest.fixture(scope="module")
+def dual() -> Cell:
+    """The GSFC dual-arm telerobot, loaded once a test module."""
+    cell = rrc_pin.load("gsfc_dual")
+    assert isinstance(cell, Cell)
+    return cell
+
+
+@pytest.fixture(scope="module")
+def tripod() -> Cell:
+    """Yeh's three-legged robot, loaded once a test module."""
+    cell = rrc_pin.load("yeh_tripod")
+    assert isinstance(cell, Cell)
+    return cell
 
 
 @pytest.fixture(scope="session")

@@ -7,22 +7,8 @@ import pinocchio as pin
 import pytest
 
 import rrc_pin
-from rrc_pin.cells import Cell, make_cell
+from rrc_pin.cells import make_cell
 from rrc_pin.errors import InvalidInput, UnknownArm
-
-
-@pytest.fixture(scope="module")
-def dual() -> Cell:
-    cell = rrc_pin.load("gsfc_dual")
-    assert isinstance(cell, Cell)
-    return cell
-
-
-@pytest.fixture(scope="module")
-def tripod() -> Cell:
-    cell = rrc_pin.load("yeh_tripod")
-    assert isinstance(cell, Cell)
-    return cell
 
 
 def test_ready_made_cells_load_by_name_with_their_parts(dual, tripod):

@@ -11,11 +11,6 @@ from rrc_pin.cells.cell_resolution import CellResolution
 from rrc_pin.solvers.tick.kernels import scale_and_veer
 
 
-@pytest.fixture(scope="module")
-def dual():
-    return rrc_pin.load("gsfc_dual")
-
-
 def test_a_tick_reports_its_applied_rates_and_its_hands(dual):
     """The configuration moves by ``applied`` (the resolver's rates and the closure's
     correction); the tasks list the object, then both hands at level 0, then the posture;

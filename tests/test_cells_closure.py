@@ -22,16 +22,6 @@ def fresh() -> int:
     return int(np.random.SeedSequence().entropy % 2**63)
 
 
-@pytest.fixture(scope="module")
-def dual():
-    return rrc_pin.load("gsfc_dual")
-
-
-@pytest.fixture(scope="module")
-def tripod():
-    return rrc_pin.load("yeh_tripod")
-
-
 def kinematics(cell, q):
     """The kinematics of a tick at ``q`` (a controller's: its own Data)."""
     _, dof, q_pin = cell.positions(q)

@@ -44,16 +44,6 @@ def fresh() -> int:
 
 
 @pytest.fixture(scope="module")
-def dual():
-    return rrc_pin.load("gsfc_dual")
-
-
-@pytest.fixture(scope="module")
-def tripod():
-    return rrc_pin.load("yeh_tripod")
-
-
-@pytest.fixture(scope="module")
 def soak():
     """benchmarks/bench_cells.py's soak, run short here (its long run is the benchmark)."""
     sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "benchmarks"))

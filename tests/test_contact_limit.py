@@ -11,11 +11,6 @@ from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits import ContactLimit, JointLimits
 
 
-@pytest.fixture(scope="module")
-def tripod():
-    return rrc_pin.load("yeh_tripod")
-
-
 def test_the_feet_are_held_and_their_anchors_errors_measured(tripod):
     """The rows keep every foot still; the error is each foot's [p* - p; log(R* R^T)] at the
     tick's configuration (world axes), in the resolver's metric units (the reach)."""

@@ -445,11 +445,6 @@ def test_type_iii_turns_gradually_up_to_a_half_turn(degrees):
 # -- frame=: one frame of a robot with several tool frames ------------------------------------
 
 
-@pytest.fixture(scope="module")
-def dual():
-    return rrc_pin.load("gsfc_dual")
-
-
 def _goal_of(cell, q, frame):
     """A goal 5 cm and 0.2 rad from ``frame``'s pose at ``q``."""
     T = cell.fk(q, frame)
