@@ -23,6 +23,7 @@ MODULES = {
     "controller": "bench_controller",
     "control_schemes": "bench_control_schemes",
     "collision": "bench_collision",
+    "cells": "bench_cells",
 }
 """Benchmark -> the module whose ``plot(result, path)`` draws it (the study's figure needs its
 sampled runs, not only the JSON: rerun ``rrc-pin bench --only study``)."""
