@@ -279,7 +279,8 @@ def correction(
     Cm = np.empty((m, n))  # the resolver's metric: metres per reach
     for i in range(m):
         Cm[i] = C[i] / unit[i]
-    null, keep = np.zeros((0, n)), np.zeros((top.shape[0], 0))
+    null: Array = np.zeros((0, n))
+    keep: Array = np.zeros((top.shape[0], 0))
     if top.shape[0] > 0 and m < n:
         Q, R = np.empty((n, n)), np.empty((n, m))
         householder_qr(np.ascontiguousarray(Cm.T), Q, R)

@@ -224,7 +224,7 @@ def _rigid(value: object) -> Array:
     Raises:
         InvalidInput: Naming ``pose``: not a finite (4, 4) rigid transform.
     """
-    pose: Array = np.array(as_array(value, "pose", (4, 4)), dtype=np.float64)  # type: ignore[arg-type]
+    pose: Array = np.array(as_array(value, "pose", (4, 4)), dtype=np.float64)  # type: ignore[arg-type, unused-ignore]
     R = pose[:3, :3]
     if not (np.allclose(R @ R.T, np.eye(3), atol=1e-6) and np.allclose(pose[3], [0, 0, 0, 1])
             and np.linalg.det(R) > 0.0):  # fmt: skip
