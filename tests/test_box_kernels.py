@@ -35,8 +35,11 @@ def kernel_args(ends, r, box):
 def coal_signed(r, length, capsule, box):
     (Ra, ta), (Rb, tb, half) = capsule, box
     result = coal.DistanceResult()
+    request = coal.DistanceRequest()  # EPA to its precision: its default 1e-6 is coarser than TOL
+    request.gjk_tolerance = request.epa_tolerance = 1e-12
+    request.epa_max_iterations = 1000
     coal.distance(coal.Capsule(r, length), coal.Transform3s(Ra, ta), coal.Box(*(2 * half)),
-                  coal.Transform3s(Rb, tb), coal.DistanceRequest(), result)  # fmt: skip
+                  coal.Transform3s(Rb, tb), request, result)  # fmt: skip
     return result.min_distance
 
 
