@@ -2,10 +2,9 @@
 and every installed backend, extreme commands included. Every answer finite, inside the
 velocity and one-step position limits, a ``scaled`` answer along its command, no exception.
 
-Fresh seeds at every run (printed on failure; ``SOAKSEED=S`` replays seed S). ``RRC_PIN_SOAK=N``
-sets the steps per arm for
-the default backend (a tenth for each other one); the suite's default is small, and
-docs/api.md ("Reliability") records a run of 10^5 steps per arm.
+Fresh seeds at every run (printed on failure; ``SOAKSEED=S`` replays seed S).
+``RRC_PIN_SOAK=N`` sets the steps per arm for the default backend (a tenth for each other one);
+the suite's default is small, and docs/api.md ("Reliability") records a run of 10^5 steps per arm.
 """
 
 from __future__ import annotations
