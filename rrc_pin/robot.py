@@ -20,11 +20,8 @@ saying why.
 Threads: a Robot may be shared between threads. Its methods never write shared state: each
 thread computes in its own ``pinocchio.Data`` (a ``threading.local``, created on the thread's
 first call), and :meth:`Robot.to_pinocchio` returns a new array. Chosen over one Data behind
-a ``threading.Lock`` by measurement (panda, 2-core AMD EPYC, Pinocchio 4.1, six interleaved
-runs of 20,000 calls): one thread, ``fk`` 4.7-7.0 us per call either way and ``jacobian``
-4.4-6.7 us (the two within run-to-run noise); two threads calling at once, 4.5-7.4 us per
-call with a Data per thread and 5.2-11.9 us with the lock, whose callers wait for each other.
-The cost of a Data per thread is its memory: about 0.2 MB for panda, 0.8 MB for baxter.
+a ``threading.Lock`` by measurement (docs/api.md, "Threads"): as fast on one thread, and two
+threads do not wait for each other; the cost is a Data's memory per thread.
 """
 
 from __future__ import annotations

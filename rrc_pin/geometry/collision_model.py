@@ -393,7 +393,7 @@ class CollisionModel:
                select: Select | None = None) -> Proximity:  # fmt: skip
         if not isinstance(data, CollisionData):
             raise InvalidInput("data", f"expected cm.create_data()'s, got {type(data).__name__}")
-        if not (type(detection) is float and 0.0 <= detection < np.inf):  # 1 us saved a tick
+        if not (type(detection) is float and 0.0 <= detection < np.inf):
             detection = finite_number(detection, "detection", 0.0)
         return query(self._scene, self.robot.model, q, placed, data, detection, ends is True,
                      select)  # fmt: skip

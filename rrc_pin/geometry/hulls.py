@@ -1,10 +1,9 @@
 """Collision meshes as convex hulls, built once per process.
 
 coal measures a mesh (a BVH of triangles) against another shape by its triangles: in
-penetration it returns a distance of 0, with no sign and no useful normal, and it is slow (the
-issue measured 71 us a pair for panda's meshes). The convex hull of the same mesh gets GJK and
-EPA: a signed distance, witness points and a normal in penetration as well, in about a
-microsecond. A hull holds its mesh, so it is conservative (it fills concavities).
+penetration it returns a distance of 0, with no sign and no useful normal, and it is slow. The
+convex hull of the same mesh gets GJK and EPA: a signed distance, witness points and a normal in
+penetration as well, in about a microsecond. A hull holds its mesh, so it is conservative (it fills concavities).
 
 Hulls are built by qhull through coal (``BVHModel.buildConvexHull``) the first time a mesh is
 met, and kept in memory for the process, keyed by the mesh file and scale: a second robot (the

@@ -78,8 +78,8 @@ class Nearness(NamedTuple):
 def nearness(cf: BarkerClosedForm, q: Array) -> Nearness:
     """Barker's singularity conditions (32), (33) and S5 at ``q`` (6,), normalised.
 
-    The values of ``cf.singularity(q)`` on Python floats: 4 us against its 100 us (its batch
-    path on one row; measured), for every tick of a controller.
+    The values of ``cf.singularity(q)`` on Python floats, for every tick of a controller (its
+    batch path costs more on one row).
     """
     g = cf.geometry
     t = joint_trig(q)
