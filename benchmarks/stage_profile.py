@@ -11,8 +11,9 @@ benchmark:
   tasks the FrameTasks built in the call and ``Resolver.solve(q, tasks)`` (``solve``);
 - ``q check``: ``Robot.configuration``; ``task checks``: the tasks and levels checked
   against the robot (``Resolver._levels``, tasks only);
-- ``kinematics``: every joint's Jacobian and every frame's pose (``Kinematics``, when a tick
-  needs more than one frame), of which ``jacobian`` is one frame's (``Kinematics.jacobian``);
+- ``kinematics``: every joint's Jacobian (``Kinematics``, when a tick needs more than one
+  frame) and every frame's pose (when it needs a pose of another frame); ``jacobian`` is one
+  frame's (``Kinematics.jacobian``);
 - ``task rows``: the tasks' rows (``FrameTask.rows_at`` and every task's ``rows``);
 - ``limits``: the limits' constraints (``JointLimits.constraints``: the step's box);
 - ``problem``: the problem built (``rrc_pin.solvers.tick.problem.build``);
@@ -140,7 +141,8 @@ def _targets(resolver: Any, tasks: bool) -> list[tuple[Any, str, str]]:
         (resolver, "solve", "solve"),
         (resolver.robot, "configuration", "q check"),
         (resolver.backend, "solve", "backend"),
-        (kinematics_module.Kinematics, "_compute_whole", "kinematics"),
+        (kinematics_module.Kinematics, "_compute_joints", "kinematics"),
+        (kinematics_module.Kinematics, "_compute_frames", "kinematics"),
         (kinematics_module.Kinematics, "jacobian", "jacobian"),
         (JointLimits, "constraints", "limits"),
         (resolver_module, "build", "problem"),
