@@ -9,7 +9,7 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.kinematics import Kinematics
+from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.solvers.checks import all_finite, as_vector, positive, real_array, rigid_transform
 from rrc_pin.solvers.spatial import Reference, check_reference
 from rrc_pin.solvers.tick.problem import TaskRows
@@ -153,6 +153,15 @@ class FrameTask(Task):
     def frames(self) -> tuple[str, ...]:
         """The commanded frame."""
         return (self.frame,)
+
+    def check(self, layout: Layout) -> None:
+        """Refuse a frame the robot does not have (:meth:`Task.check`, its one frame first).
+
+        Raises:
+            FrameNotFound: The error lists the robot's frames.
+        """
+        if self.frame not in layout.frames:
+            super().check(layout)
 
     def rows(self, kin: Kinematics) -> TaskRows:
         """The frame's Jacobian rows and the commanded twist."""
