@@ -9,10 +9,11 @@ benchmark:
 
 - ``step``: the contender's whole call (the total): ``Resolver.solve(q, twist)``, or for
   tasks the FrameTasks built in the call and ``Resolver.solve(q, tasks)`` (``solve``);
-- ``q check``: ``Robot.configuration``; ``task checks``: the tasks and levels checked
-  against the robot (``Resolver._levels``, tasks only);
-- ``kinematics``: every joint's Jacobian and every frame's pose (``Kinematics``, when a tick
-  needs more than one frame), of which ``jacobian`` is one frame's (``Kinematics.jacobian``);
+- ``q check``: ``Robot.positions`` and ``Robot.configuration``; ``task checks``: the tasks
+  and levels checked against the robot (``Resolver._levels``, tasks only);
+- ``kinematics``: every joint's Jacobian (``Kinematics``, when a tick needs more than one
+  frame) and every frame's pose (when it needs a pose of another frame); ``jacobian`` is one
+  frame's (``Kinematics.jacobian``);
 - ``task rows``: the tasks' rows (``FrameTask.rows_at`` and every task's ``rows``);
 - ``limits``: the limits' constraints (``JointLimits.constraints``: the step's box);
 - ``problem``: the problem built (``rrc_pin.solvers.tick.problem.build``);
@@ -56,7 +57,7 @@ Array = npt.NDArray[np.float64]
 STAGES = {
     "step": "the call's own code: building the tasks (none for one twist)",
     "solve": "Resolver.solve's own code",
-    "q check": "Robot.configuration",
+    "q check": "Robot.positions and Robot.configuration",
     "task checks": "tasks and levels checked against the robot",
     "kinematics": "every joint's Jacobian and frame's pose (several frames)",
     "jacobian": "one frame's Jacobian (Kinematics.jacobian)",
@@ -138,9 +139,11 @@ def _targets(resolver: Any, tasks: bool) -> list[tuple[Any, str, str]]:
     resolver_module = sys.modules[type(resolver).__module__]
     out: list[tuple[Any, str, str]] = [
         (resolver, "solve", "solve"),
+        (resolver.robot, "positions", "q check"),
         (resolver.robot, "configuration", "q check"),
         (resolver.backend, "solve", "backend"),
-        (kinematics_module.Kinematics, "_compute_whole", "kinematics"),
+        (kinematics_module.Kinematics, "_compute_joints", "kinematics"),
+        (kinematics_module.Kinematics, "_compute_frames", "kinematics"),
         (kinematics_module.Kinematics, "jacobian", "jacobian"),
         (JointLimits, "constraints", "limits"),
         (resolver_module, "build", "problem"),

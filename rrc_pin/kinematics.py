@@ -3,9 +3,11 @@
 :class:`Kinematics` answers frame Jacobians and poses at one configuration from a
 ``pinocchio.Data`` that belongs to its caller (a resolver's own: never a Data shared between
 threads). It computes lazily: the first Jacobian asked for comes from one
-``computeFrameJacobian`` call (what a one-frame tick needs); a second frame, or a pose, runs
-``computeJointJacobians`` and ``updateFramePlacements`` once, and every later request reads
-them. :class:`Layout` is what tasks and limits may name on a robot, prepared once.
+``computeFrameJacobian`` call (what a one-frame tick needs); a second frame runs
+``computeJointJacobians`` once (every joint's Jacobian, which ``getFrameJacobian`` reads for
+every later frame), and a pose of another frame ``updateFramePlacements`` once (every frame's
+pose: the Jacobians do not read them). :class:`Layout` is what tasks and limits may name on a
+robot, prepared once.
 """
 
 from __future__ import annotations
@@ -121,8 +123,8 @@ class Kinematics:
         layout: The robot's layout.
     """
 
-    __slots__ = ("_data", "_first", "_jacobians", "_model", "_placed", "_whole", "layout", "q",
-                 "q_pin")  # fmt: skip
+    __slots__ = ("_data", "_first", "_framed", "_jacobians", "_joints", "_model", "_placed",
+                 "layout", "q", "q_pin")  # fmt: skip
 
     def __init__(
         self, model: pin.Model, data: pin.Data, layout: Layout, q: Array, q_pin: Array
@@ -130,7 +132,8 @@ class Kinematics:
         self.q, self.q_pin, self.layout = q, q_pin, layout
         self._model, self._data = model, data
         self._first: str | None = None  # the one frame whose Jacobian computeFrameJacobian gave
-        self._whole = False  # every joint's Jacobian and every frame's pose computed
+        self._joints = False  # every joint's placement and Jacobian computed
+        self._framed = False  # every frame's pose computed
         self._placed = False  # the joints supporting _first placed (a world_aligned or world
         # Jacobian of it: Pinocchio's local one does not place them)
         self._jacobians: dict[tuple[str, str], Array] = {}
@@ -142,8 +145,9 @@ class Kinematics:
 
     @property
     def data(self) -> pin.Data:
-        """The Data with every joint's placement and Jacobian at q (computed on first use)."""
-        self._compute_whole()
+        """The Data with every joint's placement and Jacobian and every frame's pose at q
+        (computed on first use)."""  # noqa: D205, D209
+        self._compute_frames()
         return self._data
 
     def jacobian(self, frame: str, ref: Reference = "world_aligned") -> Array:
@@ -162,14 +166,14 @@ class Kinematics:
             return np.asarray(layout.closed_form.jacobian(self.q), dtype=np.float64)
         fid = layout.frames[frame]
         J: Array
-        if not self._whole and (self._first is None or self._first == frame):
+        if not self._joints and (self._first is None or self._first == frame):
             self._first = frame
             self._placed = self._placed or ref != "local"
             J = pin.computeFrameJacobian(
                 self._model, self._data, self.q_pin, fid, PIN_REFERENCE[ref]
             )
         else:
-            self._compute_whole()
+            self._compute_joints()
             J = pin.getFrameJacobian(self._model, self._data, fid, PIN_REFERENCE[ref])
         return J if J.ndim == 2 else J.reshape(6, 1)  # one joint: Pinocchio gives (6,)
 
@@ -190,13 +194,18 @@ class Kinematics:
         second pass.
         """
         fid = self.layout.frames[frame]
-        if frame != self._first or not self._placed or self._whole:
-            self._compute_whole()
+        if frame != self._first or not self._placed or self._joints:
+            self._compute_frames()
             return pin.SE3(self._data.oMf[fid])
         return pin.SE3(pin.updateFramePlacement(self._model, self._data, fid))
 
-    def _compute_whole(self) -> None:
-        if not self._whole:
+    def _compute_joints(self) -> None:
+        if not self._joints:
             pin.computeJointJacobians(self._model, self._data, self.q_pin)
+            self._joints = True
+
+    def _compute_frames(self) -> None:
+        if not self._framed:
+            self._compute_joints()
             pin.updateFramePlacements(self._model, self._data)
-            self._whole = True
+            self._framed = True

@@ -29,7 +29,7 @@ import threading
 import time
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal, cast
+from typing import Any, Literal, TypeGuard, cast
 
 import numpy as np
 import numpy.typing as npt
@@ -376,7 +376,7 @@ class Resolver:
         kinematics, the tasks' rows, the limits, the answer."""  # noqa: D205, D209
         step = self.dt if dt is None else _dt(dt)
         previous = None if qdot_prev is None else as_vector(qdot_prev, "qdot_prev", self.robot.nv)
-        if type(command) is not np.ndarray and (isinstance(command, Task) or _is_tasks(command)):
+        if type(command) is not np.ndarray and (_is_task(command) or _is_tasks(command)):
             if ref is not None:
                 raise InvalidInput("ref", "tasks carry their own ref; pass ref to FrameTask")
             levels, weighted = self._levels(cast(TaskCommand, command), priority)
@@ -473,28 +473,31 @@ class Resolver:
         """The tasks as priority levels, every task checked against the robot."""
         if not isinstance(priority, str) or priority not in ("weighted", "strict"):
             raise InvalidInput("priority", f"expected 'weighted' or 'strict', got {priority!r}")
-        items = [command] if isinstance(command, Task) else list(command)
+        items: list[Any] = [command] if _is_task(command) else list(cast(Sequence[Any], command))
         if not items:
             raise InvalidInput("command", "no tasks: pass a twist, a task or a list of tasks")
+        layout = self._layout
         if priority == "weighted":
-            if not all(isinstance(t, Task) for t in items):
-                raise InvalidInput(
-                    "command", "a weighted resolution takes a flat list of tasks (levels are "
-                    "for priority='strict')",
-                )
-            levels = [items]
-        else:
-            levels = [[t] if isinstance(t, Task) else list(t) for t in items]
-            for k, level in enumerate(levels):
-                if not level:
-                    raise InvalidInput("command", f"priority level {k} is empty")
-                for t in level:
-                    if not isinstance(t, Task):
-                        raise InvalidInput("command", f"level {k}: expected tasks, got {t!r}")
+            for t in items:
+                if not _is_task(t):
+                    raise InvalidInput(
+                        "command", "a weighted resolution takes a flat list of tasks (levels "
+                        "are for priority='strict')",
+                    )
+            for t in items:
+                t.check(layout)
+            return [items], True
+        levels: list[list[Any]] = [[t] if _is_task(t) else list(t) for t in items]
+        for k, level in enumerate(levels):
+            if not level:
+                raise InvalidInput("command", f"priority level {k} is empty")
+            for t in level:
+                if not _is_task(t):
+                    raise InvalidInput("command", f"level {k}: expected tasks, got {t!r}")
         for level in levels:
             for t in level:
-                t.check(self._layout)  # type: ignore[union-attr]
-        return levels, priority == "weighted"  # type: ignore[return-value]
+                t.check(layout)
+        return levels, False
 
     def _default_task(self) -> FrameTask | None:
         """The robot's tool frame, full twist (position below six joints).
@@ -546,8 +549,16 @@ def _limits(limits: Limit | Sequence[Limit] | None) -> tuple[Limit, ...]:
     return tuple(items)
 
 
+def _is_task(x: object) -> TypeGuard[Task]:
+    """``isinstance(x, Task)``, without ABCMeta's instance check (every task subclasses Task)."""
+    return Task in type(x).__mro__
+
+
 def _is_tasks(command: Any) -> bool:
     """True when ``command`` is a list of tasks or of levels (lists) of tasks, not a twist."""
     if isinstance(command, np.ndarray) or not isinstance(command, (list, tuple)):
         return False
-    return not command or any(isinstance(t, (Task, list, tuple)) for t in command)
+    for t in command:
+        if isinstance(t, (list, tuple)) or _is_task(t):
+            return True
+    return not command

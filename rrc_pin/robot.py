@@ -322,6 +322,9 @@ class Robot:
         Raises:
             InvalidInput: ``q`` is not a finite (nq,) vector.
         """
+        if self._identity_map:  # q is each rate's position and Pinocchio's vector
+            q = self.check_q(q)
+            return q, q, q
         q, q_pin = self.configuration(q)
         return q, self._dof(q), q_pin
 

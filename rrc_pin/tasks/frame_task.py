@@ -9,13 +9,15 @@ import numpy.typing as npt
 import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.kinematics import Kinematics
-from rrc_pin.solvers.checks import as_vector, positive, real_array, rigid_transform
+from rrc_pin.kinematics import Kinematics, Layout
+from rrc_pin.solvers.checks import all_finite, as_vector, positive, real_array, rigid_transform
 from rrc_pin.solvers.spatial import Reference, check_reference
 from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.task import Task, check_weight, task_name
 
 Array = npt.NDArray[np.float64]
+
+_F64 = np.dtype(np.float64)
 
 ROWS: dict[str, tuple[int, ...]] = {
     "full": (0, 1, 2, 3, 4, 5),
@@ -114,8 +116,9 @@ class FrameTask(Task):
             InvalidInput: Wrong shape or a non-finite entry.
         """
         m = len(self.selected)
-        if type(twist) is np.ndarray and twist.dtype == np.float64 and twist.shape == (m,):
-            checked: Array = as_vector(twist, "twist", m).copy()  # the common case
+        if (type(twist) is np.ndarray and twist.dtype is _F64 and twist.shape == (m,)
+                and all_finite(twist)):  # the common case  # fmt: skip
+            checked: Array = twist.copy()
             return checked
         twist = real_array(twist, "twist", "expected a real (6,) twist")
         size = twist.shape
@@ -150,6 +153,15 @@ class FrameTask(Task):
     def frames(self) -> tuple[str, ...]:
         """The commanded frame."""
         return (self.frame,)
+
+    def check(self, layout: Layout) -> None:
+        """Refuse a frame the robot does not have (:meth:`Task.check`, its one frame first).
+
+        Raises:
+            FrameNotFound: The error lists the robot's frames.
+        """
+        if self.frame not in layout.frames:
+            super().check(layout)
 
     def rows(self, kin: Kinematics) -> TaskRows:
         """The frame's Jacobian rows and the commanded twist."""

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import numpy.typing as npt
 
@@ -47,16 +49,17 @@ class PostureTask(Task):
         self.gain = positive(gain, "gain")
         self.weight = check_weight(weight, self.q_ref.size)
         self.name = task_name(name)
-        self._continuous: tuple[npt.NDArray[np.bool_] | None, bool] = (None, False)
+        self._constants: tuple[Any, ...] = (None, None, False, None, None)
 
-    def _wraps(self, continuous: npt.NDArray[np.bool_]) -> bool:
-        """Whether the mask ``continuous`` (a robot's layout's) has a continuous joint: found
-        once per layout."""  # noqa: D205, D209
-        mask, wraps = self._continuous
-        if mask is not continuous:
-            wraps = bool(continuous.any())
-            self._continuous = (continuous, wraps)
-        return wraps
+    def _constant_rows(self, continuous: npt.NDArray[np.bool_]) -> tuple[bool, Array, Array | None]:
+        """Whether the mask ``continuous`` (a robot's layout's) has a continuous joint, the
+        identity rows and the row weights (read only): found once per layout and weight."""  # noqa: D205, D209
+        mask, weight, wraps, eye, weights = self._constants
+        if mask is not continuous or weight is not self.weight:
+            n = self.q_ref.size
+            wraps, eye, weights = bool(continuous.any()), identity(n), self._row_weights(n)
+            self._constants = (continuous, self.weight, wraps, eye, weights)
+        return wraps, eye, weights
 
     def frames(self) -> tuple[str, ...]:
         """None."""
@@ -78,10 +81,11 @@ class PostureTask(Task):
 
     def rows(self, kin: Kinematics) -> TaskRows:
         """Identity rows and ``gain (q_ref - q)``."""
+        continuous = kin.layout.continuous
+        wraps, eye, weights = self._constant_rows(continuous)
         error = self.q_ref - kin.q
-        if self._wraps(kin.layout.continuous):
+        if wraps:
             wrapped = np.remainder(error + np.pi, 2.0 * np.pi) - np.pi
-            error = np.where(kin.layout.continuous, wrapped, error)
-        n = error.size
+            error = np.where(continuous, wrapped, error)
         error *= self.gain
-        return TaskRows(identity(n), error, self._row_weights(n), self.name)
+        return TaskRows(eye, error, weights, self.name)

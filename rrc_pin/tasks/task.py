@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import math
 from abc import ABC, abstractmethod
 from typing import ClassVar
 
@@ -84,6 +85,8 @@ def check_weight(weight: float | npt.ArrayLike, size: int | None = None) -> floa
     Raises:
         InvalidInput: Not positive, not finite, or the wrong shape.
     """
+    if type(weight) is float and 0.0 < weight < math.inf:  # the common case
+        return weight
     if not isinstance(weight, (list, tuple, np.ndarray)):
         return finite_number(weight, "weight", 0.0, inclusive=False)  # type: ignore[arg-type]
     if size is None:

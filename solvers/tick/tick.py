@@ -306,30 +306,32 @@ class Workspace:
         self.task_rows, self.rates = np.zeros((6, n)), np.ones((3, 6))
         self.G, self.h, self.slide = np.zeros((0, n)), np.zeros(0), np.zeros(0)
         self._held: dict[int, Held] = {}
+        self._header: tuple[int, bool, bool, list[int]] | None = None  # what ints holds
 
     def load_levels(self, levels: Sequence[Sequence[TaskRows]], weighted: bool) -> None:
         """The tasks' rows and rates, by level (highest first).
 
         A task's rows, weights and units that are None or read-only arrays owning their
         values (constants: a joint-space task's identity rows, cached units and weights) are
-        loaded once while the same arrays come at the same rows (``_held``).
+        loaded once while the same arrays come at the same rows (``_held``); the sizes and
+        flags in ``ints`` are written where they changed (``_header``).
         """
-        ints, m = self.ints, 0
+        m = 0
         for tasks in levels:
             for t in tasks:
                 m += t.b.size
         self._fit(m, len(levels))
         held, task_rows, rates, r = self._held, self.task_rows, self.rates, 0
-        rate = rates[RATE]
-        for k, tasks in enumerate(levels):
-            ints[STARTS + k] = r
+        rate, starts = rates[RATE], []
+        for tasks in levels:
+            starts.append(r)
             for t in tasks:
-                end = r + t.b.size
+                A, b, weight, unit = t.A, t.b, t.weight, t.unit
+                end = r + b.size
                 was = held.get(r)
                 if was is None or was[0] != end:  # other rows here: every part loaded
                     self._overwrite(r, end)
                     was = held[r] = [end, _LOADED, _LOADED, _LOADED]
-                A, weight, unit = t.A, t.weight, t.unit
                 if was[1] is not A:
                     task_rows[r:end] = A
                     was[1] = _constant(A)
@@ -339,14 +341,23 @@ class Workspace:
                 if was[3] is not unit:
                     rates[UNIT, r:end] = 1.0 if unit is None else unit
                     was[3] = _constant(unit)
-                rate[r:end] = t.b
+                rate[r:end] = b
                 r = end
-        ints[STARTS + len(levels)] = m
-        ints[LEVELS], ints[ROWS], ints[WEIGHTED] = len(levels), m, weighted
         units = False
         for t in levels[0]:
             units = units or t.unit is not None
-        ints[UNITS] = units
+        header = (m, weighted, units, starts)
+        if header != self._header:
+            self._write_header(header)
+
+    def _write_header(self, header: tuple[int, bool, bool, list[int]]) -> None:
+        """The sizes and flags of the levels loaded into ``ints`` (:meth:`load_levels`)."""
+        m, weighted, units, starts = header
+        ints, k = self.ints, len(starts)
+        ints[STARTS : STARTS + k] = starts
+        ints[STARTS + k] = m
+        ints[LEVELS], ints[ROWS], ints[WEIGHTED], ints[UNITS] = k, m, weighted, units
+        self._header = header
 
     def _fit(self, m: int, levels: int) -> None:
         """Room for ``m`` task rows and ``levels`` levels."""
@@ -355,6 +366,7 @@ class Workspace:
             self._held.clear()
         if self.ints.size < STARTS + 2 * levels + 2:
             self.ints = np.concatenate([self.ints, np.zeros(2 * levels + 2, np.int64)])
+            self._header = None
 
     def _overwrite(self, start: int, end: int) -> None:
         """Forget what ``_held`` says rows ``start:end`` hold (they are being written)."""
@@ -391,12 +403,13 @@ class Workspace:
     def run(self, q: Array, previous: Array, dt: float) -> int:
         """The tick at positions ``q`` (n,) after rates ``previous`` (n,), step ``dt`` [s].
 
-        One level without rows goes to :func:`run_box`, and to :func:`run` only where that
-        is not its tick.
+        One level without rows in the direction mode goes to :func:`run_box`, and to
+        :func:`run` only where that is not its tick.
         """
         self.joints[POSITION], self.joints[PREVIOUS] = q, previous
         self.reals[DT] = dt
-        if self.ints[LEVELS] == 1 and self.ints[CONSTRAINTS] == 0:
+        ints = self.ints
+        if ints[LEVELS] == 1 and ints[CONSTRAINTS] == 0 and ints[DIRECTION] and not ints[WEIGHTED]:
             code: int = run_box(self.joints, self.task_rows, self.rates, self.ints, self.reals)
             if code != ELSEWHERE:
                 return code
