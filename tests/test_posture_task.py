@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 import rrc_pin
 from rrc_pin.kinematics import Kinematics, Layout
@@ -33,3 +34,17 @@ def test_rows_follow_the_layout_and_weight_they_are_asked_with():
         assert abs(rows.b[0] - 2.0 * turn) < 1e-12
     task.weight = 3.0
     np.testing.assert_array_equal(task.rows(kin).weight, np.full(panda.nv, 3.0))
+
+
+def test_a_weight_array_is_replaced_not_written():
+    """A task's weight array is its own and read-only: its rows are kept per weight, so a
+    change of weights is a new array (seen at the next tick), never a write into the old."""
+    panda = rrc_pin.load("panda")
+    q = panda.neutral()
+    task = PostureTask(q, weight=np.ones(panda.nv))
+    kin = Kinematics(panda.model, panda.model.createData(), Layout.of(panda), q, q)
+    assert task.rows(kin).weight is None  # all ones: the unweighted rows
+    with pytest.raises(ValueError, match="read-only"):
+        task.weight[0] = 2.0
+    task.weight = np.full(panda.nv, 2.0)
+    np.testing.assert_array_equal(task.rows(kin).weight, np.full(panda.nv, 2.0))

@@ -94,6 +94,7 @@ def check_weight(weight: float | npt.ArrayLike, size: int | None = None) -> floa
     w: Array = as_vector(weight, "weight", size).copy()  # the task's own
     if (w <= 0.0).any():
         raise InvalidInput("weight", f"expected weights > 0, got {w}")
+    w.flags.writeable = False  # a task's rows may be kept per weight: replace it, not its values
     return w
 
 
