@@ -536,8 +536,8 @@ class CellController(Loop):
         self._applied = r.qdot
         self._correction_size = 0.0
         self.chain_error = (0.0, 0.0)
-        level, stacked, rows = _top_level(r)
-        hands = self._hands(level)
+        tasks, stacked, rows = _top_level(r)
+        hands = self._hands(tasks)
         measured: list[tuple[Closure | None, Lost]] = [(self.contact.last, "contact_lost"),
                                                       (self.grip.last, "grip_lost")]  # fmt: skip
         parts = [(last, kind) for last, kind in measured if last is not None]

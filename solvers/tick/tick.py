@@ -19,9 +19,9 @@ where the top level finds no usable answer, :func:`run` returns
 :data:`~rrc_pin.solvers.tick.top.FAILED` and the fallbacks (:mod:`rrc_pin.solvers.tick.fallbacks`)
 answer. Problems with equality rows (contacts, grips) have an entry of their own,
 :func:`run_within`: its top level solved within the rows
-(:mod:`rrc_pin.solvers.tick.equalities`), the rest as :func:`run`. The default tick (one level, the joint box alone)
-has an entry of its own, :func:`run_box`: the same stages without the code it does not reach,
-compiled in a fraction of the general entry's time.
+(:mod:`rrc_pin.solvers.tick.equalities`), the rest as :func:`run`. The default tick (one
+level, the joint box alone) has an entry of its own, :func:`run_box`: the same stages
+without the code it does not reach, compiled in a fraction of the general entry's time.
 """
 
 from __future__ import annotations
