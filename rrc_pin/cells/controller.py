@@ -377,7 +377,8 @@ class CellController(Loop):
         after it (the previous rates read-only), a command too fast to meet (scaled), a
         posture level the box cuts (the projected least squares), and a command one of whose
         rows is weighted past the damping threshold (damped,
-        :class:`~rrc_pin.solvers.tick.damping.Damping`); the resolver then reset.
+        :class:`~rrc_pin.solvers.tick.damping.Damping`), each tick's top level read as the
+        correction reads it (:func:`_top_level`); the resolver then reset.
         """
         kin, names = self._kinematics(), list(self._targets)
         far = PostureTask(self.posture.q_ref + 1.0, gain=1e6, name="compiling")
@@ -394,8 +395,9 @@ class CellController(Loop):
                 else [FrameTask(self.frame_of(name), np.full(6, 1e6), weight=weight)
                       for name in names]
             )  # fmt: skip
-            self.resolver.solve_at(kin, [top, [lower]] if top else [[lower]], priority="strict",
-                                   qdot_prev=self._previous_rates())  # fmt: skip
+            r = self.resolver.solve_at(kin, [top, [lower]] if top else [[lower]],
+                                       priority="strict", qdot_prev=self._previous_rates())
+            _top_level(r)  # the correction's read of the top level's rows (its kernels)
         self.resolver.reset()
         self._kin = None
 
