@@ -93,6 +93,19 @@ def test_ticks_within_equality_rows_are_the_pipelines(rng: np.random.Generator,
     assert len(seen) >= 2
 
 
+def test_weighted_ticks_within_equality_rows_are_the_pipelines(rng: np.random.Generator) -> None:
+    panda = rrc_pin.load("panda")
+    C = rng.normal(size=(2, panda.nv))
+    resolver = rrc_pin.Resolver(panda, dt=0.01,
+                                limits=[JointLimits(), Equalities(C, 0.05 * rng.normal(size=2))])
+    posture = rrc_pin.PostureTask(panda.neutral(), gain=1.0, weight=1e-2)
+    for _ in range(40):
+        twist = rng.normal(size=6) * 10.0 ** rng.uniform(-3, 1)
+        r = resolver.solve(panda.random_q(rng), [rrc_pin.FrameTask(panda.tool_frame, twist),
+                                                 posture])  # fmt: skip
+        agrees(r, resolver)
+
+
 def test_contradicting_rows_fall_back_as_the_pipeline() -> None:
     panda = rrc_pin.load("panda")
     C = np.vstack([np.eye(1, panda.nv), np.eye(1, panda.nv)])
