@@ -1,8 +1,9 @@
 """A resolver's ticks in one compiled call: its inputs loaded, its answer read back lazily.
 
 The :class:`~rrc_pin.Resolver` hands a tick here where its joint box is one
-:class:`~rrc_pin.limits.JointLimits` and no limit gives another box or equality rows (contacts):
-the tasks' rows and the other limits' constraint rows go into the resolver's
+:class:`~rrc_pin.limits.JointLimits` and no limit gives another box (equality rows, contacts
+and grips, only fewer than the rates and without rows the command slides along):
+the tasks' rows and the other limits' constraint and equality rows go into the resolver's
 :class:`~rrc_pin.solvers.tick.tick.Workspace`, one call of
 :func:`rrc_pin.solvers.tick.tick.run` answers (the QPs its kernels do not answer go to the
 backend from inside it), and the :class:`~rrc_pin.solvers.tick.resolution.Resolution` keeps the
@@ -33,10 +34,14 @@ from rrc_pin.solvers.tick.problem import (
     Box,
     Constraints,
     Problem,
+    Rows,
     TaskRows,
     build,
     finite_rows,
+    merged_equalities,
     merged_rows,
+    mode_of,
+    stacked_level,
 )
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.solvers.tick.top import FAILED
@@ -97,6 +102,21 @@ class TickSource:
             kind = out[3:5].astype(np.int8)
             self._box = Box(out[0], out[1], kind, self.zero_inside, self.recovering, self.velocity)
         return self._box
+
+    def top(self) -> tuple[tuple[TaskRows, ...], Array, Rows | None]:
+        """The top level's task rows, its stacked rows in the metric it was solved in, and the
+        constraint rows: :meth:`problem`'s ``levels[0]``, ``stacked[0][0]`` and ``rows``,
+        without building the other levels.
+        """  # noqa: D205
+        levels = self.levels
+        level = tuple(levels[0]) if isinstance(levels, list) else (
+            levels[0].rows_from(levels[1], levels[2], levels[3]),)  # fmt: skip
+        present = [c for c in self.constraints if c is not None]
+        rows = merged_rows(present) if present else None
+        keeps = any(c.d is not None and c.d.any() for c in present)
+        box = self.box
+        mode = mode_of(box, rows, keeps, self.weighted, self.direction)
+        return level, stacked_level(level, mode == "direction", box)[0], rows
 
     def problem(self) -> Problem:
         """The problem the tick answered (:func:`rrc_pin.solvers.tick.problem.build`)."""
@@ -173,9 +193,20 @@ class CompiledTick:
         return self._answer(code, twist, [None], dt, False, start)
 
     def answers(self, constraints: Sequence[Constraints | None]) -> bool:
-        """Whether the compiled tick answers with these limits' constraints: no other box, no
-        equality rows."""  # noqa: D205, D209
-        return all(c is None or (c.box is None and c.C is None) for c in constraints)
+        """Whether the compiled tick answers with these limits' constraints: no other box;
+        equality rows fewer than the rates and without rows the command slides along
+        (:func:`rrc_pin.solvers.tick.tick.run_within`)."""  # noqa: D205, D209
+        equal = slides = 0
+        for c in constraints:
+            if c is None:
+                continue
+            if c.box is not None:
+                return False
+            if c.C is not None and c.d is not None:
+                equal += c.d.size
+            if c.slide is not None and c.h is not None and c.h.size and c.slide.any():
+                slides += 1
+        return equal == 0 or (equal < self.workspace.n and slides == 0)
 
     def tasks(self, kin: Kinematics, levels: list[list[TaskRows]], weighted: bool,
               constraints: list[Constraints | None], previous: Array, dt: float,
@@ -191,6 +222,7 @@ class CompiledTick:
             ws.load_rows(None, None, None)
         else:
             ws.load_rows(rows.G, rows.h, rows.slide)
+        ws.load_equalities(*(merged_equalities(present) or (None, None)))
         self._loaded = None
         code = self._run(kin.q, previous, dt, levels)
         return self._answer(code, levels, constraints, dt, weighted, start)

@@ -67,14 +67,15 @@ out["callees"] = [damper_bound(0.01, 0.1, 0.5, 1e-3, 50.0), dot((1.0, 2.0, 3.0),
                                    (0.0, 0.0, 1.0)),
                   *turned(((0.0, 1.0, 0.0), (-1.0, 0.0, 0.0), (0.0, 0.0, 1.0)), (1.0, 2.0, 3.0))]
 # the tick's, likewise
-from rrc_pin.solvers.tick import factor, levels, problem, slide_kernels, statuses, top
+from rrc_pin.solvers.tick import equalities, factor, levels, problem, slide_kernels, statuses, top
 x = np.empty(2)
 slide_kernels.project(np.eye(2), 0.0, np.ones(2), -np.ones(2), np.ones(2), np.zeros((0, 2)),
                       np.zeros(0), 0.0, x)
 out["tick glue"] = [statuses.norm(np.ones(3)), float(levels.row_values(np.eye(2), x).sum()),
                     float(factor.qr(np.eye(2)).R.sum()),
                     problem.cap(np.eye(2), 1e200, 1.0, True, -np.ones(2), np.ones(2)),
-                    *top.along_command(np.eye(2), np.ones(2), x, np.zeros(0), 1.0)]
+                    *top.along_command(np.eye(2), np.ones(2), x, np.zeros(0), 1.0),
+                    float(equalities.space(np.eye(1, 2), np.zeros(1))[1].sum())]
 stage = rrc_pin.JerkLimiter(panda.nv, 0.01, 20.0, 500.0, lower=panda.dof_lower,
                             upper=panda.dof_upper)  # the jerk stage's kernels
 box = Resolver(panda, dt=0.01).solve(panda.ready(), np.zeros(6)).problem.box

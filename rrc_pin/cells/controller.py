@@ -59,6 +59,7 @@ from rrc_pin.cells.cell import Cell
 from rrc_pin.cells.cell_log import CellLog
 from rrc_pin.cells.cell_resolution import CellResolution
 from rrc_pin.cells.closure import ChainFrames, ClosureBound, close, compile_correction, largest
+from rrc_pin.compiled_tick import TickSource
 from rrc_pin.control.deadman import Deadman
 from rrc_pin.control.loop import Loop, Step
 from rrc_pin.control.smoothing import SmoothingOptions
@@ -74,7 +75,7 @@ from rrc_pin.solvers.checks import as_vector, flag, positive
 from rrc_pin.solvers.spatial import to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.kernels import scale_and_veer
-from rrc_pin.solvers.tick.problem import TaskRows
+from rrc_pin.solvers.tick.problem import Rows, TaskRows
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.tasks import FrameTask, PostureTask, Task
 
@@ -376,7 +377,8 @@ class CellController(Loop):
         after it (the previous rates read-only), a command too fast to meet (scaled), a
         posture level the box cuts (the projected least squares), and a command one of whose
         rows is weighted past the damping threshold (damped,
-        :class:`~rrc_pin.solvers.tick.damping.Damping`); the resolver then reset.
+        :class:`~rrc_pin.solvers.tick.damping.Damping`), each tick's top level read as the
+        correction reads it (:func:`_top_level`); the resolver then reset.
         """
         kin, names = self._kinematics(), list(self._targets)
         far = PostureTask(self.posture.q_ref + 1.0, gain=1e6, name="compiling")
@@ -393,8 +395,9 @@ class CellController(Loop):
                 else [FrameTask(self.frame_of(name), np.full(6, 1e6), weight=weight)
                       for name in names]
             )  # fmt: skip
-            self.resolver.solve_at(kin, [top, [lower]] if top else [[lower]], priority="strict",
-                                   qdot_prev=self._previous_rates())  # fmt: skip
+            r = self.resolver.solve_at(kin, [top, [lower]] if top else [[lower]],
+                                       priority="strict", qdot_prev=self._previous_rates())
+            _top_level(r)  # the correction's read of the top level's rows (its kernels)
         self.resolver.reset()
         self._kin = None
 
@@ -428,7 +431,7 @@ class CellController(Loop):
         Each moves along its command by what its frame made along it, then to at most
         :data:`HOLD` from the frame.
         """
-        tasks = {t.name: t for t in r.problem.levels[0]}
+        tasks = {t.name: t for t in _top_level(r)[0]}
         for name, twist in twists.items():
             task = tasks[name]
             factor = None if task.unit is None else 1.0 / task.unit
@@ -535,7 +538,8 @@ class CellController(Loop):
         self._applied = r.qdot
         self._correction_size = 0.0
         self.chain_error = (0.0, 0.0)
-        hands = self._hands(r)
+        tasks, stacked, rows = _top_level(r)
+        hands = self._hands(tasks)
         measured: list[tuple[Closure | None, Lost]] = [(self.contact.last, "contact_lost"),
                                                       (self.grip.last, "grip_lost")]  # fmt: skip
         parts = [(last, kind) for last, kind in measured if last is not None]
@@ -548,11 +552,10 @@ class CellController(Loop):
         if bound is None:
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
         mode, commanded, _ = self._tick
-        top = r.problem.stacked[0][0] if mode == "teleop" else np.zeros((0, self.cell.nv))
-        box = r.problem.box
+        top = stacked if mode == "teleop" else np.zeros((0, self.cell.nv))
+        box = r.box
         kin = self._kin if self._kin is not None else self._kinematics()
-        delta, after = close(kin, self._chain_frames, closure, r.qdot, top, box, r.problem.rows,
-                             self.dt)  # fmt: skip
+        delta, after = close(kin, self._chain_frames, closure, r.qdot, top, box, rows, self.dt)
         level = max(self.chain_error[0] / bound.position, self.chain_error[1] / bound.rotation)
         if level <= 1.0:
             self.lost = None
@@ -570,10 +573,12 @@ class CellController(Loop):
         self._correction_size = float(np.abs(self._applied - r.qdot).max())
         return CellResolution.of_tick(r, self._applied, hands)
 
-    def _hands(self, r: Resolution) -> Callable[[], tuple[TaskRows, ...]] | None:
-        """The held objects' hands as rows of the top level, made when read (or None)."""
+    def _hands(self, level: Sequence[TaskRows]) -> Callable[[], tuple[TaskRows, ...]] | None:
+        """The held objects' hands as rows of the top level (``level``, the tick's), made when
+        read (or None).
+        """  # noqa: D205
         mode, _, poses = self._tick
-        objects = [t for t in r.problem.levels[0] if t.name in self._grips]
+        objects = [t for t in level if t.name in self._grips]
         if mode != "teleop" or not objects:
             return None
         cell, q = self.cell, self._q
@@ -671,6 +676,18 @@ class CellController(Loop):
             grip[name] = float(np.linalg.norm(rel[:3, 3] - g.grip[:3, 3]))
         self.log.add(self.t, self._q, r.applied, r.status, r.scale, r.levels, errors, grip,
                      self.chain_error, mode)  # fmt: skip
+
+
+def _top_level(r: Resolution) -> tuple[Sequence[TaskRows], Array, Rows | None]:
+    """The top level's task rows, its stacked rows (the metric it was solved in) and the
+    constraint rows of ``r``'s problem, read without building a compiled tick's whole problem
+    (:meth:`~rrc_pin.compiled_tick.TickSource.top`).
+    """  # noqa: D205
+    source = r.source
+    if isinstance(source, TickSource):
+        return source.top()
+    problem = r.problem
+    return problem.levels[0], problem.stacked[0][0], problem.rows
 
 
 def _length(v: Array) -> float:

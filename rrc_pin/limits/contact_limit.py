@@ -101,6 +101,7 @@ class ContactLimit(Limit):
         self._goals = goals
         self._names = tuple(f"{self.name}:{f}:{a}" for f in items for a in AXES)
         self._zero = np.zeros(6 * len(items))
+        self._unit: Array | None = None  # the rows' units, once the robot's reach is known
         self.last: Closure | None = None
         """The rows and the anchors' errors at the last configuration the limit saw (None
         without anchors or frames)."""
@@ -123,6 +124,10 @@ class ContactLimit(Limit):
         C = np.vstack([kin.jacobian(f) for f in self.frames])
         if self._goals is not None:
             error = np.concatenate([g.error(kin.pose(g.frame)) for g in self._goals])
-            unit = np.concatenate([[kin.layout.reach[f]] * 3 + [1.0] * 3 for f in self.frames])
+            reach = kin.layout.reach
+            unit = self._unit
+            if unit is None or unit[::6].tolist() != [reach[f] for f in self.frames]:
+                unit = self._unit = np.array([[reach[f]] * 3 + [1.0] * 3 for f in self.frames],
+                                             dtype=np.float64).ravel()  # fmt: skip
             self.last = Closure(C, error, unit)
         return Constraints(C=C, d=self._zero, names=self._names)

@@ -221,14 +221,8 @@ def build(
     box = _box(constraints, n)
     rows = merged_rows(constraints)
     equalities, equality_names = _equalities(constraints)
-    if weighted:
-        mode: Mode = "weighted"
-    elif direction and box.contains_zero and (rows is None or bool((rows.h >= 0.0).all())):
-        mode = "direction"
-        if equalities is not None and bool(equalities[1].any()):
-            mode = "least_squares"  # rates to keep: no scale of the command stands still
-    else:
-        mode = "least_squares"
+    mode = mode_of(box, rows, equalities is not None and bool(equalities[1].any()), weighted,
+                   direction)  # fmt: skip
     stacked, factors = [], []
     for k, level in enumerate(levels):
         A, b, factor = _stack(level, k == 0 and mode == "direction", box)
@@ -237,6 +231,28 @@ def build(
     kept = tuple(map(tuple, levels))
     return Problem(kept, tuple(stacked), tuple(factors), box, rows, equalities, equality_names,
                    mode, dt)  # fmt: skip
+
+
+def mode_of(box: Box, rows: Rows | None, keeps: bool, weighted: bool, direction: bool
+            ) -> Mode:  # fmt: skip
+    """How the levels of a problem with ``box`` and ``rows`` are solved, ``keeps`` where its
+    equality rows have rates to keep (d not zero) (:func:`build`'s arguments ``weighted`` and
+    ``direction``; module docstring).
+    """  # noqa: D205
+    if weighted:
+        return "weighted"
+    if direction and box.contains_zero and (rows is None or bool((rows.h >= 0.0).all())):
+        # rates to keep: no scale of the command stands still
+        return "least_squares" if keeps else "direction"
+    return "least_squares"
+
+
+def stacked_level(tasks: Sequence[TaskRows], normalised: bool, box: Box
+                  ) -> tuple[Array, Array, float]:  # fmt: skip
+    """A level's rows and rates stacked in its metric, and the rates' factor (:func:`build`'s
+    ``stacked`` and ``factors``; ``normalised``: the direction mode's top level).
+    """  # noqa: D205
+    return _stack(tasks, normalised, box)
 
 
 def _stack(tasks: Sequence[TaskRows], normalised: bool, box: Box) -> tuple[Array, Array, float]:
@@ -406,6 +422,11 @@ def merged_rows(constraints: Sequence[Constraints]) -> Rows | None:
     return Rows(np.vstack(Gs), np.concatenate(hs), tuple(names),
                 slide if slide.any() else None,
                 None if np.isnan(distance).all() else distance)  # fmt: skip
+
+
+def merged_equalities(constraints: Sequence[Constraints]) -> tuple[Array, Array] | None:
+    """The constraints' equality rows stacked, ``(C, d)``, or None."""
+    return _equalities(constraints)[0]
 
 
 def _equalities(

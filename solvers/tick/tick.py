@@ -17,10 +17,11 @@ docs/api.md, "One compiled pass per tick"), the rows of which the module constan
 not answer go to the backend from inside the call (:mod:`rrc_pin.solvers.tick.backend_calls`);
 where the top level finds no usable answer, :func:`run` returns
 :data:`~rrc_pin.solvers.tick.top.FAILED` and the fallbacks (:mod:`rrc_pin.solvers.tick.fallbacks`)
-answer. Problems with equality rows (contacts) go to the Python pipeline
-(:func:`rrc_pin.solvers.tick.pipeline.solve`). The default tick (one level, the joint box alone)
-has an entry of its own, :func:`run_box`: the same stages without the code it does not reach,
-compiled in a fraction of the general entry's time.
+answer. Problems with equality rows (contacts, grips) have an entry of their own,
+:func:`run_within`: its top level solved within the rows
+(:mod:`rrc_pin.solvers.tick.equalities`), the rest as :func:`run`. The default tick (one
+level, the joint box alone) has an entry of its own, :func:`run_box`: the same stages
+without the code it does not reach, compiled in a fraction of the general entry's time.
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import kernels, statuses, top
+from rrc_pin.solvers.tick import equalities, kernels, statuses, top
 from rrc_pin.solvers.tick.levels import least_squares, row_values
 from rrc_pin.solvers.tick.problem import LARGE, TaskRows, cap
 from rrc_pin.solvers.tick.statuses import DROPPED, EXACT, MET, SCALED, SCALED_LEVEL, TRADED
@@ -274,6 +275,33 @@ def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide
     return report(joints, ints, reals, rows, answer, qdot)
 
 
+@kernel
+def run_within(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide: Array,
+               E: Array, ints: Ints, reals: Array) -> int:  # fmt: skip
+    """One tick within the equality rows ``E`` = [C | d] (r, n + 1): :func:`run`'s stages, the
+    top level's within the rows (:func:`rrc_pin.solvers.tick.equalities.within`).
+
+    The direction mode where :func:`run` takes it and ``d`` is zero (standing still then
+    meets the rows; :func:`rrc_pin.solvers.tick.problem.build`).
+    """  # noqa: D205
+    if not box(joints, task_rows, rates, ints, reals):
+        return INVALID_INPUT
+    p, n = ints[CONSTRAINTS], joints.shape[1]
+    rows = Rows(joints[LB], joints[UB], G[:p], h[:p], slide[:p], reals[TOLERANCE])
+    zero_inside, recovering = reals[ZERO_INSIDE] == 1.0, reals[RECOVERING] == 1.0
+    C, d = np.ascontiguousarray(E[:, :n]), np.ascontiguousarray(E[:, n])
+    direction = (ints[WEIGHTED] == 0 and ints[DIRECTION] == 1 and zero_inside
+                 and not (rows.h < 0.0).any() and not (d != 0.0).any())  # fmt: skip
+    A, b, rate_factor = level(task_rows, rates, ints, 0, direction, rows.lb, rows.ub)
+    per_unit = 1.0 / rates[UNIT][: ints[STARTS + 1]] if ints[UNITS] else np.empty(0)
+    answer = equalities.within(A, b, per_unit, C, d, rows, direction, recovering, reals[DT],
+                               reals[THRESHOLD], rate_factor, ints[LEVELS] > 1)  # fmt: skip
+    if answer.status == FAILED:
+        return FAILED
+    qdot = lower_levels(task_rows, rates, ints, rows, answer)
+    return report(joints, ints, reals, rows, answer, qdot)
+
+
 class Workspace:
     """The preallocated arrays of one resolver's ticks, and the compiled tick on them.
 
@@ -305,6 +333,7 @@ class Workspace:
         self.ints[DIRECTION] = int(direction)
         self.task_rows, self.rates = np.zeros((6, n)), np.ones((3, 6))
         self.G, self.h, self.slide = np.zeros((0, n)), np.zeros(0), np.zeros(0)
+        self.E = np.zeros((0, n + 1))  # the equality rows [C | d]: none
         self._held: dict[int, Held] = {}
         self._header: tuple[int, bool, bool, list[int]] | None = None  # what ints holds
 
@@ -400,6 +429,20 @@ class Workspace:
         self.slide[:p] = 0.0 if slide is None else slide
         self.ints[CONSTRAINTS] = p
 
+    def load_equalities(self, C: Array | None, d: Array | None) -> None:
+        """The equality rows ``C qdot = d`` (r, n) of the next ticks (None: none).
+
+        :meth:`run` answers with them by :func:`run_within`.
+        """
+        if C is None or d is None:
+            if self.E.shape[0]:
+                self.E = np.zeros((0, self.n + 1))
+            return
+        r = d.size
+        if self.E.shape[0] != r:
+            self.E = np.empty((r, self.n + 1))
+        self.E[:, : self.n], self.E[:, self.n] = C, d
+
     def run(self, q: Array, previous: Array, dt: float) -> int:
         """The tick at positions ``q`` (n,) after rates ``previous`` (n,), step ``dt`` [s].
 
@@ -408,6 +451,10 @@ class Workspace:
         """
         self.joints[POSITION], self.joints[PREVIOUS] = q, previous
         self.reals[DT] = dt
+        if self.E.shape[0]:
+            within: int = run_within(self.joints, self.task_rows, self.rates, self.G, self.h,
+                                     self.slide, self.E, self.ints, self.reals)  # fmt: skip
+            return within
         ints = self.ints
         if ints[LEVELS] == 1 and ints[CONSTRAINTS] == 0 and ints[DIRECTION] and not ints[WEIGHTED]:
             code: int = run_box(self.joints, self.task_rows, self.rates, self.ints, self.reals)
@@ -432,6 +479,10 @@ class Workspace:
         run_box(ws.joints, ws.task_rows, ws.rates, ws.ints, ws.reals)
         if general:
             run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
+            if n > 1:  # a tick within equality rows (contacts, grips): the rates of joint 1 zero
+                ws.load_equalities(np.eye(1, n, 1), np.zeros(1))
+                run_within(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.E,
+                           ws.ints, ws.reals)  # fmt: skip
 
     def level_codes(self) -> list[int]:
         """How each level was served (:data:`MET`, :data:`SCALED_LEVEL`, :data:`TRADED`)."""

@@ -1,0 +1,149 @@
+"""The compiled tick within equality rows answers as the Python pipeline does."""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+import pytest
+
+import rrc_pin
+from rrc_pin.cells import Cell, CellController
+from rrc_pin.compiled_tick import TickSource
+from rrc_pin.kinematics import Kinematics
+from rrc_pin.limits import JointLimits, Limit
+from rrc_pin.solvers.tick.equalities import CONTRADICTED, space
+from rrc_pin.solvers.tick.pipeline import _equality_space, solve
+from rrc_pin.solvers.tick.problem import Constraints
+from rrc_pin.solvers.tick.resolution import Resolution
+
+Array = npt.NDArray[np.float64]
+
+KERNELS = 1e-10
+"""[rad/s] Rates of a tick the kernels answered: the same kernels, the products with the null
+basis in other loops (within 3e-13 in the direction mode; the least squares' projection onto a
+saturated box carried them to 7e-12 on panda at 2.6 rad/s)."""
+BACKEND = 1e-8
+"""Rates of a tick the QP backend answered: DAQP's answer moves with the last bits of its
+data (tests/test_tick_answers.py)."""
+
+
+class Equalities(Limit):
+    """Equality rows ``C qdot = d`` set by the test."""
+
+    name = "equal"
+
+    def __init__(self, C: Array, d: Array) -> None:
+        self.C, self.d = C, d
+
+    def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
+        names = tuple(f"equal:{i}" for i in range(self.d.size))
+        return Constraints(C=self.C, d=self.d, names=names)
+
+
+def agrees(r: Resolution, resolver: rrc_pin.Resolver) -> None:
+    """``r`` (the compiled tick's) is the pipeline's answer to its problem."""
+    assert isinstance(r.source, TickSource) or r.status == "fallback"
+    answer = solve(r.problem, resolver.backend, resolver.options)
+    tol = BACKEND if (r.backend or answer.backend) else KERNELS
+    np.testing.assert_allclose(r.qdot, answer.qdot, rtol=0.0, atol=tol)
+    assert r.status == answer.status and r.levels == answer.levels
+    assert r.scale == pytest.approx(answer.scale, abs=max(tol, 1e-9))
+    assert r.attempts == answer.attempts
+
+
+def test_space_is_the_pipelines(rng: np.random.Generator) -> None:
+    """x0 and the null basis, full rank and rank deficient."""
+    from rrc_pin.solvers.tick.problem import Box, build
+
+    for rank in (3, 2):
+        C = rng.normal(size=(3, 7))
+        if rank == 2:
+            C[2] = C[0] + C[1]
+        d = C @ rng.normal(size=7)
+        x0, N, met = space(C, d)
+        free = np.full(7, np.inf)
+        box = Box(-free, free, np.zeros((2, 7), np.int8), True, False, free)
+        expected = _equality_space(build([], [Constraints(box), Constraints(C=C, d=d)], 7, 0.01))
+        assert met
+        np.testing.assert_allclose(x0, expected.x, atol=1e-13)
+        np.testing.assert_allclose(N, expected.N, atol=1e-13)
+
+
+@pytest.mark.parametrize("rates", ["zero", "kept"])
+def test_ticks_within_equality_rows_are_the_pipelines(rng: np.random.Generator,
+                                                      rates: str) -> None:  # fmt: skip
+    """A hand's twist and a posture below, within two equality rows (d zero: the direction
+    mode; d kept: the least squares), from fast to slow commands and from a start outside
+    the joint limits."""
+    panda = rrc_pin.load("panda")
+    C = rng.normal(size=(2, panda.nv))
+    d = np.zeros(2) if rates == "zero" else 0.05 * rng.normal(size=2)
+    resolver = rrc_pin.Resolver(panda, dt=0.01, limits=[JointLimits(), Equalities(C, d)])
+    posture = rrc_pin.PostureTask(panda.neutral(), gain=1.0)
+    seen = set()
+    for k in range(60):
+        q = panda.random_q(rng) if k % 10 else panda.upper + 0.05
+        twist = rng.normal(size=6) * 10.0 ** rng.uniform(-3, 1)
+        hand = rrc_pin.FrameTask(panda.tool_frame, twist)
+        r = resolver.solve(q, [[hand], [posture]], priority="strict")
+        agrees(r, resolver)
+        if r.status != "fallback":
+            np.testing.assert_allclose(C @ r.qdot, d, atol=1e-9)
+        seen.add(r.status)
+    assert len(seen) >= 2
+
+
+def test_weighted_ticks_within_equality_rows_are_the_pipelines(rng: np.random.Generator) -> None:
+    panda = rrc_pin.load("panda")
+    C = rng.normal(size=(2, panda.nv))
+    resolver = rrc_pin.Resolver(panda, dt=0.01,
+                                limits=[JointLimits(), Equalities(C, 0.05 * rng.normal(size=2))])
+    posture = rrc_pin.PostureTask(panda.neutral(), gain=1.0, weight=1e-2)
+    for _ in range(40):
+        twist = rng.normal(size=6) * 10.0 ** rng.uniform(-3, 1)
+        r = resolver.solve(panda.random_q(rng), [rrc_pin.FrameTask(panda.tool_frame, twist),
+                                                 posture])  # fmt: skip
+        agrees(r, resolver)
+
+
+def test_contradicting_rows_fall_back_as_the_pipeline() -> None:
+    panda = rrc_pin.load("panda")
+    C = np.vstack([np.eye(1, panda.nv), np.eye(1, panda.nv)])
+    resolver = rrc_pin.Resolver(panda, dt=0.01,
+                                limits=[JointLimits(), Equalities(C, np.array([0.1, -0.1]))])
+    r = resolver.solve(panda.neutral(), rrc_pin.FrameTask(panda.tool_frame, np.full(6, 0.01)))
+    assert r.status == "fallback" and ("qp", CONTRADICTED) in r.attempts
+    agrees(r, resolver)
+
+
+def test_rows_the_compiled_tick_leaves_to_the_pipeline() -> None:
+    """As many equality rows as rates: the pipeline answers."""
+    panda = rrc_pin.load("panda")
+    limit = Equalities(np.eye(panda.nv), np.zeros(panda.nv))
+    resolver = rrc_pin.Resolver(panda, dt=0.01, limits=[JointLimits(), limit])
+    r = resolver.solve(panda.neutral(), rrc_pin.FrameTask(panda.tool_frame, np.full(6, 0.01)))
+    assert not isinstance(r.source, TickSource)
+    np.testing.assert_allclose(r.qdot, 0.0, atol=1e-12)
+
+
+@pytest.mark.parametrize("which", ["dual", "tripod"])
+def test_cell_ticks_are_the_pipelines(which: str, request: pytest.FixtureRequest) -> None:
+    """A held object's grip and feet in support: the compiled tick's answers, command after
+    command (slow to beyond reach), are the pipeline's; the report reads the top level alike."""
+    cell: Cell = request.getfixturevalue(which)
+    ctl = CellController(cell, 0.01)
+    name = ctl.commandable()[0]
+    rng = np.random.default_rng(7)
+    statuses = set()
+    for k in range(120):
+        twist = rng.normal(size=6) * (0.02 if k < 60 else 0.5)
+        r = ctl.step({name: twist}).resolution
+        if r.status in ("grip_lost", "contact_lost"):
+            continue
+        statuses.add(r.status)
+        assert isinstance(r.source, TickSource)
+        level, stacked, rows = r.source.top()
+        assert level == r.problem.levels[0] and rows is r.problem.rows is None
+        np.testing.assert_array_equal(stacked, r.problem.stacked[0][0])
+        agrees(r, ctl.resolver)
+    assert "exact" in statuses and len(statuses) >= 2
