@@ -10,13 +10,18 @@ backend from inside it), and the :class:`~rrc_pin.solvers.tick.resolution.Resolu
 tick's arrays: its problem, task reports and active sets are built where they are read
 (:class:`TickSource`). Where the top level finds no usable answer, the fallbacks answer as the
 Python pipeline's do (:func:`rrc_pin.solvers.tick.pipeline.fallback_answer`).
+
+The default tick, ``solve(q, twist)`` with the joint box alone, loads nothing per tick: the
+Jacobian, the twist and q go to :func:`rrc_pin.solvers.tick.tick.run_twist` as they are, which
+writes the rates, the box and the twist into one new array; the resolution is made of it and
+the report's scalars (:class:`TwistSource`).
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from typing import Any, get_args
+from typing import Any, NamedTuple, get_args
 
 import numpy as np
 import numpy.typing as npt
@@ -28,7 +33,7 @@ from rrc_pin.robot import PIN_REFERENCE
 from rrc_pin.solvers.checks import as_vector
 from rrc_pin.solvers.qp_backends.base import QPBackend
 from rrc_pin.solvers.qp_backends.qp import Work, velocity_tolerance
-from rrc_pin.solvers.tick import backend_calls, tick
+from rrc_pin.solvers.tick import backend_calls, statuses, tick
 from rrc_pin.solvers.tick.pipeline import LevelStatus, Options, Status, fallback_answer
 from rrc_pin.solvers.tick.problem import (
     Box,
@@ -58,6 +63,13 @@ LEVELS: tuple[LevelStatus, ...] = get_args(LevelStatus)
 ONE_LEVEL: tuple[tuple[LevelStatus], ...] = tuple((s,) for s in LEVELS)
 """The levels of a one-level tick, by its code."""
 
+LEVEL_OF: tuple[tuple[LevelStatus], ...] = tuple(ONE_LEVEL[statuses.top_served(code)]
+                                                 for code in range(len(STATUSES)))  # fmt: skip
+"""The levels of a one-level tick, by its top level's status code."""
+
+_new = tuple.__new__
+"""A named tuple made of its fields' tuple (:meth:`~typing.NamedTuple._make` less its check)."""
+
 _NO_ACCELERATION = np.array([np.inf])
 _NO_WORK = Work()
 """The work of a tick that asked the backend nothing (read only)."""
@@ -72,8 +84,7 @@ class TickSource:
         zero_inside: Whether standing still was allowed.
         recovering: Whether a joint was outside its range.
         velocity: The velocity limits (n,).
-        levels: The tasks' rows by level; or ``(task, J, b, reach)`` of a one-twist tick, the
-            rows its task gives from them (:meth:`~rrc_pin.tasks.FrameTask.rows_from`).
+        levels: The tasks' rows by level.
         constraints: The other limits' constraints, in the limits' order, None where the joint
             box stands.
         dt: The step [s].
@@ -86,8 +97,8 @@ class TickSource:
 
     def __init__(
         self, out: Array, zero_inside: bool, recovering: bool, velocity: Array,
-        levels: list[list[TaskRows]] | tuple[FrameTask, Array, Array, float],
-        constraints: list[Constraints | None], dt: float, weighted: bool, direction: bool,
+        levels: list[list[TaskRows]], constraints: list[Constraints | None], dt: float,
+        weighted: bool, direction: bool,
     ) -> None:  # fmt: skip
         self.out, self.zero_inside, self.recovering = out, zero_inside, recovering
         self.velocity, self.levels, self.constraints = velocity, levels, constraints
@@ -120,14 +131,68 @@ class TickSource:
 
     def problem(self) -> Problem:
         """The problem the tick answered (:func:`rrc_pin.solvers.tick.problem.build`)."""
-        levels = self.levels
-        if isinstance(levels, tuple):
-            task, J, b, reach = levels
-            levels = [[task.rows_from(J, b, reach)]]
         box = Constraints(self.box)
         full = [box if c is None else c for c in self.constraints]
-        return build(levels, full, self.out.shape[1], self.dt, weighted=self.weighted,
+        return build(self.levels, full, self.out.shape[1], self.dt, weighted=self.weighted,
                      direction=self.direction)  # fmt: skip
+
+
+class TwistSpec(NamedTuple):
+    """What every twist tick of one task shares (:class:`TwistSource`).
+
+    Attributes:
+        task: The resolver's task.
+        reach: Its frame's reach [m], the unit of the linear rows.
+        velocity: The velocity limits (n,).
+        direction: The top level as the direction problem.
+    """
+
+    task: FrameTask
+    reach: float
+    velocity: Array
+    direction: bool
+
+
+class TwistSource(NamedTuple):
+    """What a twist tick's resolution builds its report from, when it is read.
+
+    Attributes:
+        out: What :func:`~rrc_pin.solvers.tick.tick.run_twist` wrote (read-only once
+            answered): the rates, the box's bounds and what sets each, the selected twist and
+            the box's flags.
+        J: The task frame's Jacobian (6, n).
+        dt: The step [s].
+        spec: The task's (:class:`TwistSpec`).
+    """
+
+    out: Array
+    J: Array
+    dt: float
+    spec: TwistSpec
+
+    @property
+    def b(self) -> Array:
+        """The task's commanded rates (m,), its selected rows of the twist."""
+        n = self.J.shape[1]
+        return self.out[5 * n : self.out.size - 2]
+
+    @property
+    def box(self) -> Box:
+        """The step's joint-rate bounds."""
+        out, n = self.out, self.J.shape[1]
+        kind = out[3 * n : 5 * n].reshape(2, n).astype(np.int8)
+        return Box(out[n : 2 * n], out[2 * n : 3 * n], kind, out[-2] == 1.0, out[-1] == 1.0,
+                   self.spec.velocity)  # fmt: skip
+
+    def levels(self) -> list[list[TaskRows]]:
+        """The task's rows (:meth:`~rrc_pin.tasks.FrameTask.rows_from`), as one level."""
+        spec = self.spec
+        return [[spec.task.rows_from(self.J, self.b, spec.reach)]]
+
+    def problem(self) -> Problem:
+        """The problem the tick answered (:func:`rrc_pin.solvers.tick.problem.build`)."""
+        return build(self.levels(), [Constraints(self.box)], self.J.shape[1], self.dt,
+                     weighted=False, direction=self.spec.direction)  # fmt: skip
 
 
 class CompiledTick:
@@ -144,6 +209,8 @@ class CompiledTick:
             only the default tick's: the resolver's ticks will have rows, tasks or a box
             that may exclude standing still.
     """
+
+    _spec: TwistSpec  # the loaded twist task's, once loaded
 
     def __init__(self, layout: Layout, limit: JointLimits, options: Options, direction: bool,
                  backend: QPBackend, names: tuple[str, ...], general: bool) -> None:  # fmt: skip
@@ -162,35 +229,94 @@ class CompiledTick:
         )  # fmt: skip
         self._context = backend_calls.Context(backend, self.velocity)
         self._loaded: tuple[Any, ...] | None = None  # the one twist task whose rows are loaded
+        self._frame, self._reference = 0, pin.LOCAL_WORLD_ALIGNED  # its frame, its reference
+        self._rows: list[int] | None = None  # its rows of the Jacobian, None: all six
+        self._size = 0  # the size of run_twist's out for it
+        self._answered: Array | None = None  # the last rates answered, joints[PREVIOUS]'s values
         self.workspace.compile(general)
         if general:  # its ticks may hand the direction problem to the backend
             backend_calls.compile_direction(self._context)
 
-    def twist(self, model: pin.Model, data: pin.Data, task: FrameTask, q: Array, b: Array,
+    def twist(self, model: pin.Model, data: pin.Data, task: FrameTask, q: Array, twist: Array,
               previous: Array, dt: float, start: float) -> Resolution | None:  # fmt: skip
-        """The default tick: the rates ``b`` of ``task`` (the resolver's, without a target),
-        its Jacobian Pinocchio's at ``q``, the joint box its only limit.
+        """The default tick: the twist (6,) of ``task`` (the resolver's, without a target), its
+        Jacobian Pinocchio's at ``q`` (nq = nv), the joint box its only limit, after the rates
+        ``previous`` (n,); ``start`` [s] when the tick began (``time.perf_counter``).
 
-        For a robot whose Pinocchio vector is q itself; the values of ``q`` and ``b`` are
-        checked in the compiled call. None where that call is not the tick's (its box excludes
-        standing still): :meth:`tasks` answers it then.
+        ``q`` and ``twist`` are float64 C-contiguous writable arrays of their shapes (the
+        compiled entry's types); their values are checked in the compiled call. None where that
+        call is not the tick's (its box excludes standing still): :meth:`tasks` answers it then.
+
+        Raises:
+            InvalidInput: ``q`` or ``twist`` not finite, named; nothing changed.
         """  # noqa: D205
-        ws, layout = self.workspace, self.layout
-        loaded = (task, task.weight, task.ref, task.selected)
-        if self._loaded != loaded:  # the task's weights and units, once
-            rows = task.rows_from(np.zeros((6, ws.n)), np.zeros(len(task.selected)),
-                                  layout.reach[task.frame])  # fmt: skip
-            ws.load_levels([[rows]], False)
-            ws.load_rows(None, None, None)
-            self._loaded = loaded
-        J = pin.computeFrameJacobian(model, data, q, layout.frames[task.frame],
-                                     PIN_REFERENCE[task.ref])  # fmt: skip
-        ws.load_twist(J, task.selected, b)
-        twist = (task, J, b, layout.reach[task.frame])
-        code = self._run(q, previous, dt, twist)
+        ws = self.workspace
+        if self._loaded != (task, task.weight, task.ref, task.selected):
+            self._load_twist(task)
+        J = pin.computeFrameJacobian(model, data, q, self._frame, self._reference)
+        rows, b = (J, twist) if self._rows is None else (J[self._rows], twist[self._rows])
+        if previous is not self._answered:
+            ws.joints[tick.PREVIOUS] = previous
+            self._answered = None
+        out = np.empty(self._size)
+        backend_calls.enter(self._context)
+        try:
+            code, scale, veer, clip, lambda_sq = tick.run_twist(
+                rows, b, q, dt, ws.joints, ws.rates, ws.ints, ws.reals, out)  # fmt: skip
+        finally:
+            backend_calls.leave()
+        source = _new(TwistSource, (out, J, dt, self._spec))
+        if code < 0:
+            return self._twist_elsewhere(code, source, q, b, previous, start)
+        out.setflags(write=False)
+        qdot = out[: ws.n]
+        self._answered = qdot
+        work = self._context.work
+        if work is None:
+            return _new(Resolution, (
+                qdot, STATUSES[code], "qp", scale, veer, LEVEL_OF[code], (), "", 0, clip,
+                lambda_sq, time.perf_counter() - start, 0.0, source, self.names, ()))  # fmt: skip
+        return _new(Resolution, (
+            qdot, STATUSES[code], "qp", scale, veer, LEVEL_OF[code], tuple(work.attempts),
+            work.backend, work.iterations, clip, lambda_sq,
+            time.perf_counter() - start - work.solve_time, work.solve_time, source, self.names,
+            ()))  # fmt: skip
+
+    def _load_twist(self, task: FrameTask) -> None:
+        """Load ``task``'s weights and units into the workspace, and where its rows come from."""
+        layout, n = self.layout, self.workspace.n
+        reach = layout.reach[task.frame]
+        rows = task.rows_from(np.zeros((6, n)), np.zeros(len(task.selected)), reach)
+        self.workspace.load_levels([[rows]], False)
+        self.workspace.load_rows(None, None, None)
+        self._frame, self._reference = layout.frames[task.frame], PIN_REFERENCE[task.ref]
+        self._rows = None if len(task.selected) == 6 else list(task.selected)
+        self._size = tick.twist_size(n, len(task.selected))
+        self._spec = TwistSpec(task, reach, self.velocity, self.direction)
+        self._loaded = (task, task.weight, task.ref, task.selected)
+
+    def _twist_elsewhere(self, code: int, source: TwistSource, q: Array, b: Array,
+                         previous: Array, start: float) -> Resolution | None:  # fmt: skip
+        """A twist tick that :func:`~rrc_pin.solvers.tick.tick.run_twist` did not answer: bad
+        values named (``q``, the selected twist ``b``), the fallbacks' answer, or the general
+        entry's.
+
+        Raises:
+            InvalidInput: A position (``q``) or twist not finite.
+        """  # noqa: D205
+        if code == tick.INVALID_INPUT:
+            as_vector(q, "q", q.size)
+            as_vector(b, "twist", b.size)
+            spec = source.spec
+            finite_rows([[spec.task.rows_from(source.J, b, spec.reach)]])
+        if code == FAILED:
+            return self._fallback(source, start)
+        levels = source.levels()
+        self.workspace.load_twist(source.J, source.spec.task.selected, source.b)
+        code = self._run(q, previous, source.dt, levels)
         if code == tick.ELSEWHERE:
             return None
-        return self._answer(code, twist, [None], dt, False, start)
+        return self._answer(code, levels, [None], source.dt, False, start)
 
     def answers(self, constraints: Sequence[Constraints | None]) -> bool:
         """Whether the compiled tick answers with these limits' constraints: no other box;
@@ -227,36 +353,28 @@ class CompiledTick:
         code = self._run(kin.q, previous, dt, levels)
         return self._answer(code, levels, constraints, dt, weighted, start)
 
-    def _run(
-        self, q: Array, previous: Array, dt: float,
-        levels: list[list[TaskRows]] | tuple[FrameTask, Array, Array, float],
-    ) -> int:  # fmt: skip
+    def _run(self, q: Array, previous: Array, dt: float, levels: list[list[TaskRows]]) -> int:
         """The loaded tick at ``q`` after ``previous`` [rad/s], its QPs handed to the backend.
 
         Raises:
-            InvalidInput: A position (``q``), twist or task row (of ``levels``, as
-                :meth:`_answer` takes them) not finite, with the message the checks give.
+            InvalidInput: A position (``q``) or task row (of ``levels``) not finite, with the
+                message the checks give.
         """
+        self._answered = None  # joints[PREVIOUS] is written
         backend_calls.enter(self._context)
         try:
             code = self.workspace.run(q, previous, dt)
         finally:
             backend_calls.leave()
         if code == tick.INVALID_INPUT:
-            bad = self.workspace.ints[tick.INVALID]
-            if bad == tick.BAD_POSITION:
+            if self.workspace.ints[tick.INVALID] == tick.BAD_POSITION:
                 as_vector(q, "q", q.size)
-            if isinstance(levels, tuple):
-                task, J, b, reach = levels
-                if bad == tick.BAD_RATE:
-                    as_vector(b, "twist", b.size)
-                levels = [[task.rows_from(J, b, reach)]]
             finite_rows(levels)
         return code
 
     def _answer(
-        self, code: int, levels: list[list[TaskRows]] | tuple[FrameTask, Array, Array, float],
-        constraints: list[Constraints | None], dt: float, weighted: bool, start: float,
+        self, code: int, levels: list[list[TaskRows]], constraints: list[Constraints | None],
+        dt: float, weighted: bool, start: float,
     ) -> Resolution:  # fmt: skip
         """The resolution of the tick just run (its code), deferring its problem."""
         ws, work = self.workspace, self._context.work
@@ -266,11 +384,9 @@ class CompiledTick:
             out, reals[tick.ZERO_INSIDE] == 1.0, reals[tick.RECOVERING] == 1.0, self.velocity,
             levels, constraints, dt, weighted, self.direction,
         )  # fmt: skip
-        elapsed = time.perf_counter() - start
         if code == FAILED:
-            problem = source.problem()
-            answer = fallback_answer(problem, self.options, work or Work())
-            return Resolution.of(problem, answer, elapsed, self.names)
+            return self._fallback(source, start)
+        elapsed = time.perf_counter() - start
         qdot = out[2]
         qdot.setflags(write=False)
         work = work or _NO_WORK
@@ -283,3 +399,12 @@ class CompiledTick:
             work.iterations, reals[tick.CLIP], reals[tick.LAMBDA_SQ],
             elapsed - work.solve_time, work.solve_time, source, self.names,
         )  # fmt: skip
+
+    def _fallback(self, source: TickSource | TwistSource, start: float) -> Resolution:
+        """The fallbacks' answer (:func:`~rrc_pin.solvers.tick.pipeline.fallback_answer`) to
+        the problem of a tick whose top level found none.
+        """  # noqa: D205
+        problem = source.problem()
+        elapsed = time.perf_counter() - start
+        answer = fallback_answer(problem, self.options, self._context.work or Work())
+        return Resolution.of(problem, answer, elapsed, self.names)

@@ -57,6 +57,10 @@ TaskCommand = Task | Sequence[Task | Sequence[Task]]
 
 Priority = Literal["weighted", "strict"]
 
+_FLOAT = np.dtype(np.float64)
+_TWIST = (6,)
+_WEIGHTED = "weighted"
+
 MIN_DT = 1e-6
 """[s] The shortest control period accepted (a 1 MHz loop): below it the one-step position
 bounds divide by a step that no joint can use (dt = 1e-310 made them infinite, and NaN)."""
@@ -186,6 +190,7 @@ class Resolver:
         self._box_only = self._compiled is not None and self.limits == (joint[0],)
         self._twists = (self._box_only and self.task is not None and closed_form is None
                         and robot.model.nq == robot.model.nv)  # fmt: skip
+        self._q_shape = (robot.nq,)
 
     @property
     def layout(self) -> Layout:
@@ -316,7 +321,7 @@ class Resolver:
         """
         if (self._twists and self._free is None and type(command) is np.ndarray
                 and type(q) is np.ndarray and ref is None and dt is None and qdot_prev is None
-                and type(priority) is str and priority == "weighted"):
+                and (priority is _WEIGHTED or (type(priority) is str and priority == _WEIGHTED))):
             r = self._twist(q, command)
             if r is not None:
                 return r
@@ -328,19 +333,24 @@ class Resolver:
         (:meth:`CompiledTick.twist`), or None where the general path answers: arrays of other
         shapes or types (it checks them), a task with a target, a box that excludes standing
         still."""  # noqa: D205, D209
-        task = cast(FrameTask, self.task)
-        if (q.dtype != np.float64 or q.shape != (self.robot.nq,) or twist.dtype != np.float64
-                or twist.shape != (6,) or task.target is not None):  # fmt: skip
+        task: FrameTask = self.task  # type: ignore[assignment]  # one, where _twists
+        if (q.dtype is not _FLOAT or twist.dtype is not _FLOAT or q.shape != self._q_shape
+                or twist.shape != _TWIST or task.target is not None):  # fmt: skip
             return None
-        b = twist.copy() if len(task.selected) == 6 else twist[list(task.selected)]
-        with self._lock:
-            start = time.perf_counter()
-            compiled = cast(CompiledTick, self._compiled)
-            r = compiled.twist(self.robot.model, self._data, task, q, b, self._last_qdot,
-                               self.dt, start)  # fmt: skip
+        if not q.flags.carray:  # the compiled entry's type: C-contiguous, aligned, writable
+            q = q.copy()
+        if not twist.flags.carray:
+            twist = twist.copy()
+        compiled: CompiledTick = self._compiled  # type: ignore[assignment]  # where _twists
+        self._lock.acquire()
+        try:
+            r = compiled.twist(self.robot.model, self._data, task, q, twist, self._last_qdot,
+                               self.dt, time.perf_counter())  # fmt: skip
             if r is not None:
                 self._last_qdot = r.qdot
             return r
+        finally:
+            self._lock.release()
 
     def solve_at(
         self,

@@ -89,3 +89,32 @@ def test_solve_at_reads_the_callers_kinematics(panda: rrc_pin.Robot) -> None:
     assert kin.jacobian(panda.tool_frame, "world_aligned") is J  # read, not computed again
     with pytest.raises(InvalidInput, match="kinematics"):
         resolver.solve_at(q, twist)  # type: ignore[arg-type]
+
+
+def test_a_twist_of_any_layout_answers_alike(panda: rrc_pin.Robot) -> None:
+    """Read-only, strided or int arrays answer as fresh ones (copied, or the general way); the
+    rates are read-only; the previous rates are the resolver's, after a reset or a tasks' tick
+    too (acceleration limits read them)."""
+    rng = np.random.default_rng(4)
+    limits = rrc_pin.JointLimits(acceleration=np.full(panda.nv, 20.0))
+    a, b = Resolver(panda, limits=limits), Resolver(panda, limits=limits)
+    q = panda.random_q(rng)
+    for k in range(12):
+        twist = rng.normal(size=6) * 0.3
+        if k == 4:
+            a.reset()
+            b.reset()
+        if k == 7:
+            tasks = [FrameTask(panda.tool_frame, twist)]
+            assert np.array_equal(a.solve(q, tasks).qdot, b.solve(q, tasks).qdot)
+        q_ro, twist_ro = q.copy(), twist.copy()
+        q_ro.flags.writeable = twist_ro.flags.writeable = False
+        strided = np.repeat(twist, 2)[::2]
+        r = a.solve(q_ro, twist_ro if k % 2 else strided)
+        want = b.solve(q.copy(), twist.copy())
+        assert np.array_equal(r.qdot, want.qdot) and r.status == want.status
+        assert not r.qdot.flags.writeable
+        q = q + r.qdot * a.dt
+    whole = np.round(q).astype(int)
+    assert np.array_equal(a.solve(whole, np.zeros(6)).qdot, b.solve(whole.astype(float),
+                                                                      np.zeros(6)).qdot)

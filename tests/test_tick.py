@@ -191,6 +191,49 @@ def test_the_default_tick_passes_a_box_without_standing_still_on() -> None:
         backend_calls.leave()
 
 
+@pytest.mark.parametrize("seed", [6, 7, 8])
+def test_the_twist_entry_answers_as_run_box(seed: int) -> None:
+    """run_twist on the caller's rows, rates and positions answers as run_box on the loaded
+    workspace: the same rates, box and report; the rates left as the next tick's previous;
+    bad values and a box without standing still passed on, nothing written to the previous."""
+    rng = np.random.default_rng(seed)
+    lower, upper, velocity = limits(rng)
+    ws = tick.Workspace(lower, upper, velocity, np.full(N, 50.0), 0.0, 1.0, 100.0, True, 1e-6)
+    answered = 0
+    for _ in range(30):
+        J, b = rng.normal(size=(6, N)), rng.normal(size=6) * rng.choice([0.1, 1.0, 10.0])
+        q, previous = rng.uniform(lower, upper), rng.normal(size=N) * 0.2
+        ws.load_levels([[TaskRows(J, b, None, "t", np.ones(6))]], False)
+        ws.load_rows(None, None, None)
+        ws.joints[tick.POSITION], ws.joints[tick.PREVIOUS], ws.reals[tick.DT] = q, previous, DT
+        code = tick.run_box(ws.joints, ws.task_rows, ws.rates, ws.ints, ws.reals)
+        ws.joints[tick.PREVIOUS] = previous
+        out = np.empty(tick.twist_size(N, 6))
+        got = tick.run_twist(J, b, q, DT, ws.joints, ws.rates, ws.ints, ws.reals, out)
+        if code == tick.ELSEWHERE:  # previous rates far from zero: the box excludes it
+            assert got[0] == code
+            continue
+        want = (code, *ws.reals[[tick.SCALE, tick.VEER, tick.CLIP, tick.LAMBDA_SQ]].tolist())
+        assert got == want
+        assert np.array_equal(out[:N], ws.joints[tick.QDOT])
+        assert np.array_equal(out[N : 5 * N].reshape(4, N),
+                              ws.joints[[tick.LB, tick.UB, tick.KIND, tick.KIND + 1]])
+        assert np.array_equal(out[5 * N : -2], b) and out[-2] == 1.0
+        assert np.array_equal(ws.joints[tick.PREVIOUS], out[:N])
+        answered += 1
+    assert answered >= 20
+    previous = ws.joints[tick.PREVIOUS].copy()
+    bad = q.copy()
+    bad[2] = np.nan
+    assert tick.run_twist(J, b, bad, DT, ws.joints, ws.rates, ws.ints, ws.reals,
+                          out)[0] == tick.INVALID_INPUT
+    outside = q.copy()
+    outside[0] = upper[0] + 0.5
+    assert tick.run_twist(J, b, outside, DT, ws.joints, ws.rates, ws.ints, ws.reals,
+                          out)[0] == tick.ELSEWHERE
+    assert np.array_equal(ws.joints[tick.PREVIOUS], previous)
+
+
 def _constant_rows(rng: np.random.Generator) -> list[TaskRows]:
     """Tasks whose rows, weights or units are read-only arrays owning their values (loaded once
     while they come at the same rows), beside writable ones, None and read-only views."""

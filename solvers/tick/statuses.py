@@ -10,7 +10,8 @@ Each rule is one kernel, called from the compiled tick (:mod:`rrc_pin.solvers.ti
 - a top level whose stacked command is met is ``exact`` where that is the command itself, else
   (a command divided down, :mod:`rrc_pin.solvers.tick.problem`) ``scaled`` by its factor
   (:func:`met_top`);
-- a lower level is ``met``, ``scaled`` along its command or ``traded`` (:func:`served`).
+- a lower level is ``met``, ``scaled`` along its command or ``traded`` (:func:`served`); the
+  top level as a level by its status (:func:`top_served`).
 """
 
 from __future__ import annotations
@@ -68,6 +69,14 @@ def met_top(rate_factor: float) -> int:
     ``rate_factor`` is 1, else :data:`SCALED` (by ``rate_factor``, its scale either way).
     """  # noqa: D205
     return EXACT if rate_factor == 1.0 else SCALED
+
+
+@kernel
+def top_served(status: int) -> int:
+    """How a top level of status code ``status`` is served, as a level: :data:`MET` where
+    ``exact``, :data:`SCALED_LEVEL` where ``scaled``, else :data:`TRADED`.
+    """  # noqa: D205
+    return MET if status == EXACT else SCALED_LEVEL if status == SCALED else TRADED
 
 
 @kernel

@@ -36,7 +36,7 @@ from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import equalities, kernels, statuses, top
 from rrc_pin.solvers.tick.levels import least_squares, row_values
 from rrc_pin.solvers.tick.problem import LARGE, TaskRows, cap
-from rrc_pin.solvers.tick.statuses import DROPPED, EXACT, MET, SCALED, SCALED_LEVEL, TRADED
+from rrc_pin.solvers.tick.statuses import DROPPED
 from rrc_pin.solvers.tick.top import FAILED, Rows, Top
 
 Array = npt.NDArray[np.float64]
@@ -195,6 +195,24 @@ def lower_levels(task_rows: Array, rates: Array, ints: Ints, rows: Rows, answer:
 
 
 @inlined
+def bounds(q: Array, dt: float, joints: Array, reals: Array, lb: Array, ub: Array,
+           kinds: Array) -> tuple[bool, bool]:  # fmt: skip
+    """Stage 2 at positions ``q`` (n,) for the step ``dt`` [s]: the box into ``lb`` and ``ub``
+    (n,), what sets each bound into ``kinds`` (2, n), the lower bounds' row then the upper
+    ones' (:func:`~rrc_pin.solvers.tick.kernels.joint_box`); whether standing still is
+    allowed, whether a joint was outside its range.
+    """  # noqa: D205
+    kind = np.empty((2, q.size), np.int8)
+    zero_inside, recovering = kernels.joint_box(
+        q, joints[LOWER], joints[UPPER], joints[VELOCITY], reals[MARGIN], reals[GAIN], dt,
+        joints[PREVIOUS], joints[ACCELERATION], lb, ub, kind,
+    )  # fmt: skip
+    for j in range(q.size):
+        kinds[0, j], kinds[1, j] = kind[0, j], kind[1, j]
+    return zero_inside, recovering
+
+
+@inlined
 def box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Array) -> bool:
     """Stages 1 and 2: the inputs checked (the code of a bad one in ``ints[INVALID]``, then
     False), the step's box and what sets each bound into ``joints``, its flags into ``reals``.
@@ -202,17 +220,20 @@ def box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Array)
     ints[INVALID] = checked(joints, task_rows, rates, ints[ROWS])
     if ints[INVALID]:
         return False
-    kind = np.empty((2, joints.shape[1]), np.int8)
-    zero_inside, recovering = kernels.joint_box(
-        joints[POSITION], joints[LOWER], joints[UPPER], joints[VELOCITY], reals[MARGIN],
-        reals[GAIN], reals[DT], joints[PREVIOUS], joints[ACCELERATION], joints[LB], joints[UB],
-        kind,
-    )  # fmt: skip
-    for j in range(kind.shape[1]):
-        joints[KIND, j], joints[KIND + 1, j] = kind[0, j], kind[1, j]
+    zero_inside, recovering = bounds(joints[POSITION], reals[DT], joints, reals, joints[LB],
+                                     joints[UB], joints[KIND : KIND + 2])  # fmt: skip
     reals[ZERO_INSIDE] = 1.0 if zero_inside else 0.0
     reals[RECOVERING] = 1.0 if recovering else 0.0
     return True
+
+
+@inlined
+def clipped(qdot: Array, rows: Rows, answer: Top, zero_inside: bool) -> tuple[float, float]:
+    """Stage 5: ``qdot`` clipped into the box and shrunk into the rows, in place; the clip's
+    size and the top level's scale after the shrink.
+    """  # noqa: D205
+    clip = kernels.clip_into(qdot, rows.lb, rows.ub)
+    return clip, answer.scale * within_rows(qdot, rows, zero_inside)
 
 
 @inlined
@@ -220,15 +241,12 @@ def report(joints: Array, ints: Ints, reals: Array, rows: Rows, answer: Top, qdo
     """Stage 5: ``qdot`` clipped into the box and shrunk into the rows, and the top level's
     report, into ``joints`` and ``reals``; the status code.
     """  # noqa: D205
-    reals[CLIP] = kernels.clip_into(qdot, rows.lb, rows.ub)
-    reals[SCALE] = answer.scale * within_rows(qdot, rows, reals[ZERO_INSIDE] == 1.0)
+    reals[CLIP], reals[SCALE] = clipped(qdot, rows, answer, reals[ZERO_INSIDE] == 1.0)
     reals[VEER], reals[LAMBDA_SQ] = answer.veer, answer.lambda_sq
     for c in range(qdot.size):  # element by element: an array copy compiles numba's shape error
         joints[QDOT, c] = qdot[c]
-    status = answer.status
-    code = MET if status == EXACT else SCALED_LEVEL if status == SCALED else TRADED
-    ints[STARTS + ints[LEVELS] + 1] = code
-    return status
+    ints[STARTS + ints[LEVELS] + 1] = statuses.top_served(answer.status)
+    return answer.status
 
 
 @kernel
@@ -250,6 +268,55 @@ def run_box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Ar
     if answer.status == FAILED:
         return FAILED
     return report(joints, ints, reals, rows, answer, answer.qdot)
+
+
+@kernel
+def run_twist(J: Array, b: Array, q: Array, dt: float, joints: Array, rates: Array, ints: Ints,
+              reals: Array, out: Array) -> tuple[int, float, float, float, float]:  # fmt: skip
+    """The default tick, ``solve(q, twist)``: what :func:`run_box` does, on the caller's arrays.
+
+    One task's rows ``J`` (m, n) and commanded rates ``b`` (m,) at positions ``q`` (n,), the
+    step ``dt`` [s], within the joint box alone; the task's weights and units are the loaded
+    ones (``rates``, :meth:`Workspace.load_levels`), the previous rates ``joints[PREVIOUS]``.
+    Writes ``out`` (:func:`twist_size`): the rates, the box's bounds, what sets each bound
+    (lower, upper), then ``b`` and the box's flags (standing still allowed, recovering); and
+    the rates into ``joints[PREVIOUS]``, the next tick's previous ones.
+
+    Returns:
+        ``(code, scale, veer, clip, lambda_sq)``: the status code and the report, or
+        :data:`INVALID_INPUT` (a position, rate or row not finite), :data:`ELSEWHERE` (the box
+        excludes standing still, or the mode is not the direction one: :func:`run` answers)
+        or :data:`FAILED` (the fallbacks answer) and zeros.
+    """
+    n, m = q.size, b.size
+    if not (kernels.all_finite(q) and kernels.all_finite(b) and kernels.all_finite(J.ravel())):
+        return INVALID_INPUT, 0.0, 0.0, 0.0, 0.0
+    lb, ub = out[n : 2 * n], out[2 * n : 3 * n]
+    zero_inside, recovering = bounds(q, dt, joints, reals, lb, ub,
+                                     out[3 * n : 5 * n].reshape(2, n))  # fmt: skip
+    flags = 5 * n + m
+    for i in range(m):
+        out[5 * n + i] = b[i]
+    out[flags] = 1.0 if zero_inside else 0.0
+    out[flags + 1] = 1.0 if recovering else 0.0
+    if not zero_inside or ints[WEIGHTED] == 1 or ints[DIRECTION] == 0:
+        return ELSEWHERE, 0.0, 0.0, 0.0, 0.0
+    rows = Rows(lb, ub, J[:0], reals[:0], reals[:0], reals[TOLERANCE])
+    A, c, rate_factor = stacked(J, b, rates[WEIGHT][:m], rates[UNIT][:m], ints[DIRECTION] == 1,
+                                lb, ub)  # fmt: skip
+    answer = top.direction_box(A, c, rows, dt, reals[THRESHOLD], rate_factor)
+    if answer.status == FAILED:
+        return FAILED, 0.0, 0.0, 0.0, 0.0
+    qdot = answer.qdot
+    clip, scale = clipped(qdot, rows, answer, True)
+    for j in range(n):
+        out[j] = joints[PREVIOUS, j] = qdot[j]
+    return answer.status, scale, answer.veer, clip, answer.lambda_sq
+
+
+def twist_size(n: int, m: int) -> int:
+    """The size of :func:`run_twist`'s ``out`` for n joints and m task rows."""
+    return 5 * n + m + 2
 
 
 @kernel
@@ -477,6 +544,8 @@ class Workspace:
         ws.joints[POSITION] = np.clip(np.zeros(n), self.joints[LOWER], self.joints[UPPER])
         ws.reals[DT] = 0.01
         run_box(ws.joints, ws.task_rows, ws.rates, ws.ints, ws.reals)
+        run_twist(np.eye(1, n), np.zeros(1), ws.joints[POSITION].copy(), 0.01, ws.joints, ws.rates,
+                  ws.ints, ws.reals, np.empty(twist_size(n, 1)))  # fmt: skip
         if general:
             run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
             if n > 1:  # a tick within equality rows (contacts, grips): the rates of joint 1 zero
@@ -485,7 +554,7 @@ class Workspace:
                            ws.ints, ws.reals)  # fmt: skip
 
     def level_codes(self) -> list[int]:
-        """How each level was served (:data:`MET`, :data:`SCALED_LEVEL`, :data:`TRADED`)."""
+        """How each level was served (the codes of :mod:`rrc_pin.solvers.tick.statuses`)."""
         ints = self.ints
         levels = ints.item(LEVELS)
         if levels == 1:
