@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from typing import Any, get_args
+from typing import Any, cast, get_args
 
 import numpy as np
 import numpy.typing as npt
@@ -33,6 +33,7 @@ from rrc_pin.solvers.tick.problem import (
     Box,
     Constraints,
     Problem,
+    Rows,
     TaskRows,
     build,
     finite_rows,
@@ -185,11 +186,14 @@ class CompiledTick:
         ``start`` [s] when the tick began (``time.perf_counter``)."""  # noqa: D205, D209
         ws = self.workspace
         ws.load_levels(levels, weighted)
-        present = [c for c in constraints if c is not None]
-        rows = merged_rows(present) if present else None
-        if rows is None:
+        present = [c for c in constraints
+                   if c is not None and c.G is not None and c.h is not None and c.h.size]
+        if not present:
             ws.load_rows(None, None, None)
+        elif len(present) == 1:  # one limit's rows: loaded as they are (names not needed)
+            ws.load_rows(present[0].G, present[0].h, present[0].slide)
         else:
+            rows = cast(Rows, merged_rows(present))
             ws.load_rows(rows.G, rows.h, rows.slide)
         self._loaded = None
         code = self._run(kin.q, previous, dt, levels)
