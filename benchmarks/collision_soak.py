@@ -464,7 +464,7 @@ def moved_at_once(r: StartReport) -> bool:
     """Whether the hands moved at the first away tick's command: its scale met, and the hands
     faster than 1 cm/s or at the command's own hand speed where that is slower (a command
     that moves every inside pair apart without bringing any other closer may have to turn the
-    hand more than move it)."""  # noqa: D205, D209
+    hand more than move it)."""
     return r.first_scale >= 0.99 and (r.first_speed > 0.01
                                       or r.first_speed >= 0.99 * r.first_command > 0.0)
 

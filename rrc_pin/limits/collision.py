@@ -57,7 +57,7 @@ from rrc_pin.geometry.proximity import Proximity, gather, measure, proximity_of
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import finite_number
-from rrc_pin.solvers.collision.collision_pass import pair_rows
+from rrc_pin.solvers.collision.collision_pass import pair_rows, row_copies
 from rrc_pin.solvers.collision.damper_kernels import damper_bound
 from rrc_pin.solvers.collision.records import SETTINGS
 from rrc_pin.solvers.tick.problem import Constraints
@@ -223,12 +223,11 @@ class CollisionLimit(Limit):
         walls = model.walls()
         if not rows and not walls:
             return _NONE
-        found = data.found[:rows]
-        G, h, distance = data.G[:rows].copy(), data.h[:rows].copy(), found["distance"].copy()
-        names = self._names(scene, found["pair"])
+        G, h, distance, pair = row_copies(data.found, data.G, data.h, rows)
+        names = self._names(scene, pair)
         if walls or unmoved:
             G, h, distance, names = self._trimmed(kin, walls, G, h, distance, names,
-                                                  found["moved"], dt)  # fmt: skip
+                                                  data.found["moved"][:rows], dt)  # fmt: skip
             if not h.size:
                 return _NONE
         return Constraints(G=G, h=h, names=names, slide=self._sliding(h.size),

@@ -173,8 +173,7 @@ def near_pairs(
     keep: npt.NDArray[np.bool_],
     out: Index,
 ) -> int:
-    """Indices of the asked pairs whose distance bound (module docstring) is below
-    ``detection``.
+    """Indices of the pairs asked for whose distance bound is below ``detection``.
 
     Args:
         first: First body (npairs,) of each pair.
