@@ -200,6 +200,7 @@ class CollisionLimit(Limit):
             measure(scene, robot.model, q, lambda: kin.data, cdata, settings, scene.every)
         pair_rows(cdata.J, scene.support, scene.bodies, scene.first, scene.second, settings,
                   cdata.found, 0, cdata.G, cdata.h)  # fmt: skip
+        row_copies(cdata.found, cdata.G, cdata.h, 0)
 
     @property
     def last(self) -> Proximity | None:
