@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from typing import Any, NamedTuple, get_args
+from typing import Any, NamedTuple, cast, get_args
 
 import numpy as np
 import numpy.typing as npt
@@ -343,10 +343,13 @@ class CompiledTick:
         ws = self.workspace
         ws.load_levels(levels, weighted)
         present = [c for c in constraints if c is not None]
-        rows = merged_rows(present) if present else None
-        if rows is None:
+        with_rows = [c for c in present if c.G is not None and c.h is not None and c.h.size]
+        if not with_rows:
             ws.load_rows(None, None, None)
+        elif len(with_rows) == 1:  # one limit's rows: loaded as they are (names not needed)
+            ws.load_rows(with_rows[0].G, with_rows[0].h, with_rows[0].slide)
         else:
+            rows = cast(Rows, merged_rows(with_rows))
             ws.load_rows(rows.G, rows.h, rows.slide)
         ws.load_equalities(*(merged_equalities(present) or (None, None)))
         self._loaded = None

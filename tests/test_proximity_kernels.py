@@ -102,6 +102,10 @@ def test_world_centres_and_near_pairs_against_numpy(rng):
         np.linalg.norm(world[first] - world[second], axis=1) - radius[first] - radius[second],
     )
     out = np.zeros(len(first), dtype=np.int64)
+    every = np.ones(len(first), dtype=np.bool_)
+    some = rng.random(len(first)) < 0.5
     for detection in (-1.0, 0.0, 0.3, 10.0):
-        count = near_pairs(first, second, world, radius, normal, offset, detection, out)
+        count = near_pairs(first, second, world, radius, normal, offset, detection, every, out)
         np.testing.assert_array_equal(out[:count], np.flatnonzero(bound < detection))
+        count = near_pairs(first, second, world, radius, normal, offset, detection, some, out)
+        np.testing.assert_array_equal(out[:count], np.flatnonzero((bound < detection) & some))

@@ -57,7 +57,7 @@ from rrc_pin.geometry.proximity import Proximity, gather, measure, proximity_of
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import finite_number
-from rrc_pin.solvers.collision.collision_pass import pair_rows
+from rrc_pin.solvers.collision.collision_pass import pair_rows, row_copies
 from rrc_pin.solvers.collision.damper_kernels import damper_bound
 from rrc_pin.solvers.collision.records import SETTINGS
 from rrc_pin.solvers.tick.problem import Constraints
@@ -167,6 +167,8 @@ class CollisionLimit(Limit):
         self._settings: tuple[float, npt.NDArray[np.void]] = (math.nan, np.zeros(1, SETTINGS))
         self._kept: tuple[Scene | None, npt.NDArray[np.bool_]] = (None, np.zeros(0, np.bool_))
         self._seen: Scene | None = None
+        self._slide = np.ones(0, dtype=np.bool_)
+        self._named: tuple[tuple[Scene | None, bytes], tuple[str, ...]] = ((None, b""), ())
         self._warn_invariant(model.scene)
 
     def check(self, layout: Layout) -> None:
@@ -198,6 +200,7 @@ class CollisionLimit(Limit):
             measure(scene, robot.model, q, lambda: kin.data, cdata, settings, scene.every)
         pair_rows(cdata.J, scene.support, scene.bodies, scene.first, scene.second, settings,
                   cdata.found, 0, cdata.G, cdata.h)  # fmt: skip
+        row_copies(cdata.found, cdata.G, cdata.h, 0)
 
     @property
     def last(self) -> Proximity | None:
@@ -211,26 +214,41 @@ class CollisionLimit(Limit):
         model = self.model
         if kin.model is not model.robot.model:
             raise InvalidInput("kin", f"kinematics of another model than {model.robot.name}'s")
-        scene = model.scene
+        scene, data = model.scene, self._data
         if scene is not self._seen:  # an obstacle added since: its pairs no joint moves
             self._warn_invariant(scene)
         keep = scene.every if self.pairs is None else self._keep(scene)
-        rows, unmoved = measure(scene, kin.model, kin.q, lambda: kin.data, self._data,
+        rows, unmoved = measure(scene, kin.model, kin.q, lambda: kin.data, data,
                                 self._damper(dt), keep)  # fmt: skip
         self._rows, self._last = rows, None
         walls = model.walls()
         if not rows and not walls:
             return _NONE
-        found = self._data.found[:rows]
-        G, h, distance = self._data.G[:rows].copy(), self._data.h[:rows].copy(), found["distance"]
-        names = gather(scene.labels, found["pair"])
+        G, h, distance, pair = row_copies(data.found, data.G, data.h, rows)
+        names = self._names(scene, pair)
         if walls or unmoved:
             G, h, distance, names = self._trimmed(kin, walls, G, h, distance, names,
-                                                  found["moved"], dt)  # fmt: skip
+                                                  data.found["moved"][:rows], dt)  # fmt: skip
             if not h.size:
                 return _NONE
-        return Constraints(G=G, h=h, names=names, slide=np.ones(h.size, dtype=np.bool_),
-                           distance=distance.copy())  # fmt: skip
+        return Constraints(G=G, h=h, names=names, slide=self._sliding(h.size),
+                           distance=distance)  # fmt: skip
+
+    def _sliding(self, rows: int) -> npt.NDArray[np.bool_]:
+        """Every one of ``rows`` rows slides (module docstring): a read-only view of one array
+        kept, grown where more rows come."""  # noqa: D205, D209
+        if self._slide.size < rows:
+            self._slide = np.ones(max(rows, 2 * self._slide.size), dtype=np.bool_)
+            self._slide.flags.writeable = False
+        return self._slide[:rows]
+
+    def _names(self, scene: Scene, pair: npt.NDArray[np.int64]) -> tuple[str, ...]:
+        """The rows' names (``"body_a|body_b"``) of the pairs ``pair`` (rows,) of ``scene``:
+        those of the last tick again where its rows were the same pairs'."""  # noqa: D205, D209
+        key = (scene, pair.tobytes())
+        if self._named[0] != key:
+            self._named = (key, gather(scene.labels, pair))
+        return self._named[1]
 
     def _trimmed(
         self, kin: Kinematics, walls: Sequence[Wall], G: Array, h: Array, distance: Array,

@@ -4,8 +4,8 @@
    (:func:`~rrc_pin.solvers.collision.proximity_kernels.joint_poses`,
    :func:`~rrc_pin.solvers.collision.proximity_kernels.joint_jacobians`), or given by the caller
    for a model the compiled forward kinematics does not cover;
-2. the broad phase: bounding-sphere centres in the world and the pairs whose bound is below
-   the detection distance (:func:`~rrc_pin.solvers.collision.proximity_kernels.near_pairs`);
+2. the broad phase: bounding-sphere centres in the world and the asked pairs whose bound is
+   below the detection distance (:func:`~rrc_pin.solvers.collision.proximity_kernels.near_pairs`);
 3. the narrow phase of those pairs: spheres, capsules and half-spaces measured, other shapes
    returned for coal (:func:`~rrc_pin.solvers.collision.narrow_kernels.narrow_phase`);
 4. the damper row of each row found (:func:`pair_rows`), when nothing is left for coal (coal's
@@ -89,7 +89,7 @@ def collision_pass(
             joint_jacobians(poses, joints["kind"], joints["axis"], joints["coordinate"], J)
     world_centres(poses, bodies["joint"], bodies["centre"], world)
     count = near_pairs(first, second, world, bodies["bounding"], bodies["normal"],
-                       bodies["offset"], s["detection"], candidates)  # fmt: skip
+                       bodies["offset"], s["detection"], keep, candidates)  # fmt: skip
     rows, others = narrow_phase(poses, bodies, world, first, second, candidates, count, keep,
                                 s["detection"], s["ends"], found, other)  # fmt: skip
     unmoved = 0
@@ -140,3 +140,12 @@ def pair_rows(
         elif found["end"][r] == FEATURE and distance[r] > own:
             h[r] = max(h[r], SLACK)  # a feature's row holds or damps, never pushes out
     return unmoved
+
+
+@kernel
+def row_copies(found: Records, G: Array, h: Array, rows: int) -> tuple[Array, Array, Array, Index]:
+    """Copies of the first ``rows`` damper rows ``G`` (rows, nv) and bounds ``h`` (rows,), and
+    of the found rows' distances (rows,) [m] and pairs (rows,): what a tick's constraints keep
+    while the pass's arrays are written again."""  # noqa: D205, D209
+    return (G[:rows].copy(), h[:rows].copy(), found["distance"][:rows].copy(),
+            found["pair"][:rows].copy())  # fmt: skip

@@ -170,9 +170,10 @@ def near_pairs(
     normal: Array,
     offset: Array,
     detection: float,
+    keep: npt.NDArray[np.bool_],
     out: Index,
 ) -> int:
-    """Indices of the pairs whose distance bound (module docstring) is below ``detection``.
+    """Indices of the pairs asked for whose distance bound is below ``detection``.
 
     Args:
         first: First body (npairs,) of each pair.
@@ -183,6 +184,7 @@ def near_pairs(
             other bodies).
         offset: Offsets (ng,) [m] of the half-spaces: the solid is ``normal . x <= offset``.
         detection: Detection distance [m].
+        keep: Whether each pair (npairs,) is asked for (the others are not candidates).
         out: Pair indices (npairs,), the first ``count`` written.
 
     Returns:
@@ -190,6 +192,8 @@ def near_pairs(
     """
     count = 0
     for k in range(first.shape[0]):
+        if not keep[k]:
+            continue
         a = first[k]
         b = second[k]
         if math.isinf(radius[a]) or math.isinf(radius[b]):
