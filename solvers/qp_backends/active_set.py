@@ -244,7 +244,8 @@ def _iterate(Pinv: Array, N: Array, b: Array, x: Array) -> tuple[int, int]:
             for i in range(nz):
                 for j in range(nz):
                     own += N[p, i] * Pinv[i, j] * N[p, j]
-            t2 = -_slack(N, b, p, x) / zn if zn > DEPENDENT * own else math.inf
+            # with nz rows active no primal step is left: p depends on them
+            t2 = -_slack(N, b, p, x) / zn if k < nz and zn > DEPENDENT * own else math.inf
             if t1 == math.inf and t2 == math.inf:
                 return INFEASIBLE, steps
             t = min(t1, t2)
