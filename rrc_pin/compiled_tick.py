@@ -31,6 +31,7 @@ from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.limits import JointLimits
 from rrc_pin.robot import PIN_REFERENCE
 from rrc_pin.solvers.checks import as_vector
+from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.base import QPBackend
 from rrc_pin.solvers.qp_backends.qp import Work, velocity_tolerance
 from rrc_pin.solvers.tick import backend_calls, statuses, tick
@@ -394,12 +395,14 @@ class CompiledTick:
         qdot.setflags(write=False)
         work = work or _NO_WORK
         codes = ws.level_codes()
+        # the backend's name where it answered a QP, else the compiled solver's where it did
+        backend = work.backend or (active_set.NAME if reals[tick.SOLVED] else "")
         levels_served = ONE_LEVEL[codes[0]] if len(codes) == 1 else tuple(map(LEVELS.__getitem__,
                                                                               codes))  # fmt: skip
         return Resolution(
             qdot, STATUSES[code], "qp", reals[tick.SCALE], reals[tick.VEER], levels_served,
-            tuple(work.attempts), work.backend,
-            work.iterations, reals[tick.CLIP], reals[tick.LAMBDA_SQ],
+            tuple(work.attempts), backend, work.iterations + int(reals[tick.SOLVED_STEPS]),
+            reals[tick.CLIP], reals[tick.LAMBDA_SQ],
             elapsed - work.solve_time, work.solve_time, source, self.names,
         )  # fmt: skip
 

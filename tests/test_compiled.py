@@ -71,6 +71,9 @@ from rrc_pin.solvers.tick import equalities, factor, levels, problem, slide_kern
 x = np.empty(2)
 slide_kernels.project(np.eye(2), 0.0, np.ones(2), -np.ones(2), np.ones(2), np.zeros((0, 2)),
                       np.zeros(0), 0.0, x)
+from rrc_pin.solvers.qp_backends import active_set
+active_set.solve(np.eye(2), -np.ones(2), np.ones((1, 2)), np.array([-np.inf]), np.ones(1),
+                 np.zeros(2), np.ones(2), x)
 out["tick glue"] = [statuses.norm(np.ones(3)), float(levels.row_values(np.eye(2), x).sum()),
                     float(factor.qr(np.eye(2)).R.sum()),
                     problem.cap(np.eye(2), 1e200, 1.0, True, -np.ones(2), np.ones(2)),

@@ -15,6 +15,7 @@ from rrc_pin.solvers.tick.direction import (
     constraint_rows,
     direction_lp,
     direction_qp,
+    solved_along,
 )
 from rrc_pin.solvers.tick.factorization import Factorization
 from rrc_pin.solvers.tick.kernels import line_scale, uniform_scale
@@ -210,6 +211,32 @@ def test_every_backend_at_the_limits_answers_right_or_not_at_all(
     assert max(bends) <= 2e-8, max(bends)
 
 
+@pytest.mark.parametrize("fixture", ["exact_scales", "exact_scales_on_limits"])
+def test_the_compiled_solver_finds_the_largest_scale_or_leaves_it_to_the_backend(
+    fixture: str, request: pytest.FixtureRequest
+) -> None:
+    """solved_along (the tick's first try, the compiled active-set solver): every answer at
+    HiGHS's maximum (1e-6 relative, 1e-8 absolute), within the box and along J w; a refusal
+    (DAQP answers then) rare: none measured on either set."""
+    cases: list[tuple[dict, float]] = request.getfixturevalue(fixture)
+    refused = 0
+    for p, u_exact in cases:
+        w, null, lb, ub = p["w"], np.ascontiguousarray(p["null"]), p["lb"], p["ub"]
+        n = w.size
+        qdot, u, veer, steps = solved_along(p["J"], w, null, lb, ub, np.zeros((0, n)),
+                                            np.zeros(0), 1e-6)  # fmt: skip
+        if u < 0.0:
+            refused += 1
+            continue
+        assert steps > 0 and (u <= 1e-9 or veer < 1e-6)  # standing still: its angle is noise
+        _, decoding = direction_qp(w, p["null"], box(lb, ub), None)
+        assert decoding.M is not None
+        assert scale_of(qdot, decoding.M) == pytest.approx(u_exact, rel=1e-6, abs=1e-8)
+        assert (qdot >= lb - 1e-9).all() and (qdot <= ub + 1e-9).all()
+        np.testing.assert_allclose(p["J"] @ qdot, u * (p["J"] @ w), atol=1e-8)
+    assert refused <= 3, refused
+
+
 def test_the_qp_caps_the_command_to_the_radius_of_the_bounds() -> None:
     """u stays of order one for absurd commands: M's last column is at most R long."""
     null = np.array([[0.0, 0.0, 1.0]])
@@ -226,7 +253,10 @@ def test_the_qp_caps_the_command_to_the_radius_of_the_bounds() -> None:
     np.testing.assert_array_equal(qp.ub, [np.inf, 1.0])
     np.testing.assert_array_equal(qp.q, [0.0, -1.0])
     np.testing.assert_allclose(np.diag(qp.P), [REGULARIZATION / radius**2, REGULARIZATION])
-    assert qp.C is decoding.M and qp.l is lb and qp.u is ub and qp.key == "direction:3:1:3"
+    assert decoding.M is not None and qp.C is not None and qp.key == "direction:3:1:3"
+    np.testing.assert_array_equal(qp.C, decoding.M)
+    np.testing.assert_array_equal(qp.l, lb)
+    np.testing.assert_array_equal(qp.u, ub)
 
 
 # -- the LP against vertex enumeration --------------------------------------------------------
@@ -346,6 +376,44 @@ def test_line_scale_with_null_components_of_rounding_size() -> None:
         assert (qdot >= lb - 1e-12).all() and (qdot <= ub + 1e-12).all()
         exact = direction_lp(w, v[None, :], box(lb, ub), None)  # to HiGHS's tolerance (1e-7)
         assert u == pytest.approx(float(exact @ w) / float(w @ w), rel=1e-6, abs=1e-7)
+
+
+def test_line_scale_leaves_a_joint_no_row_moves_still() -> None:
+    """The defect of issue 39: a null direction that is one joint (a joint no row moves, its
+    rate ~0 in w) with components of rounding size elsewhere; a row pinned at u took its
+    bound on y from its slack's rounding over its component's (y = -139 rad/s on baxter's
+    head_pan, -0.57 on panda's first joint). Now y is the least norm one: 0."""
+    lb, ub = np.array([-139.63, -1.5, -1.5, -4.0]), np.array([139.63, 1.5, 1.5, 4.0])
+    v = np.array([1.0, 4.5e-16, -2.8e-16, 9.1e-17])
+    w = np.array([-3.5e-15, -1.919, 1.2, 0.3])
+    u, y = line_scale(w, v, lb, ub)
+    assert u == pytest.approx(1.5 / 1.919, rel=1e-12) and y == 0.0
+
+
+def test_a_joint_no_row_moves_stays_still_in_the_strict_mode() -> None:
+    """Issue 39: baxter with right_e1, left_w1 and right_s1 locked at its ready pose, both hands
+    commanded at the top level (strict): head_pan, which neither hand's rows move, stays
+    still, as in the weighted mode (it ran at the edge of its box, 139.6 rad/s, on most ticks)."""
+    import pinocchio as pin
+
+    import rrc_pin
+
+    full = rrc_pin.load("baxter")
+    locked = [full.model.getJointId(name) for name in ("right_e1", "left_w1", "right_s1")]
+    model = pin.buildReducedModel(full.model, locked, full.to_pinocchio(full.ready()))
+    robot = rrc_pin.Robot(model, full.tool_frames, name="reduced", source="reduced")
+    keep = [i for i, name in enumerate(full.joint_names) if name in robot.joint_names]
+    q, head = full.ready()[keep], list(robot.joint_names).index("head_pan")
+    resolver = rrc_pin.Resolver(robot, dt=0.01)
+    left, right = robot.tool_frames
+    rng = np.random.default_rng(0)
+    sigma = np.tile([0.1, 0.1, 0.1, 0.3, 0.3, 0.3], 2)
+    for _ in range(40):
+        x = rng.normal(size=12) * sigma
+        hands = [rrc_pin.FrameTask(left, x[:6]), rrc_pin.FrameTask(right, x[6:])]
+        strict = resolver.solve(q, [hands], priority="strict")
+        weighted = resolver.solve(q, hands)
+        assert abs(strict.qdot[head]) <= 1e-9 and abs(weighted.qdot[head]) <= 1e-9
 
 
 def test_line_scale_edge_cases() -> None:

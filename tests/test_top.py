@@ -36,7 +36,7 @@ def test_the_box_scale_of_no_or_one_null_direction_is_the_pipelines(seed: int) -
     rng = np.random.default_rng(seed)
     n = 6
     lb, ub = -rng.uniform(0.1, 1.0, n), rng.uniform(0.1, 1.0, n)
-    rows = top.Rows(lb, ub, np.zeros((0, n)), np.zeros(0), np.zeros(0), 1e-6)
+    rows = top.Rows(lb, ub, np.zeros((0, n)), np.zeros(0), np.zeros(0), 1e-6, np.zeros(2))
     box = Box(lb, ub, np.zeros((2, n), np.int8), True, False, np.ones(n))
     for d in (0, 1):
         for _ in range(100):
@@ -50,7 +50,8 @@ def test_the_box_scale_of_no_or_one_null_direction_is_the_pipelines(seed: int) -
 
 def test_slide_rows_are_the_marked_ones() -> None:
     G, h = np.arange(12.0).reshape(4, 3), np.arange(4.0)
-    rows = top.Rows(np.zeros(3), np.ones(3), G, h, np.array([1.0, 0.0, 1.0, 0.0]), 1e-6)
+    rows = top.Rows(np.zeros(3), np.ones(3), G, h, np.array([1.0, 0.0, 1.0, 0.0]), 1e-6,
+                    np.zeros(2))
     Gs, hs = top.slide_rows(rows)
     np.testing.assert_array_equal(Gs, G[[0, 2]])
     np.testing.assert_array_equal(hs, h[[0, 2]])

@@ -114,13 +114,14 @@ def _failed(where: int, exc: Exception) -> Array:
 
 def direction(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array, h: Array
               ) -> tuple[Array, float, float]:  # fmt: skip
-    """The direction problem along ``w`` by the backend
-    (:func:`rrc_pin.solvers.tick.pipeline.backend_along`): its rates (n,), their scale along
-    the command and their veer off it [rad]; empty rates where it fails.
+    """The direction problem along ``w`` by the backend, where the compiled active-set solver
+    did not answer (:func:`rrc_pin.solvers.tick.pipeline.backend_along`): its rates (n,), their
+    scale along the command and their veer off it [rad]; empty rates where it fails.
     """  # noqa: D205
     context = _LOCAL.context
     try:
-        along = backend_along(A, w, null, _box(lb, ub), _rows(G, h), context.backend, _work())
+        along = backend_along(A, w, null, _box(lb, ub), _rows(G, h), context.backend, _work(),
+                              compiled=False)  # the tick's solver did not answer
     except NumericalFailure as exc:
         return _failed(TOP, exc), -1.0, 0.0
     return np.ascontiguousarray(along.qdot), float(along.u), float(along.veer)

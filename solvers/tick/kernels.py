@@ -472,6 +472,22 @@ def uniform_scale(x: Array, lb: Array, ub: Array) -> float:
     return max(s, 0.0)
 
 
+NULL_ROUNDING = 1e-12
+"""[relative to its largest entry] A component of a null direction this small is the SVD's
+rounding (a joint that no row moves): the row it belongs to does not bound the null
+coefficient y (:func:`line_scale`; its bound there would be its slack's rounding over the
+component's, anywhere in the box)."""
+
+
+@kernel
+def max_abs(x: Array) -> float:
+    """The largest ``|x_i|`` (0 for none)."""
+    top = 0.0
+    for i in range(x.size):
+        top = max(top, abs(x[i]))
+    return top
+
+
 @kernel
 def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
     r"""The largest u in [0, 1] with ``lb <= u w + y v <= ub`` for some y, and that y nearest 0.
@@ -479,7 +495,9 @@ def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
     Each row gives two half-planes :math:`\alpha u + \beta y \le \gamma` (:math:`\gamma \ge
     0`); eliminating y between each pair bounding it from opposite sides (Fourier-Motzkin
     elimination, Dantzig & Eaves 1973) leaves bounds on u alone. The direction problem of
-    one null direction v, exactly.
+    one null direction v, exactly. A component of v within :data:`NULL_ROUNDING` of its
+    largest is taken as zero: its row bounds u alone, and is met by the rates to that
+    component times ``|y|`` (the caller's clip).
 
     Args:
         w: Rates of the command (n,).
@@ -491,34 +509,38 @@ def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
         u and y: the rates are ``u w + y v``.
     """
     n = w.size
+    c = np.empty(n)  # v without its rounding
+    rounding = NULL_ROUNDING * max_abs(v)
+    for i in range(n):
+        c[i] = v[i] if abs(v[i]) > rounding else 0.0
     u = 1.0
     for i in range(n):  # rows without y bound u alone
-        if v[i] == 0.0:
+        if c[i] == 0.0:
             if w[i] > 0.0:
                 u = min(u, ub[i] / w[i])
             elif w[i] < 0.0:
                 u = min(u, lb[i] / w[i])
     # half-plane (a, b, g) of row i bounding y from above: b > 0 (the row's side where v > 0)
     for i in range(n):
-        if v[i] == 0.0:
+        if c[i] == 0.0:
             continue
-        a1, b1, g1 = (w[i], v[i], ub[i]) if v[i] > 0.0 else (-w[i], -v[i], -lb[i])
+        a1, b1, g1 = (w[i], c[i], ub[i]) if c[i] > 0.0 else (-w[i], -c[i], -lb[i])
         for j in range(n):
-            if v[j] == 0.0:
+            if c[j] == 0.0:
                 continue
-            a2, b2, g2 = (-w[j], -v[j], -lb[j]) if v[j] > 0.0 else (w[j], v[j], ub[j])
+            a2, b2, g2 = (-w[j], -c[j], -lb[j]) if c[j] > 0.0 else (w[j], c[j], ub[j])
             coefficient = b1 * a2 - b2 * a1  # -b2 (plane 1) + b1 (plane 2): y eliminated
             if coefficient > 0.0 and b1 * g2 - b2 * g1 < u * coefficient:
                 u = (b1 * g2 - b2 * g1) / coefficient
     u = max(u, 0.0)
     y_hi, v_hi, y_lo, v_lo = math.inf, 1.0, -math.inf, 1.0
     for i in range(n):
-        if v[i] == 0.0:
+        if c[i] == 0.0:
             continue
-        a1, b1, g1 = (w[i], v[i], ub[i]) if v[i] > 0.0 else (-w[i], -v[i], -lb[i])
+        a1, b1, g1 = (w[i], c[i], ub[i]) if c[i] > 0.0 else (-w[i], -c[i], -lb[i])
         if (g1 - a1 * u) / b1 < y_hi:
             y_hi, v_hi = (g1 - a1 * u) / b1, b1
-        a2, b2, g2 = (-w[i], -v[i], -lb[i]) if v[i] > 0.0 else (w[i], v[i], ub[i])
+        a2, b2, g2 = (-w[i], -c[i], -lb[i]) if c[i] > 0.0 else (w[i], c[i], ub[i])
         if (g2 - a2 * u) / b2 > y_lo:
             y_lo, v_lo = (g2 - a2 * u) / b2, -b2
     if y_lo <= y_hi:

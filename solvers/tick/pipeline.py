@@ -50,11 +50,12 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.errors import InvalidInput, NumericalFailure
+from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.base import QPBackend
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding, Work, solve_within, tolerance
 from rrc_pin.solvers.tick import kernels, statuses
 from rrc_pin.solvers.tick.damping import Damping
-from rrc_pin.solvers.tick.direction import Along, along, direction_qp
+from rrc_pin.solvers.tick.direction import DIRECTION_TOL, Along, along, direction_qp, solved_along
 from rrc_pin.solvers.tick.factorization import Factorization
 from rrc_pin.solvers.tick.kernels import scale_and_veer
 from rrc_pin.solvers.tick.least_squares import Subspace, least_squares
@@ -108,13 +109,6 @@ answer of the levels above kept)."""
 
 _STATUSES: tuple[Status, ...] = get_args(Status)
 _LEVEL_STATUSES: tuple[LevelStatus, ...] = get_args(LevelStatus)
-
-DIRECTION_TOL = 1e-7
-"""A backend's answer to the direction problem may have task rates off the command's direction
-up to this much times the largest its size can give (``|A| |qdot|``: the null basis' rounding
-times the answer's size) before it is refused. As an angle instead (1e-7 rad), the rounding
-of an answer at a small scale along the command was refused (a few 1e-11 off the direction
-at a scale of 1e-3, 448 fallback ticks in 30,000 of baxter's hands commanded in full)."""
 
 DEFAULT_FALLBACKS: tuple[Method, ...] = ("scipy", "scaling")
 """The fallbacks tried after the pipeline by default; ``hold`` ends every chain."""
@@ -537,13 +531,25 @@ def _scaled(
 
 
 def backend_along(
-    A: Array, w: Array, null: Array, box: Box, rows: Rows | None, backend: QPBackend, work: Work
-) -> Along:
-    """The direction problem along ``w`` by the backend, its answer checked (:func:`_scaled`).
+    A: Array, w: Array, null: Array, box: Box, rows: Rows | None, backend: QPBackend, work: Work,
+    compiled: bool = True,
+) -> Along:  # fmt: skip
+    """The direction problem along ``w`` as a QP, its answer checked (:func:`_scaled`): by the
+    compiled active-set solver where ``compiled`` and it answers
+    (:func:`~rrc_pin.solvers.tick.direction.solved_along`), else by the backend.
 
     Raises:
         NumericalFailure: The backend found no usable answer.
-    """
+    """  # noqa: D205
+    if compiled:
+        G, h = (A[:0], w[:0]) if rows is None else (rows.G, rows.h)
+        qdot, u, veer, steps = solved_along(
+            np.ascontiguousarray(A), w, np.ascontiguousarray(null), box.lb, box.ub,
+            np.ascontiguousarray(G), h, tolerance(box))  # fmt: skip
+        if u >= 0.0:
+            work.backend = active_set.NAME
+            work.iterations += steps
+            return Along(qdot, u, veer)
     qp, decoding = direction_qp(w, null, box, rows)
     qdot = solve_within(qp, decoding, box, rows, backend, work, clip=False)
     y = A @ qdot

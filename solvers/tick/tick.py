@@ -57,7 +57,8 @@ RATE, WEIGHT, UNIT = range(3)
 LEVELS, ROWS, CONSTRAINTS, WEIGHTED, DIRECTION, UNITS, INVALID, STARTS = range(8)
 # Entries of ``reals``: the step and the limits' settings in, the report out.
 (DT, MARGIN, GAIN, THRESHOLD, TOLERANCE, SCALE, VEER, LAMBDA_SQ, CLIP, ZERO_INSIDE,
- RECOVERING, REAL_SIZE) = range(12)  # fmt: skip
+ RECOVERING, SOLVED, SOLVED_STEPS, REAL_SIZE) = range(14)  # fmt: skip
+# SOLVED, SOLVED_STEPS: the QPs the compiled active-set solver answered, and its steps
 
 BAD_POSITION, BAD_RATE, BAD_ROWS = 1, 2, 3
 """Codes of ``ints[INVALID]``: a position, a commanded rate, or a task row not finite."""
@@ -218,6 +219,7 @@ def box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Array)
     False), the step's box and what sets each bound into ``joints``, its flags into ``reals``.
     """  # noqa: D205
     ints[INVALID] = checked(joints, task_rows, rates, ints[ROWS])
+    reals[SOLVED], reals[SOLVED_STEPS] = 0.0, 0.0
     if ints[INVALID]:
         return False
     zero_inside, recovering = bounds(joints[POSITION], reals[DT], joints, reals, joints[LB],
@@ -261,7 +263,8 @@ def run_box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Ar
         return INVALID_INPUT
     if reals[ZERO_INSIDE] == 0.0 or ints[WEIGHTED] == 1 or ints[DIRECTION] == 0:
         return ELSEWHERE
-    rows = Rows(joints[LB], joints[UB], task_rows[:0], reals[:0], reals[:0], reals[TOLERANCE])
+    rows = Rows(joints[LB], joints[UB], task_rows[:0], reals[:0], reals[:0], reals[TOLERANCE],
+                reals[SOLVED : SOLVED_STEPS + 1])  # fmt: skip
     # the direction flag, not the literal True: one compiled signature of stacked
     A, b, rate_factor = level(task_rows, rates, ints, 0, ints[DIRECTION] == 1, rows.lb, rows.ub)
     answer = top.direction_box(A, b, rows, reals[DT], reals[THRESHOLD], rate_factor)
@@ -331,7 +334,8 @@ def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide
     if not box(joints, task_rows, rates, ints, reals):
         return INVALID_INPUT
     p = ints[CONSTRAINTS]
-    rows = Rows(joints[LB], joints[UB], G[:p], h[:p], slide[:p], reals[TOLERANCE])
+    rows = Rows(joints[LB], joints[UB], G[:p], h[:p], slide[:p], reals[TOLERANCE],
+                reals[SOLVED : SOLVED_STEPS + 1])  # fmt: skip
     zero_inside, recovering = reals[ZERO_INSIDE] == 1.0, reals[RECOVERING] == 1.0
     direction = (ints[WEIGHTED] == 0 and ints[DIRECTION] == 1 and zero_inside
                  and not (rows.h < 0.0).any())  # fmt: skip

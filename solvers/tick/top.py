@@ -30,6 +30,7 @@ from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses
+from rrc_pin.solvers.tick.direction import solved_along
 from rrc_pin.solvers.tick.factor import Factor
 from rrc_pin.solvers.tick.levels import least_squares, row_values
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
@@ -85,6 +86,8 @@ class Rows(NamedTuple):
         slide: Per row, nonzero where the command may slide along it (p,).
         tol: How far a kernel's answer may leave the box and rows
             (:func:`rrc_pin.solvers.qp_backends.qp.tolerance`).
+        solved: Out (2,): the QPs the compiled active-set solver answered in the tick, and its
+            steps (:func:`scaled_along`), added to.
     """
 
     lb: Array
@@ -93,6 +96,7 @@ class Rows(NamedTuple):
     h: Array
     slide: Array
     tol: float
+    solved: Array
 
 
 @kernel
@@ -206,10 +210,18 @@ def scaled_along(A: Array, w: Array, null: Array, rows: Rows) -> tuple[Array, fl
     The veer [rad] is measured where the backend answered, else 0 (along w by construction).
 
     Without rows: the uniform scale (no null space) or the exact line scale (one null
-    direction) (:func:`rrc_pin.solvers.tick.direction.along`); else the backend's QP
+    direction) (:func:`rrc_pin.solvers.tick.direction.along`); else the direction QP by the
+    compiled active-set solver (:func:`rrc_pin.solvers.tick.direction.solved_along`, counted in
+    ``rows.solved``), or where it does not answer by the backend
     (:func:`rrc_pin.solvers.tick.backend_calls.direction`).
     """
     if rows.h.size or null.shape[0] > 1:
+        qdot, u, veer, steps = solved_along(A, w, null, rows.lb, rows.ub, rows.G, rows.h,
+                                            rows.tol)  # fmt: skip
+        if u >= 0.0:
+            rows.solved[0] += 1.0
+            rows.solved[1] += steps
+            return qdot, u, veer
         return backend_direction(A, w, null, rows.lb, rows.ub, rows.G, rows.h)
     if null.shape[0] == 0:
         u = kernels.uniform_scale(w, rows.lb, rows.ub)
