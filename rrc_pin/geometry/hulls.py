@@ -3,7 +3,8 @@
 coal measures a mesh (a BVH of triangles) against another shape by its triangles: in
 penetration it returns a distance of 0, with no sign and no useful normal, and it is slow. The
 convex hull of the same mesh gets GJK and EPA: a signed distance, witness points and a normal in
-penetration as well, in about a microsecond. A hull holds its mesh, so it is conservative (it fills concavities).
+penetration as well, in about a microsecond. A hull holds its mesh, so it is conservative (it
+fills concavities).
 
 Hulls are built by qhull through coal (``BVHModel.buildConvexHull``) the first time a mesh is
 met, and kept in memory for the process, keyed by the mesh file and scale: a second robot (the
