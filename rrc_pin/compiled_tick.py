@@ -272,14 +272,16 @@ class CompiledTick:
         out.setflags(write=False)
         qdot = out[: ws.n]
         self._answered = qdot
-        work = self._context.work
-        if work is None:
+        work, solved = self._context.work, ws.reals[tick.SOLVED]
+        if work is None and not solved:
             return _new(Resolution, (
                 qdot, STATUSES[code], "qp", scale, veer, LEVEL_OF[code], (), "", 0, clip,
                 lambda_sq, time.perf_counter() - start, 0.0, source, self.names, ()))  # fmt: skip
+        work = work or _NO_WORK
+        backend = work.backend or (active_set.NAME if solved else "")
         return _new(Resolution, (
             qdot, STATUSES[code], "qp", scale, veer, LEVEL_OF[code], tuple(work.attempts),
-            work.backend, work.iterations, clip, lambda_sq,
+            backend, work.iterations + int(ws.reals[tick.SOLVED_STEPS]), clip, lambda_sq,
             time.perf_counter() - start - work.solve_time, work.solve_time, source, self.names,
             ()))  # fmt: skip
 

@@ -90,7 +90,8 @@ def direction_within(A: Array, b: Array, N: Array, rows: Rows, dt: float, thresh
     if not outside_range and u >= 1.0 - EXACT_TOL:
         return top.met_top(qdot, rate_factor, null)
     unbounded = np.full(d, np.inf)  # z has no bounds: no column of A N^T is clamped
-    within = Rows(-unbounded, unbounded, np.empty((0, d)), rows.h[:0], rows.slide[:0], rows.tol)
+    within = Rows(-unbounded, unbounded, np.empty((0, d)), rows.h[:0], rows.slide[:0], rows.tol,
+                  rows.solved)
     usable, lam = top.damping(f, b, z, u, within, dt, threshold)
     if lam.size:
         damped, damped_u, _ = top.scaled_along(A, row_values(Nt, factor.rates(usable, b, lam)),

@@ -292,6 +292,7 @@ def run_twist(J: Array, b: Array, q: Array, dt: float, joints: Array, rates: Arr
         or :data:`FAILED` (the fallbacks answer) and zeros.
     """
     n, m = q.size, b.size
+    reals[SOLVED], reals[SOLVED_STEPS] = 0.0, 0.0
     if not (kernels.all_finite(q) and kernels.all_finite(b) and kernels.all_finite(J.ravel())):
         return INVALID_INPUT, 0.0, 0.0, 0.0, 0.0
     lb, ub = out[n : 2 * n], out[2 * n : 3 * n]
@@ -304,7 +305,8 @@ def run_twist(J: Array, b: Array, q: Array, dt: float, joints: Array, rates: Arr
     out[flags + 1] = 1.0 if recovering else 0.0
     if not zero_inside or ints[WEIGHTED] == 1 or ints[DIRECTION] == 0:
         return ELSEWHERE, 0.0, 0.0, 0.0, 0.0
-    rows = Rows(lb, ub, J[:0], reals[:0], reals[:0], reals[TOLERANCE])
+    rows = Rows(lb, ub, J[:0], reals[:0], reals[:0], reals[TOLERANCE],
+                reals[SOLVED : SOLVED_STEPS + 1])  # fmt: skip
     A, c, rate_factor = stacked(J, b, rates[WEIGHT][:m], rates[UNIT][:m], ints[DIRECTION] == 1,
                                 lb, ub)  # fmt: skip
     answer = top.direction_box(A, c, rows, dt, reals[THRESHOLD], rate_factor)
@@ -358,7 +360,8 @@ def run_within(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array
     if not box(joints, task_rows, rates, ints, reals):
         return INVALID_INPUT
     p, n = ints[CONSTRAINTS], joints.shape[1]
-    rows = Rows(joints[LB], joints[UB], G[:p], h[:p], slide[:p], reals[TOLERANCE])
+    rows = Rows(joints[LB], joints[UB], G[:p], h[:p], slide[:p], reals[TOLERANCE],
+                reals[SOLVED : SOLVED_STEPS + 1])  # fmt: skip
     zero_inside, recovering = reals[ZERO_INSIDE] == 1.0, reals[RECOVERING] == 1.0
     C, d = np.ascontiguousarray(E[:, :n]), np.ascontiguousarray(E[:, n])
     direction = (ints[WEIGHTED] == 0 and ints[DIRECTION] == 1 and zero_inside
