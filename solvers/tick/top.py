@@ -33,6 +33,7 @@ from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses
 from rrc_pin.solvers.tick.factor import Factor
 from rrc_pin.solvers.tick.levels import least_squares, row_values
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
+from rrc_pin.solvers.tick.statuses import FAILED as FAILED  # where the ticks import it
 from rrc_pin.solvers.tick.statuses import (
     DAMPED,
     EXACT,
@@ -46,9 +47,6 @@ from rrc_pin.solvers.tick.statuses import (
 )
 
 Array = npt.NDArray[np.float64]
-
-FAILED = -1
-"""The top level found no usable answer (the backend failed): the fallbacks answer."""
 
 SLIDE_DAMPING = 1e-2
 r"""Weight :math:`\mu` of the sliding stage's damping
