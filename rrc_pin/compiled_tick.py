@@ -143,8 +143,8 @@ class CompiledTick:
         self._context = backend_calls.Context(backend, self.velocity)
         self._loaded: tuple[Any, ...] | None = None  # the one twist task whose rows are loaded
         self.workspace.compile(general)
-        if general:  # its ticks may hand the direction problem to the backend
-            backend_calls.compile_direction(self._context)
+        if general:  # its ticks may hand QPs to the backend
+            backend_calls.compile_calls(self._context)
 
     def twist(self, model: pin.Model, data: pin.Data, task: FrameTask, q: Array, b: Array,
               previous: Array, dt: float, start: float) -> Resolution | None:  # fmt: skip
