@@ -33,7 +33,6 @@ from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses
 from rrc_pin.solvers.tick.factor import Factor
 from rrc_pin.solvers.tick.levels import least_squares, row_values
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
-from rrc_pin.solvers.tick.statuses import FAILED as FAILED  # where the ticks import it
 from rrc_pin.solvers.tick.statuses import (
     DAMPED,
     EXACT,
@@ -45,6 +44,7 @@ from rrc_pin.solvers.tick.statuses import (
     SLIDING,
     STILL_SCALE,
 )
+from rrc_pin.solvers.tick.statuses import FAILED as FAILED  # where the ticks import it
 
 Array = npt.NDArray[np.float64]
 
