@@ -98,64 +98,36 @@ def test_cap_against_numpy(seed: int, normalised: bool) -> None:
             assert command * factor * got == pytest.approx(limit, rel=1e-14)
 
 
-def borne_out_reference(status: int, y: np.ndarray, b: np.ndarray, direction: bool,
-                        factor: float) -> tuple[int, float]:  # fmt: skip
-    """The final rates' rule in numpy (the scale and angle on b's own size)."""
-    if status not in (statuses.EXACT, statuses.SCALED):
-        return status, 0.5
-    turned = statuses.FAILED if direction else statuses.LEAST_SQUARES
-    peak = float(np.abs(b).max())
-    if 0.0 < peak < np.finfo(np.float64).tiny:
-        return turned, 0.5
-    if status == statuses.SCALED:
-        return status, 0.5
-    ys, bs = y / max(peak, 1e-300), b / max(peak, 1e-300)
-    residual = np.linalg.norm(ys - bs) * peak
-    if residual <= 1e-9 * (1.0 + np.linalg.norm(b)) and (
-            peak == 0.0 or residual <= 1e-7 * np.linalg.norm(b)):  # fmt: skip
-        return status, 0.5
-    scale = float(ys @ bs) / float(bs @ bs)
-    cos = float(ys @ bs) / (np.linalg.norm(ys) * np.linalg.norm(bs)) if ys.any() else 1.0
-    if direction and np.arccos(np.clip(cos, -1.0, 1.0)) <= 1e-6:
-        return statuses.SCALED, min(max(scale, 0.0), 1.0) * factor
-    return turned, 0.5
-
-
 @pytest.mark.parametrize("seed", SEEDS)
 def test_borne_out_against_numpy(seed: int) -> None:
-    """Final rates of every kind (the command, rounding off it, a scale of it, turned off it,
-    zero) for commands from subnormal to huge: an ``exact`` kept only where the rates
-    reproduce the command relative to its size, else scaled along it or turned off it; a
-    subnormal command neither exact nor scaled."""
+    """An exact or scaled report of a command whose rates are all subnormal is refused
+    (the fallbacks in the direction mode, else least_squares); every other report kept."""
     rng = np.random.default_rng(seed)
-    seen = set()
     for _ in range(400):
         m = int(rng.integers(1, 7))
-        b = rng.normal(size=m) * 10.0 ** rng.choice([-320.0, -310.0, -12.0, 0.0, 2.0, 90.0])
-        case = int(rng.integers(5))
-        y = [b.copy(), b * (1.0 + 1e-12 * rng.normal(size=m)), b * rng.uniform(0.1, 0.9),
-             b + rng.normal(size=m) * np.abs(b).max(), np.zeros(m)][case]  # fmt: skip
+        b = rng.normal(size=m) * 10.0 ** rng.choice([-320.0, -310.0, -12.0, 0.0, 90.0])
+        b[rng.random(m) < 0.2] = 0.0
+        y = b * rng.uniform(0.0, 1.0)
         status = [statuses.EXACT, statuses.SCALED, statuses.DAMPED][int(rng.integers(3))]
-        direction, factor = bool(rng.random() < 0.7), float(rng.choice([1.0, 0.25]))
-        code, scale, _ = statuses.borne_out(status, y, b, direction, factor, 0.5, 0.0)
-        want, want_scale = borne_out_reference(status, y, b, direction, factor)
-        assert code == want, (seed, case, status, y, b, direction)
-        assert scale == pytest.approx(want_scale, rel=1e-9), (seed, case, y, b)
-        seen.add((status, code))
-    assert {(statuses.EXACT, statuses.EXACT), (statuses.EXACT, statuses.SCALED),
-            (statuses.EXACT, statuses.FAILED), (statuses.EXACT, statuses.LEAST_SQUARES),
-            (statuses.SCALED, statuses.FAILED)} <= seen, seed  # fmt: skip
+        direction = bool(rng.random() < 0.7)
+        got = statuses.borne_out(status, y, b, direction, 1.0, 0.5, 0.25)
+        peak = float(np.abs(b).max())
+        claims = status in (statuses.EXACT, statuses.SCALED)
+        if claims and 0.0 < peak < np.finfo(np.float64).tiny:
+            want = statuses.FAILED if direction else statuses.LEAST_SQUARES
+        else:
+            want = status
+        assert got == (want, 0.5, 0.25), (seed, status, b, direction)
 
 
-def test_a_subnormal_command_met_to_one_task_unit_is_not_reproduced() -> None:
+def test_a_subnormal_command_met_to_one_task_unit_is_refused() -> None:
     """The command of seed 2431896685595554185, step 47 (so101): its rates 46 % off, and
-    zero rates, both within EXACT_TOL of it; neither reproduces it."""
+    zero rates, both within EXACT_TOL of it: not exact."""
     b = np.array([-1e-310, -5e-324, -1e-310])
     y = np.array([-1.46e-310, -8.06e-312, -1.75e-311])
     for rates in (y, np.zeros(3)):
-        assert statuses.met(rates, b) and not statuses.reproduces(rates, b)
-    assert statuses.reproduces(b * (1.0 + 1e-12), b) and statuses.reproduces(np.zeros(3), b * 0)
-    code, _, _ = statuses.borne_out(statuses.EXACT, y, b * 1e300, True, 1.0, 1.0, 0.0)
-    assert code == statuses.FAILED
-    code, _, _ = statuses.borne_out(statuses.EXACT, y, b * 1e300, False, 1.0, 1.0, 0.0)
-    assert code == statuses.LEAST_SQUARES
+        assert statuses.met(rates, b)
+        assert statuses.borne_out(statuses.EXACT, rates, b, True, 1.0, 1.0, 0.0)[0] == (
+            statuses.FAILED)  # fmt: skip
+        assert statuses.borne_out(statuses.EXACT, rates, b, False, 1.0, 1.0, 0.0)[0] == (
+            statuses.LEAST_SQUARES)  # fmt: skip

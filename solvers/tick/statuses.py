@@ -11,10 +11,9 @@ Each rule is one kernel, called from the compiled tick (:mod:`rrc_pin.solvers.ti
   (a command divided down, :mod:`rrc_pin.solvers.tick.problem`) ``scaled`` by its factor
   (:func:`met_top`);
 - a lower level is ``met``, ``scaled`` along its command or ``traded`` (:func:`served`);
-- the top level's ``exact`` is checked on its final rates, clipped into the box and the rows
-  (:func:`borne_out`): they must reproduce the command relative to its own size
-  (:func:`reproduces`), which :func:`met` does not ask of a command far below one task unit (a
-  backend's answer to a subnormal command is met by any rates within its tolerance).
+- a top level's ``exact`` or ``scaled`` is refused for a subnormal command (:func:`borne_out`):
+  :func:`met` asks nothing of a command far below one task unit (a backend's answer to it is
+  met by any rates within its tolerance, and the clip into the box turns them off it).
 """
 
 from __future__ import annotations
@@ -41,11 +40,8 @@ MET, SCALED_LEVEL, TRADED, DROPPED = range(4)
 EXACT_TOL = 1e-9
 """Relative residual under which a command counts as met, and a scale as 1."""
 
-REPRODUCE_TOL = 1e-7
-"""Relative residual (of the command's own size) within which ``exact`` rates reproduce it."""
-
 TINY = 2.2250738585072014e-308
-"""The smallest normal float: below it a rate has fewer bits than :data:`REPRODUCE_TOL` asks."""
+"""The smallest normal float: below it a rate has fewer bits than a relative check asks."""
 
 VEER_TOL = 1e-6
 """The angle [rad] off its command under which a lower level's rates are its command scaled."""
@@ -98,28 +94,14 @@ def served(y: Array, b: Array, rate_factor: float) -> int:
 
 
 @kernel
-def reproduces(y: Array, b: Array) -> bool:
-    """Whether rates ``y`` (m,) are the command ``b`` (m,): :func:`met`, and within
-    :data:`REPRODUCE_TOL` of its own size (a zero command: met).
-    """  # noqa: D205
-    if not met(y, b):
-        return False
-    return not b.any() or norm(y - b) <= REPRODUCE_TOL * norm(b)
-
-
-@kernel
 def borne_out(status: int, y: Array, b: Array, direction: bool, rate_factor: float,
               scale: float, veer: float) -> tuple[int, float, float]:  # fmt: skip
-    """The top level's ``(status, scale, veer)`` as its final rates bear them out.
+    """The top level's ``(status, scale, veer)`` as its final rates ``y`` (m,) bear them out.
 
-    An ``exact`` top level whose final task rates ``y`` (m, clipped into the box and the rows)
-    do not reproduce its stacked command ``b`` (m,) (:func:`reproduces`) is reported by what
-    they do: in the direction mode ``scaled`` by their scale along ``b`` (times
-    ``rate_factor``) where they keep its direction (:data:`VEER_TOL`). A command whose rates
-    are all subnormal (below :data:`TINY`, a float of fewer bits than :data:`REPRODUCE_TOL`
-    asks) is neither ``exact`` nor ``scaled``. The rest is turned off the command: in the
-    direction mode :data:`FAILED` (the fallbacks answer), else ``least_squares``. Any other
-    report is kept.
+    A stacked command ``b`` (m,) whose rates are all subnormal (below :data:`TINY`: met to
+    :data:`EXACT_TOL` by any small rates)
+    is neither ``exact`` nor ``scaled``: in the direction mode :data:`FAILED` (the fallbacks
+    answer), else ``least_squares``. Any other report is kept.
     """
     if status != EXACT and status != SCALED:
         return status, scale, veer
@@ -127,9 +109,5 @@ def borne_out(status: int, y: Array, b: Array, direction: bool, rate_factor: flo
     for i in range(b.size):
         peak = max(peak, abs(b[i]))
     if peak == 0.0 or peak >= TINY:
-        if status == SCALED or reproduces(y, b):
-            return status, scale, veer
-        along, angle = kernels.scale_and_veer(y, b)
-        if direction and angle <= VEER_TOL:
-            return SCALED, along * rate_factor, angle
+        return status, scale, veer
     return (FAILED if direction else LEAST_SQUARES), scale, veer
