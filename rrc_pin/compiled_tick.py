@@ -235,8 +235,8 @@ class CompiledTick:
         self._size = 0  # the size of run_twist's out for it
         self._answered: Array | None = None  # the last rates answered, joints[PREVIOUS]'s values
         self.workspace.compile(general)
-        if general:  # its ticks may hand the direction problem to the backend
-            backend_calls.compile_direction(self._context)
+        if general:  # its ticks may hand QPs to the backend
+            backend_calls.compile_calls(self._context)
 
     def twist(self, model: pin.Model, data: pin.Data, task: FrameTask, q: Array, twist: Array,
               previous: Array, dt: float, start: float) -> Resolution | None:  # fmt: skip

@@ -81,3 +81,31 @@ def test_a_failure_is_recorded_where_the_pipeline_records_it(where, label, tail)
     assert attempt[1].endswith(tail)
     if where != backend_calls.TOP:
         assert qdot.size == 0
+
+
+def test_compile_calls_asks_every_call_and_leaves_nothing_behind() -> None:
+    """Each call answered once (none failed), the backend's warm starts forgotten, no
+    context left entered."""
+    asked: list[int] = []
+
+    class Counting(QPBackend):
+        name = "counting"
+
+        def __init__(self) -> None:
+            self.inner = make_backend("daqp")
+            self.resets = 0
+
+        def solve(self, qp: QP) -> QPSolution:
+            asked.append(qp.P.shape[0])
+            return self.inner.solve(qp)
+
+        def reset(self) -> None:
+            self.resets += 1
+            self.inner.reset()
+
+    backend = Counting()
+    context = backend_calls.Context(backend, np.ones(N))
+    backend_calls.compile_calls(context)
+    assert asked and backend.resets == 1
+    assert context.work is not None and not context.work.attempts, context.work.attempts
+    assert getattr(backend_calls._LOCAL, "context", None) is None

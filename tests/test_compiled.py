@@ -55,6 +55,8 @@ m = maps.capability("kr5_3r", 2000, 0.1, workers=1, progress=False, block_size=1
 out["maps"] = m.stats.isum.sum(axis=0).tolist()
 cell = rrc_pin.Controller("gsfc_dual", 0.01)  # a CellController: the closed chains' correction
 out["cell"] = cell.step({"object": np.array([0.05, 0.0, 0.0, 0.0, 0.0, 0.1])}).q.tolist()
+arm = rrc_pin.Controller(panda, 0.01)  # its log's kernel
+out["controller"] = arm.step([0.05, 0.0, 0.0, 0.0, 0.0, 0.1]).q.tolist()
 # only kernels call these: their own entries read here
 from rrc_pin.solvers.closed_form.base import finite
 from rrc_pin.solvers.collision.box_kernels import turned
@@ -420,6 +422,37 @@ for name in ("gsfc_dual", "yeh_tripod"):
 tripod = rrc_pin.load("yeh_tripod")
 session("yeh_tripod with its capsules", Controller(tripod, 0.01, limits=[JointLimits(),
         CollisionLimit(CollisionModel(tripod, "capsules"))]), cell_command)
+session("gsfc_dual uncoupled", Controller("gsfc_dual", 0.01, coupled=False), cell_command)
+from rrc_pin.control.smoothing import SmoothingOptions
+session("panda with the jerk stage", Controller(panda, 0.01, stretched,
+        smoothing=SmoothingOptions()), arm_command)
+
+def resolver_session(label, resolver, tasks, ticks=300):
+    # a resolver's own loop: strict levels, the lower ones answered by the backend too
+    before = signatures()
+    statuses, q = Counter(), resolver.robot.ready()
+    for k in range(ticks):
+        r = resolver.solve(q, tasks(k, q), priority="strict", dt=0.01)
+        statuses[r.status] += 1
+        q = np.clip(q + r.qdot * 0.01, resolver.robot.lower, resolver.robot.upper)
+    new = {name: sorted(s - before.get(name, set())) for name, s in signatures().items()}
+    out[label] = {"statuses": dict(statuses), "kernels": len(before),
+                  "new": {name: s for name, s in new.items() if s}}
+
+from rrc_pin import FrameTask, PostureTask, Resolver
+baxter = rrc_pin.load("baxter")
+left, right = baxter.tool_frames[:2]
+
+def baxter_tasks(k, q):
+    if k % 50 == 0:
+        speed = (0.05, 3.0, 0.5)[k // 50 % 3]
+        baxter_tasks.twists = [rng.normal(size=6) * speed for _ in range(2)]
+    hands = [FrameTask(left, baxter_tasks.twists[0]), FrameTask(right, baxter_tasks.twists[1])]
+    posture = [PostureTask(baxter.ready(), gain=1.0)]
+    # the second hand a level of its own: fewer rows than free rates (the backend's QP)
+    return [hands, posture] if k // 25 % 2 == 0 else [hands[:1], hands[1:], posture]
+
+resolver_session("baxter strict", Resolver(baxter), baxter_tasks)
 print("RESULT " + json.dumps(out))
 """
 
@@ -428,7 +461,9 @@ print("RESULT " + json.dumps(out))
                          ids=["fixed", "fresh"])  # fmt: skip
 def test_no_kernel_is_compiled_or_loaded_inside_a_control_loop(seed):
     """Each kind of controller, built, then run 300 ticks (exact, scaled, damped and at joint
-    limits; strict levels on the cells; collision rows where cheap) in a fresh interpreter:
+    limits; strict levels on the cells, a cell's hands holding an object uncoupled; the jerk
+    stage; collision rows where cheap), and a resolver's strict levels on baxter (its lower
+    levels and sliding stage answered by the backend) in a fresh interpreter:
     no compiled kernel of the package gains a signature during the ticks (compiled, or loaded
     from numba's cache), each one that does named with it."""
     code = LOOP.replace("SEED", str(seed))

@@ -10,7 +10,7 @@ from device_replay import DT, SECONDS, Replay
 
 import rrc_pin
 from rrc_pin.control import Controller, Deadman, DriftCorrection
-from rrc_pin.control.controller import _checked_twist
+from rrc_pin.control.controller import _checked_twist, active_codes
 from rrc_pin.control.random_operator import random_commands
 from rrc_pin.control.smoothing import SmoothingOptions
 from rrc_pin.control.strategies import Decision, ResolverOnly, Situation, Strategy
@@ -453,3 +453,25 @@ def test_a_bad_smoothing_is_refused_by_name(panda):
         SmoothingOptions(20.0, -1.0)
     with pytest.raises(rrc_pin.InvalidInput, match="acceleration"):
         Controller(panda, smoothing=SmoothingOptions([1.0, 2.0], 500.0))
+
+
+def test_active_codes_against_numpy() -> None:
+    """The bounds a tick's rates touch, as the log keys their text: the kernel's codes are
+    numpy's ``low (1 + kind[0]) + 4 high (1 + kind[1])``."""
+    rng = np.random.default_rng(20261206)
+    for _ in range(200):
+        n = int(rng.integers(1, 9))
+        lb, ub = -rng.uniform(0.0, 2.0, n), rng.uniform(0.0, 2.0, n)
+        qdot = np.where(rng.random(n) < 0.3, lb, np.where(rng.random(n) < 0.3, ub,
+                                                          rng.uniform(lb, ub)))  # fmt: skip
+        lb[rng.random(n) < 0.1] = 0.0
+        ub[lb == 0.0] = 0.0
+        qdot[lb == 0.0] = 0.0
+        kind = rng.integers(0, 4, (2, n)).astype(np.int8)
+        codes = np.empty(n, np.int8)
+        touched = active_codes(qdot, lb, ub, kind, codes)
+        low = (qdot - lb <= 1e-9).astype(np.int8)
+        high = (ub - qdot <= 1e-9).astype(np.int8)
+        want = low * (1 + kind[0]) + 4 * high * (1 + kind[1])
+        np.testing.assert_array_equal(codes, want)
+        assert touched == bool(want.any())

@@ -11,7 +11,7 @@ import pytest
 
 import rrc_pin
 from rrc_pin.control import Controller
-from rrc_pin.control.record_ring import BATCH, CAPACITY, FIRST_ROWS, RecordRing
+from rrc_pin.control.record_ring import CAPACITY, FIRST_ROWS, RecordRing
 
 
 class Rec(NamedTuple):
@@ -116,35 +116,20 @@ def test_ticks_are_derived_once_when_read_and_positions_need_none() -> None:
     assert calls == [3.0, 4.0, 5.0, 6.0, 7.0] and ring[-1].label == "label 2"
 
 
-def compact(ticks: list[tuple[float, float]]) -> Tick:
-    """Ticks ``(t, x)`` as one Tick of arrays: q = (x, 0)."""
-    t = np.array([k[0] for k in ticks])
-    return Tick(t, np.stack([np.array([k[1] for k in ticks]), np.zeros(len(ticks))], axis=1))
-
-
-def test_a_compacting_ring_makes_rows_a_batch_at_a_time() -> None:
-    calls: list[int] = []
-
-    def counted(ticks: list[tuple[float, float]]) -> Tick:
-        calls.append(len(ticks))
-        return compact(ticks)
-
-    ring = Ring(derive, capacity=100, compact=counted)
-    for k in range(BATCH + 5):
-        ring.append_tick((float(k), float(k)))
-    assert calls == [BATCH] and len(ring) == BATCH + 5  # five kept as they came
-    assert [q[0] for q in ring.positions(2)] == [BATCH + 3.0, BATCH + 4.0] and calls == [BATCH, 5]
-    for k in range(BATCH + 5, 250):
-        ring.append_tick((float(k), float(k)))
-    assert len(ring) == 100 and ring.dropped == 150  # reading dropped makes the rows first
+def test_each_tick_is_written_into_its_row_as_it_comes() -> None:
+    """No batch: a tick's fields are in the columns once it is appended (the same work at
+    every tick), its record derived when read; a ring of one keeps the newest."""
+    ring = Ring(derive, capacity=100)
+    for k in range(250):
+        ring.append_tick(Tick(float(k), np.array([k, 0.0])))
+        assert ring._size == min(k + 1, 100) and ring._columns["t"][ring._row(ring._size - 1)] == k
+    assert len(ring) == 100 and ring.dropped == 150 and ring._pending == 100
     assert [r.t for r in ring] == [float(k) for k in range(150, 250)]
     assert ring[-1].label == "derived" and ring[-1].q.tolist() == [249.0, 0.0]
-    small = Ring(derive, capacity=3, compact=compact)  # one batch longer than the ring
-    for k in range(BATCH):
-        small.append_tick((float(k), 0.0))
-    assert [r.t for r in small] == [BATCH - 3.0, BATCH - 2.0, BATCH - 1.0]
-    assert small.dropped == BATCH - 3
-    small.append_tick((99.0, 0.0))
+    small = Ring(derive, capacity=1)
+    for k in range(5):
+        small.append_tick(Tick(float(k), np.zeros(2)))
+    assert [r.t for r in small] == [4.0] and small.dropped == 4
     small.clear()
     assert len(small) == 0 and small.records == []
 
@@ -163,16 +148,16 @@ def test_plain_tuples_and_bad_arguments() -> None:
         Ring().append_tick(Tick(0.0, np.zeros(2)))
 
 
-TICKS = 16 * BATCH
-"""Ticks the memory test logs: a multiple of the batch, so none is left pending."""
+TICKS = 1024
+"""Ticks the memory test logs."""
 
 
 def test_a_tick_of_the_controllers_log_costs_a_few_hundred_bytes(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """Issue 38: the log kept each tick's resolution (3.4-3.5 kB a tick pending, 1.1-1.3 kB
-    derived; 212-225 MB at 60,000 ticks). Its columns now: 242 B a tick pending and 323 B
-    derived for panda (8 (19 + 2 nq) + 48 B and its strings), measured here by tracemalloc
+    derived; 212-225 MB at 60,000 ticks). Its columns now: 249 B a tick pending and 324 B
+    derived for panda (8 (19 + 2 nq) + 56 B and its strings), measured here by tracemalloc
     over 1,024 ticks (the controller's own 128 ticks in turn: stepping it under tracemalloc
     cost minutes without the compiler); at the default capacity under 32 MB."""
     ctl = Controller(rrc_pin.load("panda"))
@@ -192,7 +177,7 @@ def test_a_tick_of_the_controllers_log_costs_a_few_hundred_bytes(
         before = tracemalloc.get_traced_memory()[0]
         for k in range(TICKS):
             log.append_tick(seen[k % len(seen)])
-        assert log.dropped == 0  # (the last batch of ticks made rows)
+        assert log.dropped == 0
         gc.collect()
         pending = (tracemalloc.get_traced_memory()[0] - before) / TICKS
         assert len(log.records) == TICKS

@@ -17,8 +17,10 @@ import pytest
 
 import rrc_pin
 from rrc_pin import FrameTask, PostureTask, QPOptions, Resolver
-from rrc_pin.solvers.qp_backends import installed_backends
+from rrc_pin.solvers.qp_backends import installed_backends, make_backend
+from rrc_pin.solvers.tick import pipeline
 from rrc_pin.solvers.tick.pipeline import DIRECTION_TOL
+from rrc_pin.solvers.tick.resolution import Resolution
 
 STEPS = int(os.environ.get("RRC_PIN_SOAK", "60"))
 """Steps per arm for the default backend; each other backend gets a tenth (at least 10)."""
@@ -127,3 +129,65 @@ def test_soak_every_arm_every_backend(name: str) -> None:
             except Exception as exc:
                 raise AssertionError(f"{name}/{backend} step {k}: seed {seed}: {exc!r}") from exc
     print(f"{name}: slowest tick {slowest * 1e3:.1f} ms (seed {seed})")
+
+
+SUBNORMAL_Q = [-0.05967355435929389, -1.152656772092623, -0.9703503980628366, 1.65806, 2.84121]
+"""so101 at the step that answered ``exact`` at a scale of 0.82 (seed 2431896685595554185,
+step 47): its last two joints on their upper limits."""
+SUBNORMAL = [-1e-310, -5e-324, -1e-310, -7.5e-4, -1e150, 1e-310]
+"""That step's command: subnormal linear rates (so101's rows), huge and small angular ones."""
+
+
+def both_ticks(resolver: Resolver, q: np.ndarray, twist: np.ndarray, dt: float) -> list:
+    """The resolution of the compiled tick and the Python pipeline's answer to its problem."""
+    r = resolver.solve(q, twist, dt=dt)
+    again = pipeline.solve(r.problem, make_backend("daqp"), resolver.options)
+    return [r, Resolution.of(r.problem, again, 0.0, None)]
+
+
+@pytest.mark.parametrize("direction_preserving", [True, False])
+def test_a_subnormal_command_is_not_reported_exact(direction_preserving: bool) -> None:
+    """A backend met the subnormal command to its tolerance (1e-9), then the clip into the
+    box turned the rates off it by 0.67 rad: reported ``exact`` (and at a scale of 0.82).
+    The final rates now bear the status out, in both ticks alike."""
+    arm = rrc_pin.load("so101")
+    resolver = Resolver(arm, qp=QPOptions(backend="daqp"),
+                        direction_preserving=direction_preserving)  # fmt: skip
+    q = np.array(SUBNORMAL_Q)
+    r, again = both_ticks(resolver, q, np.array(SUBNORMAL), 0.05)
+    check(arm, q, r, 0.05)
+    assert r.status not in ("exact", "scaled") and again.status == r.status, (r, again)
+    assert again.levels == r.levels == ("traded",)
+    np.testing.assert_allclose(again.scale, r.scale, rtol=1e-6)
+
+
+def mixed_command(rng: np.random.Generator) -> np.ndarray:
+    """A twist whose entries mix subnormal, small, normal and huge magnitudes and zeros."""
+    magnitudes = [5e-324, 1e-310, 1e-3, 1.0, 1e3, 1e150, 1e300]
+    twist = rng.choice(magnitudes, 6) * rng.choice([-1.0, 1.0], 6) * rng.uniform(0.5, 2, 6)
+    twist[rng.random(6) < 0.15] = 0.0
+    return twist
+
+
+@pytest.mark.parametrize("name", ["so101", "panda"])
+def test_statuses_are_honest_for_commands_of_mixed_magnitudes(name: str) -> None:
+    """Seeded commands mixing subnormal, small and huge entries, from starts on and beyond
+    the limits, in both modes: an ``exact`` answer's rates are its command (relative 1e-6), a
+    ``scaled`` one's are its scale, in [0, 1], of it; the Python pipeline reports alike."""
+    seed = int(os.environ.get("SOAKSEED") or np.random.SeedSequence().entropy % 2**63)
+    rng = np.random.default_rng(seed)
+    arm = rrc_pin.load(name)
+    resolvers = [Resolver(arm, qp=QPOptions(backend="daqp"), direction_preserving=d)
+                 for d in (True, False)]  # fmt: skip
+    seen = set()
+    for k in range(60):
+        q, dt = start(arm, rng), float(rng.choice([1e-3, 0.01, 0.05]))
+        try:
+            for r in both_ticks(resolvers[k % 2], q, mixed_command(rng), dt):
+                check(arm, q, r, dt)
+                if r.status == "scaled":
+                    assert 0.0 <= r.scale <= 1.0, r  # 0: standing still along it
+                seen.add(r.status)
+        except AssertionError as exc:
+            raise AssertionError(f"{name} step {k}: seed {seed}: {exc!r}") from exc
+    assert "exact" in seen or "scaled" in seen, (seen, seed)

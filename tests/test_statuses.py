@@ -96,3 +96,38 @@ def test_cap_against_numpy(seed: int, normalised: bool) -> None:
         assert got == pytest.approx(want, rel=1e-14), (seed, command, factor)
         if not below:
             assert command * factor * got == pytest.approx(limit, rel=1e-14)
+
+
+@pytest.mark.parametrize("seed", SEEDS)
+def test_borne_out_against_numpy(seed: int) -> None:
+    """An exact or scaled report of a command whose rates are all subnormal is refused
+    (the fallbacks in the direction mode, else least_squares); every other report kept."""
+    rng = np.random.default_rng(seed)
+    for _ in range(400):
+        m = int(rng.integers(1, 7))
+        b = rng.normal(size=m) * 10.0 ** rng.choice([-320.0, -310.0, -12.0, 0.0, 90.0])
+        b[rng.random(m) < 0.2] = 0.0
+        y = b * rng.uniform(0.0, 1.0)
+        status = [statuses.EXACT, statuses.SCALED, statuses.DAMPED][int(rng.integers(3))]
+        direction = bool(rng.random() < 0.7)
+        got = statuses.borne_out(status, y, b, direction, 1.0, 0.5, 0.25)
+        peak = float(np.abs(b).max())
+        claims = status in (statuses.EXACT, statuses.SCALED)
+        if claims and 0.0 < peak < np.finfo(np.float64).tiny:
+            want = statuses.FAILED if direction else statuses.LEAST_SQUARES
+        else:
+            want = status
+        assert got == (want, 0.5, 0.25), (seed, status, b, direction)
+
+
+def test_a_subnormal_command_met_to_one_task_unit_is_refused() -> None:
+    """The command of seed 2431896685595554185, step 47 (so101): its rates 46 % off, and
+    zero rates, both within EXACT_TOL of it: not exact."""
+    b = np.array([-1e-310, -5e-324, -1e-310])
+    y = np.array([-1.46e-310, -8.06e-312, -1.75e-311])
+    for rates in (y, np.zeros(3)):
+        assert statuses.met(rates, b)
+        assert statuses.borne_out(statuses.EXACT, rates, b, True, 1.0, 1.0, 0.0)[0] == (
+            statuses.FAILED)  # fmt: skip
+        assert statuses.borne_out(statuses.EXACT, rates, b, False, 1.0, 1.0, 0.0)[0] == (
+            statuses.LEAST_SQUARES)  # fmt: skip

@@ -26,6 +26,7 @@ jerk stage (``smoothing=``) runs after the resolver.
 
 from __future__ import annotations
 
+import math
 import os
 import warnings
 from typing import Any, NamedTuple
@@ -52,6 +53,7 @@ from rrc_pin.loading import cells, loaded
 from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import Robot
 from rrc_pin.solvers.checks import as_vector, finite_number
+from rrc_pin.solvers.compiled import kernel
 from rrc_pin.solvers.spatial import Reference, check_reference, to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.problem import LARGE
@@ -68,45 +70,18 @@ NO_ERROR = np.zeros(6)
 NO_ERROR.flags.writeable = False
 
 
-class RawTick(NamedTuple):
-    """One tick as the controller hands it to its log (made rows a batch at a time).
-
-    Attributes:
-        t: Time at the start of the tick [s].
-        q: Joint positions at the start of the tick (nq,) [rad or m].
-        resolution: The resolver's answer.
-        command: The operator's command (6,) [m/s, rad/s] (speed override, deadman).
-        hand: The tool's pose when ``command`` is in hand axes, else None (base axes).
-        factor: The strategy's speed factor.
-        error: The pose error to the reference (6,) [m, rad]
-            (:func:`~rrc_pin.control.drift.pose_error`).
-        mode: ``"teleop"`` or ``"reverse"``.
-        note: What the strategy did.
-    """
-
-    t: float
-    q: Array
-    resolution: Resolution
-    command: Array
-    hand: pin.SE3 | None
-    factor: float
-    error: Array
-    mode: str
-    note: str
-
-
 class Tick(NamedTuple):
-    """Ticks as the log keeps them: the fields of their :class:`LogRecord` a tick knows.
+    """A tick as the log keeps it: the fields of its :class:`LogRecord` the tick knows.
 
-    One tick (its record derived from it, ``_log_record``: the rest comes from the
-    kinematics at q), or a batch of them, each field then an array of one row per tick
-    (:meth:`Controller._compact`).
+    Its record is derived from it when the log is read (``_log_record``: the rest comes from
+    the kinematics at q).
 
     Attributes:
         t: Time at the start of the tick [s].
         q: Joint positions at the start of the tick (nq,) [rad or m].
         qdot: Joint rates applied over the tick (nq,) [rad/s or m/s].
-        commanded: The operator's command, base axes (6,) [m/s, rad/s].
+        commanded: The operator's command (6,) [m/s, rad/s], in hand axes where ``local``
+            (turned to base axes when the record is derived), else in base axes.
         scale: The resolution's scale.
         factor: The strategy's speed factor.
         drift_position: Distance [m] from the reference pose.
@@ -116,21 +91,23 @@ class Tick(NamedTuple):
         status: The resolution's status.
         active: The active limits, ``joint:side:kind`` joined by ``;``.
         note: What the strategy did.
+        local: Whether ``commanded`` is in the axes of the tool at q.
     """
 
-    t: Any
+    t: float
     q: Array
     qdot: Array
     commanded: Array
-    scale: Any
-    factor: Any
-    drift_position: Any
-    drift_rotation: Any
-    mode: Any
-    method: Any
-    status: Any
-    active: Any
-    note: Any
+    scale: float
+    factor: float
+    drift_position: float
+    drift_rotation: float
+    mode: str
+    method: str
+    status: str
+    active: str
+    note: str
+    local: bool
 
 
 class Controller(Loop):
@@ -214,13 +191,19 @@ class Controller(Loop):
         self.strategy.check(robot)
         self.drift = drift
         self.label = SingularityLabel(robot, finite_number(near, "near", 0.0, inclusive=False))
-        self.log: TrajectoryLog = TrajectoryLog(robot.joint_names, self._log_record,
-                                                compact=self._compact)  # fmt: skip
+        self.log: TrajectoryLog = TrajectoryLog(robot.joint_names, self._log_record)
         self._active_texts: dict[bytes, str] = {}
+        self._codes = np.zeros(robot.nv, np.int8)  # the last tick's bounds touched
+        fixed = np.zeros(robot.nv)
+        fixed.flags.writeable = False  # as a Resolution's rates are (compiled now for both)
+        for qdot in (fixed, np.zeros(robot.nv)):
+            active_codes(qdot, np.zeros(robot.nv), np.zeros(robot.nv),
+                         np.zeros((2, robot.nv), np.int8), self._codes)  # fmt: skip
         assert self.resolver.task is not None  # one tool frame: the resolver has its task
         self._rows = tuple(self.resolver.task.selected)
         self._full = len(self._rows) == 6
         self._data = robot.model.createData()
+        self._log_data = robot.model.createData()  # the records' kinematics, when read
         self._tool: str = robot.tool_frame
         self._command: Array = np.zeros(6)
         self._command_frame: Reference = "world_aligned"
@@ -315,8 +298,7 @@ class Controller(Loop):
                 r = self.resolver.solve_at(kin, served, frame_ref, qdot_prev=before)
         r = self._smooth(r)
         # q itself, not a copy: read-only, replaced at every tick.
-        self.log.append_tick(RawTick(self.t, q, r, command, hand, factor, error, "teleop",
-                                     decision.note))
+        self._log_tick(q, r, command, hand, factor, error, "teleop", decision.note)
         fraction = None if decision.rates is not None else _followed(r)
         if fraction is None or self._tool in self.streams:  # (a stream's target: the reference)
             self._reanchor = True
@@ -396,8 +378,7 @@ class Controller(Loop):
     # -- what the loop asks of it -----------------------------------------------------------
 
     def _log_reverse(self, q: Array, r: Resolution) -> None:
-        self.log.append_tick(RawTick(self.t, q, r, np.zeros(6), None, 1.0, NO_ERROR, "reverse",
-                                     ""))
+        self._log_tick(q, r, np.zeros(6), None, 1.0, NO_ERROR, "reverse", "")
 
     def _stopped(self) -> None:
         self._command = np.zeros(6)
@@ -431,37 +412,30 @@ class Controller(Loop):
         return Kinematics(self.robot.model, self._data, self.resolver.layout,
                           self.robot.dof_positions(q), self._pinocchio_q(q))  # fmt: skip
 
-    def _compact(self, ticks: list[RawTick]) -> Tick:
-        """Ticks as the log keeps them, a row each (vectorised over the batch).
+    def _log_tick(self, q: Array, r: Resolution, command: Array, hand: pin.SE3 | None,
+                  factor: float, error: Array, mode: str, note: str) -> None:  # fmt: skip
+        """Write the tick into the log's rows as it comes (its record derived when read).
 
-        The command in base axes (:func:`to_base_axes`), the drift's two norms, and the
-        active limits' text (``Resolution.active``'s, made once per pattern of bounds
-        touched: the touches' codes are its key).
+        Args:
+            q: Joint positions at the start of the tick (nq,) [rad or m] (kept, read-only).
+            r: The resolver's answer.
+            command: The operator's command (6,) [m/s, rad/s] (speed override, deadman).
+            hand: The tool's pose when ``command`` is in hand axes, else None (base axes).
+            factor: The strategy's speed factor.
+            error: The pose error to the reference (6,) [m, rad]
+                (:func:`~rrc_pin.control.drift.pose_error`).
+            mode: ``"teleop"`` or ``"reverse"``.
+            note: What the strategy did.
         """
-        n = len(ticks)
-        rs = [tick.resolution for tick in ticks]
-        qdot = np.array([r.qdot for r in rs])
-        commanded = np.array([tick.command for tick in ticks])
-        local = [k for k, tick in enumerate(ticks) if tick.hand is not None]
-        if local:
-            rotations = np.array([ticks[k].hand.rotation for k in local])  # type: ignore[union-attr]
-            commanded[local] = to_base_axes(rotations, commanded[local])
-        error = np.array([tick.error for tick in ticks])
-        boxes = [r.box for r in rs]
-        lb, ub = np.array([b.lb for b in boxes]), np.array([b.ub for b in boxes])
-        kind = np.array([b.kind for b in boxes]).astype(np.int8)  # (n, 2, nv)
-        low = (qdot - lb <= ACTIVE_TOL).astype(np.int8)
-        high = (ub - qdot <= ACTIVE_TOL).astype(np.int8)
-        codes = low * (1 + kind[:, 0]) + 4 * high * (1 + kind[:, 1])
-        touched = codes.any(axis=1).tolist()
-        active = [self._active_text(codes[k], rs[k]) if touched[k] else "" for k in range(n)]
-        return Tick(
-            np.array([tick.t for tick in ticks]), np.array([tick.q for tick in ticks]), qdot,
-            commanded, np.array([r.scale for r in rs]), np.array([t.factor for t in ticks]),
-            np.linalg.norm(error[:, :3], axis=1), np.linalg.norm(error[:, 3:], axis=1),
-            [t.mode for t in ticks], [r.method for r in rs], [r.status for r in rs], active,
-            [t.note for t in ticks],
-        )  # fmt: skip
+        e = error.tolist()
+        box = r.box
+        touched = active_codes(r.qdot, box.lb, box.ub, box.kind, self._codes)
+        self.log.append_tick(Tick(
+            self.t, q, r.qdot, command, r.scale, factor,
+            math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]),
+            math.sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5]), mode, r.method, r.status,
+            self._active_text(self._codes, r) if touched else "", note, hand is not None,
+        ))  # fmt: skip
 
     def _active_text(self, codes: npt.NDArray[np.int8], r: Resolution) -> str:
         """The active limits of ``r`` as the log writes them, ``joint:side:kind;...``."""
@@ -474,18 +448,44 @@ class Controller(Loop):
         return text
 
     def _log_record(self, tick: Tick) -> LogRecord:
-        """The log's record of a tick: the tick and the kinematics at its q, computed now."""
+        """The log's record of a tick: the tick and the kinematics at its q, computed now (a
+        command in hand axes turned to base axes by the tool's orientation at q).
+        """  # noqa: D205
         J = self.robot.jacobian(tick.q)  # world_aligned, the tick's start
+        commanded = tick.commanded
+        if tick.local:
+            kin = Kinematics(self.robot.model, self._log_data, self.resolver.layout,
+                             self.robot.dof_positions(tick.q), self._pinocchio_q(tick.q))
+            commanded = to_base_axes(kin.placement(self._tool).rotation, commanded)
         J_task = J if self._full else J[list(self._rows)]
         sv: Array = np.asarray(np.linalg.svd(J_task, compute_uv=False), np.float64)
         return LogRecord(
-            t=tick.t, q=tick.q, qdot=tick.qdot, commanded=tick.commanded,
+            t=tick.t, q=tick.q, qdot=tick.qdot, commanded=commanded,
             achieved=J @ tick.qdot, scale=tick.scale, factor=tick.factor,
             sigma_min=float(sv[-1]), manipulability=float(np.prod(sv)),
             drift_position=tick.drift_position, drift_rotation=tick.drift_rotation,
             mode=tick.mode, method=tick.method, status=tick.status, active=tick.active,
             singularity=self.label(tick.q, J_task, sv), note=tick.note,
         )
+
+
+@kernel
+def active_codes(qdot: Array, lb: Array, ub: Array, kind: npt.NDArray[np.int8],
+                 codes: npt.NDArray[np.int8]) -> bool:  # fmt: skip
+    """The bounds ``qdot`` (n,) touches within :data:`ACTIVE_TOL` into ``codes`` (n,), and
+    whether it touches any: per joint ``1 + kind[0]`` for its lower bound ``lb``, plus ``4 (1 +
+    kind[1])`` for its upper one ``ub`` (``kind`` (2, n): what sets each bound, ``Box.kind``).
+    """  # noqa: D205
+    touched = False
+    for j in range(qdot.size):
+        code = 0
+        if qdot[j] - lb[j] <= ACTIVE_TOL:
+            code += 1 + kind[0, j]
+        if ub[j] - qdot[j] <= ACTIVE_TOL:
+            code += 4 * (1 + kind[1, j])
+        codes[j] = code
+        touched = touched or code != 0
+    return touched
 
 
 def _loaded(robot: Robot | str) -> Robot:

@@ -7,11 +7,8 @@ anything else (text, a mapping) an object column whose equal strings share one o
 row is then its numbers and a pointer per text field: a few hundred bytes a tick for an arm
 (docs/api.md, "The trajectory log's memory"), not the objects a tick was made of. A value
 that does not fit its column (another shape, a None) turns that column into an object
-column: nothing is refused or lost.
-
-A ring given ``compact`` keeps the ticks it is handed as they are, up to :data:`BATCH` of
-them, and turns them into rows a batch at a time (vectorised over the batch: a fraction of
-a microsecond a tick, where writing each tick's fields costs several).
+column: nothing is refused or lost. A tick's fields are written into their row as it comes,
+its record derived when the ring is read: every tick costs the same.
 
 The columns grow by doubling up to the capacity, then the ring overwrites its oldest rows.
 """
@@ -35,17 +32,15 @@ CAPACITY = 60_000
 FIRST_ROWS = 256
 """Rows the columns are made with; they double up to the capacity."""
 
-BATCH = 64
-"""Ticks a ring with ``compact`` keeps as they came before turning them into rows."""
-
 SHARED_TEXTS = 4096
 """Distinct strings a ring shares between its rows (more are kept as they come)."""
 
 _NUMBER, _ARRAY, _OBJECT = 0, 1, 2
 """Kinds of column (:func:`_column_for`)."""
 
-Plan = list[tuple[npt.NDArray[Any], int, tuple[int, ...]]]
-"""The columns of a kind of entry, in its fields' order, each with its kind and row shape."""
+Plan = list[tuple[npt.NDArray[Any], int, tuple[int, ...], np.dtype[Any]]]
+"""The columns of a kind of entry, in its fields' order, each with its kind, row shape and
+dtype."""
 
 
 class RecordRing(Generic[R]):
@@ -64,28 +59,20 @@ class RecordRing(Generic[R]):
             only.
         capacity: Ticks kept, >= 1 (default :data:`CAPACITY`: 10 minutes at 100 Hz);
             settable (a smaller one forgets the oldest ticks at once).
-        compact: Turns a list of the ticks passed to :meth:`append_tick` (oldest first) into
-            what ``derive`` takes, one ``NamedTuple`` whose fields hold one row per tick
-            (arrays, the first axis the ticks'), or None: each tick is stored as it comes.
 
     Raises:
-        InvalidInput: ``derive`` or ``compact`` not callable, or a bad ``capacity``, named.
+        InvalidInput: ``derive`` not callable, or a bad ``capacity``, named.
     """
 
     record_type: type[tuple[Any, ...]] = tuple
     """The records' class (:meth:`append` refuses others); a record's second field is q."""
 
-    def __init__(
-        self, derive: Callable[[Any], R] | None = None, capacity: int = CAPACITY, *,
-        compact: Callable[[list[Any]], tuple[Any, ...]] | None = None,
-    ) -> None:  # fmt: skip
-        for name, value in (("derive", derive), ("compact", compact)):
-            if value is not None and not callable(value):
-                raise InvalidInput(name, f"expected a callable or None, got {value!r}")
+    def __init__(self, derive: Callable[[Any], R] | None = None, capacity: int = CAPACITY
+                 ) -> None:  # fmt: skip
+        if derive is not None and not callable(derive):
+            raise InvalidInput("derive", f"expected a callable or None, got {derive!r}")
         self._capacity = _checked_capacity(capacity)
         self._derive = derive
-        self._compact = compact
-        self._raw: list[Any] = []  # ticks as they came, not yet rows (with ``compact``)
         self._columns: dict[str, npt.NDArray[Any]] = {}
         self._rows = 0  # rows every column has
         self._start = 0  # the row of the oldest entry
@@ -100,11 +87,10 @@ class RecordRing(Generic[R]):
     @property
     def dropped(self) -> int:
         """Ticks forgotten because the log was full (the oldest first)."""
-        self._flush()
         return self._dropped
 
     def __len__(self) -> int:
-        return min(self._size + len(self._raw), self._capacity)
+        return self._size
 
     def __iter__(self) -> Iterator[R]:
         return iter(self.records)
@@ -117,7 +103,6 @@ class RecordRing(Generic[R]):
     @capacity.setter
     def capacity(self, value: int) -> None:
         value = _checked_capacity(value)
-        self._flush()
         keep = min(self._size, value)
         self._dropped += self._size - keep
         order = self._order()[self._size - keep:]
@@ -162,26 +147,20 @@ class RecordRing(Generic[R]):
                                f"{type(record).__name__}")  # fmt: skip
         self._derive_pending()  # they are older
         self._fields = self._fields or _fields(record)
-        self._store(self._push(1)[0], record)
+        self._store(self._push(), record)
 
     def append_tick(self, tick: Any) -> None:
         """Add one tick, its record derived when the log is read (``derive``).
 
         Args:
-            tick: What ``compact`` takes, one tick; without ``compact``, what ``derive``
-                takes: a tuple that starts as its record, ``(t, q, ...)`` (a ``NamedTuple``
-                whose field names are those of the record it fills).
+            tick: What ``derive`` takes: a tuple that starts as its record, ``(t, q, ...)`` (a
+                ``NamedTuple`` whose field names are those of the record it fills).
         """
         if self._derive is None:
             raise InvalidInput("tick", "this log has no derive: append records")
-        if self._compact is not None:
-            self._raw.append(tick)
-            if len(self._raw) >= BATCH:
-                self._flush()
-            return
         if self._tick is None or type(tick) is not self._tick[0]:
             self._tick = (type(tick), _fields(tick))
-        self._store(self._push(1)[0], tick)
+        self._store(self._push(), tick)
         self._pending = min(self._pending + 1, self._size)
 
     def positions(self, n: int) -> list[Array]:
@@ -195,7 +174,6 @@ class RecordRing(Generic[R]):
         """
         if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 0:
             raise InvalidInput("n", f"expected an integer >= 0, got {n!r}")
-        self._flush()
         n = min(int(n), self._size)
         if not n:
             return []
@@ -204,7 +182,6 @@ class RecordRing(Generic[R]):
 
     def clear(self) -> None:
         """Forget every record (the columns are kept for the next ones)."""
-        self._raw.clear()
         self._start = self._size = self._pending = 0
 
     def column_values(self, name: str) -> npt.NDArray[Any]:
@@ -228,17 +205,17 @@ class RecordRing(Generic[R]):
         """The row of entry ``i`` (0 the oldest)."""
         return (self._start + i) % self._rows
 
-    def _push(self, n: int) -> npt.NDArray[np.intp]:
-        """The rows of ``n`` new newest entries: free ones, else the oldest, forgotten."""
-        wanted = min(self._capacity, self._size + n)
-        if wanted > self._rows:
-            self._grow(min(self._capacity, max(FIRST_ROWS, 2 * self._rows, wanted)))
-        rows = (self._start + self._size + np.arange(n)) % self._rows
-        over = max(0, self._size + n - self._capacity)
-        self._dropped += over
-        self._start = (self._start + over) % self._rows
-        self._size = min(self._size + n, self._capacity)
-        return rows[n - min(n, self._capacity):]  # of a batch larger than the ring: its last
+    def _push(self) -> int:
+        """The row of a new newest entry: a free one, else the oldest's, forgotten."""
+        if self._size < self._capacity:
+            if self._size == self._rows:
+                self._grow(min(self._capacity, max(FIRST_ROWS, 2 * self._rows)))
+            self._size += 1
+            return (self._start + self._size - 1) % self._rows
+        row = self._start  # a full ring has as many rows as its capacity
+        self._start = (row + 1) % self._rows
+        self._dropped += 1
+        return row
 
     def _grow(self, rows: int) -> None:
         """Every column to ``rows`` rows, the entries kept in order from row 0."""
@@ -250,46 +227,6 @@ class RecordRing(Generic[R]):
         self._plans.clear()
         self._rows, self._start = rows, 0
 
-    def _flush(self) -> None:
-        """The ticks kept as they came, made rows (``compact``), pending their records."""
-        if not self._raw:
-            return
-        assert self._compact is not None  # only append_tick with compact keeps them
-        batch = self._compact(self._raw)
-        n = len(self._raw)
-        self._raw = []
-        self._tick = (type(batch), _fields(batch))
-        rows = self._push(n)
-        skip = n - rows.size  # a batch longer than the ring: its last ticks
-        for name, values in zip(self._tick[1], batch, strict=True):
-            numbers = isinstance(values, np.ndarray) and values.dtype.kind in "biuf"
-            column = self._columns.get(name)
-            if column is None:
-                column = self._columns[name] = (
-                    np.empty((self._rows, *values.shape[1:]), values.dtype) if numbers
-                    else np.empty(self._rows, dtype=object))  # fmt: skip
-            elif column.dtype != object and not (numbers and values.shape[1:] == column.shape[1:]):
-                column = self._columns[name] = self._as_objects(column)
-            if column.dtype == object:
-                column[rows] = self._objects(list(values)[skip:])
-            else:
-                column[rows] = values[skip:]
-        self._plans.clear()
-        self._pending = min(self._pending + n, self._size)
-
-    def _objects(self, values: list[Any]) -> npt.NDArray[Any]:
-        """``values`` as an object array, equal strings one object (:data:`SHARED_TEXTS`)."""
-        texts = self._texts
-        out = np.empty(len(values), dtype=object)
-        for k, value in enumerate(values):
-            if type(value) is str:
-                known = texts.get(value)
-                if known is None and len(texts) < SHARED_TEXTS:
-                    texts[value] = value
-                value = value if known is None else known
-            out[k] = value
-        return out
-
     def _store(self, row: int, entry: tuple[Any, ...]) -> None:
         """Write ``entry``'s fields into ``row`` of their columns."""
         key = (type(entry), len(entry))  # plain tuples: their length tells them apart
@@ -297,22 +234,24 @@ class RecordRing(Generic[R]):
         if plan is None:
             plan = self._plans[key] = self._plan(entry)
         texts = self._texts
-        for (column, kind, shape), value in zip(plan, entry, strict=True):
-            if kind == _OBJECT:
-                column[row] = texts.get(value, value) if type(value) is str else value
-            elif kind == _NUMBER and (type(value) is float or isinstance(value, np.floating)):
-                column[row] = value
-            elif (kind == _ARRAY and type(value) is np.ndarray and value.shape == shape
-                  and value.dtype == column.dtype):  # fmt: skip
-                column[row] = value
-            else:  # a value its column cannot hold: the column holds objects from now on
-                self._plans.clear()
-                self._store_slowly(row, entry)
-                return
-        if len(texts) < SHARED_TEXTS:
-            for value in entry:
-                if type(value) is str and value not in texts:
+        for (column, kind, shape, dtype), value in zip(plan, entry, strict=True):
+            if kind == _NUMBER:
+                if type(value) is not float and not isinstance(value, np.floating):
+                    break
+            elif kind == _ARRAY:
+                if type(value) is not np.ndarray or value.shape != shape or value.dtype != dtype:
+                    break
+            elif type(value) is str:  # one object per string
+                shared = texts.get(value)
+                if shared is not None:
+                    value = shared
+                elif len(texts) < SHARED_TEXTS:
                     texts[value] = value
+            column[row] = value
+        else:
+            return
+        self._plans.clear()  # a value its column cannot hold: the column holds objects now
+        self._store_slowly(row, entry)
 
     def _plan(self, entry: tuple[Any, ...]) -> Plan:
         """The columns of ``entry``'s fields (made where missing), each with its kind."""
@@ -322,7 +261,7 @@ class RecordRing(Generic[R]):
             if column is None:
                 column = self._columns[name] = _column_for(value, self._rows)
             kind = _OBJECT if column.dtype == object else _NUMBER if column.ndim == 1 else _ARRAY
-            out.append((column, kind, column.shape[1:]))
+            out.append((column, kind, column.shape[1:], column.dtype))
         return out
 
     def _store_slowly(self, row: int, entry: tuple[Any, ...]) -> None:
@@ -351,7 +290,6 @@ class RecordRing(Generic[R]):
 
     def _derive_pending(self) -> None:
         """Turn the ticks not yet derived into their records, in their rows."""
-        self._flush()
         if not self._pending:
             return
         assert self._derive is not None and self._tick is not None  # append_tick's checks

@@ -167,6 +167,23 @@ class JerkLimiter:
         self.rates: Array = np.zeros(n)
         self._acceleration: Array = np.zeros(n)
         self._stopping = False
+        self._compile()
+
+    def _compile(self) -> None:
+        """Run the kernels of :meth:`step` once now, on the rates and positions it may be
+        given (writable, or read-only as a resolution's): compiled (or loaded from numba's
+        cache) before a control loop's first tick.
+        """  # noqa: D205
+        n = self.n
+        fixed = np.zeros(n)
+        fixed.flags.writeable = False
+        for given in (fixed, np.zeros(n)):
+            jerk_step(np.zeros(n), np.zeros(n), given, self.dt, self.a_max, self.j_max,
+                      np.empty(n))  # fmt: skip
+            if self._lower is not None and self._upper is not None:
+                for position in (fixed, np.zeros(n)):
+                    braked(given, position, self._lower, self._upper, self._brake, self._lead,
+                           np.empty(n))  # fmt: skip
 
     def reset(self, rates: npt.ArrayLike | None = None) -> None:
         """Start again from ``rates`` (n,) at rest in acceleration (default zero); no STOP."""

@@ -2,8 +2,8 @@
 
 The log is a :class:`~rrc_pin.control.record_ring.RecordRing`: it keeps the last
 :data:`CAPACITY` ticks (10 minutes at 100 Hz) as columns of arrays and forgets the oldest
-beyond, so that its memory is bounded however long a controller runs: ``8 (19 + 2 nq) + 48``
-bytes a tick (the numbers, and a pointer per text field), 312 B for a 7-joint arm, 18.7 MB at
+beyond, so that its memory is bounded however long a controller runs: ``8 (19 + 2 nq) + 56``
+bytes a tick (the numbers, and a pointer per text field), 320 B for a 7-joint arm, 19.2 MB at
 the default capacity (docs/api.md, "The trajectory log's memory").
 """
 
@@ -91,11 +91,10 @@ class TrajectoryLog(RecordRing[LogRecord]):
         derive: Makes the record of a tick passed to :meth:`append_tick` (the controller's),
             or None for a log of records only.
         capacity: Ticks kept, >= 1 (default :data:`CAPACITY`: 10 minutes at 100 Hz).
-        compact: Turns a batch of ticks into rows (:class:`RecordRing`), or None.
 
     Raises:
-        InvalidInput: ``joint_names`` not a sequence of names, ``derive`` or ``compact`` not
-            callable, or a bad ``capacity``, named.
+        InvalidInput: ``joint_names`` not a sequence of names, ``derive`` not callable, or a
+            bad ``capacity``, named.
     """
 
     record_type = LogRecord
@@ -104,14 +103,12 @@ class TrajectoryLog(RecordRing[LogRecord]):
         self, joint_names: list[str] | tuple[str, ...],
         derive: Callable[[Any], LogRecord] | None = None,
         capacity: int = CAPACITY,
-        *,
-        compact: Callable[[list[Any]], tuple[Any, ...]] | None = None,
     ) -> None:  # fmt: skip
         if isinstance(joint_names, str) or not isinstance(joint_names, (list, tuple)) or not all(
             isinstance(n, str) for n in joint_names
         ):
             raise InvalidInput("joint_names", f"expected a list of names, got {joint_names!r}")
-        super().__init__(derive, capacity, compact=compact)
+        super().__init__(derive, capacity)
         self.joint_names = tuple(joint_names)
 
     def column(self, name: str) -> Array | npt.NDArray[np.str_]:

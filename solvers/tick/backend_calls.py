@@ -67,16 +67,28 @@ def leave() -> None:
     _LOCAL.context = None
 
 
-def compile_direction(context: Context) -> None:
-    """Run :func:`direction` once now on a small problem of the context's rates: the kernels
-    it calls are compiled (or loaded from numba's cache) before a tick hands one over; the
-    backend's warm starts then forgotten.
-    """  # noqa: D205
+def compile_calls(context: Context) -> None:
+    """Run each call once now on small problems of the context's rates.
+
+    The kernels they reach are compiled (or loaded from numba's cache) before a tick hands a
+    QP over; the backend's warm starts are then forgotten.
+
+    The direction problem with a row (:func:`direction`); a least-squares level of one row
+    (its metric semidefinite: the backend's QP) and of every rate (the kernels'), on all
+    rates and within a subspace, with a row and without (:func:`level`); the sliding stage's
+    QP (:func:`slide`).
+    """
     n = context.velocity.size
+    lb, ub, x = np.full(n, -1.0), np.ones(n), np.zeros(n)
+    rows = ((np.zeros((1, n)), np.ones(1)), (np.zeros((0, n)), np.zeros(0)))
     enter(context)
     try:
-        direction(np.eye(n), np.full(n, 0.1), np.zeros((0, n)), np.full(n, -1.0), np.ones(n),
-                  np.zeros((1, n)), np.ones(1))  # fmt: skip
+        direction(np.eye(n), np.full(n, 0.1), np.zeros((0, n)), lb, ub, *rows[0])
+        for A in (np.eye(1, n), np.eye(n)):
+            for where, N in ((TOP, np.zeros((0, n))), (1, np.eye(n))):
+                for G, h in rows:
+                    level(where, A, np.full(A.shape[0], 0.1), x, N, lb, ub, G, h, True)
+        slide(SLIDE, np.eye(n), np.full(n, 0.1), lb, ub, *rows[0])
     finally:
         leave()
         context.backend.reset()

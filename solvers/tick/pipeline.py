@@ -231,7 +231,18 @@ def solve(problem: Problem, backend: QPBackend, options: Options) -> Answer:
             null = None
             continue
         levels.append(_served(problem, k, qdot))
-    return _answer(problem, top, qdot, "qp", levels, work)
+    answer = _answer(problem, top, qdot, "qp", levels, work)
+    A, b = problem.stacked[0]
+    code = _STATUSES.index(answer.status)
+    status, scale, veer = statuses.borne_out(code, A @ answer.qdot, b, problem.mode == "direction",
+                                             problem.rate_factor, answer.scale, answer.veer)
+    if status == statuses.FAILED:
+        work.attempts.append(("qp", "its rates, clipped into the box, veer from the command"))
+        return fallback_answer(problem, options, work)
+    if status == code:
+        return answer
+    return answer._replace(status=_STATUSES[status], scale=scale, veer=veer,
+                           levels=(_level_status(_STATUSES[status]), *answer.levels[1:]))
 
 
 def fallback_answer(problem: Problem, options: Options, work: Work) -> Answer:

@@ -11,7 +11,10 @@ Each rule is one kernel, called from the compiled tick (:mod:`rrc_pin.solvers.ti
   (a command divided down, :mod:`rrc_pin.solvers.tick.problem`) ``scaled`` by its factor
   (:func:`met_top`);
 - a lower level is ``met``, ``scaled`` along its command or ``traded`` (:func:`served`); the
-  top level as a level by its status (:func:`top_served`).
+  top level as a level by its status (:func:`top_served`);
+- a top level's ``exact`` or ``scaled`` is refused for a subnormal command (:func:`borne_out`):
+  :func:`met` asks nothing of a command far below one task unit (a backend's answer to it is
+  met by any rates within its tolerance, and the clip into the box turns them off it).
 """
 
 from __future__ import annotations
@@ -29,11 +32,17 @@ Array = npt.NDArray[np.float64]
 EXACT, SCALED, SLIDING, DAMPED, SINGULAR, LEAST_SQUARES, RECOVERING, FALLBACK = range(8)
 """Codes of :data:`~rrc_pin.solvers.tick.pipeline.Status`, in its order."""
 
+FAILED = -1
+"""The top level found no usable answer: the fallbacks answer."""
+
 MET, SCALED_LEVEL, TRADED, DROPPED = range(4)
 """Codes of :data:`~rrc_pin.solvers.tick.pipeline.LevelStatus`, in its order."""
 
 EXACT_TOL = 1e-9
 """Relative residual under which a command counts as met, and a scale as 1."""
+
+TINY = 2.2250738585072014e-308
+"""The smallest normal float: below it a rate has fewer bits than a relative check asks."""
 
 VEER_TOL = 1e-6
 """The angle [rad] off its command under which a lower level's rates are its command scaled."""
@@ -91,3 +100,23 @@ def served(y: Array, b: Array, rate_factor: float) -> int:
         return MET if rate_factor == 1.0 else SCALED_LEVEL
     scale, veer = kernels.scale_and_veer(y, b)
     return SCALED_LEVEL if veer <= VEER_TOL and scale > 0.0 and b.any() else TRADED
+
+
+@kernel
+def borne_out(status: int, y: Array, b: Array, direction: bool, rate_factor: float,
+              scale: float, veer: float) -> tuple[int, float, float]:  # fmt: skip
+    """The top level's ``(status, scale, veer)`` as its final rates ``y`` (m,) bear them out.
+
+    A stacked command ``b`` (m,) whose rates are all subnormal (below :data:`TINY`: met to
+    :data:`EXACT_TOL` by any small rates)
+    is neither ``exact`` nor ``scaled``: in the direction mode :data:`FAILED` (the fallbacks
+    answer), else ``least_squares``. Any other report is kept.
+    """
+    if status != EXACT and status != SCALED:
+        return status, scale, veer
+    peak = 0.0
+    for i in range(b.size):
+        peak = max(peak, abs(b[i]))
+    if peak == 0.0 or peak >= TINY:
+        return status, scale, veer
+    return (FAILED if direction else LEAST_SQUARES), scale, veer

@@ -160,10 +160,11 @@ def level(task_rows: Array, rates: Array, ints: Ints, k: int, normalised: bool, 
 
 
 @inlined
-def top_level(task_rows: Array, rates: Array, ints: Ints, reals: Array, rows: Rows,
-              direction: bool, recovering: bool) -> Top:  # fmt: skip
-    """The top level's answer: the direction problem's stages or a least squares."""
-    A, b, rate_factor = level(task_rows, rates, ints, 0, direction, rows.lb, rows.ub)
+def top_level(A: Array, b: Array, rate_factor: float, rates: Array, ints: Ints, reals: Array,
+              rows: Rows, direction: bool, recovering: bool) -> Top:  # fmt: skip
+    """The top level's answer to its rows ``A`` and rates ``b`` (:func:`level`): the direction
+    problem's stages or a least squares.
+    """  # noqa: D205
     need_null = ints[LEVELS] > 1
     if direction:
         return top.direction(A, b, rows, reals[DT], reals[THRESHOLD], rate_factor, need_null)
@@ -239,16 +240,23 @@ def clipped(qdot: Array, rows: Rows, answer: Top, zero_inside: bool) -> tuple[fl
 
 
 @inlined
-def report(joints: Array, ints: Ints, reals: Array, rows: Rows, answer: Top, qdot: Array) -> int:
+def report(joints: Array, ints: Ints, reals: Array, rows: Rows, answer: Top, qdot: Array,
+           A: Array, b: Array, direction: bool, rate_factor: float) -> int:  # fmt: skip
     """Stage 5: ``qdot`` clipped into the box and shrunk into the rows, and the top level's
-    report, into ``joints`` and ``reals``; the status code.
+    report as they bear it out (its rows ``A``, rates ``b``:
+    :func:`rrc_pin.solvers.tick.statuses.borne_out`), into ``joints`` and ``reals``; the status
+    code, or :data:`~rrc_pin.solvers.tick.top.FAILED`.
     """  # noqa: D205
-    reals[CLIP], reals[SCALE] = clipped(qdot, rows, answer, reals[ZERO_INSIDE] == 1.0)
-    reals[VEER], reals[LAMBDA_SQ] = answer.veer, answer.lambda_sq
+    clip, scale = clipped(qdot, rows, answer, reals[ZERO_INSIDE] == 1.0)
+    status, scale, veer = statuses.borne_out(answer.status, row_values(A, qdot), b, direction,
+                                             rate_factor, scale, answer.veer)  # fmt: skip
+    if status == FAILED:
+        return FAILED
+    reals[CLIP], reals[SCALE], reals[VEER], reals[LAMBDA_SQ] = clip, scale, veer, answer.lambda_sq
     for c in range(qdot.size):  # element by element: an array copy compiles numba's shape error
         joints[QDOT, c] = qdot[c]
-    ints[STARTS + ints[LEVELS] + 1] = statuses.top_served(answer.status)
-    return answer.status
+    ints[STARTS + ints[LEVELS] + 1] = statuses.top_served(status)
+    return status
 
 
 @kernel
@@ -270,7 +278,7 @@ def run_box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Ar
     answer = top.direction_box(A, b, rows, reals[DT], reals[THRESHOLD], rate_factor)
     if answer.status == FAILED:
         return FAILED
-    return report(joints, ints, reals, rows, answer, answer.qdot)
+    return report(joints, ints, reals, rows, answer, answer.qdot, A, b, True, rate_factor)
 
 
 @kernel
@@ -314,9 +322,13 @@ def run_twist(J: Array, b: Array, q: Array, dt: float, joints: Array, rates: Arr
         return FAILED, 0.0, 0.0, 0.0, 0.0
     qdot = answer.qdot
     clip, scale = clipped(qdot, rows, answer, True)
+    status, scale, veer = statuses.borne_out(answer.status, row_values(A, qdot), c, True,
+                                             rate_factor, scale, answer.veer)  # fmt: skip
+    if status == FAILED:
+        return FAILED, 0.0, 0.0, 0.0, 0.0
     for j in range(n):
         out[j] = joints[PREVIOUS, j] = qdot[j]
-    return answer.status, scale, answer.veer, clip, answer.lambda_sq
+    return status, scale, veer, clip, answer.lambda_sq
 
 
 def twist_size(n: int, m: int) -> int:
@@ -341,11 +353,12 @@ def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide
     zero_inside, recovering = reals[ZERO_INSIDE] == 1.0, reals[RECOVERING] == 1.0
     direction = (ints[WEIGHTED] == 0 and ints[DIRECTION] == 1 and zero_inside
                  and not (rows.h < 0.0).any())  # fmt: skip
-    answer = top_level(task_rows, rates, ints, reals, rows, direction, recovering)
+    A, b, rate_factor = level(task_rows, rates, ints, 0, direction, rows.lb, rows.ub)
+    answer = top_level(A, b, rate_factor, rates, ints, reals, rows, direction, recovering)
     if answer.status == FAILED:
         return FAILED
     qdot = lower_levels(task_rows, rates, ints, rows, answer)
-    return report(joints, ints, reals, rows, answer, qdot)
+    return report(joints, ints, reals, rows, answer, qdot, A, b, direction, rate_factor)
 
 
 @kernel
@@ -373,7 +386,7 @@ def run_within(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array
     if answer.status == FAILED:
         return FAILED
     qdot = lower_levels(task_rows, rates, ints, rows, answer)
-    return report(joints, ints, reals, rows, answer, qdot)
+    return report(joints, ints, reals, rows, answer, qdot, A, b, direction, rate_factor)
 
 
 class Workspace:

@@ -45,11 +45,9 @@ from rrc_pin.solvers.tick.statuses import (
     SLIDING,
     STILL_SCALE,
 )
+from rrc_pin.solvers.tick.statuses import FAILED as FAILED  # where the ticks import it
 
 Array = npt.NDArray[np.float64]
-
-FAILED = -1
-"""The top level found no usable answer (the backend failed): the fallbacks answer."""
 
 SLIDE_DAMPING = 1e-2
 r"""Weight :math:`\mu` of the sliding stage's damping
