@@ -615,9 +615,11 @@ class CellController(Loop):
         if not isinstance(commands, Mapping):
             raise InvalidInput("commands", f"expected a mapping name -> twist, got {commands!r}")
         out: dict[str, Array] = {}
+        allowed = self.commandable()
         for name, value in commands.items():
+            if not isinstance(name, str) or name not in allowed:
+                self._check_name(name, "commands")
             label = f"commands[{name!r}]"
-            self._check_name(name, "commands")
             ref = "world_aligned"
             if isinstance(value, tuple) and len(value) == 2 and isinstance(value[1], str):
                 value, ref = value
@@ -628,8 +630,9 @@ class CellController(Loop):
                 raise InvalidInput(label, f"ref 'base' is a hand's arm base axes; {name!r} is "
                                    f"{'the body' if name == self.cell.body else 'an object'}: "
                                    "expected world_aligned, local or world")  # fmt: skip
-            twist = as_vector(value, label, 6)
-            out[name] = np.concatenate([twist, [REFS.index(ref)]])
+            command = out[name] = np.empty(7)
+            command[:6] = as_vector(value, label, 6)
+            command[6] = REFS.index(ref)
         if any(c[6] == REFS.index("world") for c in out.values()):
             self._warn_world()
         return out
