@@ -113,7 +113,8 @@ class RelativeFrameTask(Task):
         """The relative Jacobian rows (class docstring) and the commanded relative twist."""
         Ja = kin.jacobian(self.frame_a)
         Jb = kin.jacobian(self.frame_b)
-        Ta, Tb = kin.pose(self.frame_a), kin.pose(self.frame_b)
+        oMf, index = kin.data.oMf, kin.layout.frames  # both placed by the Jacobians' pass
+        Ta, Tb = oMf[index[self.frame_a]].homogeneous, oMf[index[self.frame_b]].homogeneous
         Rt = Ta[:3, :3].T
         d = Tb[:3, 3] - Ta[:3, 3]
         D = Jb - Ja
