@@ -326,7 +326,8 @@ class CellController(Loop):
         weight = self._weight()
         cell = self.cell
         kin = self._kinematics()
-        poses = {name: kin.pose(self.frame_of(name)) for name in self._targets}
+        oMf, index = kin.data.oMf, kin.layout.frames  # one pass: every frame placed
+        poses = {name: oMf[index[self.frame_of(name)]].homogeneous for name in self._targets}
         twists = {name: weight * self._world_aligned(name, poses[name], self._commands[name])
                   if name in self._commands else np.zeros(6) for name in self._targets}  # fmt: skip
         for name, twist in self._streamed(poses).items():  # the stream's target: the reference
@@ -353,7 +354,7 @@ class CellController(Loop):
             levels: list[list[Task]] = [top, [self.posture]] if top else [[self.posture]]
             r = self.resolver.solve_at(kin, levels, priority="strict", qdot_prev=before)
         r = self._smooth(r)
-        commanded = any(bool(np.any(t != 0.0)) for t in twists.values())
+        commanded = any(t.any() for t in twists.values())
         self._tick = ("teleop", commanded, poses)
         out = self._advance(r)
         r = out.resolution
