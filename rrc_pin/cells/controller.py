@@ -326,7 +326,8 @@ class CellController(Loop):
         weight = self._weight()
         cell = self.cell
         kin = self._kinematics()
-        poses = {name: kin.pose(self.frame_of(name)) for name in self._targets}
+        oMf, index = kin.data.oMf, kin.layout.frames  # one pass: every frame placed
+        poses = {name: oMf[index[self.frame_of(name)]].homogeneous for name in self._targets}
         twists = {name: weight * self._world_aligned(name, poses[name], self._commands[name])
                   if name in self._commands else np.zeros(6) for name in self._targets}  # fmt: skip
         for name, twist in self._streamed(poses).items():  # the stream's target: the reference
@@ -353,7 +354,7 @@ class CellController(Loop):
             levels: list[list[Task]] = [top, [self.posture]] if top else [[self.posture]]
             r = self.resolver.solve_at(kin, levels, priority="strict", qdot_prev=before)
         r = self._smooth(r)
-        commanded = any(bool(np.any(t != 0.0)) for t in twists.values())
+        commanded = any(t.any() for t in twists.values())
         self._tick = ("teleop", commanded, poses)
         out = self._advance(r)
         r = out.resolution
@@ -615,9 +616,11 @@ class CellController(Loop):
         if not isinstance(commands, Mapping):
             raise InvalidInput("commands", f"expected a mapping name -> twist, got {commands!r}")
         out: dict[str, Array] = {}
+        allowed = self.commandable()
         for name, value in commands.items():
+            if not isinstance(name, str) or name not in allowed:
+                self._check_name(name, "commands")
             label = f"commands[{name!r}]"
-            self._check_name(name, "commands")
             ref = "world_aligned"
             if isinstance(value, tuple) and len(value) == 2 and isinstance(value[1], str):
                 value, ref = value
@@ -628,8 +631,9 @@ class CellController(Loop):
                 raise InvalidInput(label, f"ref 'base' is a hand's arm base axes; {name!r} is "
                                    f"{'the body' if name == self.cell.body else 'an object'}: "
                                    "expected world_aligned, local or world")  # fmt: skip
-            twist = as_vector(value, label, 6)
-            out[name] = np.concatenate([twist, [REFS.index(ref)]])
+            command = out[name] = np.empty(7)
+            command[:6] = as_vector(value, label, 6)
+            command[6] = REFS.index(ref)
         if any(c[6] == REFS.index("world") for c in out.values()):
             self._warn_world()
         return out

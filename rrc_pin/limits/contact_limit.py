@@ -123,7 +123,9 @@ class ContactLimit(Limit):
             return Constraints()
         C = np.vstack([kin.jacobian(f) for f in self.frames])
         if self._goals is not None:
-            error = np.concatenate([g.error(kin.pose(g.frame)) for g in self._goals])
+            oMf, index = kin.data.oMf, kin.layout.frames
+            error = np.concatenate([g.error(oMf[index[g.frame]].homogeneous)
+                                    for g in self._goals])  # fmt: skip
             reach = kin.layout.reach
             unit = self._unit
             if unit is None or unit[::6].tolist() != [reach[f] for f in self.frames]:

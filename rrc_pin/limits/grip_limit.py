@@ -107,8 +107,11 @@ class GripLimit(Limit):
         if not self.pairs:
             return Constraints()
         rows = [t.rows(kin) for t in self._tasks]
-        C = np.vstack([r.A for r in rows])
+        one = len(rows) == 1  # its rows as they are (new arrays)
+        C = rows[0].A if one else np.vstack([r.A for r in rows])
         if self._measured:
-            unit = np.concatenate([np.ones(6) if r.unit is None else r.unit for r in rows])
-            self.last = Closure(C, np.concatenate([r.b for r in rows]), unit)
+            units = [np.ones(6) if r.unit is None else r.unit for r in rows]
+            unit = units[0].copy() if one else np.concatenate(units)
+            self.last = Closure(C, rows[0].b if one else np.concatenate([r.b for r in rows]),
+                                unit)  # fmt: skip
         return Constraints(C=C, d=self._zero, names=self._names)

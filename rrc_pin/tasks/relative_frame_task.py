@@ -113,16 +113,21 @@ class RelativeFrameTask(Task):
         """The relative Jacobian rows (class docstring) and the commanded relative twist."""
         Ja = kin.jacobian(self.frame_a)
         Jb = kin.jacobian(self.frame_b)
-        Ta, Tb = kin.pose(self.frame_a), kin.pose(self.frame_b)
+        oMf, index = kin.data.oMf, kin.layout.frames  # both placed by the Jacobians' pass
+        Ta, Tb = oMf[index[self.frame_a]].homogeneous, oMf[index[self.frame_b]].homogeneous
         Rt = Ta[:3, :3].T
         d = Tb[:3, 3] - Ta[:3, 3]
-        J = np.vstack([Rt @ (Jb[:3] - Ja[:3] + pin.skew(d) @ Ja[3:]), Rt @ (Jb[3:] - Ja[3:])])
-        b = self.twist.copy()
-        if self.target is not None:
-            R_ab = Rt @ Tb[:3, :3]
-            error = np.concatenate([
-                self.target[:3, 3] - Rt @ d, pin.log3(self.target[:3, :3] @ R_ab.T)
-            ])  # fmt: skip
-            b = b + self.gain * error[list(self.selected)]
+        D = Jb - Ja
+        J = np.empty_like(D)
+        np.matmul(Rt, D[:3] + pin.skew(d) @ Ja[3:], out=J[:3])
+        np.matmul(Rt, D[3:], out=J[3:])
+        if self.target is None:
+            b = self.twist.copy()
+        else:
+            error = np.empty(6)
+            error[:3] = self.target[:3, 3] - Rt @ d
+            error[3:] = pin.log3(self.target[:3, :3] @ (Rt @ Tb[:3, :3]).T)
+            b = self.twist + self.gain * (error if len(self.selected) == 6
+                                          else error[list(self.selected)])  # fmt: skip
         reach = max(kin.layout.reach[self.frame_a], kin.layout.reach[self.frame_b])
         return self._spec.rows_from(J, b, reach)
