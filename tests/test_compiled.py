@@ -423,6 +423,18 @@ tripod = rrc_pin.load("yeh_tripod")
 session("yeh_tripod with its capsules", Controller(tripod, 0.01, limits=[JointLimits(),
         CollisionLimit(CollisionModel(tripod, "capsules"))]), cell_command)
 session("gsfc_dual uncoupled", Controller("gsfc_dual", 0.01, coupled=False), cell_command)
+
+def ball_command(controller, k):
+    # the held object down onto a ball: the grip's equality rows with rows it slides along
+    if k % 40 == 0:
+        ball_command.twist = np.r_[rng.normal(size=2) * 0.05, -0.15, rng.normal(size=3) * 0.2]
+    return ({"object": ball_command.twist},)
+
+dual = rrc_pin.load("gsfc_dual")
+ball = CollisionModel(dual, "capsules")
+ball.add_sphere(dual.fk(dual.ready(), "object")[:3, 3] + [0.0, 0.0, -0.25], 0.08, "ball")
+session("gsfc_dual above a ball", Controller(dual, 0.01, limits=[JointLimits(),
+        CollisionLimit(ball)]), ball_command)
 from rrc_pin.control.smoothing import SmoothingOptions
 session("panda with the jerk stage", Controller(panda, 0.01, stretched,
         smoothing=SmoothingOptions()), arm_command)

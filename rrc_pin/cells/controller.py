@@ -75,6 +75,7 @@ from rrc_pin.solvers.checks import as_vector, flag, positive
 from rrc_pin.solvers.spatial import to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.kernels import scale_and_veer
+from rrc_pin.solvers.tick.pipeline import solve
 from rrc_pin.solvers.tick.problem import Rows, TaskRows
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.tasks import FrameTask, PostureTask, Task
@@ -379,7 +380,8 @@ class CellController(Loop):
         posture level the box cuts (the projected least squares), and a command one of whose
         rows is weighted past the damping threshold (damped,
         :class:`~rrc_pin.solvers.tick.damping.Damping`), each tick's top level read as the
-        correction reads it (:func:`_top_level`); the resolver then reset.
+        correction reads it (:func:`_top_level`), and each tick's problem answered by the Python
+        pipeline (:func:`~rrc_pin.solvers.tick.pipeline.solve`); the resolver then reset.
         """
         kin, names = self._kinematics(), list(self._targets)
         far = PostureTask(self.posture.q_ref + 1.0, gain=1e6, name="compiling")
@@ -399,6 +401,14 @@ class CellController(Loop):
             r = self.resolver.solve_at(kin, [top, [lower]] if top else [[lower]],
                                        priority="strict", qdot_prev=self._previous_rates())
             _top_level(r)  # the correction's read of the top level's rows (its kernels)
+            # the Python pipeline's stages too: it answers equality rows with rows the command
+            # slides along (a binding collision limit's)
+            solve(r.problem, self.resolver.backend, self.resolver.options)
+        still = np.zeros(self.cell.nv)
+        for previous in (still, r.qdot):  # the pipeline's box after rates of either kind
+            for limit in self.resolver.limits:
+                if isinstance(limit, JointLimits):
+                    limit.constraints(kin, self.resolver.dt, previous)
         self.resolver.reset()
         self._kin = None
 
