@@ -113,8 +113,8 @@ def test_random_problems_answered_as_the_pipeline(seed: int) -> None:
         got = tuple(LEVELS[c] for c in ws.level_codes())
         tol = RATE_TOL if want.backend == "" else BACKEND_TOL
         if got != want.levels:  # a lower level's QP at rounding: refused on one side only
-            assert all(g == w or {g, w} == {"traded", "dropped"}
-                       for g, w in zip(got, want.levels)), (got, want.levels)  # fmt: skip
+            pairs = zip(got, want.levels, strict=True)
+            assert all(g == w or {g, w} == {"traded", "dropped"} for g, w in pairs), got
             relabelled += 1
         assert np.abs(qdot - want.qdot).max() <= tol * (1.0 + np.abs(want.qdot).max()), seed
         assert ws.reals[tick.SCALE] == pytest.approx(want.scale, abs=tol), seed

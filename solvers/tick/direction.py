@@ -172,7 +172,7 @@ def solved_along(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array
     code, steps = active_set.solve(P, q, C, lo, hi, z_lb, z_ub, z)
     if code != active_set.SOLVED:
         return w, -1.0, 0.0, steps
-    qdot = _decoded(M, z)
+    qdot = kernels.row_values(M, z)
     clipped = qdot.copy()
     if not (kernels.all_finite(qdot) and kernels.clip_into(clipped, lb, ub) <= tol
             and kernels.rows_hold(G, qdot, h, tol)):  # fmt: skip
@@ -181,19 +181,6 @@ def solved_along(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array
     if not (kept and math.isfinite(scale) and math.isfinite(veer)):
         return w, -1.0, 0.0, steps
     return qdot, scale, veer, steps
-
-
-@kernel
-def _decoded(M: Array, z: Array) -> Array:
-    """``M z`` (n,)."""
-    n, k = M.shape
-    x = np.empty(n)
-    for i in range(n):
-        s = 0.0
-        for j in range(k):
-            s += M[i, j] * z[j]
-        x[i] = s
-    return x
 
 
 @kernel

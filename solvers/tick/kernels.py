@@ -218,6 +218,19 @@ def least_norm_rates(Q: Array, R: Array, b: Array, x: Array) -> bool:
 
 
 @kernel
+def row_values(A: Array, x: Array) -> Array:
+    """``A x`` (m,) for rows A (m, n)."""
+    m, n = A.shape
+    y = np.empty(m)
+    for i in range(m):
+        s = 0.0
+        for j in range(n):
+            s += A[i, j] * x[j]
+        y[i] = s
+    return y
+
+
+@kernel
 def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
     r"""One-sided Jacobi SVD of a small ``A`` (m, k): ``A V = U diag(sigma)`` (Hestenes 1958).
 

@@ -17,6 +17,7 @@ from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import backend_calls, factor, kernels
+from rrc_pin.solvers.tick.kernels import row_values
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
 
 Array = npt.NDArray[np.float64]
@@ -24,19 +25,6 @@ Array = npt.NDArray[np.float64]
 ROUNDING = 1e-12
 """[rad/s] Slack given to the constraint rows of a lower level
 (:data:`rrc_pin.solvers.tick.least_squares.ROUNDING`)."""
-
-
-@kernel
-def row_values(A: Array, x: Array) -> Array:
-    """``A x`` (m,) for rows A (m, n)."""
-    m, n = A.shape
-    y = np.empty(m)
-    for i in range(m):
-        s = 0.0
-        for j in range(n):
-            s += A[i, j] * x[j]
-        y[i] = s
-    return y
 
 
 @kernel

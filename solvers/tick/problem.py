@@ -291,10 +291,11 @@ def _weighted(
     peak, r = 0.0, 0
     for t in tasks:
         k = t.b.size
-        weight = _ones(k) if t.weight is None else t.weight
-        unit = t.unit if normalised and t.unit is not None else _ones(k)
+        weight = _ones(k) if t.weight is None else _read_only(t.weight)
+        unit = _read_only(t.unit) if normalised and t.unit is not None else _ones(k)
         rows_A, rows_b = (A, b) if k == b.size else (A[r : r + k], b[r : r + k])  # one task: all
-        rows = kernels.weighted_rows(t.A, t.b, weight, top, unit, scale, rows_A, rows_b)
+        rows = kernels.weighted_rows(_read_only(t.A), _read_only(t.b), weight, top, unit, scale,
+                                     rows_A, rows_b)  # fmt: skip
         peak, r = max(peak, rows), r + k
     return peak
 
@@ -337,6 +338,19 @@ def cap(A: Array, peak: float, factor: float, normalised: bool, lb: Array, ub: A
     if normalised:
         limit = min(limit, LARGE)
     return 1.0 if command <= limit else limit / peak
+
+
+def _read_only(a: Array) -> Array:
+    """``a``, or a read-only view of it.
+
+    The rows' kernel then has one signature whichever arrays a task gives (its constant rows
+    read-only, its rates not), so that no tick compiles another.
+    """
+    if not a.flags.writeable:
+        return a
+    view: Array = a.view()
+    view.flags.writeable = False
+    return view
 
 
 @functools.cache

@@ -34,7 +34,8 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import equalities, kernels, statuses, top
-from rrc_pin.solvers.tick.levels import least_squares, row_values
+from rrc_pin.solvers.tick.kernels import row_values
+from rrc_pin.solvers.tick.levels import least_squares
 from rrc_pin.solvers.tick.problem import LARGE, TaskRows, cap
 from rrc_pin.solvers.tick.statuses import DROPPED
 from rrc_pin.solvers.tick.top import FAILED, Rows, Top
