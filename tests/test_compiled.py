@@ -76,7 +76,7 @@ slide_kernels.project(np.eye(2), 0.0, np.ones(2), -np.ones(2), np.ones(2), np.ze
 from rrc_pin.solvers.qp_backends import active_set
 active_set.solve(np.eye(2), -np.ones(2), np.ones((1, 2)), np.array([-np.inf]), np.ones(1),
                  np.zeros(2), np.ones(2), x)
-out["tick glue"] = [statuses.norm(np.ones(3)), float(levels.row_values(np.eye(2), x).sum()),
+out["tick glue"] = [statuses.norm(np.ones(3)), float(levels.product(np.eye(2), np.eye(2)).sum()),
                     float(factor.qr(np.eye(2)).R.sum()),
                     problem.cap(np.eye(2), 1e200, 1.0, True, -np.ones(2), np.ones(2)),
                     *top.along_command(np.eye(2), np.ones(2), x, np.zeros(0), 1.0),

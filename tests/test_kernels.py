@@ -247,3 +247,10 @@ def test_damping_lambda_sq_against_numpy(rng: np.random.Generator) -> None:
         assert applies == (reference is not None)
         if reference is not None:
             np.testing.assert_allclose(lam, reference, rtol=1e-14, atol=0)
+
+
+def test_row_values_against_numpy(rng: np.random.Generator) -> None:
+    for _ in range(100):
+        m, n = rng.integers(1, 9, 2)
+        A, x = rng.normal(size=(m, n)), rng.normal(size=n)
+        np.testing.assert_allclose(kernels.row_values(A, x), A @ x, atol=1e-13)
