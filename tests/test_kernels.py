@@ -254,3 +254,28 @@ def test_row_values_against_numpy(rng: np.random.Generator) -> None:
         m, n = rng.integers(1, 9, 2)
         A, x = rng.normal(size=(m, n)), rng.normal(size=n)
         np.testing.assert_allclose(kernels.row_values(A, x), A @ x, atol=1e-13)
+
+
+def test_into_rows_against_numpy(rng: np.random.Generator) -> None:
+    """The factor that scales rates into the rows: the least h_i / (G x)_i over the rows left by
+    more than their sum's rounding, 4 eps below it; 1 where every row holds."""
+    eps = np.finfo(np.float64).eps
+    for _ in range(400):
+        p, n = rng.integers(1, 7), rng.integers(1, 9)
+        G, x = rng.normal(size=(p, n)), rng.normal(size=n)
+        h = np.abs(rng.normal(size=p)) * rng.choice([0.0, 1.0], size=p)
+        values = G @ x
+        left = values - h > 1e-12
+        want = 1.0 if not left.any() else float(np.min(h[left] / values[left])) * (1 - 4 * eps)
+        got = kernels.into_rows(G, h, x)
+        assert got == pytest.approx(want, rel=1e-12, abs=0.0)
+        assert (G @ (x * got) <= h + 1e-15).all()
+
+
+def test_a_row_held_at_zero_and_met_to_rounding_keeps_the_rates() -> None:
+    """0.1 + 0.2 - 0.3 is 5.6e-17 in floating point: a row at bound 0 met to rounding, which
+    used to scale the whole answer to zero (a tripod stopped mid-walk, reported exact)."""
+    G, x = np.array([[0.1, 0.2, -0.3]]), np.ones(3)
+    assert (G @ x)[0] > 0.0
+    assert kernels.into_rows(G, np.zeros(1), x) == 1.0
+    assert kernels.into_rows(G, np.zeros(1), x + np.array([1e-9, 0.0, 0.0])) == 0.0  # left: stand still

@@ -36,7 +36,9 @@ class Tripod:
                                            gain=0.1, weight=1e-3)  # fmt: skip
         self.layout = Layout.of(self.cell)
         self.q = self.cell.ready()
-        self.worst, self.scaled = -np.inf, 0
+        self.worst, self.scaled, self.held = -np.inf, 0, 0
+        self.lifted: list[float] = []  # outside() as each foot lifts [m]
+        self.landed: list[float] = []  # each foot's distance to its goal as it lands [m]
 
     def com(self, q=None) -> np.ndarray:
         q, dof, q_pin = self.cell.positions(self.q if q is None else q)
@@ -54,6 +56,7 @@ class Tripod:
     def tick(self, top, *below) -> rrc_pin.Resolution:
         r = self.resolver.solve(self.q, [top, *below, [self.posture]], priority="strict")
         held = any(row.name.startswith("support") for row in r.active_rows)
+        self.held += held
         self.scaled += held and r.tasks[0].scale < 0.999
         self.q = self.cell.integrate(self.q, r.qdot, DT)
         self.worst = max(self.worst, self.outside())
@@ -93,21 +96,18 @@ def test_the_fixed_run_leaves_the_region_without_the_limit():
     assert free.worst > 0.05 and held.worst <= 0.0 and held.scaled > 100
 
 
-@pytest.mark.compiled
-def test_a_walk_with_one_foot_lifted():
+def walk(limit: bool) -> Tripod:
     """Each leg in turn: the centre of mass moved over the two other feet (a ComTask, three
     feet in support), the foot lifted 5 cm and set down 5 cm forward while the body is
-    pushed toward it for 2 s (two feet in support), landed, the centre of mass moved back.
-    It stays in the shrunk region of the feet in support at every tick; each foot lands
-    within 1 mm; the push that would have taken it out was scaled."""
-    tripod = Tripod(margin=0.03)
+    pushed toward it for 2 s (two feet in support), landed, the centre of mass moved back."""
+    tripod = Tripod(margin=0.03, limit=limit)
     cell, rng = tripod.cell, np.random.default_rng(0)
     middle = tripod.com()[:2]
     for leg in tripod.feet:
         rest = [f for f in tripod.feet if f != leg]
         shift(tripod, over_feet(tripod, rest, middle))
         tripod.support_on(rest)
-        assert tripod.outside() < -0.04, leg  # well inside the two feet's region
+        tripod.lifted.append(tripod.outside())
         start = cell.fk(tripod.q, leg)
         away = start[:2, 3] - tripod.com()[:2]
         away /= np.linalg.norm(away)
@@ -126,11 +126,23 @@ def test_a_walk_with_one_foot_lifted():
             tripod.tick([foot, body] if k < 200 else [foot], [body])  # then the body yields
             if k >= 200 and np.linalg.norm(cell.fk(tripod.q, leg)[:3, 3] - goal[:3, 3]) < 1e-4:
                 break
-        assert np.linalg.norm(cell.fk(tripod.q, leg)[:3, 3] - goal[:3, 3]) < 1e-3, leg
+        tripod.landed.append(float(np.linalg.norm(cell.fk(tripod.q, leg)[:3, 3] - goal[:3, 3])))
         tripod.support_on(tripod.feet)
         shift(tripod, middle)
-    assert tripod.worst <= 0.0, tripod.worst
-    assert tripod.scaled > 0
+    return tripod
+
+
+@pytest.mark.compiled
+def test_a_walk_with_one_foot_lifted():
+    """The walk (:func:`walk`) stays in the shrunk region of the feet in support at every tick
+    and each foot lands within 1 mm; without the limit, the push takes the centre of mass out,
+    so the limit's rows held it (the legs, 72 kg of 73, comply: the body's command is met)."""
+    held, free = walk(limit=True), walk(limit=False)
+    assert max(held.lifted) < -0.04, held.lifted  # each lift from well inside the two feet
+    assert max(held.landed) < 1e-3, held.landed
+    assert held.worst <= 0.0, held.worst
+    # without the limit: 13.9 mm out here, 8.5 mm under an older CPU's kernels
+    assert free.worst > 0.004 and held.held > 0, (free.worst, held.held)
 
 
 def over_feet(tripod: Tripod, feet: list[str], start: np.ndarray) -> np.ndarray:

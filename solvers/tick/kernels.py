@@ -231,6 +231,31 @@ def row_values(A: Array, x: Array) -> Array:
 
 
 @kernel
+def into_rows(G: Array, h: Array, x: Array) -> float:
+    """The factor in [0, 1] that brings rates ``x`` (n,) within the rows ``G x <= h`` (p, n)
+    when they are scaled by it (1: they hold). Standing still must meet the rows (``h >= 0``).
+
+    A row counts as left only where ``G x`` exceeds ``h`` by more than the rounding of the
+    sum, n eps sum_j |G_ij x_j| (Higham 2002, eq. 3.5): a row held at ``h = 0`` and met to
+    rounding (1e-17 over) would otherwise have the whole answer scaled to zero.
+    """  # noqa: D205
+    p, n = G.shape
+    factor = 1.0
+    for i in range(p):
+        value, size = 0.0, 0.0
+        for j in range(n):
+            value += G[i, j] * x[j]
+            size += abs(G[i, j] * x[j])
+        if value - h[i] > n * EPS * size:
+            factor = min(factor, h[i] / value)
+    return factor if factor == 1.0 else factor * (1.0 - 4.0 * EPS)
+
+
+EPS = 2.220446049250313e-16
+"""Machine epsilon of float64."""
+
+
+@kernel
 def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
     r"""One-sided Jacobi SVD of a small ``A`` (m, k): ``A V = U diag(sigma)`` (Hestenes 1958).
 

@@ -266,11 +266,14 @@ def fallback_answer(problem: Problem, options: Options, work: Work) -> Answer:
 def _answer(problem: Problem, top: _Top, qdot: Array, method: Method,
             levels: list[LevelStatus], work: Work) -> Answer:  # fmt: skip
     """The answer: the rates ``qdot`` of every level, clipped into the box and rows, and
-    ``top``'s report."""  # noqa: D205, D209
+    ``top``'s report; a shrink into the rows serves the lower levels anew."""  # noqa: D205, D209
     box = problem.box
     clip = kernels.clip_into(qdot, box.lb, box.ub)  # the kernels' answers to rounding
     qdot, shrink = _within_rows(qdot, box, problem.rows)
     qdot.flags.writeable = False
+    if shrink < 1.0 - statuses.EXACT_TOL:
+        levels = levels[:1] + [level if level == "dropped" else _served(problem, k, qdot)
+                               for k, level in enumerate(levels[1:], 1)]  # fmt: skip
     return Answer(
         qdot, method, top.status, tuple(levels), top.scale * shrink, top.veer, top.lambda_sq,
         work.backend, work.iterations, work.solve_time, tuple(work.attempts), clip,
@@ -632,19 +635,14 @@ def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
 
 
 def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:
-    """``x`` shrunk toward zero until the rows hold exactly, and the factor (zero feasible).
-
-    A backend leaves the rows by up to its tolerance (1e-9); the shrink keeps the direction.
-    """
+    """``x`` shrunk toward zero until the rows hold (:func:`kernels.into_rows`), and the factor
+    (zero feasible). A backend leaves the rows by up to its tolerance (1e-9); the shrink keeps
+    the direction.
+    """  # noqa: D205
     if rows is None or not box.contains_zero or bool((rows.h < 0.0).any()):
         return x, 1.0
-    values = rows.G @ x
-    over = values > rows.h
-    if not over.any():
-        return x, 1.0
-    factor = float(np.min(rows.h[over] / values[over])) * (1.0 - 4.0 * _EPS)
-    return x * factor, factor
+    factor = kernels.into_rows(rows.G, rows.h, x)
+    return (x, 1.0) if factor == 1.0 else (x * factor, factor)
 
 
-_EPS = float(np.finfo(np.float64).eps)
 _TINY = float(np.finfo(np.float64).tiny)

@@ -14,7 +14,8 @@ Each rule is one kernel, called from the compiled tick (:mod:`rrc_pin.solvers.ti
   top level as a level by its status (:func:`top_served`);
 - a top level's ``exact`` or ``scaled`` is refused for a subnormal command (:func:`borne_out`):
   :func:`met` asks nothing of a command far below one task unit (a backend's answer to it is
-  met by any rates within its tolerance, and the clip into the box turns them off it).
+  met by any rates within its tolerance, and the clip into the box turns them off it); an
+  ``exact`` one shrunk into the rows by the last stage is ``scaled``.
 """
 
 from __future__ import annotations
@@ -110,10 +111,14 @@ def borne_out(status: int, y: Array, b: Array, direction: bool, rate_factor: flo
     A stacked command ``b`` (m,) whose rates are all subnormal (below :data:`TINY`: met to
     :data:`EXACT_TOL` by any small rates)
     is neither ``exact`` nor ``scaled``: in the direction mode :data:`FAILED` (the fallbacks
-    answer), else ``least_squares``. Any other report is kept.
+    answer), else ``least_squares``. An ``exact`` answer whose ``scale`` the shrink into the rows
+    took below 1 (its rates that factor of the command's) is ``scaled``. Any other report is
+    kept.
     """
     if status != EXACT and status != SCALED:
         return status, scale, veer
+    if status == EXACT and scale < 1.0 - EXACT_TOL:
+        status = SCALED
     peak = 0.0
     for i in range(b.size):
         peak = max(peak, abs(b[i]))

@@ -70,8 +70,6 @@ INVALID_INPUT = -2
 ELSEWHERE = -3
 """What :func:`run_box` returns for a tick that is not its own (:func:`run` answers it)."""
 
-_EPS = float(np.finfo(np.float64).eps)
-
 
 def _constant(part: Array | None) -> object:
     """``part`` of a task's rows (A, weights or units) if it cannot change: None, or read-only
@@ -118,22 +116,15 @@ def served(A: Array, b: Array, qdot: Array, rate_factor: float) -> int:
 
 @kernel
 def within_rows(x: Array, rows: Rows, zero_inside: bool) -> float:
-    """``x`` shrunk toward zero in place until the rows hold exactly; the factor (1: kept).
-
-    (:func:`rrc_pin.solvers.tick.pipeline._within_rows`: standing still must be allowed).
-    """
+    """``x`` shrunk toward zero in place until the rows hold (:func:`kernels.into_rows`); the
+    factor (1: kept). Standing still must be allowed.
+    """  # noqa: D205
     if rows.h.size == 0 or not zero_inside or (rows.h < 0.0).any():
         return 1.0
-    values = row_values(rows.G, x)
-    factor = np.inf
-    for i in range(values.size):
-        if values[i] > rows.h[i]:
-            factor = min(factor, rows.h[i] / values[i])
-    if factor == np.inf:
-        return 1.0
-    factor *= 1.0 - 4.0 * _EPS
-    for i in range(x.size):
-        x[i] *= factor
+    factor = kernels.into_rows(rows.G, rows.h, x)
+    if factor != 1.0:
+        for i in range(x.size):
+            x[i] *= factor
     return factor
 
 
@@ -232,31 +223,37 @@ def box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Array)
 
 
 @inlined
-def clipped(qdot: Array, rows: Rows, answer: Top, zero_inside: bool) -> tuple[float, float]:
+def clipped(qdot: Array, rows: Rows, zero_inside: bool) -> tuple[float, float]:
     """Stage 5: ``qdot`` clipped into the box and shrunk into the rows, in place; the clip's
-    size and the top level's scale after the shrink.
+    size and the shrink's factor.
     """  # noqa: D205
     clip = kernels.clip_into(qdot, rows.lb, rows.ub)
-    return clip, answer.scale * within_rows(qdot, rows, zero_inside)
+    return clip, within_rows(qdot, rows, zero_inside)
 
 
 @inlined
-def report(joints: Array, ints: Ints, reals: Array, rows: Rows, answer: Top, qdot: Array,
-           A: Array, b: Array, direction: bool, rate_factor: float) -> int:  # fmt: skip
+def report(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Array, rows: Rows,
+           answer: Top, qdot: Array, A: Array, b: Array, direction: bool, rate_factor: float
+           ) -> int:  # fmt: skip
     """Stage 5: ``qdot`` clipped into the box and shrunk into the rows, and the top level's
     report as they bear it out (its rows ``A``, rates ``b``:
     :func:`rrc_pin.solvers.tick.statuses.borne_out`), into ``joints`` and ``reals``; the status
-    code, or :data:`~rrc_pin.solvers.tick.top.FAILED`.
+    code, or :data:`~rrc_pin.solvers.tick.top.FAILED`. A shrink serves the lower levels anew.
     """  # noqa: D205
-    clip, scale = clipped(qdot, rows, answer, reals[ZERO_INSIDE] == 1.0)
+    clip, shrink = clipped(qdot, rows, reals[ZERO_INSIDE] == 1.0)
     status, scale, veer = statuses.borne_out(answer.status, row_values(A, qdot), b, direction,
-                                             rate_factor, scale, answer.veer)  # fmt: skip
+                                             rate_factor, answer.scale * shrink, answer.veer)
     if status == FAILED:
         return FAILED
     reals[CLIP], reals[SCALE], reals[VEER], reals[LAMBDA_SQ] = clip, scale, veer, answer.lambda_sq
     for c in range(qdot.size):  # element by element: an array copy compiles numba's shape error
         joints[QDOT, c] = qdot[c]
-    ints[STARTS + ints[LEVELS] + 1] = statuses.top_served(status)
+    codes = STARTS + ints[LEVELS] + 1
+    ints[codes] = statuses.top_served(status)
+    for k in range(1, ints[LEVELS] if shrink < 1.0 - statuses.EXACT_TOL else 1):
+        if ints[codes + k] != DROPPED:
+            Ak, bk, factor_k = level(task_rows, rates, ints, k, False, rows.lb, rows.ub)
+            ints[codes + k] = served(Ak, bk, qdot, factor_k)
     return status
 
 
@@ -279,7 +276,8 @@ def run_box(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Ar
     answer = top.direction_box(A, b, rows, reals[DT], reals[THRESHOLD], rate_factor)
     if answer.status == FAILED:
         return FAILED
-    return report(joints, ints, reals, rows, answer, answer.qdot, A, b, True, rate_factor)
+    return report(joints, task_rows, rates, ints, reals, rows, answer, answer.qdot, A, b, True,
+                  rate_factor)  # fmt: skip
 
 
 @kernel
@@ -322,9 +320,9 @@ def run_twist(J: Array, b: Array, q: Array, dt: float, joints: Array, rates: Arr
     if answer.status == FAILED:
         return FAILED, 0.0, 0.0, 0.0, 0.0
     qdot = answer.qdot
-    clip, scale = clipped(qdot, rows, answer, True)
+    clip, shrink = clipped(qdot, rows, True)
     status, scale, veer = statuses.borne_out(answer.status, row_values(A, qdot), c, True,
-                                             rate_factor, scale, answer.veer)  # fmt: skip
+                                             rate_factor, answer.scale * shrink, answer.veer)
     if status == FAILED:
         return FAILED, 0.0, 0.0, 0.0, 0.0
     for j in range(n):
@@ -359,7 +357,8 @@ def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide
     if answer.status == FAILED:
         return FAILED
     qdot = lower_levels(task_rows, rates, ints, rows, answer)
-    return report(joints, ints, reals, rows, answer, qdot, A, b, direction, rate_factor)
+    return report(joints, task_rows, rates, ints, reals, rows, answer, qdot, A, b, direction,
+                  rate_factor)  # fmt: skip
 
 
 @kernel
@@ -387,7 +386,8 @@ def run_within(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array
     if answer.status == FAILED:
         return FAILED
     qdot = lower_levels(task_rows, rates, ints, rows, answer)
-    return report(joints, ints, reals, rows, answer, qdot, A, b, direction, rate_factor)
+    return report(joints, task_rows, rates, ints, reals, rows, answer, qdot, A, b, direction,
+                  rate_factor)  # fmt: skip
 
 
 class Workspace:
