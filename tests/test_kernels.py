@@ -278,4 +278,5 @@ def test_a_row_held_at_zero_and_met_to_rounding_keeps_the_rates() -> None:
     G, x = np.array([[0.1, 0.2, -0.3]]), np.ones(3)
     assert (G @ x)[0] > 0.0
     assert kernels.into_rows(G, np.zeros(1), x) == 1.0
-    assert kernels.into_rows(G, np.zeros(1), x + np.array([1e-9, 0.0, 0.0])) == 0.0  # left: stand still
+    left = x + np.array([1e-9, 0.0, 0.0])  # the row left: standing still
+    assert kernels.into_rows(G, np.zeros(1), left) == 0.0
