@@ -7,12 +7,13 @@ edge :math:`n_k^T x \le o_k` of the hull (outward unit normal :math:`n_k`) becom
 :math:`c_{xy}` of the centre of mass in it for the step, as the joint limits keep a position
 limit (a fraction :math:`\gamma` of the distance left, per step):
 
-.. math:: n_k^T J_{c,xy}\,\dot q \le \gamma\,\frac{g_k - \beta}{\Delta t}, \qquad
+.. math:: n_k^T J_{c,xy}\,\dot q \le \gamma\,\frac{g_k - 2\beta}{\Delta t}, \qquad
     g_k = o_k - \text{margin} - n_k^T c_{xy},
 
-with :math:`\beta` = :data:`BUFFER`. Linearised over the step, :math:`c_{xy}` then covers at
-most :math:`\gamma` of its distance to the buffer per step, and the buffer absorbs the
-second-order terms: it stays inside (measured: docs/api.md). The feet in support are taken
+with :math:`\beta` = :data:`BUFFER`, held (0) for :math:`\beta \le g_k \le 2\beta` and
+:math:`\gamma (g_k - \beta) / \Delta t` below. Linearised over the step, :math:`c_{xy}` then
+covers at most :math:`\gamma` of its distance to the buffer per step, and the buffer absorbs
+the second-order terms: it stays inside (measured: docs/api.md). The feet in support are taken
 as fixed (hold them with a :class:`~rrc_pin.limits.ContactLimit` on the same frames): the
 hull's own motion is not in the rows. A hull without area (two point feet, or one) keeps the
 centre of mass on its segment or point; with a margin that is infeasible, and the resolver
@@ -41,11 +42,13 @@ if TYPE_CHECKING:
 
 Array = npt.NDArray[np.float64]
 
-BUFFER = 1e-5
-"""[m] The centre of mass approaches an edge up to this distance inside it, and within this
-distance of it on either side is held (h = 0), not asked back: the steps' second-order
-terms and the contacts' slip (a few um a step) stay inside the region, and the command stays
-direction-preserving instead of turning the top level into least squares."""
+BUFFER = 5e-5
+"""[m] The centre of mass approaches an edge up to twice this distance inside it, is held
+(h = 0) between twice and once this distance inside, and is asked back nearer than that. The
+steps' second-order terms and the contacts' slip (a few um a step) drift a held centre of
+mass outward; asked back from inside the region, it settles where the drift and the way back
+balance (the drift over gamma), still inside. Held, the command stays direction-preserving
+instead of turning the top level into least squares."""
 
 
 class SupportPolygonLimit(Limit):
@@ -128,8 +131,8 @@ class SupportPolygonLimit(Limit):
         com = center_of_mass(kin)
         G = normals @ com.jacobian[:2]
         gap = offsets - normals @ com.position[:2]
-        held = np.maximum(gap - BUFFER, 0.0)
-        h = self.gain * np.where(gap < -BUFFER, gap, held) / dt
+        held = np.maximum(gap - 2.0 * BUFFER, 0.0)
+        h = self.gain * np.where(gap < BUFFER, gap - BUFFER, held) / dt
         names = tuple(f"{self.name}:edge{k}" for k in range(h.size))
         return Constraints(G=G, h=h, names=names)
 
