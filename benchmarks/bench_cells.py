@@ -63,9 +63,9 @@ DT = 0.01
 TICKS, QUICK_TICKS = 3000, 100
 """Ticks per cell (30 s at 100 Hz; a quick run 1 s)."""
 HOLD = 50
+"""Ticks each random command is held (0.5 s)."""
 WARM_UP = 10
 """First ticks left out of the statistics (caches, the first factorisations)."""
-"""Ticks each random command is held (0.5 s)."""
 SEED = 2030
 SPEEDS = {
     "gsfc_dual": ("object", np.array([0.15, 0.15, 0.15, 0.4, 0.4, 0.4])),

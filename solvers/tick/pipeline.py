@@ -641,7 +641,8 @@ def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:
     """  # noqa: D205
     if rows is None or not box.contains_zero or bool((rows.h < 0.0).any()):
         return x, 1.0
-    factor = kernels.into_rows(rows.G, rows.h, x)
+    G, h, y = (np.require(a, np.float64, ("C", "W")) for a in (rows.G, rows.h, x))
+    factor = kernels.into_rows(G, h, y)  # its one compiled signature (Workspace.compile)
     return (x, 1.0) if factor == 1.0 else (x * factor, factor)
 
 

@@ -553,8 +553,9 @@ class Workspace:
 
     def compile(self, general: bool) -> None:
         """Compile the default tick's entry (:func:`run_box`), and the general one where
-        ``general``, or load them from numba's cache: on a problem without rows whose answer
-        is exact, so that no QP is asked for and nothing is kept.
+        ``general`` (with the pipeline's shrink into the rows, :func:`kernels.into_rows`), or
+        load them from numba's cache: on a problem without rows whose answer is exact, so that
+        no QP is asked for and nothing is kept.
         """  # noqa: D205
         n = self.n
         ws = Workspace(self.joints[LOWER], self.joints[UPPER], self.joints[VELOCITY],
@@ -569,6 +570,7 @@ class Workspace:
                   ws.ints, ws.reals, np.empty(twist_size(n, 1)))  # fmt: skip
         if general:
             run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
+            kernels.into_rows(np.zeros((1, n)), np.zeros(1), np.zeros(n))  # the pipeline's call
             if n > 1:  # a tick within equality rows (contacts, grips): the rates of joint 1 zero
                 ws.load_equalities(np.eye(1, n, 1), np.zeros(1))
                 run_within(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.E,
