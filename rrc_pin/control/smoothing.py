@@ -38,6 +38,7 @@ joints do.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, NamedTuple
 
@@ -163,7 +164,13 @@ class JerkLimiter:
         self._lower = None if lower is None else _limits(lower, "lower", n) + margin
         self._upper = None if upper is None else _limits(upper, "upper", n) - margin
         self._brake: Array = BRAKE * self.a_max
-        self._lead: Array = self.a_max / self.j_max + 2.0 * self.dt
+        if not math.isfinite(2.0 * self.dt):
+            raise InvalidInput("dt", f"expected a period [s] whose double is finite, got {dt!r}")
+        with np.errstate(over="ignore"):
+            self._lead: Array = self.a_max / self.j_max + 2.0 * self.dt
+        if not np.isfinite(self._lead).all():
+            raise InvalidInput("jerk", f"expected acceleration / jerk [s] finite, got "
+                                       f"{acceleration!r} / {jerk!r}")  # fmt: skip
         self.rates: Array = np.zeros(n)
         self._acceleration: Array = np.zeros(n)
         self._stopping = False

@@ -114,10 +114,12 @@ def unit(v: npt.ArrayLike, name: str) -> Array:
         InvalidInput: Not finite (3,), or shorter than 1e-9.
     """
     x = as_vector(v, name, 3)
-    norm = float(np.linalg.norm(x))
-    if norm < 1e-9:
+    peak = float(np.abs(x).max())
+    y = x / peak if peak > 0.0 else x  # the norm of 1e308 entries overflows
+    norm = float(np.linalg.norm(y))
+    if peak * norm < 1e-9:
         raise InvalidInput(name, f"expected a direction, got {x.tolist()} (no length)")
-    out: Array = x / norm
+    out: Array = y / norm
     return out
 
 
