@@ -509,6 +509,27 @@ def test_collision_limits_hold_on_a_floating_cell(tripod, collision):
     assert slip < 1e-9, slip
 
 
+@pytest.mark.compiled
+def test_the_cells_benchmark_session_with_collision_never_holds(soak):
+    """benchmarks/bench_cells.py's gsfc_dual session with its collision limit (3,000 ticks,
+    its commands): no tick falls back, no joint leaves its box. Near its end a pair dips
+    below its safety distance; the tick within the grip's equality rows that must push it
+    apart once held still (``fallback``, 3 ticks): it recovers."""
+    cell = rrc_pin.load("gsfc_dual")
+    ctl = soak._controllers(cell)[0][soak.WITH]
+    command, speed = soak.SPEEDS["gsfc_dual"]
+    rng = np.random.default_rng(soak.SEED)
+    twists = [rng.normal(size=6) * speed for _ in range(soak.TICKS // soak.HOLD + 1)]
+    statuses: dict[str, int] = {}
+    for k in range(soak.TICKS):
+        r = ctl.step({command: twists[k // soak.HOLD]}).resolution
+        statuses[r.status] = statuses.get(r.status, 0) + 1
+        box = r.problem.box
+        assert ((r.applied >= box.lb) & (r.applied <= box.ub)).all(), k
+    assert "fallback" not in statuses, statuses
+    assert statuses.get("recovering", 0) >= 1, statuses  # the dip is still in the session
+
+
 def test_setting_q_moves_the_targets_and_anchors_there(tripod):
     """q set from outside (a new start): the feet in support are anchored where they are
     then, and a tick without command stays there (no pull back to the old pose)."""

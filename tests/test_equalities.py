@@ -106,6 +106,40 @@ def test_weighted_ticks_within_equality_rows_are_the_pipelines(rng: np.random.Ge
         agrees(r, resolver)
 
 
+class Apart(Equalities):
+    """Equality rows and one row ``g qdot <= h`` (not one to slide along) that the test sets,
+    h < 0: standing still breaks it."""
+
+    def __init__(self, C: Array, d: Array, g: Array, h: float) -> None:
+        super().__init__(C, d)
+        self.g, self.h = g, np.array([h])
+
+    def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
+        names = ("apart", *(f"equal:{i}" for i in range(self.d.size)))
+        return Constraints(G=self.g[None, :], h=self.h, C=self.C, d=self.d, names=names)
+
+
+def test_a_row_broken_at_the_start_within_equality_rows_is_restored(
+    rng: np.random.Generator,
+) -> None:
+    """h < 0 with equality rows, compiled: restored as the pipeline restores it, never held
+    still (the level's rows once kept the start, zero rates, feasible, and its answer was
+    refused)."""
+    panda = rrc_pin.load("panda")
+    posture = rrc_pin.PostureTask(panda.neutral(), gain=1.0)
+    for _ in range(20):
+        C, g = rng.normal(size=(2, panda.nv)), rng.normal(size=panda.nv)
+        resolver = rrc_pin.Resolver(panda, dt=0.01,
+                                    limits=[JointLimits(), Apart(C, np.zeros(2), g, -1e-3)])
+        hand = rrc_pin.FrameTask(panda.tool_frame, rng.normal(size=6) * 0.1)
+        r = resolver.solve(panda.random_q(rng), [[hand], [posture]], priority="strict")
+        assert isinstance(r.source, TickSource)
+        assert r.status == "recovering", r.attempts
+        assert float(g @ r.qdot) <= -1e-3 + 1e-9
+        np.testing.assert_allclose(C @ r.qdot, 0.0, atol=1e-9)
+        agrees(r, resolver)
+
+
 def test_contradicting_rows_fall_back_as_the_pipeline() -> None:
     panda = rrc_pin.load("panda")
     C = np.vstack([np.eye(1, panda.nv), np.eye(1, panda.nv)])

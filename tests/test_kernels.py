@@ -107,6 +107,20 @@ def test_inside_and_rows_hold(rng: np.random.Generator) -> None:
     assert not kernels.rows_hold(np.ones((1, 1)), np.array([np.nan]), np.zeros(1), 0.0)
 
 
+def test_around_start_against_numpy(rng: np.random.Generator) -> None:
+    """A bound z = 0 breaks by at most tol is widened to it, one it breaks by more kept; every
+    bound widened by the rounding."""
+    tol, rounding = 1e-6, 1e-12
+    for _ in range(200):
+        lo = rng.choice([-np.inf, -1.0, -1e-7, 0.0, 5e-7, 2e-6, 1.0], size=8)
+        hi = rng.choice([np.inf, 1.0, 1e-7, 0.0, -5e-7, -2e-6, -1.0], size=8)
+        want_lo = np.where(lo <= tol, np.minimum(lo, 0.0), lo) - rounding
+        want_hi = np.where(hi >= -tol, np.maximum(hi, 0.0), hi) + rounding
+        kernels.around_start(lo, hi, tol, rounding)
+        np.testing.assert_array_equal(lo, want_lo)
+        np.testing.assert_array_equal(hi, want_hi)
+
+
 def test_normal_equations_and_cholesky(rng: np.random.Generator) -> None:
     for m, n in itertools.product((3, 12, 27), (3, 7, 15)):
         A, b, w = rng.normal(size=(m, n)), rng.normal(size=m), rng.uniform(0.1, 10.0, m)

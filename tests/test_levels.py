@@ -72,18 +72,25 @@ def test_a_level_answers_as_the_pipeline(seed: int) -> None:
     assert projected > 50  # the constraints bound many of them
 
 
-def test_subspace_rows_against_numpy() -> None:
+@pytest.mark.parametrize("start", ["within", "outside"])
+def test_subspace_rows_against_numpy(start: str) -> None:
     """The box and rows of rates ``x + N^T z`` as one-sided rows in z, with the slack around
-    z = 0 that least_squares._level_qp gives them."""
+    z = 0 that least_squares._level_qp gives them: where x breaks a bound by at most the
+    tolerance, widened to it; beyond (x a row asks away from), the bound kept."""
     rng = np.random.default_rng(3)
     basis = np.linalg.qr(rng.normal(size=(N, N)))[0][:, :3].T.copy()
     x, lb, ub = rng.normal(size=N) * 0.1, -np.ones(N), np.ones(N)
     lb[0] = -np.inf
-    G, h = rng.normal(size=(2, N)), np.array([0.5, 0.2])
-    Gz, hz = levels.subspace_rows(x, basis, lb, ub, G, h)
+    G = rng.normal(size=(2, N))
+    tol = 1e-6
+    broken = 0.5 * tol if start == "within" else 1e-3
+    h = np.array([0.5, float(G[1] @ x) - broken])
+    Gz, hz = levels.subspace_rows(x, basis, lb, ub, G, h, tol)
     C = np.vstack([basis.T, G @ basis.T])
     lo = np.minimum(np.concatenate([lb - x, np.full(2, -np.inf)]), 0.0) - levels.ROUNDING
     hi = np.maximum(np.concatenate([ub - x, h - G @ x]), 0.0) + levels.ROUNDING
+    if start == "outside":
+        hi[-1] = h[1] - G[1] @ x + levels.ROUNDING
     low, high = np.isfinite(lo), np.isfinite(hi)
     np.testing.assert_allclose(Gz, np.vstack([C[high], -C[low]]), atol=1e-15)
     np.testing.assert_allclose(hz, np.concatenate([hi[high], -lo[low]]), atol=1e-15)

@@ -4,6 +4,7 @@
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -318,6 +319,75 @@ def test_equality_rows_hold_and_the_command_scales_within_them(rng: np.random.Ge
         assert answer.scale == pytest.approx(
             lp_maximum(with_contacts, np.r_[b, np.zeros(3)], box), abs=1e-7
         )
+
+
+def lowest_within(g: np.ndarray, C: np.ndarray, box: Box) -> float:
+    """The least value of ``g qdot`` with ``C qdot = 0`` within the box (HiGHS)."""
+    result = linprog(g[0], A_eq=C, b_eq=np.zeros(len(C)), bounds=list(zip(box.lb, box.ub,
+                     strict=True)), method="highs")  # fmt: skip
+    assert result.status == 0, result.message
+    return float(result.fun)
+
+
+@pytest.mark.parametrize("slide", [True, False])
+def test_a_row_broken_at_the_start_is_restored_within_equality_rows(
+    rng: np.random.Generator, slide: bool
+) -> None:
+    """h < 0 with equality rows (a collision pair below its safety distance, two hands
+    holding an object): the least squares within the rows moves back across it where the box
+    and the equality rows allow, reported as recovering, never held still (the rows' QP once
+    kept only their start, zero rates, feasible, and its answer was refused)."""
+    for _ in range(50):
+        levels = levels_at(rng, (4,), 1.0)
+        box = box_at(rng)
+        C, g = rng.normal(size=(2, N)), rng.normal(size=(1, N))
+        h = np.array([0.5 * lowest_within(g, C, box)])
+        problem = build(levels, [Constraints(box, g, h, C, np.zeros(2), ("pair", "e0", "e1"),
+                                             np.array([slide]))], N, DT)  # fmt: skip
+        answer = solve(problem, make_backend("daqp"), Options())
+        assert answer.status == "recovering" and answer.method == "qp", answer.attempts
+        assert float((g @ answer.qdot)[0]) <= h[0] + 1e-9
+        np.testing.assert_allclose(C @ answer.qdot, 0.0, atol=1e-9)
+
+
+def test_a_pair_that_cannot_be_pushed_apart_within_equality_rows_is_kept_apart(
+    rng: np.random.Generator,
+) -> None:
+    """A slide row asking a pair apart beyond what the box and equality rows allow: as without
+    equality rows (pipeline._damped_within), the pair only kept from approaching."""
+    for _ in range(50):
+        levels = levels_at(rng, (4,), 1.0)
+        box = box_at(rng)
+        C, g = rng.normal(size=(2, N)), rng.normal(size=(1, N))
+        h = np.array([1.5 * lowest_within(g, C, box)])  # out of reach
+        problem = build(levels, [Constraints(box, g, h, C, np.zeros(2), ("pair", "e0", "e1"),
+                                             np.array([True]))], N, DT)  # fmt: skip
+        answer = solve(problem, make_backend("daqp"), Options())
+        assert answer.status == "recovering" and answer.method == "qp", answer.attempts
+        assert [a[0] for a in answer.attempts] == ["slide"], answer.attempts
+        assert float((g @ answer.qdot)[0]) <= 1e-9
+        np.testing.assert_allclose(C @ answer.qdot, 0.0, atol=1e-9)
+
+
+def test_the_dual_cells_tick_below_a_safety_distance_is_restored() -> None:
+    """A tick of benchmarks/bench_cells.py's gsfc_dual session with collision (tick 2997 of
+    3000): the grip's six equality rows, a pair 1.6e-6 m below its safety distance asking
+    8.1e-5 m/s apart, a joint on its position limit; it was held still (``fallback``, the
+    QP's answer refused) and is restored within every constraint."""
+    data = np.load(Path(__file__).parent / "data" / "gsfc_dual_recovering.npz")
+    levels = [[TaskRows(data["A0_0"], data["b0_0"], None, "object", data["u0_0"])],
+              [TaskRows(data["A1_0"], data["b1_0"], data["w1_0"], "posture")]]  # fmt: skip
+    box = Box(data["lb"], data["ub"], data["kind"], True, False, data["velocity"])
+    G, h, C, d = data["G"], data["h"], data["C"], data["d"]
+    names = tuple(f"row{i}" for i in range(h.size + d.size))
+    problem = build(levels, [Constraints(box, G, h, C, d, names, data["slide"])], 14,
+                    float(data["dt"]))  # fmt: skip
+    answer = solve(problem, make_backend("daqp"), Options())
+    assert answer.status == "recovering" and answer.method == "qp", answer.attempts
+    assert answer.attempts == ()
+    assert (G @ answer.qdot <= h + 1e-9).all()
+    assert ((answer.qdot >= box.lb) & (answer.qdot <= box.ub)).all()
+    np.testing.assert_allclose(C @ answer.qdot, d, atol=1e-9)
 
 
 class Broken(QPBackend):

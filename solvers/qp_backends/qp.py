@@ -247,7 +247,9 @@ def solve_within(
     size = kernels.clip_into(x if clip else x.copy(), box.lb, box.ub)
     tol = tolerance(box)
     if not (size <= tol and (rows is None or kernels.rows_hold(rows.G, x, rows.h, tol))):
-        raise NumericalFailure(f"{solved.backend}: answer outside the constraints by {size:.3g}")
+        over = 0.0 if rows is None else float(np.max(rows.G @ x - rows.h, initial=0.0))
+        raise NumericalFailure(f"{solved.backend}: answer outside the box by {size:.3g}, the rows "
+                               f"by {over:.3g} (tolerance {tol:.3g})")  # fmt: skip
     return x
 
 

@@ -499,6 +499,26 @@ def rows_hold(G: Array, x: Array, h: Array, tol: float) -> bool:
 
 
 @kernel
+def around_start(lo: Array, hi: Array, tol: float, rounding: float) -> None:
+    """The bounds ``lo <= C z <= hi`` of a level's QP in a subspace, ``z = 0`` its start (the
+    rates so far), widened in place: each that the start breaks by at most ``tol`` (the
+    backend's tolerance, within which the levels above were answered) to the start, and every
+    one by ``rounding``.
+
+    A bound the start breaks by more is kept: that start is no answer the level may stay at
+    (a top level's least-norm rates of the equality rows where a row asks a pair apart, or
+    they leave the box), and the level restores it or fails.
+    """  # noqa: D205
+    for i in range(lo.size):
+        if lo[i] <= tol:
+            lo[i] = min(lo[i], 0.0)
+        if hi[i] >= -tol:
+            hi[i] = max(hi[i], 0.0)
+        lo[i] -= rounding
+        hi[i] += rounding
+
+
+@kernel
 def uniform_scale(x: Array, lb: Array, ub: Array) -> float:
     """Largest s in [0, 1] with ``lb <= s x <= ub``, for bounds with ``lb <= 0 <= ub``."""
     s = 1.0

@@ -185,9 +185,11 @@ def _level_qp(
                 f"{key}:{d}")  # fmt: skip
         return qp, Decoding(None, None)
     C, lo, hi = constraint_rows(N.T, box, rows, x)
-    # z = 0 (the answer so far) is feasible: keep it so for the backend's tolerance where
-    # joints sit exactly on their bounds
-    lo, hi = np.minimum(lo, 0.0) - ROUNDING, np.maximum(hi, 0.0) + ROUNDING
+    # z = 0, the answer so far, kept feasible where it is one to the backend's tolerance (joints
+    # exactly on their bounds); a start farther out (the equality rows' least-norm rates of a
+    # top level) is no answer: the constraints stand
+    lo, hi = np.array(lo), np.array(hi)
+    kernels.around_start(lo, hi, tolerance(box), ROUNDING)
     free = np.full(d, np.inf)
     return QP(P, q, C, lo, hi, -free, free, f"{key}:{d}:{hi.size}"), Decoding(x, N.T)
 

@@ -70,10 +70,12 @@ def one_sided(C: Array, lo: Array, hi: Array) -> tuple[Array, Array]:
 
 
 @inlined
-def subspace_rows(x: Array, N: Array, lb: Array, ub: Array, G: Array, h: Array
+def subspace_rows(x: Array, N: Array, lb: Array, ub: Array, G: Array, h: Array, tol: float
                   ) -> tuple[Array, Array]:  # fmt: skip
-    """The box and rows of rates ``x + N^T z`` as one-sided rows in z, with :data:`ROUNDING`
-    of slack around z = 0 (:func:`rrc_pin.solvers.tick.least_squares._level_qp`).
+    """The box and rows of rates ``x + N^T z`` as one-sided rows in z, widened around z = 0
+    where x breaks them by at most ``tol``, and by :data:`ROUNDING`
+    (:func:`~rrc_pin.solvers.tick.kernels.around_start`;
+    :func:`rrc_pin.solvers.tick.least_squares._level_qp`).
     """  # noqa: D205
     n, p = x.size, h.size
     C = np.empty((n + p, N.shape[0]))
@@ -85,9 +87,7 @@ def subspace_rows(x: Array, N: Array, lb: Array, ub: Array, G: Array, h: Array
         lo[i], hi[i] = lb[i] - x[i], ub[i] - x[i]
     for i in range(p):
         lo[n + i], hi[n + i] = -np.inf, h[i] - Gx[i]
-    for i in range(n + p):
-        lo[i] = min(lo[i], 0.0) - ROUNDING
-        hi[i] = max(hi[i], 0.0) + ROUNDING
+    kernels.around_start(lo, hi, tol, ROUNDING)
     return one_sided(C, lo, hi)
 
 
@@ -106,7 +106,7 @@ def projected(B: Array, z: Array, x: Array, N: Array, whole: bool, lb: Array, ub
         code = project(B, 0.0, z, lb, ub, Gz, hz, MARGIN, out)
         qdot = out
     else:
-        Gz, hz = subspace_rows(x, N, lb, ub, G, h)
+        Gz, hz = subspace_rows(x, N, lb, ub, G, h, tol)
         free = np.full(d, np.inf)
         code = project(B, 0.0, z, -free, free, Gz, hz, MARGIN, out)
         qdot = row_values(np.ascontiguousarray(N.T), out) + x

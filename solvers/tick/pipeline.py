@@ -43,8 +43,9 @@ Nothing here raises for numerical trouble.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Literal, NamedTuple, get_args
+from typing import Literal, NamedTuple, TypeVar, get_args
 
 import numpy as np
 import numpy.typing as npt
@@ -64,6 +65,7 @@ from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_me
 from rrc_pin.solvers.tick.statuses import EXACT_TOL, STILL_SCALE
 
 Array = npt.NDArray[np.float64]
+_T = TypeVar("_T")
 
 Method = Literal["qp", "scipy", "scaling", "hold"]
 """How the top level was answered: ``qp`` the pipeline (its exact kernels, or the backend),
@@ -288,8 +290,8 @@ def _top(
     box, rows = problem.box, problem.rows
     if problem.mode != "direction":
         last = len(problem.levels) == 1
-        if space.N is None and rows is not None and rows.sliding is not None:
-            qdot, null = _damped_within(A, b, box, rows, backend, work, not last,
+        if rows is not None and rows.sliding is not None:
+            qdot, null = _damped_within(A, b, space, box, rows, backend, work, not last,
                                         options.damping)  # fmt: skip
         else:
             qdot, null = least_squares(A, b, space, box, rows, backend, work, "least_squares",
@@ -442,8 +444,8 @@ def backend_slide(
 
 
 def _damped_within(
-    A: Array, b: Array, box: Box, rows: Rows, backend: QPBackend, work: Work, need_null: bool,
-    damping: Damping | None,
+    A: Array, b: Array, space: Subspace, box: Box, rows: Rows, backend: QPBackend, work: Work,
+    need_null: bool, damping: Damping | None,
 ) -> tuple[Array, Array | None]:  # fmt: skip
     """A least-squares top level with slide rows: its exact optimum where that holds every
     constraint, else the sliding stage's least squares within them all (:func:`_slide`).
@@ -457,23 +459,38 @@ def _damped_within(
     constraint, the slide rows that ask to move apart (a bound below zero) ask only not to
     approach (bound zero), and the least squares is solved again: a pair is pushed out where
     that is possible, and never holds the arm where it is not (two pairs asking for opposite
-    motions; a joint at its limit).
+    motions; a joint at its limit). Within equality rows (``space``: a grip, a foot in
+    support), the least squares within them, relaxed the same way where it fails.
 
     Returns:
         The rates (n,), and A's null space (d, n) for the next level (None when not needed).
     """  # noqa: D205
+    if space.N is not None:
+        return _relaxing(lambda kept: least_squares(A, b, space, box, kept, backend, work,
+                                                    "least_squares", need_null), rows, work)
     factor = Factorization(A)
     w = factor.least_norm(b)
     if not (kernels.inside(w, box.lb, box.ub) and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
-        try:
-            w = _slide(A, b, Subspace(None, None), box, rows, backend, work, factor, damping)
-        except (NumericalFailure, np.linalg.LinAlgError) as exc:
-            relaxed = _not_approaching(rows)
-            if relaxed is None:
-                raise
-            work.attempts.append(("slide", f"{exc}; the pairs asked apart only kept apart"))
-            w = _slide(A, b, Subspace(None, None), box, relaxed, backend, work, factor, damping)
+        w = _relaxing(lambda kept: _slide(A, b, _EVERY_RATE, box, kept, backend, work, factor,
+                                          damping), rows, work)  # fmt: skip
     return w, factor.null_basis() if need_null else None
+
+
+def _relaxing(solved: Callable[[Rows], _T], rows: Rows, work: Work) -> _T:
+    """``solved(rows)``; where it fails and a slide row asks a pair apart, ``solved`` of the
+    rows that only keep the pairs apart (:func:`_not_approaching`), the failure recorded.
+
+    Raises:
+        NumericalFailure: No answer (none with the rows relaxed, or none to relax).
+    """  # noqa: D205
+    try:
+        return solved(rows)
+    except (NumericalFailure, np.linalg.LinAlgError) as exc:
+        relaxed = _not_approaching(rows)
+        if relaxed is None:
+            raise
+        work.attempts.append(("slide", f"{exc}; the pairs asked apart only kept apart"))
+        return solved(relaxed)
 
 
 def _not_approaching(rows: Rows) -> Rows | None:
