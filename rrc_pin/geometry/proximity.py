@@ -90,8 +90,8 @@ class CollisionData:
     :meth:`CollisionModel.create_data`; never share one between threads.
     """
 
-    __slots__ = ("G", "J", "candidates", "found", "geometry_data", "h", "other", "poses", "scene",
-                 "world")  # fmt: skip
+    __slots__ = ("G", "J", "candidates", "distance", "found", "geometry_data", "h", "other", "pair",
+                 "poses", "scene", "world")  # fmt: skip
 
     def __init__(self, scene: Scene) -> None:
         self.refresh(scene)
@@ -109,8 +109,16 @@ class CollisionData:
         self.other = np.zeros(npairs, dtype=np.int64)
         rows = ROWS * npairs  # a pair's row and its end points' (narrow_kernels)
         self.found = np.zeros(rows, dtype=FOUND)
+        self.distance, self.pair = self.found["distance"], self.found["pair"]  # views, kept
         self.G = np.zeros((rows, scene.nv))
         self.h = np.zeros(rows)
+
+    def copies(self, rows: int) -> tuple[Array, Array, Array, Index]:
+        """Copies of the first ``rows`` damper rows ``G`` (rows, nv) and bounds ``h`` (rows,),
+        and of the found rows' distances (rows,) [m] and pairs (rows,): what a tick's
+        constraints keep while the pass's arrays are written again."""  # noqa: D205, D209
+        return (self.G[:rows].copy(), self.h[:rows].copy(), self.distance[:rows].copy(),
+                self.pair[:rows].copy())  # fmt: skip
 
 
 def search(detection: float, ends: bool) -> Records:
