@@ -345,3 +345,17 @@ def test_copies_are_the_first_rows_and_own_their_values(facing_pandas):
         assert copy.dtype == want.dtype
         assert copy.flags.c_contiguous and copy.flags.writeable
         assert not any(np.shares_memory(copy, a) for a in (cdata.G, cdata.h, cdata.found))
+
+
+def test_the_pass_arguments_are_kept_while_the_settings_and_pairs_are_the_same(facing_pandas):
+    cm = CollisionModel(facing_pandas(0.8), "capsules")
+    sc, cdata = cm.scene, cm.create_data()
+    settings, keep = search(0.1, True), sc.every.copy()
+    first = cdata.arguments(settings, keep)
+    assert cdata.arguments(settings, keep) is first
+    assert first[4] is keep and first[5] is settings and first[-1] is cdata.h
+    assert cdata.arguments(search(0.1, True), keep) is not first
+    assert cdata.arguments(settings, sc.every.copy())[4] is not keep
+    cm.add_sphere((0.4, 0.0, 0.5), 0.05, name="ball")
+    cdata.refresh(cm.scene)  # new arrays: nothing of the former scene's kept
+    assert cdata.arguments(settings, keep)[-1] is cdata.h
