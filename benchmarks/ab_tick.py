@@ -13,6 +13,9 @@ PlaCo imports (docs/benchmarks.md, "The peers' environment")::
 panda's and rrc_k1607's default twist tick, baxter's two hands and posture weighted and
 strict (benchmarks/bench_tasks.py's), each along a trajectory of benchmarks/workloads.py from
 a fresh seed (printed); the rows ``damped`` hold the ticks the reference answered ``damped``.
+``--only collision9`` (``collision36``, ``collision81``, ``collision221``): the two facing
+pandas of benchmarks/bench_collision.py with that many pairs, along the closed loop the
+reference drives (without PlaCo).
 """
 
 from __future__ import annotations
@@ -58,7 +61,8 @@ def load_reference(path: Path) -> Any:
         for info in pkgutil.walk_packages(reference.__path__, "rrc_pin."):
             if not info.name.startswith(skip):
                 importlib.import_module(info.name)
-        for name in ("Resolver", "FrameTask", "PostureTask", "load"):
+        for name in ("Resolver", "FrameTask", "PostureTask", "load", "combine", "CollisionModel",
+                     "CollisionLimit", "JointLimits"):
             getattr(reference, name)
     finally:
         sys.path.remove(str(path))
@@ -109,16 +113,60 @@ def contenders(workload: str, libs: dict[str, Any], placo: bool) -> dict[str, Ca
     return out
 
 
+def collision(libs: dict[str, Any], pairs: int, steps: int) -> tuple[Any, Any, dict[str, Any]]:
+    """benchmarks/bench_collision.py's cell with ``pairs`` pairs (9, 36, 81 or 221): each
+    library's tick, and the states of its closed loop driven by the first library."""
+    import bench_collision as bc
+
+    k = {9: 8, 36: 6, 81: 4, 221: None}[pairs]
+    ticks: dict[str, Callable[..., Any]] = {}
+    robots = []
+    for label, lib in libs.items():
+        panda = lib.load("panda")
+        facing = np.diag([-1.0, -1.0, 1.0, 1.0])
+        facing[0, 3] = 1.0
+        robot = lib.combine({"left": (panda, np.eye(4)), "right": (panda, facing)})
+        cm = lib.CollisionModel(robot, "capsules")
+        limit = lib.CollisionLimit(cm, bc.SAFETY, bc.DETECTION, 0.5, pairs=bc.pair_set(cm, k))
+        resolver = lib.Resolver(robot, DT, limits=[lib.JointLimits(), limit])
+        tasks = [lib.FrameTask(f, rows="position") for f in robot.tool_frames]
+        ticks[label] = _collision_tick(resolver, tasks)
+        robots.append(robot)
+    driver, robot = next(iter(ticks.values())), robots[0]
+    q, Q, X = robot.ready().copy(), [], []
+    for _ in range(steps):
+        v = bc.commands(robot, q)
+        Q.append(q.copy())
+        X.append(v)
+        q = np.clip(q + DT * np.asarray(driver(q, v).qdot), robot.lower, robot.upper)
+    return Q, X, ticks
+
+
+def _collision_tick(resolver: Any, tasks: list[Any]) -> Callable[[Array, Any], Any]:
+    """The hands' position tasks commanded ``v`` (two (3,) rates), strict, as the bench's."""
+    def solve(q: Array, v: Any) -> Any:
+        for task, twist in zip(tasks, v, strict=True):
+            task.set_twist(twist)
+        return resolver.solve(q, [tasks], priority="strict")
+
+    return solve
+
+
 def run(workload: str, libs: dict[str, Any], placo: bool, steps: int, seed: int) -> None:
     """Time every contender on one workload, interleaved, and print the table."""
-    arm = "baxter" if workload.startswith("baxter") else workload
-    frames = 2 if arm == "baxter" else 1
-    driver = contenders(workload, {"driver": rrc_pin}, False)["driver"]
-    robot = rrc_pin.load(arm)
-    rng = np.random.default_rng(seed)
-    Q, X, _ = workloads.record(robot, frames, steps, rng, DT,
-                               lambda q, x: np.asarray(driver(q, x).qdot))  # fmt: skip
-    ticks = contenders(workload, libs, placo)
+    if workload.startswith("collision"):
+        Q, X, ticks = collision({"driver": libs.get("reference", rrc_pin), **libs},
+                                int(workload[len("collision"):]), steps)  # fmt: skip
+        del ticks["driver"]
+    else:
+        arm = "baxter" if workload.startswith("baxter") else workload
+        frames = 2 if arm == "baxter" else 1
+        driver = contenders(workload, {"driver": rrc_pin}, False)["driver"]
+        robot = rrc_pin.load(arm)
+        rng = np.random.default_rng(seed)
+        Q, X, _ = workloads.record(robot, frames, steps, rng, DT,
+                                   lambda q, x: np.asarray(driver(q, x).qdot))  # fmt: skip
+        ticks = contenders(workload, libs, placo)
     names = list(ticks)
     wall = {n: np.zeros(steps) for n in names}
     cpu = {n: np.zeros(steps) for n in names}

@@ -325,7 +325,7 @@ class CompiledTick:
         """Whether the compiled tick answers with these limits' constraints: no other box;
         equality rows fewer than the rates and without rows the command slides along
         (:func:`rrc_pin.solvers.tick.tick.run_within`)."""  # noqa: D205, D209
-        equal = slides = 0
+        equal = 0
         for c in constraints:
             if c is None:
                 continue
@@ -333,9 +333,11 @@ class CompiledTick:
                 return False
             if c.C is not None and c.d is not None:
                 equal += c.d.size
-            if c.slide is not None and c.h is not None and c.h.size and c.slide.any():
-                slides += 1
-        return equal == 0 or (equal < self.workspace.n and slides == 0)
+        if equal == 0:
+            return True
+        return equal < self.workspace.n and not any(
+            c is not None and c.slide is not None and c.h is not None and c.h.size
+            and c.slide.any() for c in constraints)  # fmt: skip
 
     def tasks(self, kin: Kinematics, levels: list[list[TaskRows]], weighted: bool,
               constraints: list[Constraints | None], previous: Array, dt: float,
@@ -345,8 +347,12 @@ class CompiledTick:
         ``start`` [s] when the tick began (``time.perf_counter``)."""  # noqa: D205, D209
         ws = self.workspace
         ws.load_levels(levels, weighted)
-        present = [c for c in constraints if c is not None]
-        with_rows = [c for c in present if c.G is not None and c.h is not None and c.h.size]
+        with_rows, equalities = [], False
+        for c in constraints:
+            if c is not None:
+                if c.G is not None and c.h is not None and c.h.size:
+                    with_rows.append(c)
+                equalities = equalities or c.d is not None
         if not with_rows:
             ws.load_rows(None, None, None)
         elif len(with_rows) == 1:  # one limit's rows: loaded as they are (names not needed)
@@ -354,7 +360,10 @@ class CompiledTick:
         else:
             rows = cast(Rows, merged_rows(with_rows))
             ws.load_rows(rows.G, rows.h, rows.slide)
-        ws.load_equalities(*(merged_equalities(present) or (None, None)))
+        merged = None
+        if equalities:
+            merged = merged_equalities([c for c in constraints if c is not None])
+        ws.load_equalities(*(merged or (None, None)))
         self._loaded = None
         code = self._run(kin.q, previous, dt, levels)
         return self._answer(code, levels, constraints, dt, weighted, start)

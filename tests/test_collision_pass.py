@@ -18,7 +18,7 @@ import pytest
 import rrc_pin
 from rrc_pin import CollisionModel
 from rrc_pin.geometry.proximity import search
-from rrc_pin.solvers.collision.collision_pass import collision_pass, pair_rows, row_copies
+from rrc_pin.solvers.collision.collision_pass import collision_pass, pair_rows
 from rrc_pin.solvers.collision.damper_kernels import damper_bound
 from rrc_pin.solvers.collision.narrow_kernels import narrow_phase
 from rrc_pin.solvers.collision.records import FOUND
@@ -123,22 +123,6 @@ def test_the_pass_matches_pinocchio_coal_and_its_stages(facing_pandas, seed):
         assert unmoved == rows - np.count_nonzero(moved)
         seen += rows
     assert seen > 100, f"seed {seed}: {seen} rows"
-
-
-def test_row_copies_are_the_first_rows_and_own_their_values(facing_pandas):
-    robot, cm = scene(facing_pandas)
-    sc = cm.scene
-    w = workspace(sc)
-    rows = run(sc, robot.ready(), w, settings())[0]
-    assert rows > 0
-    got = row_copies(w["found"], w["G"], w["h"], rows)
-    found = w["found"][:rows]
-    expected = [a.copy() for a in (w["G"][:rows], w["h"][:rows], found["distance"], found["pair"])]
-    run(sc, robot.ready() + 0.1, w, settings())  # the pass writes its arrays again
-    for copy, want in zip(got, expected, strict=True):
-        np.testing.assert_array_equal(copy, want)
-        assert copy.dtype == want.dtype
-        assert not any(np.shares_memory(copy, w[k]) for k in ("G", "h", "found"))
 
 
 def test_pairs_left_for_coal_get_no_damper_row_in_the_pass(facing_pandas):

@@ -14,7 +14,7 @@ import pytest
 
 import rrc_pin
 from rrc_pin.geometry import CollisionModel, Proximity
-from rrc_pin.geometry.proximity import EMPTY
+from rrc_pin.geometry.proximity import EMPTY, measure, search
 from rrc_pin.kinematics import Kinematics, Layout
 
 TOL = 1e-9
@@ -319,3 +319,43 @@ def test_a_capsule_against_a_hull_gets_its_end_points_rows():
         assert abs(prox.distance[k] - to_cube(p)) < 1e-6  # GJK's tolerance
     assert prox.distance[rows[0]] <= min(prox.distance[rows[1:]]) + 1e-6
     assert cm.proximity_at(q, 0.3).names.count(("panda_link5_0", "cube")) == 1  # no ends
+
+
+def test_copies_are_the_first_rows_and_own_their_values(facing_pandas):
+    robot = facing_pandas(0.8)
+    cm = CollisionModel(robot, "capsules")
+    sc, cdata = cm.scene, cm.create_data()
+    settings = search(0.15, True)
+    for field, value in (("rows", True), ("safety", 0.02), ("xi", 0.5), ("xi_end", 4.0),
+                         ("blend", 0.005), ("band", 1e-3), ("recovery", 50.0), ("still", 1e-9)):
+        settings[field] = value
+
+    def run(q):
+        return measure(sc, robot.model, q, lambda: None, cdata, settings, sc.every)[0]
+
+    rows = run(robot.ready())
+    assert rows > 0
+    got = cdata.copies(rows)
+    found = cdata.found[:rows]
+    expected = [a.copy() for a in (cdata.G[:rows], cdata.h[:rows], found["distance"],
+                                   found["pair"])]  # fmt: skip
+    run(robot.ready() + 0.1)  # the pass writes its arrays again
+    for copy, want in zip(got, expected, strict=True):
+        np.testing.assert_array_equal(copy, want)
+        assert copy.dtype == want.dtype
+        assert copy.flags.c_contiguous and copy.flags.writeable
+        assert not any(np.shares_memory(copy, a) for a in (cdata.G, cdata.h, cdata.found))
+
+
+def test_the_pass_arguments_are_kept_while_the_settings_and_pairs_are_the_same(facing_pandas):
+    cm = CollisionModel(facing_pandas(0.8), "capsules")
+    sc, cdata = cm.scene, cm.create_data()
+    settings, keep = search(0.1, True), sc.every.copy()
+    first = cdata.arguments(settings, keep)
+    assert cdata.arguments(settings, keep) is first
+    assert first[4] is keep and first[5] is settings and first[-1] is cdata.h
+    assert cdata.arguments(search(0.1, True), keep) is not first
+    assert cdata.arguments(settings, sc.every.copy())[4] is not keep
+    cm.add_sphere((0.4, 0.0, 0.5), 0.05, name="ball")
+    cdata.refresh(cm.scene)  # new arrays: nothing of the former scene's kept
+    assert cdata.arguments(settings, keep)[-1] is cdata.h

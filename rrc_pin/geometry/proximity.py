@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from operator import itemgetter
-from typing import NamedTuple, TypeVar
+from typing import Any, NamedTuple, TypeVar
 
 import coal
 import numpy as np
@@ -90,8 +90,8 @@ class CollisionData:
     :meth:`CollisionModel.create_data`; never share one between threads.
     """
 
-    __slots__ = ("G", "J", "candidates", "found", "geometry_data", "h", "other", "poses", "scene",
-                 "world")  # fmt: skip
+    __slots__ = ("G", "J", "_bound", "candidates", "distance", "found", "geometry_data", "h",
+                 "other", "pair", "poses", "scene", "world")  # fmt: skip
 
     def __init__(self, scene: Scene) -> None:
         self.refresh(scene)
@@ -109,8 +109,30 @@ class CollisionData:
         self.other = np.zeros(npairs, dtype=np.int64)
         rows = ROWS * npairs  # a pair's row and its end points' (narrow_kernels)
         self.found = np.zeros(rows, dtype=FOUND)
+        self.distance, self.pair = self.found["distance"], self.found["pair"]  # views, kept
         self.G = np.zeros((rows, scene.nv))
         self.h = np.zeros(rows)
+        self._bound: tuple[Records | None, npt.NDArray[np.bool_] | None, tuple[Any, ...]] = (
+            None, None, ())  # fmt: skip
+
+    def arguments(self, settings: Records, keep: npt.NDArray[np.bool_]) -> tuple[Any, ...]:
+        """:func:`collision_pass`'s arguments after q, kept while ``settings`` and ``keep`` are
+        the same arrays."""  # noqa: D205, D209
+        bound = self._bound
+        if bound[0] is not settings or bound[1] is not keep:
+            s = self.scene
+            arguments = (s.joints, s.bodies, s.first, s.second, keep, settings, s.support,
+                         self.poses, self.J, self.world, self.candidates, self.other, self.found,
+                         self.G, self.h)  # fmt: skip
+            bound = self._bound = (settings, keep, arguments)
+        return bound[2]
+
+    def copies(self, rows: int) -> tuple[Array, Array, Array, Index]:
+        """Copies of the first ``rows`` damper rows ``G`` (rows, nv) and bounds ``h`` (rows,),
+        and of the found rows' distances (rows,) [m] and pairs (rows,): what a tick's
+        constraints keep while the pass's arrays are written again."""  # noqa: D205, D209
+        return (self.G[:rows].copy(), self.h[:rows].copy(), self.distance[:rows].copy(),
+                self.pair[:rows].copy())  # fmt: skip
 
 
 def search(detection: float, ends: bool) -> Records:
@@ -173,11 +195,7 @@ def measure(scene: Scene, model: pin.Model, q: Array, placed: Callable[[], pin.D
         cdata.poses[:] = [M.homogeneous for M in data.oMi.tolist()]
         if settings["rows"][0]:
             cdata.J[:] = data.J
-    rows, others, unmoved = collision_pass(
-        q, scene.joints, scene.bodies, scene.first, scene.second, keep, settings,
-        scene.support, cdata.poses, cdata.J, cdata.world, cdata.candidates, cdata.other,
-        cdata.found, cdata.G, cdata.h,
-    )  # fmt: skip
+    rows, others, unmoved = collision_pass(q, *cdata.arguments(settings, keep))
     if others:
         rows = _coal(scene, model, placed(), cdata, float(settings["detection"][0]), rows, others,
                      bool(settings["ends"][0]))  # fmt: skip

@@ -57,7 +57,7 @@ from rrc_pin.geometry.proximity import Proximity, gather, measure, proximity_of
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import finite_number
-from rrc_pin.solvers.collision.collision_pass import pair_rows, row_copies
+from rrc_pin.solvers.collision.collision_pass import pair_rows
 from rrc_pin.solvers.collision.damper_kernels import damper_bound
 from rrc_pin.solvers.collision.records import SETTINGS
 from rrc_pin.solvers.tick.problem import Constraints
@@ -200,7 +200,6 @@ class CollisionLimit(Limit):
             measure(scene, robot.model, q, lambda: kin.data, cdata, settings, scene.every)
         pair_rows(cdata.J, scene.support, scene.bodies, scene.first, scene.second, settings,
                   cdata.found, 0, cdata.G, cdata.h)  # fmt: skip
-        row_copies(cdata.found, cdata.G, cdata.h, 0)
 
     @property
     def last(self) -> Proximity | None:
@@ -224,7 +223,7 @@ class CollisionLimit(Limit):
         walls = model.walls()
         if not rows and not walls:
             return _NONE
-        G, h, distance, pair = row_copies(data.found, data.G, data.h, rows)
+        G, h, distance, pair = data.copies(rows)
         names = self._names(scene, pair)
         if walls or unmoved:
             G, h, distance, names = self._trimmed(kin, walls, G, h, distance, names,

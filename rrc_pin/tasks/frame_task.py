@@ -194,8 +194,25 @@ class FrameTask(Task):
         """
         selected = self.selected
         if len(selected) != 6:
-            J = J[list(selected)]
+            J = _picked(J, selected)
         return TaskRows(J, b, self._row_weights(len(selected)), self.name, _units(selected, reach))
+
+
+_RUNS: dict[tuple[int, ...], slice | None] = {}
+
+
+def _picked(J: Array, selected: tuple[int, ...]) -> Array:
+    """The ``selected`` rows of ``J`` (6, nv), a new array: ``J[list(selected)]``, as a slice's
+    copy (the same values and layout) where they are consecutive and ``J`` C-contiguous."""  # noqa: D205, D209
+    run = _RUNS.get(selected, False)
+    if run is False:
+        consecutive = bool(selected) and list(selected) == list(range(selected[0],
+                                                                      selected[-1] + 1))
+        run = _RUNS[selected] = slice(selected[0], selected[-1] + 1) if consecutive else None
+    if run is not None and J.flags.c_contiguous:
+        rows: Array = J[run].copy()
+        return rows
+    return J[list(selected)]
 
 
 _UNITS: dict[tuple[tuple[int, ...], float], Array] = {}

@@ -141,11 +141,3 @@ def pair_rows(
             h[r] = max(h[r], SLACK)  # a feature's row holds or damps, never pushes out
     return unmoved
 
-
-@kernel
-def row_copies(found: Records, G: Array, h: Array, rows: int) -> tuple[Array, Array, Array, Index]:
-    """Copies of the first ``rows`` damper rows ``G`` (rows, nv) and bounds ``h`` (rows,), and
-    of the found rows' distances (rows,) [m] and pairs (rows,): what a tick's constraints keep
-    while the pass's arrays are written again."""  # noqa: D205, D209
-    return (G[:rows].copy(), h[:rows].copy(), found["distance"][:rows].copy(),
-            found["pair"][:rows].copy())  # fmt: skip
