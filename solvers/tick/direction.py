@@ -146,10 +146,13 @@ def problem(w: Array, null: Array, lb: Array, ub: Array, G: Array, h: Array
     z_lb[d], z_ub[d] = 0.0, 1.0
     p = h.size
     C = np.empty((n + p, d + 1))
-    C[:n] = M
     lo, hi = np.full(n + p, -np.inf), np.empty(n + p)
-    lo[:n], hi[:n], hi[n:] = lb, ub, h
+    for i in range(n):  # element by element: an array copy compiles numba's shape error
+        for j in range(d + 1):
+            C[i, j] = M[i, j]
+        lo[i], hi[i] = lb[i], ub[i]
     for r in range(p):
+        hi[n + r] = h[r]
         for j in range(d + 1):
             s = 0.0
             for i in range(n):

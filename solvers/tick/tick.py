@@ -252,7 +252,8 @@ def report(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Arr
     ints[codes] = statuses.top_served(status)
     for k in range(1, ints[LEVELS] if shrink < 1.0 - statuses.EXACT_TOL else 1):
         if ints[codes + k] != DROPPED:
-            Ak, bk, factor_k = level(task_rows, rates, ints, k, False, rows.lb, rows.ub)
+            # k == 0: False, not the literal, one compiled signature of stacked
+            Ak, bk, factor_k = level(task_rows, rates, ints, k, k == 0, rows.lb, rows.ub)
             ints[codes + k] = served(Ak, bk, qdot, factor_k)
     return status
 
@@ -320,7 +321,7 @@ def run_twist(J: Array, b: Array, q: Array, dt: float, joints: Array, rates: Arr
     if answer.status == FAILED:
         return FAILED, 0.0, 0.0, 0.0, 0.0
     qdot = answer.qdot
-    clip, shrink = clipped(qdot, rows, True)
+    clip, shrink = clipped(qdot, rows, zero_inside)
     status, scale, veer = statuses.borne_out(answer.status, row_values(A, qdot), c, True,
                                              rate_factor, answer.scale * shrink, answer.veer)
     if status == FAILED:
