@@ -74,7 +74,7 @@ from rrc_pin.robot import frame_index
 from rrc_pin.solvers.checks import as_vector, flag, positive
 from rrc_pin.solvers.spatial import to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
-from rrc_pin.solvers.tick.kernels import scale_and_veer
+from rrc_pin.solvers.tick.kernels import into_rows, scale_and_veer
 from rrc_pin.solvers.tick.pipeline import solve
 from rrc_pin.solvers.tick.problem import Rows, TaskRows
 from rrc_pin.solvers.tick.resolution import Resolution
@@ -381,7 +381,8 @@ class CellController(Loop):
         rows is weighted past the damping threshold (damped,
         :class:`~rrc_pin.solvers.tick.damping.Damping`), each tick's top level read as the
         correction reads it (:func:`_top_level`), and each tick's problem answered by the Python
-        pipeline (:func:`~rrc_pin.solvers.tick.pipeline.solve`); the resolver then reset.
+        pipeline (:func:`~rrc_pin.solvers.tick.pipeline.solve`, and its shrink into the rows,
+        :func:`~rrc_pin.solvers.tick.kernels.into_rows`); the resolver then reset.
         """
         kin, names = self._kinematics(), list(self._targets)
         far = PostureTask(self.posture.q_ref + 1.0, gain=1e6, name="compiling")
@@ -404,7 +405,10 @@ class CellController(Loop):
             # the Python pipeline's stages too: it answers equality rows with rows the command
             # slides along (a binding collision limit's)
             solve(r.problem, self.resolver.backend, self.resolver.options)
-        still = np.zeros(self.cell.nv)
+        # its shrink into the rows, which only a tick with rows reaches
+        n = self.cell.nv
+        into_rows(np.zeros((1, n)), np.ones(1), np.zeros(n))
+        still = np.zeros(n)
         for previous in (still, r.qdot):  # the pipeline's box after rates of either kind
             for limit in self.resolver.limits:
                 if isinstance(limit, JointLimits):
