@@ -171,8 +171,9 @@ def inlined(function: F) -> F:
     For the compiled tick's glue between its kernels. A kernel that calls another links the
     callee's machine code into its own and LLVM optimises it again there, so along a chain of
     compiled wrappers the kernels at its end are optimised once per link; inlined, the glue is
-    optimised once, in the tick's entry (docs/api.md, "One compiled pass per tick"). Called from
-    Python, it compiles and caches as any kernel.
+    optimised once, in the tick's entry (docs/api.md, "One compiled pass per tick"); likewise a
+    kernel's private steps called from it alone. Called from Python, it compiles and caches as
+    any kernel.
     """
     dispatcher = njit(inline="always")(function)
     if not numba_config.DISABLE_JIT:

@@ -381,7 +381,8 @@ class CellController(Loop):
         rows is weighted past the damping threshold (damped,
         :class:`~rrc_pin.solvers.tick.damping.Damping`), each tick's top level read as the
         correction reads it (:func:`_top_level`), and each tick's problem answered by the Python
-        pipeline (:func:`~rrc_pin.solvers.tick.pipeline.solve`); the resolver then reset.
+        pipeline (:func:`~rrc_pin.solvers.tick.pipeline.solve`; its shrink into the rows is
+        compiled with the resolver's general tick); the resolver then reset.
         """
         kin, names = self._kinematics(), list(self._targets)
         far = PostureTask(self.posture.q_ref + 1.0, gain=1e6, name="compiling")

@@ -30,7 +30,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick.kernels import cholesky, max_abs, solve_factored
 
 Array = npt.NDArray[np.float64]
@@ -55,7 +55,7 @@ NAME = "active_set"
 """The name a tick's report gives for answers of this solver."""
 
 
-@kernel
+@inlined
 def one_sided(C: Array, lo: Array, hi: Array, lb: Array, ub: Array) -> tuple[Array, Array, bool]:
     """The constraints as rows ``N z >= b`` (m', nz), each C row of unit norm; and False
     where a row of zeros is broken (no point meets the constraints).
@@ -92,7 +92,7 @@ def one_sided(C: Array, lo: Array, hi: Array, lb: Array, ub: Array) -> tuple[Arr
     return N[:k], b[:k], True
 
 
-@kernel
+@inlined
 def _gram(Pinv: Array, N: Array, active: npt.NDArray[np.int64], k: int
           ) -> tuple[Array, Array, bool]:  # fmt: skip
     r"""The active rows through :math:`P^{-1}`, rows :math:`P^{-1}n_j` (k, nz), and the
@@ -119,7 +119,7 @@ def _gram(Pinv: Array, N: Array, active: npt.NDArray[np.int64], k: int
     return PN, L, cholesky(M, DEPENDENT, L) if k else True
 
 
-@kernel
+@inlined
 def _directions(Pinv: Array, N: Array, active: npt.NDArray[np.int64], k: int, p: int,
                 z: Array, r: Array) -> bool:  # fmt: skip
     r"""The primal step z (nz,) and the dual one r (k,) of constraint ``p`` on the active set.
@@ -151,7 +151,7 @@ def _directions(Pinv: Array, N: Array, active: npt.NDArray[np.int64], k: int, p:
     return True
 
 
-@kernel
+@inlined
 def _slack(N: Array, b: Array, i: int, x: Array) -> float:
     """``n_i^T x - b_i``: negative where constraint i is broken."""
     s = -float(b[i])
@@ -160,7 +160,7 @@ def _slack(N: Array, b: Array, i: int, x: Array) -> float:
     return s
 
 
-@kernel
+@inlined
 def _most_broken(N: Array, b: Array, x: Array, is_active: npt.NDArray[np.bool_], tol: Array
                  ) -> int:  # fmt: skip
     """The inactive constraint broken the most beyond its ``tol``, or -1."""
@@ -197,11 +197,13 @@ def solve(P: Array, q: Array, C: Array, lo: Array, hi: Array, lb: Array, ub: Arr
     if not cholesky(P, 1e-14, L):
         return NOT_DEFINITE, 0
     Pinv = np.empty((nz, nz))
-    e = np.zeros(nz)
+    e, column = np.zeros(nz), np.empty(nz)  # contiguous: one compiled signature of the solve
     for j in range(nz):
         e[j] = 1.0
-        solve_factored(L, e, Pinv[:, j])
+        solve_factored(L, e, column)
         e[j] = 0.0
+        for i in range(nz):
+            Pinv[i, j] = column[i]
     for i in range(nz):  # the unconstrained minimum
         s = 0.0
         for j in range(nz):
@@ -213,7 +215,7 @@ def solve(P: Array, q: Array, C: Array, lo: Array, hi: Array, lb: Array, ub: Arr
     return _iterate(Pinv, N, b, x)
 
 
-@kernel
+@inlined
 def _iterate(Pinv: Array, N: Array, b: Array, x: Array) -> tuple[int, int]:
     """Goldfarb & Idnani's iterations from the unconstrained minimum ``x`` (in place)."""
     nz, m = x.size, b.size
@@ -225,7 +227,7 @@ def _iterate(Pinv: Array, N: Array, b: Array, x: Array) -> tuple[int, int]:
     is_active = np.zeros(m, np.bool_)
     u = np.zeros(nz + 1)  # the multipliers of the active constraints, then of p's
     z, r = np.empty(nz), np.empty(nz + 1)
-    k, steps = 0, 0
+    k, steps = np.int64(0), 0  # k not the literal 0: one compiled signature of _directions
     limit = 10 * (m + nz) + 10
     p = _most_broken(N, b, x, is_active, tol)
     while p >= 0:

@@ -648,7 +648,9 @@ def direction_step(
         for i in range(n):
             qdot[i] = u * w[i]
         return 1, u
-    v = Q[:, m]
+    v = qdot  # Q's column m, contiguous: one compiled signature of line_scale
+    for i in range(n):
+        v[i] = Q[i, m]
     u, y = line_scale(w, v, lb, ub)
     for i in range(n):
         qdot[i] = u * w[i] + y * v[i]

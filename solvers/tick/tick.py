@@ -34,6 +34,7 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import equalities, kernels, statuses, top
+from rrc_pin.solvers.tick.direction import solved_along
 from rrc_pin.solvers.tick.kernels import row_values
 from rrc_pin.solvers.tick.levels import least_squares
 from rrc_pin.solvers.tick.problem import LARGE, TaskRows, cap
@@ -252,7 +253,8 @@ def report(joints: Array, task_rows: Array, rates: Array, ints: Ints, reals: Arr
     ints[codes] = statuses.top_served(status)
     for k in range(1, ints[LEVELS] if shrink < 1.0 - statuses.EXACT_TOL else 1):
         if ints[codes + k] != DROPPED:
-            Ak, bk, factor_k = level(task_rows, rates, ints, k, False, rows.lb, rows.ub)
+            # k == 0: False, not the literal, one compiled signature of stacked
+            Ak, bk, factor_k = level(task_rows, rates, ints, k, k == 0, rows.lb, rows.ub)
             ints[codes + k] = served(Ak, bk, qdot, factor_k)
     return status
 
@@ -320,7 +322,7 @@ def run_twist(J: Array, b: Array, q: Array, dt: float, joints: Array, rates: Arr
     if answer.status == FAILED:
         return FAILED, 0.0, 0.0, 0.0, 0.0
     qdot = answer.qdot
-    clip, shrink = clipped(qdot, rows, True)
+    clip, shrink = clipped(qdot, rows, zero_inside)
     status, scale, veer = statuses.borne_out(answer.status, row_values(A, qdot), c, True,
                                              rate_factor, answer.scale * shrink, answer.veer)
     if status == FAILED:
@@ -552,10 +554,11 @@ class Workspace:
                    self.ints, self.reals)  # fmt: skip
 
     def compile(self, general: bool) -> None:
-        """Compile the default tick's entry (:func:`run_box`), and the general one where
-        ``general`` (with the pipeline's shrink into the rows, :func:`kernels.into_rows`), or
-        load them from numba's cache: on a problem without rows whose answer is exact, so that
-        no QP is asked for and nothing is kept.
+        """Compile the default tick's entries (:func:`run_box`, :func:`run_twist`, and the
+        direction QP they call in its own entry), and the general ones where ``general`` (with
+        the pipeline's shrink into the rows, :func:`kernels.into_rows`), or load them from
+        numba's cache: on a problem without rows whose answer is exact, so that no QP is asked
+        for and nothing is kept.
         """  # noqa: D205
         n = self.n
         ws = Workspace(self.joints[LOWER], self.joints[UPPER], self.joints[VELOCITY],
@@ -568,6 +571,9 @@ class Workspace:
         run_box(ws.joints, ws.task_rows, ws.rates, ws.ints, ws.reals)
         run_twist(np.eye(1, n), np.zeros(1), ws.joints[POSITION].copy(), 0.01, ws.joints, ws.rates,
                   ws.ints, ws.reals, np.empty(twist_size(n, 1)))  # fmt: skip
+        # the direction QP of those two entries, in its own (top.scaled_along)
+        solved_along(np.eye(1, n), np.zeros(n), np.eye(n)[1:], ws.joints[LB].copy(),
+                     ws.joints[UB].copy(), np.zeros((0, n)), np.zeros(0), 1.0)  # fmt: skip
         if general:
             run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
             kernels.into_rows(np.zeros((1, n)), np.zeros(1), np.zeros(n))  # the pipeline's call
