@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from rrc_pin.solvers.tick import statuses, top
-from rrc_pin.solvers.tick.direction import along, solved_along
+from rrc_pin.solvers.tick.direction import along
 from rrc_pin.solvers.tick.kernels import scale_and_veer
 from rrc_pin.solvers.tick.problem import Box
 
@@ -42,35 +42,10 @@ def test_the_box_scale_of_no_or_one_null_direction_is_the_pipelines(seed: int) -
         for _ in range(100):
             w = rng.normal(size=n) * 3.0
             null = np.linalg.qr(rng.normal(size=(n, n)))[0][:, :d].T.copy()
-            qdot, u, veer = top.scaled_along(np.eye(n), w, null, rows, None)
+            qdot, u, veer = top.scaled_along(np.eye(n), w, null, rows)
             want = along(w, null, box, None)
             assert want is not None and u == want.u and veer == want.veer == 0.0
             np.testing.assert_allclose(qdot, want.qdot, atol=1e-15)
-
-
-@pytest.mark.parametrize("seed", SEEDS)
-def test_the_direction_qp_handed_to_its_own_entry_answers_the_same(seed: int) -> None:
-    """scaled_along with the solver's code in the kernel (handed None) and called in its own
-    entry (handed True): the same rates, scale and veer to the bit, counted alike."""
-    rng = np.random.default_rng(seed)
-    n = 6
-    lb, ub = -rng.uniform(0.1, 1.0, n), rng.uniform(0.1, 1.0, n)
-    problems = []
-    for d in (2, 3):
-        for _ in range(50):
-            Q = np.linalg.qr(rng.normal(size=(n, n)))[0]  # rows A, their null space's rows
-            problems.append((Q[:, d:].T.copy(), rng.normal(size=n) * 3.0, Q[:, :d].T.copy()))
-    problems = [(A, w, null) for A, w, null in problems  # those it answers (no backend here)
-                if solved_along(A, w, null, lb, ub, np.zeros((0, n)), np.zeros(0),
-                                1e-6)[1] >= 0.0]  # fmt: skip
-    assert len(problems) > 80
-    got = []
-    for handed in (None, True):
-        rows = top.Rows(lb, ub, np.zeros((0, n)), np.zeros(0), np.zeros(0), 1e-6, np.zeros(2))
-        answers = [top.scaled_along(A, w, null, rows, handed) for A, w, null in problems]
-        got.append(([(q.tobytes(), u, veer) for q, u, veer in answers], rows.solved.tolist()))
-    assert got[0] == got[1]
-    assert got[0][1][0] > 0  # the compiled solver answered
 
 
 def test_slide_rows_are_the_marked_ones() -> None:

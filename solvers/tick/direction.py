@@ -40,7 +40,6 @@ from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
-from numba import objmode
 from scipy.optimize import linprog
 
 from rrc_pin.solvers.compiled import kernel
@@ -185,18 +184,6 @@ def solved_along(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array
     if not (kept and math.isfinite(scale) and math.isfinite(veer)):
         return w, -1.0, 0.0, steps
     return qdot, scale, veer, steps
-
-
-@kernel
-def handed_along(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array, h: Array,
-                 tol: float) -> tuple[Array, float, float, int]:  # fmt: skip
-    """:func:`solved_along` called through Python, in its own compiled entry: the caller's
-    machine code holds a call, not the solver's code (compiled into each entry that calls it
-    else). Compiled with the tick's kernels (:meth:`rrc_pin.solvers.tick.tick.Workspace.compile`).
-    """  # noqa: D205
-    with objmode(qdot="float64[::1]", u="float64", veer="float64", steps="int64"):
-        qdot, u, veer, steps = solved_along(A, w, null, lb, ub, G, h, tol)
-    return qdot, u, veer, steps
 
 
 @kernel

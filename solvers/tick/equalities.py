@@ -85,7 +85,7 @@ def direction_within(A: Array, b: Array, N: Array, rows: Rows, dt: float, thresh
         return top.met_top(w, rate_factor, null)
     f, free = factor.null_basis(f)
     null = product(free, N)
-    qdot, u, veer = top.scaled_along(A, w, null, rows, None)
+    qdot, u, veer = top.scaled_along(A, w, null, rows)
     if u < 0.0:
         return top.passing(w, null)
     if not outside_range and u >= 1.0 - EXACT_TOL:
@@ -96,7 +96,7 @@ def direction_within(A: Array, b: Array, N: Array, rows: Rows, dt: float, thresh
     usable, lam = top.damping(f, b, z, u, within, dt, threshold)
     if lam.size:
         damped, damped_u, _ = top.scaled_along(A, row_values(Nt, factor.rates(usable, b, lam)),
-                                               null, rows, None)  # fmt: skip
+                                               null, rows)  # fmt: skip
         if damped_u < 0.0:
             return top.passing(w, null)
         return top.answer(A, b, damped, DAMPED, rate_factor, null, float(np.max(lam)))

@@ -34,7 +34,6 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import equalities, kernels, statuses, top
-from rrc_pin.solvers.tick.direction import solved_along
 from rrc_pin.solvers.tick.kernels import row_values
 from rrc_pin.solvers.tick.levels import least_squares
 from rrc_pin.solvers.tick.problem import LARGE, TaskRows, cap
@@ -554,11 +553,10 @@ class Workspace:
                    self.ints, self.reals)  # fmt: skip
 
     def compile(self, general: bool) -> None:
-        """Compile the default tick's entries (:func:`run_box`, :func:`run_twist`, and the
-        direction QP they call in its own entry), and the general ones where ``general`` (with
-        the pipeline's shrink into the rows, :func:`kernels.into_rows`), or load them from
-        numba's cache: on a problem without rows whose answer is exact, so that no QP is asked
-        for and nothing is kept.
+        """Compile the default tick's entries (:func:`run_box`, :func:`run_twist`), and the
+        general ones where ``general`` (with the pipeline's shrink into the rows,
+        :func:`kernels.into_rows`), or load them from numba's cache: on a problem without rows
+        whose answer is exact, so that no QP is asked for and nothing is kept.
         """  # noqa: D205
         n = self.n
         ws = Workspace(self.joints[LOWER], self.joints[UPPER], self.joints[VELOCITY],
@@ -571,9 +569,6 @@ class Workspace:
         run_box(ws.joints, ws.task_rows, ws.rates, ws.ints, ws.reals)
         run_twist(np.eye(1, n), np.zeros(1), ws.joints[POSITION].copy(), 0.01, ws.joints, ws.rates,
                   ws.ints, ws.reals, np.empty(twist_size(n, 1)))  # fmt: skip
-        # the direction QP of those two entries, in its own (top.scaled_along)
-        solved_along(np.eye(1, n), np.zeros(n), np.eye(n)[1:], ws.joints[LB].copy(),
-                     ws.joints[UB].copy(), np.zeros((0, n)), np.zeros(0), 1.0)  # fmt: skip
         if general:
             run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
             kernels.into_rows(np.zeros((1, n)), np.zeros(1), np.zeros(n))  # the pipeline's call

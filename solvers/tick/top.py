@@ -30,7 +30,7 @@ from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses
-from rrc_pin.solvers.tick.direction import handed_along, solved_along
+from rrc_pin.solvers.tick.direction import solved_along
 from rrc_pin.solvers.tick.factor import Factor
 from rrc_pin.solvers.tick.kernels import row_values
 from rrc_pin.solvers.tick.levels import least_squares
@@ -203,8 +203,7 @@ def slid_command(where: int, A: Array, b: Array, G: Array, h: Array, rows: Rows,
 
 
 @kernel
-def scaled_along(A: Array, w: Array, null: Array, rows: Rows, handed: bool | None
-                 ) -> tuple[Array, float, float]:  # fmt: skip
+def scaled_along(A: Array, w: Array, null: Array, rows: Rows) -> tuple[Array, float, float]:
     """The direction problem along ``w``: its rates, scale u (u < 0: the backend failed), veer.
 
     The veer [rad] is measured where the backend answered, else 0 (along w by construction).
@@ -213,18 +212,11 @@ def scaled_along(A: Array, w: Array, null: Array, rows: Rows, handed: bool | Non
     direction) (:func:`rrc_pin.solvers.tick.direction.along`); else the direction QP by the
     compiled active-set solver (:func:`rrc_pin.solvers.tick.direction.solved_along`, counted in
     ``rows.solved``), or where it does not answer by the backend
-    (:func:`rrc_pin.solvers.tick.backend_calls.direction`). ``handed`` None: the solver's
-    code compiled into this kernel; else (the entries of the box alone, whose ticks rarely
-    ask for it) called in its own entry (:func:`rrc_pin.solvers.tick.direction.handed_along`):
-    numba compiles only the branch the type of ``handed`` takes.
+    (:func:`rrc_pin.solvers.tick.backend_calls.direction`).
     """
     if rows.h.size or null.shape[0] > 1:
-        if handed is None:
-            qdot, u, veer, steps = solved_along(A, w, null, rows.lb, rows.ub, rows.G, rows.h,
-                                                rows.tol)  # fmt: skip
-        else:
-            qdot, u, veer, steps = handed_along(A, w, null, rows.lb, rows.ub, rows.G, rows.h,
-                                                rows.tol)  # fmt: skip
+        qdot, u, veer, steps = solved_along(A, w, null, rows.lb, rows.ub, rows.G, rows.h,
+                                            rows.tol)  # fmt: skip
         if u >= 0.0:
             rows.solved[0] += 1.0
             rows.solved[1] += steps
@@ -318,13 +310,12 @@ def exact(A: Array, command: Array, f: Factor, w: Array, fits: bool, rows: Rows,
 @inlined
 def scaled(A: Array, command: Array, b: Array, f: Factor, w: Array, boxed: Array, u_box: float,
            rows: Rows, slid: bool, outside_range: bool, dt: float, threshold: float,
-           rate_factor: float, handed: bool | None) -> Top:  # fmt: skip
+           rate_factor: float) -> Top:  # fmt: skip
     """Stages 3-5, where w does not keep the constraints: scaled, damped, singular (``b`` the
-    command served, ``command`` the one reported along; ``handed``: :func:`scaled_along`'s).
+    command served, ``command`` the one reported along).
     """  # noqa: D205
     f, null = factor.null_basis(f)
-    qdot, u, veer = (boxed, u_box, 0.0) if u_box >= 0.0 else scaled_along(A, w, null, rows,
-                                                                           handed)  # fmt: skip
+    qdot, u, veer = (boxed, u_box, 0.0) if u_box >= 0.0 else scaled_along(A, w, null, rows)
     if u < 0.0:
         return passing(w, null)
     if slid:
@@ -333,8 +324,7 @@ def scaled(A: Array, command: Array, b: Array, f: Factor, w: Array, boxed: Array
         return met_top(qdot, rate_factor, null)
     usable, lam = damping(f, b, w, u, rows, dt, threshold)
     if lam.size:
-        damped_qdot, damped_u, _ = scaled_along(A, factor.rates(usable, b, lam), null, rows,
-                                                handed)  # fmt: skip
+        damped_qdot, damped_u, _ = scaled_along(A, factor.rates(usable, b, lam), null, rows)
         if damped_u < 0.0:
             return passing(w, null)
         if u_box < 0.0 or not damped_u <= STILL_SCALE < u:
@@ -365,34 +355,30 @@ def direction(A: Array, b: Array, rows: Rows, dt: float, threshold: float, rate_
             w = z
             fits = kernels.inside(w, rows.lb, rows.ub)
     return command_stages(A, command, b, f, w, z, fits, boxed, u_box, rows, slid, dt, threshold,
-                          rate_factor, need_null, None)  # fmt: skip
+                          rate_factor, need_null)  # fmt: skip
 
 
 @inlined
 def direction_box(A: Array, b: Array, rows: Rows, dt: float, threshold: float,
                   rate_factor: float) -> Top:  # fmt: skip
-    """The direction mode's one level within the box alone: no row, so no sliding stage; the
-    direction QP, which only a null space of two directions or more asks for, in its own entry
-    (:func:`scaled_along`).
-    """  # noqa: D205
+    """The direction mode's one level within the box alone: no row, so no sliding stage."""
     f, w, fits, boxed, u_box = factor.fitted(A, b, rows.lb, rows.ub)
     return command_stages(A, b, b, f, w, w, fits, boxed, u_box, rows, False, dt, threshold,
-                          rate_factor, False, True)  # fmt: skip
+                          rate_factor, False)  # fmt: skip
 
 
 @inlined
 def command_stages(A: Array, command: Array, b: Array, f: Factor, w: Array, z: Array,
                    fits: bool, boxed: Array, u_box: float, rows: Rows, slid: bool, dt: float,
-                   threshold: float, rate_factor: float, need_null: bool, handed: bool | None
-                   ) -> Top:  # fmt: skip
+                   threshold: float, rate_factor: float, need_null: bool) -> Top:  # fmt: skip
     """Stages 1 and 3-5 on the command ``b`` as it stands (``slid``: the sliding stage's; the
-    report along ``command``, the one given; ``handed``: :func:`scaled_along`'s).
+    report along ``command``, the one given).
     """  # noqa: D205
     outside_range = not f.regular and not met(f.J, z, b)
     top = exact(A, command, f, w, fits, rows, slid, outside_range, rate_factor, need_null)
     if top.status == FAILED:
         top = scaled(A, command, b, f, w, boxed, u_box, rows, slid, outside_range, dt,
-                     threshold, rate_factor, handed)  # fmt: skip
+                     threshold, rate_factor)  # fmt: skip
     return top
 
 
