@@ -16,7 +16,7 @@ The columns grow by doubling up to the capacity, then the ring overwrites its ol
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
-from typing import Any, Generic, TypeVar
+from typing import Any, Generic, NamedTuple, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -35,12 +35,16 @@ FIRST_ROWS = 256
 SHARED_TEXTS = 4096
 """Distinct strings a ring shares between its rows (more are kept as they come)."""
 
-_NUMBER, _ARRAY, _OBJECT = 0, 1, 2
-"""Kinds of column (:func:`_column_for`)."""
 
-Plan = list[tuple[npt.NDArray[Any], int, tuple[int, ...], np.dtype[Any]]]
-"""The columns of a kind of entry, in its fields' order, each with its kind, row shape and
-dtype."""
+class Plan(NamedTuple):
+    """The columns of a kind of entry, by kind of column, each with its field's position."""
+
+    numbers: list[tuple[int, npt.NDArray[np.float64]]]
+    """float64 columns."""
+    arrays: list[tuple[int, npt.NDArray[Any], tuple[int, ...], np.dtype[Any]]]
+    """Array columns, with their row shape and dtype."""
+    objects: list[tuple[int, npt.NDArray[Any]]]
+    """Object columns."""
 
 
 class RecordRing(Generic[R]):
@@ -233,36 +237,51 @@ class RecordRing(Generic[R]):
         plan = self._plans.get(key)
         if plan is None:
             plan = self._plans[key] = self._plan(entry)
+        if not self._write(plan, row, entry):
+            self._plans.clear()  # a value its column cannot hold: the column holds objects now
+            self._store_slowly(row, entry)
+
+    def _write(self, plan: Plan, row: int, entry: tuple[Any, ...]) -> bool:
+        """Write ``entry``'s fields into ``row`` of ``plan``'s columns, until a value does not
+        fit its column; whether they all did.
+        """  # noqa: D205
+        for i, column in plan.numbers:
+            value = entry[i]
+            if type(value) is not float and not isinstance(value, np.floating):
+                return False
+            column[row] = value
+        for i, array, shape, dtype in plan.arrays:
+            value = entry[i]
+            if (type(value) is not np.ndarray or value.shape != shape
+                    or (value.dtype is not dtype and value.dtype != dtype)):  # fmt: skip
+                return False
+            array[row] = value
         texts = self._texts
-        for (column, kind, shape, dtype), value in zip(plan, entry, strict=True):
-            if kind == _NUMBER:
-                if type(value) is not float and not isinstance(value, np.floating):
-                    break
-            elif kind == _ARRAY:
-                if type(value) is not np.ndarray or value.shape != shape or value.dtype != dtype:
-                    break
-            elif type(value) is str:  # one object per string
+        for i, objects in plan.objects:
+            value = entry[i]
+            if type(value) is str:  # one object per string
                 shared = texts.get(value)
                 if shared is not None:
                     value = shared
                 elif len(texts) < SHARED_TEXTS:
                     texts[value] = value
-            column[row] = value
-        else:
-            return
-        self._plans.clear()  # a value its column cannot hold: the column holds objects now
-        self._store_slowly(row, entry)
+            objects[row] = value
+        return True
 
     def _plan(self, entry: tuple[Any, ...]) -> Plan:
-        """The columns of ``entry``'s fields (made where missing), each with its kind."""
-        out = []
-        for name, value in zip(_fields(entry), entry, strict=True):
+        """The columns of ``entry``'s fields (made where missing), by kind."""
+        plan = Plan([], [], [])
+        for i, (name, value) in enumerate(zip(_fields(entry), entry, strict=True)):
             column = self._columns.get(name)
             if column is None:
                 column = self._columns[name] = _column_for(value, self._rows)
-            kind = _OBJECT if column.dtype == object else _NUMBER if column.ndim == 1 else _ARRAY
-            out.append((column, kind, column.shape[1:], column.dtype))
-        return out
+            if column.dtype == object:
+                plan.objects.append((i, column))
+            elif column.ndim == 1:
+                plan.numbers.append((i, column))
+            else:
+                plan.arrays.append((i, column, column.shape[1:], column.dtype))
+        return plan
 
     def _store_slowly(self, row: int, entry: tuple[Any, ...]) -> None:
         """:meth:`_store` where a column must first become an object column."""
