@@ -252,8 +252,13 @@ def clamped(f: Factor, w: Array, rows: Rows, dt: float, threshold: float
     J = np.empty_like(f.J)
     if not kernels.clamp_pushed(f.J, w, rows.lb, rows.ub, kernels.ON_LIMIT / dt, J):
         return f, factor.surely_conditioned(f, threshold)
-    if columns_used(J) < J.shape[0] and factor.surely_conditioned(f, threshold):
-        return f, True  # the clamped rows are short of rank, f has it
+    used = columns_used(J)
+    if used < J.shape[0]:  # the clamped rows are short of rank: their rank is at most used
+        if factor.surely_conditioned(f, threshold):
+            return f, True
+        f = factor.with_svd(f)
+        if f.rank > used:  # above any the clamped rows' SVD could count: f is chosen
+            return f, False
     c = factor.qr(J)
     if factor.surely_conditioned(c, threshold):  # of full rank
         return c, True
