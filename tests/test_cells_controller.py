@@ -513,8 +513,9 @@ def test_collision_limits_hold_on_a_floating_cell(tripod, collision):
 def test_the_cells_benchmark_session_with_collision_never_holds(soak):
     """benchmarks/bench_cells.py's gsfc_dual session with its collision limit (3,000 ticks,
     its commands): no tick falls back, no joint leaves its box. Near its end a pair dips
-    below its safety distance; the tick within the grip's equality rows that must push it
-    apart once held still (``fallback``, 3 ticks): it recovers."""
+    below its safety distance here (not under an older CPU's kernels); the tick within the
+    grip's equality rows that must push it apart once held still (``fallback``, 3 ticks), and
+    recovers now (that tick, saved, is tests/data/gsfc_dual_recovering.npz's)."""
     cell = rrc_pin.load("gsfc_dual")
     ctl = soak._controllers(cell)[0][soak.WITH]
     command, speed = soak.SPEEDS["gsfc_dual"]
@@ -527,7 +528,6 @@ def test_the_cells_benchmark_session_with_collision_never_holds(soak):
         box = r.problem.box
         assert ((r.applied >= box.lb) & (r.applied <= box.ub)).all(), k
     assert "fallback" not in statuses, statuses
-    assert statuses.get("recovering", 0) >= 1, statuses  # the dip is still in the session
 
 
 def test_setting_q_moves_the_targets_and_anchors_there(tripod):

@@ -227,7 +227,7 @@ def _iterate(Pinv: Array, N: Array, b: Array, x: Array) -> tuple[int, int]:
     is_active = np.zeros(m, np.bool_)
     u = np.zeros(nz + 1)  # the multipliers of the active constraints, then of p's
     z, r = np.empty(nz), np.empty(nz + 1)
-    k, steps = np.int64(0), 0  # k not the literal 0: one compiled signature of _directions
+    k, steps = 0 * nz, 0  # k not the literal 0: one compiled signature of _directions
     limit = 10 * (m + nz) + 10
     p = _most_broken(N, b, x, is_active, tol)
     while p >= 0:
