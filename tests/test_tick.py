@@ -20,7 +20,7 @@ from rrc_pin.solvers.tick.problem import Box, Constraints, TaskRows, build
 
 STATUS_NAMES = get_args(Status)
 
-SEEDS = [20261206, int(np.random.SeedSequence().entropy % 2**63)]
+SEEDS = [20261206, 6307242558226725790, int(np.random.SeedSequence().entropy % 2**63)]
 N, DT = 7, 0.01
 LEVELS = ("met", "scaled", "traded", "dropped")
 RATE_TOL = 1e-9
@@ -99,6 +99,7 @@ def test_random_problems_answered_as_the_pipeline(seed: int) -> None:
     rng = np.random.default_rng(seed)
     kinds: dict[str, int] = {}
     relabelled = 0  # a lower level traded by one tick, dropped by the other (its rates the same)
+    sensitive = 0  # rates apart by more than RATE_TOL, as far as the pipeline's own rounding
     for _ in range(400):
         args = case(rng)
         want = pipeline_answer(*args)
@@ -116,12 +117,38 @@ def test_random_problems_answered_as_the_pipeline(seed: int) -> None:
             pairs = zip(got, want.levels, strict=True)
             assert all(g == w or {g, w} == {"traded", "dropped"} for g, w in pairs), got
             relabelled += 1
-        assert np.abs(qdot - want.qdot).max() <= tol * (1.0 + np.abs(want.qdot).max()), seed
+        apart = np.abs(qdot - want.qdot).max()
+        if apart > tol * (1.0 + np.abs(want.qdot).max()):
+            assert apart <= 3.0 * own_spread(args, want.qdot, rng), (seed, apart)
+            sensitive += 1
         assert ws.reals[tick.SCALE] == pytest.approx(want.scale, abs=tol), seed
         if max(want.scale, ws.reals[tick.SCALE]) > 1e-9:
             assert ws.reals[tick.VEER] == pytest.approx(want.veer, abs=1e-7)
     assert {"exact", "scaled", "least_squares"} <= set(kinds), kinds
     assert relabelled <= 4, relabelled  # 1 of 400 seen (the top's QP answered 1e-9 apart)
+    assert sensitive <= 4, sensitive  # 1 of 400 seen (fresh seed 6307242558226725790)
+
+
+def own_spread(args: tuple, qdot: np.ndarray, rng: np.random.Generator) -> float:
+    """How far the pipeline's own rates move when its task and constraint rows move by one ulp
+    (8 draws): the answer's sensitivity to rounding. A lower level pinned by constraint rows
+    whose slack is :data:`~rrc_pin.solvers.tick.least_squares.ROUNDING` (1e-12 rad/s) and whose
+    smallest singular value is 4.9e-4 is a region 1e-8 wide: one ulp of its data moved the
+    pipeline's rates by up to 3.2e-8, and the compiled tick's answer, formed in its own loops,
+    lay 1.3e-8 from the pipeline's."""
+    q, lower, upper, velocity, levels, weighted, G, h, slide, direction = args
+
+    def ulp(a: np.ndarray) -> np.ndarray:
+        return a * (1.0 + np.finfo(float).eps * rng.choice([-1.0, 1.0], a.shape))
+
+    spread = 0.0
+    for _ in range(8):
+        moved = [[TaskRows(ulp(t.A), t.b, t.weight, t.name, t.unit) for t in level]
+                 for level in levels]  # fmt: skip
+        answer = pipeline_answer(q, lower, upper, velocity, moved, weighted, ulp(G), h, slide,
+                                 direction)  # fmt: skip
+        spread = max(spread, float(np.abs(answer.qdot - qdot).max()))
+    return spread
 
 
 def test_stacked_rows_are_the_problems(rng: np.random.Generator) -> None:
