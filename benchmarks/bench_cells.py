@@ -11,8 +11,10 @@ Run from a checkout: ``python benchmarks/bench_cells.py --out DIR`` (``--record`
   targets fed back, the grip's equality rows, the closed chain's correction, the log), at
   100 Hz. The controllers take the same commands: joint limits only, and joint limits plus
   a ``CollisionLimit`` on the cell's capsules (every pair between the two arms and the
-  kinematic rules' pairs within each; default safety and detection distances). At every
-  tick each steps, in an order shuffled per tick (interleaved).
+  kinematic rules' pairs within each; default safety and detection distances). Timed in two
+  modes, each from fresh controllers: tight (each controller 250 ticks in a row, by turns)
+  and interleaved (at every tick each steps, in an order drawn at random: each tick finds the
+  caches the others left).
 - **yeh_tripod**: the body commanded by random twists (0.03 m/s, 0.1 rad/s per axis, held
   0.5 s) over its three feet in support (the contacts' equality rows and correction), the
   same controllers (the collision model: the three legs' capsules, rows over all 24 rates,
@@ -25,10 +27,11 @@ Run from a checkout: ``python benchmarks/bench_cells.py --out DIR`` (``--record`
 A case whose collision model cannot be built or whose limit refuses the cell is recorded in
 ``not_run`` with the refusal, never timed without its limit.
 
-Per case the tick's median, p10, p90, p99 [us] (``time.perf_counter`` around ``step``; the
-first ticks left out), the loop rate they give (1 / tick [Hz]), the statuses, the largest
-grip error or foot slip, and with collision the ticks that had collision rows and the
-smallest distance seen. One core, BLAS threads pinned to 1.
+Per case and mode the tick's median, p10, p90, p99 [us] (``time.perf_counter`` around
+``step``; the first ticks left out) and its CPU time's median and p99 (``time.thread_time``);
+of the tight mode, the loop rate they give (1 / tick [Hz]), the statuses, the largest grip
+error or foot slip, and with collision the ticks that had collision rows and the smallest
+distance seen. One core, BLAS threads pinned to 1.
 """
 
 from __future__ import annotations
@@ -41,7 +44,6 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 import collections  # noqa: E402
 import json  # noqa: E402
 import sys  # noqa: E402
-import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
@@ -50,7 +52,7 @@ import pinocchio as pin  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from script import arguments, make_parser, mark_quick, measure, pyplot, write  # noqa: E402
-from timing import one_core, progress, statistics, us  # noqa: E402
+from timing import closed_loops, one_core, progress, statistics, timed, us  # noqa: E402
 
 import rrc_pin  # noqa: E402
 from rrc_pin.cells import CellController  # noqa: E402
@@ -67,6 +69,8 @@ HOLD = 50
 WARM_UP = 10
 """First ticks left out of the statistics (caches, the first factorisations)."""
 SEED = 2030
+MODES = ("tight", "interleaved")
+"""Each from fresh controllers (:func:`timing.closed_loops`)."""
 SPEEDS = {
     "gsfc_dual": ("object", np.array([0.15, 0.15, 0.15, 0.4, 0.4, 0.4])),
     "yeh_tripod": ("body", np.array([0.03, 0.03, 0.03, 0.1, 0.1, 0.1])),
@@ -100,54 +104,66 @@ def _controllers(cell: rrc_pin.Cell) -> tuple[dict[str, CellController], dict[st
     return out, refused
 
 
+class CellLoop:
+    """One controller's closed loop on the cell's commands, and what it met: the statuses, the
+    ticks with collision rows and the smallest distance seen."""
+
+    def __init__(self, ctl: CellController, command: str, twists: list[np.ndarray]) -> None:
+        self.ctl, self.command, self.twists = ctl, command, twists
+        self.statuses: collections.Counter[str] = collections.Counter()
+        self.near, self.closest = 0, np.inf
+        self.limit = next((lim for lim in ctl.resolver.limits
+                           if isinstance(lim, rrc_pin.CollisionLimit)), None)  # fmt: skip
+
+    def __call__(self, k: int) -> tuple[float, float]:
+        """Tick ``k``: the controller's step, timed (wall-clock and CPU seconds)."""
+        commands = {self.command: self.twists[k // HOLD]}
+        step, wall, cpu = timed(lambda: self.ctl.step(commands))
+        self.statuses[step.resolution.status] += 1
+        last = None if self.limit is None else self.limit.last
+        if last is not None and len(last.names):
+            self.near += 1
+            self.closest = min(self.closest, float(last.distance.min()))
+        return wall, cpu
+
+
 def run_cell(name: str, ticks: int) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
-    """Every controller of cell ``name`` over ``ticks`` ticks, interleaved (module docstring)."""
+    """Every controller of cell ``name`` over ``ticks`` ticks, tight and interleaved, each mode
+    from fresh controllers (module docstring)."""
     cell = rrc_pin.load(name)
-    controllers, refused = _controllers(cell)
     command, speed = SPEEDS[name]
     rng = np.random.default_rng(SEED)
     order = np.random.default_rng(SEED + 1)
     twists = [rng.normal(size=6) * speed for _ in range(ticks // HOLD + 1)]
-    times: dict[str, list[float]] = {label: [] for label in controllers}
-    statuses: dict[str, collections.Counter[str]] = {k: collections.Counter() for k in controllers}
-    near = dict.fromkeys(controllers, 0)
-    closest = dict.fromkeys(controllers, np.inf)
-    limits = {label: lim for label, ctl in controllers.items() for lim in ctl.resolver.limits
-              if isinstance(lim, rrc_pin.CollisionLimit)}  # fmt: skip
+    loops, times = {}, {}
+    for mode in MODES:
+        controllers, refused = _controllers(cell)
+        loops[mode] = {label: CellLoop(ctl, command, twists) for label, ctl in controllers.items()}
+        progress(f"cells: {name}, {mode}")
+        times[mode] = closed_loops(mode, loops[mode], ticks, order)
     feet = {f: cell.fk(cell.ready(), f)[:3, 3] for f in cell.tool_frames} if cell.body else {}
-    for k in range(ticks):
-        commands = {command: twists[k // HOLD]}
-        for label in order.permutation(list(controllers)):
-            ctl = controllers[str(label)]
-            start = time.perf_counter()
-            r = ctl.step(commands).resolution
-            times[str(label)].append(time.perf_counter() - start)
-            statuses[str(label)][r.status] += 1
-            last = limits[str(label)].last if str(label) in limits else None
-            if last is not None and len(last.names):
-                near[str(label)] += 1
-                closest[str(label)] = min(closest[str(label)], float(last.distance.min()))
-        if k % 1000 == 0:
-            progress(f"cells: {name}, tick {k}")
     rows = []
-    for label, ctl in controllers.items():
-        stats = statistics(np.array(times[label][WARM_UP:]))
+    for label, loop in loops["tight"].items():
+        stats = statistics(*(t[WARM_UP:] for t in times["tight"][label]))
         row: dict[str, Any] = {
             "cell": name, "limits": label, "collision": label != WITHOUT, "ticks": ticks,
             "nv": cell.nv, **stats, "rate_hz_median": 1e6 / stats["median_us"],
-            "rate_hz_p99": 1e6 / stats["p99_us"], "statuses": dict(statuses[label]),
+            "rate_hz_p99": 1e6 / stats["p99_us"], "statuses": dict(loop.statuses),
+            "interleaved": statistics(*(t[WARM_UP:] for t in times["interleaved"][label])),
         }  # fmt: skip
+        ctl = loop.ctl
         if cell.objects:
             row["grip_max_m"] = max(max(rec.grip.values()) for rec in ctl.log)
         if feet:
             row["slip_max_m"] = max(float(np.linalg.norm(cell.fk(ctl.q, f)[:3, 3] - p))
                                     for f, p in feet.items())  # fmt: skip
         if label != WITHOUT:
-            row["collision_ticks"] = near[label]
-            row["min_distance_m"] = None if near[label] == 0 else closest[label]
+            row["collision_ticks"] = loop.near
+            row["min_distance_m"] = None if loop.near == 0 else loop.closest
         rows.append(row)
-        progress(f"cells: {name}, {label}: median {stats['median_us']:.0f} us, "
-                 f"p99 {stats['p99_us']:.0f} us")  # fmt: skip
+        progress(f"cells: {name}, {label}: tight median {stats['median_us']:.0f} us, CPU p99 "
+                 f"{stats['cpu_p99_us']:.0f} us; interleaved median "
+                 f"{row['interleaved']['median_us']:.0f} us")  # fmt: skip
     not_run = [{"cell": name, "limits": label, "reason": why} for label, why in refused.items()]
     return rows, not_run
 
@@ -174,14 +190,18 @@ def _rate(hz: float) -> str:
 def readme_table(results: dict[str, Any]) -> str:
     """One row per case: tick median / p99 and the loop rate; the cases that did not run."""
     lines = [
-        "| cell | limits | tick median / p99 [us] | loop rate (median / p99) |",
-        "| --- | --- | ---: | ---: |",
+        "| cell | limits | tight: median / CPU p99 [us] | interleaved [us] | "
+        "loop rate (median / p99) |",
+        "| --- | --- | ---: | ---: | ---: |",
     ]
     for r in results["rows"]:
-        lines.append(f"| {r['cell']} | {r['limits']} | {us(r['median_us'])} / {us(r['p99_us'])} "
-                     f"| {_rate(r['rate_hz_median'])} / {_rate(r['rate_hz_p99'])} |")  # fmt: skip
+        mixed = r["interleaved"]
+        lines.append(f"| {r['cell']} | {r['limits']} | {us(r['median_us'])} / "
+                     f"{us(r['cpu_p99_us'])} | {us(mixed['median_us'])} / "
+                     f"{us(mixed['cpu_p99_us'])} | {_rate(r['rate_hz_median'])} / "
+                     f"{_rate(r['rate_hz_p99'])} |")  # fmt: skip
     for n in results["not_run"]:
-        lines.append(f"| {n['cell']} | {n['limits']} | not run: {_reason(n)} | |")
+        lines.append(f"| {n['cell']} | {n['limits']} | not run: {_reason(n)} | | |")
     s, load = results["settings"], results.get("load_average") or {}
     start, end = (load.get(k, [float("nan")])[0] for k in ("start", "end"))
     def binding(label: str) -> str:
@@ -192,7 +212,9 @@ def readme_table(results: dict[str, Any]) -> str:
         "",
         f"`CellController.step` at {1 / s['dt']:.0f} Hz, {s['ticks']:,} ticks a cell of random "
         f"commands held {s['hold_ticks'] * s['dt']:g} s (the held object's twist on gsfc_dual, "
-        "the body's on yeh_tripod), the controllers of a cell interleaved on one core. "
+        "the body's on yeh_tripod), on one core: tight (each controller of a cell "
+        "250 ticks in a row, by turns; the loop rate from its wall-clock median and p99) and "
+        "interleaved (every tick each controller once, in an order drawn at random). "
         f"Collision: the arms' capsules (ticks with collision rows: {binding(WITH)}), and a "
         f"ball in the way ({binding(BALL)}). Load average {start:.2f} at the start, {end:.2f} "
         "at the end (2 cores, shared).",
@@ -212,14 +234,15 @@ def docs_section(results: dict[str, Any]) -> str:
     lines = [
         f"One tick of `CellController.step` at {1 / s['dt']:.0f} Hz, {s['ticks']:,} ticks per "
         f"cell, random commands held {s['hold_ticks'] * s['dt']:g} s (the object's on "
-        "gsfc_dual, the body's on yeh_tripod), the controllers of a cell interleaved at every "
-        "tick on one core.",
+        "gsfc_dual, the body's on yeh_tripod), on one core: tight (each controller of a cell "
+        "250 ticks in a row, by turns) and interleaved (every tick each controller once, in an "
+        "order drawn at random); the statuses and checks of the tight run.",
         "",
-        "| cell | rates | limits | median [us] | p10 | p90 | p99 | max | loop rate (median) | "
-        "(p99) | grip max [m] | foot slip [m] | ticks with collision rows | closest [m] | "
-        "statuses |",
+        "| cell | rates | limits | median [us] | p10 | p90 | p99 | max | CPU p99 | "
+        "interleaved median / CPU p99 | loop rate (median) | (p99) | grip max [m] | "
+        "foot slip [m] | ticks with collision rows | closest [m] | statuses |",
         "| --- | ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | "
-        "---: | ---: | --- |",
+        "---: | ---: | ---: | ---: | --- |",
     ]
     for r in results["rows"]:
         statuses = ", ".join(f"{k} {v:,}" for k, v in sorted(r["statuses"].items()))
@@ -230,7 +253,9 @@ def docs_section(results: dict[str, Any]) -> str:
         lines.append(
             f"| {r['cell']} | {r['nv']} | {r['limits']} | {us(r['median_us'])} | "
             f"{us(r['p10_us'])} | {us(r['p90_us'])} | {us(r['p99_us'])} | {us(r['max_us'])} | "
-            f"{_rate(r['rate_hz_median'])} | {_rate(r['rate_hz_p99'])} | {grip} | {slip} | "
+            f"{us(r['cpu_p99_us'])} | {us(r['interleaved']['median_us'])} / "
+            f"{us(r['interleaved']['cpu_p99_us'])} | {_rate(r['rate_hz_median'])} | "
+            f"{_rate(r['rate_hz_p99'])} | {grip} | {slip} | "
             f"{rows_} | {closest} | {statuses} |"
         )
     for n in results["not_run"]:
@@ -262,6 +287,8 @@ def plot(results: dict[str, Any], path: Path) -> bool:
               for r in rows]  # fmt: skip
     ax.bar(x, med, color=colors, yerr=[low, high], capsize=4, label="median, p10-p90")
     ax.plot(x, [r["p99_us"] for r in rows], "k_", markersize=18, mew=2, label="p99")
+    ax.plot(x, [r["interleaved"]["median_us"] for r in rows], "kv", markersize=6,
+            label="median, interleaved")  # fmt: skip
     period = 1e6 * results["settings"]["dt"]
     ax.axhline(period, color="gray", ls="--", lw=1)
     ax.text(len(rows) - 0.5, period * 1.05, f"the period at {1e6 / period:.0f} Hz", ha="right",
@@ -274,7 +301,8 @@ def plot(results: dict[str, Any], path: Path) -> bool:
     ax.set_ylim(min(r["p10_us"] for r in rows) * 0.5, period * 2.5)
     ax.set_ylabel("one tick [us]")
     ax.legend(fontsize=8, loc="upper left")
-    title = "CellController.step on one core; the loop rate at the median above each bar"
+    title = ("CellController.step on one core, tight (bars) and interleaved; the loop rate at "
+             "the tight median above each bar")
     if results["not_run"]:
         title += "\nnot run: " + "; ".join(f"{n['cell']} with {n['limits']} ({_reason(n)})"
                                            for n in results["not_run"])  # fmt: skip

@@ -14,18 +14,22 @@ The cell: two pandas facing each other 1.0 m apart (``rrc_pin.combine``), capsul
 (:mod:`collision_peers`; MuJoCo's ``mj_geomDistance`` equals coal's distance to 1e-15 on them).
 Each hand is commanded toward the other (0.3 m/s at most, position rows) plus a tangential
 0.05 m/s along +z, so that the hands meet and then have to slide. Every contender runs its own
-closed loop (its own q, integrated at 100 Hz) on the same commands, interleaved tick by tick
-(each tick steps every contender once, in turn).
+closed loop (its own q, integrated at 100 Hz) on the same commands, in two modes, each from
+fresh contenders: tight (each contender 250 ticks in a row, by turns: caches and branch
+predictors hot for it) and interleaved (every tick each contender once, in an order drawn at
+random: each step finds the caches its peers left; after pink's milliseconds of step a tick of
+ours finds little of its code and data there).
 
 Pair sets (the number of pairs each library checks): the inter-arm pairs between links from
 ``panda_link<K>`` to the fingers for K = 8 (hand and fingers), 6, 4, then every pair of the
 cell (224, self-collision included).
 
-Per contender and pair set: the step's time (median, p99; one call from q and the command to
-the joint rates, distances included), the minimum distance over every pair of the cell reached
-(coal, the same capsules), the tangential progress while constrained (the hands' mean +z speed
-over the commanded 0.05 m/s, on ticks where a pair is closer than twice the safety distance),
-and the largest joint-rate jump at a tick where a pair enters the detection distance.
+Per contender, pair set and mode: the step's time (median and the other percentiles, wall clock and
+the thread's CPU time; one call from q and the command to the joint rates, distances included); per
+contender and pair set, of its tight loop: the minimum distance over every pair of the cell reached
+(coal, the same capsules), the tangential progress while constrained (the hands' mean +z speed over
+the commanded 0.05 m/s, on ticks where a pair is closer than twice the safety distance), and the
+largest joint-rate jump at a tick where a pair enters the detection distance.
 Settings: safety 0.02 m, detection 0.10 m; rrc-pin's gain 0.5 m/s; mink's gain 0.85 (its
 default) with the same distances; pink's barrier gain 1, d_min 0.02, every pair of the set.
 """
@@ -46,7 +50,7 @@ import pinocchio as pin
 from collision_peers import mjcf
 from collision_soak import soak
 from script import arguments, make_parser, mark_quick, measure, pyplot, write
-from timing import progress
+from timing import BLOCK, closed_loops, progress, statistics, timed
 
 import rrc_pin
 from rrc_pin import CollisionLimit, CollisionModel, FrameTask, JointLimits, Resolver
@@ -55,6 +59,11 @@ DT = 0.01
 SAFETY, DETECTION = 0.02, 0.10
 SPEED, SLIDE = 0.3, 0.05
 LINKS = (8, 6, 4, None)
+MODES = ("tight", "interleaved")
+SEED = 2026
+"""Of the interleaved mode's orders."""
+WARM_UP = 10
+"""First ticks of each loop left out of the statistics (first calls' set-up)."""
 
 
 def cell() -> tuple[rrc_pin.Robot, CollisionModel]:
@@ -180,76 +189,91 @@ class Pink:
                                   safety_break=False)  # fmt: skip
 
 
+class Loop:
+    """One contender's closed loop on the cell (its own q, integrated at 100 Hz), and what it
+    reached: the minimum distance, the tangential progress while constrained, the largest
+    joint-rate jump where a pair enters the detection distance."""
+
+    def __init__(self, contender: Any, robot: rrc_pin.Robot, cm: CollisionModel) -> None:
+        self.contender, self.robot, self.cm = contender, robot, cm
+        self.q = robot.ready().copy()
+        self.minimum, self.jump = np.inf, 0.0
+        self.progress: list[float] = []
+        self.last: tuple[Any, int] = (None, 0)
+
+    def __call__(self, k: int) -> tuple[float, float]:
+        """Tick ``k``: the contender's step timed (wall-clock and CPU seconds), then its
+        integration and what it reached."""
+        robot, q = self.robot, self.q
+        v = commands(robot, q)
+        qdot, wall, cpu = timed(lambda: self.contender.step(q, v))
+        qdot = np.nan_to_num(np.asarray(qdot, dtype=float))
+        hands_before = [robot.frame_pose(q, f)[2, 3] for f in robot.tool_frames]
+        self.q = q = np.clip(q + DT * qdot, robot.lower, robot.upper)
+        prox = self.cm.proximity_at(q, DETECTION)
+        near = len(prox.names)
+        if near:
+            d = float(prox.distance.min())
+            self.minimum = min(self.minimum, d)
+            if d < 2 * SAFETY:
+                hands = [robot.frame_pose(q, f)[2, 3] for f in robot.tool_frames]
+                self.progress.append(np.mean(np.subtract(hands, hands_before)) / DT / SLIDE)
+        previous, count = self.last
+        if previous is not None and near > count:
+            self.jump = max(self.jump, float(np.abs(qdot - previous).max()))
+        self.last = (qdot, near)
+        return wall, cpu
+
+
 def run(ticks: int) -> dict[str, Any]:
+    """Every contender on every pair set, in both modes (module docstring)."""
     robot, cm = cell()
     rows = []
+    order = np.random.default_rng(SEED)
     for k in LINKS:
         pairs = pair_set(cm, k)
-        contenders = [kind(robot, cm, pairs) for kind in (Rrc, Mink, Pink)]
-        state = {c.label: robot.ready().copy() for c in contenders}
-        times: dict[str, list[float]] = {c.label: [] for c in contenders}
-        minimum = dict.fromkeys(state, np.inf)
-        progress_z: dict[str, list[float]] = {c.label: [] for c in contenders}
-        jump = dict.fromkeys(state, 0.0)
-        last: dict[str, Any] = {c.label: (None, 0) for c in contenders}
-        for tick in range(ticks):
-            for c in contenders:
-                q = state[c.label]
-                v = commands(robot, q)
-                start = time.perf_counter()
-                qdot = c.step(q, v)
-                times[c.label].append(time.perf_counter() - start)
-                qdot = np.nan_to_num(np.asarray(qdot, dtype=float))
-                hands_before = [robot.frame_pose(q, f)[2, 3] for f in robot.tool_frames]
-                q = np.clip(q + DT * qdot, robot.lower, robot.upper)
-                state[c.label] = q
-                prox = cm.proximity_at(q, DETECTION)
-                near = len(prox.names)
-                if near:
-                    d = float(prox.distance.min())
-                    minimum[c.label] = min(minimum[c.label], d)
-                    if d < 2 * SAFETY:
-                        hands = [robot.frame_pose(q, f)[2, 3] for f in robot.tool_frames]
-                        rise = np.mean(np.subtract(hands, hands_before)) / DT
-                        progress_z[c.label].append(rise / SLIDE)
-                previous, count = last[c.label]
-                if previous is not None and near > count:
-                    jump[c.label] = max(jump[c.label], float(np.abs(qdot - previous).max()))
-                last[c.label] = (qdot, near)
-            if tick % 200 == 0:
-                progress(f"{len(pairs)} pairs: tick {tick}")
-        for c in contenders:
-            t = np.array(times[c.label][10:]) * 1e6
+        modes, loops = {}, {}
+        for mode in MODES:
+            loops[mode] = {c.label: Loop(c, robot, cm)
+                           for c in (kind(robot, cm, pairs) for kind in (Rrc, Mink, Pink))}
+            progress(f"{len(pairs)} pairs: {mode}")
+            modes[mode] = closed_loops(mode, loops[mode], ticks, order)  # fmt: skip
+        for label, loop in loops["tight"].items():
+            c = loop.contender
             share = {}
             if isinstance(c, Rrc):
-                share = {"limit_median_us": float(np.median(c.limit_times[10:]) * 1e6),
-                         "limit_rows_median": float(np.median(c.limit_rows[10:]))}  # fmt: skip
+                share = {"limit_median_us": float(np.median(c.limit_times[WARM_UP:]) * 1e6),
+                         "limit_rows_median": float(np.median(c.limit_rows[WARM_UP:]))}  # fmt: skip
             rows.append({
-                "contender": c.label, "pairs": len(pairs), "median_us": float(np.median(t)),
-                "p99_us": float(np.percentile(t, 99)),
-                "min_distance_m": float(minimum[c.label]),
-                "tangential_progress": float(np.mean(progress_z[c.label]))
-                if progress_z[c.label] else None,
-                "constrained_ticks": len(progress_z[c.label]),
-                "largest_activation_jump": jump[c.label], **share,
+                "contender": label, "pairs": len(pairs),
+                "modes": {mode: statistics(*(t[WARM_UP:] for t in modes[mode][label]))
+                          for mode in MODES},
+                "min_distance_m": float(loop.minimum),
+                "tangential_progress": float(np.mean(loop.progress)) if loop.progress else None,
+                "constrained_ticks": len(loop.progress),
+                "largest_activation_jump": loop.jump, **share,
             })  # fmt: skip
             progress(str(rows[-1]))
     return {"settings": {"ticks": ticks, "dt": DT, "safety": SAFETY, "detection": DETECTION,
-                         "speed": SPEED, "slide": SLIDE}, "rows": rows}  # fmt: skip
+                         "speed": SPEED, "slide": SLIDE, "modes": list(MODES)},
+            "rows": rows}  # fmt: skip
 
 
 def _table(results: dict[str, Any], full: bool) -> str:
-    """One row per pair set: each contender's median (p99) step and minimum distance."""
+    """One row per pair set: each contender's median / CPU p99 step, tight and interleaved,
+    and its minimum distance."""
     rows = results["rows"]
     labels = list(dict.fromkeys(r["contender"] for r in rows))
     sets = sorted({r["pairs"] for r in rows})
-    head = "| pairs | " + " | ".join(f"{label} median / p99 [us] | min [mm]" for label in labels)
-    lines = [head + (" | rrc-pin limit's share [us] (rows) |" if full else " |"),
-             "| ---: |" + " ---: | ---: |" * len(labels) + (" ---: |" if full else "")]  # fmt: skip
+    head = "| pairs | " + " | ".join(
+        f"{label}, tight [us] | interleaved [us] | min [mm]" for label in labels)
+    rule = "| ---: |" + " ---: | ---: | ---: |" * len(labels) + (" ---: |" if full else "")
+    lines = [head + (" | rrc-pin limit's share [us] (rows) |" if full else " |"), rule]
     for n in sets:
         by = {r["contender"]: r for r in rows if r["pairs"] == n}
-        cells = [f"{by[lb]['median_us']:,.0f} / {by[lb]['p99_us']:,.0f} | "
-                 f"{_millimetres(by[lb]['min_distance_m'])}" for lb in labels]  # fmt: skip
+        cells = [" | ".join(f"{m['median_us']:,.0f} / {m['cpu_p99_us']:,.0f}"
+                            for m in (by[lb]["modes"][mode] for mode in MODES))
+                 + f" | {_millimetres(by[lb]['min_distance_m'])}" for lb in labels]  # fmt: skip
         line = f"| {n} | " + " | ".join(cells) + " |"
         ours = by.get(Rrc.label, {})
         if full and "limit_median_us" in ours:
@@ -262,9 +286,12 @@ def _table(results: dict[str, Any], full: bool) -> str:
     s = results["settings"]
     never = "" if all(math.isfinite(r["min_distance_m"]) for r in rows) else (
         f" min -: no pair came within the detection distance ({s['detection'] * 1e3:.0f} mm).")
-    lines += ["", f"Safety {s['safety'] * 1e3:.0f} mm, {s['ticks']:,} ticks a pair set, "
-              f"interleaved in one process; load average {start:.1f} at the start, {end:.1f} "
-              f"at the end (2 cores).{never}"]  # fmt: skip
+    lines += ["", "Step time: the wall-clock median / the CPU time's p99. "
+              f"Safety {s['safety'] * 1e3:.0f} mm, {s['ticks']:,} ticks a pair set and "
+              f"mode, one process: tight (each contender {BLOCK} ticks in a row, by turns) and "
+              "interleaved (every tick each contender once, in an order drawn at random: each "
+              "finds the caches its peers left); load average "
+              f"{start:.1f} at the start, {end:.1f} at the end (2 cores).{never}"]  # fmt: skip
     return "\n".join(lines)
 
 
@@ -303,7 +330,10 @@ def plot(results: dict[str, Any], path: Path) -> bool:
         rows = sorted((r for r in results["rows"] if r["contender"] == label),
                       key=lambda r: r["pairs"])  # fmt: skip
         x = [r["pairs"] for r in rows]
-        line = ax[0].plot(x, [r["median_us"] for r in rows], "o-", label=label)[0]
+        line = ax[0].plot(x, [r["modes"]["tight"]["median_us"] for r in rows], "o-",
+                          label=f"{label}, tight")[0]  # fmt: skip
+        ax[0].plot(x, [r["modes"]["interleaved"]["median_us"] for r in rows], "^:",
+                   color=line.get_color(), label=f"{label}, interleaved")  # fmt: skip
         if all("limit_median_us" in r for r in rows):
             ax[0].plot(x, [r["limit_median_us"] for r in rows], "s--", color=line.get_color(),
                        label=f"{label}: the limit's share")  # fmt: skip

@@ -274,9 +274,13 @@ def _collision(results: dict[str, Any]) -> Iterator[str]:
         yield "rows: empty"
     for r in rows:
         where = f"rows.{r.get('contender')}.{r.get('pairs')}"
-        for key in ("median_us", "p99_us", "pairs"):
-            if not _positive(r.get(key)):
-                yield f"{where}.{key}: expected a positive number"
+        if not _positive(r.get("pairs")):
+            yield f"{where}.pairs: expected a positive number"
+        for mode in ("tight", "interleaved"):
+            stats = (r.get("modes") or {}).get(mode) or {}
+            for key in ("median_us", "cpu_p99_us"):
+                if not _positive(stats.get(key)):
+                    yield f"{where}.modes.{mode}.{key}: expected a positive number"
         if not isinstance(r.get("min_distance_m"), (int, float)):
             yield f"{where}.min_distance_m: expected a number"
 
@@ -325,9 +329,12 @@ def _cells(results: dict[str, Any]) -> Iterator[str]:
             yield f"rows.{cell}: no tick with collision constraints, and no reason in not_run"
     for r in rows:
         where = f"rows.{r.get('cell')}.{r.get('limits')}"
-        for key in (*STATS, "rate_hz_median", "rate_hz_p99", "ticks"):
+        for key in (*STATS, "cpu_p99_us", "rate_hz_median", "rate_hz_p99", "ticks"):
             if not _positive(r.get(key)):
                 yield f"{where}.{key}: expected a positive number"
+        for key in ("median_us", "cpu_p99_us"):
+            if not _positive((r.get("interleaved") or {}).get(key)):
+                yield f"{where}.interleaved.{key}: expected a positive number"
         if not isinstance(r.get("collision"), bool):
             yield f"{where}.collision: expected true or false"
         if not r.get("statuses"):

@@ -7,9 +7,9 @@ of options), called exactly as its users call it, the whole call timed with
 
 - ``tight``: one contender at a time, every step back to back (what a micro-benchmark
   measures: caches, branch predictors and the CPU clock stay hot for that contender);
-- ``interleaved``: at every step every contender is called once, in an order rotated by one
-  at each step (each contender in turn first, after each of the others), so that each call
-  finds the caches left by its peers (one process running several libraries);
+- ``interleaved``: at every step every contender is called once, in an order drawn at random
+  at each step (each contender first and after each of the others by turns), so that each
+  call finds the caches left by its peers (one process running several libraries);
 - ``busy``: one contender at a time, and between two calls 1 ms of other work
   (:class:`OtherWork`: numpy products and Pinocchio kinematics of another model, as a
   controller does between ticks), so that each call finds its caches cooled by a tick's
@@ -142,6 +142,7 @@ def run_mode(
     Q: Array,
     X: Array,
     other: Callable[[], None] | None = None,
+    rng: np.random.Generator | None = None,
 ) -> dict[str, Run]:
     """Time ``contenders`` along the trajectory ``(Q, X)`` in ``mode`` (module docstring).
 
@@ -151,6 +152,7 @@ def run_mode(
         Q: Configurations (steps, n) [rad].
         X: Commands (steps, m).
         other: The ``busy`` mode's work between calls (default :class:`OtherWork`).
+        rng: The ``interleaved`` mode's draws of the order (default seeded 0).
 
     Returns:
         A :class:`Run` per contender label.
@@ -166,9 +168,10 @@ def run_mode(
         _step(c, Q[0], X[0])
     m = len(contenders)
     if mode == "interleaved":
+        order = np.random.default_rng(0) if rng is None else rng
         for k in range(steps):
-            for i in range(m):  # rotated: each contender in turn first, after each other
-                c = contenders[(k + i) % m]
+            for i in order.permutation(m):
+                c = contenders[i]
                 _record(runs[c.label], c, k, *_step(c, Q[k], X[k]))
         return runs
     if mode not in ("tight", "busy"):
@@ -184,6 +187,48 @@ def run_mode(
                 if work is not None:
                     work()
     return runs
+
+
+def timed(call: Callable[[], Any]) -> tuple[Any, float, float]:
+    """``call()``'s answer, its wall-clock seconds and the thread's CPU seconds."""
+    clock, cpu = time.perf_counter, time.thread_time
+    c0, t0 = cpu(), clock()
+    out = call()
+    t1, c1 = clock(), cpu()
+    return out, t1 - t0, c1 - c0
+
+
+def closed_loops(
+    mode: str, loops: dict[str, Callable[[int], tuple[float, float]]], ticks: int,
+    rng: np.random.Generator,
+) -> dict[str, tuple[Array, Array]]:
+    """Run closed loops (each its own state, advanced by ``loops[label](k)`` at tick k, which
+    returns its timed call's wall-clock and CPU seconds) for ``ticks`` ticks in ``mode``:
+    ``tight``, each loop :data:`BLOCK` ticks in a row, in turns rotated every round;
+    ``interleaved``, every tick each loop once, in an order drawn from ``rng``.
+
+    Returns:
+        Per label the wall-clock and the CPU seconds of its ticks (ticks,).
+    """
+    out = {label: (np.empty(ticks), np.empty(ticks)) for label in loops}
+    labels = list(loops)
+
+    def advance(label: str, k: int) -> None:
+        out[label][0][k], out[label][1][k] = loops[label](k)
+
+    if mode == "interleaved":
+        for k in range(ticks):
+            for i in rng.permutation(len(labels)):
+                advance(labels[i], k)
+        return out
+    if mode != "tight":
+        raise ValueError(f"unknown mode {mode!r}; expected tight or interleaved")
+    for turn, a in enumerate(range(0, ticks, BLOCK)):
+        for i in range(len(labels)):
+            label = labels[(turn + i) % len(labels)]
+            for k in range(a, min(a + BLOCK, ticks)):
+                advance(label, k)
+    return out
 
 
 def _step(c: Contender, q: Array, x: Array) -> tuple[Any, float, float, str]:
