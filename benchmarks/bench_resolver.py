@@ -184,7 +184,7 @@ def damped_ticks(first: dict[str, Any]) -> dict[str, Any]:
     if not mask.any():
         return out
     for label, run in first.items():
-        answered = mask & ~run.failed
+        answered = mask & ~run.failed & run.counted
         if answered.any():
             out["contenders"][label] = statistics(run.seconds[answered], run.cpu[answered])
     placo = out["contenders"].get(PLACO)
@@ -204,7 +204,7 @@ def profile_default(arm: Any, Q: Array, X: Array) -> dict[str, Any]:
     run = run_mode("tight", [Contender(RRC, plain.solve, lambda r: r.qdot)], Q, X)
     resolver = rrc_pin.Resolver(arm, dt=DT)
     profile = profile_steps(lambda q, x: resolver.solve(q, x), resolver, Q, X, rates)
-    profile["plain_median_us"] = float(np.median(run[RRC].seconds) * 1e6)
+    profile["plain_median_us"] = float(np.median(run[RRC].seconds[run[RRC].counted]) * 1e6)
     profile["overhead_us"] = (
         profile["stages"]["all"]["total"]["median_us"] - profile["plain_median_us"]
     )

@@ -21,8 +21,12 @@ steps (the order rotated at every round of turns), each going through the trajec
 order, so that every contender samples the whole run's machine state: on a shared machine
 the load of other processes drifts within seconds, and one contender timed at once over the
 whole trajectory would meet a different machine than the next (measured: the medians of
-identical code paths differed by up to 1.9x that way). The first call of a turn finds the
-caches of the previous contender; that is 1 call in 250 (0.4%), below the 99th percentile.
+identical code paths differed by up to 1.9x that way). The first calls of a turn find the
+caches of the previous contender: rrc-pin's panda tick took 128 us on the first call after
+2.5 ms of other work, 18 on the second, 11 on the third, 8-10 after (medians over 24 turns),
+so that these calls, 2 in 250, made most of the tight mode's top 1 %. The ``tight`` mode
+leaves the first :data:`TURN_WARM_UP` calls of every turn out of its statistics, for every
+contender: it measures the hot loop; the other two modes measure calls with cooled caches.
 
 Each mode starts from fresh contenders (warm starts carry from step to step within a mode,
 as in a control loop) and calls each once, untimed, at the first step before timing.
@@ -58,6 +62,8 @@ OTHER_WORK = 1e-3
 """[s] The other work between two calls of the ``busy`` mode."""
 BLOCK = 250
 """Steps a contender runs in one turn of the ``tight`` and ``busy`` modes."""
+TURN_WARM_UP = 5
+"""First calls of a ``tight`` turn left out of its statistics (module docstring)."""
 REPEATS = 3
 """Rounds of every mode in a full run (``--quick``: one), each from fresh contenders: one
 round's medians move by up to 2x between runs on the project's shared 2-core machine:
@@ -124,6 +130,8 @@ class Run:
             less the time the scheduler gave the core to another process.
         rates: Joint rates of each step (steps, n) [rad/s] (zero where it failed).
         failed: Steps where the call raised (steps,).
+        counted: Steps whose times count in the statistics (steps,): all but the first
+            :data:`TURN_WARM_UP` of each ``tight`` turn.
         kept: What the calls returned, if the contender keeps it.
         first_error: The first failure's exception (type and message), or "".
     """
@@ -132,6 +140,7 @@ class Run:
     rates: Array
     failed: npt.NDArray[np.bool_]
     cpu: Array = field(default_factory=lambda: np.empty(0))
+    counted: npt.NDArray[np.bool_] = field(default_factory=lambda: np.ones(0, dtype=bool))
     kept: list[Any] = field(default_factory=list)
     first_error: str = ""
 
@@ -160,7 +169,8 @@ def run_mode(
     steps, n = Q.shape
     runs = {
         c.label: Run(
-            np.empty(steps), np.zeros((steps, n)), np.zeros(steps, dtype=bool), np.empty(steps)
+            np.empty(steps), np.zeros((steps, n)), np.zeros(steps, dtype=bool), np.empty(steps),
+            np.ones(steps, dtype=bool),
         )
         for c in contenders
     }
@@ -186,6 +196,8 @@ def run_mode(
                 _record(run, c, k, *_step(c, Q[k], X[k]))
                 if work is not None:
                     work()
+            if mode == "tight":
+                run.counted[a : a + TURN_WARM_UP] = False
     return runs
 
 
@@ -208,7 +220,8 @@ def closed_loops(
     ``interleaved``, every tick each loop once, in an order drawn from ``rng``.
 
     Returns:
-        Per label the wall-clock and the CPU seconds of its ticks (ticks,).
+        Per label the wall-clock and the CPU seconds of its ticks (ticks,), in ``tight`` mode
+        without the first :data:`TURN_WARM_UP` of each turn (module docstring).
     """
     out = {label: (np.empty(ticks), np.empty(ticks)) for label in loops}
     labels = list(loops)
@@ -228,7 +241,8 @@ def closed_loops(
             label = labels[(turn + i) % len(labels)]
             for k in range(a, min(a + BLOCK, ticks)):
                 advance(label, k)
-    return out
+    counted = np.arange(ticks) % BLOCK >= TURN_WARM_UP
+    return {label: (wall[counted], cpu[counted]) for label, (wall, cpu) in out.items()}
 
 
 def _step(c: Contender, q: Array, x: Array) -> tuple[Any, float, float, str]:
@@ -318,7 +332,7 @@ def summarise(
     lower, upper, velocity = limits
     out: dict[str, dict[str, Any]] = {}
     for label, run in runs.items():
-        row: dict[str, Any] = statistics(run.seconds, run.cpu)
+        row: dict[str, Any] = statistics(run.seconds[run.counted], run.cpu[run.counted])
         row.update(compliance(Q, run.rates, lower, upper, velocity, dt))
         row["failures"] = int(run.failed.sum())
         if run.first_error:
