@@ -66,7 +66,7 @@ the first step before timing):
 
 - **tight loop**: one contender at a time, every step back to back: caches, branch
   predictors and the CPU clock stay hot for that contender (what a micro-benchmark measures);
-- **interleaved**: at every step every contender is called once, in an order rotated by one
+- **interleaved**: at every step every contender is called once, in an order drawn at random
   at each step, so each call finds the caches its peers left (one process running several
   libraries);
 - **1 ms of other work between calls** (the peers comparison): one contender at a time, and
@@ -75,7 +75,12 @@ the first step before timing):
 
 In the tight and other-work modes the contenders take turns of 250 steps, in an order
 rotated at every turn, so that the machine's load drifting over the run meets every
-contender alike. Statistics per contender and mode: median, 10th, 90th and 99th percentiles
+contender alike. The first calls of a turn find the caches of the previous contender
+(rrc-pin's panda tick: 128 us on the first call after other work, 18 on the second, 11 on
+the third, 8-10 after): the tight mode leaves the first 5 calls of every turn out of its
+statistics, for every contender; the other two modes measure calls with cooled caches. The
+collision and cells benchmarks run closed loops (each contender its own state) in the tight
+and interleaved modes the same way. Statistics per contender and mode: median, 10th, 90th and 99th percentiles
 and mean [us]; ratios to a peer measured in the same run, mode and round (the peer's time
 over the contender's: above 1, the contender is faster); the largest excess over the
 velocity limits and over the position limits after one Euler step; failures (the library
