@@ -80,17 +80,17 @@ contender alike. The first calls of a turn find the caches of the previous conte
 the third, 8-10 after): the tight mode leaves the first 5 calls of every turn out of its
 statistics, for every contender; the other two modes measure calls with cooled caches. The
 collision and cells benchmarks run closed loops (each contender its own state) in the tight
-and interleaved modes the same way. Statistics per contender and mode: median, 10th, 90th and 99th percentiles
-and mean [us]; ratios to a peer measured in the same run, mode and round (the peer's time
-over the contender's: above 1, the contender is faster); the largest excess over the
-velocity limits and over the position limits after one Euler step; failures (the library
-raised; its rates taken as zero). BLAS threads are pinned to one for every library (the
-matrices are tiny). The machine is shared: the load average (1 minute) at the start and end
-of each benchmark is recorded. It counts the benchmark's own process too: a benchmark that
-runs right after another one starts at about 1 on its own, and ends near 1 plus what other
-processes add; those inflate the tails more than the medians. On a machine with more
-runnable processes than cores, a call that loses its core waits a scheduler time slice
-(about 4 ms): the p99 then measures the machine, not the library."""
+and interleaved modes the same way. Statistics per contender and mode: median, 10th, 90th
+and 99th percentiles and mean [us]; ratios to a peer measured in the same run, mode and
+round (the peer's time over the contender's: above 1, the contender is faster); the largest
+excess over the velocity limits and over the position limits after one Euler step; failures
+(the library raised; its rates taken as zero). BLAS threads are pinned to one for every
+library (the matrices are tiny). The machine is shared: the load average (1 minute) at the
+start and end of each benchmark is recorded. It counts the benchmark's own process too: a
+benchmark that runs right after another one starts at about 1 on its own, and ends near 1
+plus what other processes add; those inflate the tails more than the medians. On a machine
+with more runnable processes than cores, a call that loses its core waits a scheduler time
+slice (about 4 ms): the p99 then measures the machine, not the library."""
 
 PEERS_TEXT = """\
 PlaCo 0.10 pins `pin==3.8.0`, so the comparison of rrc-pin with PlaCo, pink, mink and Drake
