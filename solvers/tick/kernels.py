@@ -18,7 +18,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.compiled import inlined, kernel
 
 Array = npt.NDArray[np.float64]
 
@@ -269,18 +269,20 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
         sigma: Out: the singular values (k,), descending.
     """
     m, k = A.shape
-    V[:, :] = 0.0
+    columns, rotations = A.T.copy(), np.zeros((k, k))  # rows: A's and V's columns, contiguous
     for i in range(k):
-        V[i, i] = 1.0
+        rotations[i, i] = 1.0
     for _ in range(SWEEPS):
         rotated = False
         for p in range(k - 1):
+            a_p, v_p = columns[p], rotations[p]
             for q in range(p + 1, k):
+                a_q = columns[q]
                 alpha = beta = gamma = 0.0
                 for i in range(m):
-                    alpha += A[i, p] * A[i, p]
-                    beta += A[i, q] * A[i, q]
-                    gamma += A[i, p] * A[i, q]
+                    alpha += a_p[i] * a_p[i]
+                    beta += a_q[i] * a_q[i]
+                    gamma += a_p[i] * a_q[i]
                 if gamma == 0.0 or abs(gamma) <= 1e-15 * math.sqrt(alpha * beta):
                     continue
                 rotated = True
@@ -288,18 +290,14 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
                 t = math.copysign(1.0, zeta) / (abs(zeta) + math.hypot(1.0, zeta))
                 c = 1.0 / math.sqrt(1.0 + t * t)
                 s = c * t
-                for i in range(m):
-                    ap, aq = A[i, p], A[i, q]
-                    A[i, p], A[i, q] = c * ap - s * aq, s * ap + c * aq
-                for i in range(k):
-                    vp, vq = V[i, p], V[i, q]
-                    V[i, p], V[i, q] = c * vp - s * vq, s * vp + c * vq
+                _rotate(a_p, a_q, c, s)
+                _rotate(v_p, rotations[q], c, s)
         if not rotated:
             break
     for j in range(k):
         s = 0.0
         for i in range(m):
-            s += A[i, j] * A[i, j]
+            s += columns[j, i] * columns[j, i]
         sigma[j] = math.sqrt(s)
     for j in range(k):  # selection sort, descending, columns of A and V alike
         best = j
@@ -308,10 +306,25 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
                 best = i
         if best != j:
             sigma[j], sigma[best] = sigma[best], sigma[j]
-            for i in range(m):
-                A[i, j], A[i, best] = A[i, best], A[i, j]
-            for i in range(k):
-                V[i, j], V[i, best] = V[i, best], V[i, j]
+            _swap(columns[j], columns[best])
+            _swap(rotations[j], rotations[best])
+    A[:, :] = columns.T
+    V[:, :] = rotations.T
+
+
+@inlined
+def _rotate(x: Array, y: Array, c: float, s: float) -> None:
+    """The plane rotation ``(x, y) <- (c x - s y, s x + c y)``, in place."""
+    for i in range(x.size):
+        xi, yi = x[i], y[i]
+        x[i], y[i] = c * xi - s * yi, s * xi + c * yi
+
+
+@inlined
+def _swap(x: Array, y: Array) -> None:
+    """``x`` and ``y`` exchanged, in place."""
+    for i in range(x.size):
+        x[i], y[i] = y[i], x[i]
 
 
 @kernel
