@@ -261,7 +261,9 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
 
     Plane rotations of pairs of columns until all are orthogonal (Demmel & Veselic 1992,
     Algorithm 4.1: the rotation that zeroes :math:`a_p^T a_q`), accumulated in V; the column
-    norms are then the singular values. Columns are sorted by decreasing norm at the end.
+    norms are then the singular values. Columns are sorted by decreasing norm at the end. A
+    pair of columns without a row in common (a block of the rows, as two hands' on two arms)
+    is orthogonal exactly, and left as the test would leave it.
 
     Args:
         A: The matrix (m, k); out: its columns rotated, ``U diag(sigma)``.
@@ -272,11 +274,14 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
     columns, rotations = A.T.copy(), np.zeros((k, k))  # rows: A's and V's columns, contiguous
     for i in range(k):
         rotations[i, i] = 1.0
+    support = _supports(columns)
     for _ in range(SWEEPS):
         rotated = False
         for p in range(k - 1):
             a_p, v_p = columns[p], rotations[p]
             for q in range(p + 1, k):
+                if support[p] & support[q] == 0:  # no row in common: a_p^T a_q is 0 exactly
+                    continue
                 a_q = columns[q]
                 alpha = beta = gamma = 0.0
                 for i in range(m):
@@ -292,6 +297,7 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
                 s = c * t
                 _rotate(a_p, a_q, c, s)
                 _rotate(v_p, rotations[q], c, s)
+                support[p] = support[q] = support[p] | support[q]
         if not rotated:
             break
     for j in range(k):
@@ -310,6 +316,23 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
             _swap(rotations[j], rotations[best])
     A[:, :] = columns.T
     V[:, :] = rotations.T
+
+
+@inlined
+def _supports(columns: Array) -> npt.NDArray[np.int64]:
+    """Per row of ``columns`` (k, m), the bits of its nonzero entries (every bit where m > 63:
+    a pair of rows is then never found disjoint)."""  # noqa: D205, D209
+    k, m = columns.shape
+    support = np.full(k, -1, np.int64)
+    if m > 63:
+        return support
+    for j in range(k):
+        bits = 0
+        for i in range(m):
+            if columns[j, i] != 0.0:
+                bits |= 1 << i
+        support[j] = bits
+    return support
 
 
 @inlined
