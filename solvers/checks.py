@@ -69,7 +69,7 @@ def finite_array(x: npt.ArrayLike, name: str) -> npt.NDArray[np.float64]:
 
 def all_finite(x: npt.NDArray[np.float64]) -> bool:
     """Whether every entry of ``x`` is finite (no NaN or infinity)."""
-    return kernels.all_finite(x.reshape(-1))
+    return kernels.all_finite(x if x.ndim == 1 else x.reshape(-1))
 
 
 def real_array(

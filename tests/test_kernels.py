@@ -78,6 +78,21 @@ def test_jacobi_svd_against_lapack(m: int, k: int, rng: np.random.Generator) -> 
             np.testing.assert_allclose(np.linalg.norm(US, axis=0), sigma, atol=1e-12 * sigma[0])
 
 
+def test_jacobi_svd_of_blocks_against_lapack(rng: np.random.Generator) -> None:
+    """Columns without a row in common (two arms' blocks, a zero column) are left as they are
+    orthogonal; the SVD is LAPACK's."""
+    for trial in range(200):
+        A = np.zeros((12, 10))
+        A[:6, :5], A[6:, 5:] = rng.normal(size=(6, 5)), rng.normal(size=(6, 5))
+        A[:, trial % 10] = 0.0 if trial % 3 == 0 else A[:, trial % 10]
+        US, V, sigma = A.copy(), np.empty((10, 10)), np.empty(10)
+        kernels.jacobi_svd(US, V, sigma)
+        reference = np.linalg.svd(A, compute_uv=False)
+        np.testing.assert_allclose(sigma, reference, atol=1e-12 * reference[0])
+        np.testing.assert_allclose(V.T @ V, np.eye(10), atol=1e-13)
+        np.testing.assert_allclose(A @ V, US, atol=1e-12 * reference[0])
+
+
 def test_svd_rates_are_damped_least_squares(rng: np.random.Generator) -> None:
     for _ in range(200):
         m, n = 6, 7

@@ -10,7 +10,15 @@ import numpy as np
 import pytest
 import qpsolvers
 
-from rrc_pin.solvers.tick.slide_kernels import INFEASIBLE, SOLVED, project, slide_metric
+from rrc_pin.solvers.tick.kernels import cholesky
+from rrc_pin.solvers.tick.slide_kernels import (
+    INFEASIBLE,
+    SOLVED,
+    TINY,
+    project,
+    project_factored,
+    slide_metric,
+)
 
 TRIALS = 1500
 
@@ -51,6 +59,21 @@ def test_project_is_the_qp_optimum_or_refuses_an_empty_set() -> None:
         assert (G @ x <= h + 1e-9).all()
         solved += 1
     assert solved > TRIALS // 2 and refused > 0
+
+
+def test_project_factored_is_project_in_the_metric_of_its_factor() -> None:
+    rng = np.random.default_rng(31)
+    for trial in range(300):
+        A, damping, w, lb, ub, G, h = random_problem(rng, trial)
+        n = w.size
+        M = A.T @ A + max(damping * np.trace(A.T @ A) / A.shape[0], TINY) * np.eye(n)
+        L = np.zeros((n, n))
+        assert cholesky(M, 1e-13, L)
+        x, y = np.full(n, np.nan), np.full(n, np.nan)
+        code = project(A, damping, w, lb, ub, G, h, 1e-12, x)
+        assert project_factored(L, w, lb, ub, G, h, 1e-12, y) == code
+        if code == SOLVED:
+            np.testing.assert_allclose(y, x, atol=1e-9 * (1.0 + np.abs(x).max()))
 
 
 def test_project_keeps_the_margin_and_returns_w_when_it_is_inside() -> None:

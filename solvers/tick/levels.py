@@ -18,7 +18,13 @@ from numba import objmode
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import backend_calls, factor, kernels
 from rrc_pin.solvers.tick.kernels import row_values
-from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
+from rrc_pin.solvers.tick.slide_kernels import (
+    MARGIN,
+    SOLVED,
+    TINY,
+    project,
+    project_factored,
+)
 
 Array = npt.NDArray[np.float64]
 
@@ -42,16 +48,33 @@ def product(A: Array, B: Array) -> Array:
 
 
 @inlined
-def optimum(B: Array, c: Array, H: Array, g: Array) -> tuple[Array, bool]:
+def optimum(B: Array, c: Array, H: Array, g: Array, L: Array) -> tuple[Array, bool]:
     """The least-squares solution of least norm of ``B z ~= c``, and whether :math:`B^TB` is
-    definite (:func:`rrc_pin.solvers.tick.least_squares.optimum`).
+    definite (:func:`rrc_pin.solvers.tick.least_squares.optimum`): then ``L`` (d, d), zeros
+    on entry, holds its Cholesky factor (:func:`~rrc_pin.solvers.tick.kernels.cholesky_solve`).
     """  # noqa: D205
     m, d = B.shape
     if m > d:
         z = np.empty(d)
-        if kernels.cholesky_solve(H, g, z):
+        if kernels.cholesky(H, 1e-12, L):
+            kernels.solve_factored(L, g, z)
             return z, True
     return factor.least_norm(factor.qr(B), c)[1], False
+
+
+@inlined
+def metric_projection(B: Array, H: Array, L: Array, w: Array, lb: Array, ub: Array, G: Array,
+                      h: Array, x: Array) -> int:  # fmt: skip
+    r""":func:`~rrc_pin.solvers.tick.slide_kernels.project` of ``w`` in the metric
+    :math:`B^TB` = ``H``, factorised as ``L`` by :func:`optimum`. ``project`` adds the
+    smallest normal double to the metric's diagonal and factorises it anew: where that leaves
+    the diagonal as it is (every entry above about 1e-292), its factor is ``L`` to the bit,
+    and the factorisation is not repeated.
+    """  # noqa: D205
+    for i in range(H.shape[0]):
+        if H[i, i] + TINY != H[i, i]:
+            return project(B, 0.0, w, lb, ub, G, h, MARGIN, x)
+    return project_factored(L, w, lb, ub, G, h, MARGIN, x)
 
 
 @inlined
@@ -92,10 +115,11 @@ def subspace_rows(x: Array, N: Array, lb: Array, ub: Array, G: Array, h: Array, 
 
 
 @inlined
-def projected(B: Array, z: Array, x: Array, N: Array, whole: bool, lb: Array, ub: Array,
-              G: Array, h: Array, tol: float) -> Array:  # fmt: skip
-    r"""The level's optimum ``z`` projected onto its constraints in the metric :math:`B^TB`, as
-    rates; empty where the kernel refuses or its answer leaves the box or rows beyond ``tol``
+def projected(B: Array, H: Array, L: Array, z: Array, x: Array, N: Array, whole: bool,
+              lb: Array, ub: Array, G: Array, h: Array, tol: float) -> Array:  # fmt: skip
+    r"""The level's optimum ``z`` projected onto its constraints in the metric :math:`B^TB`
+    (``H``, its Cholesky factor ``L``: :func:`optimum`), as rates; empty where the kernel
+    refuses or its answer leaves the box or rows beyond ``tol``
     (:func:`rrc_pin.solvers.tick.least_squares._projected`).
     """  # noqa: D205
     d = z.size
@@ -103,12 +127,12 @@ def projected(B: Array, z: Array, x: Array, N: Array, whole: bool, lb: Array, ub
     qdot: Array
     if whole:
         Gz, hz = one_sided(G, np.full(h.size, -np.inf), h)
-        code = project(B, 0.0, z, lb, ub, Gz, hz, MARGIN, out)
+        code = metric_projection(B, H, L, z, lb, ub, Gz, hz, out)
         qdot = out
     else:
         Gz, hz = subspace_rows(x, N, lb, ub, G, h, tol)
         free = np.full(d, np.inf)
-        code = project(B, 0.0, z, -free, free, Gz, hz, MARGIN, out)
+        code = metric_projection(B, H, L, z, -free, free, Gz, hz, out)
         qdot = row_values(np.ascontiguousarray(N.T), out) + x
     if code != SOLVED:
         return np.empty(0)
@@ -159,12 +183,13 @@ def least_squares(
     B = A if whole else product(A, np.ascontiguousarray(N.T))
     c = b if whole else b - row_values(A, x)
     m, d = B.shape
-    H, g = np.empty((d, d)), np.empty(d)
+    H, g, L = np.empty((d, d)), np.empty(d), np.zeros((d, d))
     kernels.normal_equations(B, c, np.ones(m), H, g)
-    z, definite = optimum(B, c, H, g)
+    z, definite = optimum(B, c, H, g, L)
     candidate = z if whole else x + row_values(np.ascontiguousarray(N.T), z)
     if not (kernels.inside(candidate, lb, ub) and kernels.rows_hold(G, candidate, h, 0.0)):
-        candidate = projected(B, z, x, N, whole, lb, ub, G, h, tol) if definite else np.empty(0)
+        candidate = (projected(B, H, L, z, x, N, whole, lb, ub, G, h, tol) if definite
+                     else np.empty(0))
         if candidate.size == 0:
             return backend_level(where, A, b, x, N, lb, ub, G, h, need_null)
     if not need_null:

@@ -37,7 +37,8 @@ Array = npt.NDArray[np.float64]
 SOLVED, NOT_DEFINITE, INFEASIBLE, NOT_CONVERGED = 0, 1, 2, 3
 """What :func:`project` returns."""
 
-_TINY = 2.2250738585072014e-308
+TINY = 2.2250738585072014e-308
+"""The smallest normal double: the least damping of :func:`project`'s metric."""
 
 MARGIN = 1e-12
 """[relative above 1] How far inside its rows :func:`project`'s answer is sought: an answer on a
@@ -63,7 +64,7 @@ def _damped_gram(A: Array, damping: float) -> tuple[Array, float]:
             M[i, j] = t
             M[j, i] = t
         trace += M[i, i]
-    mu = max(damping * trace / max(rows, 1), _TINY)
+    mu = max(damping * trace / max(rows, 1), TINY)
     for i in range(n):
         M[i, i] += mu
     return M, mu
@@ -95,15 +96,26 @@ def project(
         limit, or a degenerate passive set).
     """
     n = w.size
-    p = h.size
     M = _damped_gram(A, damping)[0]
+    L = np.zeros((n, n))
+    if not cholesky(M, 1e-13, L):
+        return NOT_DEFINITE
+    return project_factored(L, w, lb, ub, G, h, margin, x)
+
+
+@kernel
+def project_factored(L: Array, w: Array, lb: Array, ub: Array, G: Array, h: Array,
+                     margin: float, x: Array) -> int:  # fmt: skip
+    r""":func:`project` in the metric :math:`M = LL^T` of its Cholesky factor ``L`` (n, n)
+    (lower triangular, zeros above), for a caller that has factorised M already; the other
+    arguments and the codes are :func:`project`'s (NOT_DEFINITE never).
+    """  # noqa: D205
+    n = w.size
+    p = h.size
     tight = np.empty(p)
     for r in range(p):
         tight[r] = h[r] - margin * (1.0 + abs(h[r]))
     h = tight
-    L = np.zeros((n, n))
-    if not cholesky(M, 1e-13, L):
-        return NOT_DEFINITE
     total = 2 * n + p
     E = np.empty((n + 1, total))  # the columns of the constraints taken in, in order
     taken = np.zeros(total, dtype=np.bool_)
@@ -350,7 +362,7 @@ def slide_metric(
     trace = 0.0
     for i in range(sigma.size):
         trace += sigma[i] * sigma[i]
-    mu = max(damping * trace / max(m, 1), _TINY)
+    mu = max(damping * trace / max(m, 1), TINY)
     onset = sigma[0] / threshold if sigma.size and rank > 0 else 0.0
     for i in range(m):
         for j in range(n):
