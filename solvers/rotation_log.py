@@ -1,0 +1,137 @@
+r"""The logarithms of SO(3) and SE(3), compiled, as Pinocchio computes them.
+
+:func:`log3` is ``pinocchio.log3`` (Pinocchio's ``log3_impl``, spatial/log.hxx) step by step:
+the rotation renormalised (its first two columns scaled to unit length, the third and then
+the first made of cross products), :math:`\cos\theta = (\operatorname{tr} R - 1)/2`, and
+
+.. math::
+
+    \log R = \frac{\theta}{\sin\theta}\,\operatorname{vee}\!\Big(\frac{R - R^T}{2}\Big),
+    \qquad \theta = \arccos\frac{\operatorname{tr} R - 1}{2},
+
+with :math:`\theta` taken from :math:`\sqrt{2(1 - \cos\theta)}` within :data:`PREC` of 0 and
+of :math:`\pi` (the arc cosine's expansion), the ratio from its series
+:math:`1 + |a|^2/6 + 3|a|^4/40` (:math:`a` the vee above) below :data:`PREC`, and near
+:math:`\pi` (:math:`\cos\theta < -1 +` :data:`PREC`) the axis from the largest diagonal term of
+:math:`R + R^T` (``compute_theta_axis``), the angle :math:`2\,\mathrm{atan2}(|axis|, w)`.
+
+:func:`log6` is ``pinocchio.log6`` of a pose (4, 4): :math:`\omega = \log R` and
+:math:`v = \alpha p - \tfrac12 \omega \times p + \beta (\omega \cdot p)\,\omega` with
+:math:`\alpha = \theta \sin\theta / (2(1 - \cos\theta))`,
+:math:`\beta = 1/\theta^2 - \sin\theta / (2\theta(1 - \cos\theta))`, their series
+:math:`1 - t/12 - t^2/720` and :math:`1/12 + t/720` (:math:`t = |\operatorname{vee}(R - R^T)/2|^2`)
+where :math:`\operatorname{tr} R \ge 3 -` :data:`PREC`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.solvers.compiled import inlined
+
+Array = npt.NDArray[np.float64]
+
+EPS = float(np.finfo(np.float64).eps)
+"""The machine epsilon (Eigen's ``NumTraits<double>::epsilon``)."""
+PREC = EPS ** (1.0 / 3.0)
+"""Pinocchio's ``TaylorSeriesExpansion<double>::precision<2>()``: eps^(1/3)."""
+
+
+@inlined
+def renormalized(R: Array, out: Array) -> None:
+    """Rotation ``R`` (3, 3) renormalised into ``out`` (``renormalize_rotation_matrix``)."""
+    n0 = math.sqrt(R[0, 0] * R[0, 0] + R[1, 0] * R[1, 0] + R[2, 0] * R[2, 0])
+    n1 = math.sqrt(R[0, 1] * R[0, 1] + R[1, 1] * R[1, 1] + R[2, 1] * R[2, 1])
+    for i in range(3):
+        out[i, 0] = R[i, 0] / n0
+        out[i, 1] = R[i, 1] / n1
+    for i in range(3):  # column 2 = column 0 x column 1
+        j, k = (i + 1) % 3, (i + 2) % 3
+        out[i, 2] = out[j, 0] * out[k, 1] - out[k, 0] * out[j, 1]
+    for i in range(3):  # column 0 = column 1 x column 2
+        j, k = (i + 1) % 3, (i + 2) % 3
+        out[i, 0] = out[j, 1] * out[k, 2] - out[k, 1] * out[j, 2]
+
+
+@inlined
+def _singular_axis(i0: int, val: float, R: Array, axis: Array) -> float:
+    """The angle near pi and its unit axis into ``axis`` (3,) from diagonal term ``i0``
+    (Pinocchio's ``compute_theta_axis``); ``R`` renormalised."""  # noqa: D205, D209
+    i1, i2 = (i0 + 1) % 3, (i0 + 2) % 3
+    s = math.sqrt(val + EPS + EPS * EPS) * (1.0 if R[i2, i1] >= R[i1, i2] else -1.0)
+    axis[i0] = s / 2.0
+    axis[i1] = 1.0 / (2.0 * s) * (R[i1, i0] + R[i0, i1])
+    axis[i2] = 1.0 / (2.0 * s) * (R[i2, i0] + R[i0, i2])
+    w = 1.0 / (2.0 * s) * (R[i2, i1] - R[i1, i2])
+    norm = math.sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2])
+    for k in range(3):
+        axis[k] /= norm
+    return 2.0 * math.atan2(norm, w)
+
+
+@inlined
+def log3(R: Array, out: Array) -> float:
+    """``pinocchio.log3(R)`` of rotation ``R`` (3, 3) into ``out`` (3,) [rad]; returns the angle.
+
+    Module docstring; ``R`` is read only (renormalised into a copy).
+    """
+    Rn = np.empty((3, 3))
+    renormalized(R, Rn)
+    tr = Rn[0, 0] + (Rn[1, 1] + Rn[2, 2])  # Eigen's unrolled sum
+    cos_value = (tr - 1.0) / 2.0
+    a0 = 0.5 * (Rn[2, 1] - Rn[1, 2])
+    a1 = 0.5 * (Rn[0, 2] - Rn[2, 0])
+    a2 = 0.5 * (Rn[1, 0] - Rn[0, 1])
+    if cos_value < -1.0 + PREC:  # near pi: the axis from the largest diagonal term
+        v0, v1, v2 = (2.0 * Rn[0, 0] - tr + 1.0, 2.0 * Rn[1, 1] - tr + 1.0,
+                      2.0 * Rn[2, 2] - tr + 1.0)  # fmt: skip
+        i0 = (0 if v0 >= v2 else 2) if v0 >= v1 else (1 if v1 >= v2 else 2)
+        val = v0 if i0 == 0 else (v1 if i0 == 1 else v2)
+        theta = _singular_axis(i0, val, Rn, out)
+        for k in range(3):
+            out[k] *= theta
+        return theta
+    expansion = math.sqrt(2.0 * (1.0 - cos_value) + EPS * EPS)
+    if tr > 3.0 - PREC:
+        theta = expansion
+    elif tr < -1.0 + PREC:
+        theta = math.pi - expansion
+    else:
+        theta = math.acos(cos_value)
+    if theta >= PREC:
+        t = theta / math.sin(theta)
+    else:
+        a2n = a0 * a0 + a1 * a1 + a2 * a2
+        t = 1.0 + a2n / 6.0 + a2n * a2n * 3.0 / 40.0
+    out[0], out[1], out[2] = t * a0, t * a1, t * a2
+    return theta
+
+
+@inlined
+def log6(T: Array, out: Array) -> None:
+    """``pinocchio.log6(T).vector`` of pose ``T`` (4, 4) into ``out`` (6,) [v; w] (module doc)."""
+    w = out[3:]
+    theta = log3(T[:3, :3], w)
+    a0 = 0.5 * (T[2, 1] - T[1, 2])
+    a1 = 0.5 * (T[0, 2] - T[2, 0])
+    a2 = 0.5 * (T[1, 0] - T[0, 1])
+    t2 = a0 * a0 + a1 * a1 + a2 * a2
+    tr = T[0, 0] + (T[1, 1] + T[2, 2])
+    st, ct = math.sin(theta), math.cos(theta)
+    if tr >= 3.0 - PREC:
+        alpha = 1.0 - t2 / 12.0 - t2 * t2 / 720.0
+        beta = 1.0 / 12.0 + t2 / 720.0
+    else:
+        alpha = theta * st / (2.0 * (1.0 - ct))
+        beta = 1.0 / (theta * theta) - st / (2.0 * theta * (1.0 - ct))
+    p0, p1, p2 = T[0, 3], T[1, 3], T[2, 3]
+    wp = beta * (w[0] * p0 + w[1] * p1 + w[2] * p2)
+    c0 = w[1] * p2 - w[2] * p1
+    c1 = w[2] * p0 - w[0] * p2
+    c2 = w[0] * p1 - w[1] * p0
+    out[0] = alpha * p0 - 0.5 * c0 + wp * w[0]
+    out[1] = alpha * p1 - 0.5 * c1 + wp * w[1]
+    out[2] = alpha * p2 - 0.5 * c2 + wp * w[2]

@@ -1,0 +1,66 @@
+"""The compiled log3 / log6 against Pinocchio's, over seeded random rotations and poses and
+the cases near an angle of 0 and of pi (each branch of Pinocchio's ``log3_impl``)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+import pytest
+
+from rrc_pin.solvers.rotation_log import PREC, log3, log6
+
+ANGLES = (0.0, 1e-12, 1e-9, 1e-6, 0.5 * PREC, 2.0 * PREC, 1e-3, 1e-2, 1.0, np.pi - 5e-2,
+          np.pi - 1e-2, np.pi - 1e-3, np.pi - 2e-3, np.pi - 1e-6, np.pi - 1e-9, np.pi - 1e-12,
+          np.pi)  # fmt: skip
+"""Angles [rad] at and around each branch: the series near 0, the arc cosine, the arc cosine's
+expansion and the axis from the diagonal near pi."""
+
+
+def _poses(seed: int, count: int) -> list[pin.SE3]:
+    rng = np.random.default_rng(seed)
+    poses = []
+    for k in range(count):
+        M = pin.SE3(pin.exp3(rng.normal(size=3)), rng.normal(size=3))
+        if k % 2:  # not quite orthonormal: the renormalisation's branch too
+            M.rotation = M.rotation + 1e-10 * rng.normal(size=(3, 3))
+        poses.append(M)
+    return poses
+
+
+def _near(angle: float, seed: int, count: int) -> list[pin.SE3]:
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(count):
+        axis = rng.normal(size=3)
+        R = pin.exp3(axis / np.linalg.norm(axis) * angle)
+        if k % 3 == 0:
+            R = R + 1e-12 * rng.normal(size=(3, 3))
+        out.append(pin.SE3(R, rng.normal(size=3)))
+    return out
+
+
+def _check(poses: list[pin.SE3]) -> None:
+    for M in poses:
+        R = np.array(M.rotation)
+        w = np.empty(3)
+        theta = log3(R, w)
+        angle = np.zeros((1, 1))
+        np.testing.assert_allclose(w, pin.log3(R, angle), rtol=0.0, atol=1e-12)
+        assert abs(theta - angle[0, 0]) <= 1e-12
+        out = np.empty(6)
+        log6(M.homogeneous, out)
+        np.testing.assert_allclose(out, pin.log6(M.homogeneous).vector, rtol=0.0, atol=1e-12)
+
+
+def test_random_poses_as_pinocchio() -> None:
+    _check(_poses(2030, 4000))
+
+
+@pytest.mark.parametrize("angle", ANGLES)
+def test_near_zero_and_pi_as_pinocchio(angle: float) -> None:
+    _check(_near(angle, 7, 200))
+
+
+def test_axes_exactly_at_pi() -> None:
+    for R in (np.diag([1.0, -1.0, -1.0]), np.diag([-1.0, 1.0, -1.0]), np.diag([-1.0, -1.0, 1.0])):
+        _check([pin.SE3(R, np.array([0.1, -0.2, 0.3]))])
