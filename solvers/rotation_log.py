@@ -30,7 +30,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.compiled import inlined
+from rrc_pin.solvers.compiled import inlined, kernel
 
 Array = npt.NDArray[np.float64]
 
@@ -135,3 +135,29 @@ def log6(T: Array, out: Array) -> None:
     out[0] = alpha * p0 - 0.5 * c0 + wp * w[0]
     out[1] = alpha * p1 - 0.5 * c1 + wp * w[1]
     out[2] = alpha * p2 - 0.5 * c2 + wp * w[2]
+
+
+@inlined
+def pose_error(target: Array, pose: Array, out: Array) -> None:
+    """A frame's pose error to its target into ``out`` (6,): ``[p* - p; log(R* R^T)]`` [m, rad].
+
+    Args:
+        target: The goal pose (4, 4) [m].
+        pose: The frame's pose (4, 4) in the same axes [m].
+        out: Out (6,), rows [position; rotation] in those axes.
+    """
+    turn = np.empty((3, 3))  # R* R^T
+    for i in range(3):
+        out[i] = target[i, 3] - pose[i, 3]
+        for j in range(3):
+            turn[i, j] = (target[i, 0] * pose[j, 0] + target[i, 1] * pose[j, 1]
+                          + target[i, 2] * pose[j, 2])  # fmt: skip
+    log3(turn, out[3:])
+
+
+@kernel
+def pose_errors(targets: Array, poses: Array, out: Array) -> None:
+    """:func:`pose_error` of each frame i, ``targets[i]`` and ``poses[i]`` (k, 4, 4), into
+    ``out`` (6 k,)."""  # noqa: D205, D209
+    for i in range(targets.shape[0]):
+        pose_error(targets[i], poses[i], out[6 * i : 6 * i + 6])

@@ -7,7 +7,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from rrc_pin.solvers.rotation_log import PREC, log3, log6
+from rrc_pin.solvers.rotation_log import PREC, log3, log6, pose_errors
 
 ANGLES = (0.0, 1e-12, 1e-9, 1e-6, 0.5 * PREC, 2.0 * PREC, 1e-3, 1e-2, 1.0, np.pi - 5e-2,
           np.pi - 1e-2, np.pi - 1e-3, np.pi - 2e-3, np.pi - 1e-6, np.pi - 1e-9, np.pi - 1e-12,
@@ -64,3 +64,15 @@ def test_near_zero_and_pi_as_pinocchio(angle: float) -> None:
 def test_axes_exactly_at_pi() -> None:
     for R in (np.diag([1.0, -1.0, -1.0]), np.diag([-1.0, 1.0, -1.0]), np.diag([-1.0, -1.0, 1.0])):
         _check([pin.SE3(R, np.array([0.1, -0.2, 0.3]))])
+
+
+def test_pose_errors_as_the_formula() -> None:
+    rng = np.random.default_rng(5)
+    targets = np.array([pin.SE3.Random().homogeneous for _ in range(300)])
+    poses = np.array([pin.SE3.Random().homogeneous for _ in range(300)])
+    poses[::3, :3, :3] = targets[::3, :3, :3] @ pin.exp3(1e-7 * rng.normal(size=3))  # near
+    out = np.empty(6 * len(targets))
+    pose_errors(targets, poses, out)
+    for i, (T, P) in enumerate(zip(targets, poses, strict=True)):
+        want = np.concatenate([T[:3, 3] - P[:3, 3], pin.log3(T[:3, :3] @ P[:3, :3].T)])
+        np.testing.assert_allclose(out[6 * i : 6 * i + 6], want, rtol=0.0, atol=1e-12)

@@ -9,7 +9,7 @@ a's axes (the task's class docstring),
              R_a^T (J_b^\omega - J_a^\omega) \end{bmatrix},\qquad
     e = \begin{bmatrix} p^* - R_a^T (p_b - p_a) \\ \log(R^* (R_a^T R_b)^T) \end{bmatrix},
 
-the logarithm Pinocchio's (:func:`rrc_pin.solvers.rotation_log.log3`).
+the pose error :func:`rrc_pin.solvers.rotation_log.pose_error` (Pinocchio's logarithm).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.rotation_log import log3
+from rrc_pin.solvers.rotation_log import pose_error
 
 Array = npt.NDArray[np.float64]
 
@@ -50,14 +50,9 @@ def relative_rows(Ja: Array, Jb: Array, Ta: Array, Tb: Array, target: Array, J: 
             J[3 + i, c] = Ta[0, i] * w0 + Ta[1, i] * w1 + Ta[2, i] * w2
     if target.shape[0] == 0:
         return
-    Rab = np.empty((3, 3))  # R_a^T R_b
+    Tab = np.zeros((4, 4))  # b's pose in a: R_a^T R_b, R_a^T (p_b - p_a)
     for i in range(3):
-        error[i] = target[i, 3] - (Ta[0, i] * d[0] + Ta[1, i] * d[1] + Ta[2, i] * d[2])
+        Tab[i, 3] = Ta[0, i] * d[0] + Ta[1, i] * d[1] + Ta[2, i] * d[2]
         for j in range(3):
-            Rab[i, j] = Ta[0, i] * Tb[0, j] + Ta[1, i] * Tb[1, j] + Ta[2, i] * Tb[2, j]
-    turn = np.empty((3, 3))  # R* R_ab^T
-    for i in range(3):
-        for j in range(3):
-            turn[i, j] = (target[i, 0] * Rab[j, 0] + target[i, 1] * Rab[j, 1]
-                          + target[i, 2] * Rab[j, 2])  # fmt: skip
-    log3(turn, error[3:])
+            Tab[i, j] = Ta[0, i] * Tb[0, j] + Ta[1, i] * Tb[1, j] + Ta[2, i] * Tb[2, j]
+    pose_error(target, Tab, error)
