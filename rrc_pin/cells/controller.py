@@ -53,7 +53,6 @@ from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
-import pinocchio as pin
 
 from rrc_pin.cells.cell import Cell
 from rrc_pin.cells.cell_log import CellLog
@@ -72,7 +71,7 @@ from rrc_pin.loading import loaded
 from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import frame_index
 from rrc_pin.solvers.checks import as_vector, flag, positive
-from rrc_pin.solvers.rotation_log import pose_errors
+from rrc_pin.solvers.exp_log import displaced, pose_errors
 from rrc_pin.solvers.spatial import to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.kernels import scale_and_veer
@@ -220,6 +219,7 @@ class CellController(Loop):
         self._kin_data = cell.model.createData()  # the tick's kinematics (:meth:`_kinematics`)
         self._kin: Kinematics | None = None
         self._kin_q: Array | None = None  # the configuration _kin is of
+        self._top_tasks: Sequence[TaskRows] = ()  # the last tick's top level (:meth:`_closed`)
         self._frame_tasks: dict[str, FrameTask] = {}
         self._frames = frame_index(cell.model)
         self._chain_frames = ChainFrames.of(cell.model, (), ())
@@ -449,7 +449,7 @@ class CellController(Loop):
         :data:`HOLD` from the frame: the frames' poses of the next tick's kinematics (at the
         configuration the tick reached), which that tick then reads.
         """
-        tasks = {t.name: t for t in _top_level(r)[0]}
+        tasks = {t.name: t for t in self._top_tasks}  # the tick's, read by :meth:`_closed`
         kin = self._kinematics()
         oMf, index = kin.data.oMf, kin.layout.frames
         for name, twist in twists.items():
@@ -559,6 +559,7 @@ class CellController(Loop):
         self._correction_size = 0.0
         self.chain_error = (0.0, 0.0)
         tasks, stacked, rows = _top_level(r)
+        self._top_tasks = tasks
         hands = self._hands(tasks)
         measured: list[tuple[Closure | None, Lost]] = [(self.contact.last, "contact_lost"),
                                                       (self.grip.last, "grip_lost")]  # fmt: skip
@@ -736,7 +737,6 @@ def _transport(twist: Array, frm: Array, to: Array) -> Array:
 
 def _moved(T: Array, delta: Array) -> Array:
     """Pose ``T`` moved by the world-axes displacement ``delta`` (6,) [m, rad] of its origin."""
-    out: Array = T.copy()
-    out[:3, 3] += delta[:3]
-    out[:3, :3] = pin.exp3(delta[3:]) @ T[:3, :3]
+    out: Array = np.empty((4, 4))
+    displaced(T, delta, out)
     return out

@@ -11,7 +11,7 @@ import numpy.typing as npt
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import names, rigid_transform
-from rrc_pin.solvers.rotation_log import pose_errors
+from rrc_pin.solvers.exp_log import pose_errors
 from rrc_pin.solvers.tick.problem import Constraints
 from rrc_pin.tasks.frame_task import FrameTask
 

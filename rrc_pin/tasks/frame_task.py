@@ -10,7 +10,7 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.solvers.checks import all_finite, as_vector, positive, real_array, rigid_transform
-from rrc_pin.solvers.rotation_log import pose_errors
+from rrc_pin.solvers.exp_log import pose_errors
 from rrc_pin.solvers.spatial import Reference, check_reference
 from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.task import Task, check_weight, task_name

@@ -9,7 +9,7 @@ a's axes (the task's class docstring),
              R_a^T (J_b^\omega - J_a^\omega) \end{bmatrix},\qquad
     e = \begin{bmatrix} p^* - R_a^T (p_b - p_a) \\ \log(R^* (R_a^T R_b)^T) \end{bmatrix},
 
-the pose error :func:`rrc_pin.solvers.rotation_log.pose_error` (Pinocchio's logarithm).
+the pose error :func:`rrc_pin.solvers.exp_log.pose_error` (Pinocchio's logarithm).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.rotation_log import pose_error
+from rrc_pin.solvers.exp_log import pose_error
 
 Array = npt.NDArray[np.float64]
 

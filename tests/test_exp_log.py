@@ -7,7 +7,7 @@ import numpy as np
 import pinocchio as pin
 import pytest
 
-from rrc_pin.solvers.rotation_log import PREC, log3, log6, pose_errors
+from rrc_pin.solvers.exp_log import PREC, PREC3, displaced, exp3, log3, log6, pose_errors
 
 ANGLES = (0.0, 1e-12, 1e-9, 1e-6, 0.5 * PREC, 2.0 * PREC, 1e-3, 1e-2, 1.0, np.pi - 5e-2,
           np.pi - 1e-2, np.pi - 1e-3, np.pi - 2e-3, np.pi - 1e-6, np.pi - 1e-9, np.pi - 1e-12,
@@ -76,3 +76,26 @@ def test_pose_errors_as_the_formula() -> None:
     for i, (T, P) in enumerate(zip(targets, poses, strict=True)):
         want = np.concatenate([T[:3, 3] - P[:3, 3], pin.log3(T[:3, :3] @ P[:3, :3].T)])
         np.testing.assert_allclose(out[6 * i : 6 * i + 6], want, rtol=0.0, atol=1e-12)
+
+
+def test_exp3_as_pinocchio() -> None:
+    rng = np.random.default_rng(3)
+    for size in (0.0, 1e-12, 1e-8, 1e-5, 0.5 * PREC3, 2.0 * PREC3, 1e-3, 0.1, 1.0, 3.0, 10.0):
+        for _ in range(200):
+            v = rng.normal(size=3) * size
+            out = np.empty((3, 3))
+            exp3(v, out)
+            np.testing.assert_allclose(out, pin.exp3(v), rtol=0.0, atol=1e-12)
+
+
+def test_displaced_as_the_formula() -> None:
+    rng = np.random.default_rng(4)
+    for k in range(1000):
+        T = pin.SE3.Random().homogeneous
+        delta = rng.normal(size=6) * 10.0 ** (-k % 9)
+        out = np.empty((4, 4))
+        displaced(T, delta, out)
+        want = T.copy()
+        want[:3, 3] += delta[:3]
+        want[:3, :3] = pin.exp3(delta[3:]) @ T[:3, :3]
+        np.testing.assert_allclose(out, want, rtol=0.0, atol=1e-12)

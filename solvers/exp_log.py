@@ -1,4 +1,9 @@
-r"""The logarithms of SO(3) and SE(3), compiled, as Pinocchio computes them.
+r"""SO(3)'s exponential and the logarithms of SO(3) and SE(3), compiled, as Pinocchio's.
+
+:func:`exp3` is ``pinocchio.exp3`` (spatial/explog.hxx): with :math:`t^2 = |v|^2 + \epsilon^2`,
+:math:`\exp [v]_\times = \cos t\, I + \frac{\sin t}{t} [v]_\times + \frac{1 - \cos t}{t^2}
+v v^T`, the ratios from their series :math:`1 - t^2/6`, :math:`1/2 - t^2/24` and
+:math:`\cos t` from :math:`1 - t^2/2` at :math:`t \le` :data:`PREC3`.
 
 :func:`log3` is ``pinocchio.log3`` (Pinocchio's ``log3_impl``, spatial/log.hxx) step by step:
 the rotation renormalised (its first two columns scaled to unit length, the third and then
@@ -38,6 +43,45 @@ EPS = float(np.finfo(np.float64).eps)
 """The machine epsilon (Eigen's ``NumTraits<double>::epsilon``)."""
 PREC = EPS ** (1.0 / 3.0)
 """Pinocchio's ``TaylorSeriesExpansion<double>::precision<2>()``: eps^(1/3)."""
+PREC3 = EPS ** (1.0 / 4.0)
+"""Pinocchio's ``TaylorSeriesExpansion<double>::precision<3>()``: eps^(1/4)."""
+
+
+@inlined
+def exp3(v: Array, out: Array) -> None:
+    """``pinocchio.exp3(v)`` of a rotation vector ``v`` (3,) [rad] into ``out`` (3, 3)."""
+    t2 = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) + EPS * EPS
+    t = math.sqrt(t2)
+    st, ct = math.sin(t), math.cos(t)
+    if t > PREC3:
+        a_vxvx, a_vx = (1.0 - ct) / t2, st / t
+    else:
+        a_vxvx, a_vx, ct = 0.5 - t2 / 24.0, 1.0 - t2 / 6.0, 1.0 - t2 / 2.0
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = (a_vxvx * v[i]) * v[j]
+    out[0, 1] -= a_vx * v[2]
+    out[1, 0] += a_vx * v[2]
+    out[0, 2] += a_vx * v[1]
+    out[2, 0] -= a_vx * v[1]
+    out[1, 2] -= a_vx * v[0]
+    out[2, 1] += a_vx * v[0]
+    for i in range(3):
+        out[i, i] += ct
+
+
+@kernel
+def displaced(T: Array, delta: Array, out: Array) -> None:
+    r"""Pose ``T`` (4, 4) moved by the base-axes displacement ``delta`` (6,) [m, rad] of its
+    origin into ``out`` (4, 4): :math:`p + \delta_v`, :math:`\exp([\delta_\omega]_\times) R`."""  # noqa: D205, D209
+    E = np.empty((3, 3))
+    exp3(delta[3:], E)
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = E[i, 0] * T[0, j] + E[i, 1] * T[1, j] + E[i, 2] * T[2, j]
+        out[i, 3] = T[i, 3] + delta[i]
+        out[3, i] = T[3, i]
+    out[3, 3] = T[3, 3]
 
 
 @inlined
