@@ -226,6 +226,7 @@ class CellController(Loop):
         if closure is not None:
             compile_correction(cell.nv)
         scale_and_veer(np.zeros(6), np.zeros(6), np.ones(6))  # compiled now: damped ticks use it
+        _moved(np.eye(4), np.zeros(6))  # compiled now: every tick moves the targets
         self._close_at()
         self._compile_tick()
 
