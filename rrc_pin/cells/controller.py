@@ -53,7 +53,6 @@ from typing import Literal
 
 import numpy as np
 import numpy.typing as npt
-import pinocchio as pin
 
 from rrc_pin.cells.cell import Cell
 from rrc_pin.cells.cell_log import CellLog
@@ -72,6 +71,7 @@ from rrc_pin.loading import loaded
 from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import frame_index
 from rrc_pin.solvers.checks import as_vector, flag, positive
+from rrc_pin.solvers.exp_log import displaced, pose_errors
 from rrc_pin.solvers.spatial import to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.kernels import scale_and_veer
@@ -218,12 +218,15 @@ class CellController(Loop):
         self._correction_size = 0.0
         self._kin_data = cell.model.createData()  # the tick's kinematics (:meth:`_kinematics`)
         self._kin: Kinematics | None = None
+        self._kin_q: Array | None = None  # the configuration _kin is of
+        self._top_tasks: Sequence[TaskRows] = ()  # the last tick's top level (:meth:`_closed`)
         self._frame_tasks: dict[str, FrameTask] = {}
         self._frames = frame_index(cell.model)
         self._chain_frames = ChainFrames.of(cell.model, (), ())
         if closure is not None:
             compile_correction(cell.nv)
         scale_and_veer(np.zeros(6), np.zeros(6), np.ones(6))  # compiled now: damped ticks use it
+        _moved(np.eye(4), np.zeros(6))  # compiled now: every tick moves the targets
         self._close_at()
         self._compile_tick()
 
@@ -420,8 +423,11 @@ class CellController(Loop):
         and errors) and the closure's correction; on the controller's own Data, so that it
         holds until the next tick.
         """
+        if self._kin is not None and self._kin_q is self._q:  # made ahead (:meth:`_held_back`)
+            return self._kin
         _, dof, q_pin = self.cell.positions(self._q)
         self._kin = Kinematics(self.cell.model, self._kin_data, self.resolver.layout, dof, q_pin)
+        self._kin_q = self._q
         return self._kin
 
     def _task(self, name: str, twist: Array) -> FrameTask:
@@ -441,17 +447,20 @@ class CellController(Loop):
         """A damped tick's targets, fed back within a bound (:data:`HOLD`).
 
         Each moves along its command by what its frame made along it, then to at most
-        :data:`HOLD` from the frame.
+        :data:`HOLD` from the frame: the frames' poses of the next tick's kinematics (at the
+        configuration the tick reached), which that tick then reads.
         """
-        tasks = {t.name: t for t in _top_level(r)[0]}
+        tasks = {t.name: t for t in self._top_tasks}  # the tick's, read by :meth:`_closed`
+        kin = self._kinematics()
+        oMf, index = kin.data.oMf, kin.layout.frames
         for name, twist in twists.items():
             task = tasks[name]
             factor = None if task.unit is None else 1.0 / task.unit
             made = scale_and_veer(task.A @ r.qdot, twist, factor)[0] if twist.any() else 0.0
             target = _moved(self._targets[name], twist * (made * self.dt))
-            pose = self.cell.fk(self._q, self.frame_of(name))
-            error = np.concatenate([target[:3, 3] - pose[:3, 3],
-                                    pin.log3(target[:3, :3] @ pose[:3, :3].T)])  # fmt: skip
+            pose = oMf[index[self.frame_of(name)]].homogeneous
+            error = np.empty(6)
+            pose_errors(target[None], pose[None], error)
             for part, hold in zip((slice(0, 3), slice(3, 6)), HOLD, strict=True):
                 size = float(np.linalg.norm(error[part]))
                 if size > hold:
@@ -551,6 +560,7 @@ class CellController(Loop):
         self._correction_size = 0.0
         self.chain_error = (0.0, 0.0)
         tasks, stacked, rows = _top_level(r)
+        self._top_tasks = tasks
         hands = self._hands(tasks)
         measured: list[tuple[Closure | None, Lost]] = [(self.contact.last, "contact_lost"),
                                                       (self.grip.last, "grip_lost")]  # fmt: skip
@@ -728,7 +738,6 @@ def _transport(twist: Array, frm: Array, to: Array) -> Array:
 
 def _moved(T: Array, delta: Array) -> Array:
     """Pose ``T`` moved by the world-axes displacement ``delta`` (6,) [m, rad] of its origin."""
-    out: Array = T.copy()
-    out[:3, 3] += delta[:3]
-    out[:3, :3] = pin.exp3(delta[3:]) @ T[:3, :3]
+    out: Array = np.empty((4, 4))
+    displaced(T, delta, out)
     return out

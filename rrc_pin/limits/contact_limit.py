@@ -11,6 +11,7 @@ import numpy.typing as npt
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import names, rigid_transform
+from rrc_pin.solvers.exp_log import pose_errors
 from rrc_pin.solvers.tick.problem import Constraints
 from rrc_pin.tasks.frame_task import FrameTask
 
@@ -99,6 +100,8 @@ class ContactLimit(Limit):
                           for i, (f, T) in enumerate(zip(items, anchors, strict=True)))  # fmt: skip
         self.frames: tuple[str, ...] = items
         self._goals = goals
+        self._anchors = np.zeros((0, 4, 4)) if goals is None else np.array(
+            [g.target for g in goals]).reshape(-1, 4, 4)  # fmt: skip
         self._names = tuple(f"{self.name}:{f}:{a}" for f in items for a in AXES)
         self._zero = np.zeros(6 * len(items))
         self._unit: Array | None = None  # the rows' units, once the robot's reach is known
@@ -124,8 +127,9 @@ class ContactLimit(Limit):
         C = np.vstack([kin.jacobian(f) for f in self.frames])
         if self._goals is not None:
             oMf, index = kin.data.oMf, kin.layout.frames
-            error = np.concatenate([g.error(oMf[index[g.frame]].homogeneous)
-                                    for g in self._goals])  # fmt: skip
+            error = np.empty(6 * len(self.frames))
+            pose_errors(self._anchors, np.array([oMf[index[f]].homogeneous for f in self.frames]),
+                        error)  # fmt: skip
             reach = kin.layout.reach
             unit = self._unit
             if unit is None or unit[::6].tolist() != [reach[f] for f in self.frames]:

@@ -6,11 +6,11 @@ from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
-import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.solvers.checks import all_finite, as_vector, positive, real_array, rigid_transform
+from rrc_pin.solvers.exp_log import pose_errors
 from rrc_pin.solvers.spatial import Reference, check_reference
 from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.task import Task, check_weight, task_name
@@ -103,11 +103,10 @@ class FrameTask(Task):
 
         Zero without a target; ``pose`` (4, 4) is the frame's.
         """
-        if self.target is None:
-            return np.zeros(6)
-        return np.concatenate([
-            self.target[:3, 3] - pose[:3, 3], pin.log3(self.target[:3, :3] @ pose[:3, :3].T)
-        ])  # fmt: skip
+        out = np.zeros(6)
+        if self.target is not None:
+            pose_errors(self.target[None], pose[None], out)
+        return out
 
     def check_twist(self, twist: npt.ArrayLike) -> Array:
         """``twist`` as the selected rows: (6,) or (rows,) finite, a new array (the task's own).

@@ -6,13 +6,13 @@ from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
-import pinocchio as pin
 
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.solvers.checks import positive, rigid_transform
 from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.frame_task import FrameTask
+from rrc_pin.tasks.relative_frame_kernels import relative_rows
 from rrc_pin.tasks.task import Task
 
 Array = npt.NDArray[np.float64]
@@ -110,24 +110,26 @@ class RelativeFrameTask(Task):
         return (self.frame_a, self.frame_b)
 
     def rows(self, kin: Kinematics) -> TaskRows:
-        """The relative Jacobian rows (class docstring) and the commanded relative twist."""
-        Ja = kin.jacobian(self.frame_a)
-        Jb = kin.jacobian(self.frame_b)
+        """The relative Jacobian rows (class docstring) and the commanded relative twist.
+
+        One compiled call (:func:`~rrc_pin.tasks.relative_frame_kernels.relative_rows`).
+        """
+        a, b = self.frame_a, self.frame_b
+        Ja, Jb = kin.jacobian(a), kin.jacobian(b)
         oMf, index = kin.data.oMf, kin.layout.frames  # both placed by the Jacobians' pass
-        Ta, Tb = oMf[index[self.frame_a]].homogeneous, oMf[index[self.frame_b]].homogeneous
-        Rt = Ta[:3, :3].T
-        d = Tb[:3, 3] - Ta[:3, 3]
-        D = Jb - Ja
-        J = np.empty_like(D)
-        np.matmul(Rt, D[:3] + pin.skew(d) @ Ja[3:], out=J[:3])
-        np.matmul(Rt, D[3:], out=J[3:])
+        J = np.empty_like(Ja)
+        target = _NO_TARGET if self.target is None else self.target
+        error = np.empty(6)
+        relative_rows(Ja, Jb, oMf[index[a]].homogeneous, oMf[index[b]].homogeneous, target, J,
+                      error)  # fmt: skip
         if self.target is None:
-            b = self.twist.copy()
+            rates = self.twist.copy()
         else:
-            error = np.empty(6)
-            error[:3] = self.target[:3, 3] - Rt @ d
-            error[3:] = pin.log3(self.target[:3, :3] @ (Rt @ Tb[:3, :3]).T)
-            b = self.twist + self.gain * (error if len(self.selected) == 6
-                                          else error[list(self.selected)])  # fmt: skip
-        reach = max(kin.layout.reach[self.frame_a], kin.layout.reach[self.frame_b])
-        return self._spec.rows_from(J, b, reach)
+            rates = self.twist + self.gain * (error if len(self.selected) == 6
+                                              else error[list(self.selected)])  # fmt: skip
+        reach = max(kin.layout.reach[a], kin.layout.reach[b])
+        return self._spec.rows_from(J, rates, reach)
+
+
+_NO_TARGET = np.zeros((0, 4))
+"""The kernel's target argument of a task without one."""
