@@ -42,7 +42,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.optimize import linprog
 
-from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.errors import NumericalFailure
 from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding
@@ -161,7 +161,7 @@ def problem(w: Array, null: Array, lb: Array, ub: Array, G: Array, h: Array
     return P, q, C, lo, hi, z_lb, z_ub, M
 
 
-@kernel
+@inlined
 def solved_along(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array, h: Array,
                  tol: float) -> tuple[Array, float, float, int]:  # fmt: skip
     """The direction problem along ``w`` by the compiled active-set solver: its rates (n,),
