@@ -18,7 +18,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.compiled import inlined, kernel
 
 Array = npt.NDArray[np.float64]
 
@@ -314,7 +314,7 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
                 V[i, j], V[i, best] = V[i, best], V[i, j]
 
 
-@kernel
+@inlined
 def triangle_svd(Q: Array, R: Array, tol: float, US: Array, W: Array, sigma: Array,
                  right: Array) -> int:  # fmt: skip
     r"""The SVD of J from the QR of its transpose, :math:`J^T = QR` (k = min(m, n)).
@@ -608,7 +608,7 @@ def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
     return u, (v_lo * y_lo + v_hi * y_hi) / (v_lo + v_hi)
 
 
-@kernel
+@inlined
 def direction_step(
     J: Array, b: Array, lb: Array, ub: Array, Q: Array, R: Array, w: Array, qdot: Array
 ) -> tuple[int, float]:
