@@ -14,7 +14,7 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.compiled import inlined, kernel
+from rrc_pin.solvers.compiled import kernel
 from rrc_pin.solvers.tick import kernels
 
 Array = npt.NDArray[np.float64]
@@ -93,7 +93,7 @@ def least_norm(f: Factor, b: Array) -> tuple[Factor, Array]:
     return f, rates(f, b, np.zeros(f.sigma.size))
 
 
-@inlined
+@kernel
 def fitted(J: Array, b: Array, lb: Array, ub: Array) -> tuple[Factor, Array, bool, Array, float]:
     """The factorisation of J, the least-norm rates w of ``J x ~= b``, whether they fit.
 

@@ -608,7 +608,7 @@ def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
     return u, (v_lo * y_lo + v_hi * y_hi) / (v_lo + v_hi)
 
 
-@inlined
+@kernel
 def direction_step(
     J: Array, b: Array, lb: Array, ub: Array, Q: Array, R: Array, w: Array, qdot: Array
 ) -> tuple[int, float]:

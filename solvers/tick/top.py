@@ -269,7 +269,7 @@ def clamped(f: Factor, w: Array, rows: Rows, dt: float, threshold: float
     return (c if c.rank >= f.rank else f), False
 
 
-@inlined
+@kernel
 def damping(f: Factor, b: Array, w: Array, u: float, rows: Rows, dt: float, threshold: float
             ) -> tuple[Factor, Array]:  # fmt: skip
     """The damping (k,) a command that cannot be met needs (empty where none), and the
