@@ -209,12 +209,15 @@ class CompiledTick:
         general: Compile the general entry now (:func:`rrc_pin.solvers.tick.tick.run`), not
             only the default tick's: the resolver's ticks will have rows, tasks or a box
             that may exclude standing still.
+        twists: Compile the twist tick's entry now (:func:`rrc_pin.solvers.tick.tick.run_twist`,
+            :meth:`twist`): the resolver's ``solve(q, twist)`` reaches it; else at its first call.
     """
 
     _spec: TwistSpec  # the loaded twist task's, once loaded
 
     def __init__(self, layout: Layout, limit: JointLimits, options: Options, direction: bool,
-                 backend: QPBackend, names: tuple[str, ...], general: bool) -> None:  # fmt: skip
+                 backend: QPBackend, names: tuple[str, ...], general: bool,
+                 twists: bool = True) -> None:  # fmt: skip
         velocity = limit.velocities(layout)
         acceleration = _NO_ACCELERATION if limit.acceleration is None else np.asarray(
             limit.acceleration)  # fmt: skip
@@ -234,7 +237,7 @@ class CompiledTick:
         self._rows: list[int] | None = None  # its rows of the Jacobian, None: all six
         self._size = 0  # the size of run_twist's out for it
         self._answered: Array | None = None  # the last rates answered, joints[PREVIOUS]'s values
-        self.workspace.compile(general)
+        self.workspace.compile(general, twists)
         if general:  # its ticks may hand QPs to the backend
             backend_calls.compile_calls(self._context)
 

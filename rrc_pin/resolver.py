@@ -121,6 +121,9 @@ class Resolver:
             instead of distorting it (the direction problem); False: least squares.
         use_closed_form: Take the tool frame's world_aligned Jacobian from
             ``robot.closed_form`` (the paper's equations) instead of Pinocchio.
+        twists: Whether ``solve(q, twist)`` will be called: its compiled entry is built with
+            the resolver; False builds it at the first such call (for callers that tick
+            through :meth:`solve_at` or tasks alone, as the controller does).
 
     Raises:
         InvalidInput: Any invalid argument, named.
@@ -139,6 +142,7 @@ class Resolver:
         damping: Damping | None = Damping(),  # noqa: B008 - immutable
         direction_preserving: bool = True,
         use_closed_form: bool = False,
+        twists: bool = True,
     ) -> None:
         if isinstance(robot, (str, os.PathLike)):
             robot = loaded(robot, "robot")
@@ -150,6 +154,8 @@ class Resolver:
         if not isinstance(use_closed_form, bool):
             raise InvalidInput("use_closed_form", f"expected True or False, got "
                                f"{use_closed_form!r}")
+        if not isinstance(twists, bool):
+            raise InvalidInput("twists", f"expected True or False, got {twists!r}")
         self.robot = robot
         self.dt = _dt(dt)
         self.qp = QPOptions() if qp is None else _typed(qp, QPOptions, "qp")
@@ -182,14 +188,14 @@ class Resolver:
         # given to a one-tool resolver, a start outside the joint limits)
         general = (len(self.limits) > 1 or self.task is None or not direction_preserving
                    or (len(joint) == 1 and joint[0].acceleration is not None))  # fmt: skip
-        self._compiled = None if len(joint) != 1 else CompiledTick(
-            self._layout, joint[0], self.options, direction_preserving, self.backend,
-            self._names, general)  # fmt: skip
         # solve(q, twist) straight into the compiled tick: the joint box the only limit, the
         # Jacobian Pinocchio's and its vector q itself
-        self._box_only = self._compiled is not None and self.limits == (joint[0],)
+        self._box_only = len(joint) == 1 and self.limits == (joint[0],)
         self._twists = (self._box_only and self.task is not None and closed_form is None
                         and robot.model.nq == robot.model.nv)  # fmt: skip
+        self._compiled = None if len(joint) != 1 else CompiledTick(
+            self._layout, joint[0], self.options, direction_preserving, self.backend,
+            self._names, general, twists and self._twists)  # fmt: skip
         self._q_shape = (robot.nq,)
 
     @property

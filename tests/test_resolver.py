@@ -834,3 +834,18 @@ def test_a_floating_base_is_masked_as_one_joint() -> None:
     for task in tasks:
         J = robot.jacobian(q, frame=task.frame)
         assert np.abs(J[:, 6:] @ r.qdot[6:] - task.twist).max() <= 1e-9
+
+
+def test_a_resolver_built_without_the_twist_entry_answers_twists_the_same() -> None:
+    """``twists=False`` only defers the compile of ``solve(q, twist)``'s entry: the same
+    answers, bit for bit; a value that is not a bool is refused, named."""
+    arm = rrc_pin.load("panda")
+    eager, deferred = Resolver(arm), Resolver(arm, twists=False)
+    rng = np.random.default_rng(29)
+    for _ in range(20):
+        q, twist = arm.random_q(rng), rng.standard_normal(6) * 0.3
+        a, b = eager.solve(q, twist), deferred.solve(q, twist)
+        assert a.status == b.status and np.array_equal(a.qdot, b.qdot)
+    with pytest.raises(InvalidInput) as info:
+        Resolver(arm, twists=1)  # type: ignore[arg-type]
+    assert info.value.argument == "twists"

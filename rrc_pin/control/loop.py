@@ -126,7 +126,9 @@ class Loop:
         if smoothing is not None and not isinstance(smoothing, SmoothingOptions):
             raise InvalidInput("smoothing", f"expected SmoothingOptions or None, got {smoothing!r}")
         self.robot = robot
-        self.resolver = Resolver(robot, dt, limits=limits, qp=qp, damping=damping)
+        # its ticks go through solve_at and tasks: the twist entry is not built
+        self.resolver = Resolver(robot, dt, limits=limits, qp=qp, damping=damping,
+                                 twists=False)
         self.dt = self.resolver.dt
         self._q = self._checked_q(robot.ready() if q0 is None else q0, "q0")
         self.speed = speed

@@ -42,7 +42,7 @@ import numpy as np
 import numpy.typing as npt
 from scipy.optimize import linprog
 
-from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.errors import NumericalFailure
 from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding
@@ -118,7 +118,7 @@ def direction_qp(w: Array, null: Array, box: Box, rows: Rows | None) -> tuple[QP
     return QP(P, q, C, lo, hi, z_lb, z_ub, key), Decoding(None, M)
 
 
-@kernel
+@inlined
 def problem(w: Array, null: Array, lb: Array, ub: Array, G: Array, h: Array
             ) -> tuple[Array, Array, Array, Array, Array, Array, Array, Array]:  # fmt: skip
     r"""The direction QP's data in z = (y, u) (module docstring): ``(P, q, C, lo, hi, z_lb,
@@ -161,7 +161,7 @@ def problem(w: Array, null: Array, lb: Array, ub: Array, G: Array, h: Array
     return P, q, C, lo, hi, z_lb, z_ub, M
 
 
-@kernel
+@inlined
 def solved_along(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array, h: Array,
                  tol: float) -> tuple[Array, float, float, int]:  # fmt: skip
     """The direction problem along ``w`` by the compiled active-set solver: its rates (n,),
@@ -186,7 +186,7 @@ def solved_along(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array
     return qdot, scale, veer, steps
 
 
-@kernel
+@inlined
 def along_checked(A: Array, w: Array, qdot: Array) -> tuple[float, float, bool]:
     """The scale and veer of a QP's rates ``qdot`` along ``A w``, and whether they keep its
     direction to :data:`DIRECTION_TOL` (their task rates off it at most that times

@@ -350,7 +350,7 @@ def _swap(x: Array, y: Array) -> None:
         x[i], y[i] = y[i], x[i]
 
 
-@kernel
+@inlined
 def triangle_svd(Q: Array, R: Array, tol: float, US: Array, W: Array, sigma: Array,
                  right: Array) -> int:  # fmt: skip
     r"""The SVD of J from the QR of its transpose, :math:`J^T = QR` (k = min(m, n)).

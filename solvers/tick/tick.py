@@ -552,11 +552,11 @@ class Workspace:
         return run(self.joints, self.task_rows, self.rates, self.G, self.h, self.slide,
                    self.ints, self.reals)  # fmt: skip
 
-    def compile(self, general: bool) -> None:
-        """Compile the default tick's entries (:func:`run_box`, :func:`run_twist`), and the
-        general ones where ``general`` (with the pipeline's shrink into the rows,
-        :func:`kernels.into_rows`), or load them from numba's cache: on a problem without rows
-        whose answer is exact, so that no QP is asked for and nothing is kept.
+    def compile(self, general: bool, twists: bool = True) -> None:
+        """Compile the default tick's entries (:func:`run_box`; :func:`run_twist` where
+        ``twists``), and the general ones where ``general`` (with the pipeline's shrink into
+        the rows, :func:`kernels.into_rows`), or load them from numba's cache: on a problem
+        without rows whose answer is exact, so that no QP is asked for and nothing is kept.
         """  # noqa: D205
         n = self.n
         ws = Workspace(self.joints[LOWER], self.joints[UPPER], self.joints[VELOCITY],
@@ -567,8 +567,9 @@ class Workspace:
         ws.joints[POSITION] = np.clip(np.zeros(n), self.joints[LOWER], self.joints[UPPER])
         ws.reals[DT] = 0.01
         run_box(ws.joints, ws.task_rows, ws.rates, ws.ints, ws.reals)
-        run_twist(np.eye(1, n), np.zeros(1), ws.joints[POSITION].copy(), 0.01, ws.joints, ws.rates,
-                  ws.ints, ws.reals, np.empty(twist_size(n, 1)))  # fmt: skip
+        if twists:
+            run_twist(np.eye(1, n), np.zeros(1), ws.joints[POSITION].copy(), 0.01, ws.joints,
+                      ws.rates, ws.ints, ws.reals, np.empty(twist_size(n, 1)))  # fmt: skip
         if general:
             run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
             kernels.into_rows(np.zeros((1, n)), np.zeros(1), np.zeros(n))  # the pipeline's call
