@@ -209,8 +209,9 @@ class CompiledTick:
         general: Compile the general entry now (:func:`rrc_pin.solvers.tick.tick.run`), not
             only the default tick's: the resolver's ticks will have rows, tasks or a box
             that may exclude standing still.
-        twists: Compile the twist tick's entry now (:func:`rrc_pin.solvers.tick.tick.run_twist`,
-            :meth:`twist`): the resolver's ``solve(q, twist)`` reaches it; else at its first call.
+        twists: Compile the twist tick's entry (:func:`rrc_pin.solvers.tick.tick.run_twist`,
+            :meth:`twist`): the resolver's ``solve(q, twist)`` reaches it; False only where the
+            resolver never calls :meth:`twist`.
     """
 
     _spec: TwistSpec  # the loaded twist task's, once loaded

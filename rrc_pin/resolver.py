@@ -121,9 +121,10 @@ class Resolver:
             instead of distorting it (the direction problem); False: least squares.
         use_closed_form: Take the tool frame's world_aligned Jacobian from
             ``robot.closed_form`` (the paper's equations) instead of Pinocchio.
-        twists: Whether ``solve(q, twist)`` will be called: its compiled entry is built with
-            the resolver; False builds it at the first such call (for callers that tick
-            through :meth:`solve_at` or tasks alone, as the controller does).
+        twists: Whether ``solve(q, twist)`` takes its own compiled entry, built with the
+            resolver; False builds none (for callers that tick through :meth:`solve_at` or
+            tasks alone, as the controller does): a twist then takes the tasks' way, the
+            same answers, nothing compiled in the loop.
 
     Raises:
         InvalidInput: Any invalid argument, named.
@@ -191,11 +192,11 @@ class Resolver:
         # solve(q, twist) straight into the compiled tick: the joint box the only limit, the
         # Jacobian Pinocchio's and its vector q itself
         self._box_only = len(joint) == 1 and self.limits == (joint[0],)
-        self._twists = (self._box_only and self.task is not None and closed_form is None
-                        and robot.model.nq == robot.model.nv)  # fmt: skip
+        self._twists = (twists and self._box_only and self.task is not None
+                        and closed_form is None and robot.model.nq == robot.model.nv)  # fmt: skip
         self._compiled = None if len(joint) != 1 else CompiledTick(
             self._layout, joint[0], self.options, direction_preserving, self.backend,
-            self._names, general, twists and self._twists)  # fmt: skip
+            self._names, general, self._twists)  # fmt: skip
         self._q_shape = (robot.nq,)
 
     @property

@@ -18,6 +18,7 @@ import rrc_pin
 from rrc_pin import Damping, FrameTask, JointLimits, PostureTask, QPOptions, Resolver
 from rrc_pin.errors import InvalidInput, RrcPinError
 from rrc_pin.solvers.qp_backends import installed_backends
+from rrc_pin.solvers.tick import tick
 from rrc_pin.solvers.tick.kernels import ON_LIMIT
 
 ARMS = ("barker6", "rrc_k1607", "kr5_3r", "panda")
@@ -836,15 +837,24 @@ def test_a_floating_base_is_masked_as_one_joint() -> None:
         assert np.abs(J[:, 6:] @ r.qdot[6:] - task.twist).max() <= 1e-9
 
 
-def test_a_resolver_built_without_the_twist_entry_answers_twists_the_same() -> None:
-    """``twists=False`` only defers the compile of ``solve(q, twist)``'s entry: the same
-    answers, bit for bit; a value that is not a bool is refused, named."""
+def test_a_resolver_built_without_the_twist_entry_answers_twists_the_same(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``twists=False`` builds no entry of its own for ``solve(q, twist)``: a twist takes the
+    tasks' way, the same answers, bit for bit, and nothing is compiled at the call; a value
+    that is not a bool is refused, named."""
     arm = rrc_pin.load("panda")
     eager, deferred = Resolver(arm), Resolver(arm, twists=False)
     rng = np.random.default_rng(29)
-    for _ in range(20):
-        q, twist = arm.random_q(rng), rng.standard_normal(6) * 0.3
-        a, b = eager.solve(q, twist), deferred.solve(q, twist)
+    calls = [(arm.random_q(rng), rng.standard_normal(6) * 0.3) for _ in range(20)]
+    answers = [eager.solve(q, twist) for q, twist in calls]
+
+    def refused(*args: object) -> None:
+        raise AssertionError("the twist entry called")
+
+    monkeypatch.setattr(tick, "run_twist", refused)
+    for (q, twist), a in zip(calls, answers, strict=True):
+        b = deferred.solve(q, twist)
         assert a.status == b.status and np.array_equal(a.qdot, b.qdot)
     with pytest.raises(InvalidInput) as info:
         Resolver(arm, twists=1)  # type: ignore[arg-type]
