@@ -79,8 +79,8 @@ def test_jacobi_svd_against_lapack(m: int, k: int, rng: np.random.Generator) -> 
 
 
 def test_jacobi_svd_of_blocks_against_lapack(rng: np.random.Generator) -> None:
-    """Columns without a row in common (two arms' blocks, a zero column) are left as they are
-    orthogonal; the SVD is LAPACK's."""
+    """Columns without a row in common (two arms' blocks, a zero column): orthogonal exactly,
+    left as they are; the SVD is LAPACK's."""
     for trial in range(200):
         A = np.zeros((12, 10))
         A[:6, :5], A[6:, 5:] = rng.normal(size=(6, 5)), rng.normal(size=(6, 5))

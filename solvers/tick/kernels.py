@@ -261,9 +261,7 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
 
     Plane rotations of pairs of columns until all are orthogonal (Demmel & Veselic 1992,
     Algorithm 4.1: the rotation that zeroes :math:`a_p^T a_q`), accumulated in V; the column
-    norms are then the singular values. Columns are sorted by decreasing norm at the end. A
-    pair of columns without a row in common (a block of the rows, as two hands' on two arms)
-    is orthogonal exactly, and left as the test would leave it.
+    norms are then the singular values. Columns are sorted by decreasing norm at the end.
 
     Args:
         A: The matrix (m, k); out: its columns rotated, ``U diag(sigma)``.
@@ -271,23 +269,18 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
         sigma: Out: the singular values (k,), descending.
     """
     m, k = A.shape
-    columns, rotations = A.T.copy(), np.zeros((k, k))  # rows: A's and V's columns, contiguous
+    V[:, :] = 0.0
     for i in range(k):
-        rotations[i, i] = 1.0
-    support = _supports(columns)
+        V[i, i] = 1.0
     for _ in range(SWEEPS):
         rotated = False
         for p in range(k - 1):
-            a_p, v_p = columns[p], rotations[p]
             for q in range(p + 1, k):
-                if support[p] & support[q] == 0:  # no row in common: a_p^T a_q is 0 exactly
-                    continue
-                a_q = columns[q]
                 alpha = beta = gamma = 0.0
                 for i in range(m):
-                    alpha += a_p[i] * a_p[i]
-                    beta += a_q[i] * a_q[i]
-                    gamma += a_p[i] * a_q[i]
+                    alpha += A[i, p] * A[i, p]
+                    beta += A[i, q] * A[i, q]
+                    gamma += A[i, p] * A[i, q]
                 if gamma == 0.0 or abs(gamma) <= 1e-15 * math.sqrt(alpha * beta):
                     continue
                 rotated = True
@@ -295,15 +288,18 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
                 t = math.copysign(1.0, zeta) / (abs(zeta) + math.hypot(1.0, zeta))
                 c = 1.0 / math.sqrt(1.0 + t * t)
                 s = c * t
-                _rotate(a_p, a_q, c, s)
-                _rotate(v_p, rotations[q], c, s)
-                support[p] = support[q] = support[p] | support[q]
+                for i in range(m):
+                    ap, aq = A[i, p], A[i, q]
+                    A[i, p], A[i, q] = c * ap - s * aq, s * ap + c * aq
+                for i in range(k):
+                    vp, vq = V[i, p], V[i, q]
+                    V[i, p], V[i, q] = c * vp - s * vq, s * vp + c * vq
         if not rotated:
             break
     for j in range(k):
         s = 0.0
         for i in range(m):
-            s += columns[j, i] * columns[j, i]
+            s += A[i, j] * A[i, j]
         sigma[j] = math.sqrt(s)
     for j in range(k):  # selection sort, descending, columns of A and V alike
         best = j
@@ -312,42 +308,10 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
                 best = i
         if best != j:
             sigma[j], sigma[best] = sigma[best], sigma[j]
-            _swap(columns[j], columns[best])
-            _swap(rotations[j], rotations[best])
-    A[:, :] = columns.T
-    V[:, :] = rotations.T
-
-
-@inlined
-def _supports(columns: Array) -> npt.NDArray[np.int64]:
-    """Per row of ``columns`` (k, m), the bits of its nonzero entries (every bit where m > 63:
-    a pair of rows is then never found disjoint)."""  # noqa: D205, D209
-    k, m = columns.shape
-    support = np.full(k, -1, np.int64)
-    if m > 63:
-        return support
-    for j in range(k):
-        bits = 0
-        for i in range(m):
-            if columns[j, i] != 0.0:
-                bits |= 1 << i
-        support[j] = bits
-    return support
-
-
-@inlined
-def _rotate(x: Array, y: Array, c: float, s: float) -> None:
-    """The plane rotation ``(x, y) <- (c x - s y, s x + c y)``, in place."""
-    for i in range(x.size):
-        xi, yi = x[i], y[i]
-        x[i], y[i] = c * xi - s * yi, s * xi + c * yi
-
-
-@inlined
-def _swap(x: Array, y: Array) -> None:
-    """``x`` and ``y`` exchanged, in place."""
-    for i in range(x.size):
-        x[i], y[i] = y[i], x[i]
+            for i in range(m):
+                A[i, j], A[i, best] = A[i, best], A[i, j]
+            for i in range(k):
+                V[i, j], V[i, best] = V[i, best], V[i, j]
 
 
 @inlined
