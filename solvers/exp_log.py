@@ -1,4 +1,4 @@
-r"""SO(3)'s exponential and the logarithms of SO(3) and SE(3), compiled, as Pinocchio's.
+r"""SO(3)'s exponential and logarithm, compiled, as Pinocchio's.
 
 :func:`exp3` is ``pinocchio.exp3`` (spatial/explog.hxx): with :math:`t^2 = |v|^2 + \epsilon^2`,
 :math:`\exp [v]_\times = \cos t\, I + \frac{\sin t}{t} [v]_\times + \frac{1 - \cos t}{t^2}
@@ -19,13 +19,6 @@ of :math:`\pi` (the arc cosine's expansion), the ratio from its series
 :math:`1 + |a|^2/6 + 3|a|^4/40` (:math:`a` the vee above) below :data:`PREC`, and near
 :math:`\pi` (:math:`\cos\theta < -1 +` :data:`PREC`) the axis from the largest diagonal term of
 :math:`R + R^T` (``compute_theta_axis``), the angle :math:`2\,\mathrm{atan2}(|axis|, w)`.
-
-:func:`log6` is ``pinocchio.log6`` of a pose (4, 4): :math:`\omega = \log R` and
-:math:`v = \alpha p - \tfrac12 \omega \times p + \beta (\omega \cdot p)\,\omega` with
-:math:`\alpha = \theta \sin\theta / (2(1 - \cos\theta))`,
-:math:`\beta = 1/\theta^2 - \sin\theta / (2\theta(1 - \cos\theta))`, their series
-:math:`1 - t/12 - t^2/720` and :math:`1/12 + t/720` (:math:`t = |\operatorname{vee}(R - R^T)/2|^2`)
-where :math:`\operatorname{tr} R \ge 3 -` :data:`PREC`.
 """
 
 from __future__ import annotations
@@ -152,33 +145,6 @@ def log3(R: Array, out: Array) -> float:
         t = 1.0 + a2n / 6.0 + a2n * a2n * 3.0 / 40.0
     out[0], out[1], out[2] = t * a0, t * a1, t * a2
     return theta
-
-
-@inlined
-def log6(T: Array, out: Array) -> None:
-    """``pinocchio.log6(T).vector`` of pose ``T`` (4, 4) into ``out`` (6,) [v; w] (module doc)."""
-    w = out[3:]
-    theta = log3(T[:3, :3], w)
-    a0 = 0.5 * (T[2, 1] - T[1, 2])
-    a1 = 0.5 * (T[0, 2] - T[2, 0])
-    a2 = 0.5 * (T[1, 0] - T[0, 1])
-    t2 = a0 * a0 + a1 * a1 + a2 * a2
-    tr = T[0, 0] + (T[1, 1] + T[2, 2])
-    st, ct = math.sin(theta), math.cos(theta)
-    if tr >= 3.0 - PREC:
-        alpha = 1.0 - t2 / 12.0 - t2 * t2 / 720.0
-        beta = 1.0 / 12.0 + t2 / 720.0
-    else:
-        alpha = theta * st / (2.0 * (1.0 - ct))
-        beta = 1.0 / (theta * theta) - st / (2.0 * theta * (1.0 - ct))
-    p0, p1, p2 = T[0, 3], T[1, 3], T[2, 3]
-    wp = beta * (w[0] * p0 + w[1] * p1 + w[2] * p2)
-    c0 = w[1] * p2 - w[2] * p1
-    c1 = w[2] * p0 - w[0] * p2
-    c2 = w[0] * p1 - w[1] * p0
-    out[0] = alpha * p0 - 0.5 * c0 + wp * w[0]
-    out[1] = alpha * p1 - 0.5 * c1 + wp * w[1]
-    out[2] = alpha * p2 - 0.5 * c2 + wp * w[2]
 
 
 @inlined

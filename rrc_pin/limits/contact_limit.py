@@ -13,7 +13,6 @@ from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import names, rigid_transform
 from rrc_pin.solvers.exp_log import pose_errors
 from rrc_pin.solvers.tick.problem import Constraints
-from rrc_pin.tasks.frame_task import FrameTask
 
 if TYPE_CHECKING:
     from rrc_pin.kinematics import Kinematics, Layout
@@ -92,16 +91,14 @@ class ContactLimit(Limit):
             for frame in items:
                 if frame not in self._layout.frames:
                     raise FrameNotFound(frame, sorted(self._layout.frames), "frames")
-        goals = None
+        poses = None
         if anchors is not None:
             if len(anchors) != len(items):
                 raise InvalidInput("anchors", f"expected {len(items)} poses, got {len(anchors)}")
-            goals = tuple(FrameTask(f, target=rigid_transform(T, f"anchors[{i}]"))
-                          for i, (f, T) in enumerate(zip(items, anchors, strict=True)))  # fmt: skip
+            poses = np.array([rigid_transform(T, f"anchors[{i}]")
+                              for i, T in enumerate(anchors)]).reshape(-1, 4, 4)  # fmt: skip
         self.frames: tuple[str, ...] = items
-        self._goals = goals
-        self._anchors = np.zeros((0, 4, 4)) if goals is None else np.array(
-            [g.target for g in goals]).reshape(-1, 4, 4)  # fmt: skip
+        self._anchors: Array | None = poses  # (k, 4, 4), None: no error measured
         self._names = tuple(f"{self.name}:{f}:{a}" for f in items for a in AXES)
         self._zero = np.zeros(6 * len(items))
         self._unit: Array | None = None  # the rows' units, once the robot's reach is known
@@ -125,7 +122,7 @@ class ContactLimit(Limit):
         if not self.frames:
             return Constraints()
         C = np.vstack([kin.jacobian(f) for f in self.frames])
-        if self._goals is not None:
+        if self._anchors is not None:
             oMf, index = kin.data.oMf, kin.layout.frames
             error = np.empty(6 * len(self.frames))
             pose_errors(self._anchors, np.array([oMf[index[f]].homogeneous for f in self.frames]),

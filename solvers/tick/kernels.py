@@ -833,18 +833,22 @@ def solve_factored(L: Array, g: Array, x: Array) -> None:
         x[i] = s / L[i, i]
 
 
+DEFINITE = 1e-12
+"""Relative pivot at or below which :func:`cholesky_solve` finds a matrix not definite."""
+
+
 @kernel
 def cholesky_solve(H: Array, g: Array, x: Array) -> bool:
     r"""``x`` solving :math:`Hx = g` for a symmetric positive definite H: :func:`cholesky`,
     then :func:`solve_factored`.
 
     Returns:
-        False where H is not numerically definite (a pivot at or below ``1e-12`` times the
-        largest diagonal entry); ``x`` is then not set.
+        False where H is not numerically definite (a pivot at or below :data:`DEFINITE`
+        times the largest diagonal entry); ``x`` is then not set.
     """  # noqa: D205
     n = g.size
     L = np.zeros((n, n))
-    if not cholesky(H, 1e-12, L):
+    if not cholesky(H, DEFINITE, L):
         return False
     solve_factored(L, g, x)
     return True

@@ -56,7 +56,7 @@ def optimum(B: Array, c: Array, H: Array, g: Array, L: Array) -> tuple[Array, bo
     m, d = B.shape
     if m > d:
         z = np.empty(d)
-        if kernels.cholesky(H, 1e-12, L):
+        if kernels.cholesky(H, kernels.DEFINITE, L):  # cholesky_solve's steps, L kept
             kernels.solve_factored(L, g, z)
             return z, True
     return factor.least_norm(factor.qr(B), c)[1], False
