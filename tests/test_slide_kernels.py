@@ -96,8 +96,9 @@ def test_project_refuses_a_row_of_zeros_broken_at_w() -> None:
     assert code == INFEASIBLE
 
 
-SEEDS = (3, int(np.random.SeedSequence().entropy % 2**63))
-"""A fixed seed, and one drawn fresh each run (printed on failure)."""
+SEEDS = (3, 1052011918281309717, int(np.random.SeedSequence().entropy % 2**63))
+"""A fixed seed, the one whose undamped rows (condition 5e8) failed on an older CPU, and one
+drawn fresh each run (printed on failure)."""
 
 
 def metric_of(A, b, mu_rel, threshold):
@@ -122,7 +123,7 @@ def metric_of(A, b, mu_rel, threshold):
     return inputs, M, want
 
 
-@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "fresh"))
+@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "condition-5e8", "fresh"))
 def test_slide_metric_is_the_damped_metric_and_its_optimum(seed) -> None:
     rng = np.random.default_rng(seed)
     for trial in range(300):
@@ -140,7 +141,11 @@ def test_slide_metric_is_the_damped_metric_and_its_optimum(seed) -> None:
         scale = np.abs(M).max()
         np.testing.assert_allclose(B[:rows].T @ B[:rows], M, atol=1e-10 * scale,
                                    err_msg=f"seed {seed} trial {trial}")  # fmt: skip
-        np.testing.assert_allclose(target, want, rtol=1e-8, atol=1e-9 * np.abs(want).max(),
+        # a backward-stable solve is accurate to about cond * eps (Higham, Accuracy and
+        # Stability of Numerical Algorithms, 2002, 20.1): undamped rows of condition 5e8 give
+        # 1e-8 relative, on both sides of the comparison
+        conditioned = 1e-9 + 4.0 * np.linalg.cond(B[:rows]) * np.finfo(float).eps
+        np.testing.assert_allclose(target, want, rtol=1e-8, atol=conditioned * np.abs(want).max(),
                                    err_msg=f"seed {seed} trial {trial}")  # fmt: skip
 
 
