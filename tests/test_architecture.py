@@ -5,6 +5,7 @@ from __future__ import annotations
 import ast
 import importlib
 import pkgutil
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -148,6 +149,22 @@ def test_ruff_is_clean():
         text=True,
     )
     assert out.returncode == 0, out.stdout + out.stderr
+
+
+TIMING = re.compile(r"\d(\.\d+)? ?(us|µs|ns)\b")
+"""A duration in micro- or nanoseconds: a measurement, which docs/api.md keeps, not the code."""
+
+
+def test_the_package_holds_no_timings():
+    """Measurements go stale with the code around them: docs/api.md ("One tick's cost") and
+    docs/benchmarks.md keep them, with the machine and what was measured."""
+    found = []
+    for folder in (Path(rrc_pin.__file__).parent, Path(solvers.__file__).parent):
+        for path in sorted(folder.rglob("*.py")):
+            for k, line in enumerate(path.read_text().splitlines(), 1):
+                if TIMING.search(line):
+                    found.append(f"{path.relative_to(ROOT)}:{k}: {line.strip()}")
+    assert not found, "\n".join(found)
 
 
 def test_a_users_solvers_module_beside_a_script_does_not_break_the_import(tmp_path):

@@ -7,9 +7,8 @@ solution of the identified active set (no ADMM tolerance), takes two-sided rows 
 bounds natively, and is warm-started here with the previous primal solution of the same
 problem structure (``primal_start``, which seeds the active set).
 
-Called directly rather than through ``qpsolvers.solve_problem``: 6.6 us against 16 us per
-7-variable box QP, measured on panda's resolver problems (the default backend's cost on every
-step with an active limit).
+Called directly rather than through ``qpsolvers.solve_problem``, whose conversions cost more
+than DAQP's solve of a resolver's small QP (docs/api.md, "One tick's cost").
 """
 
 from __future__ import annotations

@@ -353,8 +353,8 @@ def _top(
             return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot),
                         float(np.max(lam)), null)  # fmt: skip
         # a bound stops the damped rates and not the command's own exact answer (the box's
-        # kernels): that answer (panda stood still for up to ten ticks where the LP allowed
-        # up to 19 %; a backend's inexact answer is not taken for the command's direction)
+        # kernels): that answer (docs/api.md, the direction problem's step 3; a backend's
+        # inexact answer is not taken for the command's direction)
     if outside_range:
         return _Top(u_w.qdot, "singular", *_along_command(problem, u_w.qdot), 0.0, null)
     return _Top(u_w.qdot, "scaled", u_w.u * problem.rate_factor, u_w.veer, 0.0, null)

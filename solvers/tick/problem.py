@@ -151,7 +151,7 @@ class Rows(NamedTuple):
         if self.slide is None or not self.slide.any():
             return None
         keep = self.slide
-        if keep.all():  # a collision limit's rows all slide: no copy, no names rebuilt (8 us)
+        if keep.all():  # a collision limit's rows all slide: no copy, no names rebuilt
             return Rows(self.G, self.h, self.names)
         names = tuple(n for n, k in zip(self.names, keep.tolist(), strict=True) if k)
         return Rows(self.G[keep], self.h[keep], names)

@@ -16,8 +16,7 @@ Each constraint's column is divided by the norm of its part in y (a constraint t
 positive number is the same constraint), so that NNLS's tolerances read alike for every row.
 Only the constraints that ``w`` breaks enter first; those the answer then breaks are added and
 the problem solved again (the optimum over fewer constraints that meets them all is the
-optimum over all): two pandas' 67 collision rows and 28 bounds cost 16 us each tick in full,
-and the answer rarely meets more than a few of them.
+optimum over all): the answer rarely meets more than a few of a collision limit's rows.
 The caller checks the answer against the constraints (the kernel's only failure mode left is
 rounding, which that check catches) and falls back to a QP backend where it is refused.
 """
