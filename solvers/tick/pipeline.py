@@ -285,71 +285,149 @@ def _answer(problem: Problem, top: _Top, qdot: Array, method: Method,
 def _top(
     problem: Problem, space: Subspace, backend: QPBackend, options: Options, work: Work
 ) -> _Top:
-    """The top level's answer (module docstring)."""
+    """The top level's answer (module docstring): the least squares of the other modes, or the
+    direction problem's stages in turn, each answering or passing on.
+    """  # noqa: D205
+    if problem.mode != "direction":
+        return _least_squares_top(problem, space, backend, options, work)
+    exact = _exact(problem, space)
+    slide = None if problem.rows is None else problem.rows.sliding
+    if slide is not None:
+        slid = _slid(problem, space, backend, options, work, exact, slide)
+        if isinstance(slid, _Top):
+            return slid
+        exact = slid
+    within = _exact_within(problem, space, exact)
+    if within is not None:
+        return within
+    return _scaled_top(problem, space, backend, options, work, exact)
+
+
+class _Exact(NamedTuple):
+    """The direction problem's exact rates: the rows' factorisation, the rates in the level's
+    free directions ``z`` and in the joints ``w``, whether ``w`` is inside the box, the
+    problem along ``w`` where the box is all (the box's kernels), the command ``b`` they
+    meet and whether it is a slid one (:func:`_slid`).
+    """  # noqa: D205
+
+    factor: Factorization
+    z: Array
+    w: Array
+    fits: bool
+    boxed: Along | None
+    b: Array
+    slid: bool
+
+    @property
+    def outside_range(self) -> bool:
+        """Part of the command is outside the rows' range (``singular``)."""
+        return not self.factor.regular and not statuses.met(self.factor.J @ self.z, self.b)
+
+
+def _least_squares_top(
+    problem: Problem, space: Subspace, backend: QPBackend, options: Options, work: Work
+) -> _Top:
+    """The top level of the tracking and weighted modes: its least squares within the
+    constraints (damped where it breaks a slide row, as the sliding stage).
+    """  # noqa: D205
     A, b = problem.stacked[0]
     box, rows = problem.box, problem.rows
-    if problem.mode != "direction":
-        last = len(problem.levels) == 1
-        if rows is not None and rows.sliding is not None:
-            qdot, null = _damped_within(A, b, space, box, rows, backend, work, not last,
-                                        options.damping)  # fmt: skip
-        else:
-            qdot, null = least_squares(A, b, space, box, rows, backend, work, "least_squares",
-                                       not last)  # fmt: skip
-        met = statuses.met(A @ qdot, b) and problem.rate_factor == 1.0
-        status: Status = "recovering" if box.recovering or _broken(rows) else (
-            "exact" if met else "least_squares")  # fmt: skip
-        return _Top(qdot, status, *_along_command(problem, qdot), 0.0, null)
-    boxed: Along | None = None  # the direction problem along w, where the box is all
+    last = len(problem.levels) == 1
+    if rows is not None and rows.sliding is not None:
+        qdot, null = _damped_within(A, b, space, box, rows, backend, work, not last,
+                                    options.damping)  # fmt: skip
+    else:
+        qdot, null = least_squares(A, b, space, box, rows, backend, work, "least_squares",
+                                   not last)  # fmt: skip
+    met = statuses.met(A @ qdot, b) and problem.rate_factor == 1.0
+    status: Status = "recovering" if box.recovering or _broken(rows) else (
+        "exact" if met else "least_squares")  # fmt: skip
+    return _Top(qdot, status, *_along_command(problem, qdot), 0.0, null)
+
+
+def _exact(problem: Problem, space: Subspace) -> _Exact:
+    """Stage 1: the exact rates of the command (least squares of least norm)."""
+    A, b = problem.stacked[0]
+    box = problem.box
     if space.N is None:
         factor, w, fits, boxed = Factorization.fitted(A, b, box.lb, box.ub)
-        boxed = boxed if rows is None else None
-        z = w
-    else:
-        factor = Factorization(A @ space.N.T)
-        z = factor.least_norm(b)
-        w = z @ space.N
-        fits = kernels.inside(w, box.lb, box.ub)
-    slid = False
-    slide = None if rows is None else rows.sliding
-    if slide is not None and not kernels.rows_hold(slide.G, w, slide.h, 0.0):
-        # the exact rates cross a row the command may slide along: the command becomes what
-        # the slide rows and the box let it keep (the rest of the pipeline is unchanged)
-        try:
-            kept = _slide(A, b, space, box, slide, backend, work, factor, options.damping)
-        except (NumericalFailure, np.linalg.LinAlgError) as exc:
-            work.attempts.append(("slide", f"{exc}; the command kept as given"))
-        else:
-            if rows is not None and (rows.slide is None or not rows.slide.all()):
-                within = kernels.rows_hold(rows.G, kept, rows.h, tolerance(box))
-            else:
-                within = True  # every row slides: the least squares kept them all
-            if within:  # the slid command met within every row: its rates as they are
-                null = _null(factor, space) if len(problem.levels) > 1 else None
-                return _Top(kept, "sliding", *_along_command(problem, kept), 0.0, null)
-            b, slid = A @ kept, True
-            z = factor.least_norm(b)
-            w = z if space.N is None else z @ space.N
-            fits = kernels.inside(w, box.lb, box.ub)
-    outside_range = not factor.regular and not statuses.met(factor.J @ z, b)
-    if fits and (rows is None or kernels.rows_hold(rows.G, w, rows.h, 0.0)):
-        null = _null(factor, space) if len(problem.levels) > 1 else None
-        if slid:
-            return _Top(w, "sliding", *_along_command(problem, w), 0.0, null)
-        if outside_range:
-            return _Top(w, "singular", *_along_command(problem, w), 0.0, null)
-        return _met_top(problem, w, null)
-    null = _null(factor, space)
-    u_w = boxed if boxed is not None else _scaled(A, w, null, box, rows, backend, work)
-    if slid:
+        return _Exact(factor, w, w, fits, boxed if problem.rows is None else None, b, False)
+    factor = Factorization(A @ space.N.T)
+    z = factor.least_norm(b)
+    w = z @ space.N
+    return _Exact(factor, z, w, kernels.inside(w, box.lb, box.ub), None, b, False)
+
+
+def _slid(
+    problem: Problem, space: Subspace, backend: QPBackend, options: Options, work: Work,
+    exact: _Exact, slide: Rows,
+) -> _Top | _Exact:  # fmt: skip
+    """Where the exact rates cross a row the command may slide along (of ``slide``, the
+    problem's rows marked so): the command becomes what the slide rows and the box let it
+    keep (:func:`_slide`); its rates, ``sliding``, where they meet every other row too, else
+    its exact rates for the stages after. Where none cross (or the slide fails, reported),
+    ``exact`` as it is.
+    """  # noqa: D205
+    A = problem.stacked[0][0]
+    box, rows = problem.box, problem.rows
+    assert rows is not None
+    if kernels.rows_hold(slide.G, exact.w, slide.h, 0.0):
+        return exact
+    try:
+        kept = _slide(A, exact.b, space, box, slide, backend, work, exact.factor,
+                      options.damping)  # fmt: skip
+    except (NumericalFailure, np.linalg.LinAlgError) as exc:
+        work.attempts.append(("slide", f"{exc}; the command kept as given"))
+        return exact
+    every = rows.slide is not None and bool(rows.slide.all())  # the least squares kept them all
+    if every or kernels.rows_hold(rows.G, kept, rows.h, tolerance(box)):
+        null = _null(exact.factor, space) if len(problem.levels) > 1 else None
+        return _Top(kept, "sliding", *_along_command(problem, kept), 0.0, null)
+    b = A @ kept
+    z = exact.factor.least_norm(b)
+    w = z if space.N is None else z @ space.N
+    return exact._replace(z=z, w=w, fits=kernels.inside(w, box.lb, box.ub), b=b, slid=True)
+
+
+def _exact_within(problem: Problem, space: Subspace, exact: _Exact) -> _Top | None:
+    """Stage 1's answer where the exact rates are inside the box and rows: ``sliding``,
+    ``singular`` or met; else None.
+    """  # noqa: D205
+    rows = problem.rows
+    if not (exact.fits and (rows is None or kernels.rows_hold(rows.G, exact.w, rows.h, 0.0))):
+        return None
+    null = _null(exact.factor, space) if len(problem.levels) > 1 else None
+    w = exact.w
+    if exact.slid:
+        return _Top(w, "sliding", *_along_command(problem, w), 0.0, null)
+    if exact.outside_range:
+        return _Top(w, "singular", *_along_command(problem, w), 0.0, null)
+    return _met_top(problem, w, null)
+
+
+def _scaled_top(
+    problem: Problem, space: Subspace, backend: QPBackend, options: Options, work: Work,
+    exact: _Exact,
+) -> _Top:  # fmt: skip
+    """Stages 2 and 3: the LP maximum scale along the exact rates, met, ``scaled`` or
+    ``singular``; past the damping threshold the damped rates scaled along themselves.
+    """  # noqa: D205
+    A = problem.stacked[0][0]
+    box, rows = problem.box, problem.rows
+    null = _null(exact.factor, space)
+    u_w = exact.boxed if exact.boxed is not None else _scaled(A, exact.w, null, box, rows,
+                                                              backend, work)  # fmt: skip
+    if exact.slid:
         return _Top(u_w.qdot, "sliding", *_along_command(problem, u_w.qdot), 0.0, null)
+    outside_range = exact.outside_range
     if not outside_range and u_w.u >= 1.0 - EXACT_TOL:
         return _met_top(problem, u_w.qdot, null)
-    lam, usable = _damping(options.damping, factor, b, w, u_w.u, box, problem.dt, space.N is None)
+    lam, usable = _damping(options.damping, exact.factor, exact.b, exact.w, u_w.u, box,
+                           problem.dt, space.N is None)  # fmt: skip
     if lam is not None:
-        z = usable.rates(b, lam)
+        z = usable.rates(exact.b, lam)
         damped = _scaled(A, z if space.N is None else z @ space.N, null, box, rows, backend, work)
-        if boxed is None or not damped.u <= STILL_SCALE < u_w.u:
+        if exact.boxed is None or not damped.u <= STILL_SCALE < u_w.u:
             return _Top(damped.qdot, "damped", *_along_command(problem, damped.qdot),
                         float(np.max(lam)), null)  # fmt: skip
         # a bound stops the damped rates and not the command's own exact answer (the box's
