@@ -10,7 +10,7 @@ import subprocess
 import sys
 import textwrap
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from rrc_pin.errors import RrcPinError
@@ -58,9 +58,35 @@ def parser() -> argparse.ArgumentParser:
         description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter,  # DESCRIPTION's own lines
     )
-    sub = out.add_subparsers(dest="command", required=True)
-    sub.add_parser("arms", help="table of the robots rrc_pin.load accepts, with their tool frames")
-    demo = sub.add_parser(
+    add = out.add_subparsers(dest="command", required=True).add_parser
+    add("arms", help="table of the robots rrc_pin.load accepts, with their tool frames")
+    _demo(add)
+    check = add("check", help="cross-check every catalogue arm: DH, Pinocchio, yourdfpy")
+    check.add_argument("--samples", type=int, default=200, help="configurations per arm (>= 1)")
+    _bench(add)
+    guidance = add(
+        "guidance",
+        help="Nadkarni's Appendix II: the thesis's numbers beside the computed ones, the "
+        "known errata marked",
+    )
+    guidance.add_argument(
+        "--illustration",
+        type=int,
+        required=True,
+        choices=ILLUSTRATIONS,
+        metavar="N",
+        help="the illustration: " + ", ".join(map(str, ILLUSTRATIONS[:-1]))
+        + f" or {ILLUSTRATIONS[-1]} (3 is 1 and 2 in one run)",
+    )
+    _map(add)
+    _console(add)
+    _urdf(add)
+    return out
+
+
+def _demo(add: Callable[..., argparse.ArgumentParser]) -> None:
+    """``rrc-pin demo``'s arguments."""
+    demo = add(
         "demo",
         help="a scripted teleoperation session on the paper arms under every singularity "
         "strategy: summary table, trajectories (CSV) and a figure (PNG) in a folder",
@@ -88,9 +114,11 @@ def parser() -> argparse.ArgumentParser:
         "the held object; yeh_tripod: the walk along the beam): table, log (CSV), figure (PNG)",
     )
     demo.add_argument("--quick", action="store_true", help="shorter scripts (a smoke test)")
-    check = sub.add_parser("check", help="cross-check every catalogue arm: DH, Pinocchio, yourdfpy")
-    check.add_argument("--samples", type=int, default=200, help="configurations per arm (>= 1)")
-    bench = sub.add_parser(
+
+
+def _bench(add: Callable[..., argparse.ArgumentParser]) -> None:
+    """``rrc-pin bench``'s arguments."""
+    bench = add(
         "bench",
         help="run the benchmarks of a checkout (needs the bench extra): results to a new "
         "folder, or with --record to benchmarks/results, docs/benchmarks.md and the README",
@@ -117,21 +145,11 @@ def parser() -> argparse.ArgumentParser:
         help="interpreter with placo for the tasks benchmark (default: .venv-placo/bin/python "
         "of the checkout, if any; placo pins its own Pinocchio)",
     )
-    guidance = sub.add_parser(
-        "guidance",
-        help="Nadkarni's Appendix II: the thesis's numbers beside the computed ones, the "
-        "known errata marked",
-    )
-    guidance.add_argument(
-        "--illustration",
-        type=int,
-        required=True,
-        choices=ILLUSTRATIONS,
-        metavar="N",
-        help="the illustration: " + ", ".join(map(str, ILLUSTRATIONS[:-1]))
-        + f" or {ILLUSTRATIONS[-1]} (3 is 1 and 2 in one run)",
-    )
-    mapping = sub.add_parser(
+
+
+def _map(add: Callable[..., argparse.ArgumentParser]) -> None:
+    """``rrc-pin map``'s arguments."""
+    mapping = add(
         "map",
         help="capability map of an arm or a cell (needs the maps extra): reachability, "
         "orientation coverage, manipulability, singular conditions per voxel, on Dask",
@@ -178,7 +196,11 @@ def parser() -> argparse.ArgumentParser:
         metavar="K",
         help="confirm K random reached voxels by resolved-rate IK through the resolver",
     )
-    console = sub.add_parser(
+
+
+def _console(add: Callable[..., argparse.ArgumentParser]) -> None:
+    """``rrc-pin console``'s arguments."""
+    console = add(
         "console",
         help="the operator's console in the browser (needs the console extra): the arm in 3-D, "
         "hand-frame commands, joint limits and singularities live",
@@ -210,7 +232,11 @@ def parser() -> argparse.ArgumentParser:
     console.add_argument(
         "--out", type=Path, default=Path("."), metavar="DIR", help="folder for saved records"
     )
-    urdf = sub.add_parser("urdf", help="compare or rewrite the committed URDFs")
+
+
+def _urdf(add: Callable[..., argparse.ArgumentParser]) -> None:
+    """``rrc-pin urdf``'s arguments."""
+    urdf = add("urdf", help="compare or rewrite the committed URDFs")
     mode = urdf.add_mutually_exclusive_group(required=True)
     mode.add_argument("--check", action="store_true", help="fail if a committed file differs")
     mode.add_argument("--write", action="store_true", help="rewrite the committed files")
@@ -218,7 +244,6 @@ def parser() -> argparse.ArgumentParser:
         "--dir", type=Path, default=CHECKOUT / "urdf", help="folder of the URDFs (default: the "
         "checkout's urdf/)"
     )
-    return out
 
 
 def run(args: argparse.Namespace) -> int:
