@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Mapping, Sequence
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -152,49 +153,11 @@ class Robot:
             raise URDFError(source, "no moving joint: there is nothing to control")
         mimics = mimics_of(model, mimic_limits)
         model = tightened(model, mimics, source, UNBOUNDED)
-        scalar_api, scalar_pin, angle_api, angle_pin = [], [], [], []
-        moving: list[tuple[int, str]] = []  # (index in qdot, joint name)
-        mimic: list[str] = []
-        floating = model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer"
-        offset = 1 if floating else 0  # API coordinates before a joint's: idx_v + offset
-        for j in range(2 if floating else 1, model.njoints):
-            joint = model.joints[j]
-            if joint.shortname() == "JointModelMimic":  # follows its primary: no coordinate
-                mimic.append(str(model.names[j]))
-                continue
-            if joint.nv != 1 or joint.nq not in (1, 2):
-                raise URDFError(
-                    source,
-                    f"joint {model.names[j]!r} is a {joint.shortname()} (nq={joint.nq}, "
-                    f"nv={joint.nv}); rrc-pin handles serial arms of 1-DOF joints only "
-                    "(lock or remove it, e.g. with pinocchio.buildReducedModel); a floating "
-                    "base is a free-flyer as the first joint, from the universe",
-                )
-            moving.append((joint.idx_v, str(model.names[j])))
-            if joint.nq == 1:
-                scalar_api.append(joint.idx_v + offset)
-                scalar_pin.append(joint.idx_q)
-            else:
-                angle_api.append(joint.idx_v + offset)
-                angle_pin.append(joint.idx_q)
+        joints = _Joints.of(model, source)
+        floating, offset = joints.floating, joints.offset
+        scalar_api, scalar_pin, angle_api, angle_pin = joints.coordinates
         self._frame_ids = frame_index(model)
-        if tool_frames is None:
-            ends = end_links(model)
-            if len(ends) != 1:
-                shape = "a serial chain ending in" if is_chain(model) else "a tree with"
-                raise ToolFrameRequired(
-                    "tool_frame", f"{source} is {shape} {len(ends)} end links", ends
-                )
-            tool_frames = ends
-        tools = (tool_frames,) if isinstance(tool_frames, str) else tool_frames
-        if (
-            not isinstance(tools, Sequence)
-            or not tools
-            or not all(isinstance(t, str) for t in tools)
-            or len(set(tools)) != len(tools)
-        ):
-            raise InvalidInput("tool_frame", f"expected distinct frame names, got {tools!r}")
-        tools = tuple(tools)
+        tools = _tool_names(model, tool_frames, source)
         for tool in tools:
             self._frame(tool, "tool_frame")
         self.name = name
@@ -207,10 +170,10 @@ class Robot:
         self.nv: int = model.nv
         self.nq: int = model.nv + offset
         self.base_joint: str | None = str(model.names[1]) if floating else None
-        self.joint_names = [joint for _, joint in sorted(moving)]  # = moving_joints(model)
+        self.joint_names = [joint for _, joint in sorted(joints.moving)]  # = moving_joints(model)
         base_dofs = [f"{self.base_joint}:{axis}" for axis in BASE_AXES] if floating else []
         self.dof_names: tuple[str, ...] = (*base_dofs, *self.joint_names)
-        self.mimic_joints: tuple[str, ...] = tuple(mimic)
+        self.mimic_joints: tuple[str, ...] = tuple(joints.mimic)
         self.mimics: tuple[Mimic, ...] = mimics
         self.mimic_velocity = velocity_caps(model, mimics)
         self.mimic_velocity.flags.writeable = False
@@ -651,6 +614,89 @@ def frame_id(model: pin.Model, name: str) -> int:
     if name not in index:
         raise FrameNotFound(name, sorted(index))
     return index[name]
+
+
+class _Joints(NamedTuple):
+    """A model's joints as a :class:`Robot` reads them.
+
+    Attributes:
+        floating: The first joint is a free-flyer (the floating base).
+        offset: API coordinates before a joint's: ``idx_v + offset`` (1 with a floating
+            base, whose position is 7 coordinates and its rates 6).
+        coordinates: The 1-DOF joints' API and Pinocchio indices: scalar ones (api, pin),
+            then continuous ones (cos, sin in Pinocchio: api, pin).
+        moving: (index in qdot, name) of each 1-DOF joint.
+        mimic: The mimic joints' names (they follow a primary: no coordinate).
+    """
+
+    floating: bool
+    offset: int
+    coordinates: tuple[list[int], list[int], list[int], list[int]]
+    moving: list[tuple[int, str]]
+    mimic: list[str]
+
+    @classmethod
+    def of(cls, model: pin.Model, source: str) -> _Joints:
+        """``model``'s joints.
+
+        Raises:
+            URDFError: A joint that is not one coordinate, a floating base aside (named).
+        """
+        scalar_api: list[int] = []
+        scalar_pin: list[int] = []
+        angle_api: list[int] = []
+        angle_pin: list[int] = []
+        moving: list[tuple[int, str]] = []
+        mimic: list[str] = []
+        floating = model.njoints > 1 and model.joints[1].shortname() == "JointModelFreeFlyer"
+        offset = 1 if floating else 0
+        for j in range(2 if floating else 1, model.njoints):
+            joint = model.joints[j]
+            if joint.shortname() == "JointModelMimic":
+                mimic.append(str(model.names[j]))
+                continue
+            if joint.nv != 1 or joint.nq not in (1, 2):
+                raise URDFError(
+                    source,
+                    f"joint {model.names[j]!r} is a {joint.shortname()} (nq={joint.nq}, "
+                    f"nv={joint.nv}); rrc-pin handles serial arms of 1-DOF joints only "
+                    "(lock or remove it, e.g. with pinocchio.buildReducedModel); a floating "
+                    "base is a free-flyer as the first joint, from the universe",
+                )
+            moving.append((joint.idx_v, str(model.names[j])))
+            if joint.nq == 1:
+                scalar_api.append(joint.idx_v + offset)
+                scalar_pin.append(joint.idx_q)
+            else:
+                angle_api.append(joint.idx_v + offset)
+                angle_pin.append(joint.idx_q)
+        return cls(floating, offset, (scalar_api, scalar_pin, angle_api, angle_pin), moving, mimic)
+
+
+def _tool_names(model: pin.Model, tool_frames: str | Sequence[str] | None,
+                source: str) -> tuple[str, ...]:  # fmt: skip
+    """The tool frames' names: ``tool_frames``, or the model's one end link where None.
+
+    Raises:
+        ToolFrameRequired: None given and the tree has several end links (listed).
+        InvalidInput: Not distinct frame names.
+    """
+    if tool_frames is None:
+        ends = end_links(model)
+        if len(ends) != 1:
+            shape = "a serial chain ending in" if is_chain(model) else "a tree with"
+            raise ToolFrameRequired("tool_frame", f"{source} is {shape} {len(ends)} end links",
+                                    ends)  # fmt: skip
+        tool_frames = ends
+    tools = (tool_frames,) if isinstance(tool_frames, str) else tool_frames
+    if (
+        not isinstance(tools, Sequence)
+        or not tools
+        or not all(isinstance(t, str) for t in tools)
+        or len(set(tools)) != len(tools)
+    ):
+        raise InvalidInput("tool_frame", f"expected distinct frame names, got {tools!r}")
+    return tuple(tools)
 
 
 def _finite_window(
