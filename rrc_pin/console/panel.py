@@ -99,9 +99,30 @@ class Panel:
         self.errors = 0
         self._stops = loop.operator.stops
         self._rebuilds = TokenBucket(REBUILDS_PER_SECOND, 2, time.monotonic())
-        s = loop.operator.settings
         gui = server.gui
         gui.configure_theme(control_width="large", dark_mode=False, show_logo=False)
+        self._command_folder(gui, loop)
+        with gui.add_folder("Readouts"):
+            self.joints = gui.add_html("")
+            self.status = gui.add_html("")
+        self._resolution_folder(gui, loop)
+        self._trajectory_folder(gui)
+        self._jog_keys(gui)
+        space = gui.add_command("STOP", hotkey="space")
+        space.on_trigger(_now(self.stop))
+        # Taken as their message arrives (urgent): viser keeps its elements' ids private, and
+        # without one of them that control's message goes the way of the others.
+        self._urgent = {uuid: how for uuid, how in (
+            (_id(self.stop_button), ("GuiUpdateMessage", True, self.stop)),
+            (_id(space), ("CommandTriggerMessage", None, self.stop)),
+            (_id(self.latch), ("GuiUpdateMessage", False, self._let_go)),
+        ) if uuid is not None}  # fmt: skip
+
+    def _command_folder(self, gui: Any, loop: ControlLoop) -> None:
+        """The command's controls: the hand, the frame, the sliders, the deadman, STOP, the
+        speed override, the target and a device's pose stream.
+        """  # noqa: D205
+        s = loop.operator.settings
         with gui.add_folder("Command"):
             self.hand = None
             if len(loop.hands) > 1:
@@ -139,9 +160,9 @@ class Panel:
                                        "qw qx qy qz [clutch 0/1] in metres, from a page or a "
                                        "program (empty: the stream ends)")  # fmt: skip
             self.device.on_update(self._guard(lambda e: cmd.pose_from_page(self.device.value)))
-        with gui.add_folder("Readouts"):
-            self.joints = gui.add_html("")
-            self.status = gui.add_html("")
+
+    def _resolution_folder(self, gui: Any, loop: ControlLoop) -> None:
+        """The strategy (an arm's controller) and the QP backend."""
         with gui.add_folder("Resolution", expand_by_default=False):
             self.strategy = None
             if loop.strategies:  # (a cell's controller takes none)
@@ -153,6 +174,9 @@ class Panel:
                                             initial_value=loop.snapshot.backend)  # fmt: skip
             self.backend.on_update(self._guard(lambda e: cmd.Backend(
                 cmd.one_of(self.backend.value, "backend", loop.backends))))
+
+    def _trajectory_folder(self, gui: Any) -> None:
+        """Recording, reversing, saving and loading the trajectory, and going home."""
         with gui.add_folder("Trajectory", expand_by_default=False):
             self.record = gui.add_checkbox("record", False)
             self.record.on_update(self._guard(lambda e: cmd.Record(bool(self.record.value))))
@@ -166,6 +190,9 @@ class Panel:
             self.upload.on_upload(self._guard(self._load))
             home = gui.add_button("home")
             home.on_click(self._guard(lambda e: cmd.Home()))
+
+    def _jog_keys(self, gui: Any) -> None:
+        """The keyboard's jog commands (:data:`KEYS`; shift: the rotations)."""
         for key, (axis, sign) in KEYS.items():
             for shift in (False, True):
                 which = axis + 3 if shift else axis
@@ -173,15 +200,6 @@ class Panel:
                 command = gui.add_command(label, hotkey=key,
                                           modifier="shift" if shift else None)  # fmt: skip
                 command.on_trigger(self._guard(_jog(which, sign)))
-        space = gui.add_command("STOP", hotkey="space")
-        space.on_trigger(_now(self.stop))
-        # Taken as their message arrives (urgent): viser keeps its elements' ids private, and
-        # without one of them that control's message goes the way of the others.
-        self._urgent = {uuid: how for uuid, how in (
-            (_id(self.stop_button), ("GuiUpdateMessage", True, self.stop)),
-            (_id(space), ("CommandTriggerMessage", None, self.stop)),
-            (_id(self.latch), ("GuiUpdateMessage", False, self._let_go)),
-        ) if uuid is not None}  # fmt: skip
 
     # -- events -------------------------------------------------------------------------------
 
