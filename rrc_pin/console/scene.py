@@ -68,6 +68,21 @@ def wxyz(R: Array) -> Array:
     return np.array([w, x, y, z])
 
 
+def _stage(server: Any, reach: float) -> None:
+    """The scene around the robot: up along +z, lights, the ground's grid and the camera."""
+    scene = server.scene
+    scene.set_up_direction("+z")
+    # Plain lights, no image-based lighting and no shadows: a frame renders several times
+    # faster where the page has no GPU (a software renderer, as in the tests' chromium).
+    scene.configure_environment_map(None)
+    scene.configure_default_lights(enabled=True, cast_shadow=False)
+    scene.add_light_ambient("/light/ambient", intensity=1.2)
+    scene.add_grid("/ground", width=4 * reach, height=4 * reach, cell_size=0.1 * reach,
+                   section_size=0.5 * reach, shadow_opacity=0.0)  # fmt: skip
+    server.initial_camera.position = (1.3 * reach, -1.1 * reach, 0.9 * reach)
+    server.initial_camera.look_at = (0.15 * reach, 0.0, 0.35 * reach)
+
+
 class Scene:
     """The console's 3-D view of one robot.
 
@@ -95,16 +110,7 @@ class Scene:
         self.reach = reach
         self.scale = (ARROW * reach / full[0], ARROW * reach / full[1])
         scene = server.scene
-        scene.set_up_direction("+z")
-        # Plain lights, no image-based lighting and no shadows: a frame renders several times
-        # faster where the page has no GPU (a software renderer, as in the tests' chromium).
-        scene.configure_environment_map(None)
-        scene.configure_default_lights(enabled=True, cast_shadow=False)
-        scene.add_light_ambient("/light/ambient", intensity=1.2)
-        scene.add_grid("/ground", width=4 * reach, height=4 * reach, cell_size=0.1 * reach,
-                       section_size=0.5 * reach, shadow_opacity=0.0)  # fmt: skip
-        server.initial_camera.position = (1.3 * reach, -1.1 * reach, 0.9 * reach)
-        server.initial_camera.look_at = (0.15 * reach, 0.0, 0.35 * reach)
+        _stage(server, reach)
         self.robot_root = scene.add_frame("/robot", show_axes=False)
         self._nodes = self._joint_tree(scene)
         self._coordinate = [int(self.model.joints[j].idx_v) for j in range(self.model.njoints)]
@@ -115,22 +121,8 @@ class Scene:
         kinds = [joint.shortname()[len("JointModel"):] for joint in self.model.joints]
         self._turns = [k in ("RX", "RY", "RZ") or k.startswith(("RUB", "Revolute")) for k in kinds]
         self._slides = [k in ("PX", "PY", "PZ") or k.startswith("Prismatic") for k in kinds]
-        for k, shape in enumerate(visuals.shapes):
-            name = f"{self._paths[shape.joint]}/shape{k}"
-            if shape.color is None:
-                scene.add_mesh_trimesh(name, shape.mesh)
-            else:
-                scene.add_mesh_simple(name, np.asarray(shape.mesh.vertices, np.float32),
-                                      np.asarray(shape.mesh.faces, np.uint32),
-                                      color=shape.color)  # fmt: skip
-        self.hands: dict[str, Any] = {}
-        for tool in robot.tool_frames:
-            frame = self.model.frames[self.model.getFrameId(tool)]
-            self.hands[tool] = scene.add_frame(
-                f"{self._paths[int(frame.parentJoint)]}/hand{len(self.hands)}",
-                axes_length=0.15 * reach, axes_radius=0.008 * reach,
-                wxyz=wxyz(frame.placement.rotation), position=frame.placement.translation,
-            )  # fmt: skip
+        self._add_shapes(scene, visuals)
+        self.hands: dict[str, Any] = self._hands(scene)
         self.arrows = scene.add_arrows("/twist", np.zeros((4, 2, 3)),
                                        np.array([*COMMANDED, *ACHIEVED], np.uint8),
                                        shaft_radius=0.006 * reach, head_radius=0.015 * reach,
@@ -157,6 +149,30 @@ class Scene:
 
         self.hand = robot.tool_frames[0]
         self.set_hand(self.hand)
+
+    def _add_shapes(self, scene: Any, visuals: Visuals) -> None:
+        """Each visual shape under its joint's node."""
+        for k, shape in enumerate(visuals.shapes):
+            name = f"{self._paths[shape.joint]}/shape{k}"
+            if shape.color is None:
+                scene.add_mesh_trimesh(name, shape.mesh)
+            else:
+                scene.add_mesh_simple(name, np.asarray(shape.mesh.vertices, np.float32),
+                                      np.asarray(shape.mesh.faces, np.uint32),
+                                      color=shape.color)  # fmt: skip
+
+    def _hands(self, scene: Any) -> dict[str, Any]:
+        """A frame node per tool frame, under its joint's node."""
+        reach = self.reach
+        hands: dict[str, Any] = {}
+        for tool in self.robot.tool_frames:
+            frame = self.model.frames[self.model.getFrameId(tool)]
+            hands[tool] = scene.add_frame(
+                f"{self._paths[int(frame.parentJoint)]}/hand{len(hands)}",
+                axes_length=0.15 * reach, axes_radius=0.008 * reach,
+                wxyz=wxyz(frame.placement.rotation), position=frame.placement.translation,
+            )  # fmt: skip
+        return hands
 
     def _joint_tree(self, scene: Any) -> list[Any]:
         """A frame node per joint, nested as the joints are (index 0: the base)."""
