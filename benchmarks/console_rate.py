@@ -12,7 +12,9 @@ second the loop's tick periods (start to start) and work times (the tick itself)
 ``--seconds``. The view's own update time (scene and readouts) is sampled too. Cases: panda at
 100 Hz and at 1 kHz with the console's thread switch interval (0.2 ms), and panda at 1 kHz with
 Python's default (5 ms), which shows what the setting buys, and panda at 1 kHz with the loop
-under real-time scheduling (``--realtime``: ``SCHED_FIFO``, root here). Then the cost of
+under real-time scheduling (``--realtime``: ``SCHED_FIFO``, root here); the gsfc_dual cell at
+1 kHz (its ``CellController``, the held object commanded), with and without real-time
+scheduling. Then the cost of
 moving the arm in the scene (``Scene.update`` inside ``server.atomic()``, browser connected)
 against viser's ``ViserUrdf.update_cfg`` on the same panda.
 
@@ -48,8 +50,10 @@ CASES = (
     ("panda", 1000.0, SWITCH_INTERVAL, False),
     ("panda", 1000.0, SWITCH_INTERVAL, True),
     ("panda", 1000.0, 5e-3, False),
+    ("gsfc_dual", 1000.0, SWITCH_INTERVAL, False),
+    ("gsfc_dual", 1000.0, SWITCH_INTERVAL, True),
 )
-"""(arm, loop rate [Hz], thread switch interval [s], real-time scheduling)."""
+"""(arm or cell, loop rate [Hz], thread switch interval [s], real-time scheduling)."""
 
 
 def ms(values: np.ndarray) -> dict[str, float]:
