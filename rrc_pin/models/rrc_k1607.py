@@ -45,7 +45,7 @@ def cylinder_links(rows: tuple[DHRow, ...]) -> tuple[LinkInertial, ...]:
     The segment's far end is the origin of frame i + 1 at q = 0 (the tool for the last link,
     a stub of one diameter along z).
     """
-    ends = [link_transform(row, 0.0, "modified")[:3, 3] for row in rows[1:]] + [np.zeros(3)]
+    ends = [link_transform(row, 0.0, "modified")[:3, 3].copy() for row in rows[1:]] + [np.zeros(3)]
     return tuple(
         cylinder(mass, radius, end)
         for mass, radius, end in zip(LINK_MASSES, LINK_RADII, ends, strict=True)

@@ -11,9 +11,12 @@ report: ``S1 = sin(theta_1)``, ``C23 = cos(theta_2 + theta_3)``, ``SAL3 = sin(al
 Each equation is one small kernel (:func:`~rrc_pin.solvers.tick.kernels.kernel`:
 ``numba.njit(cache=True)``)
 on the floats of one configuration, cited once; corrections to the printed equations are
-cited as in docs/errata.md. The paths of :mod:`rrc_pin.solvers.closed_form.barker` (the arm, the
-wrist, their bands) and the loops over N configurations are at the end: a batch is a
-compiled loop over the same kernels.
+cited as in docs/errata.md. The steps private to the arm's and the wrist's rates (eqs (25),
+(34)-(44), (50), (51), (58), the band measures, the band's solve) and ``joint_rates`` are
+:func:`~rrc_pin.solvers.compiled.inlined` into the kernels that call them, so that numba does
+not compile and optimise each as a library of its own. The paths of
+:mod:`rrc_pin.solvers.closed_form.barker` (the arm, the wrist, their bands) and the loops over
+N configurations are at the end: a batch is a compiled loop over the same kernels.
 
 Singular set (Appendix D): ``det J = det M det W = ES (S2 ES + F5)(SAL3 WE S3 + A3 C3) S5``
 (up to sign), for any R3 and alpha3: conditions (32), (33) and S5 = 0.
@@ -28,7 +31,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.closed_form.base import finite
-from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick.kernels import jacobi_svd, svd_rates
 
 Array = npt.NDArray[np.float64]
@@ -189,7 +192,7 @@ def m_matrix(t: Trig, F: FTerms, M: Array) -> None:
     M[2, 0], M[2, 1], M[2, 2] = 0.0, -F.f1, -F.f5
 
 
-@kernel
+@inlined
 def m_rotated(t: Trig, F: FTerms, T1: float, T2: float, T3: float, A: Array, b: Array) -> None:
     """Eq. (25) with its rows turned by theta_1, and TVEL^ with them: ``A`` (3, 3), ``b`` (3,).
 
@@ -203,7 +206,7 @@ def m_rotated(t: Trig, F: FTerms, T1: float, T2: float, T3: float, A: Array, b: 
     b[2] = T3
 
 
-@kernel
+@inlined
 def det_adj2(g: BarkerGeometry, t: Trig, F: FTerms) -> tuple[float, float]:
     """Det M = ES F1 (SAL3 WE S3 + A3 C3) (eq. (D9)) [m^3] and ||adj M||_F^2 [m^4].
 
@@ -218,7 +221,7 @@ def det_adj2(g: BarkerGeometry, t: Trig, F: FTerms) -> tuple[float, float]:
     return F.f1 * e, adj2
 
 
-@kernel
+@inlined
 def arm_full(
     t: Trig, F: FTerms, det: float, T1: float, T2: float, T3: float
 ) -> tuple[float, float, float]:
@@ -231,7 +234,7 @@ def arm_full(
     )
 
 
-@kernel
+@inlined
 def m1_system(
     t: Trig, F: FTerms, T1: float, T2: float, T3: float, A: Array, b: Array
 ) -> float:
@@ -251,7 +254,7 @@ def m1_system(
     return ta
 
 
-@kernel
+@inlined
 def arm_from_m1(F: FTerms, th2: float, th3: float, ta: float) -> float:
     """thetadot_1 by Barker eq. (39), with thetadot_2, thetadot_3 of eq. (44)."""
     return (F.f3 * th2 + F.f4 * th3 - ta) / F.f2
@@ -285,20 +288,20 @@ def wrist_equations(
     return th5, -t.s4 * d5 + t.c4 * d4, g.sal3 * d3 - g.cal3 * d2  # eq. (59) ("D6" is D5)
 
 
-@kernel
+@inlined
 def wrist_regular(t: Trig, ga: float, gb: float) -> tuple[float, float]:
     """(thetadot_4, thetadot_6) by Barker eqs (51), (50): ``M2^-1 (ga, gb)``."""
     th6 = ga / t.s5  # eq. (50)
     return gb - t.c5 * th6, th6  # eq. (51)
 
 
-@kernel
+@inlined
 def m2_matrix(t: Trig, A: Array) -> None:
     """Barker's M2 = [[0, S5], [1, C5]] (eq. (58)) into ``A`` (2, 2): of thetadot_4, thetadot_6."""
     A[0, 0], A[0, 1], A[1, 0], A[1, 1] = 0.0, t.s5, 1.0, t.c5
 
 
-@kernel
+@inlined
 def wrist_s2(t: Trig) -> float:
     """The wrist's band measure ``s^2 = sigma_min(M2)^2 = 1 - |C5| = S5^2 / (1 + |C5|)``.
 
@@ -308,7 +311,7 @@ def wrist_s2(t: Trig) -> float:
     return t.s5 * t.s5 / (1.0 + abs(t.c5))
 
 
-@kernel
+@inlined
 def arm_s2(det: float, adj2: float) -> float:
     """The arm's band measure ``s^2 = det^2 / ||adj||_F^2 <= sigma_min^2`` of M or of M1.
 
@@ -318,7 +321,7 @@ def arm_s2(det: float, adj2: float) -> float:
     return det * det / adj2 if adj2 > 0.0 else 0.0
 
 
-@kernel
+@inlined
 def arm_in_band(det: float, adj2: float, eps: float) -> bool:
     """Whether the arm is in its band, ``arm_s2(det, adj2) <= eps^2``, without the division."""
     return det * det <= eps * eps * adj2
@@ -397,7 +400,7 @@ def tvel_frame2(t: Trig, T1: float, T2: float, T3: float) -> tuple[float, float,
 # -- the paths: a block exactly outside its band, by the SVD inside ------------------------
 
 
-@kernel
+@inlined
 def band_solve(A: Array, b: Array, s2: float, eps: float, exact: bool, x: Array) -> None:
     r"""Rates ``x`` of a 2x2 or 3x3 block ``A x = b`` inside its band, by the SVD of ``A``.
 
@@ -418,7 +421,7 @@ def band_solve(A: Array, b: Array, s2: float, eps: float, exact: bool, x: Array)
     jacobi_svd(A, V, sigma)
     lambda_sq = np.full(m, 0.0 if exact else eps * eps - s2)
     cut = eps if exact else 0.0
-    rank = 0
+    rank = 0 * m  # not the literal 0: one compiled signature of svd_rates
     for i in range(m):
         if sigma[i] > cut:
             rank += 1
@@ -484,7 +487,7 @@ def wrist_rates(
     return x[0], th5, x[1], bad
 
 
-@kernel
+@inlined
 def joint_rates(
     g: BarkerGeometry, t: Trig, x: Array, reduced: bool, exact: bool, eps_arm: float,
     eps_wrist: float, out: Array,
