@@ -30,6 +30,8 @@ exceptions = pytest.importorskip("websockets.exceptions")
 
 PATIENCE = 180.0
 """Longest wait [s] for a state (a loaded 2-core machine: seconds where a quiet one takes ms)."""
+SENT_STOP = 0.02
+"""[s] A STOP sent under the flood is applied within this (2 ticks at 100 Hz)."""
 PROTOCOL = f"viser-v{viser.__version__}"
 CAMERA = {"type": "ViewerCameraMessage", "wxyz": [1, 0, 0, 0], "position": [1, 1, 1],
           "fov": 1.0, "near": 0.01, "far": 100.0, "image_height": 100, "image_width": 100,
@@ -336,7 +338,13 @@ def test_a_flood_of_four_sockets_costs_the_loop_nothing_and_stop_comes_next_tick
               f"{latencies}; flood messages sent {sent}, posted {loop.mailbox.posted - posted}, "
               f"dropped {loop.mailbox.dropped - dropped}; guard: {dict(c.guard.closed)}")
         assert flooded_share > quiet_share - 0.05
-        assert all(sending <= 2 and arrival <= 2 for sending, arrival in latencies)
+        # the console's part: a STOP applied at the tick after it arrived
+        assert all(arrival <= 2 for _, arrival in latencies), latencies
+        # the bytes' way to the guard: viser's event loop reads the four flooding sockets'
+        # chunks in turn, the same milliseconds at any loop rate (1 kHz on a loaded 2-core
+        # CI: 3 and 5 ticks once each in 10); within SENT_STOP, most within 2 ticks
+        assert all(sending / rate <= SENT_STOP for sending, _ in latencies), latencies
+        assert np.median([sending for sending, _ in latencies]) <= 2, latencies
         assert c.guard.urgents >= len(latencies)  # taken as they came, not by viser
         assert loop.mailbox.dropped == dropped
         reason = f"more than {c.intake.rate:g} messages a second for {c.intake.patience:g} s"
