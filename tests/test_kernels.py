@@ -78,6 +78,22 @@ def test_jacobi_svd_against_lapack(m: int, k: int, rng: np.random.Generator) -> 
             np.testing.assert_allclose(np.linalg.norm(US, axis=0), sigma, atol=1e-12 * sigma[0])
 
 
+@pytest.mark.parametrize("size", [1e-76, 1e-30, 1e30, 1e76])
+def test_jacobi_svd_of_tiny_and_huge_matrices_against_lapack(
+    size: float, rng: np.random.Generator
+) -> None:
+    """Entries whose squares leave the range of normal floats (1e-76, 1e76: the rotation's
+    root by hypot) or stay within it: the SVD is LAPACK's, relative to the largest value."""
+    for _ in range(100):
+        A = random_rows(rng, 6, 6, 6) * size
+        US, V, sigma = A.copy(), np.empty((6, 6)), np.empty(6)
+        kernels.jacobi_svd(US, V, sigma)
+        reference = np.linalg.svd(A / size, compute_uv=False) * size
+        np.testing.assert_allclose(sigma, reference, rtol=0.0, atol=1e-12 * reference[0])
+        np.testing.assert_allclose(V.T @ V, np.eye(6), atol=1e-13)
+        np.testing.assert_allclose((A / size) @ V, US / size, atol=1e-12 * reference[0] / size)
+
+
 def test_jacobi_svd_of_blocks_against_lapack(rng: np.random.Generator) -> None:
     """Columns without a row in common (two arms' blocks, a zero column): orthogonal exactly,
     left as they are; the SVD is LAPACK's."""

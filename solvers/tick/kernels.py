@@ -263,6 +263,15 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
     Algorithm 4.1: the rotation that zeroes :math:`a_p^T a_q`), accumulated in V; the column
     norms are then the singular values. Columns are sorted by decreasing norm at the end.
 
+    Each column's squared norm is kept from the rotation that last changed it (the same sum,
+    in the same order, as from the column). The rotation is Golub & Van Loan 2013's
+    (Algorithm 8.5.1, the tangent :math:`t = \mathrm{sign}(\tau)\gamma/d`) in terms of
+    :math:`\tau = (\beta - \alpha)/2`, :math:`r = \sqrt{\tau^2 + \gamma^2}` and
+    :math:`d = |\tau| + r`: as :math:`d^2 + \gamma^2 = 2rd`, its cosine and sine are
+    :math:`c = d/h` and :math:`s = \mathrm{sign}(\tau)\gamma/h` with :math:`h = \sqrt{2rd}`
+    (where a square or :math:`2rd` would leave the range of normal floats, of
+    :math:`\tau/r` and :math:`\gamma/r`, r by :func:`math.hypot`).
+
     Args:
         A: The matrix (m, k); out: its columns rotated, ``U diag(sigma)``.
         V: Out: orthogonal (k, k), the right singular vectors (columns).
@@ -272,35 +281,44 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
     V[:, :] = 0.0
     for i in range(k):
         V[i, i] = 1.0
+    norms = np.empty(k)  # each column's squared norm
+    for j in range(k):
+        s = 0.0
+        for i in range(m):
+            s += A[i, j] * A[i, j]
+        norms[j] = s
     for _ in range(SWEEPS):
         rotated = False
         for p in range(k - 1):
             for q in range(p + 1, k):
-                alpha = beta = gamma = 0.0
+                alpha, beta, gamma = norms[p], norms[q], 0.0
                 for i in range(m):
-                    alpha += A[i, p] * A[i, p]
-                    beta += A[i, q] * A[i, q]
                     gamma += A[i, p] * A[i, q]
                 if gamma == 0.0 or abs(gamma) <= 1e-15 * math.sqrt(alpha * beta):
                     continue
                 rotated = True
-                zeta = (beta - alpha) / (2.0 * gamma)
-                t = math.copysign(1.0, zeta) / (abs(zeta) + math.hypot(1.0, zeta))
-                c = 1.0 / math.sqrt(1.0 + t * t)
-                s = c * t
+                tau = 0.5 * (beta - alpha)
+                r = math.sqrt(tau * tau + gamma * gamma)
+                if not 1e-150 < r < 1e150:  # the same rotation of tau / r, gamma / r
+                    r = math.hypot(tau, gamma)
+                    tau, gamma, r = tau / r, gamma / r, 1.0
+                d = abs(tau) + r
+                h = math.sqrt(2.0 * r * d)
+                c, s = d / h, math.copysign(1.0, tau) * gamma / h
+                alpha = beta = 0.0
                 for i in range(m):
                     ap, aq = A[i, p], A[i, q]
                     A[i, p], A[i, q] = c * ap - s * aq, s * ap + c * aq
+                    alpha += A[i, p] * A[i, p]
+                    beta += A[i, q] * A[i, q]
+                norms[p], norms[q] = alpha, beta
                 for i in range(k):
                     vp, vq = V[i, p], V[i, q]
                     V[i, p], V[i, q] = c * vp - s * vq, s * vp + c * vq
         if not rotated:
             break
     for j in range(k):
-        s = 0.0
-        for i in range(m):
-            s += A[i, j] * A[i, j]
-        sigma[j] = math.sqrt(s)
+        sigma[j] = math.sqrt(norms[j])
     for j in range(k):  # selection sort, descending, columns of A and V alike
         best = j
         for i in range(j + 1, k):
