@@ -17,21 +17,26 @@ next to its wrist singularity, which its script turns through first.
 from __future__ import annotations
 
 import csv
+import subprocess
+import sys
 import tempfile
 import time
 from collections import Counter
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import NamedTuple
+from typing import NamedTuple, cast
 
 import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.control import Controller, TrajectoryLog
 from rrc_pin.control.strategies import make_strategy
+from rrc_pin.control.strategies.barker_arm import compile_closed_form
 from rrc_pin.limits import JointLimits
 from rrc_pin.loading import load
 from rrc_pin.robot import Robot
+from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
+from rrc_pin.solvers.compiled import numba_config
 
 Array = npt.NDArray[np.float64]
 DT = 0.01  # [s], control period
@@ -215,8 +220,43 @@ def default_out() -> Path:
     return Path(tempfile.mkdtemp(prefix=f"rrc-pin-demo-{time.strftime('%Y%m%d-%H%M%S')}-"))
 
 
+def compile_barker() -> None:
+    """Compile Barker's kernels (:func:`compile_closed_form`) or load them from numba's cache."""
+    compile_closed_form(cast(BarkerClosedForm, load("barker6").closed_form))
+
+
+def compiling_beside() -> subprocess.Popen[bytes] | None:
+    """A second process that compiles Barker's kernels into numba's cache (:func:`compile_barker`).
+
+    On a fresh install the first session's controller compiles the resolver's tick, then
+    Barker's kernels: the second process compiles those on another core meanwhile, and the
+    controller loads them from the cache. Where they are cached already it loads them and
+    exits. None where no process can be started, or nothing is compiled
+    (``NUMBA_DISABLE_JIT=1``).
+    """
+    if numba_config.DISABLE_JIT:
+        return None
+    try:
+        return subprocess.Popen(
+            [sys.executable, "-c", "from rrc_pin.demo import compile_barker; compile_barker()"],
+            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        )  # fmt: skip
+    except OSError:
+        return None
+
+
 def teleoperation(out: Path | None = None, quick: bool = False) -> int:
     """The scripted sessions, the table, the CSV files and the figure; the exit code."""
+    beside = compiling_beside()
+    try:
+        return _teleoperation(out, quick)
+    finally:
+        if beside is not None:
+            beside.wait()
+
+
+def _teleoperation(out: Path | None, quick: bool) -> int:
+    """:func:`teleoperation`'s sessions, table, files and figure."""
     out = default_out() if out is None else out
     out.mkdir(parents=True, exist_ok=True)
     runs = [(s, name) for s in SESSIONS for name in s.strategies]

@@ -135,3 +135,16 @@ def test_an_arm_given_by_path_keeps_the_table_intact(tmp_path, capsys):
         assert str(path) not in lines[1]
         ends = {re.match(r"^\S+\s+(\d+|dof)", line).end() for line in lines}
         assert len(ends) == 1  # the dof column lines up under its header
+
+
+def test_barker_is_compiled_beside_the_first_session():
+    """The second process of a demo loads or compiles Barker's kernels and exits cleanly; none
+    is started where nothing is compiled."""
+    from rrc_pin import demo
+
+    beside = demo.compiling_beside()
+    if os.environ.get("NUMBA_DISABLE_JIT") == "1":
+        assert beside is None
+        return
+    assert beside is not None
+    assert beside.wait(timeout=300) == 0
