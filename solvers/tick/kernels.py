@@ -290,26 +290,8 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
     block, blocks = column_blocks(A)
     if blocks <= 1:
         jacobi_rotations(A, V, norms)
-    row_block = np.full(m, -1)  # each nonzero row's block
-    for i in range(m):
-        for j in range(k):
-            if A[i, j] != 0.0:
-                row_block[i] = block[j]
-    for b in range(blocks if blocks > 1 else 0):
-        cols, rows = np.flatnonzero(block == b), np.flatnonzero(row_block == b)
-        part = np.empty((rows.size, cols.size))
-        for i in range(rows.size):
-            for j in range(cols.size):
-                part[i, j] = A[rows[i], cols[j]]
-        W = np.eye(cols.size)
-        part_norms = np.empty(cols.size)
-        jacobi_rotations(part, W, part_norms)
-        for j in range(cols.size):
-            norms[cols[j]] = part_norms[j]
-            for i in range(rows.size):
-                A[rows[i], cols[j]] = part[i, j]
-            for i in range(cols.size):
-                V[cols[i], cols[j]] = W[i, j]
+    else:
+        block_rotations(A, V, norms, block, blocks)
     for j in range(k):
         sigma[j] = math.sqrt(norms[j])
     for j in range(k):  # selection sort, descending, columns of A and V alike
@@ -364,6 +346,35 @@ def column_blocks(A: Array) -> tuple[npt.NDArray[np.int64], int]:
         else:
             block[j] = block[r]
     return block, blocks
+
+
+@inlined
+def block_rotations(A: Array, V: Array, norms: Array, block: npt.NDArray[np.int64],
+                    blocks: int) -> None:  # fmt: skip
+    """:func:`jacobi_rotations` of each block of ``A``'s columns (:func:`column_blocks`) on its
+    own rows and columns, written back into ``A``, ``V`` (the identity on entry) and ``norms``.
+    """  # noqa: D205
+    m, k = A.shape
+    row_block = np.full(m, -1)  # each nonzero row's block
+    for i in range(m):
+        for j in range(k):
+            if A[i, j] != 0.0:
+                row_block[i] = block[j]
+    for b in range(blocks):
+        cols, rows = np.flatnonzero(block == b), np.flatnonzero(row_block == b)
+        part = np.empty((rows.size, cols.size))
+        for i in range(rows.size):
+            for j in range(cols.size):
+                part[i, j] = A[rows[i], cols[j]]
+        W = np.eye(cols.size)
+        part_norms = np.empty(cols.size)
+        jacobi_rotations(part, W, part_norms)
+        for j in range(cols.size):
+            norms[cols[j]] = part_norms[j]
+            for i in range(rows.size):
+                A[rows[i], cols[j]] = part[i, j]
+            for i in range(cols.size):
+                V[cols[i], cols[j]] = W[i, j]
 
 
 @inlined
