@@ -47,7 +47,7 @@ from rrc_pin.solvers.tick.problem import (
     merged_equalities,
     merged_rows,
     mode_of,
-    stacked_level,
+    stacked_rows,
 )
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.solvers.tick.top import FAILED
@@ -125,10 +125,10 @@ class TickSource:
             levels[0].rows_from(levels[1], levels[2], levels[3]),)  # fmt: skip
         present = [c for c in self.constraints if c is not None]
         rows = merged_rows(present) if present else None
-        keeps = any(c.d is not None and c.d.any() for c in present)
+        keeps = any([c.d is not None and np.count_nonzero(c.d) > 0 for c in present])
         box = self.box
         mode = mode_of(box, rows, keeps, self.weighted, self.direction)
-        return level, stacked_level(level, mode == "direction", box)[0], rows
+        return level, stacked_rows(level, mode == "direction"), rows
 
     def problem(self) -> Problem:
         """The problem the tick answered (:func:`rrc_pin.solvers.tick.problem.build`)."""
@@ -351,12 +351,13 @@ class CompiledTick:
         ``start`` [s] when the tick began (``time.perf_counter``)."""  # noqa: D205, D209
         ws = self.workspace
         ws.load_levels(levels, weighted)
-        with_rows, equalities = [], False
+        with_rows, with_equalities = [], []
         for c in constraints:
             if c is not None:
                 if c.G is not None and c.h is not None and c.h.size:
                     with_rows.append(c)
-                equalities = equalities or c.d is not None
+                if c.C is not None and c.d is not None and c.d.size:
+                    with_equalities.append(c)
         if not with_rows:
             ws.load_rows(None, None, None)
         elif len(with_rows) == 1:  # one limit's rows: loaded as they are (names not needed)
@@ -364,10 +365,10 @@ class CompiledTick:
         else:
             rows = cast(Rows, merged_rows(with_rows))
             ws.load_rows(rows.G, rows.h, rows.slide)
-        merged = None
-        if equalities:
-            merged = merged_equalities([c for c in constraints if c is not None])
-        ws.load_equalities(*(merged or (None, None)))
+        if len(with_equalities) == 1:  # one limit's rows (the grip's): loaded as they are
+            ws.load_equalities(with_equalities[0].C, with_equalities[0].d)
+        else:
+            ws.load_equalities(*(merged_equalities(with_equalities) or (None, None)))
         self._loaded = None
         code = self._run(kin.q, previous, dt, levels)
         return self._answer(code, levels, constraints, dt, weighted, start)

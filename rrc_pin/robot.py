@@ -366,8 +366,9 @@ class Robot:
         api, pin_idx = self._scalar
         out[pin_idx] = q[api]
         api, pin_idx = self._angle
-        out[pin_idx] = np.cos(q[api])
-        out[pin_idx + 1] = np.sin(q[api])
+        if api.size:  # continuous joints: (cos, sin)
+            out[pin_idx] = np.cos(q[api])
+            out[pin_idx + 1] = np.sin(q[api])
         return q, out
 
     def neutral(self) -> npt.NDArray[np.float64]:

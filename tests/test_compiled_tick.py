@@ -60,6 +60,31 @@ def test_the_problem_is_built_where_it_is_read(panda: rrc_pin.Robot) -> None:
     assert isinstance(Constraints(problem.box).box, type(want.box))
 
 
+
+@pytest.mark.parametrize("speed", [0.05, 5.0, 1e200])
+@pytest.mark.parametrize("weighted", [False, True])
+def test_the_top_level_is_read_as_the_problem_stacks_it(panda: rrc_pin.Robot, speed: float,
+                                                        weighted: bool) -> None:  # fmt: skip
+    """TickSource.top's rows are the problem's top level stacked in its metric, bitwise: the
+    direction mode's units, a level's weights, a command past the cap (its rates rescaled,
+    its rows not)."""
+    rng = np.random.default_rng(7)
+    resolver = Resolver(panda)
+    weight = np.array([1.0, 4.0, 1.0, 0.5, 1.0, 2.0]) if weighted else 1.0
+    modes = set()
+    for k in range(20):
+        top_tasks = [FrameTask(panda.tool_frame, rng.normal(size=6) * speed, weight=weight),
+                     FrameTask("panda_link5", rng.normal(size=6) * speed)][: 1 + k % 2]
+        tasks = [top_tasks, [PostureTask(panda.ready(), weight=0.1)]]
+        r = resolver.solve(panda.random_q(rng), tasks, priority="strict")
+        level, top, rows = r.source.top()
+        problem = r.problem
+        assert level == problem.levels[0] and rows == problem.rows
+        assert np.array_equal(top, problem.stacked[0][0])
+        modes.add(problem.mode)
+    assert "direction" in modes
+
+
 @pytest.mark.parametrize("which", ["q", "twist"])
 def test_a_bad_value_is_named_and_changes_nothing(panda: rrc_pin.Robot, which: str) -> None:
     resolver = Resolver(panda)

@@ -33,6 +33,10 @@ STATUSES: tuple[str, ...] = get_args(Status)
 """The statuses a row codes, by index."""
 LEVEL_STATUSES: tuple[str, ...] = get_args(LevelStatus)
 MODES = ("teleop", "reverse")
+STATUS_CODES = {name: i for i, name in enumerate(STATUSES)}
+LEVEL_CODES = {name: i for i, name in enumerate(LEVEL_STATUSES)}
+MODE_CODES = {name: i for i, name in enumerate(MODES)}
+"""A status's, level status's or mode's code in a row: its index in the tuple above."""
 LEVELS = 4
 """Level statuses a row keeps (a cell's tick has two levels, the top and the posture)."""
 NONE = 255
@@ -141,11 +145,11 @@ class CellLog(RecordRing[CellRecord]):
 
         The row is written in one assignment (a tuple of :attr:`dtype`'s fields).
         """
-        codes = [LEVEL_STATUSES.index(s) for s in levels[:LEVELS]]
+        codes = [LEVEL_CODES[s] for s in levels[:LEVELS]]
         row = (
             t, q, qdot, scale, [errors.get(n, math.nan) for n in self.commands],
-            [grip.get(n, math.nan) for n in self.objects], chain, STATUSES.index(status),
-            MODES.index(mode), codes + [NONE] * (LEVELS - len(codes)),
+            [grip.get(n, math.nan) for n in self.objects], chain, STATUS_CODES[status],
+            MODE_CODES[mode], codes + [NONE] * (LEVELS - len(codes)),
         )  # fmt: skip
         index = self._next()  # may grow the table: read it after
         self._table[index] = row

@@ -171,7 +171,9 @@ def close(
     """
     n = qdot.size
     data = kin.data
-    poses = np.array([data.oMf[f].homogeneous for f in frames.frames]).reshape(-1, 4, 4)
+    oMf, poses = data.oMf, np.empty((len(frames.frames), 4, 4))
+    for i, f in enumerate(frames.frames):
+        poses[i] = oMf[f].homogeneous
     G, h = (np.zeros((0, n)), np.zeros(0)) if rows is None else (rows.G, np.array(rows.h))
     delta, after = np.empty(n), np.empty(closure.error.size)
     closure_kernels.correction(

@@ -84,6 +84,8 @@ Array = npt.NDArray[np.float64]
 Ref = Literal["world_aligned", "local", "world", "base"]
 REFS: tuple[Ref, ...] = ("world_aligned", "local", "world", "base")
 """The frames a command's twist may be given in: every entry point's, and a hand's ``base``."""
+REF_INDEX = {ref: i for i, ref in enumerate(REFS)}
+"""Each ref's index in :data:`REFS` (a checked command's last entry)."""
 Command = npt.ArrayLike | tuple[npt.ArrayLike, str]
 """A twist (6,) in ``world_aligned``, or ``(twist, ref)``."""
 REANCHOR = ("singular", "least_squares", "recovering", "fallback")
@@ -208,6 +210,7 @@ class CellController(Loop):
         """``"grip_lost"`` or ``"contact_lost"`` while a chain is open beyond its bound (the
         cell then holds still until a command closes it), else None."""
         self.support: list[str] = list(cell.tool_frames) if cell.body is not None else []
+        self._commandable_of: tuple[tuple[str, ...] | None, tuple[str, ...]] = (None, ())
         self._anchors: dict[str, Array] = {}
         self._grips: dict[str, Array] = {}
         self._commands: dict[str, Array] = {}
@@ -215,13 +218,14 @@ class CellController(Loop):
         self._targets: dict[str, Array] = {}
         self._tick: tuple[str, bool, dict[str, Array]] = ("teleop", False, {})
         self._applied: Array = np.zeros(cell.nv)
-        self._correction_size = 0.0
+        self._corrected: tuple[Array, Array] | None = None  # applied, resolved: a corrected tick's
         self._kin_data = cell.model.createData()  # the tick's kinematics (:meth:`_kinematics`)
         self._kin: Kinematics | None = None
         self._kin_q: Array | None = None  # the configuration _kin is of
         self._top_tasks: Sequence[TaskRows] = ()  # the last tick's top level (:meth:`_closed`)
         self._frame_tasks: dict[str, FrameTask] = {}
         self._frames = frame_index(cell.model)
+        self._frame_ids: dict[str, int] = {}  # a command's frame's index (:meth:`_frame_id`)
         self._chain_frames = ChainFrames.of(cell.model, (), ())
         if closure is not None:
             compile_correction(cell.nv)
@@ -234,15 +238,25 @@ class CellController(Loop):
 
     def commandable(self) -> list[str]:
         """Names :meth:`step` takes: held objects, the body, free hands and swinging feet."""
+        return list(self._commandable())
+
+    def _commandable(self) -> tuple[str, ...]:
+        """:meth:`commandable`'s names, made again only when the feet in support change (the
+        cell's objects and arms are fixed).
+        """  # noqa: D205
+        support = tuple(self.support)
+        if self._commandable_of[0] == support:
+            return self._commandable_of[1]
         cell = self.cell
         names = list(cell.objects)
         if cell.body is not None:
             names.append(cell.body)
         for arm in cell.arms.values():
-            if arm.hand in self.support or cell.holder(arm.hand) is not None:
+            if arm.hand in support or cell.holder(arm.hand) is not None:
                 continue
             names.append(arm.key)
-        return names
+        self._commandable_of = (support, tuple(names))
+        return self._commandable_of[1]
 
     def target(self, name: str) -> Array:
         """The target pose (4, 4) of command ``name`` in the cell's base frame (a copy).
@@ -330,8 +344,8 @@ class CellController(Loop):
         weight = self._weight()
         cell = self.cell
         kin = self._kinematics()
-        oMf, index = kin.data.oMf, kin.layout.frames  # one pass: every frame placed
-        poses = {name: oMf[index[self.frame_of(name)]].homogeneous for name in self._targets}
+        oMf = kin.data.oMf  # one pass: every frame placed
+        poses = {name: oMf[self._frame_id(name)].homogeneous for name in self._targets}
         twists = {name: weight * self._world_aligned(name, poses[name], self._commands[name])
                   if name in self._commands else np.zeros(6) for name in self._targets}  # fmt: skip
         for name, twist in self._streamed(poses).items():  # the stream's target: the reference
@@ -358,7 +372,7 @@ class CellController(Loop):
             levels: list[list[Task]] = [top, [self.posture]] if top else [[self.posture]]
             r = self.resolver.solve_at(kin, levels, priority="strict", qdot_prev=before)
         r = self._smooth(r)
-        commanded = any(t.any() for t in twists.values())
+        commanded = any(map(np.count_nonzero, twists.values()))  # a twist not zero
         self._tick = ("teleop", commanded, poses)
         out = self._advance(r)
         r = out.resolution
@@ -429,6 +443,15 @@ class CellController(Loop):
         self._kin = Kinematics(self.cell.model, self._kin_data, self.resolver.layout, dof, q_pin)
         self._kin_q = self._q
         return self._kin
+
+    def _frame_id(self, name: str) -> int:
+        """The Pinocchio index of the frame command ``name`` moves (:meth:`frame_of`), kept
+        (the cell's frames are fixed).
+        """  # noqa: D205
+        index = self._frame_ids.get(name)
+        if index is None:
+            index = self._frame_ids[name] = self._frames[self.frame_of(name)]
+        return index
 
     def _task(self, name: str, twist: Array) -> FrameTask:
         """Command ``name``'s frame task of this tick: ``twist`` (6,) toward its target.
@@ -519,7 +542,10 @@ class CellController(Loop):
         """
         warn_renamed("CellController.contact_correction",
                      "CellController.step(...).resolution.correction", stacklevel=2)  # fmt: skip
-        return self._correction_size
+        if self._corrected is None:
+            return 0.0
+        applied, resolved = self._corrected
+        return float(np.abs(applied - resolved).max())
 
     # -- the closed chains ------------------------------------------------------------------
 
@@ -557,7 +583,7 @@ class CellController(Loop):
         until the chain is back within the bound.
         """
         self._applied = r.qdot
-        self._correction_size = 0.0
+        self._corrected = None
         self.chain_error = (0.0, 0.0)
         tasks, stacked, rows = _top_level(r)
         self._top_tasks = tasks
@@ -592,7 +618,7 @@ class CellController(Loop):
             return CellResolution.of_tick(r._replace(qdot=still, status=self.lost, scale=0.0,
                                                 veer=0.0), still.copy(), hands)  # fmt: skip
         self._applied = box.clip(r.qdot + delta)  # inside the box as the resolver's rates are
-        self._correction_size = float(np.abs(self._applied - r.qdot).max())
+        self._corrected = (self._applied, r.qdot)
         return CellResolution.of_tick(r, self._applied, hands)
 
     def _hands(self, level: Sequence[TaskRows]) -> Callable[[], tuple[TaskRows, ...]] | None:
@@ -619,7 +645,7 @@ class CellController(Loop):
     # -- helpers --------------------------------------------------------------------------
 
     def _check_name(self, name: object, argument: str) -> str:
-        allowed = self.commandable()
+        allowed = self._commandable()
         if not isinstance(name, str) or name not in allowed:
             why = ""
             cell = self.cell
@@ -637,7 +663,8 @@ class CellController(Loop):
         if not isinstance(commands, Mapping):
             raise InvalidInput("commands", f"expected a mapping name -> twist, got {commands!r}")
         out: dict[str, Array] = {}
-        allowed = self.commandable()
+        allowed = self._commandable()
+        world = False
         for name, value in commands.items():
             if not isinstance(name, str) or name not in allowed:
                 self._check_name(name, "commands")
@@ -654,8 +681,9 @@ class CellController(Loop):
                                    "expected world_aligned, local or world")  # fmt: skip
             command = out[name] = np.empty(7)
             command[:6] = as_vector(value, label, 6)
-            command[6] = REFS.index(ref)
-        if any(c[6] == REFS.index("world") for c in out.values()):
+            command[6] = REF_INDEX[ref]
+            world = world or ref == "world"
+        if world:
             self._warn_world()
         return out
 
@@ -675,6 +703,8 @@ class CellController(Loop):
     def _world_aligned(self, name: str, pose: Array, command: Array) -> Array:
         """A checked command (twist and its ref's index) in ``world_aligned`` at ``pose`` (4, 4)."""
         twist, ref = command[:6], REFS[int(command[6])]
+        if ref == "world_aligned":
+            return twist
         if ref != "base":
             return to_world_aligned(twist, pose[:3, :3], pose[:3, 3], ref)
         R = self.cell.arms[name].base[:3, :3]  # the arm's base axes: on the body, if any
@@ -685,7 +715,7 @@ class CellController(Loop):
     def _retarget(self) -> None:
         """Targets at the current poses of every commandable frame."""
         q = self._q
-        self._targets = {n: self.cell.fk(q, self.frame_of(n)) for n in self.commandable()}
+        self._targets = {n: self.cell.fk(q, self.frame_of(n)) for n in self._commandable()}
 
     def _record(self, r: CellResolution) -> None:
         """Log the tick: its rates, status, the commands' pose errors, the grips' errors."""

@@ -247,14 +247,6 @@ def mode_of(box: Box, rows: Rows | None, keeps: bool, weighted: bool, direction:
     return "least_squares"
 
 
-def stacked_level(tasks: Sequence[TaskRows], normalised: bool, box: Box
-                  ) -> tuple[Array, Array, float]:  # fmt: skip
-    """A level's rows and rates stacked in its metric, and the rates' factor (:func:`build`'s
-    ``stacked`` and ``factors``; ``normalised``: the direction mode's top level).
-    """  # noqa: D205
-    return _stack(tasks, normalised, box)
-
-
 def _stack(tasks: Sequence[TaskRows], normalised: bool, box: Box) -> tuple[Array, Array, float]:
     """Rows and rates of ``tasks`` stacked in the level's metric, and the rates' factor.
 
@@ -264,13 +256,11 @@ def _stack(tasks: Sequence[TaskRows], normalised: bool, box: Box) -> tuple[Array
     capped as the module docstring says (:func:`_capped`).
     """
     top = largest_weight(tasks)
-    if len(tasks) == 1 and top == 1.0 and tasks[0].weight is None:
-        if not normalised or tasks[0].unit is None:  # the rows as they are
-            A, b = tasks[0].A, tasks[0].b
-            peak = float(np.abs(b).max()) if b.size else 0.0
-            return _capped(A, b, peak, normalised, box)
-    m = tasks[0].b.size if len(tasks) == 1 else sum(t.b.size for t in tasks)
-    A, b = np.empty((m, tasks[0].A.shape[1])), np.empty(m)
+    if _as_they_are(tasks, top, normalised):
+        A, b = tasks[0].A, tasks[0].b
+        peak = float(np.abs(b).max()) if b.size else 0.0
+        return _capped(A, b, peak, normalised, box)
+    A, b = _level_arrays(tasks)
     peak = _weighted(tasks, top, normalised, 1.0, A, b)
     if normalised and peak > LARGE:  # the direction first: b / its largest, before the
         # rows' factors (up to 1 / MIN_REACH) could overflow
@@ -278,6 +268,31 @@ def _stack(tasks: Sequence[TaskRows], normalised: bool, box: Box) -> tuple[Array
         return _capped(A, b, _weighted(tasks, top, normalised, scale, A, b), normalised, box,
                        scale)  # fmt: skip
     return _capped(A, b, peak, normalised, box)
+
+
+def stacked_rows(tasks: Sequence[TaskRows], normalised: bool) -> Array:
+    """A level's rows stacked in its metric: :func:`build`'s ``stacked`` rows, without their
+    rates (whose factor and cap leave the rows as they are; ``normalised``: the direction
+    mode's top level).
+    """  # noqa: D205
+    top = largest_weight(tasks)
+    if _as_they_are(tasks, top, normalised):
+        return tasks[0].A
+    A, b = _level_arrays(tasks)
+    _weighted(tasks, top, normalised, 1.0, A, b)
+    return A
+
+
+def _as_they_are(tasks: Sequence[TaskRows], top: float, normalised: bool) -> bool:
+    """Whether a level's rows in its metric are its one task's own (no weight, no unit)."""
+    return len(tasks) == 1 and top == 1.0 and tasks[0].weight is None and (
+        not normalised or tasks[0].unit is None)  # fmt: skip
+
+
+def _level_arrays(tasks: Sequence[TaskRows]) -> tuple[Array, Array]:
+    """Empty rows (m, n) and rates (m,) for a level of ``tasks``."""
+    m = tasks[0].b.size if len(tasks) == 1 else sum(t.b.size for t in tasks)
+    return np.empty((m, tasks[0].A.shape[1])), np.empty(m)
 
 
 def _weighted(
