@@ -109,36 +109,6 @@ def test_jacobi_svd_of_blocks_against_lapack(rng: np.random.Generator) -> None:
         np.testing.assert_allclose(A @ V, US, atol=1e-12 * reference[0])
 
 
-def test_jacobi_svd_rotates_each_block_as_alone(rng: np.random.Generator) -> None:
-    """A block diagonal matrix, its blocks' rows and columns interleaved (each block's in their
-    order: the order of its sums and rotations): each block's values, columns and rotations
-    are the floats of that block's SVD alone (a triangle's: one block), placed."""
-    for _ in range(200):
-        first, second = np.tril(rng.normal(size=(6, 6))), np.tril(rng.normal(size=(6, 6)))
-        A = np.zeros((12, 12))
-        A[:6, :6], A[6:, 6:] = first, second
-        rows, cols = np.empty(12, dtype=int), np.empty(12, dtype=int)
-        for order in (rows, cols):  # where the first block's go, the second's in the others
-            at_first = np.sort(rng.choice(12, 6, replace=False))
-            order[at_first], order[np.setdiff1d(np.arange(12), at_first)] = range(6), range(6, 12)
-        shuffled = A[rows][:, cols]
-        assert kernels.column_blocks(first)[1] == 1
-        assert kernels.column_blocks(shuffled)[1] == 2
-        US, V, sigma = shuffled.copy(), np.empty((12, 12)), np.empty(12)
-        kernels.jacobi_svd(US, V, sigma)
-        for block, part in ((slice(0, 6), first), (slice(6, 12), second)):
-            alone, W, values = part.copy(), np.empty((6, 6)), np.empty(6)
-            kernels.jacobi_svd(alone, W, values)
-            where = np.flatnonzero(np.isin(cols, np.arange(12)[block]))  # its columns, placed
-            at = [int(np.flatnonzero(sigma == v)[0]) for v in values]  # their sorted places
-            assert set(values) <= set(sigma)
-            placed_rows = np.flatnonzero(np.isin(rows, np.arange(12)[block]))
-            in_block_rows = rows[placed_rows] - block.start
-            np.testing.assert_array_equal(US[np.ix_(placed_rows, at)], alone[in_block_rows])
-            in_block_cols = cols[where] - block.start
-            np.testing.assert_array_equal(V[np.ix_(where, at)], W[in_block_cols])
-
-
 def test_svd_rates_are_damped_least_squares(rng: np.random.Generator) -> None:
     for _ in range(200):
         m, n = 6, 7

@@ -272,11 +272,6 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
     (where a square or :math:`2rd` would leave the range of normal floats, of
     :math:`\tau/r` and :math:`\gamma/r`, r by :func:`math.hypot`).
 
-    Columns without a nonzero row in common (two arms' rows: the triangle of their stacked
-    rows' QR is block diagonal) are rotated as separate blocks (:func:`column_blocks`): the
-    products across blocks are exact zeros, so each block's rotations are the whole matrix's,
-    the same floats in the same order, on its own rows and columns only.
-
     Args:
         A: The matrix (m, k); out: its columns rotated, ``U diag(sigma)``.
         V: Out: orthogonal (k, k), the right singular vectors (columns).
@@ -287,102 +282,6 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
     for i in range(k):
         V[i, i] = 1.0
     norms = np.empty(k)  # each column's squared norm
-    block, blocks = column_blocks(A)
-    if blocks <= 1:
-        jacobi_rotations(A, V, norms)
-    else:
-        block_rotations(A, V, norms, block, blocks)
-    for j in range(k):
-        sigma[j] = math.sqrt(norms[j])
-    for j in range(k):  # selection sort, descending, columns of A and V alike
-        best = j
-        for i in range(j + 1, k):
-            if sigma[i] > sigma[best]:
-                best = i
-        if best != j:
-            sigma[j], sigma[best] = sigma[best], sigma[j]
-            for i in range(m):
-                A[i, j], A[i, best] = A[i, best], A[i, j]
-            for i in range(k):
-                V[i, j], V[i, best] = V[i, best], V[i, j]
-
-
-@inlined
-def column_blocks(A: Array) -> tuple[npt.NDArray[np.int64], int]:
-    """The columns of ``A`` (m, k) by block: two columns with a nonzero in one row are in one
-    block. Returns each column's block (k,), numbered in the order of their first columns,
-    and the number of blocks (a zero column is a block of its own).
-    """  # noqa: D205
-    m, k = A.shape
-    chained = m >= k  # each column shares row j + 1 with the next: one block (a triangle's)
-    for j in range(k - 1):
-        if not chained:
-            break
-        chained = A[j + 1, j] != 0.0 and A[j + 1, j + 1] != 0.0
-    if chained:
-        return np.zeros(k, dtype=np.int64), min(k, 1)
-    parent = np.arange(k)  # union-find: each column's parent, a root its own
-    for i in range(m):
-        first = -1
-        for j in range(k):
-            if A[i, j] != 0.0:
-                r = j
-                while parent[r] != r:
-                    r = parent[r]
-                if first < 0:
-                    first = r
-                elif r != first:
-                    parent[max(r, first)] = min(r, first)
-                    first = min(r, first)
-    block = np.empty(k, dtype=np.int64)
-    blocks = 0
-    for j in range(k):
-        r = j
-        while parent[r] != r:
-            r = parent[r]
-        if r == j:
-            block[j] = blocks
-            blocks += 1
-        else:
-            block[j] = block[r]
-    return block, blocks
-
-
-@inlined
-def block_rotations(A: Array, V: Array, norms: Array, block: npt.NDArray[np.int64],
-                    blocks: int) -> None:  # fmt: skip
-    """:func:`jacobi_rotations` of each block of ``A``'s columns (:func:`column_blocks`) on its
-    own rows and columns, written back into ``A``, ``V`` (the identity on entry) and ``norms``.
-    """  # noqa: D205
-    m, k = A.shape
-    row_block = np.full(m, -1)  # each nonzero row's block
-    for i in range(m):
-        for j in range(k):
-            if A[i, j] != 0.0:
-                row_block[i] = block[j]
-    for b in range(blocks):
-        cols, rows = np.flatnonzero(block == b), np.flatnonzero(row_block == b)
-        part = np.empty((rows.size, cols.size))
-        for i in range(rows.size):
-            for j in range(cols.size):
-                part[i, j] = A[rows[i], cols[j]]
-        W = np.eye(cols.size)
-        part_norms = np.empty(cols.size)
-        jacobi_rotations(part, W, part_norms)
-        for j in range(cols.size):
-            norms[cols[j]] = part_norms[j]
-            for i in range(rows.size):
-                A[rows[i], cols[j]] = part[i, j]
-            for i in range(cols.size):
-                V[cols[i], cols[j]] = W[i, j]
-
-
-@inlined
-def jacobi_rotations(A: Array, V: Array, norms: Array) -> None:
-    """:func:`jacobi_svd`'s sweeps on ``A`` (m, k), accumulated into ``V`` (k, k, orthogonal
-    on entry); ``norms`` (k,) out: the columns' squared norms.
-    """  # noqa: D205
-    m, k = A.shape
     for j in range(k):
         s = 0.0
         for i in range(m):
@@ -418,6 +317,19 @@ def jacobi_rotations(A: Array, V: Array, norms: Array) -> None:
                     V[i, p], V[i, q] = c * vp - s * vq, s * vp + c * vq
         if not rotated:
             break
+    for j in range(k):
+        sigma[j] = math.sqrt(norms[j])
+    for j in range(k):  # selection sort, descending, columns of A and V alike
+        best = j
+        for i in range(j + 1, k):
+            if sigma[i] > sigma[best]:
+                best = i
+        if best != j:
+            sigma[j], sigma[best] = sigma[best], sigma[j]
+            for i in range(m):
+                A[i, j], A[i, best] = A[i, best], A[i, j]
+            for i in range(k):
+                V[i, j], V[i, best] = V[i, best], V[i, j]
 
 
 @inlined
