@@ -125,7 +125,7 @@ class TickSource:
             levels[0].rows_from(levels[1], levels[2], levels[3]),)  # fmt: skip
         present = [c for c in self.constraints if c is not None]
         rows = merged_rows(present) if present else None
-        keeps = any([c.d is not None and np.count_nonzero(c.d) > 0 for c in present])
+        keeps = any(c.d is not None and np.count_nonzero(c.d) > 0 for c in present)
         box = self.box
         mode = mode_of(box, rows, keeps, self.weighted, self.direction)
         return level, stacked_rows(level, mode == "direction"), rows

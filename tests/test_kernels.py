@@ -152,28 +152,6 @@ def test_around_start_against_numpy(rng: np.random.Generator) -> None:
         np.testing.assert_array_equal(hi, want_hi)
 
 
-def test_normal_equations_of_sparse_rows_are_the_full_sums(rng: np.random.Generator) -> None:
-    """Rows mostly zeros (two arms' hands and a posture: 6 + 6 + 15 rows over 15 joints, then
-    random patterns): H and g are the sums over every row in order, float for float."""
-    baxter = np.zeros((27, 15))
-    baxter[:6, 1:8], baxter[6:12, 8:15], baxter[12:] = 1.0, 1.0, 0.1 * np.eye(15)
-    for pattern in [baxter] + [rng.random((m, 9)) < 0.4 for m in (4, 9, 20) for _ in range(10)]:
-        A = pattern * rng.normal(size=pattern.shape)
-        m, n = A.shape
-        b, w = rng.normal(size=m), rng.uniform(0.1, 10.0, m)
-        H, g = np.empty((n, n)), np.empty(n)
-        kernels.normal_equations(A, b, w, H, g)
-        full_H, full_g = np.zeros((n, n)), np.zeros(n)
-        for i in range(n):
-            for r in range(m):
-                full_g[i] += A[r, i] * w[r] * b[r]
-            for j in range(n):
-                for r in range(m):
-                    full_H[i, j] += A[r, i] * w[r] * A[r, j]
-        np.testing.assert_array_equal(H, np.triu(full_H) + np.triu(full_H, 1).T)
-        np.testing.assert_array_equal(g, full_g)
-
-
 def test_normal_equations_and_cholesky(rng: np.random.Generator) -> None:
     for m, n in itertools.product((3, 12, 27), (3, 7, 15)):
         A, b, w = rng.normal(size=(m, n)), rng.normal(size=m), rng.uniform(0.1, 10.0, m)

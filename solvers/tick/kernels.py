@@ -778,33 +778,23 @@ def weighted_rows(
 def normal_equations(A: Array, b: Array, weight: Array, H: Array, g: Array) -> None:
     r"""The normal equations of weighted rows: :math:`H = A^T W A`, :math:`g = A^T W b`.
 
-    Each sum runs over the rows in order, those where column i of A is zero left out: their
-    terms are zeros, so the sums are the full ones, float for float (the task rows of two
-    arms and a posture are mostly zeros).
-
     Args:
-        A: Rows (m, n), finite.
+        A: Rows (m, n).
         b: Their rates (m,).
         weight: Row weights W (m,) > 0.
         H: Out (n, n).
         g: Out (n,).
     """
     m, n = A.shape
-    rows, scaled = np.empty(m, dtype=np.int64), np.empty(m)  # column i's nonzero rows, A W
     for i in range(n):
-        k = 0
-        for r in range(m):
-            if A[r, i] != 0.0:
-                rows[k], scaled[k] = r, A[r, i] * weight[r]
-                k += 1
         s = 0.0
-        for t in range(k):
-            s += scaled[t] * b[rows[t]]
+        for r in range(m):
+            s += A[r, i] * weight[r] * b[r]
         g[i] = s
         for j in range(i, n):
             s = 0.0
-            for t in range(k):
-                s += scaled[t] * A[rows[t], j]
+            for r in range(m):
+                s += A[r, i] * weight[r] * A[r, j]
             H[i, j] = s
             H[j, i] = s
 
