@@ -351,6 +351,15 @@ class CompiledTick:
         ``start`` [s] when the tick began (``time.perf_counter``)."""  # noqa: D205, D209
         ws = self.workspace
         ws.load_levels(levels, weighted)
+        self._load_constraints(constraints)
+        self._loaded = None
+        code = self._run(kin.q, previous, dt, levels)
+        return self._answer(code, levels, constraints, dt, weighted, start)
+
+    def _load_constraints(self, constraints: list[Constraints | None]) -> None:
+        """The other limits' constraint rows and equality rows into the workspace (a limit's
+        own arrays where it alone has them, else merged in the limits' order)."""  # noqa: D205, D209
+        ws = self.workspace
         with_rows, with_equalities = [], []
         for c in constraints:
             if c is not None:
@@ -365,13 +374,12 @@ class CompiledTick:
         else:
             rows = cast(Rows, merged_rows(with_rows))
             ws.load_rows(rows.G, rows.h, rows.slide)
-        if len(with_equalities) == 1:  # one limit's rows (the grip's): loaded as they are
+        if not with_equalities:
+            ws.load_equalities(None, None)
+        elif len(with_equalities) == 1:  # one limit's rows (the grip's): loaded as they are
             ws.load_equalities(with_equalities[0].C, with_equalities[0].d)
         else:
-            ws.load_equalities(*(merged_equalities(with_equalities) or (None, None)))
-        self._loaded = None
-        code = self._run(kin.q, previous, dt, levels)
-        return self._answer(code, levels, constraints, dt, weighted, start)
+            ws.load_equalities(*cast(tuple[Array, Array], merged_equalities(with_equalities)))
 
     def _run(self, q: Array, previous: Array, dt: float, levels: list[list[TaskRows]]) -> int:
         """The loaded tick at ``q`` after ``previous`` [rad/s], its QPs handed to the backend.
@@ -415,12 +423,11 @@ class CompiledTick:
         backend = work.backend or (active_set.NAME if reals[tick.SOLVED] else "")
         levels_served = ONE_LEVEL[codes[0]] if len(codes) == 1 else tuple(map(LEVELS.__getitem__,
                                                                               codes))  # fmt: skip
-        return Resolution(
+        return _new(Resolution, (
             qdot, STATUSES[code], "qp", reals[tick.SCALE], reals[tick.VEER], levels_served,
             tuple(work.attempts), backend, work.iterations + int(reals[tick.SOLVED_STEPS]),
-            reals[tick.CLIP], reals[tick.LAMBDA_SQ],
-            elapsed - work.solve_time, work.solve_time, source, self.names,
-        )  # fmt: skip
+            reals[tick.CLIP], reals[tick.LAMBDA_SQ], elapsed - work.solve_time, work.solve_time,
+            source, self.names, ()))  # fmt: skip
 
     def _fallback(self, source: TickSource | TwistSource, start: float) -> Resolution:
         """The fallbacks' answer (:func:`~rrc_pin.solvers.tick.pipeline.fallback_answer`) to

@@ -434,18 +434,16 @@ class Workspace:
         loaded once while the same arrays come at the same rows (``_held``); the sizes and
         flags in ``ints`` are written where they changed (``_header``).
         """
-        m = 0
-        for tasks in levels:
-            for t in tasks:
-                m += t.b.size
-        self._fit(m, len(levels))
-        held, task_rows, rates, r = self._held, self.task_rows, self.rates, 0
-        rate, starts = rates[RATE], []
+        held, task_rows, rates = self._held, self.task_rows, self.rates
+        size, rate, r, starts = rates.shape[1], rates[RATE], 0, []
         for tasks in levels:
             starts.append(r)
-            for t in tasks:
-                A, b, weight, unit = t.A, t.b, t.weight, t.unit
+            for A, b, weight, _, unit in tasks:
                 end = r + b.size
+                if end > size:  # no room: made, then every level loaded again
+                    self._fit(sum(t.b.size for level in levels for t in level))
+                    self.load_levels(levels, weighted)
+                    return
                 was = held.get(r)
                 if was is None or was[0] != end:  # other rows here: every part loaded
                     self._overwrite(r, end)
@@ -464,27 +462,26 @@ class Workspace:
         units = False
         for t in levels[0]:
             units = units or t.unit is not None
-        header = (m, weighted, units, starts)
+        header = (r, weighted, units, starts)
         if header != self._header:
             self._write_header(header)
 
     def _write_header(self, header: tuple[int, bool, bool, list[int]]) -> None:
         """The sizes and flags of the levels loaded into ``ints`` (:meth:`load_levels`)."""
         m, weighted, units, starts = header
-        ints, k = self.ints, len(starts)
+        k = len(starts)
+        if self.ints.size < STARTS + 2 * k + 2:
+            self.ints = np.concatenate([self.ints, np.zeros(2 * k + 2, np.int64)])
+        ints = self.ints
         ints[STARTS : STARTS + k] = starts
         ints[STARTS + k] = m
         ints[LEVELS], ints[ROWS], ints[WEIGHTED], ints[UNITS] = k, m, weighted, units
         self._header = header
 
-    def _fit(self, m: int, levels: int) -> None:
-        """Room for ``m`` task rows and ``levels`` levels."""
-        if m > self.rates.shape[1]:
-            self.task_rows, self.rates = np.zeros((m, self.n)), np.ones((3, m))
-            self._held.clear()
-        if self.ints.size < STARTS + 2 * levels + 2:
-            self.ints = np.concatenate([self.ints, np.zeros(2 * levels + 2, np.int64)])
-            self._header = None
+    def _fit(self, m: int) -> None:
+        """Room for ``m`` task rows."""
+        self.task_rows, self.rates = np.zeros((m, self.n)), np.ones((3, m))
+        self._held.clear()
 
     def _overwrite(self, start: int, end: int) -> None:
         """Forget what ``_held`` says rows ``start:end`` hold (they are being written)."""
