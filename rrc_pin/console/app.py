@@ -17,6 +17,7 @@ The loop never waits for a page or for the renderer; a page never touches the co
 
 from __future__ import annotations
 
+import gc
 import logging
 import sys
 import threading
@@ -154,6 +155,10 @@ class Console:
 
         self._switch = sys.getswitchinterval()
         sys.setswitchinterval(SWITCH_INTERVAL)
+        # what the process holds by now (modules, models, the server) is left out of every
+        # later garbage collection: a full one stops every thread, the loop's with them, for
+        # as long as it takes to walk them (docs/api.md, "Pauses of the garbage collector")
+        gc.freeze()
         self.loop.start()
         self.view.update(force=True)
         self.view.start()
