@@ -16,8 +16,9 @@ at every recorded configuration, the whole call timed.
 Weighted (one least squares of the tasks' costs): frame tasks weight 1 (position and
 orientation), posture 0.01 (pink's costs 1 and 0.1 squared: pink and mink square their costs):
 
-- rrc-pin: ``solve(q, [FrameTask(left, v_l), FrameTask(right, v_r), posture])``, the
-  FrameTasks built in the call, as the README writes it;
+- rrc-pin: ``solve(q, [hand_l, hand_r, posture])``, its two FrameTasks kept and their twists
+  set in the call (``FrameTask.set_twist``), as every peer keeps its tasks and sets their
+  targets in the call;
 - PlaCo: two soft frame tasks and a soft joints task (targets ``q + k dt (q_ref - q)``),
   PlaCo's regularisation 1e-8 on top: the same problem;
 - pink and mink (quadprog): FrameTasks with the targets moved by ``twist * dt`` and a
@@ -104,19 +105,21 @@ def _posture(robot: Any) -> PostureTask:
 
 
 def rrc_call(robot: Any, strict: bool) -> tuple[Any, Any]:
-    """rrc-pin's step (weighted or strict), the FrameTasks built in the call; and its Resolver."""
-    left, right = robot.tool_frames
+    """rrc-pin's step (weighted or strict), its FrameTasks' twists set in the call; and its
+    Resolver."""  # noqa: D205, D209
+    hands = [FrameTask(frame, weight=FRAME_WEIGHT) for frame in robot.tool_frames]
+    left, right = hands
     posture = _posture(robot)
     resolver = rrc_pin.Resolver(robot, dt=DT)
 
     def weighted(q: Array, x: Array) -> Any:
-        hands = [FrameTask(left, x[:6], weight=FRAME_WEIGHT),
-                 FrameTask(right, x[6:], weight=FRAME_WEIGHT)]  # fmt: skip
-        return resolver.solve(q, [*hands, posture])
+        left.set_twist(x[:6])
+        right.set_twist(x[6:])
+        return resolver.solve(q, [left, right, posture])
 
     def levels(q: Array, x: Array) -> Any:
-        hands = [FrameTask(left, x[:6], weight=FRAME_WEIGHT),
-                 FrameTask(right, x[6:], weight=FRAME_WEIGHT)]  # fmt: skip
+        left.set_twist(x[:6])
+        right.set_twist(x[6:])
         return resolver.solve(q, [hands, posture], priority="strict")
 
     return (levels if strict else weighted), resolver
