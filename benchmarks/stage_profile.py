@@ -8,7 +8,7 @@ looked up by name, so that a renamed one is reported as ``missing`` rather than 
 benchmark:
 
 - ``step``: the contender's whole call (the total): ``Resolver.solve(q, twist)``, or for
-  tasks the FrameTasks built in the call and ``Resolver.solve(q, tasks)`` (``solve``);
+  tasks the FrameTasks' twists set in the call and ``Resolver.solve(q, tasks)`` (``solve``);
 - ``q check``: ``Robot.positions`` and ``Robot.configuration``; ``task checks``: the tasks
   and levels checked against the robot (``Resolver._levels``, tasks only);
 - ``kinematics``: every joint's Jacobian (``Kinematics``, when a tick needs more than one
