@@ -46,7 +46,7 @@ from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.errors import NumericalFailure
 from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding
-from rrc_pin.solvers.tick import kernels, statuses
+from rrc_pin.solvers.tick import kernels, linalg, statuses
 from rrc_pin.solvers.tick.problem import Box, Rows
 from rrc_pin.solvers.tick.statuses import STILL_SCALE
 
@@ -175,7 +175,7 @@ def solved_along(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array
     code, steps = active_set.solve(P, q, C, lo, hi, z_lb, z_ub, z)
     if code != active_set.SOLVED:
         return w, -1.0, 0.0, steps
-    qdot = kernels.row_values(M, z)
+    qdot = linalg.row_values(M, z)
     clipped = qdot.copy()
     if not (kernels.all_finite(qdot) and kernels.clip_into(clipped, lb, ub) <= tol
             and kernels.rows_hold(G, qdot, h, tol)):  # fmt: skip

@@ -33,8 +33,8 @@ from numba import objmode
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.errors import NumericalFailure
 from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses, top
-from rrc_pin.solvers.tick.kernels import row_values
 from rrc_pin.solvers.tick.levels import least_squares, product
+from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.statuses import (
     DAMPED,
     EXACT,

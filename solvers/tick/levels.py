@@ -16,8 +16,8 @@ import numpy.typing as npt
 from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import backend_calls, factor, kernels
-from rrc_pin.solvers.tick.kernels import row_values
+from rrc_pin.solvers.tick import backend_calls, factor, kernels, linalg
+from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.slide_kernels import (
     MARGIN,
     SOLVED,
@@ -51,13 +51,13 @@ def product(A: Array, B: Array) -> Array:
 def optimum(B: Array, c: Array, H: Array, g: Array, L: Array) -> tuple[Array, bool]:
     """The least-squares solution of least norm of ``B z ~= c``, and whether :math:`B^TB` is
     definite (:func:`rrc_pin.solvers.tick.least_squares.optimum`): then ``L`` (d, d), zeros
-    on entry, holds its Cholesky factor (:func:`~rrc_pin.solvers.tick.kernels.cholesky_solve`).
+    on entry, holds its Cholesky factor (:func:`~rrc_pin.solvers.tick.linalg.cholesky_solve`).
     """  # noqa: D205
     m, d = B.shape
     if m > d:
         z = np.empty(d)
-        if kernels.cholesky(H, kernels.DEFINITE, L):  # cholesky_solve's steps, L kept
-            kernels.solve_factored(L, g, z)
+        if linalg.cholesky(H, linalg.DEFINITE, L):  # cholesky_solve's steps, L kept
+            linalg.solve_factored(L, g, z)
             return z, True
     return factor.least_norm(factor.qr(B), c)[1], False
 
@@ -184,7 +184,7 @@ def least_squares(
     c = b if whole else b - row_values(A, x)
     m, d = B.shape
     H, g, L = np.empty((d, d)), np.empty(d), np.zeros((d, d))
-    kernels.normal_equations(B, c, np.ones(m), H, g)
+    linalg.normal_equations(B, c, np.ones(m), H, g)
     z, definite = optimum(B, c, H, g, L)
     candidate = z if whole else x + row_values(np.ascontiguousarray(N.T), z)
     if not (kernels.inside(candidate, lb, ub) and kernels.rows_hold(G, candidate, h, 0.0)):

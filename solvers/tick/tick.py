@@ -33,9 +33,9 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import equalities, kernels, statuses, top
-from rrc_pin.solvers.tick.kernels import row_values
+from rrc_pin.solvers.tick import equalities, kernels, linalg, statuses, top
 from rrc_pin.solvers.tick.levels import least_squares
+from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.problem import LARGE, TaskRows, cap
 from rrc_pin.solvers.tick.statuses import DROPPED
 from rrc_pin.solvers.tick.top import FAILED, Rows, Top
@@ -95,7 +95,7 @@ def stacked(A: Array, b: Array, weight: Array, unit: Array, normalised: bool, lb
     space = np.empty(m * (n + 1))  # one allocation: the rows and rates
     rows, rates = space[: m * n].reshape(m, n), space[m * n :]
     units = unit if normalised else np.ones(m)
-    peak = kernels.weighted_rows(A, b, weight, top_weight, units, 1.0, rows, rates)
+    peak = linalg.weighted_rows(A, b, weight, top_weight, units, 1.0, rows, rates)
     factor = 1.0
     if normalised and peak > LARGE:  # the direction first: b over its largest entry, before
         # the rows' factors could overflow
@@ -103,7 +103,7 @@ def stacked(A: Array, b: Array, weight: Array, unit: Array, normalised: bool, lb
         for i in range(m):
             b_max = max(b_max, abs(b[i]))
         factor = 1.0 / b_max
-        peak = kernels.weighted_rows(A, b, weight, top_weight, units, factor, rows, rates)
+        peak = linalg.weighted_rows(A, b, weight, top_weight, units, factor, rows, rates)
     c = cap(rows, peak, factor, normalised, lb, ub)
     return (rows, rates, factor) if c == 1.0 else (rows, rates * c, factor * c)
 

@@ -32,8 +32,8 @@ from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses
 from rrc_pin.solvers.tick.direction import solved_along
 from rrc_pin.solvers.tick.factor import Factor
-from rrc_pin.solvers.tick.kernels import row_values
 from rrc_pin.solvers.tick.levels import least_squares
+from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
 from rrc_pin.solvers.tick.statuses import (
     DAMPED,
