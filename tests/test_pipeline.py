@@ -18,6 +18,7 @@ from rrc_pin.solvers.errors import InvalidInput, ProblemError
 from rrc_pin.solvers.qp_backends import QPBackend, QPSolution, make_backend
 from rrc_pin.solvers.tick import kernels
 from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.pipeline import Answer, Options, solve
 from rrc_pin.solvers.tick.problem import Box, Constraints, Problem, TaskRows, build
 
@@ -32,7 +33,7 @@ def box_at(
     v = rng.uniform(0.5, 2.0, n) * tight
     q = rng.uniform(-2.5, 2.5, n) if q is None else q
     lb, ub, kind = np.empty(n), np.empty(n), np.empty((2, n), np.int8)
-    zero, recovering = kernels.joint_box(
+    zero, recovering = joint_box(
         q,
         np.full(n, -3.0),
         np.full(n, 3.0),

@@ -58,6 +58,7 @@ from rrc_pin.solvers.tick import kernels, statuses
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.direction import DIRECTION_TOL, Along, along, direction_qp, solved_along
 from rrc_pin.solvers.tick.factorization import Factorization
+from rrc_pin.solvers.tick.joint_box import ON_LIMIT
 from rrc_pin.solvers.tick.kernels import scale_and_veer
 from rrc_pin.solvers.tick.least_squares import Subspace, least_squares
 from rrc_pin.solvers.tick.problem import Box, Problem, Rows
@@ -609,7 +610,7 @@ def _damping(
 def _clamped(factor: Factorization, w: Array, box: Box, dt: float) -> Factorization:
     """The rows without the joints ``w`` pushes against a bound that holds them (``_damping``)."""
     J = np.empty_like(factor.J)  # a bound within rounding of zero holds the joint
-    if not kernels.clamp_pushed(factor.J, w, box.lb, box.ub, kernels.ON_LIMIT / dt, J):
+    if not kernels.clamp_pushed(factor.J, w, box.lb, box.ub, ON_LIMIT / dt, J):
         return factor
     clamped = Factorization(J)
     rank = clamped.svd[3]  # at most the rows' own: where full, theirs is not needed (one SVD)

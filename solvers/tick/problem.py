@@ -82,7 +82,7 @@ class Box(NamedTuple):
         lb: Lower bounds (n,) [rad/s or m/s].
         ub: Upper bounds (n,), ``lb <= ub``.
         kind: (2, n) codes of what sets each bound (lower, upper):
-            :data:`~rrc_pin.solvers.tick.kernels.VELOCITY`, ``POSITION`` or ``ACCELERATION``.
+            :data:`~rrc_pin.solvers.tick.joint_box.VELOCITY`, ``POSITION`` or ``ACCELERATION``.
         contains_zero: Whether standing still is allowed.
         recovering: Whether a joint is outside its range and must move back.
         velocity: The velocity limits (n,), the scale of the backends' tolerance.

@@ -3,7 +3,7 @@ r"""One resolver tick in one compiled call, on a workspace of preallocated array
 :func:`run` goes down the stages of docs/api.md ("One tick, one pipeline") once:
 
 1. the inputs' **checks** (every position and commanded rate finite);
-2. the step's **box** (:func:`~rrc_pin.solvers.tick.kernels.joint_box`);
+2. the step's **box** (:func:`~rrc_pin.solvers.tick.joint_box.joint_box`);
 3. the **problem**: the mode, and each level's rows in the metric it is solved in
    (:func:`stacked`: :func:`rrc_pin.solvers.tick.problem.build`'s);
 4. the **top level** (:func:`rrc_pin.solvers.tick.top.direction`, or a least squares), then each
@@ -34,6 +34,7 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import equalities, kernels, linalg, statuses, top
+from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.levels import least_squares
 from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.problem import LARGE, TaskRows, cap
@@ -193,11 +194,11 @@ def bounds(q: Array, dt: float, joints: Array, reals: Array, lb: Array, ub: Arra
            kinds: Array) -> tuple[bool, bool]:  # fmt: skip
     """Stage 2 at positions ``q`` (n,) for the step ``dt`` [s]: the box into ``lb`` and ``ub``
     (n,), what sets each bound into ``kinds`` (2, n), the lower bounds' row then the upper
-    ones' (:func:`~rrc_pin.solvers.tick.kernels.joint_box`); whether standing still is
+    ones' (:func:`~rrc_pin.solvers.tick.joint_box.joint_box`); whether standing still is
     allowed, whether a joint was outside its range.
     """  # noqa: D205
     kind = np.empty((2, q.size), np.int8)
-    zero_inside, recovering = kernels.joint_box(
+    zero_inside, recovering = joint_box(
         q, joints[LOWER], joints[UPPER], joints[VELOCITY], reals[MARGIN], reals[GAIN], dt,
         joints[PREVIOUS], joints[ACCELERATION], lb, ub, kind,
     )  # fmt: skip

@@ -32,6 +32,7 @@ from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses
 from rrc_pin.solvers.tick.direction import solved_along
 from rrc_pin.solvers.tick.factor import Factor
+from rrc_pin.solvers.tick.joint_box import ON_LIMIT
 from rrc_pin.solvers.tick.levels import least_squares
 from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
@@ -250,7 +251,7 @@ def clamped(f: Factor, w: Array, rows: Rows, dt: float, threshold: float
     where it is, the SVDs would choose the same rows).
     """  # noqa: D205
     J = np.empty_like(f.J)
-    if not kernels.clamp_pushed(f.J, w, rows.lb, rows.ub, kernels.ON_LIMIT / dt, J):
+    if not kernels.clamp_pushed(f.J, w, rows.lb, rows.ub, ON_LIMIT / dt, J):
         return f, factor.surely_conditioned(f, threshold)
     used = columns_used(J)
     if used < J.shape[0]:  # the clamped rows are short of rank: their rank is at most used
