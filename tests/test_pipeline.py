@@ -16,7 +16,7 @@ import rrc_pin.solvers.tick.pipeline as pipeline_module
 from rrc_pin.solvers.collision.damper_kernels import SLACK
 from rrc_pin.solvers.errors import InvalidInput, ProblemError
 from rrc_pin.solvers.qp_backends import QPBackend, QPSolution, make_backend
-from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick import feasibility, kernels
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.pipeline import Answer, Options, solve
@@ -207,7 +207,7 @@ def test_where_the_lp_maximum_is_one_the_command_is_met_exactly(rng: np.random.G
         assert answer.status == "exact" and answer.scale == 1.0 and answer.veer == 0.0
         np.testing.assert_allclose(A @ answer.qdot, b, atol=1e-9 * (1.0 + np.abs(b).max()))
         exact = np.linalg.pinv(A) @ b
-        met += not kernels.inside(exact, box.lb, box.ub)
+        met += not feasibility.inside(exact, box.lb, box.ub)
     assert met > 20  # the exact rates did not fit: the null space answered
 
 
@@ -266,7 +266,7 @@ def test_weighted_is_the_exact_optimum_of_its_costs(rng: np.random.Generator) ->
         y = np.concatenate([r * t.b for r, t in zip(root, tasks, strict=True)])
         ref = lsq_linear(A, y, bounds=(box.lb, box.ub), method="bvls", tol=1e-14).x
         np.testing.assert_allclose(answer.qdot, ref, atol=1e-6)
-        active += not kernels.inside(np.linalg.lstsq(A, y, rcond=None)[0], box.lb, box.ub)
+        active += not feasibility.inside(np.linalg.lstsq(A, y, rcond=None)[0], box.lb, box.ub)
     assert active > 150
 
 

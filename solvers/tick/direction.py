@@ -46,7 +46,7 @@ from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.errors import NumericalFailure
 from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding
-from rrc_pin.solvers.tick import kernels, linalg, statuses
+from rrc_pin.solvers.tick import feasibility, kernels, linalg, statuses
 from rrc_pin.solvers.tick.problem import Box, Rows
 from rrc_pin.solvers.tick.statuses import STILL_SCALE
 
@@ -177,8 +177,8 @@ def solved_along(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array
         return w, -1.0, 0.0, steps
     qdot = linalg.row_values(M, z)
     clipped = qdot.copy()
-    if not (kernels.all_finite(qdot) and kernels.clip_into(clipped, lb, ub) <= tol
-            and kernels.rows_hold(G, qdot, h, tol)):  # fmt: skip
+    if not (feasibility.all_finite(qdot) and feasibility.clip_into(clipped, lb, ub) <= tol
+            and feasibility.rows_hold(G, qdot, h, tol)):  # fmt: skip
         return w, -1.0, 0.0, steps
     scale, veer, kept = along_checked(A, w, qdot)
     if not (kept and math.isfinite(scale) and math.isfinite(veer)):

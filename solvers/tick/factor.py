@@ -15,7 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.tick import kernels, linalg
+from rrc_pin.solvers.tick import feasibility, kernels, linalg
 
 Array = npt.NDArray[np.float64]
 
@@ -115,7 +115,7 @@ def fitted(J: Array, b: Array, lb: Array, ub: Array) -> tuple[Factor, Array, boo
         return f, w, fit == 2, boxed, u
     f = with_svd(f)
     w = rates(f, b, np.zeros(f.sigma.size))
-    return f, w, kernels.inside(w, lb, ub), boxed, -1.0
+    return f, w, feasibility.inside(w, lb, ub), boxed, -1.0
 
 
 @kernel

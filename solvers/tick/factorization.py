@@ -22,7 +22,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.tick import kernels, linalg
+from rrc_pin.solvers.tick import feasibility, kernels, linalg
 from rrc_pin.solvers.tick.direction import Along
 
 Array = npt.NDArray[np.float64]
@@ -87,7 +87,7 @@ class Factorization:
         if fit:
             return factor, x, fit == 2, Along(qdot, u) if u >= 0.0 else None
         x = factor.rates(b, None)
-        return factor, x, kernels.inside(x, lb, ub), None
+        return factor, x, feasibility.inside(x, lb, ub), None
 
     def least_norm(self, b: Array) -> Array:
         """The least-squares rates of least norm, :math:`J^+ b` (n,), rank by :data:`RANK_TOL`."""

@@ -54,7 +54,7 @@ from rrc_pin.solvers.errors import InvalidInput, NumericalFailure
 from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.base import QPBackend
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding, Work, solve_within, tolerance
-from rrc_pin.solvers.tick import kernels, statuses
+from rrc_pin.solvers.tick import feasibility, kernels, statuses
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.direction import DIRECTION_TOL, Along, along, direction_qp, solved_along
 from rrc_pin.solvers.tick.factorization import Factorization
@@ -271,7 +271,7 @@ def _answer(problem: Problem, top: _Top, qdot: Array, method: Method,
     """The answer: the rates ``qdot`` of every level, clipped into the box and rows, and
     ``top``'s report; a shrink into the rows serves the lower levels anew."""  # noqa: D205, D209
     box = problem.box
-    clip = kernels.clip_into(qdot, box.lb, box.ub)  # the kernels' answers to rounding
+    clip = feasibility.clip_into(qdot, box.lb, box.ub)  # the kernels' answers to rounding
     qdot, shrink = _within_rows(qdot, box, problem.rows)
     qdot.flags.writeable = False
     if shrink < 1.0 - statuses.EXACT_TOL:
@@ -356,7 +356,7 @@ def _exact(problem: Problem, space: Subspace) -> _Exact:
     factor = Factorization(A @ space.N.T)
     z = factor.least_norm(b)
     w = z @ space.N
-    return _Exact(factor, z, w, kernels.inside(w, box.lb, box.ub), None, b, False)
+    return _Exact(factor, z, w, feasibility.inside(w, box.lb, box.ub), None, b, False)
 
 
 def _slid(
@@ -372,7 +372,7 @@ def _slid(
     A = problem.stacked[0][0]
     box, rows = problem.box, problem.rows
     assert rows is not None
-    if kernels.rows_hold(slide.G, exact.w, slide.h, 0.0):
+    if feasibility.rows_hold(slide.G, exact.w, slide.h, 0.0):
         return exact
     try:
         kept = _slide(A, exact.b, space, box, slide, backend, work, exact.factor,
@@ -381,13 +381,13 @@ def _slid(
         work.attempts.append(("slide", f"{exc}; the command kept as given"))
         return exact
     every = rows.slide is not None and bool(rows.slide.all())  # the least squares kept them all
-    if every or kernels.rows_hold(rows.G, kept, rows.h, tolerance(box)):
+    if every or feasibility.rows_hold(rows.G, kept, rows.h, tolerance(box)):
         null = _null(exact.factor, space) if len(problem.levels) > 1 else None
         return _Top(kept, "sliding", *_along_command(problem, kept), 0.0, null)
     b = A @ kept
     z = exact.factor.least_norm(b)
     w = z if space.N is None else z @ space.N
-    return exact._replace(z=z, w=w, fits=kernels.inside(w, box.lb, box.ub), b=b, slid=True)
+    return exact._replace(z=z, w=w, fits=feasibility.inside(w, box.lb, box.ub), b=b, slid=True)
 
 
 def _exact_within(problem: Problem, space: Subspace, exact: _Exact) -> _Top | None:
@@ -395,7 +395,7 @@ def _exact_within(problem: Problem, space: Subspace, exact: _Exact) -> _Top | No
     ``singular`` or met; else None.
     """  # noqa: D205
     rows = problem.rows
-    if not (exact.fits and (rows is None or kernels.rows_hold(rows.G, exact.w, rows.h, 0.0))):
+    if not (exact.fits and (rows is None or feasibility.rows_hold(rows.G, exact.w, rows.h, 0.0))):
         return None
     null = _null(exact.factor, space) if len(problem.levels) > 1 else None
     w = exact.w
@@ -500,7 +500,7 @@ def _slide(
     B = B[:rows]
     x = np.empty(n)
     if project(B, 0.0, target, box.lb, box.ub, slide.G, slide.h, MARGIN, x) == SOLVED:
-        kernels.clip_into(x, box.lb, box.ub)  # by the kernel's rounding at most (1e-9)
+        feasibility.clip_into(x, box.lb, box.ub)  # by the kernel's rounding at most (1e-9)
         return x
     return backend_slide(B, target, box, slide, backend, work)
 
@@ -549,7 +549,8 @@ def _damped_within(
                                                     "least_squares", need_null), rows, work)
     factor = Factorization(A)
     w = factor.least_norm(b)
-    if not (kernels.inside(w, box.lb, box.ub) and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
+    if not (feasibility.inside(w, box.lb, box.ub)
+            and feasibility.rows_hold(rows.G, w, rows.h, 0.0)):  # fmt: skip
         w = _relaxing(lambda kept: _slide(A, b, _EVERY_RATE, box, kept, backend, work, factor,
                                           damping), rows, work)  # fmt: skip
     return w, factor.null_basis() if need_null else None
@@ -731,14 +732,14 @@ def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
 
 
 def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:
-    """``x`` shrunk toward zero until the rows hold (:func:`kernels.into_rows`), and the factor
+    """``x`` shrunk toward zero until the rows hold (:func:`feasibility.into_rows`), and the factor
     (zero feasible). A backend leaves the rows by up to its tolerance (1e-9); the shrink keeps
     the direction.
     """  # noqa: D205
     if rows is None or not box.contains_zero or bool((rows.h < 0.0).any()):
         return x, 1.0
     G, h, y = (np.require(a, np.float64, ("C", "W")) for a in (rows.G, rows.h, x))
-    factor = kernels.into_rows(G, h, y)  # its one compiled signature (Workspace.compile)
+    factor = feasibility.into_rows(G, h, y)  # its one compiled signature (Workspace.compile)
     return (x, 1.0) if factor == 1.0 else (x * factor, factor)
 
 

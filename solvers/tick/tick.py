@@ -33,7 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import equalities, kernels, linalg, statuses, top
+from rrc_pin.solvers.tick import equalities, feasibility, linalg, statuses, top
 from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.levels import least_squares
 from rrc_pin.solvers.tick.linalg import row_values
@@ -117,12 +117,12 @@ def served(A: Array, b: Array, qdot: Array, rate_factor: float) -> int:
 
 @kernel
 def within_rows(x: Array, rows: Rows, zero_inside: bool) -> float:
-    """``x`` shrunk toward zero in place until the rows hold (:func:`kernels.into_rows`); the
+    """``x`` shrunk toward zero in place until the rows hold (:func:`feasibility.into_rows`); the
     factor (1: kept). Standing still must be allowed.
     """  # noqa: D205
     if rows.h.size == 0 or not zero_inside or (rows.h < 0.0).any():
         return 1.0
-    factor = kernels.into_rows(rows.G, rows.h, x)
+    factor = feasibility.into_rows(rows.G, rows.h, x)
     if factor != 1.0:
         for i in range(x.size):
             x[i] *= factor
@@ -134,11 +134,11 @@ def checked(joints: Array, task_rows: Array, rates: Array, m: int) -> int:
     """0 where every position, commanded rate and task row is finite, else the code of the
     first bad.
     """  # noqa: D205
-    if not kernels.all_finite(joints[POSITION]):
+    if not feasibility.all_finite(joints[POSITION]):
         return BAD_POSITION
-    if not kernels.all_finite(rates[RATE][:m]):
+    if not feasibility.all_finite(rates[RATE][:m]):
         return BAD_RATE
-    if not kernels.all_finite(task_rows.ravel()[: m * task_rows.shape[1]]):  # a view: C order
+    if not feasibility.all_finite(task_rows.ravel()[: m * task_rows.shape[1]]):  # a view: C order
         return BAD_ROWS
     return 0
 
@@ -228,7 +228,7 @@ def clipped(qdot: Array, rows: Rows, zero_inside: bool) -> tuple[float, float]:
     """Stage 5: ``qdot`` clipped into the box and shrunk into the rows, in place; the clip's
     size and the shrink's factor.
     """  # noqa: D205
-    clip = kernels.clip_into(qdot, rows.lb, rows.ub)
+    clip = feasibility.clip_into(qdot, rows.lb, rows.ub)
     return clip, within_rows(qdot, rows, zero_inside)
 
 
@@ -302,7 +302,8 @@ def run_twist(J: Array, b: Array, q: Array, dt: float, joints: Array, rates: Arr
     """
     n, m = q.size, b.size
     reals[SOLVED], reals[SOLVED_STEPS] = 0.0, 0.0
-    if not (kernels.all_finite(q) and kernels.all_finite(b) and kernels.all_finite(J.ravel())):
+    if not (feasibility.all_finite(q) and feasibility.all_finite(b)
+            and feasibility.all_finite(J.ravel())):  # fmt: skip
         return INVALID_INPUT, 0.0, 0.0, 0.0, 0.0
     lb, ub = out[n : 2 * n], out[2 * n : 3 * n]
     zero_inside, recovering = bounds(q, dt, joints, reals, lb, ub,
@@ -553,7 +554,7 @@ class Workspace:
     def compile(self, general: bool, twists: bool = True) -> None:
         """Compile the default tick's entries (:func:`run_box`; :func:`run_twist` where
         ``twists``), and the general ones where ``general`` (with the pipeline's shrink into
-        the rows, :func:`kernels.into_rows`), or load them from numba's cache: on a problem
+        the rows, :func:`feasibility.into_rows`), or load them from numba's cache: on a problem
         without rows whose answer is exact, so that no QP is asked for and nothing is kept.
         """  # noqa: D205
         n = self.n
@@ -570,7 +571,7 @@ class Workspace:
                       ws.rates, ws.ints, ws.reals, np.empty(twist_size(n, 1)))  # fmt: skip
         if general:
             run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
-            kernels.into_rows(np.zeros((1, n)), np.zeros(1), np.zeros(n))  # the pipeline's call
+            feasibility.into_rows(np.zeros((1, n)), np.zeros(1), np.zeros(n))  # the pipeline's call
             if n > 1:  # a tick within equality rows (contacts, grips): the rates of joint 1 zero
                 ws.load_equalities(np.eye(1, n, 1), np.zeros(1))
                 run_within(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.E,

@@ -29,7 +29,7 @@ import numpy.typing as npt
 from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses
+from rrc_pin.solvers.tick import backend_calls, factor, feasibility, kernels, statuses
 from rrc_pin.solvers.tick.direction import solved_along
 from rrc_pin.solvers.tick.factor import Factor
 from rrc_pin.solvers.tick.joint_box import ON_LIMIT
@@ -197,7 +197,7 @@ def slid_command(where: int, A: Array, b: Array, G: Array, h: Array, rows: Rows,
     B = B[:count]
     x: Array = np.empty(n)
     if project(B, 0.0, target, rows.lb, rows.ub, G, h, MARGIN, x) == SOLVED:
-        kernels.clip_into(x, rows.lb, rows.ub)  # by the kernel's rounding at most
+        feasibility.clip_into(x, rows.lb, rows.ub)  # by the kernel's rounding at most
         return 0, x, f
     x = backend_slide(where, B, target, rows.lb, rows.ub, G, h)
     return (0 if x.size else FAILED), x, f
@@ -303,7 +303,7 @@ def exact(A: Array, command: Array, f: Factor, w: Array, fits: bool, rows: Rows,
     """Stage 1: the exact rates where they keep every constraint, else pass on (the scale and
     veer reported along ``command``, the top level's as given).
     """  # noqa: D205
-    if not (fits and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
+    if not (fits and feasibility.rows_hold(rows.G, w, rows.h, 0.0)):
         return passing(w, A[:0])
     null = factor.null_basis(f)[1] if need_null else A[:0]
     if slid:
@@ -350,16 +350,16 @@ def direction(A: Array, b: Array, rows: Rows, dt: float, threshold: float, rate_
         u_box = -1.0
     command, z, slid = b, w, False
     G, h = slide_rows(rows)
-    if h.size and not kernels.rows_hold(G, w, h, 0.0):  # stage 2 changes the command
+    if h.size and not feasibility.rows_hold(G, w, h, 0.0):  # stage 2 changes the command
         code, kept, f = slid_command(backend_calls.SLIDE, A, b, G, h, rows, f, threshold)
         if code == 0:
-            if rows.slide.all() or kernels.rows_hold(rows.G, kept, rows.h, rows.tol):
+            if rows.slide.all() or feasibility.rows_hold(rows.G, kept, rows.h, rows.tol):
                 null = factor.null_basis(f)[1] if need_null else np.empty((0, A.shape[1]))
                 return answer(A, b, kept, SLIDING, rate_factor, null, 0.0)
             b, slid = row_values(A, kept), True
             f, z = factor.least_norm(f, b)
             w = z
-            fits = kernels.inside(w, rows.lb, rows.ub)
+            fits = feasibility.inside(w, rows.lb, rows.ub)
     return command_stages(A, command, b, f, w, z, fits, boxed, u_box, rows, slid, dt, threshold,
                           rate_factor, need_null)  # fmt: skip
 
@@ -398,7 +398,8 @@ def least_squares_top(A: Array, b: Array, per_unit: Array, rows: Rows, recoverin
     n = A.shape[1]
     if rows.slide.any():
         f, w = factor.least_norm(factor.qr(A), b)
-        if not (kernels.inside(w, rows.lb, rows.ub) and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
+        if not (feasibility.inside(w, rows.lb, rows.ub)
+                and feasibility.rows_hold(rows.G, w, rows.h, 0.0)):  # fmt: skip
             # where no rates meet them all, the pairs asked apart are only kept apart
             # (rrc_pin.solvers.tick.pipeline._damped_within)
             relaxed = np.where((rows.slide != 0.0) & (rows.h < 0.0), 0.0, rows.h)
