@@ -21,6 +21,7 @@ from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.pipeline import Answer, Options, solve
 from rrc_pin.solvers.tick.problem import Box, Constraints, Problem, TaskRows, build
+from rrc_pin.solvers.tick.statuses import scale_and_veer
 
 N = 10
 DT = 0.01
@@ -627,7 +628,7 @@ def test_a_backends_scaled_answer_reports_the_veer_it_measured(rng: np.random.Ge
         scaled += 1
         A, b = stacked(levels[0])
         y = A @ answer.qdot
-        veer = kernels.scale_and_veer(y, b)[1]
+        veer = scale_and_veer(y, b)[1]
         assert answer.veer == pytest.approx(veer, abs=1e-7) and veer_accepted(A, answer)
         measured += answer.veer > 0.0
     assert scaled > 20 and measured > 0

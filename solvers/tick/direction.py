@@ -48,7 +48,7 @@ from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding
 from rrc_pin.solvers.tick import feasibility, kernels, linalg, statuses
 from rrc_pin.solvers.tick.problem import Box, Rows
-from rrc_pin.solvers.tick.statuses import STILL_SCALE
+from rrc_pin.solvers.tick.statuses import STILL_SCALE, scale_and_veer
 
 Array = npt.NDArray[np.float64]
 
@@ -200,7 +200,7 @@ def along_checked(A: Array, w: Array, qdot: Array) -> tuple[float, float, bool]:
             s += A[i, j] * qdot[j]
             t += A[i, j] * w[j]
         y[i], b[i] = s, t
-    scale, veer = kernels.scale_and_veer(y, b)
+    scale, veer = scale_and_veer(y, b)
     off = statuses.norm(y) * math.sin(min(veer, 0.5 * math.pi))
     kept = not (off > DIRECTION_TOL * statuses.norm(A.ravel()) * statuses.norm(qdot)
                 and scale > STILL_SCALE)  # fmt: skip

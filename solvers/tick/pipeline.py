@@ -54,16 +54,15 @@ from rrc_pin.solvers.errors import InvalidInput, NumericalFailure
 from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.base import QPBackend
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding, Work, solve_within, tolerance
-from rrc_pin.solvers.tick import feasibility, kernels, statuses
-from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick import feasibility, statuses
+from rrc_pin.solvers.tick.damping import Damping, clamp_pushed
 from rrc_pin.solvers.tick.direction import DIRECTION_TOL, Along, along, direction_qp, solved_along
 from rrc_pin.solvers.tick.factorization import Factorization
 from rrc_pin.solvers.tick.joint_box import ON_LIMIT
-from rrc_pin.solvers.tick.kernels import scale_and_veer
 from rrc_pin.solvers.tick.least_squares import Subspace, least_squares
 from rrc_pin.solvers.tick.problem import Box, Problem, Rows
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
-from rrc_pin.solvers.tick.statuses import EXACT_TOL, STILL_SCALE
+from rrc_pin.solvers.tick.statuses import EXACT_TOL, STILL_SCALE, scale_and_veer
 
 Array = npt.NDArray[np.float64]
 _T = TypeVar("_T")
@@ -611,7 +610,7 @@ def _damping(
 def _clamped(factor: Factorization, w: Array, box: Box, dt: float) -> Factorization:
     """The rows without the joints ``w`` pushes against a bound that holds them (``_damping``)."""
     J = np.empty_like(factor.J)  # a bound within rounding of zero holds the joint
-    if not kernels.clamp_pushed(factor.J, w, box.lb, box.ub, ON_LIMIT / dt, J):
+    if not clamp_pushed(factor.J, w, box.lb, box.ub, ON_LIMIT / dt, J):
         return factor
     clamped = Factorization(J)
     rank = clamped.svd[3]  # at most the rows' own: where full, theirs is not needed (one SVD)

@@ -30,6 +30,7 @@ from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.tick import backend_calls, factor, feasibility, kernels, statuses
+from rrc_pin.solvers.tick.damping import clamp_pushed, damping_lambda_sq
 from rrc_pin.solvers.tick.direction import solved_along
 from rrc_pin.solvers.tick.factor import Factor
 from rrc_pin.solvers.tick.joint_box import ON_LIMIT
@@ -46,6 +47,7 @@ from rrc_pin.solvers.tick.statuses import (
     SINGULAR,
     SLIDING,
     STILL_SCALE,
+    scale_and_veer,
 )
 from rrc_pin.solvers.tick.statuses import FAILED as FAILED  # where the ticks import it
 
@@ -114,9 +116,9 @@ def along_command(A: Array, b: Array, qdot: Array, per_unit: Array, rate_factor:
     """  # noqa: D205
     y = row_values(A, qdot)
     if per_unit.size:
-        scale, veer = kernels.scale_and_veer(y, b, per_unit)
+        scale, veer = scale_and_veer(y, b, per_unit)
     else:
-        scale, veer = kernels.scale_and_veer(y, b)
+        scale, veer = scale_and_veer(y, b)
     return scale * rate_factor, veer
 
 
@@ -251,7 +253,7 @@ def clamped(f: Factor, w: Array, rows: Rows, dt: float, threshold: float
     where it is, the SVDs would choose the same rows).
     """  # noqa: D205
     J = np.empty_like(f.J)
-    if not kernels.clamp_pushed(f.J, w, rows.lb, rows.ub, ON_LIMIT / dt, J):
+    if not clamp_pushed(f.J, w, rows.lb, rows.ub, ON_LIMIT / dt, J):
         return f, factor.surely_conditioned(f, threshold)
     used = columns_used(J)
     if used < J.shape[0]:  # the clamped rows are short of rank: their rank is at most used
@@ -292,7 +294,7 @@ def damping(f: Factor, b: Array, w: Array, u: float, rows: Rows, dt: float, thre
             s += b[r] * usable.US[r, i]
         along[i] = abs(s) / max(usable.sigma[i], 1e-300)
     lam = np.empty(k)
-    if not kernels.damping_lambda_sq(usable.sigma, usable.rank, u, along, dt, threshold, lam):
+    if not damping_lambda_sq(usable.sigma, usable.rank, u, along, dt, threshold, lam):
         return usable, np.empty(0)
     return usable, lam
 
