@@ -16,8 +16,9 @@ import rrc_pin.solvers.tick.pipeline as pipeline_module
 from rrc_pin.solvers.collision.damper_kernels import SLACK
 from rrc_pin.solvers.errors import InvalidInput, ProblemError
 from rrc_pin.solvers.qp_backends import QPBackend, QPSolution, make_backend
-from rrc_pin.solvers.tick import feasibility, kernels
+from rrc_pin.solvers.tick import feasibility
 from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.direction import uniform_scale
 from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.pipeline import Answer, Options, solve
 from rrc_pin.solvers.tick.problem import Box, Constraints, Problem, TaskRows, build
@@ -511,7 +512,7 @@ def test_fallbacks_keep_the_constraint_rows_or_give_way(rng: np.random.Generator
     levels = levels_at(rng, (3,), 50.0)
     box = box_at(rng)
     exact = np.linalg.pinv(levels[0][0].A) @ levels[0][0].b
-    scaled = kernels.uniform_scale(exact, box.lb, box.ub) * exact
+    scaled = uniform_scale(exact, box.lb, box.ub) * exact
     g = rng.normal(size=(1, N))
     h = np.array([g[0] @ scaled - 0.1])  # just broken by the uniform scale
     _, answer = run(levels, box, Broken("raise"), Options(fallbacks=("scaling",)), G=g, h=h)

@@ -8,7 +8,7 @@ is block lower-triangular (eq. (22)): the arm rates solve ``M thetadot_123 = TVE
 report: ``S1 = sin(theta_1)``, ``C23 = cos(theta_2 + theta_3)``, ``SAL3 = sin(alpha_3)``,
 ``SN~ = SN + R3`` (the OCR'd report drops the tilde).
 
-Each equation is one small kernel (:func:`~rrc_pin.solvers.tick.kernels.kernel`:
+Each equation is one small kernel (:func:`~rrc_pin.solvers.compiled.kernel`:
 ``numba.njit(cache=True)``)
 on the floats of one configuration, cited once; corrections to the printed equations are
 cited as in docs/errata.md. The steps private to the arm's and the wrist's rates (eqs (25),

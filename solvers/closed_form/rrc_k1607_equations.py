@@ -2,7 +2,7 @@ r"""The equations of Nguyen & Zhou's closed forms for the RRC K-1607 (NAG 5-1124
 
 Craig's modified DH (Nguyen eq. (2)), twists fixed at ``alpha_{i-1} = (0, -90, 90, -90, 90,
 -90, 90)`` deg (Table 1); ``a`` holds ``a_0..a_6`` and ``d`` holds ``d_1..d_7`` [m]. Each
-equation is one small kernel (:func:`~rrc_pin.solvers.tick.kernels.kernel`) on one configuration,
+equation is one small kernel (:func:`~rrc_pin.solvers.compiled.kernel`) on one configuration,
 cited
 once; the loops over N configurations at the end call the same kernels.
 

@@ -15,7 +15,8 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.tick import feasibility, kernels, linalg
+from rrc_pin.solvers.tick import feasibility, linalg
+from rrc_pin.solvers.tick.direction import direction_step
 
 Array = npt.NDArray[np.float64]
 
@@ -98,7 +99,7 @@ def fitted(J: Array, b: Array, lb: Array, ub: Array) -> tuple[Factor, Array, boo
     """The factorisation of J, the least-norm rates w of ``J x ~= b``, whether they fit.
 
     One kernel call where J has full row rank
-    (:func:`~rrc_pin.solvers.tick.kernels.direction_step`), the SVD otherwise.
+    (:func:`~rrc_pin.solvers.tick.direction.direction_step`), the SVD otherwise.
 
     Returns:
         The record, w (n,), whether ``lb <= w <= ub``, and where they do not fit and J has at
@@ -109,7 +110,7 @@ def fitted(J: Array, b: Array, lb: Array, ub: Array) -> tuple[Factor, Array, boo
     space = np.empty(n * (n + m + 2))  # one allocation: Q, R, w and the boxed rates
     Q, R = space[: n * n].reshape(n, n), space[n * n : n * (n + m)].reshape(n, m)
     w, boxed = space[n * (n + m) : n * (n + m + 1)], space[n * (n + m + 1) :]
-    fit, u = kernels.direction_step(J, b, lb, ub, Q, R, w, boxed)
+    fit, u = direction_step(J, b, lb, ub, Q, R, w, boxed)
     f = Factor(J, Q, R, fit > 0, Q[:0], w[:0], Q[:0], -1)
     if fit:
         return f, w, fit == 2, boxed, u

@@ -22,8 +22,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.tick import feasibility, kernels, linalg
-from rrc_pin.solvers.tick.direction import Along
+from rrc_pin.solvers.tick import feasibility, linalg
+from rrc_pin.solvers.tick.direction import Along, direction_step
 
 Array = npt.NDArray[np.float64]
 
@@ -62,7 +62,7 @@ class Factorization:
         """The factorisation of J, the least-norm rates of ``J x ~= b``, whether they fit.
 
         Where they do not, also the largest scale along them within the box. One kernel call
-        where J has full row rank (:func:`~rrc_pin.solvers.tick.kernels.direction_step`), the SVD
+        where J has full row rank (:func:`~rrc_pin.solvers.tick.direction.direction_step`), the SVD
         otherwise.
 
         Args:
@@ -82,7 +82,7 @@ class Factorization:
         x: Array = np.empty(n)
         qdot: Array = np.empty(n)
         factor.Q, factor.R = np.empty((n, n)), np.empty((n, m))
-        fit, u = kernels.direction_step(J, b, lb, ub, factor.Q, factor.R, x, qdot)
+        fit, u = direction_step(J, b, lb, ub, factor.Q, factor.R, x, qdot)
         factor.regular = fit > 0
         if fit:
             return factor, x, fit == 2, Along(qdot, u) if u >= 0.0 else None

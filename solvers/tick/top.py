@@ -29,9 +29,9 @@ import numpy.typing as npt
 from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import backend_calls, factor, feasibility, kernels, statuses
+from rrc_pin.solvers.tick import backend_calls, factor, feasibility, statuses
 from rrc_pin.solvers.tick.damping import clamp_pushed, damping_lambda_sq
-from rrc_pin.solvers.tick.direction import solved_along
+from rrc_pin.solvers.tick.direction import line_scale, solved_along, uniform_scale
 from rrc_pin.solvers.tick.factor import Factor
 from rrc_pin.solvers.tick.joint_box import ON_LIMIT
 from rrc_pin.solvers.tick.levels import least_squares
@@ -226,9 +226,9 @@ def scaled_along(A: Array, w: Array, null: Array, rows: Rows) -> tuple[Array, fl
             return qdot, u, veer
         return backend_direction(A, w, null, rows.lb, rows.ub, rows.G, rows.h)
     if null.shape[0] == 0:
-        u = kernels.uniform_scale(w, rows.lb, rows.ub)
+        u = uniform_scale(w, rows.lb, rows.ub)
         return u * w, u, 0.0
-    u, y = kernels.line_scale(w, null[0], rows.lb, rows.ub)
+    u, y = line_scale(w, null[0], rows.lb, rows.ub)
     return u * w + y * null[0], u, 0.0
 
 
