@@ -9,7 +9,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.errors import InvalidInput
-from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick import feasibility
 
 _F64 = np.dtype(np.float64)
 
@@ -69,7 +69,7 @@ def finite_array(x: npt.ArrayLike, name: str) -> npt.NDArray[np.float64]:
 
 def all_finite(x: npt.NDArray[np.float64]) -> bool:
     """Whether every entry of ``x`` is finite (no NaN or infinity)."""
-    return kernels.all_finite(x if x.ndim == 1 else x.reshape(-1))
+    return feasibility.all_finite(x if x.ndim == 1 else x.reshape(-1))
 
 
 def real_array(

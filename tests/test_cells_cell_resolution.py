@@ -8,7 +8,7 @@ import pytest
 import rrc_pin
 from rrc_pin.cells import CellController
 from rrc_pin.cells.cell_resolution import CellResolution
-from rrc_pin.solvers.tick.kernels import scale_and_veer
+from rrc_pin.solvers.tick.statuses import scale_and_veer
 
 
 def test_a_tick_reports_its_applied_rates_and_its_hands(dual):

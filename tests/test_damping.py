@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rrc_pin.solvers.errors import InvalidInput
-from rrc_pin.solvers.tick.damping import MIN_THRESHOLD, Damping
+from rrc_pin.solvers.tick.damping import MIN_THRESHOLD, Damping, damping_lambda_sq
 
 
 def test_none_below_the_threshold_or_where_the_command_can_be_met() -> None:
@@ -40,3 +40,36 @@ def test_bad_thresholds_are_refused(threshold: object) -> None:
         Damping(threshold=threshold)  # type: ignore[arg-type]
     assert info.value.argument == "threshold"
     assert Damping(threshold=MIN_THRESHOLD).threshold == 10.0
+
+
+def lambda_sq_reference(
+    sigma: np.ndarray, rank: int, scale: float, along: np.ndarray, dt: float, threshold: float
+) -> np.ndarray | None:
+    """The damping schedule in plain numpy (solvers/tick/damping.py's former implementation)."""
+    if rank == 0 or scale >= 1.0:
+        return None
+    onset = float(sigma[0]) / threshold
+    s = sigma[:rank]
+    if float(s[-1]) >= onset:
+        return None
+    lam = np.zeros(sigma.size)
+    weak = s < onset
+    floor = np.maximum(onset * onset, float(sigma[0]) * along[:rank][weak] * dt)
+    lam[:rank][weak] = (1.0 - (s[weak] / onset) ** 2) * floor * (1.0 - scale)
+    return lam
+
+
+def test_damping_lambda_sq_against_numpy(rng: np.random.Generator) -> None:
+    for _ in range(2000):
+        k = int(rng.integers(1, 8))
+        sigma = np.sort(10.0 ** rng.uniform(-5, 1, k))[::-1].copy()
+        rank = int(rng.integers(0, k + 1))
+        scale = float(rng.choice([rng.uniform(0, 1), 1.0, 0.0]))
+        along = np.abs(rng.normal(size=k)) * 10.0 ** rng.uniform(-4, 2)
+        dt, threshold = float(rng.choice([0.001, 0.01, 0.05])), float(rng.uniform(10, 1e4))
+        lam = np.full(k, np.nan)
+        applies = damping_lambda_sq(sigma, rank, scale, along, dt, threshold, lam)
+        reference = lambda_sq_reference(sigma, rank, scale, along, dt, threshold)
+        assert applies == (reference is not None)
+        if reference is not None:
+            np.testing.assert_allclose(lam, reference, rtol=1e-14, atol=0)

@@ -6,19 +6,23 @@ import itertools
 
 import numpy as np
 import pytest
+from test_linalg import random_rows
 
 from rrc_pin.solvers.errors import NumericalFailure
 from rrc_pin.solvers.qp_backends import installed_backends, make_backend
+from rrc_pin.solvers.tick import linalg
 from rrc_pin.solvers.tick.direction import (
     REGULARIZATION,
     along,
     constraint_rows,
     direction_lp,
     direction_qp,
+    direction_step,
+    line_scale,
     solved_along,
+    uniform_scale,
 )
 from rrc_pin.solvers.tick.factorization import Factorization
-from rrc_pin.solvers.tick.kernels import line_scale, uniform_scale
 from rrc_pin.solvers.tick.problem import Box, Rows
 
 
@@ -428,3 +432,35 @@ def test_line_scale_edge_cases() -> None:
     # w leaves joint 1's bound; the null direction brings it back, as little as needed
     u, y = line_scale(np.array([0.0, 1.6, -1.2]), v, np.array([-1.0, -1.0, -3.0]), ub)
     assert u == 1.0 and y == pytest.approx(-1.0, abs=1e-15)
+
+
+@pytest.mark.parametrize(("m", "n"), [(6, 7), (6, 6), (3, 3), (6, 9), (7, 6), (1, 2)])
+def test_direction_step_against_its_parts(m: int, n: int, rng: np.random.Generator) -> None:
+    """The fused step: the QR and least-norm rates, the box check, then the exact scale (the
+    uniform scale without a null direction, the line scale with one), as the parts give."""
+    for _ in range(300):
+        J = random_rows(rng, m, n, rank=min(m, n) - int(rng.random() < 0.1))
+        b = rng.normal(size=m)
+        lb, ub = -rng.uniform(0.0, 2.0, n), rng.uniform(0.0, 2.0, n)
+        Q, R, w, qdot = np.empty((n, n)), np.empty((n, m)), np.empty(n), np.empty(n)
+        fit, u = direction_step(J, b, lb, ub, Q, R, w, qdot)
+        Q0, R0, x = np.empty((n, n)), np.empty((n, m)), np.empty(n)
+        linalg.householder_qr(J.T.copy(), Q0, R0)
+        np.testing.assert_array_equal(Q, Q0)
+        np.testing.assert_array_equal(R, R0)
+        if m > n or not linalg.least_norm_rates(Q0, R0, b, x):
+            assert (fit, u) == (0, -1.0)
+            continue
+        np.testing.assert_array_equal(w, x)
+        inside = bool(((x >= lb) & (x <= ub)).all())
+        assert fit == (2 if inside else 1)
+        if inside or n - m > 1:
+            assert u == -1.0
+        elif n == m:
+            assert u == uniform_scale(x, lb, ub)
+            np.testing.assert_array_equal(qdot, u * x)
+        else:
+            u0, y0 = line_scale(x, Q0[:, m].copy(), lb, ub)
+            assert u == u0
+            np.testing.assert_allclose(qdot, u0 * x + y0 * Q0[:, m], rtol=0, atol=1e-15)
+            assert (qdot >= lb - 1e-12).all() and (qdot <= ub + 1e-12).all()

@@ -1,4 +1,4 @@
-"""JointLimits: the step's box (rrc_pin.solvers.tick.kernels.joint_box), exact in floating point,
+"""JointLimits: the step's box (rrc_pin.solvers.tick.joint_box.joint_box), exact in floating point,
 recovery,
 priorities, kinds; its fields checked at construction and against the robot."""
 
@@ -12,8 +12,7 @@ import pytest
 
 import rrc_pin
 from rrc_pin import InvalidInput, JointLimits, Resolver
-from rrc_pin.solvers.tick import kernels
-from rrc_pin.solvers.tick.kernels import ON_LIMIT, SHRINK
+from rrc_pin.solvers.tick.joint_box import ON_LIMIT, SHRINK, joint_box
 from rrc_pin.solvers.tick.resolution import KIND_NAMES
 
 KINDS = ("velocity", "position", "acceleration")
@@ -48,7 +47,7 @@ class JointBounds:
         n = q.size
         lb, ub, kind = np.empty(n), np.empty(n), np.empty((2, n), np.int8)
         prev = np.zeros(n) if prev is None else prev
-        zero, recovering = kernels.joint_box(
+        zero, recovering = joint_box(
             np.asarray(q, float), self.lower, self.upper, self.velocity, self.margin, self.gain,
             dt, prev, self.acceleration, lb, ub, kind)  # fmt: skip
         return Step(lb, ub, kind, zero, recovering)

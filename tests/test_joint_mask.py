@@ -34,8 +34,8 @@ from rrc_pin.geometry.robot_geometry import robot_geometry
 from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import Robot
 from rrc_pin.solvers.qp_backends import make_backend
+from rrc_pin.solvers.tick.joint_box import VELOCITY
 from rrc_pin.solvers.tick.joint_mask import free_columns, scattered, widened_rates
-from rrc_pin.solvers.tick.kernels import VELOCITY
 from rrc_pin.solvers.tick.pipeline import Options, solve
 from rrc_pin.solvers.tick.problem import Box, Constraints, Problem, TaskRows, build
 from rrc_pin.solvers.tick.resolution import Resolution

@@ -99,7 +99,7 @@ def test_subspace_rows_against_numpy(start: str) -> None:
 def test_metric_projection_is_project_to_the_bit() -> None:
     """The projection in the level's factorised metric is project's, bit for bit, and project's
     own where the metric's diagonal is too small to ignore its damping."""
-    from rrc_pin.solvers.tick import kernels
+    from rrc_pin.solvers.tick import linalg
     from rrc_pin.solvers.tick.slide_kernels import MARGIN, project
 
     rng = np.random.default_rng(7)
@@ -109,8 +109,8 @@ def test_metric_projection_is_project_to_the_bit() -> None:
         lb, ub = -rng.uniform(0.1, 1.0, 5), rng.uniform(0.1, 1.0, 5)
         G, h = rng.normal(size=(3, 5)), rng.uniform(0.0, 1.0, 3)
         H, g, L = np.empty((5, 5)), np.empty(5), np.zeros((5, 5))
-        kernels.normal_equations(B, np.zeros(12), np.ones(12), H, g)
-        if not kernels.cholesky(H, 1e-12, L):
+        linalg.normal_equations(B, np.zeros(12), np.ones(12), H, g)
+        if not linalg.cholesky(H, 1e-12, L):
             continue
         x, y = np.full(5, np.nan), np.full(5, np.nan)
         code = project(B, 0.0, w, lb, ub, G, h, MARGIN, x)

@@ -16,10 +16,13 @@ import rrc_pin.solvers.tick.pipeline as pipeline_module
 from rrc_pin.solvers.collision.damper_kernels import SLACK
 from rrc_pin.solvers.errors import InvalidInput, ProblemError
 from rrc_pin.solvers.qp_backends import QPBackend, QPSolution, make_backend
-from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick import feasibility
 from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.direction import uniform_scale
+from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.pipeline import Answer, Options, solve
 from rrc_pin.solvers.tick.problem import Box, Constraints, Problem, TaskRows, build
+from rrc_pin.solvers.tick.statuses import scale_and_veer
 
 N = 10
 DT = 0.01
@@ -32,7 +35,7 @@ def box_at(
     v = rng.uniform(0.5, 2.0, n) * tight
     q = rng.uniform(-2.5, 2.5, n) if q is None else q
     lb, ub, kind = np.empty(n), np.empty(n), np.empty((2, n), np.int8)
-    zero, recovering = kernels.joint_box(
+    zero, recovering = joint_box(
         q,
         np.full(n, -3.0),
         np.full(n, 3.0),
@@ -206,7 +209,7 @@ def test_where_the_lp_maximum_is_one_the_command_is_met_exactly(rng: np.random.G
         assert answer.status == "exact" and answer.scale == 1.0 and answer.veer == 0.0
         np.testing.assert_allclose(A @ answer.qdot, b, atol=1e-9 * (1.0 + np.abs(b).max()))
         exact = np.linalg.pinv(A) @ b
-        met += not kernels.inside(exact, box.lb, box.ub)
+        met += not feasibility.inside(exact, box.lb, box.ub)
     assert met > 20  # the exact rates did not fit: the null space answered
 
 
@@ -265,7 +268,7 @@ def test_weighted_is_the_exact_optimum_of_its_costs(rng: np.random.Generator) ->
         y = np.concatenate([r * t.b for r, t in zip(root, tasks, strict=True)])
         ref = lsq_linear(A, y, bounds=(box.lb, box.ub), method="bvls", tol=1e-14).x
         np.testing.assert_allclose(answer.qdot, ref, atol=1e-6)
-        active += not kernels.inside(np.linalg.lstsq(A, y, rcond=None)[0], box.lb, box.ub)
+        active += not feasibility.inside(np.linalg.lstsq(A, y, rcond=None)[0], box.lb, box.ub)
     assert active > 150
 
 
@@ -509,7 +512,7 @@ def test_fallbacks_keep_the_constraint_rows_or_give_way(rng: np.random.Generator
     levels = levels_at(rng, (3,), 50.0)
     box = box_at(rng)
     exact = np.linalg.pinv(levels[0][0].A) @ levels[0][0].b
-    scaled = kernels.uniform_scale(exact, box.lb, box.ub) * exact
+    scaled = uniform_scale(exact, box.lb, box.ub) * exact
     g = rng.normal(size=(1, N))
     h = np.array([g[0] @ scaled - 0.1])  # just broken by the uniform scale
     _, answer = run(levels, box, Broken("raise"), Options(fallbacks=("scaling",)), G=g, h=h)
@@ -626,7 +629,7 @@ def test_a_backends_scaled_answer_reports_the_veer_it_measured(rng: np.random.Ge
         scaled += 1
         A, b = stacked(levels[0])
         y = A @ answer.qdot
-        veer = kernels.scale_and_veer(y, b)[1]
+        veer = scale_and_veer(y, b)[1]
         assert answer.veer == pytest.approx(veer, abs=1e-7) and veer_accepted(A, answer)
         measured += answer.veer > 0.0
     assert scaled > 20 and measured > 0

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rrc_pin.solvers.qp_backends import make_backend
-from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.pipeline import METHODS, Options, scale_and_veer, solve
 from rrc_pin.solvers.tick.problem import Box, Constraints, TaskRows, build
 from rrc_pin.solvers.tick.resolution import (
@@ -21,7 +21,7 @@ from rrc_pin.solvers.tick.resolution import (
 def box(n: int = 3, v: float = 1.0, q: np.ndarray | None = None) -> Box:
     lb, ub, kind = np.empty(n), np.empty(n), np.empty((2, n), np.int8)
     q = np.zeros(n) if q is None else q
-    zero, recovering = kernels.joint_box(
+    zero, recovering = joint_box(
         q,
         -np.ones(n),
         np.ones(n),

@@ -19,7 +19,7 @@ from rrc_pin import Damping, FrameTask, JointLimits, PostureTask, QPOptions, Res
 from rrc_pin.errors import InvalidInput, RrcPinError
 from rrc_pin.solvers.qp_backends import installed_backends
 from rrc_pin.solvers.tick import tick
-from rrc_pin.solvers.tick.kernels import ON_LIMIT
+from rrc_pin.solvers.tick.joint_box import ON_LIMIT
 
 ARMS = ("barker6", "rrc_k1607", "kr5_3r", "panda")
 BACKENDS = ("daqp", "osqp", "clarabel", "proxqp", "quadprog")
@@ -50,7 +50,7 @@ def check_step(arm: rrc_pin.Robot, q: np.ndarray, qdot: np.ndarray, dt: float) -
     """Velocity limits exactly; the step inside the position limits, or no further out and
     moving back, in floating point (no tolerance). A start outside by at most ON_LIMIT (the
     rounding of ``lower + 1.0 * (upper - lower)``) is on its limit
-    (rrc_pin.solvers.tick.kernels.joint_box):
+    (rrc_pin.solvers.tick.joint_box.joint_box):
     it may stand still, never move further out."""
     assert np.all(np.isfinite(qdot))
     assert np.all(np.abs(qdot) <= arm.velocity_limit)

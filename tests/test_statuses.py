@@ -11,6 +11,7 @@ import pytest
 from rrc_pin.solvers.tick import statuses
 from rrc_pin.solvers.tick.pipeline import LevelStatus, Status, served
 from rrc_pin.solvers.tick.problem import LARGE, SATURATION, cap
+from rrc_pin.solvers.tick.statuses import scale_and_veer
 
 SEEDS = [20261206, int(np.random.SeedSequence().entropy % 2**63)]
 
@@ -135,3 +136,44 @@ def test_a_subnormal_command_met_to_one_task_unit_is_refused() -> None:
             statuses.FAILED)  # fmt: skip
         assert statuses.borne_out(statuses.EXACT, rates, b, False, 1.0, 1.0, 0.0)[0] == (
             statuses.LEAST_SQUARES)  # fmt: skip
+
+
+def scale_and_veer_reference(y: np.ndarray, b: np.ndarray) -> tuple[float, float]:
+    """The scale and veer in plain numpy (the pipeline's former Python implementation)."""
+    top_b = float(np.abs(b).max()) if b.size else 0.0
+    if top_b == 0.0:
+        return 1.0, 0.0
+    top_y = float(np.abs(y).max())
+    if top_y == 0.0:
+        return 0.0, 0.0
+    bn, yn = b / top_b, y / top_y
+    cosine = float(yn @ bn) / (np.linalg.norm(yn) * np.linalg.norm(bn))
+    veer = float(np.arccos(np.clip(cosine, -1.0, 1.0)))
+    with np.errstate(over="ignore"):
+        ratio = float(np.float64(top_y) / top_b) * float(yn @ bn) / float(bn @ bn)
+    return min(max(ratio, 0.0), 1.0), veer
+
+
+def test_scale_and_veer_against_numpy(rng: np.random.Generator) -> None:
+    for _ in range(2000):
+        m = int(rng.integers(1, 13))
+        b = rng.normal(size=m) * 10.0 ** rng.uniform(-300, 300)
+        y = (rng.uniform(-0.5, 1.5) * b + rng.normal(size=m) * rng.choice([0.0, 1e-6, 1.0])
+             * np.abs(b).max())  # fmt: skip
+        y = y / np.abs(y).max() * 10.0 ** rng.uniform(-300, 300) if rng.random() < 0.3 else y
+        scale, veer = scale_and_veer(y, b)
+        reference = scale_and_veer_reference(y, b)
+        assert scale == pytest.approx(reference[0], rel=1e-12, abs=1e-300)
+        assert veer == pytest.approx(reference[1], abs=1e-7)  # acos near 0: sqrt of rounding
+        factor = rng.uniform(0.01, 100.0, m)  # a level's metric: command first divided down
+        peak = max(1.0, float(np.abs(b).max()))
+        scale, veer = scale_and_veer(y, b, factor)
+        reference = scale_and_veer_reference(factor * (y / peak), factor * (b / peak))
+        assert scale == pytest.approx(reference[0], rel=1e-12, abs=1e-300)
+        assert veer == pytest.approx(reference[1], abs=1e-7)
+    assert scale_and_veer(np.zeros(0), np.zeros(0)) == (1.0, 0.0)
+    huge = np.array([1.7e308, -1.7e308])  # times 100 would overflow
+    scale, veer = scale_and_veer(0.5 * huge, huge, np.full(2, 100.0))
+    assert scale == pytest.approx(0.5) and veer < 1e-7
+    assert scale_and_veer(np.array([1.0, 0.0]), np.array([5e-324, 0.0])) == (1.0, 0.0)
+    assert scale_and_veer(np.array([5e-324, 0.0]), np.array([1e308, 0.0]))[0] == 0.0

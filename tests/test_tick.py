@@ -13,8 +13,9 @@ import pytest
 
 from rrc_pin.solvers.qp_backends import make_backend
 from rrc_pin.solvers.qp_backends.qp import velocity_tolerance
-from rrc_pin.solvers.tick import backend_calls, kernels, tick
+from rrc_pin.solvers.tick import backend_calls, tick
 from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.pipeline import Options, Status, served, solve
 from rrc_pin.solvers.tick.problem import Box, Constraints, TaskRows, build
 
@@ -69,7 +70,7 @@ def case(rng: np.random.Generator) -> tuple:
 
 def pipeline_answer(q, lower, upper, velocity, levels, weighted, G, h, slide, direction):
     lb, ub, kind = np.empty(N), np.empty(N), np.empty((2, N), np.int8)
-    zero, recovering = kernels.joint_box(q, lower, upper, velocity, 0.0, 1.0, DT, np.zeros(N),
+    zero, recovering = joint_box(q, lower, upper, velocity, 0.0, 1.0, DT, np.zeros(N),
                                          np.array([np.inf]), lb, ub, kind)  # fmt: skip
     box = Box(lb, ub, kind, zero, recovering, velocity)
     names = tuple(f"row{i}" for i in range(h.size))

@@ -11,8 +11,8 @@ from rrc_pin.solvers.tick import factor, pipeline, statuses, top
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.direction import along
 from rrc_pin.solvers.tick.factorization import Factorization
-from rrc_pin.solvers.tick.kernels import scale_and_veer
 from rrc_pin.solvers.tick.problem import Box
+from rrc_pin.solvers.tick.statuses import scale_and_veer
 
 SEEDS = [20261206, int(np.random.SeedSequence().entropy % 2**63)]
 

@@ -32,14 +32,8 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.tick.kernels import (
-    cholesky,
-    clip_into,
-    householder_qr,
-    inside,
-    rows_hold,
-    solve_factored,
-)
+from rrc_pin.solvers.tick.feasibility import clip_into, inside, rows_hold
+from rrc_pin.solvers.tick.linalg import cholesky, householder_qr, solve_factored
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
 
 Array = npt.NDArray[np.float64]

@@ -74,10 +74,10 @@ from rrc_pin.solvers.checks import as_vector, flag, positive
 from rrc_pin.solvers.exp_log import displaced, pose_errors
 from rrc_pin.solvers.spatial import to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
-from rrc_pin.solvers.tick.kernels import scale_and_veer
 from rrc_pin.solvers.tick.pipeline import solve
 from rrc_pin.solvers.tick.problem import Rows, TaskRows
 from rrc_pin.solvers.tick.resolution import Resolution
+from rrc_pin.solvers.tick.statuses import scale_and_veer
 from rrc_pin.tasks import FrameTask, PostureTask, Task
 
 Array = npt.NDArray[np.float64]

@@ -11,7 +11,7 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import as_vector, finite_number, real_array
-from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.problem import Box, Constraints
 
 if TYPE_CHECKING:
@@ -22,7 +22,7 @@ Array = npt.NDArray[np.float64]
 
 @dataclass(frozen=True)
 class JointLimits(Limit):
-    """The joint limits a resolver keeps: the box of :func:`rrc_pin.solvers.tick.kernels.joint_box`.
+    """The joint limits a resolver keeps: the box of :mod:`rrc_pin.solvers.tick.joint_box`.
 
     Every step keeps the velocity limits and the position limits over the step exactly (in
     floating point); a start outside the position limits only moves back (``recovering``).
@@ -125,7 +125,7 @@ class JointLimits(Limit):
         return velocity
 
     def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
-        """The step's box (:func:`rrc_pin.solvers.tick.kernels.joint_box`)."""
+        """The step's box (:func:`rrc_pin.solvers.tick.joint_box.joint_box`)."""
         layout = kin.layout
         n = layout.nv
         velocity = self.velocities(layout)
@@ -133,7 +133,7 @@ class JointLimits(Limit):
             self.acceleration
         )
         lb, ub, kind = np.empty(n), np.empty(n), np.empty((2, n), np.int8)
-        zero, recovering = kernels.joint_box(
+        zero, recovering = joint_box(
             kin.q, layout.lower, layout.upper, velocity, self.margin, self.position_gain, dt,
             previous, acceleration, lb, ub, kind,
         )  # fmt: skip

@@ -8,7 +8,7 @@ is block lower-triangular (eq. (22)): the arm rates solve ``M thetadot_123 = TVE
 report: ``S1 = sin(theta_1)``, ``C23 = cos(theta_2 + theta_3)``, ``SAL3 = sin(alpha_3)``,
 ``SN~ = SN + R3`` (the OCR'd report drops the tilde).
 
-Each equation is one small kernel (:func:`~rrc_pin.solvers.tick.kernels.kernel`:
+Each equation is one small kernel (:func:`~rrc_pin.solvers.compiled.kernel`:
 ``numba.njit(cache=True)``)
 on the floats of one configuration, cited once; corrections to the printed equations are
 cited as in docs/errata.md. The steps private to the arm's and the wrist's rates (eqs (25),
@@ -32,7 +32,7 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.closed_form.base import finite
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick.kernels import jacobi_svd, svd_rates
+from rrc_pin.solvers.tick.linalg import jacobi_svd, svd_rates
 
 Array = npt.NDArray[np.float64]
 Flags = npt.NDArray[np.bool_]
@@ -412,7 +412,7 @@ def band_solve(A: Array, b: Array, s2: float, eps: float, exact: bool, x: Array)
 
     ``s2`` the block's measure ``s^2 <= eps^2``. With ``exact``: the truncated pseudo-inverse,
     singular values ``<= eps`` dropped (M* of eq. (38), M1* of eq. (44), M2* of eq. (60)).
-    The SVD is one-sided Jacobi (:func:`~rrc_pin.solvers.tick.kernels.jacobi_svd`); ``A`` is
+    The SVD is one-sided Jacobi (:func:`~rrc_pin.solvers.tick.linalg.jacobi_svd`); ``A`` is
     overwritten.
     """
     m = b.size

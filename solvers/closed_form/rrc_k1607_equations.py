@@ -2,7 +2,7 @@ r"""The equations of Nguyen & Zhou's closed forms for the RRC K-1607 (NAG 5-1124
 
 Craig's modified DH (Nguyen eq. (2)), twists fixed at ``alpha_{i-1} = (0, -90, 90, -90, 90,
 -90, 90)`` deg (Table 1); ``a`` holds ``a_0..a_6`` and ``d`` holds ``d_1..d_7`` [m]. Each
-equation is one small kernel (:func:`~rrc_pin.solvers.tick.kernels.kernel`) on one configuration,
+equation is one small kernel (:func:`~rrc_pin.solvers.compiled.kernel`) on one configuration,
 cited
 once; the loops over N configurations at the end call the same kernels.
 
@@ -27,7 +27,7 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.closed_form.base import finite
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.tick.kernels import cholesky_solve, jacobi_svd, svd_rates
+from rrc_pin.solvers.tick.linalg import cholesky_solve, jacobi_svd, svd_rates
 
 Array = npt.NDArray[np.float64]
 Vector3 = tuple[float, float, float]
@@ -136,7 +136,7 @@ def weighted_rates(
                = W J^T (J W J^T)^{-1} (\dot x - J z) + z
 
     (the same vector, one solve), with ``B = J L``: ``B B^T y = xdot - J z`` by Cholesky's
-    method (:func:`~rrc_pin.solvers.tick.kernels.cholesky_solve`), then ``qdot = L B^T y + z``.
+    method (:func:`~rrc_pin.solvers.tick.linalg.cholesky_solve`), then ``qdot = L B^T y + z``.
     ``L``
     lower triangular, None for ``W = I``; ``z`` None for zero (eq. (23): the minimum-norm
     rates). Forming ``B B^T`` squares the condition number: accurate to about eps kappa(B)^2

@@ -2,7 +2,7 @@ r"""The equations of the 3R arm of the Robotics I exam (2012), as compiled kerne
 
 Standard DH (exam Table 1): ``alpha = (90, 0, 0)`` deg, ``a = (a1, a2, a3)``, ``d = 0``;
 ``p = (a1, a2, a3, a1 + a2 + a3)`` [m] holds the lengths and the reach. Each equation is one
-small kernel (:func:`~rrc_pin.solvers.tick.kernels.kernel`) on one configuration; the loops over N
+small kernel (:func:`~rrc_pin.solvers.compiled.kernel`) on one configuration; the loops over N
 configurations at the end call the same kernels. The derivation of the inverse is in
 :mod:`rrc_pin.solvers.closed_form.three_r`.
 """

@@ -21,7 +21,7 @@ import numpy.typing as npt
 import qpsolvers
 
 from rrc_pin.solvers.errors import NumericalFailure
-from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick import feasibility
 from rrc_pin.solvers.tick.problem import Box, Rows
 
 if TYPE_CHECKING:
@@ -131,7 +131,7 @@ def finite_solution(x: object, nz: int) -> Array | None:
     if z.dtype.kind not in "fiu" or z.shape != (nz,):
         return None
     z = np.array(z, dtype=np.float64)
-    return z if kernels.all_finite(z) else None
+    return z if feasibility.all_finite(z) else None
 
 
 class Solved(NamedTuple):
@@ -244,9 +244,9 @@ def solve_within(
     work.iterations += solved.iterations
     work.solve_time += solved.solve_time
     x: Array = solved.x.copy()
-    size = kernels.clip_into(x if clip else x.copy(), box.lb, box.ub)
+    size = feasibility.clip_into(x if clip else x.copy(), box.lb, box.ub)
     tol = tolerance(box)
-    if not (size <= tol and (rows is None or kernels.rows_hold(rows.G, x, rows.h, tol))):
+    if not (size <= tol and (rows is None or feasibility.rows_hold(rows.G, x, rows.h, tol))):
         over = 0.0 if rows is None else float(np.max(rows.G @ x - rows.h, initial=0.0))
         raise NumericalFailure(f"{solved.backend}: answer outside the box by {size:.3g}, the rows "
                                f"by {over:.3g} (tolerance {tol:.3g})")  # fmt: skip

@@ -44,8 +44,8 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.checks import as_array, finite_number, integer, positive
+from rrc_pin.solvers.compiled import kernel
 from rrc_pin.solvers.errors import InvalidInput
-from rrc_pin.solvers.tick import kernels
 
 Array = npt.NDArray[np.float64]
 
@@ -77,7 +77,7 @@ class Damping:
     ) -> Array | None:
         """Squared damping per singular direction (k,), or None where none applies.
 
-        The module docstring's schedule (:func:`~rrc_pin.solvers.tick.kernels.damping_lambda_sq`).
+        The module docstring's schedule (:func:`damping_lambda_sq`).
 
         Args:
             sigma: Singular values (k,) of the level's normalised rows, descending.
@@ -96,7 +96,7 @@ class Damping:
         scale = finite_number(scale, "scale", 0.0, upper=math.nextafter(1.0, 2.0))
         dt = positive(dt, "dt")
         lam = np.empty(sigma.size)
-        if not kernels.damping_lambda_sq(sigma, rank, scale, along, dt, float(self.threshold), lam):
+        if not damping_lambda_sq(sigma, rank, scale, along, dt, float(self.threshold), lam):
             return None
         return np.minimum(lam, _HUGE, out=lam)  # finite where sigma_1 or the command overflow
 
@@ -120,3 +120,69 @@ def _singular(sigma: Array, along: Array) -> tuple[Array, Array]:
     if out[0].size != out[1].size:
         raise InvalidInput("sigma, along", f"sizes differ: {out[0].size} and {out[1].size}")
     return out[0], out[1]
+
+
+@kernel
+def clamp_pushed(J: Array, w: Array, lb: Array, ub: Array, still: float, out: Array) -> bool:
+    """J's columns of the joints that ``w`` pushes against a bound holding them still, zeroed.
+
+    A joint is held where its bound on the side ``w`` moves it is within ``still`` of zero
+    (Baerlocher & Boulic 2004's clamping).
+
+    Args:
+        J: The rows (m, n).
+        w: The rates (n,).
+        lb: Lower bounds (n,).
+        ub: Upper bounds (n,).
+        still: A bound within this of zero holds its joint.
+        out: Out: J with those columns zeroed (m, n), set where True is returned.
+
+    Returns:
+        Whether any joint is held.
+    """
+    m, n = J.shape
+    any_held = False
+    for j in range(n):
+        held = (w[j] > 0.0 and ub[j] <= still) or (w[j] < 0.0 and lb[j] >= -still)
+        any_held = any_held or held
+        for i in range(m):
+            out[i, j] = 0.0 if held else J[i, j]
+    return any_held
+
+
+@kernel
+def damping_lambda_sq(
+    sigma: Array, rank: int, scale: float, along: Array, dt: float, threshold: float, lam: Array
+) -> bool:
+    r"""Squared damping per singular direction (the module docstring's schedule).
+
+    With the onset :math:`\sigma_{on} = \sigma_1/\kappa`, every direction i < rank whose
+    singular value is below it gets :math:`\lambda_i^2 = (1 - (\sigma_i/\sigma_{on})^2)\,
+    \max(\sigma_{on}^2, \sigma_1 |u_i^T b|\,\Delta t)\,(1 - u^*)` (Maciejewski & Klein 1988's
+    smooth onset, with a floor for the step), the others zero.
+
+    Args:
+        sigma: Singular values (k,), descending.
+        rank: How many of them count.
+        scale: The LP maximum :math:`u^*` in [0, 1].
+        along: :math:`|u_i^T b|` (k,).
+        dt: The step [s].
+        threshold: :math:`\kappa`.
+        lam: Out: the squared damping (k,), set where True is returned.
+
+    Returns:
+        False where none applies (no rank, :math:`u^* \ge 1`, or every counted singular value
+        at or above the onset).
+    """
+    if rank == 0 or scale >= 1.0:
+        return False
+    onset = sigma[0] / threshold
+    if sigma[rank - 1] >= onset:
+        return False
+    for i in range(sigma.size):
+        lam[i] = 0.0
+        if i < rank and sigma[i] < onset:
+            floor = max(onset * onset, sigma[0] * along[i] * dt)
+            ratio = sigma[i] / onset
+            lam[i] = (1.0 - ratio * ratio) * floor * (1.0 - scale)
+    return True

@@ -19,12 +19,10 @@ equality rows appear)
 
 solved here (:func:`along`):
 
-- without rows and null space: the largest uniform scale
-  (:func:`~rrc_pin.solvers.tick.kernels.uniform_scale`);
+- without rows and null space: the largest uniform scale (:func:`uniform_scale`);
 - without rows, one null direction (a 7-joint arm's six rows): exactly, by eliminating y
-  (:func:`~rrc_pin.solvers.tick.kernels.line_scale`); for the top level's exact rates these two
-  come in
-  the same kernel call as the rates (:func:`~rrc_pin.solvers.tick.kernels.direction_step`, through
+  (:func:`line_scale`); for the top level's exact rates these two come in the same kernel call
+  as the rates (:func:`direction_step`, through
   :meth:`~rrc_pin.solvers.tick.factorization.Factorization.fitted`);
 - otherwise as the QP :func:`direction_qp` (the LP with a small regularisation that picks the
   least-norm y; its optimum is the LP's vertex): by the compiled active-set solver
@@ -46,9 +44,11 @@ from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.errors import NumericalFailure
 from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding
-from rrc_pin.solvers.tick import kernels, statuses
+from rrc_pin.solvers.tick import feasibility, linalg, statuses
+from rrc_pin.solvers.tick.feasibility import inside
+from rrc_pin.solvers.tick.linalg import householder_qr, least_norm_rates, max_abs
 from rrc_pin.solvers.tick.problem import Box, Rows
-from rrc_pin.solvers.tick.statuses import STILL_SCALE
+from rrc_pin.solvers.tick.statuses import STILL_SCALE, scale_and_veer
 
 Array = npt.NDArray[np.float64]
 
@@ -97,10 +97,141 @@ def along(w: Array, null: Array, box: Box, rows: Rows | None) -> Along | None:
     if rows is not None or null.shape[0] > 1:
         return None
     if null.shape[0] == 0:
-        u = kernels.uniform_scale(w, box.lb, box.ub)
+        u = uniform_scale(w, box.lb, box.ub)
         return Along(u * w, u)
-    u, y = kernels.line_scale(w, null[0], box.lb, box.ub)
+    u, y = line_scale(w, null[0], box.lb, box.ub)
     return Along(u * w + y * null[0], u)
+
+
+@kernel
+def uniform_scale(x: Array, lb: Array, ub: Array) -> float:
+    """Largest s in [0, 1] with ``lb <= s x <= ub``, for bounds with ``lb <= 0 <= ub``."""
+    s = 1.0
+    for i in range(x.size):
+        if x[i] > 0.0:
+            s = min(s, ub[i] / x[i])
+        elif x[i] < 0.0:
+            s = min(s, lb[i] / x[i])
+    return max(s, 0.0)
+
+
+NULL_ROUNDING = 1e-12
+"""[relative to its largest entry] A component of a null direction this small is the SVD's
+rounding (a joint that no row moves): the row it belongs to does not bound the null
+coefficient y (:func:`line_scale`; its bound there would be its slack's rounding over the
+component's, anywhere in the box)."""
+
+
+@kernel
+def line_scale(w: Array, v: Array, lb: Array, ub: Array) -> tuple[float, float]:
+    r"""The largest u in [0, 1] with ``lb <= u w + y v <= ub`` for some y, and that y nearest 0.
+
+    Each row gives two half-planes :math:`\alpha u + \beta y \le \gamma` (:math:`\gamma \ge
+    0`); eliminating y between each pair bounding it from opposite sides (Fourier-Motzkin
+    elimination, Dantzig & Eaves 1973) leaves bounds on u alone. The direction problem of
+    one null direction v, exactly. A component of v within :data:`NULL_ROUNDING` of its
+    largest is taken as zero: its row bounds u alone, and is met by the rates to that
+    component times ``|y|`` (the caller's clip).
+
+    Args:
+        w: Rates of the command (n,).
+        v: Null-space direction (n,).
+        lb: Lower bounds (n,) <= 0.
+        ub: Upper bounds (n,) >= 0.
+
+    Returns:
+        u and y: the rates are ``u w + y v``.
+    """
+    n = w.size
+    c = np.empty(n)  # v without its rounding
+    rounding = NULL_ROUNDING * max_abs(v)
+    for i in range(n):
+        c[i] = v[i] if abs(v[i]) > rounding else 0.0
+    u = 1.0
+    for i in range(n):  # rows without y bound u alone
+        if c[i] == 0.0:
+            if w[i] > 0.0:
+                u = min(u, ub[i] / w[i])
+            elif w[i] < 0.0:
+                u = min(u, lb[i] / w[i])
+    # half-plane (a, b, g) of row i bounding y from above: b > 0 (the row's side where v > 0)
+    for i in range(n):
+        if c[i] == 0.0:
+            continue
+        a1, b1, g1 = (w[i], c[i], ub[i]) if c[i] > 0.0 else (-w[i], -c[i], -lb[i])
+        for j in range(n):
+            if c[j] == 0.0:
+                continue
+            a2, b2, g2 = (-w[j], -c[j], -lb[j]) if c[j] > 0.0 else (w[j], c[j], ub[j])
+            coefficient = b1 * a2 - b2 * a1  # -b2 (plane 1) + b1 (plane 2): y eliminated
+            if coefficient > 0.0 and b1 * g2 - b2 * g1 < u * coefficient:
+                u = (b1 * g2 - b2 * g1) / coefficient
+    u = max(u, 0.0)
+    y_hi, v_hi, y_lo, v_lo = math.inf, 1.0, -math.inf, 1.0
+    for i in range(n):
+        if c[i] == 0.0:
+            continue
+        a1, b1, g1 = (w[i], c[i], ub[i]) if c[i] > 0.0 else (-w[i], -c[i], -lb[i])
+        if (g1 - a1 * u) / b1 < y_hi:
+            y_hi, v_hi = (g1 - a1 * u) / b1, b1
+        a2, b2, g2 = (-w[i], -c[i], -lb[i]) if c[i] > 0.0 else (w[i], c[i], ub[i])
+        if (g2 - a2 * u) / b2 > y_lo:
+            y_lo, v_lo = (g2 - a2 * u) / b2, -b2
+    if y_lo <= y_hi:
+        return u, min(max(0.0, y_lo), y_hi)
+    # rounding at a vertex: the y that leaves both rows by the same rate (a row with a
+    # null component of rounding size, 1e-15, pins u; its y bound is off by up to 0.1)
+    return u, (v_lo * y_lo + v_hi * y_hi) / (v_lo + v_hi)
+
+
+@kernel
+def direction_step(
+    J: Array, b: Array, lb: Array, ub: Array, Q: Array, R: Array, w: Array, qdot: Array
+) -> tuple[int, float]:
+    r"""The top level's step within a box: its exact rates, whether they fit, else their scale.
+
+    :func:`~rrc_pin.solvers.tick.linalg.householder_qr` of :math:`J^T`, the least-norm rates w
+    of :math:`Jx = b` (:func:`~rrc_pin.solvers.tick.linalg.least_norm_rates`),
+    :func:`~rrc_pin.solvers.tick.feasibility.inside`; where w leaves the box and the null space
+    of J has at most one direction (:math:`Q_{:,m}`, a 7-joint arm's six rows), the direction
+    problem's exact answer :math:`u\,w + y\,Q_{:,m}` (:func:`uniform_scale`,
+    :func:`line_scale`); one call for what most ticks need.
+
+    Args:
+        J: Rows (m, n).
+        b: Their rates (m,).
+        lb: Lower bounds (n,) (containing zero where the scale is asked for).
+        ub: Upper bounds (n,).
+        Q: Out: orthogonal factor (n, n).
+        R: Out: triangular factor (n, m).
+        w: Out: the least-norm rates (n,), set unless 0 is returned.
+        qdot: Out: the scaled rates (n,), set where 1 is returned with u >= 0.
+
+    Returns:
+        ``(fit, u)``: fit 0 where the rows are numerically dependent or more than the joints
+        (w not set), 1 where w is outside ``[lb, ub]``, 2 inside; u the largest scale in
+        [0, 1] along w where fit is 1 and n - m <= 1, else -1.
+    """
+    m, n = J.shape
+    householder_qr(J.T, Q, R)
+    if m > n or not least_norm_rates(Q, R, b, w):
+        return 0, -1.0
+    if inside(w, lb, ub):
+        return 2, -1.0
+    if n - m > 1:
+        return 1, -1.0
+    if n == m:
+        u = uniform_scale(w, lb, ub)
+        for i in range(n):
+            qdot[i] = u * w[i]
+        return 1, u
+    v = qdot  # Q's column m, contiguous: one compiled signature of line_scale
+    for i in range(n):
+        v[i] = Q[i, m]
+    u, y = line_scale(w, v, lb, ub)
+    for i in range(n):
+        qdot[i] = u * w[i] + y * v[i]
+    return 1, u
 
 
 def direction_qp(w: Array, null: Array, box: Box, rows: Rows | None) -> tuple[QP, Decoding]:
@@ -175,10 +306,10 @@ def solved_along(A: Array, w: Array, null: Array, lb: Array, ub: Array, G: Array
     code, steps = active_set.solve(P, q, C, lo, hi, z_lb, z_ub, z)
     if code != active_set.SOLVED:
         return w, -1.0, 0.0, steps
-    qdot = kernels.row_values(M, z)
+    qdot = linalg.row_values(M, z)
     clipped = qdot.copy()
-    if not (kernels.all_finite(qdot) and kernels.clip_into(clipped, lb, ub) <= tol
-            and kernels.rows_hold(G, qdot, h, tol)):  # fmt: skip
+    if not (feasibility.all_finite(qdot) and feasibility.clip_into(clipped, lb, ub) <= tol
+            and feasibility.rows_hold(G, qdot, h, tol)):  # fmt: skip
         return w, -1.0, 0.0, steps
     scale, veer, kept = along_checked(A, w, qdot)
     if not (kept and math.isfinite(scale) and math.isfinite(veer)):
@@ -200,7 +331,7 @@ def along_checked(A: Array, w: Array, qdot: Array) -> tuple[float, float, bool]:
             s += A[i, j] * qdot[j]
             t += A[i, j] * w[j]
         y[i], b[i] = s, t
-    scale, veer = kernels.scale_and_veer(y, b)
+    scale, veer = scale_and_veer(y, b)
     off = statuses.norm(y) * math.sin(min(veer, 0.5 * math.pi))
     kept = not (off > DIRECTION_TOL * statuses.norm(A.ravel()) * statuses.norm(qdot)
                 and scale > STILL_SCALE)  # fmt: skip

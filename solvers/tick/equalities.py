@@ -32,9 +32,9 @@ from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.errors import NumericalFailure
-from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses, top
-from rrc_pin.solvers.tick.kernels import row_values
+from rrc_pin.solvers.tick import backend_calls, factor, feasibility, statuses, top
 from rrc_pin.solvers.tick.levels import least_squares, product
+from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.statuses import (
     DAMPED,
     EXACT,
@@ -78,7 +78,7 @@ def direction_within(A: Array, b: Array, N: Array, rows: Rows, dt: float, thresh
     f, z = factor.least_norm(factor.qr(product(A, Nt)), b)
     w = row_values(Nt, z)
     outside_range = not f.regular and not top.met(f.J, z, b)
-    if kernels.inside(w, rows.lb, rows.ub) and kernels.rows_hold(rows.G, w, rows.h, 0.0):
+    if feasibility.inside(w, rows.lb, rows.ub) and feasibility.rows_hold(rows.G, w, rows.h, 0.0):
         null = product(factor.null_basis(f)[1], N) if need_null else np.empty((0, n))
         if outside_range:
             return top.answer(A, b, w, SINGULAR, rate_factor, null, 0.0)

@@ -15,7 +15,8 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick import feasibility, linalg
+from rrc_pin.solvers.tick.direction import direction_step
 
 Array = npt.NDArray[np.float64]
 
@@ -50,32 +51,32 @@ class Factor(NamedTuple):
 
 @kernel
 def qr(J: Array) -> Factor:
-    """The QR of ``J^T`` (:func:`~rrc_pin.solvers.tick.kernels.householder_qr`), no SVD yet."""
+    """The QR of ``J^T`` (:func:`~rrc_pin.solvers.tick.linalg.householder_qr`), no SVD yet."""
     m, n = J.shape
     Q, R = np.empty((n, n)), np.empty((n, m))
-    kernels.householder_qr(J.T, Q, R)
+    linalg.householder_qr(J.T, Q, R)
     return Factor(J, Q, R, False, Q[:0], Q[0, :0], Q[:0], -1)
 
 
 @kernel
 def with_svd(f: Factor) -> Factor:
-    r"""``f`` with its SVD (:func:`~rrc_pin.solvers.tick.kernels.triangle_svd`)."""
+    r"""``f`` with its SVD (:func:`~rrc_pin.solvers.tick.linalg.triangle_svd`)."""
     if f.rank >= 0:
         return f
     m, n = f.J.shape
     k = min(m, n)
     US, W, sigma, right = np.empty((m, k)), np.empty((k, k)), np.empty(k), np.empty((n, k))
-    rank = kernels.triangle_svd(f.Q, f.R, RANK_TOL, US, W, sigma, right)
+    rank = linalg.triangle_svd(f.Q, f.R, RANK_TOL, US, W, sigma, right)
     return Factor(f.J, f.Q, f.R, f.regular, US, sigma, right, rank)
 
 
 @kernel
 def rates(f: Factor, b: Array, lambda_sq: Array) -> Array:
     r"""Damped least-squares rates (n,) :math:`\sum_i \sigma_i/(\sigma_i^2+\lambda_i^2)(u_i^Tb)v_i`
-    of a record with its SVD (:func:`~rrc_pin.solvers.tick.kernels.svd_rates`).
+    of a record with its SVD (:func:`~rrc_pin.solvers.tick.linalg.svd_rates`).
     """  # noqa: D205
     x = np.empty(f.J.shape[1])
-    kernels.svd_rates(f.US, f.sigma, f.right, b, lambda_sq, f.rank, x)
+    linalg.svd_rates(f.US, f.sigma, f.right, b, lambda_sq, f.rank, x)
     return x
 
 
@@ -87,7 +88,7 @@ def least_norm(f: Factor, b: Array) -> tuple[Factor, Array]:
     """
     m, n = f.J.shape
     x = np.empty(n)
-    if m <= n and kernels.least_norm_rates(f.Q, f.R, b, x):
+    if m <= n and linalg.least_norm_rates(f.Q, f.R, b, x):
         return Factor(f.J, f.Q, f.R, True, f.US, f.sigma, f.right, f.rank), x
     f = with_svd(f)
     return f, rates(f, b, np.zeros(f.sigma.size))
@@ -98,7 +99,7 @@ def fitted(J: Array, b: Array, lb: Array, ub: Array) -> tuple[Factor, Array, boo
     """The factorisation of J, the least-norm rates w of ``J x ~= b``, whether they fit.
 
     One kernel call where J has full row rank
-    (:func:`~rrc_pin.solvers.tick.kernels.direction_step`), the SVD otherwise.
+    (:func:`~rrc_pin.solvers.tick.direction.direction_step`), the SVD otherwise.
 
     Returns:
         The record, w (n,), whether ``lb <= w <= ub``, and where they do not fit and J has at
@@ -109,13 +110,13 @@ def fitted(J: Array, b: Array, lb: Array, ub: Array) -> tuple[Factor, Array, boo
     space = np.empty(n * (n + m + 2))  # one allocation: Q, R, w and the boxed rates
     Q, R = space[: n * n].reshape(n, n), space[n * n : n * (n + m)].reshape(n, m)
     w, boxed = space[n * (n + m) : n * (n + m + 1)], space[n * (n + m + 1) :]
-    fit, u = kernels.direction_step(J, b, lb, ub, Q, R, w, boxed)
+    fit, u = direction_step(J, b, lb, ub, Q, R, w, boxed)
     f = Factor(J, Q, R, fit > 0, Q[:0], w[:0], Q[:0], -1)
     if fit:
         return f, w, fit == 2, boxed, u
     f = with_svd(f)
     w = rates(f, b, np.zeros(f.sigma.size))
-    return f, w, kernels.inside(w, lb, ub), boxed, -1.0
+    return f, w, feasibility.inside(w, lb, ub), boxed, -1.0
 
 
 @kernel

@@ -1,15 +1,15 @@
 r"""The factorisation of a level's rows: QR for the exact rates, the SVD only when needed.
 
 For rows J (m, n), the Householder QR of the transpose, :math:`J^T = QR`
-(:func:`~rrc_pin.solvers.tick.kernels.householder_qr`), gives at once:
+(:func:`~rrc_pin.solvers.tick.linalg.householder_qr`), gives at once:
 
 - the least-norm rates of a full-row-rank J, :math:`x = Q_1 R_1^{-T} b`
-  (:func:`~rrc_pin.solvers.tick.kernels.least_norm_rates`), what most ticks need;
+  (:func:`~rrc_pin.solvers.tick.linalg.least_norm_rates`), what most ticks need;
 - the null space, the last n - m columns of Q.
 
 The singular values are those of the small triangle :math:`R_1` (k = min(m, n) rows), so
 the SVD of J costs a one-sided Jacobi SVD of :math:`R_1^T` (m, k)
-(:func:`~rrc_pin.solvers.tick.kernels.jacobi_svd`): :math:`R_1^T V = U\Sigma` gives
+(:func:`~rrc_pin.solvers.tick.linalg.jacobi_svd`): :math:`R_1^T V = U\Sigma` gives
 :math:`J = U\Sigma (Q_1 V)^T`. It is computed on first use, where the rows are numerically
 dependent (a singularity, more rows than joints), and for the condition number and the
 damping near singularities.
@@ -22,8 +22,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.tick import kernels
-from rrc_pin.solvers.tick.direction import Along
+from rrc_pin.solvers.tick import feasibility, linalg
+from rrc_pin.solvers.tick.direction import Along, direction_step
 
 Array = npt.NDArray[np.float64]
 
@@ -51,7 +51,7 @@ class Factorization:
         m, n = J.shape
         self.J = J
         self.Q, self.R = np.empty((n, n)), np.empty((n, m))
-        kernels.householder_qr(J.T, self.Q, self.R)
+        linalg.householder_qr(J.T, self.Q, self.R)
         self.regular = False  # full row rank, known once least_norm's forward solve ran
         self._svd: tuple[Array, Array, Array, int] | None = None
 
@@ -62,7 +62,7 @@ class Factorization:
         """The factorisation of J, the least-norm rates of ``J x ~= b``, whether they fit.
 
         Where they do not, also the largest scale along them within the box. One kernel call
-        where J has full row rank (:func:`~rrc_pin.solvers.tick.kernels.direction_step`), the SVD
+        where J has full row rank (:func:`~rrc_pin.solvers.tick.direction.direction_step`), the SVD
         otherwise.
 
         Args:
@@ -82,18 +82,18 @@ class Factorization:
         x: Array = np.empty(n)
         qdot: Array = np.empty(n)
         factor.Q, factor.R = np.empty((n, n)), np.empty((n, m))
-        fit, u = kernels.direction_step(J, b, lb, ub, factor.Q, factor.R, x, qdot)
+        fit, u = direction_step(J, b, lb, ub, factor.Q, factor.R, x, qdot)
         factor.regular = fit > 0
         if fit:
             return factor, x, fit == 2, Along(qdot, u) if u >= 0.0 else None
         x = factor.rates(b, None)
-        return factor, x, kernels.inside(x, lb, ub), None
+        return factor, x, feasibility.inside(x, lb, ub), None
 
     def least_norm(self, b: Array) -> Array:
         """The least-squares rates of least norm, :math:`J^+ b` (n,), rank by :data:`RANK_TOL`."""
         m, n = self.J.shape
         x = np.empty(n)
-        if m <= n and kernels.least_norm_rates(self.Q, self.R, b, x):
+        if m <= n and linalg.least_norm_rates(self.Q, self.R, b, x):
             self.regular = True
             return x
         return self.rates(b, None)
@@ -108,7 +108,7 @@ class Factorization:
         US, sigma, right, rank = self.svd
         x = np.empty(self.J.shape[1])
         lam = np.zeros(sigma.size) if lambda_sq is None else lambda_sq
-        kernels.svd_rates(US, sigma, right, b, lam, rank, x)
+        linalg.svd_rates(US, sigma, right, b, lam, rank, x)
         return x
 
     @property
@@ -119,7 +119,7 @@ class Factorization:
             m, n = self.J.shape
             k = min(m, n)
             US, W, sigma, right = np.empty((m, k)), np.empty((k, k)), np.empty(k), np.empty((n, k))
-            rank = kernels.triangle_svd(self.Q, self.R, RANK_TOL, US, W, sigma, right)
+            rank = linalg.triangle_svd(self.Q, self.R, RANK_TOL, US, W, sigma, right)
             self._svd = (US, sigma, right, rank)
         return self._svd
 

@@ -18,8 +18,8 @@ from scipy.optimize import lsq_linear
 
 from rrc_pin.solvers.errors import NumericalFailure
 from rrc_pin.solvers.qp_backends.qp import FEASIBILITY_TOL, Work
-from rrc_pin.solvers.tick import kernels
-from rrc_pin.solvers.tick.direction import direction_lp
+from rrc_pin.solvers.tick import feasibility
+from rrc_pin.solvers.tick.direction import direction_lp, uniform_scale
 from rrc_pin.solvers.tick.factorization import Factorization
 from rrc_pin.solvers.tick.problem import Problem
 
@@ -47,10 +47,10 @@ def fallback(name: str, problem: Problem, work: Work) -> Array:
     elif not box.contains_zero:
         raise NumericalFailure("scaling: zero rates are outside the bounds")
     else:
-        qdot = kernels.uniform_scale(w, box.lb, box.ub) * w
+        qdot = uniform_scale(w, box.lb, box.ub) * w
     rows = problem.rows
     tol = FEASIBILITY_TOL * (1.0 + float(np.abs(np.minimum(box.velocity, 1e300)).sum()))
-    if rows is not None and not kernels.rows_hold(rows.G, qdot, rows.h, tol):
+    if rows is not None and not feasibility.rows_hold(rows.G, qdot, rows.h, tol):
         raise NumericalFailure(f"{name}: the answer breaks a constraint row")
     if not np.isfinite(qdot).all():
         raise NumericalFailure(f"{name}: non-finite answer")

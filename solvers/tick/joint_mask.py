@@ -21,7 +21,7 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.tick.kernels import VELOCITY
+from rrc_pin.solvers.tick.joint_box import VELOCITY
 from rrc_pin.solvers.tick.problem import Box, Constraints, Problem, TaskRows
 
 Array = npt.NDArray[np.float64]

@@ -9,7 +9,7 @@ the levels above and their null space; all rates for the first level), so the le
     \quad \text{s.t.} \quad lb \le x + N^Tz \le ub,\quad G(x + N^Tz) \le h.
 
 Its unconstrained optimum of least norm is the answer when it satisfies the constraints:
-by the normal equations :math:`B^TBz = B^Tc` (:func:`~rrc_pin.solvers.tick.kernels.cholesky_solve`)
+by the normal equations :math:`B^TBz = B^Tc` (:func:`~rrc_pin.solvers.tick.linalg.cholesky_solve`)
 for
 more rows than unknowns, by the QR of :math:`B^T`
 (:class:`~rrc_pin.solvers.tick.factorization.Factorization`)
@@ -42,7 +42,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding, Work, solve_within, tolerance
-from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick import feasibility, linalg
 from rrc_pin.solvers.tick.direction import constraint_rows
 from rrc_pin.solvers.tick.factorization import Factorization
 from rrc_pin.solvers.tick.problem import Box, Rows
@@ -78,12 +78,12 @@ class Subspace(NamedTuple):
 
 
 def normal_equations(B: Array, c: Array) -> tuple[Array, Array]:
-    r""":math:`(B^TB, B^Tc)` (:func:`~rrc_pin.solvers.tick.kernels.normal_equations`): the
+    r""":math:`(B^TB, B^Tc)` (:func:`~rrc_pin.solvers.tick.linalg.normal_equations`): the
     optimum's normal
     equations, and the QP's costs."""  # noqa: D205, D209
     m, d = B.shape
     H, g = np.empty((d, d)), np.empty(d)
-    kernels.normal_equations(B, c, np.ones(m), H, g)
+    linalg.normal_equations(B, c, np.ones(m), H, g)
     return H, g
 
 
@@ -103,7 +103,7 @@ def optimum(B: Array, c: Array, H: Array, g: Array) -> tuple[Array, Factorizatio
     m, d = B.shape
     if m > d:
         z = np.empty(d)
-        if kernels.cholesky_solve(H, g, z):
+        if linalg.cholesky_solve(H, g, z):
             return z, None, True
     factor = Factorization(B)
     return factor.least_norm(c), factor, False
@@ -146,8 +146,8 @@ def least_squares(
     H, g = normal_equations(B, c)
     z, factor, definite = optimum(B, c, H, g)
     candidate = z if N is None or x is None else x + z @ N
-    feasible = kernels.inside(candidate, box.lb, box.ub) and (
-        rows is None or kernels.rows_hold(rows.G, candidate, rows.h, 0.0)
+    feasible = feasibility.inside(candidate, box.lb, box.ub) and (
+        rows is None or feasibility.rows_hold(rows.G, candidate, rows.h, 0.0)
     )
     if not feasible:
         qp, decoding = _level_qp(H, g, definite, space, box, rows, key)
@@ -189,7 +189,7 @@ def _level_qp(
     # exactly on their bounds); a start farther out (the equality rows' least-norm rates of a
     # top level) is no answer: the constraints stand
     lo, hi = np.array(lo), np.array(hi)
-    kernels.around_start(lo, hi, tolerance(box), ROUNDING)
+    feasibility.around_start(lo, hi, tolerance(box), ROUNDING)
     free = np.full(d, np.inf)
     return QP(P, q, C, lo, hi, -free, free, f"{key}:{d}:{hi.size}"), Decoding(x, N.T)
 
@@ -219,8 +219,8 @@ def _projected(
         return None
     qdot = decoding.rates(out)
     tol = tolerance(box)
-    if kernels.clip_into(qdot, box.lb, box.ub) > tol or (
-        rows is not None and not kernels.rows_hold(rows.G, qdot, rows.h, tol)
+    if feasibility.clip_into(qdot, box.lb, box.ub) > tol or (
+        rows is not None and not feasibility.rows_hold(rows.G, qdot, rows.h, tol)
     ):
         return None
     return qdot

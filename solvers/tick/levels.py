@@ -16,8 +16,8 @@ import numpy.typing as npt
 from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import backend_calls, factor, kernels
-from rrc_pin.solvers.tick.kernels import row_values
+from rrc_pin.solvers.tick import backend_calls, factor, feasibility, linalg
+from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.slide_kernels import (
     MARGIN,
     SOLVED,
@@ -51,13 +51,13 @@ def product(A: Array, B: Array) -> Array:
 def optimum(B: Array, c: Array, H: Array, g: Array, L: Array) -> tuple[Array, bool]:
     """The least-squares solution of least norm of ``B z ~= c``, and whether :math:`B^TB` is
     definite (:func:`rrc_pin.solvers.tick.least_squares.optimum`): then ``L`` (d, d), zeros
-    on entry, holds its Cholesky factor (:func:`~rrc_pin.solvers.tick.kernels.cholesky_solve`).
+    on entry, holds its Cholesky factor (:func:`~rrc_pin.solvers.tick.linalg.cholesky_solve`).
     """  # noqa: D205
     m, d = B.shape
     if m > d:
         z = np.empty(d)
-        if kernels.cholesky(H, kernels.DEFINITE, L):  # cholesky_solve's steps, L kept
-            kernels.solve_factored(L, g, z)
+        if linalg.cholesky(H, linalg.DEFINITE, L):  # cholesky_solve's steps, L kept
+            linalg.solve_factored(L, g, z)
             return z, True
     return factor.least_norm(factor.qr(B), c)[1], False
 
@@ -97,7 +97,7 @@ def subspace_rows(x: Array, N: Array, lb: Array, ub: Array, G: Array, h: Array, 
                   ) -> tuple[Array, Array]:  # fmt: skip
     """The box and rows of rates ``x + N^T z`` as one-sided rows in z, widened around z = 0
     where x breaks them by at most ``tol``, and by :data:`ROUNDING`
-    (:func:`~rrc_pin.solvers.tick.kernels.around_start`;
+    (:func:`~rrc_pin.solvers.tick.feasibility.around_start`;
     :func:`rrc_pin.solvers.tick.least_squares._level_qp`).
     """  # noqa: D205
     n, p = x.size, h.size
@@ -110,7 +110,7 @@ def subspace_rows(x: Array, N: Array, lb: Array, ub: Array, G: Array, h: Array, 
         lo[i], hi[i] = lb[i] - x[i], ub[i] - x[i]
     for i in range(p):
         lo[n + i], hi[n + i] = -np.inf, h[i] - Gx[i]
-    kernels.around_start(lo, hi, tol, ROUNDING)
+    feasibility.around_start(lo, hi, tol, ROUNDING)
     return one_sided(C, lo, hi)
 
 
@@ -136,7 +136,7 @@ def projected(B: Array, H: Array, L: Array, z: Array, x: Array, N: Array, whole:
         qdot = row_values(np.ascontiguousarray(N.T), out) + x
     if code != SOLVED:
         return np.empty(0)
-    if kernels.clip_into(qdot, lb, ub) > tol or not kernels.rows_hold(G, qdot, h, tol):
+    if feasibility.clip_into(qdot, lb, ub) > tol or not feasibility.rows_hold(G, qdot, h, tol):
         return np.empty(0)
     return qdot
 
@@ -184,10 +184,10 @@ def least_squares(
     c = b if whole else b - row_values(A, x)
     m, d = B.shape
     H, g, L = np.empty((d, d)), np.empty(d), np.zeros((d, d))
-    kernels.normal_equations(B, c, np.ones(m), H, g)
+    linalg.normal_equations(B, c, np.ones(m), H, g)
     z, definite = optimum(B, c, H, g, L)
     candidate = z if whole else x + row_values(np.ascontiguousarray(N.T), z)
-    if not (kernels.inside(candidate, lb, ub) and kernels.rows_hold(G, candidate, h, 0.0)):
+    if not (feasibility.inside(candidate, lb, ub) and feasibility.rows_hold(G, candidate, h, 0.0)):
         candidate = (projected(B, H, L, z, x, N, whole, lb, ub, G, h, tol) if definite
                      else np.empty(0))
         if candidate.size == 0:

@@ -54,15 +54,15 @@ from rrc_pin.solvers.errors import InvalidInput, NumericalFailure
 from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.base import QPBackend
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding, Work, solve_within, tolerance
-from rrc_pin.solvers.tick import kernels, statuses
-from rrc_pin.solvers.tick.damping import Damping
+from rrc_pin.solvers.tick import feasibility, statuses
+from rrc_pin.solvers.tick.damping import Damping, clamp_pushed
 from rrc_pin.solvers.tick.direction import DIRECTION_TOL, Along, along, direction_qp, solved_along
 from rrc_pin.solvers.tick.factorization import Factorization
-from rrc_pin.solvers.tick.kernels import scale_and_veer
+from rrc_pin.solvers.tick.joint_box import ON_LIMIT
 from rrc_pin.solvers.tick.least_squares import Subspace, least_squares
 from rrc_pin.solvers.tick.problem import Box, Problem, Rows
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
-from rrc_pin.solvers.tick.statuses import EXACT_TOL, STILL_SCALE
+from rrc_pin.solvers.tick.statuses import EXACT_TOL, STILL_SCALE, scale_and_veer
 
 Array = npt.NDArray[np.float64]
 _T = TypeVar("_T")
@@ -270,7 +270,7 @@ def _answer(problem: Problem, top: _Top, qdot: Array, method: Method,
     """The answer: the rates ``qdot`` of every level, clipped into the box and rows, and
     ``top``'s report; a shrink into the rows serves the lower levels anew."""  # noqa: D205, D209
     box = problem.box
-    clip = kernels.clip_into(qdot, box.lb, box.ub)  # the kernels' answers to rounding
+    clip = feasibility.clip_into(qdot, box.lb, box.ub)  # the kernels' answers to rounding
     qdot, shrink = _within_rows(qdot, box, problem.rows)
     qdot.flags.writeable = False
     if shrink < 1.0 - statuses.EXACT_TOL:
@@ -355,7 +355,7 @@ def _exact(problem: Problem, space: Subspace) -> _Exact:
     factor = Factorization(A @ space.N.T)
     z = factor.least_norm(b)
     w = z @ space.N
-    return _Exact(factor, z, w, kernels.inside(w, box.lb, box.ub), None, b, False)
+    return _Exact(factor, z, w, feasibility.inside(w, box.lb, box.ub), None, b, False)
 
 
 def _slid(
@@ -371,7 +371,7 @@ def _slid(
     A = problem.stacked[0][0]
     box, rows = problem.box, problem.rows
     assert rows is not None
-    if kernels.rows_hold(slide.G, exact.w, slide.h, 0.0):
+    if feasibility.rows_hold(slide.G, exact.w, slide.h, 0.0):
         return exact
     try:
         kept = _slide(A, exact.b, space, box, slide, backend, work, exact.factor,
@@ -380,13 +380,13 @@ def _slid(
         work.attempts.append(("slide", f"{exc}; the command kept as given"))
         return exact
     every = rows.slide is not None and bool(rows.slide.all())  # the least squares kept them all
-    if every or kernels.rows_hold(rows.G, kept, rows.h, tolerance(box)):
+    if every or feasibility.rows_hold(rows.G, kept, rows.h, tolerance(box)):
         null = _null(exact.factor, space) if len(problem.levels) > 1 else None
         return _Top(kept, "sliding", *_along_command(problem, kept), 0.0, null)
     b = A @ kept
     z = exact.factor.least_norm(b)
     w = z if space.N is None else z @ space.N
-    return exact._replace(z=z, w=w, fits=kernels.inside(w, box.lb, box.ub), b=b, slid=True)
+    return exact._replace(z=z, w=w, fits=feasibility.inside(w, box.lb, box.ub), b=b, slid=True)
 
 
 def _exact_within(problem: Problem, space: Subspace, exact: _Exact) -> _Top | None:
@@ -394,7 +394,7 @@ def _exact_within(problem: Problem, space: Subspace, exact: _Exact) -> _Top | No
     ``singular`` or met; else None.
     """  # noqa: D205
     rows = problem.rows
-    if not (exact.fits and (rows is None or kernels.rows_hold(rows.G, exact.w, rows.h, 0.0))):
+    if not (exact.fits and (rows is None or feasibility.rows_hold(rows.G, exact.w, rows.h, 0.0))):
         return None
     null = _null(exact.factor, space) if len(problem.levels) > 1 else None
     w = exact.w
@@ -499,7 +499,7 @@ def _slide(
     B = B[:rows]
     x = np.empty(n)
     if project(B, 0.0, target, box.lb, box.ub, slide.G, slide.h, MARGIN, x) == SOLVED:
-        kernels.clip_into(x, box.lb, box.ub)  # by the kernel's rounding at most (1e-9)
+        feasibility.clip_into(x, box.lb, box.ub)  # by the kernel's rounding at most (1e-9)
         return x
     return backend_slide(B, target, box, slide, backend, work)
 
@@ -548,7 +548,8 @@ def _damped_within(
                                                     "least_squares", need_null), rows, work)
     factor = Factorization(A)
     w = factor.least_norm(b)
-    if not (kernels.inside(w, box.lb, box.ub) and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
+    if not (feasibility.inside(w, box.lb, box.ub)
+            and feasibility.rows_hold(rows.G, w, rows.h, 0.0)):  # fmt: skip
         w = _relaxing(lambda kept: _slide(A, b, _EVERY_RATE, box, kept, backend, work, factor,
                                           damping), rows, work)  # fmt: skip
     return w, factor.null_basis() if need_null else None
@@ -609,7 +610,7 @@ def _damping(
 def _clamped(factor: Factorization, w: Array, box: Box, dt: float) -> Factorization:
     """The rows without the joints ``w`` pushes against a bound that holds them (``_damping``)."""
     J = np.empty_like(factor.J)  # a bound within rounding of zero holds the joint
-    if not kernels.clamp_pushed(factor.J, w, box.lb, box.ub, kernels.ON_LIMIT / dt, J):
+    if not clamp_pushed(factor.J, w, box.lb, box.ub, ON_LIMIT / dt, J):
         return factor
     clamped = Factorization(J)
     rank = clamped.svd[3]  # at most the rows' own: where full, theirs is not needed (one SVD)
@@ -730,14 +731,14 @@ def _along_command(problem: Problem, qdot: Array) -> tuple[float, float]:
 
 
 def _within_rows(x: Array, box: Box, rows: Rows | None) -> tuple[Array, float]:
-    """``x`` shrunk toward zero until the rows hold (:func:`kernels.into_rows`), and the factor
+    """``x`` shrunk toward zero until the rows hold (:func:`feasibility.into_rows`), and the factor
     (zero feasible). A backend leaves the rows by up to its tolerance (1e-9); the shrink keeps
     the direction.
     """  # noqa: D205
     if rows is None or not box.contains_zero or bool((rows.h < 0.0).any()):
         return x, 1.0
     G, h, y = (np.require(a, np.float64, ("C", "W")) for a in (rows.G, rows.h, x))
-    factor = kernels.into_rows(G, h, y)  # its one compiled signature (Workspace.compile)
+    factor = feasibility.into_rows(G, h, y)  # its one compiled signature (Workspace.compile)
     return (x, 1.0) if factor == 1.0 else (x * factor, factor)
 
 

@@ -40,7 +40,7 @@ import numpy.typing as npt
 from rrc_pin.solvers.checks import all_finite
 from rrc_pin.solvers.compiled import kernel
 from rrc_pin.solvers.errors import InvalidInput
-from rrc_pin.solvers.tick import kernels
+from rrc_pin.solvers.tick import linalg
 
 Array = npt.NDArray[np.float64]
 
@@ -82,7 +82,7 @@ class Box(NamedTuple):
         lb: Lower bounds (n,) [rad/s or m/s].
         ub: Upper bounds (n,), ``lb <= ub``.
         kind: (2, n) codes of what sets each bound (lower, upper):
-            :data:`~rrc_pin.solvers.tick.kernels.VELOCITY`, ``POSITION`` or ``ACCELERATION``.
+            :data:`~rrc_pin.solvers.tick.joint_box.VELOCITY`, ``POSITION`` or ``ACCELERATION``.
         contains_zero: Whether standing still is allowed.
         recovering: Whether a joint is outside its range and must move back.
         velocity: The velocity limits (n,), the scale of the backends' tolerance.
@@ -251,7 +251,7 @@ def _stack(tasks: Sequence[TaskRows], normalised: bool, box: Box) -> tuple[Array
     """Rows and rates of ``tasks`` stacked in the level's metric, and the rates' factor.
 
     Each row times the square root of its weight over the level's largest (and in the
-    normalised metric divided by its unit, :func:`rrc_pin.solvers.tick.kernels.weighted_rows`); the
+    normalised metric divided by its unit, :func:`rrc_pin.solvers.tick.linalg.weighted_rows`); the
     rates
     capped as the module docstring says (:func:`_capped`).
     """
@@ -309,7 +309,7 @@ def _weighted(
         weight = _ones(k) if t.weight is None else _read_only(t.weight)
         unit = _read_only(t.unit) if normalised and t.unit is not None else _ones(k)
         rows_A, rows_b = (A, b) if k == b.size else (A[r : r + k], b[r : r + k])  # one task: all
-        rows = kernels.weighted_rows(_read_only(t.A), _read_only(t.b), weight, top, unit, scale,
+        rows = linalg.weighted_rows(_read_only(t.A), _read_only(t.b), weight, top, unit, scale,
                                      rows_A, rows_b)  # fmt: skip
         peak, r = max(peak, rows), r + k
     return peak

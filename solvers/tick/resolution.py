@@ -22,10 +22,10 @@ from typing import Literal, NamedTuple, Protocol
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.tick.kernels import ACCELERATION, POSITION, scale_and_veer
+from rrc_pin.solvers.tick.joint_box import ACCELERATION, POSITION
 from rrc_pin.solvers.tick.pipeline import Answer, LevelStatus, Method, Status, served
 from rrc_pin.solvers.tick.problem import Box, Problem, TaskRows, largest_weight, row_factors
-from rrc_pin.solvers.tick.statuses import norm
+from rrc_pin.solvers.tick.statuses import norm, scale_and_veer
 
 Array = npt.NDArray[np.float64]
 

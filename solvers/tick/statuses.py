@@ -26,7 +26,6 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.tick import kernels
 
 Array = npt.NDArray[np.float64]
 
@@ -90,6 +89,64 @@ def top_served(status: int) -> int:
 
 
 @kernel
+def scale_and_veer(y: Array, b: Array, factor: Array | None = None) -> tuple[float, float]:
+    r"""Fraction of ``b`` achieved along it by ``y`` (in [0, 1]) and the angle between them [rad].
+
+    The scale is :math:`y^Tb/b^Tb` and the angle :math:`\arccos(y^Tb/(|y||b|))`, computed on
+    both divided by their largest entries so that no product overflows; the ratio of those
+    entries is formed with the larger one as divisor (a subnormal command's would overflow).
+
+    Args:
+        y: Achieved rates (m,).
+        b: Commanded rates (m,).
+        factor: Row factors (m,) of a level's metric, or None: the scale and angle of
+            ``factor * y`` and ``factor * b``, both first divided by b's largest entry where
+            it exceeds 1 (so that the factors cannot overflow a command near the float range;
+            a subnormal one is not divided up: the achieved rates would overflow).
+
+    Returns:
+        (scale, veer): (1, 0) for a zero command, (0, 0) for zero rates.
+    """
+    m = b.size
+    ys, bs = np.empty(m), np.empty(m)
+    if factor is None:
+        for i in range(m):
+            ys[i] = y[i]
+            bs[i] = b[i]
+    else:
+        peak = 1.0
+        for i in range(m):
+            peak = max(peak, abs(b[i]))
+        for i in range(m):
+            ys[i] = factor[i] * (y[i] / peak)
+            bs[i] = factor[i] * (b[i] / peak)
+    top_b = 0.0
+    top_y = 0.0
+    for i in range(m):
+        top_b = max(top_b, abs(bs[i]))
+        top_y = max(top_y, abs(ys[i]))
+    if top_b == 0.0:
+        return 1.0, 0.0
+    if top_y == 0.0:
+        return 0.0, 0.0
+    yb = yy = bb = 0.0
+    for i in range(m):
+        yn, bn = ys[i] / top_y, bs[i] / top_b
+        yb += yn * bn
+        yy += yn * yn
+        bb += bn * bn
+    cosine = yb / (math.sqrt(yy) * math.sqrt(bb))
+    veer = math.acos(min(max(cosine, -1.0), 1.0))
+    along = yb / bb  # the scale, times top_b / top_y
+    if along <= 0.0:
+        return 0.0, veer
+    if top_y <= top_b:
+        return min(along * (top_y / top_b), 1.0), veer
+    ratio = top_b / top_y
+    return (along / ratio if along < ratio else 1.0), veer
+
+
+@kernel
 def served(y: Array, b: Array, rate_factor: float) -> int:
     """How rates ``y`` (m,) serve a level's command ``b`` (m,) (its rates times
     ``rate_factor``): a code of :data:`MET`, :data:`SCALED_LEVEL`, :data:`TRADED`.
@@ -99,7 +156,7 @@ def served(y: Array, b: Array, rate_factor: float) -> int:
     """  # noqa: D205
     if met(y, b):
         return MET if rate_factor == 1.0 else SCALED_LEVEL
-    scale, veer = kernels.scale_and_veer(y, b)
+    scale, veer = scale_and_veer(y, b)
     return SCALED_LEVEL if veer <= VEER_TOL and scale > 0.0 and b.any() else TRADED
 
 

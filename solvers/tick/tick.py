@@ -3,7 +3,7 @@ r"""One resolver tick in one compiled call, on a workspace of preallocated array
 :func:`run` goes down the stages of docs/api.md ("One tick, one pipeline") once:
 
 1. the inputs' **checks** (every position and commanded rate finite);
-2. the step's **box** (:func:`~rrc_pin.solvers.tick.kernels.joint_box`);
+2. the step's **box** (:func:`~rrc_pin.solvers.tick.joint_box.joint_box`);
 3. the **problem**: the mode, and each level's rows in the metric it is solved in
    (:func:`stacked`: :func:`rrc_pin.solvers.tick.problem.build`'s);
 4. the **top level** (:func:`rrc_pin.solvers.tick.top.direction`, or a least squares), then each
@@ -33,9 +33,10 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import equalities, kernels, statuses, top
-from rrc_pin.solvers.tick.kernels import row_values
+from rrc_pin.solvers.tick import equalities, feasibility, linalg, statuses, top
+from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.levels import least_squares
+from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.problem import LARGE, TaskRows, cap
 from rrc_pin.solvers.tick.statuses import DROPPED
 from rrc_pin.solvers.tick.top import FAILED, Rows, Top
@@ -95,7 +96,7 @@ def stacked(A: Array, b: Array, weight: Array, unit: Array, normalised: bool, lb
     space = np.empty(m * (n + 1))  # one allocation: the rows and rates
     rows, rates = space[: m * n].reshape(m, n), space[m * n :]
     units = unit if normalised else np.ones(m)
-    peak = kernels.weighted_rows(A, b, weight, top_weight, units, 1.0, rows, rates)
+    peak = linalg.weighted_rows(A, b, weight, top_weight, units, 1.0, rows, rates)
     factor = 1.0
     if normalised and peak > LARGE:  # the direction first: b over its largest entry, before
         # the rows' factors could overflow
@@ -103,7 +104,7 @@ def stacked(A: Array, b: Array, weight: Array, unit: Array, normalised: bool, lb
         for i in range(m):
             b_max = max(b_max, abs(b[i]))
         factor = 1.0 / b_max
-        peak = kernels.weighted_rows(A, b, weight, top_weight, units, factor, rows, rates)
+        peak = linalg.weighted_rows(A, b, weight, top_weight, units, factor, rows, rates)
     c = cap(rows, peak, factor, normalised, lb, ub)
     return (rows, rates, factor) if c == 1.0 else (rows, rates * c, factor * c)
 
@@ -116,12 +117,12 @@ def served(A: Array, b: Array, qdot: Array, rate_factor: float) -> int:
 
 @kernel
 def within_rows(x: Array, rows: Rows, zero_inside: bool) -> float:
-    """``x`` shrunk toward zero in place until the rows hold (:func:`kernels.into_rows`); the
+    """``x`` shrunk toward zero in place until the rows hold (:func:`feasibility.into_rows`); the
     factor (1: kept). Standing still must be allowed.
     """  # noqa: D205
     if rows.h.size == 0 or not zero_inside or (rows.h < 0.0).any():
         return 1.0
-    factor = kernels.into_rows(rows.G, rows.h, x)
+    factor = feasibility.into_rows(rows.G, rows.h, x)
     if factor != 1.0:
         for i in range(x.size):
             x[i] *= factor
@@ -133,11 +134,11 @@ def checked(joints: Array, task_rows: Array, rates: Array, m: int) -> int:
     """0 where every position, commanded rate and task row is finite, else the code of the
     first bad.
     """  # noqa: D205
-    if not kernels.all_finite(joints[POSITION]):
+    if not feasibility.all_finite(joints[POSITION]):
         return BAD_POSITION
-    if not kernels.all_finite(rates[RATE][:m]):
+    if not feasibility.all_finite(rates[RATE][:m]):
         return BAD_RATE
-    if not kernels.all_finite(task_rows.ravel()[: m * task_rows.shape[1]]):  # a view: C order
+    if not feasibility.all_finite(task_rows.ravel()[: m * task_rows.shape[1]]):  # a view: C order
         return BAD_ROWS
     return 0
 
@@ -193,11 +194,11 @@ def bounds(q: Array, dt: float, joints: Array, reals: Array, lb: Array, ub: Arra
            kinds: Array) -> tuple[bool, bool]:  # fmt: skip
     """Stage 2 at positions ``q`` (n,) for the step ``dt`` [s]: the box into ``lb`` and ``ub``
     (n,), what sets each bound into ``kinds`` (2, n), the lower bounds' row then the upper
-    ones' (:func:`~rrc_pin.solvers.tick.kernels.joint_box`); whether standing still is
+    ones' (:func:`~rrc_pin.solvers.tick.joint_box.joint_box`); whether standing still is
     allowed, whether a joint was outside its range.
     """  # noqa: D205
     kind = np.empty((2, q.size), np.int8)
-    zero_inside, recovering = kernels.joint_box(
+    zero_inside, recovering = joint_box(
         q, joints[LOWER], joints[UPPER], joints[VELOCITY], reals[MARGIN], reals[GAIN], dt,
         joints[PREVIOUS], joints[ACCELERATION], lb, ub, kind,
     )  # fmt: skip
@@ -227,7 +228,7 @@ def clipped(qdot: Array, rows: Rows, zero_inside: bool) -> tuple[float, float]:
     """Stage 5: ``qdot`` clipped into the box and shrunk into the rows, in place; the clip's
     size and the shrink's factor.
     """  # noqa: D205
-    clip = kernels.clip_into(qdot, rows.lb, rows.ub)
+    clip = feasibility.clip_into(qdot, rows.lb, rows.ub)
     return clip, within_rows(qdot, rows, zero_inside)
 
 
@@ -301,7 +302,8 @@ def run_twist(J: Array, b: Array, q: Array, dt: float, joints: Array, rates: Arr
     """
     n, m = q.size, b.size
     reals[SOLVED], reals[SOLVED_STEPS] = 0.0, 0.0
-    if not (kernels.all_finite(q) and kernels.all_finite(b) and kernels.all_finite(J.ravel())):
+    if not (feasibility.all_finite(q) and feasibility.all_finite(b)
+            and feasibility.all_finite(J.ravel())):  # fmt: skip
         return INVALID_INPUT, 0.0, 0.0, 0.0, 0.0
     lb, ub = out[n : 2 * n], out[2 * n : 3 * n]
     zero_inside, recovering = bounds(q, dt, joints, reals, lb, ub,
@@ -552,7 +554,7 @@ class Workspace:
     def compile(self, general: bool, twists: bool = True) -> None:
         """Compile the default tick's entries (:func:`run_box`; :func:`run_twist` where
         ``twists``), and the general ones where ``general`` (with the pipeline's shrink into
-        the rows, :func:`kernels.into_rows`), or load them from numba's cache: on a problem
+        the rows, :func:`feasibility.into_rows`), or load them from numba's cache: on a problem
         without rows whose answer is exact, so that no QP is asked for and nothing is kept.
         """  # noqa: D205
         n = self.n
@@ -569,7 +571,7 @@ class Workspace:
                       ws.rates, ws.ints, ws.reals, np.empty(twist_size(n, 1)))  # fmt: skip
         if general:
             run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
-            kernels.into_rows(np.zeros((1, n)), np.zeros(1), np.zeros(n))  # the pipeline's call
+            feasibility.into_rows(np.zeros((1, n)), np.zeros(1), np.zeros(n))  # the pipeline's call
             if n > 1:  # a tick within equality rows (contacts, grips): the rates of joint 1 zero
                 ws.load_equalities(np.eye(1, n, 1), np.zeros(1))
                 run_within(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.E,

@@ -29,11 +29,13 @@ import numpy.typing as npt
 from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import backend_calls, factor, kernels, statuses
-from rrc_pin.solvers.tick.direction import solved_along
+from rrc_pin.solvers.tick import backend_calls, factor, feasibility, statuses
+from rrc_pin.solvers.tick.damping import clamp_pushed, damping_lambda_sq
+from rrc_pin.solvers.tick.direction import line_scale, solved_along, uniform_scale
 from rrc_pin.solvers.tick.factor import Factor
-from rrc_pin.solvers.tick.kernels import row_values
+from rrc_pin.solvers.tick.joint_box import ON_LIMIT
 from rrc_pin.solvers.tick.levels import least_squares
+from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
 from rrc_pin.solvers.tick.statuses import (
     DAMPED,
@@ -45,6 +47,7 @@ from rrc_pin.solvers.tick.statuses import (
     SINGULAR,
     SLIDING,
     STILL_SCALE,
+    scale_and_veer,
 )
 from rrc_pin.solvers.tick.statuses import FAILED as FAILED  # where the ticks import it
 
@@ -113,9 +116,9 @@ def along_command(A: Array, b: Array, qdot: Array, per_unit: Array, rate_factor:
     """  # noqa: D205
     y = row_values(A, qdot)
     if per_unit.size:
-        scale, veer = kernels.scale_and_veer(y, b, per_unit)
+        scale, veer = scale_and_veer(y, b, per_unit)
     else:
-        scale, veer = kernels.scale_and_veer(y, b)
+        scale, veer = scale_and_veer(y, b)
     return scale * rate_factor, veer
 
 
@@ -196,7 +199,7 @@ def slid_command(where: int, A: Array, b: Array, G: Array, h: Array, rows: Rows,
     B = B[:count]
     x: Array = np.empty(n)
     if project(B, 0.0, target, rows.lb, rows.ub, G, h, MARGIN, x) == SOLVED:
-        kernels.clip_into(x, rows.lb, rows.ub)  # by the kernel's rounding at most
+        feasibility.clip_into(x, rows.lb, rows.ub)  # by the kernel's rounding at most
         return 0, x, f
     x = backend_slide(where, B, target, rows.lb, rows.ub, G, h)
     return (0 if x.size else FAILED), x, f
@@ -223,9 +226,9 @@ def scaled_along(A: Array, w: Array, null: Array, rows: Rows) -> tuple[Array, fl
             return qdot, u, veer
         return backend_direction(A, w, null, rows.lb, rows.ub, rows.G, rows.h)
     if null.shape[0] == 0:
-        u = kernels.uniform_scale(w, rows.lb, rows.ub)
+        u = uniform_scale(w, rows.lb, rows.ub)
         return u * w, u, 0.0
-    u, y = kernels.line_scale(w, null[0], rows.lb, rows.ub)
+    u, y = line_scale(w, null[0], rows.lb, rows.ub)
     return u * w + y * null[0], u, 0.0
 
 
@@ -250,7 +253,7 @@ def clamped(f: Factor, w: Array, rows: Rows, dt: float, threshold: float
     where it is, the SVDs would choose the same rows).
     """  # noqa: D205
     J = np.empty_like(f.J)
-    if not kernels.clamp_pushed(f.J, w, rows.lb, rows.ub, kernels.ON_LIMIT / dt, J):
+    if not clamp_pushed(f.J, w, rows.lb, rows.ub, ON_LIMIT / dt, J):
         return f, factor.surely_conditioned(f, threshold)
     used = columns_used(J)
     if used < J.shape[0]:  # the clamped rows are short of rank: their rank is at most used
@@ -291,7 +294,7 @@ def damping(f: Factor, b: Array, w: Array, u: float, rows: Rows, dt: float, thre
             s += b[r] * usable.US[r, i]
         along[i] = abs(s) / max(usable.sigma[i], 1e-300)
     lam = np.empty(k)
-    if not kernels.damping_lambda_sq(usable.sigma, usable.rank, u, along, dt, threshold, lam):
+    if not damping_lambda_sq(usable.sigma, usable.rank, u, along, dt, threshold, lam):
         return usable, np.empty(0)
     return usable, lam
 
@@ -302,7 +305,7 @@ def exact(A: Array, command: Array, f: Factor, w: Array, fits: bool, rows: Rows,
     """Stage 1: the exact rates where they keep every constraint, else pass on (the scale and
     veer reported along ``command``, the top level's as given).
     """  # noqa: D205
-    if not (fits and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
+    if not (fits and feasibility.rows_hold(rows.G, w, rows.h, 0.0)):
         return passing(w, A[:0])
     null = factor.null_basis(f)[1] if need_null else A[:0]
     if slid:
@@ -349,16 +352,16 @@ def direction(A: Array, b: Array, rows: Rows, dt: float, threshold: float, rate_
         u_box = -1.0
     command, z, slid = b, w, False
     G, h = slide_rows(rows)
-    if h.size and not kernels.rows_hold(G, w, h, 0.0):  # stage 2 changes the command
+    if h.size and not feasibility.rows_hold(G, w, h, 0.0):  # stage 2 changes the command
         code, kept, f = slid_command(backend_calls.SLIDE, A, b, G, h, rows, f, threshold)
         if code == 0:
-            if rows.slide.all() or kernels.rows_hold(rows.G, kept, rows.h, rows.tol):
+            if rows.slide.all() or feasibility.rows_hold(rows.G, kept, rows.h, rows.tol):
                 null = factor.null_basis(f)[1] if need_null else np.empty((0, A.shape[1]))
                 return answer(A, b, kept, SLIDING, rate_factor, null, 0.0)
             b, slid = row_values(A, kept), True
             f, z = factor.least_norm(f, b)
             w = z
-            fits = kernels.inside(w, rows.lb, rows.ub)
+            fits = feasibility.inside(w, rows.lb, rows.ub)
     return command_stages(A, command, b, f, w, z, fits, boxed, u_box, rows, slid, dt, threshold,
                           rate_factor, need_null)  # fmt: skip
 
@@ -397,7 +400,8 @@ def least_squares_top(A: Array, b: Array, per_unit: Array, rows: Rows, recoverin
     n = A.shape[1]
     if rows.slide.any():
         f, w = factor.least_norm(factor.qr(A), b)
-        if not (kernels.inside(w, rows.lb, rows.ub) and kernels.rows_hold(rows.G, w, rows.h, 0.0)):
+        if not (feasibility.inside(w, rows.lb, rows.ub)
+                and feasibility.rows_hold(rows.G, w, rows.h, 0.0)):  # fmt: skip
             # where no rates meet them all, the pairs asked apart are only kept apart
             # (rrc_pin.solvers.tick.pipeline._damped_within)
             relaxed = np.where((rows.slide != 0.0) & (rows.h < 0.0), 0.0, rows.h)
