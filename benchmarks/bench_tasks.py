@@ -106,7 +106,7 @@ def _posture(robot: Any) -> PostureTask:
 
 def rrc_call(robot: Any, strict: bool) -> tuple[Any, Any]:
     """rrc-pin's step (weighted or strict), its FrameTasks' twists set in the call; and its
-    Resolver."""  # noqa: D205, D209
+    Resolver."""
     hands = [FrameTask(frame, weight=FRAME_WEIGHT) for frame in robot.tool_frames]
     left, right = hands
     posture = _posture(robot)

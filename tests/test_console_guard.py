@@ -9,7 +9,6 @@ counts the loop's ticks against its deadlines, quiet and flooded in turn.
 from __future__ import annotations
 
 import gc
-
 import json
 import logging
 import subprocess
@@ -109,7 +108,7 @@ def console(tmp_path):
 
 def test_the_heap_built_before_the_loop_is_left_out_of_collections(console) -> None:
     """A full collection stops the loop's thread while it walks the heap: what the console
-    built before its loop started is frozen out of it."""  # noqa: D205, D209
+    built before its loop started is frozen out of it."""
     assert gc.get_freeze_count() > 10_000
     assert console.loop.alive
 

@@ -126,7 +126,9 @@ class Guard:
         """
         loop = self.server.get_event_loop()
         port = self.server.get_port()
-        found = [o for o in gc.get_objects() if isinstance(o, Server) and o.get_loop() is loop
+        # by type, not isinstance: a weak proxy whose object is gone raises on isinstance
+        found = [o for o in gc.get_objects() if issubclass(type(o), Server)
+                 and o.get_loop() is loop
                  and any(s.getsockname()[1] == port for s in o.sockets)]  # fmt: skip
         if len(found) != 1:
             raise GuardError(f"no websockets server of viser's on port {port}: the console "
