@@ -107,6 +107,34 @@ def test_jacobi_svd_of_blocks_against_lapack(rng: np.random.Generator) -> None:
         np.testing.assert_allclose(A @ V, US, atol=1e-12 * reference[0])
 
 
+def test_jacobi_svd_rotates_blocks_as_the_whole_matrix(rng: np.random.Generator) -> None:
+    """Diagonal blocks rotated one by one over their own rows give, bit for bit, the sweeps of
+    every pair over every row (a row outside a block is zero in both columns of its pairs;
+    pairs across blocks are orthogonal), then the same sort."""
+    one = np.uint64(1)
+    for _ in range(300):
+        sizes = rng.integers(1, 5, size=rng.integers(1, 4))  # 1 to 3 blocks of 1 to 4 columns
+        rows = rng.integers(1, 6, size=sizes.size)
+        A = np.zeros((rows.sum(), sizes.sum()))
+        r = c = 0
+        for m_b, k_b in zip(rows, sizes, strict=True):
+            A[r : r + m_b, c : c + k_b] = rng.normal(size=(m_b, k_b))
+            r, c = r + m_b, c + k_b
+        m, k = A.shape
+        whole, V = A.copy(), np.eye(k)
+        norms = np.array([sum(x * x for x in whole[:, j].tolist()) for j in range(k)])
+        linalg._rotate_block(whole, V, norms, np.uint64(0), np.uint64(m), np.uint64(0),
+                             np.uint64(k), one)  # fmt: skip
+        sigma = np.sqrt(norms)
+        for j in range(k):  # the kernel's selection sort
+            best = j + int(np.argmax(sigma[j:]))
+            sigma[[j, best]], whole[:, [j, best]], V[:, [j, best]] = (
+                sigma[[best, j]], whole[:, [best, j]], V[:, [best, j]])  # fmt: skip
+        US, W, s = A.copy(), np.empty((k, k)), np.empty(k)
+        linalg.jacobi_svd(US, W, s)
+        assert np.array_equal(s, sigma) and np.array_equal(US, whole) and np.array_equal(W, V)
+
+
 def test_svd_rates_are_damped_least_squares(rng: np.random.Generator) -> None:
     for _ in range(200):
         m, n = 6, 7

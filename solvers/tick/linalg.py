@@ -161,6 +161,12 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
     (where a square or :math:`2rd` would leave the range of normal floats, of
     :math:`\tau/r` and :math:`\gamma/r`, r by :func:`math.hypot`).
 
+    A block diagonal ``A`` (columns ``c0:c1`` nonzero in rows ``r0:r1`` only, as the
+    triangle of two arms' tasks on joints of their own) is rotated block by block, over the
+    block's rows: a pair of columns of two blocks is orthogonal already, and a row outside a
+    block is zero in both columns of its pairs, so the rotations, norms and order are those of
+    the whole matrix.
+
     Args:
         A: The matrix (m, k); out: its columns rotated, ``U diag(sigma)``.
         V: Out: orthogonal (k, k), the right singular vectors (columns).
@@ -176,36 +182,26 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
         for i in range(m):
             s += A[i, j] * A[i, j]
         norms[j] = s
-    for _ in range(SWEEPS):
-        rotated = False
-        for p in range(k - 1):
-            for q in range(p + 1, k):
-                alpha, beta, gamma = norms[p], norms[q], 0.0
-                for i in range(m):
-                    gamma += A[i, p] * A[i, q]
-                if gamma == 0.0 or abs(gamma) <= 1e-15 * math.sqrt(alpha * beta):
-                    continue
-                rotated = True
-                tau = 0.5 * (beta - alpha)
-                r = math.sqrt(tau * tau + gamma * gamma)
-                if not 1e-150 < r < 1e150:  # the same rotation of tau / r, gamma / r
-                    r = math.hypot(tau, gamma)
-                    tau, gamma, r = tau / r, gamma / r, 1.0
-                d = abs(tau) + r
-                h = math.sqrt(2.0 * r * d)
-                c, s = d / h, math.copysign(1.0, tau) * gamma / h
-                alpha = beta = 0.0
-                for i in range(m):
-                    ap, aq = A[i, p], A[i, q]
-                    A[i, p], A[i, q] = c * ap - s * aq, s * ap + c * aq
-                    alpha += A[i, p] * A[i, p]
-                    beta += A[i, q] * A[i, q]
-                norms[p], norms[q] = alpha, beta
-                for i in range(k):
-                    vp, vq = V[i, p], V[i, q]
-                    V[i, p], V[i, q] = c * vp - s * vq, s * vp + c * vq
-        if not rotated:
-            break
+    first = np.empty(k + 1, np.int64)  # the first row nonzero in a column from j on
+    first[k] = m
+    for j in range(k - 1, -1, -1):
+        i = 0
+        while i < m and A[i, j] == 0.0:
+            i += 1
+        first[j] = min(i, first[j + 1])
+    c0, r0, last = 0, 0, -1  # the block's first column and row, its last nonzero row so far
+    for c1 in range(1, k + 1):
+        i = m - 1
+        while i >= 0 and A[i, c1 - 1] == 0.0:
+            i -= 1
+        last = max(last, i)
+        if c1 < k and last >= first[c1]:  # the columns from c1 on reach into these rows
+            continue
+        r1 = m if c1 == k else first[c1]
+        # unsigned indices: numba leaves out the wrap of a negative index at every access
+        _rotate_block(A, V, norms, np.uint64(r0), np.uint64(r1), np.uint64(c0), np.uint64(c1),
+                      np.uint64(1))  # fmt: skip
+        c0, r0, last = c1, r1, -1
     for j in range(k):
         sigma[j] = math.sqrt(norms[j])
     for j in range(k):  # selection sort, descending, columns of A and V alike
@@ -219,6 +215,43 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
                 A[i, j], A[i, best] = A[i, best], A[i, j]
             for i in range(k):
                 V[i, j], V[i, best] = V[i, best], V[i, j]
+
+
+@inlined
+def _rotate_block(A: Array, V: Array, norms: Array, r0: np.uint64, r1: np.uint64, c0: np.uint64,
+                  c1: np.uint64, one: np.uint64) -> None:  # fmt: skip
+    """:func:`jacobi_svd`'s sweeps over the columns ``c0:c1`` of ``A``, nonzero in rows
+    ``r0:r1`` only, until they are orthogonal; their rotations accumulated in V's."""  # noqa: D205, D209
+    for _ in range(SWEEPS):
+        rotated = False
+        for p in range(c0, c1 - one):
+            for q in range(p + one, c1):
+                alpha, beta, gamma = norms[p], norms[q], 0.0
+                for i in range(r0, r1):
+                    gamma += A[i, p] * A[i, q]
+                if gamma == 0.0 or abs(gamma) <= 1e-15 * math.sqrt(alpha * beta):
+                    continue
+                rotated = True
+                tau = 0.5 * (beta - alpha)
+                r = math.sqrt(tau * tau + gamma * gamma)
+                if not 1e-150 < r < 1e150:  # the same rotation of tau / r, gamma / r
+                    r = math.hypot(tau, gamma)
+                    tau, gamma, r = tau / r, gamma / r, 1.0
+                d = abs(tau) + r
+                h = math.sqrt(2.0 * r * d)
+                c, s = d / h, math.copysign(1.0, tau) * gamma / h
+                alpha = beta = 0.0
+                for i in range(r0, r1):
+                    ap, aq = A[i, p], A[i, q]
+                    A[i, p], A[i, q] = c * ap - s * aq, s * ap + c * aq
+                    alpha += A[i, p] * A[i, p]
+                    beta += A[i, q] * A[i, q]
+                norms[p], norms[q] = alpha, beta
+                for i in range(c0, c1):
+                    vp, vq = V[i, p], V[i, q]
+                    V[i, p], V[i, q] = c * vp - s * vq, s * vp + c * vq
+        if not rotated:
+            return
 
 
 @inlined
