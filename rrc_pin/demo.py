@@ -37,6 +37,7 @@ from rrc_pin.loading import load
 from rrc_pin.robot import Robot
 from rrc_pin.solvers.closed_form.barker import BarkerClosedForm
 from rrc_pin.solvers.compiled import numba_config
+from rrc_pin.solvers.tick.tick import compile_stages
 
 Array = npt.NDArray[np.float64]
 DT = 0.01  # [s], control period
@@ -220,25 +221,28 @@ def default_out() -> Path:
     return Path(tempfile.mkdtemp(prefix=f"rrc-pin-demo-{time.strftime('%Y%m%d-%H%M%S')}-"))
 
 
-def compile_barker() -> None:
-    """Compile Barker's kernels (:func:`compile_closed_form`) or load them from numba's cache."""
+def compile_beside() -> None:
+    """Compile, or load from numba's cache, the default tick's two longest stages
+    (:func:`~rrc_pin.solvers.tick.tick.compile_stages`), then Barker's kernels
+    (:func:`compile_closed_form`): :func:`compiling_beside`'s work."""  # noqa: D205, D209
+    compile_stages()
     compile_closed_form(cast(BarkerClosedForm, load("barker6").closed_form))
 
 
 def compiling_beside() -> subprocess.Popen[bytes] | None:
-    """A second process that compiles Barker's kernels into numba's cache (:func:`compile_barker`).
+    """A second process that compiles into numba's cache (:func:`compile_beside`).
 
     On a fresh install the first session's controller compiles the resolver's tick, then
-    Barker's kernels: the second process compiles those on another core meanwhile, and the
-    controller loads them from the cache. Where they are cached already it loads them and
-    exits. None where no process can be started, or nothing is compiled
-    (``NUMBA_DISABLE_JIT=1``).
+    Barker's kernels: the second process compiles, on another core meanwhile, two stages of
+    the tick before that compilation reaches them, then Barker's kernels, and the controller
+    loads them from the cache. Where they are cached already it loads them and exits. None
+    where no process can be started, or nothing is compiled (``NUMBA_DISABLE_JIT=1``).
     """
     if numba_config.DISABLE_JIT:
         return None
     try:
         return subprocess.Popen(
-            [sys.executable, "-c", "from rrc_pin.demo import compile_barker; compile_barker()"],
+            [sys.executable, "-c", "from rrc_pin.demo import compile_beside; compile_beside()"],
             stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
         )  # fmt: skip
     except OSError:

@@ -8,12 +8,13 @@ from __future__ import annotations
 
 from typing import get_args
 
+import numba
 import numpy as np
 import pytest
 
 from rrc_pin.solvers.qp_backends import make_backend
 from rrc_pin.solvers.qp_backends.qp import velocity_tolerance
-from rrc_pin.solvers.tick import backend_calls, tick
+from rrc_pin.solvers.tick import backend_calls, tick, top
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.pipeline import Options, Status, served, solve
@@ -314,3 +315,22 @@ def test_loaded_rows_are_a_fresh_workspaces_after_any_sequence(seed: int) -> Non
         assert np.array_equal(ws.ints[:used], fresh.ints[:used]), (seed, step)
         if rng.random() < 0.2:  # the default tick's twist over the rows loaded last
             ws.load_twist(rng.normal(size=(6, N)), (0, 1, 2, 3, 4, 5), rng.normal(size=6))
+
+
+@pytest.mark.compiled
+def test_the_stages_compiled_beside_are_those_the_default_tick_calls() -> None:
+    """compile_stages compiles the stages for the types run_box passes them: run_box's body,
+    compiled anew, calls them without compiling another signature (its compilation then loads
+    them from the cache a second process filled)."""
+    tick.compile_stages()
+    stages = (top.scaled_along, top.damping)
+    before = [set(stage.signatures) for stage in stages]
+    fresh = numba.njit(tick.run_box.py_func)  # not cached: its callees typed anew
+    rng = np.random.default_rng(9)
+    lower, upper, velocity = limits(rng)
+    ws = tick.Workspace(lower, upper, velocity, np.array([np.inf]), 0.0, 1.0, 100.0, True, 1e-6)
+    ws.load_levels([[TaskRows(rng.normal(size=(6, N)), rng.normal(size=6), None, "t")]], False)
+    ws.load_rows(None, None, None)
+    ws.joints[tick.POSITION], ws.reals[tick.DT] = np.zeros(N), DT
+    assert fresh(ws.joints, ws.task_rows, ws.rates, ws.ints, ws.reals) >= 0
+    assert [set(stage.signatures) for stage in stages] == before

@@ -33,7 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import equalities, feasibility, linalg, statuses, top
+from rrc_pin.solvers.tick import equalities, factor, feasibility, linalg, statuses, top
 from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.levels import least_squares
 from rrc_pin.solvers.tick.linalg import row_values
@@ -336,6 +336,22 @@ def run_twist(J: Array, b: Array, q: Array, dt: float, joints: Array, rates: Arr
 def twist_size(n: int, m: int) -> int:
     """The size of :func:`run_twist`'s ``out`` for n joints and m task rows."""
     return 5 * n + m + 2
+
+
+def compile_stages(n: int = 6) -> None:
+    """Compile the default tick's two longest stages, or load them from numba's cache: the
+    direction problem along the least-norm rates (:func:`rrc_pin.solvers.tick.top.scaled_along`)
+    and the damping (:func:`rrc_pin.solvers.tick.top.damping`), for arrays of the types
+    :func:`run_box` passes them (C order, writable), on ``n`` joints.
+
+    For a second process, while the first compiles :func:`run_box`: that compilation then
+    loads them from the cache where they are there before it reaches them (the first
+    ``rrc-pin demo``, :func:`rrc_pin.demo.compiling_beside`).
+    """  # noqa: D205
+    A, w, lb, ub = np.eye(n), np.ones(n), -np.ones(n), np.ones(n)
+    rows = Rows(lb, ub, np.zeros((0, n)), np.zeros(0), np.zeros(0), 1e-9, np.zeros(2))
+    top.scaled_along(A, w, np.zeros((0, n)), rows)
+    top.damping(factor.qr(A), w, w, 0.5, rows, 0.01, 100.0)
 
 
 @kernel
