@@ -380,17 +380,19 @@ def normal_equations(A: Array, b: Array, weight: Array, H: Array, g: Array) -> N
         g: Out (n,).
     """
     m, n = A.shape
+    H[:, :] = 0.0
+    g[:] = 0.0
+    for r in range(m):  # each row's outer product added, the entries' sums in row order
+        for i in range(n):
+            a = A[r, i] * weight[r]
+            if a == 0.0:  # its terms are zero: a joint the row's task does not move
+                continue
+            g[i] += a * b[r]
+            for j in range(i, n):
+                H[i, j] += a * A[r, j]
     for i in range(n):
-        s = 0.0
-        for r in range(m):
-            s += A[r, i] * weight[r] * b[r]
-        g[i] = s
-        for j in range(i, n):
-            s = 0.0
-            for r in range(m):
-                s += A[r, i] * weight[r] * A[r, j]
-            H[i, j] = s
-            H[j, i] = s
+        for j in range(i + 1, n):
+            H[j, i] = H[i, j]
 
 
 @kernel
