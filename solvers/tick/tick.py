@@ -344,9 +344,9 @@ def compile_stages(n: int = 6) -> None:
     and the damping (:func:`rrc_pin.solvers.tick.top.damping`), for arrays of the types
     :func:`run_box` passes them (C order, writable), on ``n`` joints.
 
-    For a second process, while the first compiles :func:`run_box`: that compilation then
-    loads them from the cache where they are there before it reaches them (the first
-    ``rrc-pin demo``, :func:`rrc_pin.demo.compiling_beside`).
+    For a second process, while the first compiles :func:`run_box`: that compilation loads
+    from the cache each stage cached by the time it reaches it (the first ``rrc-pin demo``,
+    :func:`rrc_pin.demo.compiling_beside`).
     """  # noqa: D205
     A, w, lb, ub = np.eye(n), np.ones(n), -np.ones(n), np.ones(n)
     rows = Rows(lb, ub, np.zeros((0, n)), np.zeros(0), np.zeros(0), 1e-9, np.zeros(2))
