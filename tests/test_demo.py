@@ -137,9 +137,9 @@ def test_an_arm_given_by_path_keeps_the_table_intact(tmp_path, capsys):
         assert len(ends) == 1  # the dof column lines up under its header
 
 
-def test_barker_is_compiled_beside_the_first_session():
-    """The second process of a demo loads or compiles Barker's kernels and exits cleanly; none
-    is started where nothing is compiled."""
+def test_the_stages_and_barker_are_compiled_beside_the_first_session():
+    """The second process of a demo loads or compiles two of the tick's stages and Barker's
+    kernels and exits cleanly; none is started where nothing is compiled."""
     from rrc_pin import demo
 
     beside = demo.compiling_beside()
