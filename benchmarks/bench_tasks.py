@@ -300,8 +300,28 @@ def readme_table(results: dict[str, Any]) -> str:
             )
             cells += f" {us(r['median_us'])} / {us(r['p99_us'])} | {ratio} |"
         lines.append(cells)
-    lines += ["", _setup_line(results), "", _answers_line(results)]
+    answered = _answered_line(results)
+    lines += ["", _setup_line(results), *(["", answered] if answered else []), "",
+              _answers_line(results)]  # fmt: skip
     return "\n".join(lines)
+
+
+def _answered_line(results: dict[str, Any]) -> str:
+    """The strict rows on the steps PlaCo strict answered (it raises on the others); "" where
+    it did not run or answered every step."""
+    tight = results["modes"]["tight"]["contenders"]
+    placo = tight.get(PLACO_S)
+    if placo is None or "answered_steps" not in placo:
+        return ""
+    shown = [label for label in (STRICT, PLACO_S, DRAKE) if "answered_median_us" in tight.get(
+        label, {})]  # fmt: skip
+    parts = [f"{label} {tight[label]['answered_median_us']:.0f} us "
+             f"({tight[label]['vs_placo_answered_median']:.2f}x)" for label in shown]  # fmt: skip
+    return (
+        f"PlaCo strict raised at {placo['failures']} of {results['settings']['steps']} steps "
+        f"(its hard tasks not met within the limits); on the {placo['answered_steps']} steps "
+        "it answered, tight-loop medians and PlaCo's over them: " + ", ".join(parts) + "."
+    )
 
 
 def _setup_line(results: dict[str, Any]) -> str:

@@ -72,6 +72,7 @@ def time_workload(
             rows = summarise(runs, Q, limits, dt)
             add_ratios(rows, rrc, "rrc_pin")
             add_placo_ratios(rows, placo_of)
+            add_answered_ratios(rows, runs, placo_of)
             per_mode[mode].append(rows)
             if round_ == 0 and mode == "tight":
                 first = runs
@@ -88,6 +89,25 @@ def add_placo_ratios(rows: dict[str, dict[str, Any]], placo_of: dict[str, str]) 
             row["vs_placo_p99"] = base["p99_us"] / row["p99_us"]
             if "cpu_p99_us" in base and "cpu_p99_us" in row:
                 row["vs_placo_cpu_p99"] = base["cpu_p99_us"] / row["cpu_p99_us"]
+
+
+def add_answered_ratios(rows: dict[str, dict[str, Any]], runs: dict[str, Run],
+                        placo_of: dict[str, str]) -> None:  # fmt: skip
+    """Where the PlaCo row failed at some steps (PlaCo raises where its hard tasks cannot be
+    met), each row's comparison on the steps both answered, in place: ``answered_steps``,
+    ``answered_median_us`` (the row's median there) and ``vs_placo_answered_median`` (PlaCo's
+    median there over the row's)."""
+    for label, row in rows.items():
+        peer = placo_of.get(label, "")
+        if peer not in runs or not runs[peer].failed.any():
+            continue
+        run, base = runs[label], runs[peer]
+        both = run.counted & base.counted & ~run.failed & ~base.failed
+        row["answered_steps"] = int(both.sum())
+        if both.any():
+            row["answered_median_us"] = float(np.median(run.seconds[both]) * 1e6)
+            row["vs_placo_answered_median"] = float(np.median(base.seconds[both])
+                                                    / np.median(run.seconds[both]))  # fmt: skip
 
 
 def spread(row: dict[str, Any], key: str = "median_us") -> str:
