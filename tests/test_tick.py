@@ -22,7 +22,8 @@ from rrc_pin.solvers.tick.problem import Box, Constraints, TaskRows, build
 
 STATUS_NAMES = get_args(Status)
 
-SEEDS = [20261206, 6307242558226725790, int(np.random.SeedSequence().entropy % 2**63)]
+SEEDS = [20261206, 6307242558226725790, 8806618223483400590,
+         int(np.random.SeedSequence().entropy % 2**63)]  # fmt: skip
 N, DT = 7, 0.01
 LEVELS = ("met", "scaled", "traded", "dropped")
 RATE_TOL = 1e-9
@@ -100,7 +101,7 @@ def compiled_answer(q, lower, upper, velocity, levels, weighted, G, h, slide, di
 def test_random_problems_answered_as_the_pipeline(seed: int) -> None:
     rng = np.random.default_rng(seed)
     kinds: dict[str, int] = {}
-    relabelled = 0  # a lower level traded by one tick, dropped by the other (its rates the same)
+    relabelled = 0  # a lower level served by one tick, dropped by the other (its rates the same)
     sensitive = 0  # rates apart by more than RATE_TOL, as far as the pipeline's own rounding
     for _ in range(400):
         args = case(rng)
@@ -116,8 +117,9 @@ def test_random_problems_answered_as_the_pipeline(seed: int) -> None:
         got = tuple(LEVELS[c] for c in ws.level_codes())
         tol = RATE_TOL if want.backend == "" else BACKEND_TOL
         if got != want.levels:  # a lower level's QP at rounding: refused on one side only
+            # (the backend's, on data apart in their last bits; the rates are checked below)
             pairs = zip(got, want.levels, strict=True)
-            assert all(g == w or {g, w} == {"traded", "dropped"} for g, w in pairs), got
+            assert all(g == w or "dropped" in {g, w} for g, w in pairs), (got, want.levels)
             relabelled += 1
         apart = np.abs(qdot - want.qdot).max()
         if apart > tol * (1.0 + np.abs(want.qdot).max()):

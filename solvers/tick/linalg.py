@@ -12,6 +12,7 @@ numpy reference.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -19,6 +20,10 @@ import numpy.typing as npt
 from rrc_pin.solvers.compiled import inlined, kernel
 
 Array = npt.NDArray[np.float64]
+
+Index = Any
+"""An unsigned index (``np.uint64``): numba leaves out the wrap of a negative index where it
+indexes an array (its sums with Python ints are not typed as integers by numpy's stubs)."""
 
 SWEEPS = 60
 """Most sweeps of the one-sided Jacobi SVD (:func:`jacobi_svd`); it converges quadratically and
@@ -218,8 +223,8 @@ def jacobi_svd(A: Array, V: Array, sigma: Array) -> None:
 
 
 @inlined
-def _rotate_block(A: Array, V: Array, norms: Array, r0: np.uint64, r1: np.uint64, c0: np.uint64,
-                  c1: np.uint64, one: np.uint64) -> None:  # fmt: skip
+def _rotate_block(A: Array, V: Array, norms: Array, r0: Index, r1: Index, c0: Index, c1: Index,
+                  one: Index) -> None:  # fmt: skip
     """:func:`jacobi_svd`'s sweeps over the columns ``c0:c1`` of ``A``, nonzero in rows
     ``r0:r1`` only, until they are orthogonal; their rotations accumulated in V's."""  # noqa: D205, D209
     for _ in range(SWEEPS):
