@@ -313,8 +313,8 @@ def _answered_line(results: dict[str, Any]) -> str:
     placo = tight.get(PLACO_S)
     if placo is None or "answered_steps" not in placo:
         return ""
-    shown = [label for label in (STRICT, PLACO_S, DRAKE) if "answered_median_us" in tight.get(
-        label, {})]  # fmt: skip
+    shown = [label for label in (STRICT, PLACO_S, DRAKE)
+             if "answered_median_us" in tight.get(label, {})]  # fmt: skip
     parts = [f"{label} {tight[label]['answered_median_us']:.0f} us "
              f"({tight[label]['vs_placo_answered_median']:.2f}x)" for label in shown]  # fmt: skip
     return (

@@ -263,11 +263,11 @@ def test_capsule_end_points_against_a_box_match_coal():
 
 
 
-SEEDS = (17, int(np.random.SeedSequence().entropy % 2**63))
+SEEDS = (17, 1049562248620298025, int(np.random.SeedSequence().entropy % 2**63))
 """A fixed seed and one drawn fresh each run (named in every failure's message)."""
 
 
-@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "fresh"))
+@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "found", "fresh"))
 @pytest.mark.parametrize("kind", ["box", "cylinder", "convex"])
 def test_coal_gets_a_pair_unless_its_bound_is_beyond_the_detection_distance(kind, seed):
     """A sphere or capsule against a shape coal measures: left for coal unless the segment's
@@ -322,7 +322,7 @@ def segment_to_segment(p0, p1, q0, q1, samples=4001):
     return float(d.min())
 
 
-@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "fresh"))
+@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "found", "fresh"))
 def test_capsule_outside_a_box_gets_the_rows_of_its_nearest_edges(seed):
     """A capsule whose segment is outside a box: after its end points' rows, the rows of the
     box's edges nearest the segment (those of the nearest corner once, none an end's row
