@@ -182,8 +182,9 @@ class Kinematics:
         return self.layout.joints[joint]
 
     def pose(self, frame: str) -> Array:
-        """Pose (4, 4) of ``frame`` in the base frame [m] (a copy)."""
-        return np.array(self.placement(frame).homogeneous)
+        """Pose (4, 4) of ``frame`` in the base frame [m] (a new array, :meth:`placement`'s)."""
+        pose: Array = self._placed_in(frame).homogeneous
+        return pose
 
     def placement(self, frame: str) -> pin.SE3:
         """Pose of ``frame`` in the base frame (a copy).
@@ -193,11 +194,15 @@ class Kinematics:
         (Pinocchio's ``updateFramePlacement``, the same floats as a forward pass), without a
         second pass.
         """
+        return pin.SE3(self._placed_in(frame))
+
+    def _placed_in(self, frame: str) -> pin.SE3:
+        """The Data's placement of ``frame`` (:meth:`placement`), not a copy."""
         fid = self.layout.frames[frame]
         if frame != self._first or not self._placed or self._joints:
             self._compute_frames()
-            return pin.SE3(self._data.oMf[fid])
-        return pin.SE3(pin.updateFramePlacement(self._model, self._data, fid))
+            return self._data.oMf[fid]
+        return pin.updateFramePlacement(self._model, self._data, fid)
 
     def _compute_joints(self) -> None:
         if not self._joints:

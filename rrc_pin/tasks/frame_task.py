@@ -10,7 +10,7 @@ import numpy.typing as npt
 from rrc_pin.errors import InvalidInput
 from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.solvers.checks import all_finite, as_vector, positive, real_array, rigid_transform
-from rrc_pin.solvers.exp_log import pose_errors
+from rrc_pin.solvers.exp_log import pose_error
 from rrc_pin.solvers.spatial import Reference, check_reference
 from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.task import Task, check_weight, task_name
@@ -105,7 +105,7 @@ class FrameTask(Task):
         """
         out = np.zeros(6)
         if self.target is not None:
-            pose_errors(self.target[None], pose[None], out)
+            pose_error(self.target, pose, out)
         return out
 
     def check_twist(self, twist: npt.ArrayLike) -> Array:
@@ -180,7 +180,7 @@ class FrameTask(Task):
                 error = np.concatenate([R.T @ error[:3], R.T @ error[3:]])
             elif ref == "world":  # spatial velocity at the base origin
                 error[:3] += np.cross(pose[:3, 3], error[3:])
-            b = b + self.gain * self.selected_rates(error)
+            b = b + self.gain * (error if len(self.selected) == 6 else self.selected_rates(error))
         return self.rows_from(kin.jacobian(self.frame, ref), b, kin.layout.reach[self.frame])
 
     def rows_from(self, J: Array, b: Array, reach: float) -> TaskRows:
