@@ -111,7 +111,8 @@ class CellLog(RecordRing[CellRecord]):
         ])  # fmt: skip
         self._float_at = _float_fields(self.dtype)
         self._error_at = _columns(self.commands, self._float_at[3].start)
-        self._grip_at = _columns(self.objects, self._float_at[4].start)
+        self._grip_at = _columns(self.objects, self._float_at[3].start + len(self.commands))
+        self._unknown = np.full(self._float_at[3].stop - self._float_at[3].start, math.nan)
         self._codes_of: dict[tuple[str, str, tuple[str, ...]], npt.NDArray[np.uint8]] = {}
         self._set_table(np.zeros(0, self.dtype))
         self._start = 0  # the oldest row's index in the ring
@@ -156,18 +157,17 @@ class CellLog(RecordRing[CellRecord]):
         codes = self._codes_of.get((status, mode, levels))
         if codes is None:
             codes = self._codes(status, mode, levels)
-        (q_at, qdot_at, scale_at, errors_at, grip_at, chain_at) = self._float_at
+        q_at, qdot_at, scale_at, errors_at, chain_at = self._float_at
         index = self._next()  # may grow the table: read it after
         row = self._floats[index]
         row[0] = t
         row[q_at] = q
         row[qdot_at] = qdot
         row[scale_at] = scale
-        row[errors_at] = math.nan
+        row[errors_at] = self._unknown  # the errors' and grips', then those given
         for name, error in errors.items():
             for at in self._error_at.get(name, ()):
                 row[at] = error
-        row[grip_at] = math.nan
         for name, error in grip.items():
             for at in self._grip_at.get(name, ()):
                 row[at] = error
@@ -328,12 +328,13 @@ def _columns(names: tuple[str, ...], start: int) -> dict[str, tuple[int, ...]]:
     return {n: tuple(start + k for k, m in enumerate(names) if m == n) for n in names}
 
 
-def _float_fields(dtype: np.dtype[Any]) -> tuple[slice, slice, int, slice, slice, int]:
-    """Where :class:`CellLog`'s float fields are in a row read as float64 (from ``t`` at 0):
-    ``q``, ``qdot``, ``scale``, ``errors``, ``grip`` and ``chain``, the row's first bytes.
+def _float_fields(dtype: np.dtype[Any]) -> tuple[slice, slice, int, slice, int]:
+    """Where :class:`CellLog`'s float fields are in a row read as float64 (from ``t`` at 0,
+    the row's first bytes): ``q``, ``qdot``, ``scale``, ``errors`` and ``grip`` (one after
+    the other) and ``chain``.
     """  # noqa: D205
     at: list[slice] = []
     for name in ("q", "qdot", "scale", "errors", "grip", "chain"):
         field, offset = dtype.fields[name][:2]  # type: ignore[index]
         at.append(slice(offset // 8, (offset + field.itemsize) // 8))
-    return at[0], at[1], at[2].start, at[3], at[4], at[5].start
+    return at[0], at[1], at[2].start, slice(at[3].start, at[4].stop), at[5].start
