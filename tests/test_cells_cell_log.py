@@ -7,6 +7,16 @@ import pytest
 
 import rrc_pin
 from rrc_pin.cells import CellController, CellLog, CellRecord
+from rrc_pin.cells.cell_log import (
+    LEVEL_CODES,
+    LEVEL_STATUSES,
+    LEVELS,
+    MODE_CODES,
+    MODES,
+    NONE,
+    STATUS_CODES,
+    STATUSES,
+)
 from rrc_pin.control.trajectory_log import CAPACITY
 from rrc_pin.errors import InvalidInput
 
@@ -94,3 +104,37 @@ def test_the_csv_has_a_row_per_tick_with_the_chains_errors(tmp_path):
         ctl.save(tmp_path / "cell.npz")
     with pytest.raises(InvalidInput, match="path: cannot write"):
         ctl.save(tmp_path / "missing" / "cell.csv")
+
+
+def _former_row(log, t, q, qdot, status, scale, levels, errors, grip, chain, mode):
+    """A row as the log packed it in one assignment (the reference of :meth:`CellLog.add`)."""
+    codes = [LEVEL_CODES[s] for s in levels[:LEVELS]]
+    row = np.zeros(1, log.dtype)
+    row[0] = (t, q, qdot, scale, [errors.get(n, np.nan) for n in log.commands],
+              [grip.get(n, np.nan) for n in log.objects], chain, STATUS_CODES[status],
+              MODE_CODES[mode], codes + [NONE] * (LEVELS - len(codes)))  # fmt: skip
+    return row
+
+
+@pytest.mark.parametrize(("commands", "objects"), [(["object", "left", "right"], ["object"]),
+                                                   (["body", "leg1"], []), ([], [])])
+def test_each_row_is_the_one_assignment_of_its_fields_byte_for_byte(commands, objects, rng):
+    """Ticks with some commands' and grips' errors (names the log does not know ignored),
+    levels of any length (past LEVELS cut), through the table's growth and its ring: the
+    rows are those the former tuple assignment wrote, and read back as the same records."""
+    nq, nv = 5, 4
+    log = CellLog(nq, nv, commands, objects, capacity=1500)
+    want = []
+    for k in range(2000):
+        errors = {n: float(rng.uniform()) for n in [*commands, "other"] if rng.uniform() < 0.5}
+        grip = {n: float(rng.uniform()) for n in [*objects, "other"] if rng.uniform() < 0.7}
+        levels = tuple(rng.choice(LEVEL_STATUSES, size=int(rng.integers(0, LEVELS + 2))))
+        tick = (0.01 * k, rng.normal(size=nq), rng.normal(size=nv),
+                STATUSES[int(rng.integers(len(STATUSES)))], float(rng.uniform()), levels, errors,
+                grip, (float(rng.uniform()), float(rng.uniform())), MODES[k % 2])  # fmt: skip
+        log.add(*tick)
+        want.append(_former_row(log, *tick))
+    table = log.table()
+    assert table.tobytes() == np.concatenate(want[-1500:]).tobytes()
+    assert log.dropped == 500 and log[-1].levels == "/".join(levels[:LEVELS])
+    assert log[-1].errors == {n: e for n, e in errors.items() if n in commands}

@@ -343,6 +343,8 @@ def test_a_swinging_leg_moves_while_two_feet_carry_the_body(tripod):
         ({"left": np.zeros(6)}, "left's hand holds 'object'"),
         ({"object": [0, 0, np.nan, 0, 0, 0]}, r"commands\['object'\]"),
         ({"object": np.zeros(5)}, r"commands\['object'\]"),
+        ({"object": np.array([0, 0, np.inf, 0, 0, 0])}, r"commands\['object'\]: .*inf"),
+        ([("object", np.zeros(6))], "commands: expected a mapping name -> twist"),
         ({"object": (np.zeros(6), "hand")}, r"commands\['object'\]: ref 'hand'"),
         ({"object": (np.zeros(6), "base")},
          r"commands\['object'\]: ref 'base' is a hand's arm base axes; 'object' is an object"),
@@ -357,6 +359,17 @@ def test_bad_commands_raise_naming_the_argument_and_change_nothing(dual, command
     assert ctl.t == t and len(ctl.log) == n
     np.testing.assert_array_equal(ctl.q, q)
     np.testing.assert_array_equal(ctl.target("object"), target)
+
+
+def test_a_command_is_the_twist_as_given_not_the_callers_array_later(dual):
+    """A command in force is a copy: the caller's array changed after the tick is not read."""
+    given = np.array([0.01, 0.0, 0.0, 0.0, 0.0, 0.0])
+    ctl, twin = CellController(dual, 0.01), CellController(dual, 0.01)
+    ctl.step({"object": given})
+    twin.step({"object": given.copy()})
+    given[:] = [0.0, 0.05, 0.0, 0.0, 0.0, 0.3]
+    for _ in range(3):
+        np.testing.assert_array_equal(ctl.step().q, twin.step().q)
 
 
 def test_a_foot_in_support_cannot_be_commanded(tripod):

@@ -43,6 +43,8 @@ NONE = 255
 """The code of a level a tick did not have."""
 FIRST = 1024
 """Rows allocated at the first tick (then doubled up to the capacity)."""
+KINDS = 256
+"""Rows' codes kept made (:meth:`CellLog.add`), at most."""
 
 
 class CellRecord(NamedTuple):
@@ -107,7 +109,12 @@ class CellLog(RecordRing[CellRecord]):
             ("errors", "f8", (len(self.commands),)), ("grip", "f8", (len(self.objects),)),
             ("chain", "f8", (2,)), ("status", "u1"), ("mode", "u1"), ("levels", "u1", (LEVELS,)),
         ])  # fmt: skip
-        self._table: npt.NDArray[Any] = np.zeros(0, self.dtype)
+        self._float_at = _float_fields(self.dtype)
+        self._error_at = _columns(self.commands, self._float_at[3].start)
+        self._grip_at = _columns(self.objects, self._float_at[3].start + len(self.commands))
+        self._unknown = np.full(self._float_at[3].stop - self._float_at[3].start, math.nan)
+        self._codes_of: dict[tuple[str, str, tuple[str, ...]], npt.NDArray[np.uint8]] = {}
+        self._set_table(np.zeros(0, self.dtype))
         self._start = 0  # the oldest row's index in the ring
         self._count = 0
 
@@ -133,7 +140,7 @@ class CellLog(RecordRing[CellRecord]):
         kept = self.table()
         self._dropped += max(0, kept.size - value)
         self._capacity = value
-        self._table = kept[kept.size - min(kept.size, value) :].copy()
+        self._set_table(kept[kept.size - min(kept.size, value) :].copy())
         self._start, self._count = 0, self._table.size
 
     def add(
@@ -143,16 +150,29 @@ class CellLog(RecordRing[CellRecord]):
     ) -> None:  # fmt: skip
         """Append one tick (the oldest forgotten when the log is full); no object kept.
 
-        The row is written in one assignment (a tuple of :attr:`dtype`'s fields).
+        The row's floats are written through a float view of the table (:func:`_float_fields`),
+        its codes as one array (made once for each status, mode and levels).
         """
-        codes = [LEVEL_CODES[s] for s in levels[:LEVELS]]
-        row = (
-            t, q, qdot, scale, [errors.get(n, math.nan) for n in self.commands],
-            [grip.get(n, math.nan) for n in self.objects], chain, STATUS_CODES[status],
-            MODE_CODES[mode], codes + [NONE] * (LEVELS - len(codes)),
-        )  # fmt: skip
+        levels = tuple(levels)
+        codes = self._codes_of.get((status, mode, levels))
+        if codes is None:
+            codes = self._codes(status, mode, levels)
+        q_at, qdot_at, scale_at, errors_at, chain_at = self._float_at
         index = self._next()  # may grow the table: read it after
-        self._table[index] = row
+        row = self._floats[index]
+        row[0] = t
+        row[q_at] = q
+        row[qdot_at] = qdot
+        row[scale_at] = scale
+        row[errors_at] = self._unknown  # the errors' and grips', then those given
+        for name, error in errors.items():
+            for at in self._error_at.get(name, ()):
+                row[at] = error
+        for name, error in grip.items():
+            for at in self._grip_at.get(name, ()):
+                row[at] = error
+        row[chain_at], row[chain_at + 1] = chain
+        self._codes_table[index] = codes
 
     def append(self, record: CellRecord) -> None:
         """Append one tick's record (packed into a row).
@@ -253,6 +273,26 @@ class CellLog(RecordRing[CellRecord]):
             raise InvalidInput("path", f"cannot write {str(out)!r}: {reason(exc)}") from exc
         return out
 
+    def _codes(self, status: str, mode: str, levels: tuple[str, ...]) -> npt.NDArray[np.uint8]:
+        """A row's status, mode and level codes (:attr:`dtype`'s last fields), kept for the next
+        rows (a few kinds: statuses, modes, levels' statuses).
+        """  # noqa: D205
+        kept = [LEVEL_CODES[s] for s in levels[:LEVELS]]
+        codes = np.array([STATUS_CODES[status], MODE_CODES[mode], *kept,
+                          *[NONE] * (LEVELS - len(kept))], np.uint8)  # fmt: skip
+        if len(self._codes_of) >= KINDS:
+            self._codes_of.clear()
+        self._codes_of[(status, mode, levels)] = codes
+        return codes
+
+    def _set_table(self, table: npt.NDArray[Any]) -> None:
+        """``table`` the log's rows, with its float and code views (:func:`_float_fields`)."""
+        self._table = table
+        floats = self._float_at[-1] + 2
+        raw = table.view(np.uint8).reshape(table.size, self.dtype.itemsize)
+        self._floats: npt.NDArray[np.float64] = raw[:, : 8 * floats].view(np.float64)
+        self._codes_table: npt.NDArray[np.uint8] = raw[:, 8 * floats :]
+
     def _next(self) -> int:
         """The index of the next tick's row (the array grown, or the oldest row reused)."""
         size = self._table.size
@@ -262,7 +302,8 @@ class CellLog(RecordRing[CellRecord]):
         elif size < self._capacity:  # grow: the rows in time order, then room
             grown = np.zeros(min(max(2 * size, FIRST), self._capacity), self.dtype)
             grown[:size] = self.table()
-            self._table, self._start, index = grown, 0, size
+            self._set_table(grown)
+            self._start, index = 0, size
             self._count += 1
         else:  # full: the oldest row is reused
             index = self._start
@@ -280,3 +321,20 @@ class CellLog(RecordRing[CellRecord]):
             {n: float(g) for n, g in zip(self.objects, row["grip"], strict=True)},
             float(row["chain"][0]), float(row["chain"][1]), MODES[row["mode"]],
         )  # fmt: skip
+
+
+def _columns(names: tuple[str, ...], start: int) -> dict[str, tuple[int, ...]]:
+    """Each name's columns in a row read as float64, its field starting at ``start``."""
+    return {n: tuple(start + k for k, m in enumerate(names) if m == n) for n in names}
+
+
+def _float_fields(dtype: np.dtype[Any]) -> tuple[slice, slice, int, slice, int]:
+    """Where :class:`CellLog`'s float fields are in a row read as float64 (from ``t`` at 0,
+    the row's first bytes): ``q``, ``qdot``, ``scale``, ``errors`` and ``grip`` (one after
+    the other) and ``chain``.
+    """  # noqa: D205
+    at: list[slice] = []
+    for name in ("q", "qdot", "scale", "errors", "grip", "chain"):
+        field, offset = dtype.fields[name][:2]  # type: ignore[index]
+        at.append(slice(offset // 8, (offset + field.itemsize) // 8))
+    return at[0], at[1], at[2].start, slice(at[3].start, at[4].stop), at[5].start

@@ -84,8 +84,6 @@ Array = npt.NDArray[np.float64]
 Ref = Literal["world_aligned", "local", "world", "base"]
 REFS: tuple[Ref, ...] = ("world_aligned", "local", "world", "base")
 """The frames a command's twist may be given in: every entry point's, and a hand's ``base``."""
-REF_INDEX = {ref: i for i, ref in enumerate(REFS)}
-"""Each ref's index in :data:`REFS` (a checked command's last entry)."""
 Command = npt.ArrayLike | tuple[npt.ArrayLike, str]
 """A twist (6,) in ``world_aligned``, or ``(twist, ref)``."""
 REANCHOR = ("singular", "least_squares", "recovering", "fallback")
@@ -213,7 +211,7 @@ class CellController(Loop):
         self._commandable_of: tuple[tuple[str, ...] | None, tuple[str, ...]] = (None, ())
         self._anchors: dict[str, Array] = {}
         self._grips: dict[str, Array] = {}
-        self._commands: dict[str, Array] = {}
+        self._commands: dict[str, tuple[Array, Ref]] = {}
         self._world_warned = False
         self._targets: dict[str, Array] = {}
         self._tick: tuple[str, bool, dict[str, Array]] = ("teleop", False, {})
@@ -348,8 +346,9 @@ class CellController(Loop):
         poses = {name: oMf[self._frame_id(name)].homogeneous for name in self._targets}
         twists = {name: weight * self._world_aligned(name, poses[name], self._commands[name])
                   if name in self._commands else np.zeros(6) for name in self._targets}  # fmt: skip
-        for name, twist in self._streamed(poses).items():  # the stream's target: the reference
-            twists[name], self._targets[name] = self.speed * twist, poses[name]
+        if self.streams:
+            for name, twist in self._streamed(poses).items():  # the stream's target: the reference
+                twists[name], self._targets[name] = self.speed * twist, poses[name]
         top: list[Task] = []
         hands: list[Task] = []
         for name, twist in twists.items():
@@ -442,6 +441,7 @@ class CellController(Loop):
         _, dof, q_pin = self.cell.positions(self._q)
         self._kin = Kinematics(self.cell.model, self._kin_data, self.resolver.layout, dof, q_pin)
         self._kin_q = self._q
+        self._q_pin = (self._q, q_pin)  # the loop's integration reads it (:meth:`_pinocchio_q`)
         return self._kin
 
     def _frame_id(self, name: str) -> int:
@@ -658,30 +658,32 @@ class CellController(Loop):
                                f"commandable: {', '.join(allowed)}")  # fmt: skip
         return name
 
-    def _checked(self, commands: Mapping[str, Command]) -> dict[str, Array]:
-        """Every command checked and turned into (twist, ref) before anything changes."""
-        if not isinstance(commands, Mapping):
+    def _checked(self, commands: Mapping[str, Command]) -> dict[str, tuple[Array, Ref]]:
+        """Every command checked and turned into (twist, ref) before anything changes.
+
+        Each value is checked as ``commands[name]``: the label is made when one is refused
+        (:func:`_twist`).
+        """
+        if type(commands) is not dict and not isinstance(commands, Mapping):
             raise InvalidInput("commands", f"expected a mapping name -> twist, got {commands!r}")
-        out: dict[str, Array] = {}
+        out: dict[str, tuple[Array, Ref]] = {}
         allowed = self._commandable()
         world = False
         for name, value in commands.items():
             if not isinstance(name, str) or name not in allowed:
                 self._check_name(name, "commands")
-            label = f"commands[{name!r}]"
             ref = "world_aligned"
             if isinstance(value, tuple) and len(value) == 2 and isinstance(value[1], str):
                 value, ref = value
             if ref not in REFS:
-                raise InvalidInput(label, f"ref {ref!r}: expected world_aligned, local, world, "
-                                   "or base (a hand's arm base axes)")  # fmt: skip
+                raise InvalidInput(f"commands[{name!r}]", f"ref {ref!r}: expected world_aligned, "
+                                   "local, world, or base (a hand's arm base axes)")  # fmt: skip
             if ref == "base" and name not in self.cell.arms:
-                raise InvalidInput(label, f"ref 'base' is a hand's arm base axes; {name!r} is "
+                raise InvalidInput(f"commands[{name!r}]", f"ref 'base' is a hand's arm base "
+                                   f"axes; {name!r} is "
                                    f"{'the body' if name == self.cell.body else 'an object'}: "
                                    "expected world_aligned, local or world")  # fmt: skip
-            command = out[name] = np.empty(7)
-            command[:6] = as_vector(value, label, 6)
-            command[6] = REF_INDEX[ref]
+            out[name] = (_twist(value, name).copy(), ref)
             world = world or ref == "world"
         if world:
             self._warn_world()
@@ -700,9 +702,9 @@ class CellController(Loop):
                 stacklevel=4,
             )
 
-    def _world_aligned(self, name: str, pose: Array, command: Array) -> Array:
-        """A checked command (twist and its ref's index) in ``world_aligned`` at ``pose`` (4, 4)."""
-        twist, ref = command[:6], REFS[int(command[6])]
+    def _world_aligned(self, name: str, pose: Array, command: tuple[Array, Ref]) -> Array:
+        """A checked command (twist and its ref) in ``world_aligned`` at ``pose`` (4, 4)."""
+        twist, ref = command
         if ref == "world_aligned":
             return twist
         if ref != "base":
@@ -743,6 +745,17 @@ def _top_level(r: Resolution) -> tuple[Sequence[TaskRows], Array, Rows | None]:
         return source.top()
     problem = r.problem
     return problem.levels[0], problem.stacked[0][0], problem.rows
+
+
+def _twist(value: npt.ArrayLike, name: str) -> Array:
+    """Command ``name``'s twist checked (6,), refused as ``commands[name]``
+    (:func:`~rrc_pin.solvers.checks.as_vector`, checked again with its label to refuse it).
+    """  # noqa: D205
+    try:
+        return as_vector(value, "commands", 6)
+    except InvalidInput:
+        pass
+    return as_vector(value, f"commands[{name!r}]", 6)
 
 
 def _length(v: Array) -> float:

@@ -44,7 +44,7 @@ from rrc_pin.errors import InvalidInput
 from rrc_pin.limits import JointLimits, Limit
 from rrc_pin.resolver import QPOptions, Resolver
 from rrc_pin.robot import Robot
-from rrc_pin.solvers.checks import finite_number
+from rrc_pin.solvers.checks import all_finite, finite_number
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.resolution import Resolution
 
@@ -138,6 +138,11 @@ class Loop:
         # Continuous joints as (cos, sin) or a floating base: q is not Pinocchio's q.
         self._manifold = robot.model.nq != robot.model.nv
         self._floating = robot.nq != robot.nv
+        # A floating base and one-coordinate joints only: q is Pinocchio's q but the base's
+        # quaternion normalised, each joint's coordinate at the same index.
+        self._base_only = self._floating and robot.model.nq == robot.model.nv + 1
+        self._q_pin: tuple[Array | None, Array] = (None, self._q)
+        """The loop's ``q`` of the last conversion and Pinocchio's configuration of it."""
         margin = max((lim.margin for lim in self.resolver.limits if isinstance(lim, JointLimits)),
                      default=0.0)  # fmt: skip
         self.smoothing: JerkLimiter | None = (None if smoothing is None else
@@ -355,8 +360,19 @@ class Loop:
         return weight
 
     def _pinocchio_q(self, q: Array) -> Array:
-        """Pinocchio's configuration of the loop's own ``q`` (valid: not checked again)."""
-        return self.robot.to_pinocchio(q) if self._manifold else q
+        """Pinocchio's configuration of the loop's own ``q`` (valid: not checked again).
+
+        The loop's current ``q`` is converted once (:attr:`_q_pin`, which a tick's kinematics
+        may have set already): never write into the array returned.
+        """
+        if not self._manifold:
+            return q
+        known, q_pin = self._q_pin
+        if known is not q:
+            q_pin = self.robot.to_pinocchio(q)
+            if q is self._q:
+                self._q_pin = (q, q_pin)
+        return q_pin
 
     def _difference(self, q: Array, target: Array) -> Array:
         """The displacement (nv,) [rad or m] from ``q`` to ``target`` on the manifold.
@@ -374,14 +390,24 @@ class Loop:
     def _integrate(self, qdot: Array) -> Array:
         """The configuration (nq,) one period on from ``q`` at rates ``qdot`` (nv,).
 
-        A new array (Barker eq. (21), ``pinocchio.integrate``).
+        A new array (Barker eq. (21), ``pinocchio.integrate``), the floats of
+        :meth:`~rrc_pin.robot.Robot.integrate` without checking the loop's own ``q`` again:
+        one-coordinate joints move by ``q + qdot dt`` (Pinocchio's integration of a vector
+        space); with a floating base, Pinocchio's integration of Pinocchio's configuration
+        (:meth:`_pinocchio_q`) places the base, and each joint moves by the difference it made
+        of the joint's coordinate (Pinocchio's difference of a vector space).
         """
         q = self._q
         self._rates = qdot
         if not self._manifold:
-            out: Array = pin.integrate(self.robot.model, q, qdot * self.dt)
+            out: Array = q + qdot * self.dt
             return out
-        return self.robot.integrate(q, qdot, self.dt)
+        if not self._base_only or not all_finite(qdot):  # continuous joints, or refused
+            return self.robot.integrate(q, qdot, self.dt)
+        q_pin = self._pinocchio_q(q)
+        moved: Array = pin.integrate(self.robot.model, q_pin, qdot * self.dt)
+        moved[7:] = q[7:] + (moved[7:] - q_pin[7:])
+        return moved
 
     def _advance(self, r: Resolution) -> Step:
         """Integrate ``r.qdot`` over one period and move the clock on."""
