@@ -184,6 +184,10 @@ class Robot:
         self.continuous[self._angle[0]] = True
         self.continuous.flags.writeable = False
         self._identity_map = not angle_api and model.nq == model.nv
+        # a floating base and one coordinate per joint, in Pinocchio's order: Pinocchio's vector
+        # is q with its quaternion normalised
+        self._same_order = (floating and not angle_api and model.nq == self.nq
+                            and scalar_api == scalar_pin)  # fmt: skip
 
         self.lower = np.full(self.nq, -np.inf)
         self.upper = np.full(self.nq, np.inf)
@@ -294,7 +298,8 @@ class Robot:
     def _dof(self, q: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
         if not self.floating:
             return q
-        out: npt.NDArray[np.float64] = np.concatenate([np.zeros(6), q[7:]])
+        out = np.zeros(self.nv)
+        out[6:] = q[7:]
         return out
 
     @property
@@ -356,19 +361,23 @@ class Robot:
         q = self.check_q(q)
         if self._identity_map:
             return q, q
-        out = np.empty(self.model.nq)
+        if self._same_order:
+            out = q.copy()
+        else:
+            out = np.empty(self.model.nq)
+            if self.floating:
+                out[:7] = q[:7]
+            api, pin_idx = self._scalar
+            out[pin_idx] = q[api]
+            api, pin_idx = self._angle
+            if api.size:  # continuous joints: (cos, sin)
+                out[pin_idx] = np.cos(q[api])
+                out[pin_idx + 1] = np.sin(q[api])
         if self.floating:
-            out[:7] = q[:7]
             norm = math.hypot(*q[3:7].tolist())
             if not norm > QUATERNION_TOL:
                 raise InvalidInput("q", f"the base quaternion q[3:7] = {q[3:7]} has no direction")
             out[3:7] /= norm
-        api, pin_idx = self._scalar
-        out[pin_idx] = q[api]
-        api, pin_idx = self._angle
-        if api.size:  # continuous joints: (cos, sin)
-            out[pin_idx] = np.cos(q[api])
-            out[pin_idx + 1] = np.sin(q[api])
         return q, out
 
     def neutral(self) -> npt.NDArray[np.float64]:
