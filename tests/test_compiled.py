@@ -64,6 +64,10 @@ from rrc_pin.solvers.collision.damper_kernels import damper_bound
 from rrc_pin.solvers.collision.narrow_kernels import segment_closest
 from rrc_pin.solvers.collision.vectors import dot
 out["finite"] = [bool(finite(np.ones(6), 6))]
+from rrc_pin.tasks.relative_frame_kernels import relative_rows  # a cell's grip: in its kernel
+J = np.zeros((6, 2))
+relative_rows(J, J, np.eye(4), np.eye(4), np.eye(4), np.empty((6, 2)), x6 := np.empty(6))
+out["relative"] = x6.tolist()
 out["callees"] = [damper_bound(0.01, 0.1, 0.5, 1e-3, 50.0), dot((1.0, 2.0, 3.0), (4.0, 5.0, 6.0)),
                   *segment_closest((0.0, 0.0, 0.0), (1.0, 0.0, 0.0), (0.5, 1.0, 0.0),
                                    (0.0, 0.0, 1.0)),

@@ -8,7 +8,9 @@ import pytest
 
 import rrc_pin
 from rrc_pin.errors import FrameNotFound, InvalidInput
+from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits import ContactLimit, JointLimits
+from rrc_pin.solvers.exp_log import pose_errors
 
 
 def test_the_feet_are_held_and_their_anchors_errors_measured(tripod):
@@ -44,3 +46,38 @@ def test_without_anchors_nothing_is_measured_and_bad_anchors_are_named(tripod):
     assert limit.frames == ("leg1/flange",)
     with pytest.raises(FrameNotFound):
         limit.set_frames(["nope"], [np.eye(4)])
+
+
+@pytest.mark.parametrize("measured", [True, False])
+def test_the_rows_and_errors_are_pinocchios_jacobians_and_pose_errors(tripod, measured) -> None:
+    """On seeded random configurations: the rows are each foot's world_aligned Jacobian (the
+    tick's kinematics), the errors its pose error to its anchor, within 1e-12; ``last`` holds
+    the rows the tick is given, or stays None without anchors."""
+    q0 = tripod.ready()
+    feet = list(tripod.tool_frames)
+    anchors = np.array([tripod.fk(q0, f) for f in feet])
+    limit = ContactLimit(feet, anchors=anchors if measured else None)
+    resolver = rrc_pin.Resolver(tripod, 0.01, limits=[JointLimits(), limit])
+    rng = np.random.default_rng(33)
+
+    def kinematics(q: np.ndarray) -> Kinematics:
+        _, dof, q_pin = tripod.positions(q)
+        return Kinematics(tripod.model, tripod.model.createData(), resolver.layout, dof, q_pin)
+
+    for _ in range(1000):
+        q = tripod.integrate(q0, rng.normal(size=tripod.nv) * rng.uniform(0.0, 1.0), 1.0)
+        c = limit.constraints(kinematics(q), 0.01, np.zeros(tripod.nv))
+        kin = kinematics(q)
+        np.testing.assert_allclose(c.C, np.vstack([kin.jacobian(f) for f in feet]), rtol=0.0,
+                                   atol=1e-12)  # fmt: skip
+        np.testing.assert_array_equal(c.d, 0.0)
+        if not measured:
+            assert limit.last is None
+            continue
+        assert limit.last.C is c.C
+        want = np.empty(6 * len(feet))
+        pose_errors(anchors, np.array([kin.pose(f) for f in feet]), want)
+        np.testing.assert_allclose(limit.last.error, want, rtol=0.0, atol=1e-12)
+        reach = [resolver.layout.reach[f] for f in feet]
+        unit = np.ravel([[r] * 3 + [1.0] * 3 for r in reach])
+        np.testing.assert_array_equal(limit.last.unit, unit)

@@ -9,7 +9,9 @@ import pytest
 
 import rrc_pin
 from rrc_pin.errors import InvalidInput
+from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits import GripLimit, JointLimits
+from rrc_pin.tasks import RelativeFrameTask
 
 
 def test_the_grip_is_held_and_its_error_measured_in_the_first_hands_axes():
@@ -37,3 +39,59 @@ def test_bad_grips_are_named_and_change_nothing():
     with pytest.raises(InvalidInput, match=r"grips\[0\]"):
         limit.set_pairs([("a", "b")], [np.zeros((4, 4))])
     assert limit.pairs == (("a", "b"),)
+
+
+def _kinematics(resolver: rrc_pin.Resolver, robot: rrc_pin.Robot, q: np.ndarray) -> Kinematics:
+    _, dof, q_pin = robot.positions(q)
+    return Kinematics(robot.model, robot.model.createData(), resolver.layout, dof, q_pin)
+
+
+@pytest.mark.parametrize("measured", [True, False])
+def test_the_rows_errors_and_units_are_the_relative_tasks(measured: bool) -> None:
+    """On seeded random configurations: each pair's rows, grip error and units are those of a
+    RelativeFrameTask holding the grip at gain 1 (its rates are then the error), within 1e-12;
+    ``last`` holds the rows the tick is given, or stays None without grips."""
+    dual = rrc_pin.load("gsfc_dual")
+    a, b = dual.objects["object"].hands
+    q0 = dual.ready()
+    pairs = [(a, b), (b, a)]
+    grips = [np.linalg.inv(dual.fk(q0, x)) @ dual.fk(q0, y) for x, y in pairs]
+    limit = GripLimit(pairs, grips=grips if measured else None)
+    resolver = rrc_pin.Resolver(dual, 0.01, limits=[JointLimits(), limit])
+    tasks = [RelativeFrameTask(x, y, target=T, gain=1.0)
+             for (x, y), T in zip(pairs, grips, strict=True)]  # fmt: skip
+    rng = np.random.default_rng(31)
+    for _ in range(1000):
+        q = q0 + rng.normal(size=dual.nq) * rng.uniform(0.0, 0.5)
+        c = limit.constraints(_kinematics(resolver, dual, q), 0.01, np.zeros(dual.nv))
+        kin = _kinematics(resolver, dual, q)
+        rows = [t.rows(kin) for t in tasks]
+        np.testing.assert_allclose(c.C, np.vstack([r.A for r in rows]), rtol=0.0, atol=1e-12)
+        np.testing.assert_array_equal(c.d, 0.0)
+        assert c.names[0] == f"grip:{b}/{a}:vx" and len(c.names) == 12
+        if not measured:
+            assert limit.last is None
+            continue
+        assert limit.last.C is c.C
+        want = np.concatenate([r.b for r in rows])
+        np.testing.assert_allclose(limit.last.error, want, rtol=0.0, atol=1e-12)
+        np.testing.assert_array_equal(limit.last.unit, np.concatenate([r.unit for r in rows]))
+
+
+def test_the_rows_follow_the_robot_and_pairs_of_the_tick() -> None:
+    """One limit on two resolvers (two layouts, two models), and after its pairs change: each
+    tick's rows are those of its robot and pairs."""
+    duals = [rrc_pin.load("gsfc_dual") for _ in range(2)]
+    a, b = duals[0].objects["object"].hands
+    limit = GripLimit([(a, b)])
+    resolvers = [rrc_pin.Resolver(d, 0.01, limits=[limit]) for d in duals]
+    rng = np.random.default_rng(32)
+    for k in range(6):
+        if k == 3:
+            limit.set_pairs([(b, a)])
+        robot, resolver = duals[k % 2], resolvers[k % 2]
+        q = robot.ready() + rng.normal(size=robot.nq) * 0.3
+        task = RelativeFrameTask(*limit.pairs[0])
+        want = task.rows(_kinematics(resolver, robot, q)).A
+        C = limit.constraints(_kinematics(resolver, robot, q), 0.01, None).C
+        np.testing.assert_allclose(C, want, rtol=0.0, atol=1e-12)

@@ -9,9 +9,10 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import FrameNotFound, InvalidInput
+from rrc_pin.limits.chain_kernels import NO_POSES, UNMEASURED, contact_rows
+from rrc_pin.limits.frame_columns import FrameReader
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import names, rigid_transform
-from rrc_pin.solvers.exp_log import pose_errors
 from rrc_pin.solvers.tick.problem import Constraints
 
 if TYPE_CHECKING:
@@ -101,7 +102,8 @@ class ContactLimit(Limit):
         self._anchors: Array | None = poses  # (k, 4, 4), None: no error measured
         self._names = tuple(f"{self.name}:{f}:{a}" for f in items for a in AXES)
         self._zero = np.zeros(6 * len(items))
-        self._unit: Array | None = None  # the rows' units, once the robot's reach is known
+        # what the rows read of a tick's kinematics, and the rows' units (:meth:`_prepared`)
+        self._prepared_for: tuple[FrameReader, Array] | None = None
         self.last: Closure | None = None
         """The rows and the anchors' errors at the last configuration the limit saw (None
         without anchors or frames)."""
@@ -118,19 +120,32 @@ class ContactLimit(Limit):
         self._layout = layout
 
     def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
-        """The contact rows ``C qdot = 0`` (C: (6 k, nv), world_aligned Jacobians)."""
+        """The contact rows ``C qdot = 0`` (C: (6 k, nv), world_aligned Jacobians).
+
+        One compiled call (:func:`~rrc_pin.limits.chain_kernels.contact_rows`) on the tick's
+        joint Jacobians.
+        """
         if not self.frames:
             return Constraints()
-        C = np.vstack([kin.jacobian(f) for f in self.frames])
-        if self._anchors is not None:
-            oMf, index = kin.data.oMf, kin.layout.frames
-            error = np.empty(6 * len(self.frames))
-            pose_errors(self._anchors, np.array([oMf[index[f]].homogeneous for f in self.frames]),
-                        error)  # fmt: skip
-            reach = kin.layout.reach
-            unit = self._unit
-            if unit is None or unit[::6].tolist() != [reach[f] for f in self.frames]:
-                unit = self._unit = np.array([[reach[f]] * 3 + [1.0] * 3 for f in self.frames],
-                                             dtype=np.float64).ravel()  # fmt: skip
+        reader, unit = self._prepared(kin)
+        columns = reader.columns
+        measured = self._anchors is not None
+        C = np.zeros((6 * len(self.frames), kin.layout.nv))
+        error = np.empty(C.shape[0]) if measured else UNMEASURED
+        contact_rows(reader.data.J, columns.steps, columns.starts, *reader.poses(),
+                     NO_POSES if self._anchors is None else self._anchors, C, error)  # fmt: skip
+        if measured:
             self.last = Closure(C, error, unit)
         return Constraints(C=C, d=self._zero, names=self._names)
+
+    def _prepared(self, kin: Kinematics) -> tuple[FrameReader, Array]:
+        """What the rows read of the tick's kinematics (the frames' columns and poses) and the
+        rows' units (each frame's reach [m] for its position rows, 1 for its rotation rows),
+        made once per robot layout and Data."""  # noqa: D205, D209
+        prepared = self._prepared_for
+        if prepared is None or not prepared[0].fits(kin):
+            reach = kin.layout.reach
+            unit = np.array([[reach[f]] * 3 + [1.0] * 3 for f in self.frames], dtype=np.float64)
+            reader = FrameReader(kin, [kin.layout.frames[f] for f in self.frames])
+            prepared = self._prepared_for = (reader, unit.ravel())
+        return prepared

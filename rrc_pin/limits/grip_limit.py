@@ -9,10 +9,13 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import FrameNotFound, InvalidInput
+from rrc_pin.limits.chain_kernels import NO_POSES, UNMEASURED, grip_rows
 from rrc_pin.limits.contact_limit import AXES, Closure
+from rrc_pin.limits.frame_columns import FrameReader
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import names, rigid_transform
 from rrc_pin.solvers.tick.problem import Constraints
+from rrc_pin.tasks.frame_task import ROWS, row_units
 from rrc_pin.tasks.relative_frame_task import RelativeFrameTask
 
 if TYPE_CHECKING:
@@ -85,6 +88,9 @@ class GripLimit(Limit):
                             for (a, b), T in zip(self.pairs, targets, strict=True))  # fmt: skip
         self._measured = grips is not None and bool(items)
         self._names = tuple(f"{self.name}:{b}/{a}:{x}" for a, b in self.pairs for x in AXES)
+        self._grips = NO_POSES if grips is None else np.array(targets).reshape(-1, 4, 4)
+        # what the rows read of a tick's kinematics, and the rows' units (:meth:`_prepared`)
+        self._prepared_for: tuple[FrameReader, Array] | None = None
         self._zero = np.zeros(6 * len(items))
         self.last: Closure | None = None
         """The rows and the grips' errors at the last configuration the limit saw (None
@@ -103,15 +109,32 @@ class GripLimit(Limit):
         self._layout = layout
 
     def constraints(self, kin: Kinematics, dt: float, previous: Array) -> Constraints:
-        """The grip rows ``C qdot = 0`` (C: (6 k, nv))."""
+        """The grip rows ``C qdot = 0`` (C: (6 k, nv)).
+
+        One compiled call (:func:`~rrc_pin.limits.chain_kernels.grip_rows`) on the tick's
+        joint Jacobians.
+        """
         if not self.pairs:
             return Constraints()
-        rows = [t.rows(kin) for t in self._tasks]
-        one = len(rows) == 1  # its rows as they are (new arrays)
-        C = rows[0].A if one else np.vstack([r.A for r in rows])
+        reader, unit = self._prepared(kin)
+        columns = reader.columns
+        C = np.zeros((6 * len(self.pairs), kin.layout.nv))
+        error = np.empty(C.shape[0]) if self._measured else UNMEASURED
+        grip_rows(reader.data.J, columns.steps, columns.starts, *reader.poses(), self._grips, C,
+                  error)  # fmt: skip
         if self._measured:
-            units = [np.ones(6) if r.unit is None else r.unit for r in rows]
-            unit = units[0].copy() if one else np.concatenate(units)
-            self.last = Closure(C, rows[0].b if one else np.concatenate([r.b for r in rows]),
-                                unit)  # fmt: skip
+            self.last = Closure(C, error, unit)
         return Constraints(C=C, d=self._zero, names=self._names)
+
+    def _prepared(self, kin: Kinematics) -> tuple[FrameReader, Array]:
+        """What the rows read of the tick's kinematics (the pairs' frames' columns and poses,
+        a and b of each pair) and the rows' units (each pair's
+        :meth:`~rrc_pin.tasks.RelativeFrameTask.reach` [m] for its position rows, 1 for its
+        rotation rows), made once per robot layout and Data."""  # noqa: D205, D209
+        prepared = self._prepared_for
+        if prepared is None or not prepared[0].fits(kin):
+            layout = kin.layout
+            unit = np.concatenate([row_units(ROWS["full"], t.reach(layout)) for t in self._tasks])
+            reader = FrameReader(kin, [layout.frames[f] for pair in self.pairs for f in pair])
+            prepared = self._prepared_for = (reader, unit)
+        return prepared

@@ -194,7 +194,8 @@ class FrameTask(Task):
         selected = self.selected
         if len(selected) != 6:
             J = _picked(J, selected)
-        return TaskRows(J, b, self._row_weights(len(selected)), self.name, _units(selected, reach))
+        weights = self._row_weights(len(selected))
+        return TaskRows(J, b, weights, self.name, row_units(selected, reach))
 
 
 _RUNS: dict[tuple[int, ...], slice | None] = {}
@@ -217,7 +218,7 @@ def _picked(J: Array, selected: tuple[int, ...]) -> Array:
 _UNITS: dict[tuple[tuple[int, ...], float], Array] = {}
 
 
-def _units(selected: tuple[int, ...], reach: float) -> Array:
+def row_units(selected: tuple[int, ...], reach: float) -> Array:
     """The rows' units: the reach [m] for linear rows, 1 for angular ones.
 
     Read-only, made once per selection and reach: the tasks built at every tick share them.

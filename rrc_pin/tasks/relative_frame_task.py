@@ -8,7 +8,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.errors import InvalidInput
-from rrc_pin.kinematics import Kinematics
+from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.solvers.checks import positive, rigid_transform
 from rrc_pin.solvers.tick.problem import TaskRows
 from rrc_pin.tasks.frame_task import FrameTask
@@ -127,8 +127,11 @@ class RelativeFrameTask(Task):
         else:
             rates = self.twist + self.gain * (error if len(self.selected) == 6
                                               else error[list(self.selected)])  # fmt: skip
-        reach = max(kin.layout.reach[a], kin.layout.reach[b])
-        return self._spec.rows_from(J, rates, reach)
+        return self._spec.rows_from(J, rates, self.reach(kin.layout))
+
+    def reach(self, layout: Layout) -> float:
+        """The pair's reach [m], the unit of its position rows: the longer chain's."""
+        return max(layout.reach[self.frame_a], layout.reach[self.frame_b])
 
 
 _NO_TARGET = np.zeros((0, 4))
