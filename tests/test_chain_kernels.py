@@ -11,7 +11,7 @@ from test_relative_frame_kernels import _pose, _reference
 
 import rrc_pin
 from rrc_pin.limits.chain_kernels import NO_POSES, UNMEASURED, contact_rows, grip_rows
-from rrc_pin.limits.frame_columns import FrameColumns, placed_frames
+from rrc_pin.limits.frame_columns import FrameColumns
 
 CONFIGURATIONS = 2000
 
@@ -27,7 +27,7 @@ def _ticks(robot: rrc_pin.Robot, frames: list[int], seed: int):
         q = robot.integrate(q0, rng.normal(size=robot.nv) * rng.uniform(0.0, 1.0), 1.0)
         pin.computeJointJacobians(model, data, robot.positions(q)[2])
         pin.updateFramePlacements(model, data)
-        yield rng, data, columns, placed_frames(data)
+        yield rng, data, columns
 
 
 def _jacobian(robot: rrc_pin.Robot, data: pin.Data, frame: int) -> np.ndarray:
@@ -37,13 +37,12 @@ def _jacobian(robot: rrc_pin.Robot, data: pin.Data, frame: int) -> np.ndarray:
 def test_contact_rows_as_pinocchios_jacobians_and_the_anchors_errors(tripod) -> None:
     frames = [tripod.model.getFrameId(f) for f in tripod.tool_frames]
     k = len(frames)
-    for rng, data, columns, placed in _ticks(tripod, frames, 21):
-        poses = [data.oMf[f].homogeneous for f in frames]
+    for rng, data, columns in _ticks(tripod, frames, 21):
+        poses = columns.poses(data)
         turn = 1e-6 if rng.uniform() < 0.5 else rng.uniform(0.0, 2.5)
         anchors = np.array([T @ _pose(rng, turn) for T in poses])
         C, error = np.zeros((6 * k, tripod.nv)), np.empty(6 * k)
-        contact_rows(data.J, columns.steps, columns.starts, placed, columns.frames, anchors, C,
-                     error)  # fmt: skip
+        contact_rows(data.J, columns.steps, columns.starts, poses, anchors, C, error)
         for i, f in enumerate(frames):
             np.testing.assert_array_equal(C[6 * i : 6 * i + 6], _jacobian(tripod, data, f))
             T, A = poses[i], anchors[i]
@@ -55,13 +54,13 @@ def test_grip_rows_as_the_relative_formula_and_the_grips_errors() -> None:
     dual = rrc_pin.load("gsfc_dual")
     a, b = (dual.model.getFrameId(h) for h in dual.objects["object"].hands)
     frames = [a, b, b, a]  # two pairs: the grip and its reverse
-    for rng, data, columns, placed in _ticks(dual, frames, 22):
-        poses = [data.oMf[f].homogeneous for f in frames]
+    for rng, data, columns in _ticks(dual, frames, 22):
+        poses = columns.poses(data)
         turn = 1e-6 if rng.uniform() < 0.5 else rng.uniform(0.0, 2.5)
         grips = np.array([np.linalg.inv(poses[2 * i]) @ poses[2 * i + 1] @ _pose(rng, turn)
                           for i in range(2)])  # fmt: skip
         C, error = np.full((12, dual.nv), np.nan), np.empty(12)
-        grip_rows(data.J, columns.steps, columns.starts, placed, columns.frames, grips, C, error)
+        grip_rows(data.J, columns.steps, columns.starts, poses, grips, C, error)
         for i, (fa, fb) in enumerate([(a, b), (b, a)]):
             want_J, want_error = _reference(_jacobian(dual, data, fa), _jacobian(dual, data, fb),
                                             poses[2 * i], poses[2 * i + 1], grips[i])  # fmt: skip
@@ -73,8 +72,8 @@ def test_grip_rows_as_the_relative_formula_and_the_grips_errors() -> None:
 def test_without_anchors_or_grips_no_error_is_written(kernel) -> None:
     dual = rrc_pin.load("gsfc_dual")
     hands = [dual.model.getFrameId(h) for h in dual.objects["object"].hands]
-    _, data, columns, placed = next(_ticks(dual, hands, 23))
+    _, data, columns = next(_ticks(dual, hands, 23))
     C = np.zeros((12 if kernel is contact_rows else 6, dual.nv))
-    kernel(data.J, columns.steps, columns.starts, placed, columns.frames, NO_POSES, C, UNMEASURED)
+    kernel(data.J, columns.steps, columns.starts, columns.poses(data), NO_POSES, C, UNMEASURED)
     assert np.isfinite(C).all() and np.abs(C).max() > 0.0
     assert UNMEASURED.size == 0 and NO_POSES.size == 0

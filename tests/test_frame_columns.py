@@ -8,9 +8,8 @@ import pytest
 from test_mimic import chain
 
 import rrc_pin
-from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits.chain_kernels import frame_jacobian
-from rrc_pin.limits.frame_columns import FrameColumns, FrameReader, placed_frames
+from rrc_pin.limits.frame_columns import FrameColumns
 
 
 def _configurations(robot: rrc_pin.Robot, rng: np.random.Generator, count: int):
@@ -23,21 +22,19 @@ def _every_frame_as_pinocchio(robot: rrc_pin.Robot, seed: int, count: int) -> No
     model = robot.model
     data = model.createData()
     columns = FrameColumns.of(model, data, list(range(model.nframes)))
-    assert columns.frames.tolist() == list(range(model.nframes))
-    placed = placed_frames(data)
-    assert placed is not None and placed.shape == (model.nframes, 3, 4)
-    assert not placed.flags.writeable
+    assert columns.frames == tuple(range(model.nframes))
     for q in _configurations(robot, np.random.default_rng(seed), count):
         q_pin = robot.positions(q)[2]
         pin.computeJointJacobians(model, data, q_pin)
         pin.updateFramePlacements(model, data)
+        poses = columns.poses(data)
         for f in range(model.nframes):
             J = np.zeros((6, model.nv))
             frame_jacobian(data.J, columns.steps, columns.starts[f], columns.starts[f + 1],
-                           placed[f, :, 3], J)  # fmt: skip
+                           poses[f, :3, 3], J)  # fmt: skip
             want = pin.getFrameJacobian(model, data, f, pin.LOCAL_WORLD_ALIGNED)
             np.testing.assert_array_equal(J, want, err_msg=f"{robot.name} {model.frames[f].name}")
-            np.testing.assert_array_equal(placed[f], data.oMf[f].homogeneous[:3])
+            np.testing.assert_array_equal(poses[f], data.oMf[f].homogeneous)
 
 
 @pytest.mark.parametrize("name", ["gsfc_dual", "yeh_tripod", "panda"])
@@ -66,33 +63,4 @@ def test_repeated_frames_and_none() -> None:
     np.testing.assert_array_equal(columns.steps[:half], columns.steps[half:])
     empty = FrameColumns.of(dual.model, data, [])
     assert empty.steps.shape == (0, 3) and empty.starts.tolist() == [0]
-
-
-def test_the_reader_keeps_its_data_and_copies_where_it_cannot_read_in_place() -> None:
-    """The poses read in place follow the Data's every pass; where Pinocchio's array is not one
-    (a stand-in here), the reader copies the frames' poses, the same values."""
-    dual = rrc_pin.load("gsfc_dual")
-    resolver = rrc_pin.Resolver(dual, 0.01)
-    hands = [dual.model.getFrameId(h) for h in dual.objects["object"].hands]
-    data = dual.model.createData()
-    rng = np.random.default_rng(12)
-
-    def kinematics(q: np.ndarray) -> Kinematics:
-        _, dof, q_pin = dual.positions(q)
-        return Kinematics(dual.model, data, resolver.layout, dof, q_pin)
-
-    reader = FrameReader(kinematics(dual.ready()), hands)
-    copying = FrameReader(kinematics(dual.ready()), hands)
-    copying._view = None
-    for _ in range(5):
-        kin = kinematics(dual.ready() + rng.normal(size=dual.nq))
-        assert reader.fits(kin)  # and the Data placed at its q
-        for r in (reader, copying):
-            placed, rows = r.poses()
-            for i, f in enumerate(hands):
-                np.testing.assert_array_equal(placed[rows[i]], data.oMf[f].homogeneous[:3])
-    _, dof, q_pin = dual.positions(dual.ready())
-    assert not reader.fits(Kinematics(dual.model, dual.model.createData(), resolver.layout, dof,
-                                      q_pin))  # fmt: skip
-    assert not reader.fits(Kinematics(dual.model, data, rrc_pin.Resolver(dual, 0.01).layout, dof,
-                                      q_pin))  # fmt: skip
+    assert empty.poses(data).shape == (0, 4, 4)

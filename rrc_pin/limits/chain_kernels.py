@@ -64,49 +64,38 @@ def frame_jacobian(Jw: Array, steps: Ints, start: int, end: int, p: Array, out: 
             out[3, dst], out[4, dst], out[5, dst] = w0, w1, w2
 
 
-@inlined
-def pose_of(placed: Array, row: int, out: Array) -> Array:
-    """Frame pose ``placed[row]`` ([R | p], (3, 4)) as a homogeneous matrix into ``out`` (4, 4)."""
-    out[:3] = placed[row]
-    out[3, 0], out[3, 1], out[3, 2], out[3, 3] = 0.0, 0.0, 0.0, 1.0
-    return out
-
-
 @kernel
-def contact_rows(Jw: Array, steps: Ints, starts: Ints, placed: Array, rows: Ints,
-                 anchors: Array, C: Array, error: Array) -> None:  # fmt: skip
+def contact_rows(Jw: Array, steps: Ints, starts: Ints, poses: Array, anchors: Array, C: Array,
+                 error: Array) -> None:  # fmt: skip
     """Each contact's Jacobian into ``C`` and its anchor's pose error into ``error``.
 
     Args:
         Jw: The joint Jacobians (6, nv_ext) in the world frame (``data.J``).
         steps: The contacts' steps (s, 3), ``starts`` (k + 1,) each contact's first.
         starts: See ``steps``.
-        placed: Frame poses ``[R | p]`` (m, 3, 4) in the world frame [m].
-        rows: (k,) each contact's row in ``placed``.
+        poses: The contacts' poses (k, 4, 4) in the world frame [m].
         anchors: Their anchors (k, 4, 4) [m], or (0, 4, 4): no error (``error`` untouched).
         C: Out (6 k, nv), zero on entry: contact i's ``world_aligned`` Jacobian in rows
             ``6 i : 6 i + 6``.
         error: Out (6 k,): ``[p* - p; log(R* R^T)]`` [m, rad] of each contact, world axes.
     """
-    pose = np.empty((4, 4))
-    for i in range(rows.size):
-        pose_of(placed, rows[i], pose)
-        frame_jacobian(Jw, steps, starts[i], starts[i + 1], pose[:3, 3], C[6 * i : 6 * i + 6])
+    for i in range(poses.shape[0]):
+        rows = C[6 * i : 6 * i + 6]
+        frame_jacobian(Jw, steps, starts[i], starts[i + 1], poses[i, :3, 3], rows)
         if anchors.shape[0]:
-            pose_error(anchors[i], pose, error[6 * i : 6 * i + 6])
+            pose_error(anchors[i], poses[i], error[6 * i : 6 * i + 6])
 
 
 @kernel
-def grip_rows(Jw: Array, steps: Ints, starts: Ints, placed: Array, rows: Ints, grips: Array,
-              C: Array, error: Array) -> None:  # fmt: skip
+def grip_rows(Jw: Array, steps: Ints, starts: Ints, poses: Array, grips: Array, C: Array,
+              error: Array) -> None:  # fmt: skip
     """Each pair's relative rows into ``C`` and its grip's error into ``error``.
 
     Args:
         Jw: The joint Jacobians (6, nv_ext) in the world frame (``data.J``).
         steps: The frames' steps (s, 3): pair i's frames a and b are frames ``2 i, 2 i + 1``.
         starts: (2 k + 1,) each frame's first step.
-        placed: Frame poses ``[R | p]`` (m, 3, 4) in the world frame [m].
-        rows: (2 k,) each frame's row in ``placed``.
+        poses: The frames' poses (2 k, 4, 4) in the world frame [m], a and b of each pair.
         grips: Each pair's grip (k, 4, 4), b's pose in a [m], or (0, 4, 4): no error
             (``error`` untouched).
         C: Out (6 k, nv): pair i's rows (b's twist relative to a, in a's axes) in rows
@@ -115,14 +104,12 @@ def grip_rows(Jw: Array, steps: Ints, starts: Ints, placed: Array, rows: Ints, g
     """
     nv = C.shape[1]
     Ja, Jb = np.empty((6, nv)), np.empty((6, nv))
-    Ta, Tb = np.empty((4, 4)), np.empty((4, 4))
     none = np.zeros((0, 4))
     for i in range(C.shape[0] // 6):
         a, b = 2 * i, 2 * i + 1
-        pose_of(placed, rows[a], Ta)
-        pose_of(placed, rows[b], Tb)
         Ja[:], Jb[:] = 0.0, 0.0
-        frame_jacobian(Jw, steps, starts[a], starts[a + 1], Ta[:3, 3], Ja)
-        frame_jacobian(Jw, steps, starts[b], starts[b + 1], Tb[:3, 3], Jb)
+        frame_jacobian(Jw, steps, starts[a], starts[a + 1], poses[a, :3, 3], Ja)
+        frame_jacobian(Jw, steps, starts[b], starts[b + 1], poses[b, :3, 3], Jb)
         grip = grips[i] if grips.shape[0] else none
-        relative_rows(Ja, Jb, Ta, Tb, grip, C[6 * i : 6 * i + 6], error[6 * i : 6 * i + 6])
+        relative_rows(Ja, Jb, poses[a], poses[b], grip, C[6 * i : 6 * i + 6],
+                      error[6 * i : 6 * i + 6])  # fmt: skip

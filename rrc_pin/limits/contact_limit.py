@@ -10,7 +10,7 @@ import numpy.typing as npt
 
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits.chain_kernels import NO_POSES, UNMEASURED, contact_rows
-from rrc_pin.limits.frame_columns import FrameReader
+from rrc_pin.limits.frame_columns import FrameColumns
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import names, rigid_transform
 from rrc_pin.solvers.tick.problem import Constraints
@@ -102,8 +102,8 @@ class ContactLimit(Limit):
         self._anchors: Array | None = poses  # (k, 4, 4), None: no error measured
         self._names = tuple(f"{self.name}:{f}:{a}" for f in items for a in AXES)
         self._zero = np.zeros(6 * len(items))
-        # what the rows read of a tick's kinematics, and the rows' units (:meth:`_prepared`)
-        self._prepared_for: tuple[FrameReader, Array] | None = None
+        # the robot's layout, the frames' columns on its model and the rows' units
+        self._prepared_for: tuple[Layout, FrameColumns, Array] | None = None
         self.last: Closure | None = None
         """The rows and the anchors' errors at the last configuration the limit saw (None
         without anchors or frames)."""
@@ -127,25 +127,25 @@ class ContactLimit(Limit):
         """
         if not self.frames:
             return Constraints()
-        reader, unit = self._prepared(kin)
-        columns = reader.columns
+        data = kin.data
+        columns, unit = self._prepared(kin)
         measured = self._anchors is not None
         C = np.zeros((6 * len(self.frames), kin.layout.nv))
         error = np.empty(C.shape[0]) if measured else UNMEASURED
-        contact_rows(reader.data.J, columns.steps, columns.starts, *reader.poses(),
+        contact_rows(data.J, columns.steps, columns.starts, columns.poses(data),
                      NO_POSES if self._anchors is None else self._anchors, C, error)  # fmt: skip
         if measured:
             self.last = Closure(C, error, unit)
         return Constraints(C=C, d=self._zero, names=self._names)
 
-    def _prepared(self, kin: Kinematics) -> tuple[FrameReader, Array]:
-        """What the rows read of the tick's kinematics (the frames' columns and poses) and the
-        rows' units (each frame's reach [m] for its position rows, 1 for its rotation rows),
-        made once per robot layout and Data."""  # noqa: D205, D209
+    def _prepared(self, kin: Kinematics) -> tuple[FrameColumns, Array]:
+        """The frames' columns on the tick's model and the rows' units (its frames' reach [m]
+        for the position rows, 1 for the rotation rows), made once per robot layout."""  # noqa: D205, D209
         prepared = self._prepared_for
-        if prepared is None or not prepared[0].fits(kin):
-            reach = kin.layout.reach
-            unit = np.array([[reach[f]] * 3 + [1.0] * 3 for f in self.frames], dtype=np.float64)
-            reader = FrameReader(kin, [kin.layout.frames[f] for f in self.frames])
-            prepared = self._prepared_for = (reader, unit.ravel())
-        return prepared
+        if prepared is None or prepared[0] is not kin.layout:
+            layout = kin.layout
+            columns = FrameColumns.of(kin.model, kin.data, [layout.frames[f] for f in self.frames])
+            unit = np.array([[layout.reach[f]] * 3 + [1.0] * 3 for f in self.frames],
+                            dtype=np.float64).ravel()  # fmt: skip
+            prepared = self._prepared_for = (layout, columns, unit)
+        return prepared[1], prepared[2]

@@ -11,7 +11,7 @@ import numpy.typing as npt
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.limits.chain_kernels import NO_POSES, UNMEASURED, grip_rows
 from rrc_pin.limits.contact_limit import AXES, Closure
-from rrc_pin.limits.frame_columns import FrameReader
+from rrc_pin.limits.frame_columns import FrameColumns
 from rrc_pin.limits.limit import Limit
 from rrc_pin.solvers.checks import names, rigid_transform
 from rrc_pin.solvers.tick.problem import Constraints
@@ -89,8 +89,8 @@ class GripLimit(Limit):
         self._measured = grips is not None and bool(items)
         self._names = tuple(f"{self.name}:{b}/{a}:{x}" for a, b in self.pairs for x in AXES)
         self._grips = NO_POSES if grips is None else np.array(targets).reshape(-1, 4, 4)
-        # what the rows read of a tick's kinematics, and the rows' units (:meth:`_prepared`)
-        self._prepared_for: tuple[FrameReader, Array] | None = None
+        # the robot's layout, the frames' columns on its model and the rows' units
+        self._prepared_for: tuple[Layout, FrameColumns, Array] | None = None
         self._zero = np.zeros(6 * len(items))
         self.last: Closure | None = None
         """The rows and the grips' errors at the last configuration the limit saw (None
@@ -116,25 +116,25 @@ class GripLimit(Limit):
         """
         if not self.pairs:
             return Constraints()
-        reader, unit = self._prepared(kin)
-        columns = reader.columns
+        data = kin.data
+        columns, unit = self._prepared(kin)
         C = np.zeros((6 * len(self.pairs), kin.layout.nv))
         error = np.empty(C.shape[0]) if self._measured else UNMEASURED
-        grip_rows(reader.data.J, columns.steps, columns.starts, *reader.poses(), self._grips, C,
+        grip_rows(data.J, columns.steps, columns.starts, columns.poses(data), self._grips, C,
                   error)  # fmt: skip
         if self._measured:
             self.last = Closure(C, error, unit)
         return Constraints(C=C, d=self._zero, names=self._names)
 
-    def _prepared(self, kin: Kinematics) -> tuple[FrameReader, Array]:
-        """What the rows read of the tick's kinematics (the pairs' frames' columns and poses,
-        a and b of each pair) and the rows' units (each pair's
-        :meth:`~rrc_pin.tasks.RelativeFrameTask.reach` [m] for its position rows, 1 for its
-        rotation rows), made once per robot layout and Data."""  # noqa: D205, D209
+    def _prepared(self, kin: Kinematics) -> tuple[FrameColumns, Array]:
+        """The pairs' frames' columns on the tick's model (a, b of each pair) and the rows'
+        units (each pair's :meth:`~rrc_pin.tasks.RelativeFrameTask.reach`), made once per
+        robot layout."""  # noqa: D205, D209
         prepared = self._prepared_for
-        if prepared is None or not prepared[0].fits(kin):
+        if prepared is None or prepared[0] is not kin.layout:
             layout = kin.layout
+            frames = [layout.frames[f] for pair in self.pairs for f in pair]
             unit = np.concatenate([row_units(ROWS["full"], t.reach(layout)) for t in self._tasks])
-            reader = FrameReader(kin, [layout.frames[f] for pair in self.pairs for f in pair])
-            prepared = self._prepared_for = (reader, unit)
-        return prepared
+            prepared = self._prepared_for = (layout, FrameColumns.of(kin.model, kin.data, frames),
+                                             unit)  # fmt: skip
+        return prepared[1], prepared[2]
