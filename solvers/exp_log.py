@@ -163,11 +163,3 @@ def pose_error(target: Array, pose: Array, out: Array) -> None:
             turn[i, j] = (target[i, 0] * pose[j, 0] + target[i, 1] * pose[j, 1]
                           + target[i, 2] * pose[j, 2])  # fmt: skip
     log3(turn, out[3:])
-
-
-@kernel
-def pose_errors(targets: Array, poses: Array, out: Array) -> None:
-    """:func:`pose_error` of each frame i, ``targets[i]`` and ``poses[i]`` (k, 4, 4), into
-    ``out`` (6 k,)."""  # noqa: D205, D209
-    for i in range(targets.shape[0]):
-        pose_error(targets[i], poses[i], out[6 * i : 6 * i + 6])

@@ -10,7 +10,7 @@ import rrc_pin
 from rrc_pin.errors import FrameNotFound, InvalidInput
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits import ContactLimit, JointLimits
-from rrc_pin.solvers.exp_log import pose_errors
+from rrc_pin.solvers.exp_log import pose_error
 
 
 def test_the_feet_are_held_and_their_anchors_errors_measured(tripod):
@@ -76,7 +76,8 @@ def test_the_rows_and_errors_are_pinocchios_jacobians_and_pose_errors(tripod, me
             continue
         assert limit.last.C is c.C
         want = np.empty(6 * len(feet))
-        pose_errors(anchors, np.array([kin.pose(f) for f in feet]), want)
+        for i, f in enumerate(feet):
+            pose_error(anchors[i], kin.pose(f), want[6 * i : 6 * i + 6])
         np.testing.assert_allclose(limit.last.error, want, rtol=0.0, atol=1e-12)
         reach = [resolver.layout.reach[f] for f in feet]
         unit = np.ravel([[r] * 3 + [1.0] * 3 for r in reach])

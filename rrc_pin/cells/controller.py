@@ -71,7 +71,7 @@ from rrc_pin.loading import loaded
 from rrc_pin.resolver import QPOptions
 from rrc_pin.robot import frame_index
 from rrc_pin.solvers.checks import as_vector, flag, positive
-from rrc_pin.solvers.exp_log import displaced, pose_errors
+from rrc_pin.solvers.exp_log import displaced, pose_error
 from rrc_pin.solvers.spatial import to_world_aligned
 from rrc_pin.solvers.tick.damping import Damping
 from rrc_pin.solvers.tick.pipeline import solve
@@ -483,7 +483,7 @@ class CellController(Loop):
             target = _moved(self._targets[name], twist * (made * self.dt))
             pose = oMf[index[self.frame_of(name)]].homogeneous
             error = np.empty(6)
-            pose_errors(target[None], pose[None], error)
+            pose_error(target, pose, error)
             for part, hold in zip((slice(0, 3), slice(3, 6)), HOLD, strict=True):
                 size = float(np.linalg.norm(error[part]))
                 if size > hold:
