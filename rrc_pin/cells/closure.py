@@ -177,7 +177,7 @@ def close(
     G, h = (np.zeros((0, n)), np.zeros(0)) if rows is None else (rows.G, np.array(rows.h))
     delta, after = np.empty(n), np.empty(closure.error.size)
     closure_kernels.correction(
-        np.ascontiguousarray(data.J), frames.support, frames.joint, poses, frames.contacts,
+        data.J, frames.support, frames.joint, poses, frames.contacts,
         frames.grips, np.ascontiguousarray(closure.C), closure.error, closure.unit,
         np.ascontiguousarray(top), qdot, np.array([box.lb, box.ub, box.velocity]),
         np.ascontiguousarray(G), h, dt, delta, after,
@@ -188,15 +188,15 @@ def close(
 def compile_correction(nv: int) -> None:
     """Compile the correction's kernels now (or load them from the cache), for ``nv`` rates.
 
-    With the arrays' types a tick passes (the resolver's rates read-only), so that a
-    controller's first tick does not compile it.
+    With the arrays' types a tick passes (Pinocchio's world Jacobian in column order, the
+    resolver's rates read-only), so that a controller's first tick does not compile it.
     """
     qdot = np.zeros(nv)
     qdot.flags.writeable = False
     empty, rows = np.zeros(0), np.zeros((0, nv))
     ints = np.zeros(0, dtype=np.int64)
     closure_kernels.correction(
-        np.zeros((6, nv)), np.zeros((0, nv), dtype=bool), np.zeros(nv, dtype=np.int64),
+        np.zeros((6, nv), order="F"), np.zeros((0, nv), dtype=bool), np.zeros(nv, dtype=np.int64),
         np.zeros((0, 4, 4)), ints, ints.reshape(0, 2), rows, empty, empty, rows, qdot,
         np.zeros((3, nv)), rows, empty, 0.01, np.empty(nv), np.empty(0),
     )  # fmt: skip

@@ -33,7 +33,14 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import kernel
 from rrc_pin.solvers.tick.feasibility import clip_into, inside, rows_hold
-from rrc_pin.solvers.tick.linalg import cholesky, householder_qr, solve_factored
+from rrc_pin.solvers.tick.linalg import (
+    cholesky,
+    householder_null,
+    householder_vectors,
+    normal_equations,
+    row_values,
+    solve_factored,
+)
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
 
 Array = npt.NDArray[np.float64]
@@ -186,6 +193,43 @@ def second_order(
 
 
 @kernel
+def damped_factor(J: Array, L: Array) -> float:
+    r"""The Cholesky factor ``L`` (n, n) of :func:`damped`'s :math:`M = J^TJ + \mu I` of rows
+    ``J`` (m, n), and :math:`\mu`; 0 where M is not definite (``L`` then not set).
+
+    ``L``'s upper triangle is left as M's (:func:`~rrc_pin.solvers.tick.linalg.cholesky`
+    in place; :func:`~rrc_pin.solvers.tick.linalg.solve_factored` does not read it).
+    """  # noqa: D205
+    m, n = J.shape
+    normal_equations(J, np.zeros(m), np.ones(m), L, np.empty(n))
+    trace = 0.0
+    for i in range(n):
+        trace += L[i, i]
+    mu = max(DAMPING * trace / max(m, 1), _TINY)
+    for i in range(n):
+        L[i, i] += mu
+    return mu if cholesky(L, 1e-12, L) else 0.0
+
+
+@kernel
+def damped_solve(J: Array, L: Array, mu: float, b: Array, out: Array) -> None:
+    r"""``out``: :func:`damped` of ``J x = b`` from :func:`damped_factor`'s ``L`` and ``mu``
+    (zero where ``mu`` is 0: not definite)."""  # noqa: D205, D209
+    m, n = J.shape
+    if mu == 0.0:
+        out[:] = 0.0
+        return
+    g, t, s = np.zeros(n), np.empty(n), np.empty(n)
+    for r in range(m):  # J^T b
+        for i in range(n):
+            g[i] += J[r, i] * b[r]
+    solve_factored(L, g, t)
+    solve_factored(L, t, s)
+    for i in range(n):
+        out[i] = t[i] + mu * s[i]
+
+
+@kernel
 def damped(J: Array, b: Array, out: Array) -> None:
     r"""``out``: the damped least squares of ``J x = b`` pulled toward itself (zero where not
     definite).
@@ -195,46 +239,74 @@ def damped(J: Array, b: Array, out: Array) -> None:
     minimiser of :math:`\|Jx - b\|^2 + \mu\|x - t\|^2`, :math:`t + \mu M^{-1}t`: along a
     right singular vector of singular value :math:`\sigma`,
     :math:`\beta\sigma(\sigma^2 + 2\mu)/(\sigma^2 + \mu)^2` of the exact
-    :math:`\beta/\sigma`, bounded through a singularity. One Cholesky factorisation, two
-    triangular solves.
+    :math:`\beta/\sigma`, bounded through a singularity. One Cholesky factorisation
+    (:func:`damped_factor`, once for all right-hand sides), two triangular solves
+    (:func:`damped_solve`).
     """  # noqa: D205
-    m, n = J.shape
-    M = J.T @ J
-    trace = 0.0
-    for i in range(n):
-        trace += M[i, i]
-    mu = max(DAMPING * trace / max(m, 1), _TINY)
-    for i in range(n):
-        M[i, i] += mu
-    L = np.zeros((n, n))
-    if not cholesky(M, 1e-12, L):
-        out[:] = 0.0
-        return
-    t, s = np.empty(n), np.empty(n)
-    solve_factored(L, J.T @ b, t)
-    solve_factored(L, t, s)
-    out[:] = t + mu * s
+    n = J.shape[1]
+    L = np.empty((n, n))
+    damped_solve(J, L, damped_factor(J, L), b, out)
 
 
 @kernel
-def lexicographic(C: Array, top: Array, null: Array, keep: Array, r: Array, out: Array) -> None:
+def kept(C: Array, top: Array) -> tuple[Array, Array]:
+    """A basis of the null space of rows ``C`` (m, n) and the top level's rows in it.
+
+    Returns:
+        ``null`` (n - m, n), orthonormal rows from the Householder QR of :math:`C^T`
+        (:func:`~rrc_pin.solvers.tick.linalg.householder_null`), and ``keep``, ``top @
+        null.T`` (t, n - m); (0, n) and (t, 0) where there is no top level (t = 0) or no
+        null space (m >= n).
+    """
+    m, n = C.shape
+    t = top.shape[0]
+    if t == 0 or m >= n:
+        return np.zeros((0, n)), np.zeros((t, 0))
+    k = min(n - 1, m)
+    R, V, beta = np.empty((n, m)), np.empty((k, n)), np.empty(k)
+    householder_vectors(C.T, R, V, beta)
+    null, keep = np.empty((n - m, n)), np.zeros((t, n - m))
+    householder_null(V, beta, m, null)
+    for r in range(t):
+        for c in range(n - m):
+            for i in range(n):
+                keep[r, c] += top[r, i] * null[c, i]
+    return null, keep
+
+
+@kernel
+def lexicographic(
+    C: Array, LC: Array, muC: float, top: Array, null: Array, keep: Array, LK: Array,
+    muK: float, r: Array, out: Array,
+) -> None:  # fmt: skip
     """``out``: the chains' rates ``C x = r`` first, then, among the corrections with those
     rates, the one that keeps the top level's (``top x`` nearest zero), each :func:`damped`.
 
     Args:
         C: The chains' rows (m, n), in their metric.
+        LC: :func:`damped_factor`'s factor of C (n, n).
+        muC: Its damping (0: not definite).
         top: The top level's rows (t, n) (t = 0: none kept).
-        null: (n - m, n) a basis of C's null space (rows), or (0, n): none.
+        null: (n - m, n) a basis of C's null space (rows), or (0, n): none (:func:`kept`).
         keep: ``top @ null.T`` (t, n - m).
+        LK: :func:`damped_factor`'s factor of keep (n - m, n - m).
+        muK: Its damping.
         r: The chains' rates (m,).
         out: Out: (n,).
     """  # noqa: D205
-    damped(C, r, out)
-    if null.shape[0] == 0 or top.shape[0] == 0:
+    damped_solve(C, LC, muC, r, out)
+    p, n = null.shape
+    t = top.shape[0]
+    if p == 0 or t == 0:
         return
-    y = np.empty(null.shape[0])
-    damped(keep, -(top @ out), y)
-    out += y @ null
+    b, y = np.zeros(t), np.empty(p)
+    for i in range(t):
+        for j in range(n):
+            b[i] -= top[i, j] * out[j]
+    damped_solve(keep, LK, muK, b, y)
+    for c in range(p):
+        for j in range(n):
+            out[j] += y[c] * null[c, j]
 
 
 @kernel
@@ -246,7 +318,8 @@ def correction(
     r"""The correction that closes the chains within the step, and their error after it.
 
     :func:`rrc_pin.cells.closure.close` (its docstring: the least squares, the box, the
-    passes), on the tick's kinematics.
+    passes), on the tick's kinematics. The least squares' factors are made once, for every
+    pass (the rows do not change between passes, only their rates).
 
     Args:
         J: The world Jacobian (6, nv) of every joint (:func:`second_order`).
@@ -269,35 +342,41 @@ def correction(
         delta: Out: the correction (nv,).
         after: Out: the chains' error after the step (6 k,), to second order.
     """
-    m, n = C.shape[0], qdot.size
-    Cm = np.empty((m, n))  # the resolver's metric: metres per reach
-    for i in range(m):
-        Cm[i] = C[i] / unit[i]
-    null: Array = np.zeros((0, n))
-    keep: Array = np.zeros((top.shape[0], 0))
-    if top.shape[0] > 0 and m < n:
-        Q, R = np.empty((n, n)), np.empty((n, m))
-        householder_qr(np.ascontiguousarray(Cm.T), Q, R)
-        null = np.ascontiguousarray(Q[:, m:].T)
-        keep = top @ null.T
-    trust = TRUST * box[2]
-    low = np.minimum(np.maximum(box[0] - qdot, -trust), 0.0)  # zero always inside
-    high = np.maximum(np.minimum(box[1] - qdot, trust), 0.0)
-    room = np.maximum(h - G @ qdot, 0.0)
-    M = np.empty((m + top.shape[0], n))
-    M[:m] = Cm
-    M[m:] = KEEP * top
+    m, n, t = C.shape[0], qdot.size, top.shape[0]
+    M = np.empty((m + t, n))  # the projection's rows: the chains' in the resolver's metric
+    for i in range(m):  # (metres per reach), the top level's
+        for j in range(n):
+            M[i, j] = C[i, j] / unit[i]
+    for i in range(t):
+        for j in range(n):
+            M[m + i, j] = KEEP * top[i, j]
+    Cm = M[:m]
+    null, keep = kept(Cm, top)
+    LC, LK = np.empty((n, n)), np.empty((keep.shape[1], keep.shape[1]))
+    muC, muK = damped_factor(Cm, LC), damped_factor(keep, LK)
+    low, high, room = np.empty(n), np.empty(n), row_values(G, qdot)
+    for i in range(n):  # zero always inside
+        trust = TRUST * box[2, i]
+        low[i] = min(max(box[0, i] - qdot[i], -trust), 0.0)
+        high[i] = max(min(box[1, i] - qdot[i], trust), 0.0)
+    for i in range(h.size):
+        room[i] = max(h[i] - room[i], 0.0)
     second, r, u, x = np.empty(m), np.empty(m), np.empty(n), np.empty(n)
     delta[:] = 0.0
     for _ in range(PASSES):
-        u[:] = qdot + delta
+        for i in range(n):
+            u[i] = qdot[i] + delta[i]
         second_order(J, support, joint, poses, contacts, grips, u, second)
-        r[:] = (error - 0.5 * dt * dt * second) / (dt * unit)
-        lexicographic(Cm, top, null, keep, r, delta)
+        for i in range(m):
+            r[i] = (error[i] - 0.5 * dt * dt * second[i]) / (dt * unit[i])
+        lexicographic(Cm, LC, muC, top, null, keep, LK, muK, r, delta)
         if not (inside(delta, low, high) and rows_hold(G, delta, room, 0.0)):
             if project(M, DAMPING, delta, low, high, G, room, MARGIN, x) != SOLVED:
                 x[:] = 0.0
             clip_into(x, low, high)
             delta[:] = x
-    u[:] = qdot + delta
-    after[:] = error - (C @ u + 0.5 * dt * second) * dt
+    for i in range(m):
+        s = 0.0
+        for j in range(n):
+            s += C[i, j] * (qdot[j] + delta[j])
+        after[i] = error[i] - (s + 0.5 * dt * second[i]) * dt

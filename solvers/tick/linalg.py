@@ -59,8 +59,62 @@ def max_abs(x: Array) -> float:
 
 
 @kernel
+def householder_vectors(At: Array, R: Array, V: Array, beta: Array) -> None:
+    r"""Householder QR of ``At`` (n, m) in factored form (Golub & Van Loan, Algorithm 5.2.1).
+
+    :math:`At = H_0 H_1 \cdots H_{k-1} R` with :math:`H_j = I - \beta_j v_j v_j^T`,
+    k = min(n - 1, m).
+
+    Args:
+        At: The transposed task rows (n, m).
+        R: Out: upper triangular (n, m).
+        V: Out: (k, n) the Householder vectors :math:`v_j` (rows: zero before j, one at j).
+        beta: Out: (k,) their factors (0 where the column is zero below j already:
+            :math:`H_j = I`, its row of V not set).
+    """
+    n, m = At.shape
+    for i in range(n):  # element by element: an array copy compiles numba's shape error too
+        for j in range(m):
+            R[i, j] = At[i, j]
+    s = np.empty(m)
+    for j in range(min(n - 1, m)):
+        sigma = 0.0  # the Householder vector of R[j:, j] (Golub & Van Loan, Algorithm 5.1.1)
+        for i in range(j + 1, n):
+            sigma += R[i, j] * R[i, j]
+        beta[j] = 0.0
+        if sigma == 0.0:
+            continue
+        x0 = R[j, j]
+        mu = math.sqrt(x0 * x0 + sigma)
+        v0 = x0 - mu if x0 <= 0.0 else -sigma / (x0 + mu)
+        b = 2.0 * v0 * v0 / (sigma + v0 * v0)
+        beta[j] = b
+        v = V[j]
+        v[:j] = 0.0
+        v[j] = 1.0
+        for i in range(j + 1, n):
+            v[i] = R[i, j] / v0
+        # R = (I - beta v v^T) R: each column's v^T R[:, c] summed in row order, the columns
+        # side by side
+        s[j:] = 0.0
+        for i in range(j, n):
+            for c in range(j, m):
+                s[c] += v[i] * R[i, c]
+        for c in range(j, m):
+            s[c] *= b
+        for i in range(j, n):
+            for c in range(j, m):
+                R[i, c] -= s[c] * v[i]
+        for i in range(j + 1, n):
+            R[i, j] = 0.0
+
+
+@kernel
 def householder_qr(At: Array, Q: Array, R: Array) -> None:
-    """Householder QR of ``At`` (n, m): ``At = Q R`` (Golub & Van Loan, Algorithm 5.2.1).
+    r"""Householder QR of ``At`` (n, m): ``At = Q R`` (Golub & Van Loan, Algorithm 5.2.1).
+
+    :func:`householder_vectors`, then Q accumulated from the left,
+    :math:`Q = H_0 H_1 \cdots H_{k-1}`.
 
     Args:
         At: The transposed task rows (n, m).
@@ -68,42 +122,52 @@ def householder_qr(At: Array, Q: Array, R: Array) -> None:
         R: Out: upper triangular (n, m).
     """
     n, m = At.shape
-    for i in range(n):  # element by element: an array copy compiles numba's shape error too
-        for j in range(m):
-            R[i, j] = At[i, j]
+    k = max(min(n - 1, m), 0)
+    V, beta = np.empty((k, n)), np.empty(k)
+    householder_vectors(At, R, V, beta)
     Q[:, :] = 0.0
     for i in range(n):
         Q[i, i] = 1.0
-    v = np.empty(n)
-    for j in range(min(n - 1, m)):
-        sigma = 0.0  # the Householder vector of R[j:, j] (Golub & Van Loan, Algorithm 5.1.1)
-        for i in range(j + 1, n):
-            sigma += R[i, j] * R[i, j]
-        if sigma == 0.0:
+    for j in range(k):
+        if beta[j] == 0.0:
             continue
-        x0 = R[j, j]
-        mu = math.sqrt(x0 * x0 + sigma)
-        v0 = x0 - mu if x0 <= 0.0 else -sigma / (x0 + mu)
-        beta = 2.0 * v0 * v0 / (sigma + v0 * v0)
-        v[j] = 1.0
-        for i in range(j + 1, n):
-            v[i] = R[i, j] / v0
-        for c in range(j, m):  # R = (I - beta v v^T) R
-            s = 0.0
-            for i in range(j, n):
-                s += v[i] * R[i, c]
-            s *= beta
-            for i in range(j, n):
-                R[i, c] -= s * v[i]
+        v = V[j]
         for r in range(n):  # Q = Q (I - beta v v^T)
             s = 0.0
             for i in range(j, n):
                 s += Q[r, i] * v[i]
-            s *= beta
+            s *= beta[j]
             for i in range(j, n):
                 Q[r, i] -= s * v[i]
-        for i in range(j + 1, n):
-            R[i, j] = 0.0
+
+
+@kernel
+def householder_null(V: Array, beta: Array, m: int, N: Array) -> None:
+    r"""The trailing columns of :math:`Q = H_0 \cdots H_{k-1}` (:func:`householder_vectors`),
+    as rows: ``N = Q[:, m:].T`` (n - m, n), an orthonormal basis of the complement of the
+    span of ``At``'s m columns (the null space of the rows ``At.T``).
+
+    Accumulated from the right, :math:`H_0(H_1(\cdots H_{k-1}[0; I]))` (Golub & Van Loan,
+    5.1.6: backward accumulation, each :math:`H_j` on entries j: only).
+    """  # noqa: D205
+    n = N.shape[1]
+    p = n - m
+    N[:, :] = 0.0
+    for c in range(p):
+        N[c, m + c] = 1.0
+    s = np.empty(p)
+    for j in range(beta.size - 1, -1, -1):
+        if beta[j] == 0.0:
+            continue
+        v = V[j]
+        s[:] = 0.0  # each row's v^T N[c], summed in order, the rows side by side
+        for i in range(j, n):
+            for c in range(p):
+                s[c] += v[i] * N[c, i]
+        for c in range(p):
+            s[c] *= beta[j]
+            for i in range(j, n):
+                N[c, i] -= s[c] * v[i]
 
 
 @kernel
