@@ -19,7 +19,7 @@ from rrc_pin.cells.closure import TRUST, ChainFrames, close
 from rrc_pin.kinematics import Kinematics, Layout
 from rrc_pin.limits.contact_limit import Closure
 from rrc_pin.robot import frame_index
-from rrc_pin.solvers.tick.problem import Box
+from rrc_pin.solvers.tick.problem import Box, Rows
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
 
 FIXED = 11
@@ -74,9 +74,10 @@ def reference_damped(J, b):
     return t + mu * np.linalg.solve(M, t)
 
 
-def reference_close(model, q_pin, frames, closure, qdot, top, box, dt):
-    """The correction in numpy (no constraint rows): passes, lexicographic damped least
-    squares in numpy's QR null space, the projection where the box binds."""
+def reference_close(model, q_pin, frames, closure, qdot, top, box, dt, G=None, h=None):
+    """The correction in numpy: passes, lexicographic damped least squares in numpy's QR null
+    space, the projection where the box or a constraint row ``G delta <= max(h - G qdot, 0)``
+    binds."""
     n = qdot.size
     C = closure.C / closure.unit[:, None]
     m = C.shape[0]
@@ -84,7 +85,8 @@ def reference_close(model, q_pin, frames, closure, qdot, top, box, dt):
     trust = TRUST * box.velocity
     low = np.minimum(np.maximum(box.lb - qdot, -trust), 0.0)
     high = np.maximum(np.minimum(box.ub - qdot, trust), 0.0)
-    G, h = np.zeros((0, n)), np.zeros(0)
+    G, h = (np.zeros((0, n)), np.zeros(0)) if G is None else (G, h)
+    room = np.maximum(h - G @ qdot, 0.0)
     contacts = [frames.frames[i] for i in frames.contacts]
     grips = [(frames.frames[a], frames.frames[b]) for a, b in frames.grips]
     delta = np.zeros(n)
@@ -94,10 +96,10 @@ def reference_close(model, q_pin, frames, closure, qdot, top, box, dt):
         delta = reference_damped(C, r)
         if null is not None:
             delta = delta + reference_damped(top @ null.T, -(top @ delta)) @ null
-        if not np.all((low <= delta) & (delta <= high)):
+        if not (np.all((low <= delta) & (delta <= high)) and np.all(G @ delta <= room)):
             x = np.empty(n)
             M = np.vstack([C, ck.KEEP * top])
-            if project(M, ck.DAMPING, delta, low, high, G, h, MARGIN, x) != SOLVED:
+            if project(M, ck.DAMPING, delta, low, high, G, room, MARGIN, x) != SOLVED:
                 x[:] = 0.0
             delta = np.clip(x, low, high)
     after = closure.error - (closure.C @ (qdot + delta) + 0.5 * dt * second) * dt
@@ -151,55 +153,115 @@ def test_damped_is_its_formula(seed):
     """Against numpy's solves; its residual within the two damped steps' bound."""
     seed = fresh() if seed is None else seed
     rng = np.random.default_rng(seed)
-    for m, n in ((6, 14), (18, 24), (6, 6)):
+    for m, n in ((6, 14), (18, 24), (6, 6), (9, 5), (1, 3)):  # the rows' side, M's
         J, b = rng.normal(size=(m, n)), rng.normal(size=m)
         got = np.empty(n)
         ck.damped(J, b, got)
         np.testing.assert_allclose(got, reference_damped(J, b), rtol=1e-9, atol=1e-12,
                                    err_msg=f"seed {seed}")  # fmt: skip
+        if m > n:  # more rows than rates: a least squares' residual
+            continue
         # Two damped steps leave (mu / (sigma^2 + mu))^2 of b along each singular direction.
         mu, sigma = ck.DAMPING * np.trace(J.T @ J) / m, np.linalg.svd(J, compute_uv=False)[-1]
         left = (mu / (sigma**2 + mu)) ** 2 * np.linalg.norm(b)
         assert np.linalg.norm(J @ got - b) <= 1.01 * left + 1e-12, f"seed {seed}"
-    got = np.ones(3)
-    ck.damped(np.zeros((2, 3)), np.ones(2), got)  # not definite: zero
-    np.testing.assert_array_equal(got, 0.0)
+    for m, n in ((2, 3), (3, 2), (0, 3)):  # no rows, or all zero: zero
+        got = np.ones(n)
+        ck.damped(np.zeros((m, n)), np.ones(m), got)
+        np.testing.assert_array_equal(got, 0.0)
+
+
+@pytest.mark.parametrize("seed", [FIXED, None])
+def test_damped_factors_serve_every_right_hand_side(seed):
+    """:func:`damped_factor` once, :func:`damped_solve` for several rates: :func:`damped`'s
+    answers, bit for bit; and the kept rows' null space is numpy's, to rounding."""
+    seed = fresh() if seed is None else seed
+    rng = np.random.default_rng(seed)
+    for m, n in ((6, 14), (18, 24), (9, 5)):
+        J = rng.normal(size=(m, n))
+        L = np.empty((min(m, n), min(m, n)))
+        mu = ck.damped_factor(J, L)
+        assert mu > 0.0
+        for _ in range(3):
+            b, got, want = rng.normal(size=m), np.empty(n), np.empty(n)
+            ck.damped_solve(J, L, mu, b, got)
+            ck.damped(J, b, want)
+            np.testing.assert_array_equal(got, want, err_msg=f"seed {seed}")
+        top = rng.normal(size=(6, n))
+        null, keep = ck.kept(J, top)
+        if m >= n:
+            assert null.shape == (0, n) and keep.shape == (6, 0)
+            continue
+        want_null = np.linalg.qr(J.T, mode="complete")[0][:, m:].T
+        # the same subspace, orthonormal rows: the same projector
+        np.testing.assert_allclose(null.T @ null, want_null.T @ want_null, atol=1e-13,
+                                   err_msg=f"seed {seed}")  # fmt: skip
+        np.testing.assert_allclose(null @ null.T, np.eye(n - m), atol=1e-13)
+        np.testing.assert_allclose(keep, top @ null.T, atol=1e-13)
+
+
+def random_case(cell, frames, rng, k):
+    """A random tick's inputs to :func:`close`: chains' errors, rates, a wide box (k odd) or a
+    tight one (the trust region binds), a top level (k % 4 < 2) and constraint rows (k % 3 ==
+    0, one of them held at zero room where k % 6 == 0)."""
+    names = {v: k for k, v in frame_index(cell.model).items()}
+    contacts = [frames.frames[i] for i in frames.contacts]
+    grips = [(frames.frames[a], frames.frames[b]) for a, b in frames.grips]
+    q = cell.random_q(rng)
+    kin = kinematics(cell, q)
+    C = np.vstack([kin.jacobian(names[f]) for f in contacts]
+                  + [rrc_pin.tasks.RelativeFrameTask(names[a], names[b]).rows(kin).A
+                     for a, b in grips])  # fmt: skip
+    unit = np.tile([1.7, 1.7, 1.7, 1.0, 1.0, 1.0], C.shape[0] // 6)
+    closure = Closure(C, rng.normal(size=C.shape[0]) * 1e-5, unit)
+    scale = 1e3 if k % 2 else 1e-3  # wide, or the correction's trust region binds
+    lb = -cell.velocity_limit * rng.uniform(0.0, 1.0, cell.nv)
+    ub = cell.velocity_limit * rng.uniform(0.0, 1.0, cell.nv)
+    box = Box(lb, ub, np.zeros((2, cell.nv), np.int8), True, False,
+              cell.velocity_limit * scale)  # fmt: skip
+    qdot = box.clip(rng.normal(size=cell.nv) * 0.3)
+    top = rng.normal(size=(6, cell.nv)) if k % 4 < 2 else np.zeros((0, cell.nv))
+    rows = None
+    if k % 3 == 0:
+        G = rng.normal(size=(4, cell.nv))
+        h = G @ qdot + np.abs(rng.normal(size=4)) * 1e-4
+        if k % 6 == 0:
+            h[0] = G[0] @ qdot  # held: no room
+        rows = Rows(G, h, ("row",) * 4)
+    return q, kin, closure, qdot, top, box, rows
 
 
 @pytest.mark.parametrize("seed", [FIXED, None])
 def test_the_correction_is_the_numpy_reference(cell, seed):
     """:func:`close` (one compiled call) against the numpy reference on random chains'
-    errors, rates and boxes: a wide box (the least squares) and a tight one (the projection)."""
+    errors, rates, boxes and constraint rows: a wide box (the least squares) and a tight one
+    (the projection), rows with room and a row held."""
     seed = fresh() if seed is None else seed
     rng = np.random.default_rng(seed)
-    contacts, grips = chains_of(cell)
-    frames = ChainFrames.of(cell.model, contacts, grips)
-    names = {v: k for k, v in frame_index(cell.model).items()}
-    for k in range(16):
-        q = cell.random_q(rng)
-        kin = kinematics(cell, q)
-        C = np.vstack([kin.jacobian(names[f]) for f in contacts]
-                      + [rrc_pin.tasks.RelativeFrameTask(names[a], names[b]).rows(kin).A
-                         for a, b in grips])  # fmt: skip
-        unit = np.tile([1.7, 1.7, 1.7, 1.0, 1.0, 1.0], C.shape[0] // 6)
-        closure = Closure(C, rng.normal(size=C.shape[0]) * 1e-5, unit)
-        scale = 1e3 if k % 2 else 1e-3  # wide, or the correction's trust region binds
-        lb = -cell.velocity_limit * rng.uniform(0.0, 1.0, cell.nv)
-        ub = cell.velocity_limit * rng.uniform(0.0, 1.0, cell.nv)
-        box = Box(lb, ub, np.zeros((2, cell.nv), np.int8), True, False,
-                  cell.velocity_limit * scale)  # fmt: skip
-        qdot = box.clip(rng.normal(size=cell.nv) * 0.3)
-        top = rng.normal(size=(6, cell.nv)) if k % 4 < 2 else np.zeros((0, cell.nv))
-        got, after = close(kin, frames, closure, qdot, top, box, None, 0.01)
+    frames = ChainFrames.of(cell.model, *chains_of(cell))
+    projected = 0
+    for k in range(24):
+        q, kin, closure, qdot, top, box, rows = random_case(cell, frames, rng, k)
+        got, after = close(kin, frames, closure, qdot, top, box, rows, 0.01)
+        G, h = (None, None) if rows is None else (rows.G, np.asarray(rows.h))
         want, want_after = reference_close(cell.model, cell.to_pinocchio(q), frames, closure,
-                                           qdot, top, box, 0.01)  # fmt: skip
-        if scale < 1.0:  # the trust region binds: the projection's answer, on it
+                                           qdot, top, box, 0.01, G, h)  # fmt: skip
+        if k % 2 == 0:  # the trust region binds: the projection's answer, on it
             on = np.isclose(np.abs(got), TRUST * box.velocity, rtol=1e-9, atol=0.0)
             assert on.any(), f"seed {seed}"
+            projected += 1
         np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12 * (1 + np.abs(want).max()),
                                    err_msg=f"seed {seed}, case {k}")  # fmt: skip
         np.testing.assert_allclose(after, want_after, rtol=0.0, atol=1e-15,
                                    err_msg=f"seed {seed}, case {k}")  # fmt: skip
+        trust = TRUST * box.velocity  # inside the box and the trust region
+        low = np.minimum(np.maximum(box.lb - qdot, -trust), 0.0)
+        high = np.maximum(np.minimum(box.ub - qdot, trust), 0.0)
+        assert np.all((low <= got) & (got <= high)), f"seed {seed}"
+        if rows is not None:
+            room = np.maximum(h - G @ qdot, 0.0)
+            assert np.all(G @ got <= room + 1e-12 * (1 + np.abs(room))), f"seed {seed}"
+    assert projected == 12
 
 
 @pytest.mark.parametrize("seed", [FIXED, None])

@@ -189,3 +189,22 @@ def test_row_values_against_numpy(rng: np.random.Generator) -> None:
         m, n = rng.integers(1, 9, 2)
         A, x = rng.normal(size=(m, n)), rng.normal(size=n)
         np.testing.assert_allclose(linalg.row_values(A, x), A @ x, atol=1e-13)
+
+
+@pytest.mark.parametrize(("m", "n"), [(6, 7), (6, 14), (18, 24), (1, 4), (6, 6), (0, 3)])
+def test_householder_null_is_q_s_trailing_columns(m: int, n: int, rng: np.random.Generator) -> None:
+    """householder_vectors' reflectors: householder_qr's R bit for bit, and Q's trailing
+    columns (the rows' null space) from them, to rounding; dependent and zero columns too."""
+    for rank in {min(m, n), max(min(m, n) - 1, 0), 0}:
+        for _ in range(50):
+            J = random_rows(rng, m, n, rank)
+            Q, R = np.empty((n, n)), np.empty((n, m))
+            linalg.householder_qr(J.T.copy(), Q, R)
+            k = max(min(n - 1, m), 0)
+            R2, V, beta = np.empty((n, m)), np.empty((k, n)), np.empty(k)
+            linalg.householder_vectors(J.T.copy(), R2, V, beta)
+            np.testing.assert_array_equal(R2, R)
+            N = np.empty((n - m, n))
+            linalg.householder_null(V, beta, m, N)
+            np.testing.assert_allclose(N, Q[:, m:].T, atol=1e-13)
+            np.testing.assert_allclose(J @ N.T, 0.0, atol=1e-12 * np.abs(J).max(initial=1.0))

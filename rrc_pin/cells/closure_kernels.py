@@ -41,7 +41,7 @@ from rrc_pin.solvers.tick.linalg import (
     row_values,
     solve_factored,
 )
-from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
+from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project_factored
 
 Array = npt.NDArray[np.float64]
 Ints = npt.NDArray[np.int64]
@@ -75,6 +75,14 @@ def _cross(a: Array, b: Array, out: Array) -> None:
 
 
 @kernel
+def _cross_add(a: Array, i: int, b: Array, j: int, sign: float, out: Array, k: int) -> None:
+    """``out[k:k + 3] += sign (a[i:i + 3] x b[j:j + 3])`` (sign 1 or -1: exact)."""
+    out[k] += sign * (a[i + 1] * b[j + 2] - a[i + 2] * b[j + 1])
+    out[k + 1] += sign * (a[i + 2] * b[j] - a[i] * b[j + 2])
+    out[k + 2] += sign * (a[i] * b[j + 1] - a[i + 1] * b[j])
+
+
+@kernel
 def largest(error: Array) -> tuple[float, float]:
     """The largest position [m] and rotation [rad] error of chains ``error`` (6 k,) (0 for none).
 
@@ -105,7 +113,7 @@ def chain_motion(
         a: Out: (k, 6) each frame's classical acceleration [m/s^2, rad/s^2], the same axes.
     """
     k, n = support.shape
-    V, A, nu, t = np.empty(6), np.empty(6), np.empty(6), np.empty(3)
+    V, A, nu = np.empty(6), np.empty(6), np.empty(6)
     for i in range(k):
         V[:] = 0.0
         A[:] = 0.0
@@ -121,21 +129,17 @@ def chain_motion(
                     nu[r] += J[r, c] * u[c]
                 c += 1
             # A += V x nu: (w x nu_v + v x nu_w, w x nu_w)
-            _cross(V[3:], nu[:3], t)
-            A[:3] += t
-            _cross(V[:3], nu[3:], t)
-            A[:3] += t
-            _cross(V[3:], nu[3:], t)
-            A[3:] += t
-            V += nu
-        _cross(V[3:], P[i], t)
-        v[i, :3] = V[:3] + t
-        v[i, 3:] = V[3:]
-        _cross(A[3:], P[i], t)
-        a[i, :3] = A[:3] + t
-        _cross(V[3:], v[i, :3], t)
-        a[i, :3] += t
-        a[i, 3:] = A[3:]
+            _cross_add(V, 3, nu, 0, 1.0, A, 0)
+            _cross_add(V, 0, nu, 3, 1.0, A, 0)
+            _cross_add(V, 3, nu, 3, 1.0, A, 3)
+            for r in range(6):
+                V[r] += nu[r]
+        p, vi, ai = P[i], v[i], a[i]
+        vi[:] = V
+        _cross_add(V, 3, p, 0, 1.0, vi, 0)
+        ai[:] = A
+        _cross_add(A, 3, p, 0, 1.0, ai, 0)
+        _cross_add(V, 3, vi, 0, 1.0, ai, 0)
 
 
 @kernel
@@ -194,19 +198,31 @@ def second_order(
 
 @kernel
 def damped_factor(J: Array, L: Array) -> float:
-    r"""The Cholesky factor ``L`` (n, n) of :func:`damped`'s :math:`M = J^TJ + \mu I` of rows
-    ``J`` (m, n), and :math:`\mu`; 0 where M is not definite (``L`` then not set).
+    r""":func:`damped`'s factor of rows ``J`` (m, n), and its damping :math:`\mu`.
 
-    ``L``'s upper triangle is left as M's (:func:`~rrc_pin.solvers.tick.linalg.cholesky`
-    in place; :func:`~rrc_pin.solvers.tick.linalg.solve_factored` does not read it).
-    """  # noqa: D205
+    The Cholesky factor ``L`` (k, k) of :math:`W = JJ^T + \mu I` where k = m < n (the rows'
+    side: the smaller where there are fewer rows than rates), else (k = n) of
+    :math:`M = J^TJ + \mu I` (:func:`damped_solve`). ``L``'s upper triangle is left as the
+    matrix's (:func:`~rrc_pin.solvers.tick.linalg.cholesky` in place;
+    :func:`~rrc_pin.solvers.tick.linalg.solve_factored` does not read it).
+
+    Returns:
+        :math:`\mu`, or 0 where the matrix is not definite or the rows are all zero (the
+        correction is then zero; ``L`` not set).
+    """
     m, n = J.shape
-    normal_equations(J, np.zeros(m), np.ones(m), L, np.empty(n))
+    if L.shape[0] < n:
+        normal_equations(J.T, np.zeros(n), np.ones(n), L, np.empty(m))
+    else:
+        normal_equations(J, np.zeros(m), np.ones(m), L, np.empty(n))
+    k = L.shape[0]
     trace = 0.0
-    for i in range(n):
+    for i in range(k):
         trace += L[i, i]
+    if not trace > 0.0:
+        return 0.0
     mu = max(DAMPING * trace / max(m, 1), _TINY)
-    for i in range(n):
+    for i in range(k):
         L[i, i] += mu
     return mu if cholesky(L, 1e-12, L) else 0.0
 
@@ -214,12 +230,26 @@ def damped_factor(J: Array, L: Array) -> float:
 @kernel
 def damped_solve(J: Array, L: Array, mu: float, b: Array, out: Array) -> None:
     r"""``out``: :func:`damped` of ``J x = b`` from :func:`damped_factor`'s ``L`` and ``mu``
-    (zero where ``mu`` is 0: not definite)."""  # noqa: D205, D209
+    (zero where ``mu`` is 0).
+
+    With :math:`M^{-1}J^T = J^TW^{-1}` (:math:`W = JJ^T + \mu I`), on the rows' side
+    :math:`t + \mu M^{-1}t = J^T(s + \mu W^{-1}s)` with :math:`s = W^{-1}b`.
+    """  # noqa: D205
     m, n = J.shape
     if mu == 0.0:
         out[:] = 0.0
         return
-    g, t, s = np.zeros(n), np.empty(n), np.empty(n)
+    k = L.shape[0]
+    g, t, s = np.zeros(k), np.empty(k), np.empty(k)
+    if k < n:  # the rows' side
+        solve_factored(L, b, t)
+        solve_factored(L, t, s)
+        out[:] = 0.0
+        for r in range(m):
+            c = t[r] + mu * s[r]
+            for i in range(n):
+                out[i] += J[r, i] * c
+        return
     for r in range(m):  # J^T b
         for i in range(n):
             g[i] += J[r, i] * b[r]
@@ -240,11 +270,11 @@ def damped(J: Array, b: Array, out: Array) -> None:
     right singular vector of singular value :math:`\sigma`,
     :math:`\beta\sigma(\sigma^2 + 2\mu)/(\sigma^2 + \mu)^2` of the exact
     :math:`\beta/\sigma`, bounded through a singularity. One Cholesky factorisation
-    (:func:`damped_factor`, once for all right-hand sides), two triangular solves
-    (:func:`damped_solve`).
+    (:func:`damped_factor`, once for all right-hand sides: of the smaller of M and
+    :math:`JJ^T + \mu I`), two triangular solves (:func:`damped_solve`).
     """  # noqa: D205
-    n = J.shape[1]
-    L = np.empty((n, n))
+    m, n = J.shape
+    L = np.empty((min(m, n), min(m, n)))
     damped_solve(J, L, damped_factor(J, L), b, out)
 
 
@@ -265,12 +295,14 @@ def kept(C: Array, top: Array) -> tuple[Array, Array]:
     k = min(n - 1, m)
     R, V, beta = np.empty((n, m)), np.empty((k, n)), np.empty(k)
     householder_vectors(C.T, R, V, beta)
-    null, keep = np.empty((n - m, n)), np.zeros((t, n - m))
+    null, keep = np.empty((n - m, n)), np.empty((t, n - m))
     householder_null(V, beta, m, null)
     for r in range(t):
         for c in range(n - m):
+            s = 0.0
             for i in range(n):
-                keep[r, c] += top[r, i] * null[c, i]
+                s += top[r, i] * null[c, i]
+            keep[r, c] = s
     return null, keep
 
 
@@ -284,12 +316,12 @@ def lexicographic(
 
     Args:
         C: The chains' rows (m, n), in their metric.
-        LC: :func:`damped_factor`'s factor of C (n, n).
+        LC: :func:`damped_factor`'s factor of C.
         muC: Its damping (0: not definite).
         top: The top level's rows (t, n) (t = 0: none kept).
         null: (n - m, n) a basis of C's null space (rows), or (0, n): none (:func:`kept`).
         keep: ``top @ null.T`` (t, n - m).
-        LK: :func:`damped_factor`'s factor of keep (n - m, n - m).
+        LK: :func:`damped_factor`'s factor of keep.
         muK: Its damping.
         r: The chains' rates (m,).
         out: Out: (n,).
@@ -299,10 +331,12 @@ def lexicographic(
     t = top.shape[0]
     if p == 0 or t == 0:
         return
-    b, y = np.zeros(t), np.empty(p)
+    b, y = np.empty(t), np.empty(p)
     for i in range(t):
+        s = 0.0
         for j in range(n):
-            b[i] -= top[i, j] * out[j]
+            s += top[i, j] * out[j]
+        b[i] = -s
     damped_solve(keep, LK, muK, b, y)
     for c in range(p):
         for j in range(n):
@@ -343,16 +377,17 @@ def correction(
         after: Out: the chains' error after the step (6 k,), to second order.
     """
     m, n, t = C.shape[0], qdot.size, top.shape[0]
-    M = np.empty((m + t, n))  # the projection's rows: the chains' in the resolver's metric
-    for i in range(m):  # (metres per reach), the top level's
+    Cm = np.empty((m, n))  # the chains' rows in the resolver's metric (metres per reach)
+    M = np.empty((m + t, n))  # the projection's rows: the chains', the top level's
+    for i in range(m):
         for j in range(n):
-            M[i, j] = C[i, j] / unit[i]
+            Cm[i, j] = M[i, j] = C[i, j] / unit[i]
     for i in range(t):
         for j in range(n):
             M[m + i, j] = KEEP * top[i, j]
-    Cm = M[:m]
     null, keep = kept(Cm, top)
-    LC, LK = np.empty((n, n)), np.empty((keep.shape[1], keep.shape[1]))
+    k = min(t, keep.shape[1])
+    LC, LK = np.empty((min(m, n), min(m, n))), np.empty((k, k))
     muC, muK = damped_factor(Cm, LC), damped_factor(keep, LK)
     low, high, room = np.empty(n), np.empty(n), row_values(G, qdot)
     for i in range(n):  # zero always inside
@@ -362,6 +397,7 @@ def correction(
     for i in range(h.size):
         room[i] = max(h[i] - room[i], 0.0)
     second, r, u, x = np.empty(m), np.empty(m), np.empty(n), np.empty(n)
+    LP, muP = np.empty((n, n)), -1.0
     delta[:] = 0.0
     for _ in range(PASSES):
         for i in range(n):
@@ -371,7 +407,10 @@ def correction(
             r[i] = (error[i] - 0.5 * dt * dt * second[i]) / (dt * unit[i])
         lexicographic(Cm, LC, muC, top, null, keep, LK, muK, r, delta)
         if not (inside(delta, low, high) and rows_hold(G, delta, room, 0.0)):
-            if project(M, DAMPING, delta, low, high, G, room, MARGIN, x) != SOLVED:
+            if muP < 0.0:  # the projection's metric, factored once where it is first needed
+                muP = damped_factor(M, LP)
+            if muP == 0.0 or project_factored(LP, delta, low, high, G, room, MARGIN,
+                                              x) != SOLVED:  # fmt: skip
                 x[:] = 0.0
             clip_into(x, low, high)
             delta[:] = x

@@ -87,26 +87,49 @@ def householder_vectors(At: Array, R: Array, V: Array, beta: Array) -> None:
         x0 = R[j, j]
         mu = math.sqrt(x0 * x0 + sigma)
         v0 = x0 - mu if x0 <= 0.0 else -sigma / (x0 + mu)
-        b = 2.0 * v0 * v0 / (sigma + v0 * v0)
-        beta[j] = b
+        beta[j] = 2.0 * v0 * v0 / (sigma + v0 * v0)
         v = V[j]
         v[:j] = 0.0
         v[j] = 1.0
         for i in range(j + 1, n):
             v[i] = R[i, j] / v0
-        # R = (I - beta v v^T) R: each column's v^T R[:, c] summed in row order, the columns
-        # side by side
-        s[j:] = 0.0
-        for i in range(j, n):
-            for c in range(j, m):
-                s[c] += v[i] * R[i, c]
-        for c in range(j, m):
-            s[c] *= b
-        for i in range(j, n):
-            for c in range(j, m):
-                R[i, c] -= s[c] * v[i]
+        _reflect_columns(R, v, beta[j], np.uint64(j), np.uint64(n), np.uint64(m), s)
         for i in range(j + 1, n):
             R[i, j] = 0.0
+
+
+@inlined
+def _reflect_columns(R: Array, v: Array, b: float, j: Index, n: Index, m: Index,
+                     s: Array) -> None:  # fmt: skip
+    """``R[j:, j:] = (I - b v v^T) R[j:, j:]``: each column's :math:`v^T R_c` summed in row
+    order, the columns side by side (``s`` (m,) their sums)."""  # noqa: D205, D209
+    for c in range(j, m):
+        s[c] = 0.0
+    for i in range(j, n):
+        vi = v[i]
+        for c in range(j, m):
+            s[c] += vi * R[i, c]
+    for c in range(j, m):
+        s[c] *= b
+    for i in range(j, n):
+        vi = v[i]
+        for c in range(j, m):
+            R[i, c] -= s[c] * vi
+
+
+@inlined
+def _reflect_rows(A: Array, v: Array, b: float, j: Index, n: Index, rows: Index,
+                  s: Array) -> None:  # fmt: skip
+    """``A[:, j:] = A[:, j:] (I - b v v^T)`` for A's first ``rows`` rows: each row's
+    :math:`A_r v` summed in order (``s`` (rows,) their sums)."""  # noqa: D205, D209
+    for r in range(rows):
+        t = 0.0
+        for i in range(j, n):
+            t += A[r, i] * v[i]
+        s[r] = t * b
+    for r in range(rows):
+        for i in range(j, n):
+            A[r, i] -= s[r] * v[i]
 
 
 @kernel
@@ -123,22 +146,14 @@ def householder_qr(At: Array, Q: Array, R: Array) -> None:
     """
     n, m = At.shape
     k = max(min(n - 1, m), 0)
-    V, beta = np.empty((k, n)), np.empty(k)
+    V, beta, s = np.empty((k, n)), np.empty(k), np.empty(n)
     householder_vectors(At, R, V, beta)
     Q[:, :] = 0.0
     for i in range(n):
         Q[i, i] = 1.0
     for j in range(k):
-        if beta[j] == 0.0:
-            continue
-        v = V[j]
-        for r in range(n):  # Q = Q (I - beta v v^T)
-            s = 0.0
-            for i in range(j, n):
-                s += Q[r, i] * v[i]
-            s *= beta[j]
-            for i in range(j, n):
-                Q[r, i] -= s * v[i]
+        if beta[j] != 0.0:
+            _reflect_rows(Q, V[j], beta[j], np.uint64(j), np.uint64(n), np.uint64(n), s)
 
 
 @kernel
@@ -157,17 +172,8 @@ def householder_null(V: Array, beta: Array, m: int, N: Array) -> None:
         N[c, m + c] = 1.0
     s = np.empty(p)
     for j in range(beta.size - 1, -1, -1):
-        if beta[j] == 0.0:
-            continue
-        v = V[j]
-        s[:] = 0.0  # each row's v^T N[c], summed in order, the rows side by side
-        for i in range(j, n):
-            for c in range(p):
-                s[c] += v[i] * N[c, i]
-        for c in range(p):
-            s[c] *= beta[j]
-            for i in range(j, n):
-                N[c, i] -= s[c] * v[i]
+        if beta[j] != 0.0:
+            _reflect_rows(N, V[j], beta[j], np.uint64(j), np.uint64(n), np.uint64(p), s)
 
 
 @kernel
