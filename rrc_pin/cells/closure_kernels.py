@@ -4,7 +4,9 @@ One call, :func:`correction`, makes a tick's whole correction from the tick's ki
 chains' second order along the step (:func:`chain_motion` and :func:`second_order`, from the
 world Jacobian's columns instead of a second forward pass), the lexicographic damped least
 squares (:func:`lexicographic`, :func:`damped`) and, where that leaves the box or breaks a row,
-the projection (:func:`~rrc_pin.solvers.tick.slide_kernels.project`), :data:`PASSES` times.
+the projection (:func:`~rrc_pin.solvers.tick.slide_kernels.project_factored`), :data:`PASSES`
+times. The factors are made once for every pass (:func:`damped_factor`, :func:`kept`): only the
+rates change between passes.
 
 The second order. With :math:`S_c` the world Jacobian's column c (the joint's motion as a
 spatial twist at the base origin, Pinocchio's ``computeJointJacobians``) and :math:`u_c` its
@@ -240,7 +242,7 @@ def damped_solve(J: Array, L: Array, mu: float, b: Array, out: Array) -> None:
         out[:] = 0.0
         return
     k = L.shape[0]
-    g, t, s = np.zeros(k), np.empty(k), np.empty(k)
+    t, s = np.empty(k), np.empty(k)
     if k < n:  # the rows' side
         solve_factored(L, b, t)
         solve_factored(L, t, s)
@@ -250,6 +252,7 @@ def damped_solve(J: Array, L: Array, mu: float, b: Array, out: Array) -> None:
             for i in range(n):
                 out[i] += J[r, i] * c
         return
+    g = np.zeros(n)
     for r in range(m):  # J^T b
         for i in range(n):
             g[i] += J[r, i] * b[r]
