@@ -91,19 +91,22 @@ class TickSource:
         dt: The step [s].
         weighted: One weighted level.
         direction: The top level as the direction problem.
+        stacked: The top level's rows in the metric the tick solved it in (m, n), where the
+            tick kept them (:meth:`Workspace.stacked_top`), else None.
     """
 
     __slots__ = ("_box", "constraints", "direction", "dt", "levels", "out", "recovering",
-                 "velocity", "weighted", "zero_inside")  # fmt: skip
+                 "stacked", "velocity", "weighted", "zero_inside")  # fmt: skip
 
     def __init__(
         self, out: Array, zero_inside: bool, recovering: bool, velocity: Array,
         levels: list[list[TaskRows]], constraints: list[Constraints | None], dt: float,
-        weighted: bool, direction: bool,
+        weighted: bool, direction: bool, stacked: Array | None = None,
     ) -> None:  # fmt: skip
         self.out, self.zero_inside, self.recovering = out, zero_inside, recovering
         self.velocity, self.levels, self.constraints = velocity, levels, constraints
         self.dt, self.weighted, self.direction = dt, weighted, direction
+        self.stacked = stacked
         self._box: Box | None = None
 
     @property
@@ -125,6 +128,8 @@ class TickSource:
             levels[0].rows_from(levels[1], levels[2], levels[3]),)  # fmt: skip
         present = [c for c in self.constraints if c is not None]
         rows = merged_rows(present) if present else None
+        if self.stacked is not None:
+            return level, self.stacked, rows
         keeps = any(c.d is not None and np.count_nonzero(c.d) > 0 for c in present)
         box = self.box
         mode = mode_of(box, rows, keeps, self.weighted, self.direction)
@@ -410,7 +415,7 @@ class CompiledTick:
         reals = ws.reals.tolist()
         source = TickSource(
             out, reals[tick.ZERO_INSIDE] == 1.0, reals[tick.RECOVERING] == 1.0, self.velocity,
-            levels, constraints, dt, weighted, self.direction,
+            levels, constraints, dt, weighted, self.direction, ws.stacked_top(),
         )  # fmt: skip
         if code == FAILED:
             return self._fallback(source, start)

@@ -85,6 +85,32 @@ def test_the_top_level_is_read_as_the_problem_stacks_it(panda: rrc_pin.Robot, sp
     assert "direction" in modes
 
 
+@pytest.mark.parametrize(("name", "command"), [("gsfc_dual", "object"), ("yeh_tripod", "body")])
+def test_a_tick_within_equality_rows_keeps_its_top_level_as_the_problem_stacks_it(
+    name: str, command: str
+) -> None:
+    """A cell's tick (a grip's or the feet's equality rows) keeps its top level's rows in their
+    metric from its kernel: bitwise the problem's, on exact, scaled and damped ticks."""
+    from rrc_pin.cells import CellController
+    from rrc_pin.solvers.tick.damping import Damping
+
+    controller = CellController(rrc_pin.load(name), 0.01, damping=Damping(10.0))  # damped often
+    rng = np.random.default_rng(2030)
+    speed = np.array([0.15, 0.15, 0.15, 0.4, 0.4, 0.4]) / (1.0 if name == "gsfc_dual" else 5.0)
+    statuses = set()
+    for k in range(400):
+        if k % 20 == 0:
+            twist = rng.normal(size=6) * speed * (1.0, 10.0)[k // 20 % 2]
+        r = controller.step({command: twist}).resolution
+        level, top, rows = r.source.top()
+        assert r.source.stacked is not None
+        problem = r.problem
+        assert level == problem.levels[0] and rows == problem.rows
+        assert np.array_equal(top, problem.stacked[0][0])
+        statuses.add(r.status)
+    assert {"exact", "scaled", "damped"} <= statuses, statuses
+
+
 @pytest.mark.parametrize("which", ["q", "twist"])
 def test_a_bad_value_is_named_and_changes_nothing(panda: rrc_pin.Robot, which: str) -> None:
     resolver = Resolver(panda)

@@ -382,9 +382,10 @@ def run(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide
 
 @kernel
 def run_within(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array, slide: Array,
-               E: Array, ints: Ints, reals: Array) -> int:  # fmt: skip
+               E: Array, ints: Ints, reals: Array, top: Array) -> int:  # fmt: skip
     """One tick within the equality rows ``E`` = [C | d] (r, n + 1): :func:`run`'s stages, the
-    top level's within the rows (:func:`rrc_pin.solvers.tick.equalities.within`).
+    top level's within the rows (:func:`rrc_pin.solvers.tick.equalities.within`), its rows in
+    their metric kept in ``top`` (what a cell's closure keeps, :meth:`Workspace.stacked_top`).
 
     The direction mode where :func:`run` takes it and ``d`` is zero (standing still then
     meets the rows; :func:`rrc_pin.solvers.tick.problem.build`).
@@ -399,6 +400,7 @@ def run_within(joints: Array, task_rows: Array, rates: Array, G: Array, h: Array
     direction = (ints[WEIGHTED] == 0 and ints[DIRECTION] == 1 and zero_inside
                  and not (rows.h < 0.0).any() and not (d != 0.0).any())  # fmt: skip
     A, b, rate_factor = level(task_rows, rates, ints, 0, direction, rows.lb, rows.ub)
+    top[: A.shape[0]] = A
     per_unit = 1.0 / rates[UNIT][: ints[STARTS + 1]] if ints[UNITS] else np.empty(0)
     answer = equalities.within(A, b, per_unit, C, d, rows, direction, recovering, reals[DT],
                                reals[THRESHOLD], rate_factor, ints[LEVELS] > 1)  # fmt: skip
@@ -441,6 +443,7 @@ class Workspace:
         self.task_rows, self.rates = np.zeros((6, n)), np.ones((3, 6))
         self.G, self.h, self.slide = np.zeros((0, n)), np.zeros(0), np.zeros(0)
         self.E = np.zeros((0, n + 1))  # the equality rows [C | d]: none
+        self.top = np.zeros((6, n))  # a tick within them: its top level's rows in their metric
         self._held: dict[int, Held] = {}
         self._header: tuple[int, bool, bool, list[int]] | None = None  # what ints holds
 
@@ -499,6 +502,7 @@ class Workspace:
     def _fit(self, m: int) -> None:
         """Room for ``m`` task rows."""
         self.task_rows, self.rates = np.zeros((m, self.n)), np.ones((3, m))
+        self.top = np.zeros((m, self.n))
         self._held.clear()
 
     def _overwrite(self, start: int, end: int) -> None:
@@ -557,7 +561,7 @@ class Workspace:
         self.reals[DT] = dt
         if self.E.shape[0]:
             within: int = run_within(self.joints, self.task_rows, self.rates, self.G, self.h,
-                                     self.slide, self.E, self.ints, self.reals)  # fmt: skip
+                                     self.slide, self.E, self.ints, self.reals, self.top)  # fmt: skip
             return within
         ints = self.ints
         if ints[LEVELS] == 1 and ints[CONSTRAINTS] == 0 and ints[DIRECTION] and not ints[WEIGHTED]:
@@ -591,7 +595,15 @@ class Workspace:
             if n > 1:  # a tick within equality rows (contacts, grips): the rates of joint 1 zero
                 ws.load_equalities(np.eye(1, n, 1), np.zeros(1))
                 run_within(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.E,
-                           ws.ints, ws.reals)  # fmt: skip
+                           ws.ints, ws.reals, ws.top)  # fmt: skip
+
+    def stacked_top(self) -> Array | None:
+        """The top level's rows in their metric (m, n) of the tick just run within equality rows
+        (a copy), or None for a tick without them.
+        """  # noqa: D205
+        if not self.E.shape[0]:
+            return None
+        return self.top[: self.ints.item(STARTS + 1)].copy()
 
     def level_codes(self) -> list[int]:
         """How each level was served (the codes of :mod:`rrc_pin.solvers.tick.statuses`)."""
