@@ -560,8 +560,9 @@ class Workspace:
         self.joints[POSITION], self.joints[PREVIOUS] = q, previous
         self.reals[DT] = dt
         if self.E.shape[0]:
-            within: int = run_within(self.joints, self.task_rows, self.rates, self.G, self.h,
-                                     self.slide, self.E, self.ints, self.reals, self.top)  # fmt: skip
+            within: int = run_within(self.joints, self.task_rows, self.rates, self.G,
+                                     self.h, self.slide, self.E, self.ints, self.reals,
+                                     self.top)  # fmt: skip
             return within
         ints = self.ints
         if ints[LEVELS] == 1 and ints[CONSTRAINTS] == 0 and ints[DIRECTION] and not ints[WEIGHTED]:
