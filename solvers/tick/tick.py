@@ -604,7 +604,8 @@ class Workspace:
         """  # noqa: D205
         if not self.E.shape[0]:
             return None
-        return self.top[: self.ints.item(STARTS + 1)].copy()
+        rows: Array = self.top[: self.ints.item(STARTS + 1)].copy()
+        return rows
 
     def level_codes(self) -> list[int]:
         """How each level was served (the codes of :mod:`rrc_pin.solvers.tick.statuses`)."""
