@@ -145,7 +145,7 @@ def test_the_correction_stays_in_the_box_left_and_its_trust_region(dual, tripod,
         for _ in range(20):
             q, closure, chains, box, qdot = _problem(cell, rng)
             top = rng.normal(size=(6, cell.nv))
-            delta, _ = close(kinematics(cell, q), chains, closure, qdot, top, box, None, 0.01)
+            delta, _, _ = close(kinematics(cell, q), chains, closure, qdot, top, box, None, 0.01)
             assert np.all(np.isfinite(delta)), seed
             applied = qdot + delta
             assert np.all(applied >= box.lb - 1e-12) and np.all(applied <= box.ub + 1e-12), seed
@@ -171,7 +171,7 @@ def test_an_unbounded_correction_closes_the_chains_and_keeps_the_top_level(dual,
         if sigma[0] > 10 * sigma[-1] or np.linalg.svd(C, compute_uv=False)[-1] < 0.1:
             continue  # nearer a singular configuration: the damping takes its share
         box = box._replace(velocity=box.velocity * 1e3)
-        delta, after = close(kinematics(dual, q), chains, closure, qdot, top, box, None, 0.01)
+        delta, after, _ = close(kinematics(dual, q), chains, closure, qdot, top, box, None, 0.01)
         size = np.abs(closure.error).max()  # what the chains' rows must take out
         # exact to second order in the damping (1e-4 of the rows' mean squared singular value)
         np.testing.assert_allclose(top @ delta, 0.0, atol=1e-3 * size / 0.01,
@@ -197,7 +197,7 @@ def test_a_singular_chain_is_corrected_by_bounded_rates(dual):
         closure = Closure(C, error, np.array([1.5] * 3 + [1.0] * 3))
         wide = np.full(dual.nv, 1e3)
         box = Box(-wide, wide, np.zeros((2, dual.nv), np.int8), True, False, wide)
-        delta, _ = close(kinematics(dual, q), chains, closure, np.zeros(dual.nv),
+        delta, _, _ = close(kinematics(dual, q), chains, closure, np.zeros(dual.nv),
                          np.zeros((0, dual.nv)), box, None, 0.01)  # fmt: skip
         assert np.all(np.isfinite(delta))
         assert np.abs(delta).max() < 0.1, np.abs(delta).max()

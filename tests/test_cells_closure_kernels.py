@@ -242,7 +242,7 @@ def test_the_correction_is_the_numpy_reference(cell, seed):
     projected = 0
     for k in range(24):
         q, kin, closure, qdot, top, box, rows = random_case(cell, frames, rng, k)
-        got, after = close(kin, frames, closure, qdot, top, box, rows, 0.01)
+        got, after, applied = close(kin, frames, closure, qdot, top, box, rows, 0.01)
         G, h = (None, None) if rows is None else (rows.G, np.asarray(rows.h))
         want, want_after = reference_close(cell.model, cell.to_pinocchio(q), frames, closure,
                                            qdot, top, box, 0.01, G, h)  # fmt: skip
@@ -258,6 +258,7 @@ def test_the_correction_is_the_numpy_reference(cell, seed):
         low = np.minimum(np.maximum(box.lb - qdot, -trust), 0.0)
         high = np.maximum(np.minimum(box.ub - qdot, trust), 0.0)
         assert np.all((low <= got) & (got <= high)), f"seed {seed}"
+        assert np.array_equal(applied, box.clip(qdot + got)), f"seed {seed}"
         if rows is not None:
             room = np.maximum(h - G @ qdot, 0.0)
             assert np.all(G @ got <= room + 1e-12 * (1 + np.abs(room))), f"seed {seed}"

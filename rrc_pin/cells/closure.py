@@ -140,7 +140,7 @@ class ChainFrames(NamedTuple):
 def close(
     kin: Kinematics, frames: ChainFrames, closure: Closure, qdot: Array, top: Array, box: Box,
     rows: Rows | None, dt: float,
-) -> tuple[Array, Array]:  # fmt: skip
+) -> tuple[Array, Array, Array]:  # fmt: skip
     r"""The correction that closes the chains within the step, and their error after it.
 
     The least squares of the module docstring, in the resolver's metric (each chain's position
@@ -167,7 +167,8 @@ def close(
 
     Returns:
         The correction (nv,), zero where the projection finds none (``qdot + delta`` inside
-        the box), and the chains' error after the step (6 k,), predicted to second order.
+        the box); the chains' error after the step (6 k,), predicted to second order; the
+        rates applied, ``qdot + delta`` clipped into the box (against its rounding).
     """
     n = qdot.size
     data = kin.data
@@ -175,14 +176,14 @@ def close(
     for i, f in enumerate(frames.frames):
         poses[i] = oMf[f].homogeneous
     G, h = (np.zeros((0, n)), np.zeros(0)) if rows is None else (rows.G, np.array(rows.h))
-    delta, after = np.empty(n), np.empty(closure.error.size)
+    delta, after, applied = np.empty(n), np.empty(closure.error.size), np.empty(n)
     closure_kernels.correction(
         data.J, frames.support, frames.joint, poses, frames.contacts,
         frames.grips, np.ascontiguousarray(closure.C), closure.error, closure.unit,
         np.ascontiguousarray(top), qdot, np.array([box.lb, box.ub, box.velocity]),
-        np.ascontiguousarray(G), h, dt, delta, after,
+        np.ascontiguousarray(G), h, dt, delta, after, applied,
     )  # fmt: skip
-    return delta, after
+    return delta, after, applied
 
 
 def compile_correction(nv: int) -> None:
@@ -198,6 +199,6 @@ def compile_correction(nv: int) -> None:
     closure_kernels.correction(
         np.zeros((6, nv), order="F"), np.zeros((0, nv), dtype=bool), np.zeros(nv, dtype=np.int64),
         np.zeros((0, 4, 4)), ints, ints.reshape(0, 2), rows, empty, empty, rows, qdot,
-        np.zeros((3, nv)), rows, empty, 0.01, np.empty(nv), np.empty(0),
+        np.zeros((3, nv)), rows, empty, 0.01, np.empty(nv), np.empty(0), np.empty(nv),
     )  # fmt: skip
     largest(np.zeros(0))

@@ -350,7 +350,7 @@ def lexicographic(
 def correction(
     J: Array, support: npt.NDArray[np.bool_], joint: Ints, poses: Array, contacts: Ints,
     grips: Ints, C: Array, error: Array, unit: Array, top: Array, qdot: Array, box: Array,
-    G: Array, h: Array, dt: float, delta: Array, after: Array,
+    G: Array, h: Array, dt: float, delta: Array, after: Array, applied: Array,
 ) -> None:  # fmt: skip
     r"""The correction that closes the chains within the step, and their error after it.
 
@@ -378,6 +378,8 @@ def correction(
         dt: The step [s].
         delta: Out: the correction (nv,).
         after: Out: the chains' error after the step (6 k,), to second order.
+        applied: Out: the rates with the correction, ``qdot + delta`` clipped into the box
+            (numpy's ``minimum(maximum(x, lb), ub)``, against the rounding of ``qdot + delta``).
     """
     m, n, t = C.shape[0], qdot.size, top.shape[0]
     Cm = np.empty((m, n))  # the chains' rows in the resolver's metric (metres per reach)
@@ -422,3 +424,7 @@ def correction(
         for j in range(n):
             s += C[i, j] * (qdot[j] + delta[j])
         after[i] = error[i] - (s + 0.5 * dt * second[i]) * dt
+    for j in range(n):
+        x = qdot[j] + delta[j]
+        x = x if x >= box[0, j] else box[0, j]
+        applied[j] = x if x <= box[1, j] else box[1, j]

@@ -603,7 +603,8 @@ class CellController(Loop):
         top = stacked if mode == "teleop" else np.zeros((0, self.cell.nv))
         box = r.box
         kin = self._kin if self._kin is not None else self._kinematics()
-        delta, after = close(kin, self._chain_frames, closure, r.qdot, top, box, rows, self.dt)
+        _, after, applied = close(kin, self._chain_frames, closure, r.qdot, top, box, rows,
+                                  self.dt)  # fmt: skip
         level = max(self.chain_error[0] / bound.position, self.chain_error[1] / bound.rotation)
         if level <= 1.0:
             self.lost = None
@@ -617,7 +618,7 @@ class CellController(Loop):
             self._applied = still
             return CellResolution.of_tick(r._replace(qdot=still, status=self.lost, scale=0.0,
                                                 veer=0.0), still.copy(), hands)  # fmt: skip
-        self._applied = box.clip(r.qdot + delta)  # inside the box as the resolver's rates are
+        self._applied = applied  # inside the box as the resolver's rates are
         self._corrected = (self._applied, r.qdot)
         return CellResolution.of_tick(r, self._applied, hands)
 
