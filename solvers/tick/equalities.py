@@ -32,7 +32,7 @@ from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.errors import NumericalFailure
-from rrc_pin.solvers.tick import backend_calls, factor, feasibility, linalg, statuses, top
+from rrc_pin.solvers.tick import backend_calls, factor, feasibility, statuses, top
 from rrc_pin.solvers.tick.levels import least_squares, product, product_transposed
 from rrc_pin.solvers.tick.linalg import row_values, transposed_values
 from rrc_pin.solvers.tick.statuses import (
@@ -61,21 +61,7 @@ def contradicted() -> None:
 def space(C: Array, d: Array) -> tuple[Array, Array, bool]:
     """The least-norm rates x0 (n,) of ``C x = d``, the null space N (r', n) of C, and
     whether x0 meets the rows (:func:`~rrc_pin.solvers.tick.pipeline._equality_space`).
-
-    Where C has full row rank r < n, from its QR's Householder vectors alone
-    (:func:`~rrc_pin.solvers.tick.linalg.householder_rates`,
-    :func:`~rrc_pin.solvers.tick.linalg.householder_null`: Q is not formed); else from
-    :func:`~rrc_pin.solvers.tick.factor.least_norm`.
     """  # noqa: D205
-    r, n = C.shape
-    if r < n:
-        R, V, beta = np.empty((n, r)), np.empty((r, n)), np.empty(r)
-        linalg.householder_vectors(C.T, R, V, beta)
-        x0 = np.empty(n)
-        if linalg.householder_rates(V, beta, R, d, x0):
-            N = np.empty((n - r, n))
-            linalg.householder_null(V, beta, r, N)
-            return x0, N, statuses.met(row_values(C, x0), d)
     f, x0 = factor.least_norm(factor.qr(C), d)
     met = statuses.met(row_values(C, x0), d)
     return x0, factor.null_basis(f)[1], met

@@ -189,56 +189,6 @@ def householder_null(V: Array, beta: Array, m: int, N: Array) -> None:
             _reflect_rows(N, V[j], beta[j], np.uint64(j), np.uint64(n), np.uint64(p), s)
 
 
-@inlined
-def _forward_solve(R: Array, b: Array, y: Array) -> bool:
-    r""":math:`R_1^T y = b` by forward substitution (R (n, m), its leading m x m triangle
-    :math:`R_1`); False, ``y`` not set, where a pivot is not above ``1e-12`` times the largest.
-    """  # noqa: D205
-    m = R.shape[1]
-    largest = 0.0
-    for i in range(m):
-        largest = max(largest, abs(R[i, i]))
-    for i in range(m):
-        if abs(R[i, i]) <= 1e-12 * largest:
-            return False
-    for i in range(m):
-        s = b[i]
-        for k in range(i):
-            s -= R[k, i] * y[k]
-        y[i] = s / R[i, i]
-    return True
-
-
-@kernel
-def householder_rates(V: Array, beta: Array, R: Array, b: Array, x: Array) -> bool:
-    r""":func:`least_norm_rates` from the factored QR (:func:`householder_vectors`), m < n:
-    :math:`x = Q_1 y = H_0 \cdots H_{k-1} [y; 0]`, each :math:`H_j` on entries j: only
-    (Golub & Van Loan, 5.1.6), without forming Q.
-
-    Args:
-        V: The Householder vectors (k, n).
-        beta: Their factors (k,).
-        R: Triangular factor (n, m).
-        b: Right-hand side (m,).
-        x: Out: the rates (n,).
-
-    Returns:
-        False where :func:`least_norm_rates` is (``x`` then not set).
-    """  # noqa: D205
-    n, m = R.shape
-    y = np.empty(m)
-    if not _forward_solve(R, b, y):
-        return False
-    X = x.reshape(1, n)
-    X[0, :m] = y
-    X[0, m:] = 0.0
-    s = np.empty(1)
-    for j in range(beta.size - 1, -1, -1):
-        if beta[j] != 0.0:
-            _reflect_rows(X, V[j], beta[j], np.uint64(j), np.uint64(n), np.uint64(1), s)
-    return True
-
-
 @kernel
 def least_norm_rates(Q: Array, R: Array, b: Array, x: Array) -> bool:
     r"""The least-norm solution of ``J x = b`` from the QR of :math:`J^T = QR` (m <= n).
@@ -259,9 +209,18 @@ def least_norm_rates(Q: Array, R: Array, b: Array, x: Array) -> bool:
         set.
     """
     n, m = R.shape
+    largest = 0.0
+    for i in range(m):
+        largest = max(largest, abs(R[i, i]))
+    for i in range(m):
+        if abs(R[i, i]) <= 1e-12 * largest:
+            return False
     y = np.empty(m)
-    if not _forward_solve(R, b, y):
-        return False
+    for i in range(m):
+        s = b[i]
+        for k in range(i):
+            s -= R[k, i] * y[k]
+        y[i] = s / R[i, i]
     for r in range(n):
         s = 0.0
         for i in range(m):
