@@ -69,6 +69,28 @@ def test_space_is_the_pipelines(rng: np.random.Generator) -> None:
         np.testing.assert_allclose(N, expected.N, atol=1e-13)
 
 
+@pytest.mark.parametrize(("r", "n"), [(6, 14), (18, 24), (3, 3), (1, 7)])
+def test_space_against_numpy(r: int, n: int, rng: np.random.Generator) -> None:
+    """x0 the pseudo-inverse's rates (zero for d = 0), N orthonormal rows spanning C's null
+    space (its projector numpy's), met; full rank and rank deficient."""
+    for rank in {r, r - 1}:
+        for zero in (True, False):
+            C = rng.normal(size=(r, n))
+            if rank < r:
+                C[-1] = C[0] - 2.0 * C[-2 % r]
+            d = np.zeros(r) if zero else C @ rng.normal(size=n)
+            x0, N, met = space(C, d)
+            assert met
+            np.testing.assert_allclose(x0, np.linalg.pinv(C) @ d, rtol=0, atol=1e-12)
+            if zero:
+                np.testing.assert_array_equal(x0, 0.0)
+            free = n - np.linalg.matrix_rank(C)
+            assert N.shape == (free, n)
+            np.testing.assert_allclose(N @ N.T, np.eye(free), atol=1e-13)
+            projector = np.eye(n) - np.linalg.pinv(C) @ C
+            np.testing.assert_allclose(N.T @ N, projector, atol=1e-12)
+
+
 @pytest.mark.parametrize("rates", ["zero", "kept"])
 def test_ticks_within_equality_rows_are_the_pipelines(rng: np.random.Generator,
                                                       rates: str) -> None:  # fmt: skip
