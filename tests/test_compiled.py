@@ -95,7 +95,8 @@ SOLVE_ONE = """
 import numpy as np
 import rrc_pin
 # the tick's kernels made dispatchers with their caches
-from rrc_pin.solvers.tick import damping, direction, feasibility, joint_box, linalg, statuses
+from rrc_pin.solvers import linalg
+from rrc_pin.solvers.tick import damping, direction, feasibility, joint_box, statuses
 arm = rrc_pin.load("kr5_3r")
 q = arm.random_q(np.random.default_rng(1))
 out = {"file": rrc_pin.__file__,
@@ -159,7 +160,7 @@ def same_answers(a: dict, b: dict) -> None:
 
 
 def cache_files(root: Path) -> dict[str, list[Path]]:
-    """numba's cache files under the copy, by module (``rrc_pin.solvers.tick.linalg``...)."""
+    """numba's cache files under the copy, by module (``rrc_pin.solvers.linalg``...)."""
     out: dict[str, list[Path]] = {}
     for path in sorted(root.rglob("__pycache__/*.nb[ic]")):
         package = path.parent.parent.relative_to(root).parts

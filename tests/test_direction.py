@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from test_linalg import random_rows
 
+from rrc_pin.solvers import linalg
 from rrc_pin.solvers.errors import NumericalFailure
 from rrc_pin.solvers.qp_backends import installed_backends, make_backend
-from rrc_pin.solvers.tick import linalg
 from rrc_pin.solvers.tick.direction import (
     REGULARIZATION,
     along,

@@ -111,7 +111,7 @@ def test_subspace_rows_against_numpy(start: str) -> None:
 def test_metric_projection_is_project_to_the_bit() -> None:
     """The projection in the level's factorised metric is project's, bit for bit, and project's
     own where the metric's diagonal is too small to ignore its damping."""
-    from rrc_pin.solvers.tick import linalg
+    from rrc_pin.solvers import linalg
     from rrc_pin.solvers.tick.slide_kernels import MARGIN, project
 
     rng = np.random.default_rng(7)

@@ -1,4 +1,4 @@
-"""The dense linear algebra kernels (rrc_pin.solvers.tick.linalg) against numpy (or LAPACK), to
+"""The dense linear algebra kernels (rrc_pin.solvers.linalg) against numpy (or LAPACK), to
 1e-12. The whole suite also runs once with ``NUMBA_DISABLE_JIT=1`` (.ci/run), the same source as
 plain Python.
 """
@@ -10,7 +10,7 @@ import itertools
 import numpy as np
 import pytest
 
-from rrc_pin.solvers.tick import linalg
+from rrc_pin.solvers import linalg
 
 
 def random_rows(

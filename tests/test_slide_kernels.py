@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 import qpsolvers
 
-from rrc_pin.solvers.tick.linalg import cholesky
+from rrc_pin.solvers.linalg import cholesky
 from rrc_pin.solvers.tick.slide_kernels import (
     INFEASIBLE,
     SOLVED,

@@ -34,8 +34,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.tick.feasibility import clip_into, inside, rows_hold
-from rrc_pin.solvers.tick.linalg import (
+from rrc_pin.solvers.linalg import (
     cholesky,
     householder_null,
     householder_vectors,
@@ -43,6 +42,7 @@ from rrc_pin.solvers.tick.linalg import (
     row_values,
     solve_factored,
 )
+from rrc_pin.solvers.tick.feasibility import clip_into, inside, rows_hold
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project_factored
 
 Array = npt.NDArray[np.float64]
@@ -205,8 +205,8 @@ def damped_factor(J: Array, L: Array) -> float:
     The Cholesky factor ``L`` (k, k) of :math:`W = JJ^T + \mu I` where k = m < n (the rows'
     side: the smaller where there are fewer rows than rates), else (k = n) of
     :math:`M = J^TJ + \mu I` (:func:`damped_solve`). ``L``'s upper triangle is left as the
-    matrix's (:func:`~rrc_pin.solvers.tick.linalg.cholesky` in place;
-    :func:`~rrc_pin.solvers.tick.linalg.solve_factored` does not read it).
+    matrix's (:func:`~rrc_pin.solvers.linalg.cholesky` in place;
+    :func:`~rrc_pin.solvers.linalg.solve_factored` does not read it).
 
     Returns:
         :math:`\mu`, or 0 where the matrix is not definite or the rows are all zero (the
@@ -287,7 +287,7 @@ def kept(C: Array, top: Array) -> tuple[Array, Array]:
 
     Returns:
         ``null`` (n - m, n), orthonormal rows from the Householder QR of :math:`C^T`
-        (:func:`~rrc_pin.solvers.tick.linalg.householder_null`), and ``keep``, ``top @
+        (:func:`~rrc_pin.solvers.linalg.householder_null`), and ``keep``, ``top @
         null.T`` (t, n - m); (0, n) and (t, 0) where there is no top level (t = 0) or no
         null space (m >= n).
     """

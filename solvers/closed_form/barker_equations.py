@@ -32,7 +32,7 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.closed_form.base import finite
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick.linalg import jacobi_svd, svd_rates
+from rrc_pin.solvers.linalg import jacobi_svd, svd_rates
 
 Array = npt.NDArray[np.float64]
 Flags = npt.NDArray[np.bool_]
@@ -412,7 +412,7 @@ def band_solve(A: Array, b: Array, s2: float, eps: float, exact: bool, x: Array)
 
     ``s2`` the block's measure ``s^2 <= eps^2``. With ``exact``: the truncated pseudo-inverse,
     singular values ``<= eps`` dropped (M* of eq. (38), M1* of eq. (44), M2* of eq. (60)).
-    The SVD is one-sided Jacobi (:func:`~rrc_pin.solvers.tick.linalg.jacobi_svd`); ``A`` is
+    The SVD is one-sided Jacobi (:func:`~rrc_pin.solvers.linalg.jacobi_svd`); ``A`` is
     overwritten.
     """
     m = b.size

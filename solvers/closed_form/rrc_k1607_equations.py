@@ -27,7 +27,7 @@ import numpy.typing as npt
 
 from rrc_pin.solvers.closed_form.base import finite
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.tick.linalg import cholesky_solve, jacobi_svd, svd_rates
+from rrc_pin.solvers.linalg import cholesky_solve, jacobi_svd, svd_rates
 
 Array = npt.NDArray[np.float64]
 Vector3 = tuple[float, float, float]
@@ -136,7 +136,7 @@ def weighted_rates(
                = W J^T (J W J^T)^{-1} (\dot x - J z) + z
 
     (the same vector, one solve), with ``B = J L``: ``B B^T y = xdot - J z`` by Cholesky's
-    method (:func:`~rrc_pin.solvers.tick.linalg.cholesky_solve`), then ``qdot = L B^T y + z``.
+    method (:func:`~rrc_pin.solvers.linalg.cholesky_solve`), then ``qdot = L B^T y + z``.
     ``L``
     lower triangular, None for ``W = I``; ``z`` None for zero (eq. (23): the minimum-norm
     rates). Forming ``B B^T`` squares the condition number: accurate to about eps kappa(B)^2

@@ -31,7 +31,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick.linalg import cholesky, max_abs, solve_factored
+from rrc_pin.solvers.linalg import cholesky, max_abs, solve_factored
 
 Array = npt.NDArray[np.float64]
 

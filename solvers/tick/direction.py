@@ -40,13 +40,14 @@ import numpy as np
 import numpy.typing as npt
 from scipy.optimize import linprog
 
+from rrc_pin.solvers import linalg
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.errors import NumericalFailure
+from rrc_pin.solvers.linalg import householder_qr, least_norm_rates, max_abs
 from rrc_pin.solvers.qp_backends import active_set
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding
-from rrc_pin.solvers.tick import feasibility, linalg, statuses
+from rrc_pin.solvers.tick import feasibility, statuses
 from rrc_pin.solvers.tick.feasibility import inside
-from rrc_pin.solvers.tick.linalg import householder_qr, least_norm_rates, max_abs
 from rrc_pin.solvers.tick.problem import Box, Rows
 from rrc_pin.solvers.tick.statuses import STILL_SCALE, scale_and_veer
 
@@ -190,8 +191,8 @@ def direction_step(
 ) -> tuple[int, float]:
     r"""The top level's step within a box: its exact rates, whether they fit, else their scale.
 
-    :func:`~rrc_pin.solvers.tick.linalg.householder_qr` of :math:`J^T`, the least-norm rates w
-    of :math:`Jx = b` (:func:`~rrc_pin.solvers.tick.linalg.least_norm_rates`),
+    :func:`~rrc_pin.solvers.linalg.householder_qr` of :math:`J^T`, the least-norm rates w
+    of :math:`Jx = b` (:func:`~rrc_pin.solvers.linalg.least_norm_rates`),
     :func:`~rrc_pin.solvers.tick.feasibility.inside`; where w leaves the box and the null space
     of J has at most one direction (:math:`Q_{:,m}`, a 7-joint arm's six rows), the direction
     problem's exact answer :math:`u\,w + y\,Q_{:,m}` (:func:`uniform_scale`,

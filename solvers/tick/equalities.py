@@ -32,9 +32,9 @@ from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.errors import NumericalFailure
+from rrc_pin.solvers.linalg import row_values, transposed_values
 from rrc_pin.solvers.tick import backend_calls, factor, feasibility, statuses, top
 from rrc_pin.solvers.tick.levels import least_squares, product, product_transposed
-from rrc_pin.solvers.tick.linalg import row_values, transposed_values
 from rrc_pin.solvers.tick.statuses import (
     DAMPED,
     EXACT,

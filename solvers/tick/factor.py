@@ -14,8 +14,9 @@ from typing import NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.solvers import linalg
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.tick import feasibility, linalg
+from rrc_pin.solvers.tick import feasibility
 from rrc_pin.solvers.tick.direction import direction_step
 
 Array = npt.NDArray[np.float64]
@@ -51,7 +52,7 @@ class Factor(NamedTuple):
 
 @kernel
 def qr(J: Array) -> Factor:
-    """The QR of ``J^T`` (:func:`~rrc_pin.solvers.tick.linalg.householder_qr`), no SVD yet."""
+    """The QR of ``J^T`` (:func:`~rrc_pin.solvers.linalg.householder_qr`), no SVD yet."""
     m, n = J.shape
     Q, R = np.empty((n, n)), np.empty((n, m))
     linalg.householder_qr(J.T, Q, R)
@@ -60,7 +61,7 @@ def qr(J: Array) -> Factor:
 
 @kernel
 def with_svd(f: Factor) -> Factor:
-    r"""``f`` with its SVD (:func:`~rrc_pin.solvers.tick.linalg.triangle_svd`)."""
+    r"""``f`` with its SVD (:func:`~rrc_pin.solvers.linalg.triangle_svd`)."""
     if f.rank >= 0:
         return f
     m, n = f.J.shape
@@ -73,7 +74,7 @@ def with_svd(f: Factor) -> Factor:
 @kernel
 def rates(f: Factor, b: Array, lambda_sq: Array) -> Array:
     r"""Damped least-squares rates (n,) :math:`\sum_i \sigma_i/(\sigma_i^2+\lambda_i^2)(u_i^Tb)v_i`
-    of a record with its SVD (:func:`~rrc_pin.solvers.tick.linalg.svd_rates`).
+    of a record with its SVD (:func:`~rrc_pin.solvers.linalg.svd_rates`).
     """  # noqa: D205
     x = np.empty(f.J.shape[1])
     linalg.svd_rates(f.US, f.sigma, f.right, b, lambda_sq, f.rank, x)

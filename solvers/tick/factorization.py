@@ -1,15 +1,15 @@
 r"""The factorisation of a level's rows: QR for the exact rates, the SVD only when needed.
 
 For rows J (m, n), the Householder QR of the transpose, :math:`J^T = QR`
-(:func:`~rrc_pin.solvers.tick.linalg.householder_qr`), gives at once:
+(:func:`~rrc_pin.solvers.linalg.householder_qr`), gives at once:
 
 - the least-norm rates of a full-row-rank J, :math:`x = Q_1 R_1^{-T} b`
-  (:func:`~rrc_pin.solvers.tick.linalg.least_norm_rates`), what most ticks need;
+  (:func:`~rrc_pin.solvers.linalg.least_norm_rates`), what most ticks need;
 - the null space, the last n - m columns of Q.
 
 The singular values are those of the small triangle :math:`R_1` (k = min(m, n) rows), so
 the SVD of J costs a one-sided Jacobi SVD of :math:`R_1^T` (m, k)
-(:func:`~rrc_pin.solvers.tick.linalg.jacobi_svd`): :math:`R_1^T V = U\Sigma` gives
+(:func:`~rrc_pin.solvers.linalg.jacobi_svd`): :math:`R_1^T V = U\Sigma` gives
 :math:`J = U\Sigma (Q_1 V)^T`. It is computed on first use, where the rows are numerically
 dependent (a singularity, more rows than joints), and for the condition number and the
 damping near singularities.
@@ -22,7 +22,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.tick import feasibility, linalg
+from rrc_pin.solvers import linalg
+from rrc_pin.solvers.tick import feasibility
 from rrc_pin.solvers.tick.direction import Along, direction_step
 
 Array = npt.NDArray[np.float64]

@@ -9,7 +9,7 @@ the levels above and their null space; all rates for the first level), so the le
     \quad \text{s.t.} \quad lb \le x + N^Tz \le ub,\quad G(x + N^Tz) \le h.
 
 Its unconstrained optimum of least norm is the answer when it satisfies the constraints:
-by the normal equations :math:`B^TBz = B^Tc` (:func:`~rrc_pin.solvers.tick.linalg.cholesky_solve`)
+by the normal equations :math:`B^TBz = B^Tc` (:func:`~rrc_pin.solvers.linalg.cholesky_solve`)
 for
 more rows than unknowns, by the QR of :math:`B^T`
 (:class:`~rrc_pin.solvers.tick.factorization.Factorization`)
@@ -41,8 +41,9 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.solvers import linalg
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding, Work, solve_within, tolerance
-from rrc_pin.solvers.tick import feasibility, linalg
+from rrc_pin.solvers.tick import feasibility
 from rrc_pin.solvers.tick.direction import constraint_rows
 from rrc_pin.solvers.tick.factorization import Factorization
 from rrc_pin.solvers.tick.problem import Box, Rows
@@ -78,7 +79,7 @@ class Subspace(NamedTuple):
 
 
 def normal_equations(B: Array, c: Array) -> tuple[Array, Array]:
-    r""":math:`(B^TB, B^Tc)` (:func:`~rrc_pin.solvers.tick.linalg.normal_equations`): the
+    r""":math:`(B^TB, B^Tc)` (:func:`~rrc_pin.solvers.linalg.normal_equations`): the
     optimum's normal
     equations, and the QP's costs."""  # noqa: D205, D209
     m, d = B.shape

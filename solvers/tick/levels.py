@@ -15,9 +15,10 @@ import numpy as np
 import numpy.typing as npt
 from numba import objmode
 
+from rrc_pin.solvers import linalg
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import backend_calls, factor, feasibility, linalg
-from rrc_pin.solvers.tick.linalg import row_values
+from rrc_pin.solvers.linalg import row_values
+from rrc_pin.solvers.tick import backend_calls, factor, feasibility
 from rrc_pin.solvers.tick.slide_kernels import (
     MARGIN,
     SOLVED,
@@ -67,7 +68,7 @@ def product_transposed(A: Array, N: Array) -> Array:
 def optimum(B: Array, c: Array, H: Array, g: Array, L: Array) -> tuple[Array, bool]:
     """The least-squares solution of least norm of ``B z ~= c``, and whether :math:`B^TB` is
     definite (:func:`rrc_pin.solvers.tick.least_squares.optimum`): then ``L`` (d, d), zeros
-    on entry, holds its Cholesky factor (:func:`~rrc_pin.solvers.tick.linalg.cholesky_solve`).
+    on entry, holds its Cholesky factor (:func:`~rrc_pin.solvers.linalg.cholesky_solve`).
     """  # noqa: D205
     m, d = B.shape
     if m > d:

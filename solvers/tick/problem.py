@@ -37,10 +37,10 @@ from typing import Literal, NamedTuple
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.solvers import linalg
 from rrc_pin.solvers.checks import all_finite
 from rrc_pin.solvers.compiled import kernel
 from rrc_pin.solvers.errors import InvalidInput
-from rrc_pin.solvers.tick import linalg
 
 Array = npt.NDArray[np.float64]
 
@@ -251,7 +251,7 @@ def _stack(tasks: Sequence[TaskRows], normalised: bool, box: Box) -> tuple[Array
     """Rows and rates of ``tasks`` stacked in the level's metric, and the rates' factor.
 
     Each row times the square root of its weight over the level's largest (and in the
-    normalised metric divided by its unit, :func:`rrc_pin.solvers.tick.linalg.weighted_rows`); the
+    normalised metric divided by its unit, :func:`rrc_pin.solvers.linalg.weighted_rows`); the
     rates
     capped as the module docstring says (:func:`_capped`).
     """

@@ -29,7 +29,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers.compiled import kernel
-from rrc_pin.solvers.tick.linalg import cholesky, solve_factored
+from rrc_pin.solvers.linalg import cholesky, solve_factored
 
 Array = npt.NDArray[np.float64]
 

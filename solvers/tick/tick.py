@@ -32,11 +32,12 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.solvers import linalg
 from rrc_pin.solvers.compiled import inlined, kernel
-from rrc_pin.solvers.tick import equalities, factor, feasibility, linalg, statuses, top
+from rrc_pin.solvers.linalg import row_values
+from rrc_pin.solvers.tick import equalities, factor, feasibility, statuses, top
 from rrc_pin.solvers.tick.joint_box import joint_box
 from rrc_pin.solvers.tick.levels import least_squares
-from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.problem import LARGE, TaskRows, cap
 from rrc_pin.solvers.tick.statuses import DROPPED
 from rrc_pin.solvers.tick.top import FAILED, Rows, Top

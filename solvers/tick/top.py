@@ -29,13 +29,13 @@ import numpy.typing as npt
 from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
+from rrc_pin.solvers.linalg import row_values
 from rrc_pin.solvers.tick import backend_calls, factor, feasibility, statuses
 from rrc_pin.solvers.tick.damping import clamp_pushed, damping_lambda_sq
 from rrc_pin.solvers.tick.direction import line_scale, solved_along, uniform_scale
 from rrc_pin.solvers.tick.factor import Factor
 from rrc_pin.solvers.tick.joint_box import ON_LIMIT
 from rrc_pin.solvers.tick.levels import least_squares
-from rrc_pin.solvers.tick.linalg import row_values
 from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, slide_metric
 from rrc_pin.solvers.tick.statuses import (
     DAMPED,

@@ -1,4 +1,7 @@
-r"""Dense linear algebra of the tick's small matrices, compiled: QR, SVD, Cholesky.
+r"""Dense linear algebra of small matrices, compiled: QR, SVD, Cholesky.
+
+Shared by the resolver's tick (:mod:`rrc_pin.solvers.tick`), the closed forms, the active-set
+QP and the cells' closure.
 
 The Householder QR of a level's transposed rows and its least-norm rates, the one-sided Jacobi
 SVD (of the QR's triangle, or of any small matrix: the closed forms'), the damped
