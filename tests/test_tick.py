@@ -22,7 +22,7 @@ from rrc_pin.solvers.tick.problem import Box, Constraints, TaskRows, build
 
 STATUS_NAMES = get_args(Status)
 
-SEEDS = [20261206, 6307242558226725790, 8806618223483400590,
+SEEDS = [20261206, 6307242558226725790, 8806618223483400590, 481931199943053647,
          int(np.random.SeedSequence().entropy % 2**63)]  # fmt: skip
 N, DT = 7, 0.01
 LEVELS = ("met", "scaled", "traded", "dropped")
@@ -121,11 +121,13 @@ def test_random_problems_answered_as_the_pipeline(seed: int) -> None:
             pairs = zip(got, want.levels, strict=True)
             assert all(g == w or "dropped" in {g, w} for g, w in pairs), (got, want.levels)
             relabelled += 1
-        apart = np.abs(qdot - want.qdot).max()
+        apart, scale_tol = np.abs(qdot - want.qdot).max(), tol
         if apart > tol * (1.0 + np.abs(want.qdot).max()):
-            assert apart <= 3.0 * own_spread(args, want.qdot, rng), (seed, apart)
+            spread, scale_spread = own_spread(args, want.qdot, want.scale, rng)
+            assert apart <= 3.0 * spread, (seed, apart)
+            scale_tol = max(tol, 3.0 * scale_spread)
             sensitive += 1
-        assert ws.reals[tick.SCALE] == pytest.approx(want.scale, abs=tol), seed
+        assert ws.reals[tick.SCALE] == pytest.approx(want.scale, abs=scale_tol), seed
         if max(want.scale, ws.reals[tick.SCALE]) > 1e-9:
             assert ws.reals[tick.VEER] == pytest.approx(want.veer, abs=1e-7)
     assert {"exact", "scaled", "least_squares"} <= set(kinds), kinds
@@ -133,26 +135,29 @@ def test_random_problems_answered_as_the_pipeline(seed: int) -> None:
     assert sensitive <= 4, sensitive  # 1 of 400 seen (fresh seed 6307242558226725790)
 
 
-def own_spread(args: tuple, qdot: np.ndarray, rng: np.random.Generator) -> float:
-    """How far the pipeline's own rates move when its task and constraint rows move by one ulp
-    (8 draws): the answer's sensitivity to rounding. A lower level pinned by constraint rows
+def own_spread(args: tuple, qdot: np.ndarray, scale: float, rng: np.random.Generator
+               ) -> tuple[float, float]:  # fmt: skip
+    """How far the pipeline's own rates and scale move when its task and constraint rows move
+    by one ulp (8 draws): the answer's sensitivity to rounding. A lower level pinned by constraint rows
     whose slack is :data:`~rrc_pin.solvers.tick.least_squares.ROUNDING` (1e-12 rad/s) and whose
     smallest singular value is 4.9e-4 is a region 1e-8 wide: one ulp of its data moved the
     pipeline's rates by up to 3.2e-8, and the compiled tick's answer, formed in its own loops,
-    lay 1.3e-8 from the pipeline's."""
+    lay 1.3e-8 from the pipeline's (seed 481931199943053647: rates 1.1e-8 apart, the pipeline's
+    own spread 1.1e-8, the scales 2.8e-9 apart)."""
     q, lower, upper, velocity, levels, weighted, G, h, slide, direction = args
 
     def ulp(a: np.ndarray) -> np.ndarray:
         return a * (1.0 + np.finfo(float).eps * rng.choice([-1.0, 1.0], a.shape))
 
-    spread = 0.0
+    spread = scale_spread = 0.0
     for _ in range(8):
         moved = [[TaskRows(ulp(t.A), t.b, t.weight, t.name, t.unit) for t in level]
                  for level in levels]  # fmt: skip
         answer = pipeline_answer(q, lower, upper, velocity, moved, weighted, ulp(G), h, slide,
                                  direction)  # fmt: skip
         spread = max(spread, float(np.abs(answer.qdot - qdot).max()))
-    return spread
+        scale_spread = max(scale_spread, abs(answer.scale - scale))
+    return spread, scale_spread
 
 
 def test_stacked_rows_are_the_problems(rng: np.random.Generator) -> None:
