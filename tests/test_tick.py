@@ -138,12 +138,12 @@ def test_random_problems_answered_as_the_pipeline(seed: int) -> None:
 def own_spread(args: tuple, qdot: np.ndarray, scale: float, rng: np.random.Generator
                ) -> tuple[float, float]:  # fmt: skip
     """How far the pipeline's own rates and scale move when its task and constraint rows move
-    by one ulp (8 draws): the answer's sensitivity to rounding. A lower level pinned by constraint rows
-    whose slack is :data:`~rrc_pin.solvers.tick.least_squares.ROUNDING` (1e-12 rad/s) and whose
-    smallest singular value is 4.9e-4 is a region 1e-8 wide: one ulp of its data moved the
-    pipeline's rates by up to 3.2e-8, and the compiled tick's answer, formed in its own loops,
-    lay 1.3e-8 from the pipeline's (seed 481931199943053647: rates 1.1e-8 apart, the pipeline's
-    own spread 1.1e-8, the scales 2.8e-9 apart)."""
+    by one ulp (8 draws): the answer's sensitivity to rounding. A lower level pinned by
+    constraint rows whose slack is :data:`~rrc_pin.solvers.tick.least_squares.ROUNDING`
+    (1e-12 rad/s) and whose smallest singular value is 4.9e-4 is a region 1e-8 wide: one ulp
+    of its data moved the pipeline's rates by up to 3.2e-8, and the compiled tick's answer,
+    formed in its own loops, lay 1.3e-8 from the pipeline's (seed 481931199943053647: rates
+    1.1e-8 apart, the pipeline's own spread 1.1e-8, the scales 2.8e-9 apart)."""
     q, lower, upper, velocity, levels, weighted, G, h, slide, direction = args
 
     def ulp(a: np.ndarray) -> np.ndarray:
