@@ -64,3 +64,28 @@ def test_repeated_frames_and_none() -> None:
     empty = FrameColumns.of(dual.model, data, [])
     assert empty.steps.shape == (0, 3) and empty.starts.tolist() == [0]
     assert empty.poses(data).shape == (0, 4, 4)
+
+
+class _Without:
+    """``inner`` without the attributes Pinocchio 3.4 added for mimic joints."""
+
+    def __init__(self, inner: object) -> None:
+        self._inner = inner
+
+    def __getattr__(self, name: str) -> object:
+        if "Extended" in name or "mimic" in name:
+            raise AttributeError(name)
+        return getattr(self._inner, name)
+
+
+@pytest.mark.parametrize("name", ["gsfc_dual", "yeh_tripod", "panda"])
+def test_the_walk_of_a_pinocchio_without_mimic_columns(name: str) -> None:
+    """Where the model has no extended columns (Pinocchio before 3.4), the walk over
+    ``parents_fromRow`` gives the same steps on a model without mimic joints."""
+    model = rrc_pin.load(name).model
+    data = model.createData()
+    frames = list(range(model.nframes))
+    want = FrameColumns.of(model, data, frames)
+    got = FrameColumns.of(_Without(model), _Without(data), frames)  # type: ignore[arg-type]
+    np.testing.assert_array_equal(got.steps, want.steps)
+    np.testing.assert_array_equal(got.starts, want.starts)

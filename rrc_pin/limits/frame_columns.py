@@ -7,9 +7,10 @@ frame's Jacobian from the columns that support the frame's parent joint, followi
 ``data.non_mimic_parents_fromRow`` from the joint's last column (from its first non-mimic
 parent's, for a mimic joint), then adds the mimic joints' columns, following
 ``data.mimic_parents_fromRow``, into the columns of the joints they follow
-(``data.idx_vExtended_to_idx_v_fromRow``); every other column is zero. :class:`FrameColumns`
-is that walk, made once per model and frames, as the compiled rows
-(:mod:`rrc_pin.limits.chain_kernels`) read it at every tick.
+(``data.idx_vExtended_to_idx_v_fromRow``); every other column is zero. Before Pinocchio 3.4's
+mimic joints (no ``model.nvExtended``) one column per rate, the walk ``data.parents_fromRow``
+from the joint's last column. :class:`FrameColumns` is that walk, made once per model and
+frames, as the compiled rows (:mod:`rrc_pin.limits.chain_kernels`) read it at every tick.
 """
 
 from __future__ import annotations
@@ -59,6 +60,13 @@ class FrameColumns(NamedTuple):
 
 def _walk(model: pin.Model, data: pin.Data, joint: int) -> list[tuple[int, int, int]]:
     """The steps of a frame on ``joint``: Pinocchio's two passes (module docstring)."""
+    if not hasattr(model, "nvExtended"):  # a Pinocchio without extended (mimic) columns
+        column = model.joints[joint].idx_v + model.joints[joint].nv - 1
+        plain = []
+        while column >= 0:
+            plain.append((column, column, 0))
+            column = data.parents_fromRow[column]
+        return plain
     if model.nvExtended == 0:
         return []
     first = model.idx_vExtendeds[joint]
