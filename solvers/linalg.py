@@ -50,19 +50,6 @@ def row_values(A: Array, x: Array) -> Array:
 
 
 @kernel
-def transposed_values(N: Array, z: Array) -> Array:
-    """``N^T z`` (n,) for rows N (d, n): :func:`row_values` of ``N^T`` (the same sums, in the
-    same order), without its copy."""  # noqa: D205, D209
-    d, n = N.shape
-    y = np.zeros(n)
-    for j in range(d):
-        zj = z[j]
-        for i in range(n):
-            y[i] += N[j, i] * zj
-    return y
-
-
-@kernel
 def max_abs(x: Array) -> float:
     """The largest ``|x_i|`` (0 for none)."""
     top = 0.0

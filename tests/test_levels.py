@@ -27,18 +27,6 @@ def test_products_against_numpy(seed: int) -> None:
         np.testing.assert_allclose(levels.product(A, B), A @ B, atol=1e-13)
 
 
-@pytest.mark.parametrize("seed", SEEDS)
-def test_product_transposed_is_product_to_the_bit(seed: int) -> None:
-    """``A N^T`` without the copy of ``N^T``: numpy's, and product's floats exactly."""
-    rng = np.random.default_rng(seed)
-    for _ in range(100):
-        m, n, d = rng.integers(0, 15, 3)
-        A, rows = rng.normal(size=(m, n)), rng.normal(size=(d, n))
-        C = levels.product_transposed(A, rows)
-        np.testing.assert_allclose(C, A @ rows.T, atol=1e-13)
-        np.testing.assert_array_equal(C, levels.product(A, np.ascontiguousarray(rows.T)))
-
-
 def level_case(rng: np.random.Generator) -> tuple:
     """A level's rows and rates, a box around zero, maybe rows, maybe a subspace."""
     m = int(rng.integers(2, 12))

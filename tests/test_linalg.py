@@ -191,16 +191,6 @@ def test_row_values_against_numpy(rng: np.random.Generator) -> None:
         np.testing.assert_allclose(linalg.row_values(A, x), A @ x, atol=1e-13)
 
 
-def test_transposed_values_are_row_values_to_the_bit(rng: np.random.Generator) -> None:
-    """``N^T z`` without the copy of ``N^T``: numpy's, and row_values' floats exactly."""
-    for _ in range(100):
-        d, n = rng.integers(0, 15, 2)
-        N, z = rng.normal(size=(d, n)), rng.normal(size=d)
-        y = linalg.transposed_values(N, z)
-        np.testing.assert_allclose(y, N.T @ z, atol=1e-13)
-        np.testing.assert_array_equal(y, linalg.row_values(np.ascontiguousarray(N.T), z))
-
-
 @pytest.mark.parametrize(("m", "n"), [(6, 7), (6, 14), (18, 24), (1, 4), (6, 6), (0, 3)])
 def test_householder_null_is_q_s_trailing_columns(m: int, n: int, rng: np.random.Generator) -> None:
     """householder_vectors' reflectors: householder_qr's R bit for bit, and Q's trailing

@@ -32,9 +32,9 @@ from numba import objmode
 
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.errors import NumericalFailure
-from rrc_pin.solvers.linalg import row_values, transposed_values
+from rrc_pin.solvers.linalg import row_values
 from rrc_pin.solvers.tick import backend_calls, factor, feasibility, statuses, top
-from rrc_pin.solvers.tick.levels import least_squares, product, product_transposed
+from rrc_pin.solvers.tick.levels import least_squares, product
 from rrc_pin.solvers.tick.statuses import (
     DAMPED,
     EXACT,
@@ -74,8 +74,9 @@ def direction_within(A: Array, b: Array, N: Array, rows: Rows, dt: float, thresh
     ``_top`` with an equality space).
     """  # noqa: D205
     n, d = A.shape[1], N.shape[0]
-    f, z = factor.least_norm(factor.qr(product_transposed(A, N)), b)
-    w = transposed_values(N, z)
+    Nt = np.ascontiguousarray(N.T)
+    f, z = factor.least_norm(factor.qr(product(A, Nt)), b)
+    w = row_values(Nt, z)
     outside_range = not f.regular and not top.met(f.J, z, b)
     if feasibility.inside(w, rows.lb, rows.ub) and feasibility.rows_hold(rows.G, w, rows.h, 0.0):
         null = product(factor.null_basis(f)[1], N) if need_null else np.empty((0, n))
@@ -94,8 +95,8 @@ def direction_within(A: Array, b: Array, N: Array, rows: Rows, dt: float, thresh
                   rows.solved)
     usable, lam = top.damping(f, b, z, u, within, dt, threshold)
     if lam.size:
-        damped_rates = transposed_values(N, factor.rates(usable, b, lam))
-        damped, damped_u, _ = top.scaled_along(A, damped_rates, null, rows)
+        damped, damped_u, _ = top.scaled_along(A, row_values(Nt, factor.rates(usable, b, lam)),
+                                               null, rows)  # fmt: skip
         if damped_u < 0.0:
             return top.passing(w, null)
         return top.answer(A, b, damped, DAMPED, rate_factor, null, float(np.max(lam)))

@@ -48,22 +48,6 @@ def product(A: Array, B: Array) -> Array:
     return C
 
 
-@kernel
-def product_transposed(A: Array, N: Array) -> Array:
-    """``A N^T`` (m, d) for A (m, n) and rows N (d, n): :func:`product` of ``N^T`` (the same
-    sums, in the same order), without its copy."""  # noqa: D205, D209
-    m, n = A.shape
-    d = N.shape[0]
-    C = np.empty((m, d))
-    for i in range(m):
-        for j in range(d):
-            s = 0.0
-            for p in range(n):
-                s += A[i, p] * N[j, p]
-            C[i, j] = s
-    return C
-
-
 @inlined
 def optimum(B: Array, c: Array, H: Array, g: Array, L: Array) -> tuple[Array, bool]:
     """The least-squares solution of least norm of ``B z ~= c``, and whether :math:`B^TB` is
@@ -120,7 +104,7 @@ def subspace_rows(x: Array, N: Array, lb: Array, ub: Array, G: Array, h: Array, 
     n, p = x.size, h.size
     C = np.empty((n + p, N.shape[0]))
     C[:n] = N.T
-    C[n:] = product_transposed(G, N)
+    C[n:] = product(G, np.ascontiguousarray(N.T))
     Gx = row_values(G, x)
     lo, hi = np.empty(n + p), np.empty(n + p)
     for i in range(n):
@@ -150,7 +134,7 @@ def projected(B: Array, H: Array, L: Array, z: Array, x: Array, N: Array, whole:
         Gz, hz = subspace_rows(x, N, lb, ub, G, h, tol)
         free = np.full(d, np.inf)
         code = metric_projection(B, H, L, z, -free, free, Gz, hz, out)
-        qdot = linalg.transposed_values(N, out) + x
+        qdot = row_values(np.ascontiguousarray(N.T), out) + x
     if code != SOLVED:
         return np.empty(0)
     if feasibility.clip_into(qdot, lb, ub) > tol or not feasibility.rows_hold(G, qdot, h, tol):
@@ -197,13 +181,13 @@ def least_squares(
     """
     n = A.shape[1]
     whole = N.shape[0] == 0
-    B = A if whole else product_transposed(A, N)
+    B = A if whole else product(A, np.ascontiguousarray(N.T))
     c = b if whole else b - row_values(A, x)
     m, d = B.shape
     H, g, L = np.empty((d, d)), np.empty(d), np.zeros((d, d))
     linalg.normal_equations(B, c, np.ones(m), H, g)
     z, definite = optimum(B, c, H, g, L)
-    candidate = z if whole else x + linalg.transposed_values(N, z)
+    candidate = z if whole else x + row_values(np.ascontiguousarray(N.T), z)
     if not (feasibility.inside(candidate, lb, ub) and feasibility.rows_hold(G, candidate, h, 0.0)):
         candidate = (projected(B, H, L, z, x, N, whole, lb, ub, G, h, tol) if definite
                      else np.empty(0))
