@@ -328,7 +328,7 @@ class CompiledTick:
         code = self._run(q, previous, source.dt, levels)
         if code == tick.ELSEWHERE:
             return None
-        return self._answer(code, levels, [None], source.dt, False, start)
+        return self.answer(code, levels, [None], source.dt, False, start)
 
     def answers(self, constraints: Sequence[Constraints | None]) -> bool:
         """Whether the compiled tick answers with these limits' constraints: no other box;
@@ -359,7 +359,24 @@ class CompiledTick:
         self._load_constraints(constraints)
         self._loaded = None
         code = self._run(kin.q, previous, dt, levels)
-        return self._answer(code, levels, constraints, dt, weighted, start)
+        return self.answer(code, levels, constraints, dt, weighted, start)
+
+    def run_loaded(self, q: Array, previous: Array, dt: float) -> int:
+        """The tick at ``q`` after ``previous`` [rad/s], step ``dt`` [s], of the rows another
+        compiled call loaded into the workspace (a cell's,
+        :func:`rrc_pin.cells.cell_kernels.cell_rows`), the QPs handed to the backend: its code
+        (:meth:`answer` reads the answer; negative: none, the caller's Python path answers).
+        What the workspace held is loaded again at the next tick.
+        """  # noqa: D205
+        self._answered = None  # joints[PREVIOUS] is written
+        self._loaded = None  # and the task rows
+        backend_calls.enter(self._context)
+        try:
+            code = self.workspace.run(q, previous, dt)
+        finally:
+            backend_calls.leave()
+        self.workspace.forget()
+        return code
 
     def _load_constraints(self, constraints: list[Constraints | None]) -> None:
         """The other limits' constraint rows and equality rows into the workspace (a limit's
@@ -405,11 +422,14 @@ class CompiledTick:
             finite_rows(levels)
         return code
 
-    def _answer(
+    def answer(
         self, code: int, levels: list[list[TaskRows]], constraints: list[Constraints | None],
         dt: float, weighted: bool, start: float,
     ) -> Resolution:  # fmt: skip
-        """The resolution of the tick just run (its code), deferring its problem."""
+        """The resolution of the tick just run (its code), deferring its problem: of ``levels``
+        (the tasks' rows by level) within the joint box and the other limits' ``constraints``,
+        ``start`` [s] when the tick began (``time.perf_counter``).
+        """  # noqa: D205
         ws, work = self.workspace, self._context.work
         out = ws.joints[tick.LB : tick.KIND + 2].copy()
         reals = ws.reals.tolist()

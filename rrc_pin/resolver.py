@@ -27,7 +27,7 @@ from __future__ import annotations
 import os
 import threading
 import time
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal, TypeGuard, cast
 
@@ -417,6 +417,22 @@ class Resolver:
             before = self._last_qdot if previous is None else previous
             r = self._tick(kin, rows, weighted, step, before, start, levels)
             self._last_qdot = r.qdot
+            return r
+
+    def run_compiled(self, tick: Callable[..., Resolution | None], *args: Any) -> Resolution | None:
+        """``tick(compiled, previous, *args)`` under the resolver's lock: a caller's tick on its
+        compiled tick (:class:`~rrc_pin.compiled_tick.CompiledTick`, a cell's,
+        :class:`~rrc_pin.cells.cell_tick.CellTick`), after the rates it returned last
+        (``previous``); the rates answered are its last from then on. None where there is no
+        compiled tick (several joint boxes, a mask) or ``tick`` answers none.
+        """  # noqa: D205
+        compiled = self._compiled if self._free is None else None
+        if compiled is None:
+            return None
+        with self._lock:
+            r = tick(compiled, self._last_qdot, *args)
+            if r is not None:
+                self._last_qdot = r.qdot
             return r
 
     def _tick(self, kin: Kinematics, rows: list[list[TaskRows]], weighted: bool, step: float,

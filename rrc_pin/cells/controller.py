@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import math
 import os
+import time
 import warnings
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
@@ -57,6 +58,7 @@ import numpy.typing as npt
 from rrc_pin.cells.cell import Cell
 from rrc_pin.cells.cell_log import CellLog
 from rrc_pin.cells.cell_resolution import CellResolution
+from rrc_pin.cells.cell_tick import CellTick
 from rrc_pin.cells.closure import ChainFrames, ClosureBound, close, compile_correction, largest
 from rrc_pin.compiled_tick import TickSource
 from rrc_pin.control.deadman import Deadman
@@ -225,6 +227,12 @@ class CellController(Loop):
         self._frames = frame_index(cell.model)
         self._frame_ids: dict[str, int] = {}  # a command's frame's index (:meth:`_frame_id`)
         self._chain_frames = ChainFrames.of(cell.model, (), ())
+        # a tick in one compiled call (:meth:`_compiled_tick`) where the resolver's limits are
+        # the joint limits and the chains alone and the posture wraps no joint
+        limits = self.resolver.limits
+        self._compiles = (len(limits) == 3 and isinstance(limits[0], JointLimits)
+                          and not self.resolver.layout.continuous.any())  # fmt: skip
+        self._cell_tick: tuple[tuple[object, ...], CellTick | None] = ((), None)
         if closure is not None:
             compile_correction(cell.nv)
         scale_and_veer(np.zeros(6), np.zeros(6), np.ones(6))  # compiled now: damped ticks use it
@@ -349,7 +357,7 @@ class CellController(Loop):
         if self.streams:
             for name, twist in self._streamed(poses).items():  # the stream's target: the reference
                 twists[name], self._targets[name] = self.speed * twist, poses[name]
-        top: list[Task] = []
+        top: list[FrameTask] = []
         hands: list[Task] = []
         for name, twist in twists.items():
             grasp = cell.objects.get(name)
@@ -365,12 +373,14 @@ class CellController(Loop):
                 continue
             top.append(self._task(name, twist))
         before = self._previous_rates()
-        if hands:
-            r = self.resolver.solve_at(kin, [*top, *hands, self.posture], qdot_prev=before)
-        else:
-            levels: list[list[Task]] = [top, [self.posture]] if top else [[self.posture]]
-            r = self.resolver.solve_at(kin, levels, priority="strict", qdot_prev=before)
-        r = self._smooth(r)
+        r = None if hands or before is not None else self._compiled_tick(kin, top)
+        if r is None:
+            if hands:
+                r = self.resolver.solve_at(kin, [*top, *hands, self.posture], qdot_prev=before)
+            else:
+                levels: list[list[Task]] = [[*top], [self.posture]] if top else [[self.posture]]
+                r = self.resolver.solve_at(kin, levels, priority="strict", qdot_prev=before)
+            r = self._smooth(r)
         commanded = any(map(np.count_nonzero, twists.values()))  # a twist not zero
         self._tick = ("teleop", commanded, poses)
         out = self._advance(r)
@@ -398,7 +408,8 @@ class CellController(Loop):
         :class:`~rrc_pin.solvers.tick.damping.Damping`), each tick's top level read as the
         correction reads it (:func:`_top_level`), and each tick's problem answered by the Python
         pipeline (:func:`~rrc_pin.solvers.tick.pipeline.solve`; its shrink into the rows is
-        compiled with the resolver's general tick); the resolver then reset.
+        compiled with the resolver's general tick); the rows of the cell's compiled tick
+        (:meth:`_compiled_tick`); the resolver then reset.
         """
         kin, names = self._kinematics(), list(self._targets)
         far = PostureTask(self.posture.q_ref + 1.0, gain=1e6, name="compiling")
@@ -421,6 +432,7 @@ class CellController(Loop):
             # the Python pipeline's stages too: it answers equality rows with rows the command
             # slides along (a binding collision limit's)
             solve(r.problem, self.resolver.backend, self.resolver.options)
+        self._compiled_tick(kin, [self._task(name, np.zeros(6)) for name in names])
         still = np.zeros(self.cell.nv)
         for previous in (still, r.qdot):  # the pipeline's box after rates of either kind
             for limit in self.resolver.limits:
@@ -443,6 +455,30 @@ class CellController(Loop):
         self._kin_q = self._q
         self._q_pin = (self._q, q_pin)  # the loop's integration reads it (:meth:`_pinocchio_q`)
         return self._kin
+
+    def _compiled_tick(self, kin: Kinematics, top: list[FrameTask]) -> Resolution | None:
+        """The resolver's tick of the frame tasks ``top`` and the posture within the joint limits
+        and the chains, their rows in one compiled call
+        (:class:`~rrc_pin.cells.cell_tick.CellTick`); None where the tick is not one (other
+        limits, no chain, as many chain rows as rates) or it finds no answer: the resolver
+        answers from the tasks and limits.
+        """  # noqa: D205
+        if not self._compiles or not top:
+            return None
+        posture, contact, grip = self.posture, self.contact, self.grip
+        key = (*top, posture, posture.q_ref, posture.gain, posture.weight, contact.frames,
+               contact.anchors, grip.pairs, grip.grips, self.gain)  # fmt: skip
+        known, tick = self._cell_tick
+        if len(known) != len(key) or any(a is not b for a, b in zip(known, key, strict=True)):
+            chains = 6 * (len(contact.frames) + len(grip.pairs))
+            measured = ((not contact.frames or contact.anchors is not None)
+                        and grip.grips.shape[0] == len(grip.pairs))  # fmt: skip
+            tick = CellTick(kin, top, posture, contact, grip, self.gain) if (
+                0 < chains < self.cell.nv and measured) else None  # fmt: skip
+            self._cell_tick = (key, tick)
+        if tick is None:
+            return None
+        return self.resolver.run_compiled(tick, kin, self.resolver.dt, time.perf_counter())
 
     def _frame_id(self, name: str) -> int:
         """The Pinocchio index of the frame command ``name`` moves (:meth:`frame_of`), kept
@@ -601,9 +637,8 @@ class CellController(Loop):
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
         mode, commanded, _ = self._tick
         top = stacked if mode == "teleop" else np.zeros((0, self.cell.nv))
-        box = r.box
         kin = self._kin if self._kin is not None else self._kinematics()
-        _, after, applied = close(kin, self._chain_frames, closure, r.qdot, top, box, rows,
+        _, after, applied = close(kin, self._chain_frames, closure, r.qdot, top, r.box, rows,
                                   self.dt)  # fmt: skip
         level = max(self.chain_error[0] / bound.position, self.chain_error[1] / bound.rotation)
         if level <= 1.0:

@@ -128,17 +128,30 @@ class ContactLimit(Limit):
         if not self.frames:
             return Constraints()
         data = kin.data
-        columns, unit = self._prepared(kin)
+        columns, unit = self.columns(kin)
         measured = self._anchors is not None
         C = np.zeros((6 * len(self.frames), kin.layout.nv))
         error = np.empty(C.shape[0]) if measured else UNMEASURED
         contact_rows(data.J, columns.steps, columns.starts, columns.poses(data),
                      NO_POSES if self._anchors is None else self._anchors, C, error)  # fmt: skip
-        if measured:
+        return self.rows_of(C, error, unit)
+
+    @property
+    def anchors(self) -> Array | None:
+        """The frames' anchors (k, 4, 4) [m] in ``frames``' order, or None."""
+        return self._anchors
+
+    def rows_of(self, C: Array, error: Array, unit: Array) -> Constraints:
+        """The constraints of the rows ``C`` (6 k, nv) and the anchors' errors ``error`` (6 k,)
+        [m, rad] of units ``unit`` (:meth:`columns`) at a tick: those :meth:`constraints`
+        computes, or a cell's compiled tick (:mod:`rrc_pin.cells.cell_kernels`); kept in
+        :attr:`last` where the anchors are measured.
+        """  # noqa: D205
+        if self._anchors is not None:
             self.last = Closure(C, error, unit)
         return Constraints(C=C, d=self._zero, names=self._names)
 
-    def _prepared(self, kin: Kinematics) -> tuple[FrameColumns, Array]:
+    def columns(self, kin: Kinematics) -> tuple[FrameColumns, Array]:
         """The frames' columns on the tick's model and the rows' units (its frames' reach [m]
         for the position rows, 1 for the rotation rows), made once per robot layout."""  # noqa: D205, D209
         prepared = self._prepared_for

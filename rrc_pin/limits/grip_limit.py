@@ -117,16 +117,29 @@ class GripLimit(Limit):
         if not self.pairs:
             return Constraints()
         data = kin.data
-        columns, unit = self._prepared(kin)
+        columns, unit = self.columns(kin)
         C = np.zeros((6 * len(self.pairs), kin.layout.nv))
         error = np.empty(C.shape[0]) if self._measured else UNMEASURED
         grip_rows(data.J, columns.steps, columns.starts, columns.poses(data), self._grips, C,
                   error)  # fmt: skip
+        return self.rows_of(C, error, unit)
+
+    @property
+    def grips(self) -> Array:
+        """The pairs' grips (k, 4, 4) [m], b's pose in a; (0, 4, 4) where none is measured."""
+        return self._grips
+
+    def rows_of(self, C: Array, error: Array, unit: Array) -> Constraints:
+        """The constraints of the rows ``C`` (6 k, nv) and the grips' errors ``error`` (6 k,)
+        [m, rad] of units ``unit`` (:meth:`columns`) at a tick: those :meth:`constraints`
+        computes, or a cell's compiled tick (:mod:`rrc_pin.cells.cell_kernels`); kept in
+        :attr:`last` where the grips are measured.
+        """  # noqa: D205
         if self._measured:
             self.last = Closure(C, error, unit)
         return Constraints(C=C, d=self._zero, names=self._names)
 
-    def _prepared(self, kin: Kinematics) -> tuple[FrameColumns, Array]:
+    def columns(self, kin: Kinematics) -> tuple[FrameColumns, Array]:
         """The pairs' frames' columns on the tick's model (a, b of each pair) and the rows'
         units (each pair's :meth:`~rrc_pin.tasks.RelativeFrameTask.reach`), made once per
         robot layout."""  # noqa: D205, D209

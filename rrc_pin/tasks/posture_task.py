@@ -51,7 +51,7 @@ class PostureTask(Task):
         self.name = task_name(name)
         self._constants: tuple[Any, ...] = (None, None, False, None, None)
 
-    def _constant_rows(self, continuous: npt.NDArray[np.bool_]) -> tuple[bool, Array, Array | None]:
+    def constant_rows(self, continuous: npt.NDArray[np.bool_]) -> tuple[bool, Array, Array | None]:
         """Whether the mask ``continuous`` (a robot's layout's) has a continuous joint, the
         identity rows and the row weights (read only): found once per layout and weight."""  # noqa: D205, D209
         mask, weight, wraps, eye, weights = self._constants
@@ -82,7 +82,7 @@ class PostureTask(Task):
     def rows(self, kin: Kinematics) -> TaskRows:
         """Identity rows and ``gain (q_ref - q)``."""
         continuous = kin.layout.continuous
-        wraps, eye, weights = self._constant_rows(continuous)
+        wraps, eye, weights = self.constant_rows(continuous)
         error = self.q_ref - kin.q
         if wraps:
             wrapped = np.remainder(error + np.pi, 2.0 * np.pi) - np.pi

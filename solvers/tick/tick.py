@@ -513,6 +513,14 @@ class Workspace:
             for s in [s for s, was in held.items() if s < end and start < was[0]]:
                 del held[s]
 
+    def forget(self) -> None:
+        """Forget what the arrays hold: another compiled call wrote them (a cell's tick,
+        :func:`rrc_pin.cells.cell_kernels.cell_tick`), so the next :meth:`load_levels` loads
+        every part and writes the sizes and flags.
+        """  # noqa: D205
+        self._held.clear()
+        self._header = None
+
     def load_twist(self, J: Array, selected: tuple[int, ...], b: Array) -> None:
         """One task's rows ``J`` (6, n) (the ``selected`` ones) and rates ``b``, over those
         loaded last (:meth:`load_levels`: the same task, whose weights and units stay).

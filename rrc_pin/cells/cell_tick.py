@@ -1,0 +1,120 @@
+"""CellTick: a cell controller's usual tick, its rows in one compiled call.
+
+A :class:`~rrc_pin.cells.CellController` tick whose top level is the commanded frames' tasks
+(each toward its target), with the posture below them, within the joint limits and the closed
+chains' rows (the contacts', the grips') alone, has its rows written into the resolver's
+workspace by one compiled call (:func:`~rrc_pin.cells.cell_kernels.cell_rows`) instead of the
+tasks' and limits' own calls and the workspace's loading; the resolver's compiled tick then runs
+on them (:meth:`CompiledTick.run_loaded <rrc_pin.compiled_tick.CompiledTick.run_loaded>`). The
+resolution is the resolver's (:meth:`CompiledTick.answer
+<rrc_pin.compiled_tick.CompiledTick.answer>`), of the rows and constraints the tasks and
+limits give, which the limits keep as their own (:meth:`GripLimit.rows_of
+<rrc_pin.limits.GripLimit.rows_of>`): the same bits as the tasks' and limits' path. A tick the
+compiled tick finds no answer to goes that path (the fallbacks, the messages).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from rrc_pin.cells.cell_kernels import cell_rows
+from rrc_pin.compiled_tick import CompiledTick
+from rrc_pin.kinematics import Kinematics
+from rrc_pin.limits import ContactLimit, GripLimit
+from rrc_pin.limits.chain_kernels import NO_POSES
+from rrc_pin.limits.frame_columns import FrameColumns
+from rrc_pin.solvers.tick.problem import Constraints, TaskRows
+from rrc_pin.solvers.tick.resolution import Resolution
+from rrc_pin.solvers.tick.tick import POSITION, RATE
+from rrc_pin.tasks import FrameTask, PostureTask
+from rrc_pin.tasks.frame_task import row_units
+
+Array = npt.NDArray[np.float64]
+
+_new = tuple.__new__
+"""A named tuple made of its fields' tuple (:meth:`~typing.NamedTuple._make` less its check)."""
+
+
+class CellTick:
+    """The compiled rows of one set of commanded frames, chains and settings (module docstring).
+
+    Args:
+        kin: A tick's kinematics of the cell (its model, data and layout are read).
+        tasks: The top level's frame tasks (full rows, ``world_aligned``, each with a target).
+        posture: The posture task below them (no continuous joint to wrap).
+        contact: The cell's contact limit, its anchors measured where it has frames.
+        grip: The cell's grip limit, its grips measured where it has pairs.
+        gain: The frame tasks' gain [1/s].
+
+    The resolver's limits are the joint limits, ``contact`` and ``grip``, in that order (the
+    controller's).
+    """
+
+    def __init__(
+        self, kin: Kinematics, tasks: Sequence[FrameTask], posture: PostureTask,
+        contact: ContactLimit, grip: GripLimit, gain: float,
+    ) -> None:  # fmt: skip
+        layout = kin.layout
+        ids = layout.frames
+        frames = [ids[t.frame] for t in tasks] + [ids[f] for f in contact.frames] + [
+            ids[f] for pair in grip.pairs for f in pair]  # fmt: skip
+        self.columns = FrameColumns.of(kin.model, kin.data, frames)
+        self.frames = tuple(dict.fromkeys(frames))  # each pose read once a tick
+        row = {f: i for i, f in enumerate(self.frames)}
+        c, g = len(contact.frames), len(grip.pairs)
+        self.plan = np.array([len(tasks), c, g, *(row[f] for f in frames)], dtype=np.int64)
+        self.units = [row_units(t.selected, layout.reach[t.frame]) for t in tasks]
+        _, self.eye, self.weights = posture.constant_rows(layout.continuous)
+        n = layout.nv
+        self.values = np.concatenate([
+            [gain, posture.gain], *self.units,
+            np.ones(n) if self.weights is None else self.weights, posture.q_ref,
+        ])  # fmt: skip
+        # each chain limit's place among the resolver's limits, its rows and their units
+        self.parts = [(at, limit, slice(start, start + 6 * k), limit.columns(kin)[1])
+                      for at, limit, start, k in ((1, contact, 0, c), (2, grip, 6 * c, g))
+                      if k]  # fmt: skip
+        self.anchors = NO_POSES if contact.anchors is None else contact.anchors
+        self.tasks, self.posture, self.grip = tuple(tasks), posture, grip
+        self.rows = 6 * (c + g)
+
+    def __call__(self, compiled: CompiledTick, previous: Array, kin: Kinematics, dt: float,
+                 start: float) -> Resolution | None:  # fmt: skip
+        """The tick at ``kin`` after the rates ``previous`` (nv,), step ``dt`` [s], on the
+        resolver's ``compiled`` tick (:meth:`Resolver.run_compiled
+        <rrc_pin.resolver.Resolver.run_compiled>`), ``start`` [s] when it began: its
+        resolution; None where the compiled tick finds no answer.
+        """  # noqa: D205
+        ws, n, tasks = compiled.workspace, kin.layout.nv, self.tasks
+        m_top, r = 6 * len(tasks), self.rows
+        if ws.task_rows.shape[0] < m_top + n or ws.E.shape[0] != r:  # room for the rows
+            ws.load_levels([[TaskRows(np.zeros((m_top + n, n)), np.zeros(m_top + n), None, "")]],
+                           False)  # fmt: skip
+            ws.load_equalities(np.zeros((r, n)), np.zeros(r))
+        data = kin.data
+        oMf = data.oMf
+        poses = np.empty((len(self.frames), 4, 4))
+        for i, f in enumerate(self.frames):
+            poses[i] = oMf[f].homogeneous
+        twists, targets = np.empty((len(tasks), 6)), np.empty((len(tasks), 4, 4))
+        for i, task in enumerate(tasks):
+            twists[i], targets[i] = task.twist, task.target
+        C, error = np.zeros((r, n)), np.empty(r)
+        ws.joints[POSITION] = kin.q  # the posture's rows read it
+        cell_rows(data.J, poses, self.columns.steps, self.columns.starts, self.plan,
+                  self.values, twists, targets, self.anchors, self.grip.grips, ws.joints,
+                  ws.task_rows, ws.rates, ws.ints, ws.E, C, error)  # fmt: skip
+        code = compiled.run_loaded(kin.q, previous, dt)
+        if code < 0:
+            return None
+        rows, b = ws.task_rows[:m_top].copy(), ws.rates[RATE, : m_top + n].copy()
+        top = [_new(TaskRows, (rows[6 * i : 6 * i + 6], b[6 * i : 6 * i + 6], None, t.name, u))
+               for i, (t, u) in enumerate(zip(tasks, self.units, strict=True))]  # fmt: skip
+        posture = _new(TaskRows, (self.eye, b[m_top:], self.weights, self.posture.name, None))
+        constraints: list[Constraints | None] = [None, Constraints(), Constraints()]
+        for at, limit, part, unit in self.parts:
+            constraints[at] = limit.rows_of(C[part], error[part], unit)
+        return compiled.answer(code, [top, [posture]], constraints, dt, False, start)
