@@ -244,8 +244,11 @@ def test_a_pair_entering_the_detection_distance_slower_than_the_gain_changes_not
     assert entered >= 1
 
 
-SEEDS = (37, int(np.random.SeedSequence().entropy % 2**63))
-"""A fixed seed and one drawn fresh each run (named in every failure's message)."""
+SEEDS = (37, 3336166274496982007, int(np.random.SeedSequence().entropy % 2**63))
+"""A fixed seed, seeds that once failed, and one drawn fresh each run (named in every failure's
+message). 3336166274496982007: panda's finger on the slab slid at 0.98941 of the LP's best,
+its row's normal 0.39 deg off the face (coal's GJK at its default tolerance,
+:data:`rrc_pin.geometry.proximity.GJK_TOLERANCE`)."""
 
 
 def wall_scene(robot_name, kind, rng, fixed):
@@ -315,32 +318,76 @@ def best_tangential(A, twist, n, t, rows, box):
     return float(result.x[nv])
 
 
-@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "fresh"))
+TILT = 1e-4
+"""[rad] The most a row's normal is off its pair's true normal at 0.02 m and beyond: coal's
+within :data:`rrc_pin.geometry.proximity.GJK_TOLERANCE` (its docstring), the compiled pass's
+to rounding."""
+
+
+@pytest.mark.parametrize("seed", SEEDS, ids=("fixed", "failed", "fresh"))
 @pytest.mark.parametrize("kind", ["halfspace", "virtual", "slab"])
 @pytest.mark.parametrize("robot_name", ["panda", "rrc_k1607"])
 def test_sliding_keeps_the_lps_best_tangential_speed(robot_name, kind, seed):
     """A hand commanded into a wall at an angle, orientation held: on every sliding tick the
-    hand's speed along the wall is at least 0.99 of the best an LP over the same tick's rows
-    and box reaches (HiGHS). The sliding stage damps only past the damping threshold, which
-    no tick here reaches (before: 0.93 median, 0.89 min on panda's half-space)."""
+    hand's speed along the wall is the best an LP over the tick's own rows and box reaches
+    (HiGHS), less :data:`TILT` of the command's speed into the wall. The sliding stage damps
+    only past the damping threshold, which no tick here reaches, and the rows here move with
+    the hand, so it projects the command onto them in the task space: a row whose normal is
+    off the wall's by theta takes sin(theta) of the speed it removes into the wall from the
+    speed along it. The limit is read before the resolver reads it, as a monitor would (a read
+    leaves coal's solver state behind). Before: 0.93 median, 0.89 min of the LP's on panda's
+    half-space; 0.98941 on the slab with coal's normals 0.39 deg off (seed
+    3336166274496982007; 27 of 42 seeds below 0.999), 1 - 1e-14 at worst since."""
     rng = np.random.default_rng(seed)
     robot, cm, q, twist, n, t = wall_scene(robot_name, kind, rng, seed == SEEDS[0])
-    limit, joints = CollisionLimit(cm), JointLimits()
-    resolver = Resolver(robot, DT, limits=[joints, limit])
+    limit = CollisionLimit(cm)
+    resolver = Resolver(robot, DT, limits=[JointLimits(), limit])
     sliding, previous = 0, np.zeros(robot.nv)
     for _ in range(60):
-        kin = kinematics(robot, q)
-        rows, box = limit.constraints(kin, DT, previous), joints.constraints(kin, DT, previous).box
+        limit.constraints(kinematics(robot, q), DT, previous)  # read first, as a monitor would
         res = resolver.solve(q, twist)
         assert res.status != "fallback", f"seed {seed}"
         if res.status == "sliding":
             sliding += 1
             kept = float(t @ (robot.jacobian(q)[:3] @ res.qdot))
-            best = best_tangential(robot.jacobian(q), twist, n, t, rows, box)
-            assert kept >= 0.99 * best - 1e-9, f"seed {seed}: {kept} of the LP's {best} m/s"
+            problem = res.problem
+            best = best_tangential(robot.jacobian(q), twist, n, t, problem.rows, problem.box)
+            into = float(twist[:3] @ n)
+            assert kept >= best - TILT * into - 1e-9, f"seed {seed}: {kept} of the LP's {best} m/s"
         previous = np.asarray(res.qdot)
         q = q + DT * previous
     assert sliding >= 20, f"seed {seed}: {sliding} sliding ticks"
+
+
+def test_the_hand_along_a_tilted_slab_has_the_face_normal_at_every_call():
+    """The slab's draw of seed 3336166274496982007 in
+    :func:`test_sliding_keeps_the_lps_best_tangential_speed`, the limit read at every tick
+    before the resolver reads it (as a monitor would): the rows of the hand and fingers against
+    the slab's face (their normals within 0.01 rad of it; the others are its edges, 0.15 m to
+    the side) have its normal to :data:`TILT`, at either read. Before
+    (coal's GJK at its default tolerance, 1e-6, a finger's capsule lying along the face): 6.8e-3
+    rad at the resolver's read of tick 16, which read depending on the solver's cached state,
+    and the hand slid at 0.98941 of the LP's best."""
+    rng = np.random.default_rng(3336166274496982007)
+    robot, cm, q, twist, n, _ = wall_scene("panda", "slab", rng, False)
+    limit = CollisionLimit(cm)
+    resolver = Resolver(robot, DT, limits=[JointLimits(), limit])
+    previous, face = np.zeros(robot.nv), 0
+    for _ in range(60):
+        for read in range(2):
+            if read == 0:
+                limit.constraints(kinematics(robot, q), DT, previous)
+            else:
+                previous = np.asarray(resolver.solve(q, twist).qdot)
+            prox = limit.last
+            for name, normal in zip(prox.names, prox.normal, strict=True):
+                tilt = float(np.linalg.norm(np.cross(normal, n)))
+                hand = name[1] == "wall" and ("hand" in name[0] or "finger" in name[0])
+                if hand and normal @ n > 0.0 and tilt < 0.01:
+                    face += 1
+                    assert tilt <= TILT, name
+        q = q + DT * previous
+    assert face >= 240  # both fingers, each tick, each read
 
 
 SLIDE_JUMP = 0.15

@@ -55,6 +55,20 @@ REPEAT = 1e-6
 (coal's, found to GJK's tolerance) repeats it and is left out."""
 
 
+GJK_TOLERANCE = 1e-10
+r"""[m] coal's GJK tolerance :math:`\tau` for the pairs it measures: GJK stops where the
+distance is within :math:`\tau(1 + \|v\|)` of its iterate's :math:`\|v\|`. Where the closest
+points are not unique (a capsule lying along a box's face) the iterate may stop a tangential
+offset :math:`\delta` from them, :math:`\|v\| - d \approx \delta^2 / 2d`, so the normal tilts
+by up to :math:`\theta \approx \sqrt{2\tau(1 + d)/d}`, and the damper row with it, which then
+takes :math:`\sin\theta` of the speed it removes into the pair from the speed along it. coal's
+default, 1e-6, is 0.01 rad at d = 0.02 m (panda's finger sliding on a tilted slab: 0.39 deg,
+1.1 % of its tangential speed; where GJK stops depends on the solver's cached state, so the
+same configuration gave different rows from one call to the next); 1e-10 is 1e-4 rad there,
+less farther. That scene's limit takes 115 us a tick either way, and the recorded arm ticks
+(benchmarks/tick_answers.py: a table, facing hands) answer bitwise as before."""
+
+
 class Proximity(NamedTuple):
     """The pairs whose signed distance is below the detection distance, one row each (k rows).
 
@@ -100,6 +114,8 @@ class CollisionData:
         """Take ``scene`` as the one to answer for (new geometry data and arrays)."""
         self.scene = scene
         self.geometry_data = pin.GeometryData(scene.geometry)
+        for request in self.geometry_data.distanceRequests:
+            request.gjk_tolerance = GJK_TOLERANCE
         self.poses = np.zeros((scene.njoints, 4, 4))
         self.poses[0] = np.eye(4)
         self.J = np.zeros((6, scene.nv))
@@ -266,14 +282,16 @@ def _coal(scene: Scene, model: pin.Model, data: pin.Data, cdata: CollisionData,
             other = geometry.geometryObjects[o].geometry
             M = cdata.poses[scene.joint[g]]
             there = coal.Transform3s(gdata.oMg[o].rotation, gdata.oMg[o].translation)
+            request = coal.DistanceRequest()
+            request.gjk_tolerance = GJK_TOLERANCE
             for e in range(2):
                 centre = M[:3, :3] @ segment[g, e] + M[:3, 3]
                 at = coal.Transform3s(np.eye(3), centre)
                 end_result = coal.DistanceResult()
                 if side == 0:
-                    coal.distance(sphere, at, other, there, coal.DistanceRequest(), end_result)
+                    coal.distance(sphere, at, other, there, request, end_result)
                 else:
-                    coal.distance(other, there, sphere, at, coal.DistanceRequest(), end_result)
+                    coal.distance(other, there, sphere, at, request, end_result)
                 if end_result.min_distance < detection:
                     rows = _coal_row(scene, cdata, k, end_result, 1, rows)
     found = cdata.found
