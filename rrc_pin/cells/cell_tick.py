@@ -36,6 +36,9 @@ Array = npt.NDArray[np.float64]
 
 _new = tuple.__new__
 """A named tuple made of its fields' tuple (:meth:`~typing.NamedTuple._make` less its check)."""
+NONE = Constraints()
+"""What a limit without rows gives (:meth:`ContactLimit.constraints
+<rrc_pin.limits.ContactLimit.constraints>` without frames)."""
 
 
 class CellTick:
@@ -48,6 +51,12 @@ class CellTick:
         contact: The cell's contact limit, its anchors measured where it has frames.
         grip: The cell's grip limit, its grips measured where it has pairs.
         gain: The frame tasks' gain [1/s].
+        chains: The chains' frames (:class:`~rrc_pin.cells.closure.ChainFrames`' ``frames``):
+            their poses are kept (:attr:`chain_poses`).
+
+    Attributes:
+        chain_poses: The chains' frames' poses (k, 4, 4) [m] at the last tick's kinematics,
+            for the closure's correction (:func:`~rrc_pin.cells.closure.close`).
 
     The resolver's limits are the joint limits, ``contact`` and ``grip``, in that order (the
     controller's).
@@ -55,7 +64,7 @@ class CellTick:
 
     def __init__(
         self, kin: Kinematics, tasks: Sequence[FrameTask], posture: PostureTask,
-        contact: ContactLimit, grip: GripLimit, gain: float,
+        contact: ContactLimit, grip: GripLimit, gain: float, chains: tuple[int, ...],
     ) -> None:  # fmt: skip
         layout = kin.layout
         ids = layout.frames
@@ -64,6 +73,8 @@ class CellTick:
         self.columns = FrameColumns.of(kin.model, kin.data, frames)
         self.frames = tuple(dict.fromkeys(frames))  # each pose read once a tick
         row = {f: i for i, f in enumerate(self.frames)}
+        self.chains = np.array([row[f] for f in chains], dtype=np.intp)
+        self.chain_poses = np.zeros((0, 4, 4))
         c, g = len(contact.frames), len(grip.pairs)
         self.plan = np.array([len(tasks), c, g, *(row[f] for f in frames)], dtype=np.int64)
         self.units = [row_units(t.selected, layout.reach[t.frame]) for t in tasks]
@@ -114,7 +125,8 @@ class CellTick:
         top = [_new(TaskRows, (rows[6 * i : 6 * i + 6], b[6 * i : 6 * i + 6], None, t.name, u))
                for i, (t, u) in enumerate(zip(tasks, self.units, strict=True))]  # fmt: skip
         posture = _new(TaskRows, (self.eye, b[m_top:], self.weights, self.posture.name, None))
-        constraints: list[Constraints | None] = [None, Constraints(), Constraints()]
+        self.chain_poses = poses[self.chains]
+        constraints: list[Constraints | None] = [None, NONE, NONE]
         for at, limit, part, unit in self.parts:
             constraints[at] = limit.rows_of(C[part], error[part], unit)
         return compiled.answer(code, [top, [posture]], constraints, dt, False, start)

@@ -233,6 +233,7 @@ class CellController(Loop):
         self._compiles = (len(limits) == 3 and isinstance(limits[0], JointLimits)
                           and not self.resolver.layout.continuous.any())  # fmt: skip
         self._cell_tick: tuple[tuple[object, ...], CellTick | None] = ((), None)
+        self._chain_poses: Array | None = None  # that tick's chain frames' poses, for _closed
         if closure is not None:
             compile_correction(cell.nv)
         scale_and_veer(np.zeros(6), np.zeros(6), np.ones(6))  # compiled now: damped ticks use it
@@ -473,12 +474,16 @@ class CellController(Loop):
             chains = 6 * (len(contact.frames) + len(grip.pairs))
             measured = ((not contact.frames or contact.anchors is not None)
                         and grip.grips.shape[0] == len(grip.pairs))  # fmt: skip
-            tick = CellTick(kin, top, posture, contact, grip, self.gain) if (
+            tick = CellTick(kin, top, posture, contact, grip, self.gain,
+                            self._chain_frames.frames) if (
                 0 < chains < self.cell.nv and measured) else None  # fmt: skip
             self._cell_tick = (key, tick)
         if tick is None:
             return None
-        return self.resolver.run_compiled(tick, kin, self.resolver.dt, time.perf_counter())
+        r = self.resolver.run_compiled(tick, kin, self.resolver.dt, time.perf_counter())
+        if r is not None:
+            self._chain_poses = tick.chain_poses
+        return r
 
     def _frame_id(self, name: str) -> int:
         """The Pinocchio index of the frame command ``name`` moves (:meth:`frame_of`), kept
@@ -621,6 +626,7 @@ class CellController(Loop):
         self._applied = r.qdot
         self._corrected = None
         self.chain_error = (0.0, 0.0)
+        poses, self._chain_poses = self._chain_poses, None
         tasks, stacked, rows = _top_level(r)
         self._top_tasks = tasks
         hands = self._hands(tasks)
@@ -639,7 +645,7 @@ class CellController(Loop):
         top = stacked if mode == "teleop" else np.zeros((0, self.cell.nv))
         kin = self._kin if self._kin is not None else self._kinematics()
         _, after, applied = close(kin, self._chain_frames, closure, r.qdot, top, r.box, rows,
-                                  self.dt)  # fmt: skip
+                                  self.dt, poses)  # fmt: skip
         level = max(self.chain_error[0] / bound.position, self.chain_error[1] / bound.rotation)
         if level <= 1.0:
             self.lost = None
