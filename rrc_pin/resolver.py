@@ -420,17 +420,20 @@ class Resolver:
             return r
 
     def run_compiled(self, tick: Callable[..., Resolution | None], *args: Any) -> Resolution | None:
-        """``tick(compiled, previous, *args)`` under the resolver's lock: a caller's tick on its
-        compiled tick (:class:`~rrc_pin.compiled_tick.CompiledTick`, a cell's,
+        """``tick(compiled, previous, within, *args)`` under the resolver's lock: a caller's tick
+        on its compiled tick (:class:`~rrc_pin.compiled_tick.CompiledTick`, a cell's,
         :class:`~rrc_pin.cells.cell_tick.CellTick`), after the rates it returned last
-        (``previous``); the rates answered are its last from then on. None where there is no
-        compiled tick (several joint boxes, a mask) or ``tick`` answers none.
+        (``previous``), which may hand the tick back to the resolver with the rows and the
+        limits' constraints it has (``within(kin, rows, constraints, weighted, dt, previous,
+        start, tasks)``, as :meth:`solve_at` goes on once its limits have given theirs); the
+        rates answered are its last from then on. None where there is no compiled tick
+        (several joint boxes, a mask) or ``tick`` answers none.
         """  # noqa: D205
         compiled = self._compiled if self._free is None else None
         if compiled is None:
             return None
         with self._lock:
-            r = tick(compiled, self._last_qdot, *args)
+            r = tick(compiled, self._last_qdot, self._tick_within, *args)
             if r is not None:
                 self._last_qdot = r.qdot
             return r
@@ -447,6 +450,17 @@ class Resolver:
         joint = None if compiled is None else compiled.limit
         constraints = [None if limit is joint else limit.constraints(kin, step, before)
                        for limit in self.limits]  # fmt: skip
+        return self._tick_within(kin, rows, constraints, weighted, step, before, start, tasks)
+
+    def _tick_within(
+        self, kin: Kinematics, rows: list[list[TaskRows]], constraints: list[Constraints | None],
+        weighted: bool, step: float, before: Array, start: float, tasks: list[list[Task]],
+    ) -> Resolution:  # fmt: skip
+        """The tick of ``rows`` (those of ``tasks``) within the limits' ``constraints`` (each
+        limit's, in the limits' order; None for the compiled tick's joint limits, whose box it
+        computes): :meth:`_tick` once the limits have given them."""  # noqa: D205, D209
+        compiled = self._compiled if self._free is None else None
+        joint = None if compiled is None else compiled.limit
         if compiled is not None and compiled.answers(constraints):
             return compiled.tasks(kin, rows, weighted, constraints, before, step, start)
         if joint is not None:

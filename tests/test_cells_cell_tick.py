@@ -1,5 +1,6 @@
 """CellTick: a cell's usual tick with its rows in one compiled call answers as the tasks' and
-limits' own path does, bit for bit, over sessions that scale, damp, swing and land a leg, and
+limits' own path does, bit for bit, over sessions that scale, damp, swing and land a leg, with
+a collision limit (its rows loaded, or the tick handed back where one is slid along), and
 where the compiled tick finds no answer."""
 
 from __future__ import annotations
@@ -7,9 +8,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import rrc_pin
+from rrc_pin import CollisionLimit, CollisionModel, JointLimits
 from rrc_pin.cells.cell_tick import CellTick
 from rrc_pin.cells.controller import CellController
 from rrc_pin.compiled_tick import CompiledTick
+from rrc_pin.limits import SingularityLimit
+from rrc_pin.solvers.tick.tick import CONSTRAINTS
 from rrc_pin.solvers.tick.top import FAILED
 
 SEEDS = (0, int(np.random.SeedSequence().entropy % 2**63))
@@ -21,17 +26,39 @@ SPEED = {"object": np.array([0.15, 0.15, 0.15, 0.4, 0.4, 0.4]),
          "leg1": np.array([0.05, 0.05, 0.05, 0.0, 0.0, 0.0])}  # fmt: skip
 
 
-def _session(cell, seed, compiled, monkeypatch, ticks=240, refuse=0):
+BALLS = {"gsfc_dual": ("object", [0.0, 0.0, -0.25], 0.08),
+         "yeh_tripod": ("body", [0.0, 0.0, -0.6], 0.1)}  # fmt: skip
+"""Cell: a ball in the commands' way (benchmarks/bench_cells.py's): the frame its centre is
+placed from at the ready pose, the offset [m] and its radius [m]."""
+
+
+def _limits(cell, collision):
+    """The controller's limits: the joint limits, with a collision limit on the cell's capsules
+    (and a ball in the way) where ``collision``, or a singularity limit on the first tool
+    frame whose rows are always there (``"singular"``)."""
+    if not collision:
+        return None
+    if collision == "singular":
+        return [JointLimits(), SingularityLimit(cell.tool_frames[0], 0.02, detection=5.0)]
+    model = CollisionModel(cell, "capsules")
+    if collision == "ball":
+        frame, offset, radius = BALLS[cell.name]
+        model.add_sphere(cell.fk(cell.ready(), frame)[:3, 3] + offset, radius, "ball")
+    return [JointLimits(), CollisionLimit(model)]
+
+
+def _session(cell, seed, compiled, monkeypatch, ticks=240, refuse=0, collision=None):
     """Each tick's state and report, ``compiled`` or the tasks' and limits' path alone; every
     ``refuse``-th compiled tick finds no answer (0: none). The tripod swings leg 1 a third of
     the way in and lands it at two thirds."""
-    ctl = CellController(cell, 0.01)
+    robot = rrc_pin.load(cell)
+    ctl = CellController(robot, 0.01, limits=_limits(robot, collision))
     ctl._compiles = compiled
     calls = []
     run_loaded = CompiledTick.run_loaded
 
     def counted(self, q, previous, dt):
-        calls.append(1)
+        calls.append(self.workspace.ints[CONSTRAINTS])
         if refuse and len(calls) % refuse == 0:
             return FAILED
         return run_loaded(self, q, previous, dt)
@@ -87,6 +114,37 @@ def test_the_compiled_rows_answer_as_the_tasks_and_limits_do(cell, seed, monkeyp
 
 
 @pytest.mark.parametrize("cell", ["gsfc_dual", "yeh_tripod"])
+@pytest.mark.parametrize("collision", ["capsules", "ball"])
+def test_with_a_collision_limit_the_ticks_whose_rows_slide_go_to_the_resolver(
+    cell, collision, monkeypatch
+):
+    """A collision limit beside the chains: its rows are loaded beside the chains' where none
+    is slid along, and the tick goes back to the resolver with its rows where one is (the
+    ball in the way); the same session, bit for bit, with ticks of both kinds."""
+    compiled, calls, _ = _session(cell, SEEDS[0], True, monkeypatch, collision=collision)
+    plain, _, _ = _session(cell, SEEDS[0], False, monkeypatch, collision=collision)
+    _same(compiled, plain, SEEDS[0])
+    statuses = [x[3] for x in compiled]
+    assert calls > len(compiled) // 4, f"{calls} compiled ticks"
+    if collision == "ball":
+        assert calls + statuses.count("sliding") <= len(compiled) and "sliding" in statuses
+
+
+@pytest.mark.parametrize("cell", ["gsfc_dual", "yeh_tripod"])
+def test_a_limits_rows_no_command_slides_along_are_loaded_beside_the_chains(cell, monkeypatch):
+    """A singularity limit's rows on every tick: loaded into the compiled tick with the chains'
+    rows, the same session bit for bit."""
+    compiled, _, ctl = _session(cell, SEEDS[0], True, monkeypatch, collision="singular")
+    rows = []
+    monkeypatch.setattr(CompiledTick, "run_loaded", lambda self, *a: rows.append(
+        int(self.workspace.ints[CONSTRAINTS])) or FAILED)  # fmt: skip
+    ctl.step({n: np.zeros(6) for n in ctl.commandable() if n in SPEED})
+    plain, _, _ = _session(cell, SEEDS[0], False, monkeypatch, collision="singular")
+    _same(compiled, plain, SEEDS[0])
+    assert rows and rows[0] > 0, rows
+
+
+@pytest.mark.parametrize("cell", ["gsfc_dual", "yeh_tripod"])
 def test_a_tick_the_compiled_rows_find_no_answer_to_goes_the_tasks_and_limits_path(
     cell, monkeypatch
 ):
@@ -96,13 +154,8 @@ def test_a_tick_the_compiled_rows_find_no_answer_to_goes_the_tasks_and_limits_pa
     _same(refused, plain, SEEDS[0])
 
 
-def test_other_limits_or_free_hands_take_the_tasks_and_limits_path(dual):
-    """A collision limit beside the chains, or hands resolved each on its own: no CellTick."""
-    from rrc_pin import CollisionLimit, CollisionModel, JointLimits
-
-    limited = CellController(dual, 0.01, limits=[JointLimits(),
-                                                 CollisionLimit(CollisionModel(dual, "capsules"))])
-    apart = CellController(dual, 0.01, coupled=False)
-    for ctl in (limited, apart):
-        ctl.step({"object": SPEED["object"]})
-        assert ctl._cell_tick[1] is None
+def test_hands_resolved_each_on_its_own_take_the_resolver(dual):
+    """``coupled=False``: the hands' tasks are weighted, not the compiled rows' levels."""
+    ctl = CellController(dual, 0.01, coupled=False)
+    ctl.step({"object": SPEED["object"]})
+    assert ctl._cell_tick[1] is None

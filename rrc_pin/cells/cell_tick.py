@@ -15,7 +15,7 @@ compiled tick finds no answer to goes that path (the fallbacks, the messages).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import numpy.typing as npt
@@ -23,19 +23,22 @@ import numpy.typing as npt
 from rrc_pin.cells.cell_kernels import cell_rows
 from rrc_pin.compiled_tick import CompiledTick
 from rrc_pin.kinematics import Kinematics
-from rrc_pin.limits import ContactLimit, GripLimit
+from rrc_pin.limits import ContactLimit, GripLimit, Limit
 from rrc_pin.limits.chain_kernels import NO_POSES
 from rrc_pin.limits.frame_columns import FrameColumns
-from rrc_pin.solvers.tick.problem import Constraints, TaskRows
+from rrc_pin.solvers.tick.problem import Constraints, TaskRows, finite_rows, merged_rows
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.solvers.tick.tick import POSITION, RATE
-from rrc_pin.tasks import FrameTask, PostureTask
+from rrc_pin.tasks import FrameTask, PostureTask, Task
 from rrc_pin.tasks.frame_task import row_units
 
 Array = npt.NDArray[np.float64]
 
 _new = tuple.__new__
 """A named tuple made of its fields' tuple (:meth:`~typing.NamedTuple._make` less its check)."""
+Within = Callable[..., Resolution]
+"""The resolver's tick once its limits have given their constraints
+(:meth:`Resolver.run_compiled <rrc_pin.resolver.Resolver.run_compiled>`)."""
 NONE = Constraints()
 """What a limit without rows gives (:meth:`ContactLimit.constraints
 <rrc_pin.limits.ContactLimit.constraints>` without frames)."""
@@ -53,18 +56,25 @@ class CellTick:
         gain: The frame tasks' gain [1/s].
         chains: The chains' frames (:class:`~rrc_pin.cells.closure.ChainFrames`' ``frames``):
             their poses are kept (:attr:`chain_poses`).
+        others: The resolver's other limits (a :class:`~rrc_pin.limits.CollisionLimit`),
+            between the joint limits and the chains': their constraints computed as the
+            resolver computes them; rows ``G qdot <= h`` are loaded beside the chains', and a
+            tick where one gives a box, equality rows or rows the command slides along (a
+            collision pair) goes back to the resolver with the rows and constraints it has.
 
     Attributes:
         chain_poses: The chains' frames' poses (k, 4, 4) [m] at the last tick's kinematics,
-            for the closure's correction (:func:`~rrc_pin.cells.closure.close`).
+            for the closure's correction (:func:`~rrc_pin.cells.closure.close`); None where
+            the resolver answered it.
 
-    The resolver's limits are the joint limits, ``contact`` and ``grip``, in that order (the
-    controller's).
+    The resolver's limits are the joint limits, ``others``, ``contact`` and ``grip``, in that
+    order (the controller's).
     """
 
     def __init__(
         self, kin: Kinematics, tasks: Sequence[FrameTask], posture: PostureTask,
         contact: ContactLimit, grip: GripLimit, gain: float, chains: tuple[int, ...],
+        others: Sequence[Limit] = (),
     ) -> None:  # fmt: skip
         layout = kin.layout
         ids = layout.frames
@@ -74,7 +84,7 @@ class CellTick:
         self.frames = tuple(dict.fromkeys(frames))  # each pose read once a tick
         row = {f: i for i, f in enumerate(self.frames)}
         self.chains = np.array([row[f] for f in chains], dtype=np.intp)
-        self.chain_poses = np.zeros((0, 4, 4))
+        self.chain_poses: Array | None = None
         c, g = len(contact.frames), len(grip.pairs)
         self.plan = np.array([len(tasks), c, g, *(row[f] for f in frames)], dtype=np.int64)
         self.units = [row_units(t.selected, layout.reach[t.frame]) for t in tasks]
@@ -85,20 +95,32 @@ class CellTick:
             np.ones(n) if self.weights is None else self.weights, posture.q_ref,
         ])  # fmt: skip
         # each chain limit's place among the resolver's limits, its rows and their units
-        self.parts = [(at, limit, slice(start, start + 6 * k), limit.columns(kin)[1])
-                      for at, limit, start, k in ((1, contact, 0, c), (2, grip, 6 * c, g))
-                      if k]  # fmt: skip
+        at = 1 + len(others)
+        chain_limits: tuple[tuple[ContactLimit | GripLimit, int, int], ...] = (
+            (contact, 0, c), (grip, 6 * c, g))  # fmt: skip
+        self.parts = [(at + i, limit, slice(start, start + 6 * k), limit.columns(kin)[1])
+                      for i, (limit, start, k) in enumerate(chain_limits) if k]  # fmt: skip
+        self.others = tuple(others)
         self.anchors = NO_POSES if contact.anchors is None else contact.anchors
-        self.tasks, self.posture, self.grip = tuple(tasks), posture, grip
+        self.tasks, self.posture, self.contact, self.grip = tuple(tasks), posture, contact, grip
         self.rows = 6 * (c + g)
 
-    def __call__(self, compiled: CompiledTick, previous: Array, kin: Kinematics, dt: float,
-                 start: float) -> Resolution | None:  # fmt: skip
+    def __call__(self, compiled: CompiledTick, previous: Array, within: Within, kin: Kinematics,
+                 dt: float, start: float) -> Resolution | None:  # fmt: skip
         """The tick at ``kin`` after the rates ``previous`` (nv,), step ``dt`` [s], on the
         resolver's ``compiled`` tick (:meth:`Resolver.run_compiled
         <rrc_pin.resolver.Resolver.run_compiled>`), ``start`` [s] when it began: its
-        resolution; None where the compiled tick finds no answer.
+        resolution; None where the compiled tick finds no answer. A tick whose other limits
+        give what the compiled rows do not take goes on in the resolver (``within``).
         """  # noqa: D205
+        others = [limit.constraints(kin, dt, previous) for limit in self.others]
+        G = h = slide = None
+        if others:
+            if not all(_rows_only(c) for c in others):
+                return self._within(within, kin, others, dt, previous, start)
+            merged = merged_rows(others)
+            if merged is not None:
+                G, h, slide = merged.G, merged.h, merged.slide
         ws, n, tasks = compiled.workspace, kin.layout.nv, self.tasks
         m_top, r = 6 * len(tasks), self.rows
         if ws.task_rows.shape[0] < m_top + n or ws.E.shape[0] != r:  # room for the rows
@@ -118,6 +140,8 @@ class CellTick:
         cell_rows(data.J, poses, self.columns.steps, self.columns.starts, self.plan,
                   self.values, twists, targets, self.anchors, self.grip.grips, ws.joints,
                   ws.task_rows, ws.rates, ws.ints, ws.E, C, error)  # fmt: skip
+        if h is not None:
+            ws.load_rows(G, h, slide)
         code = compiled.run_loaded(kin.q, previous, dt)
         if code < 0:
             return None
@@ -126,7 +150,27 @@ class CellTick:
                for i, (t, u) in enumerate(zip(tasks, self.units, strict=True))]  # fmt: skip
         posture = _new(TaskRows, (self.eye, b[m_top:], self.weights, self.posture.name, None))
         self.chain_poses = poses[self.chains]
-        constraints: list[Constraints | None] = [None, NONE, NONE]
+        constraints: list[Constraints | None] = [None, *others, NONE, NONE]
         for at, limit, part, unit in self.parts:
             constraints[at] = limit.rows_of(C[part], error[part], unit)
         return compiled.answer(code, [top, [posture]], constraints, dt, False, start)
+
+    def _within(self, within: Within, kin: Kinematics, others: list[Constraints], dt: float,
+                previous: Array, start: float) -> Resolution:  # fmt: skip
+        """The tick in the resolver, from the tasks' rows, the other limits' ``others`` and the
+        chains' constraints (as the resolver computes them; the chains' poses read again).
+        """  # noqa: D205
+        tasks: list[list[Task]] = [[*self.tasks], [self.posture]]
+        rows = [[t.rows(kin) for t in level] for level in tasks]
+        finite_rows(rows)
+        constraints: list[Constraints | None] = [None, *others]
+        constraints += [limit.constraints(kin, dt, previous) for limit in (self.contact,
+                                                                           self.grip)]  # fmt: skip
+        self.chain_poses = None
+        return within(kin, rows, constraints, False, dt, previous, start, tasks)
+
+
+def _rows_only(c: Constraints) -> bool:
+    """Whether ``c`` is inequality rows at most, none of which the command slides along."""
+    return c.box is None and (c.d is None or not c.d.size) and (
+        c.slide is None or c.h is None or not c.h.size or not c.slide.any())  # fmt: skip

@@ -227,10 +227,12 @@ class CellController(Loop):
         self._frames = frame_index(cell.model)
         self._frame_ids: dict[str, int] = {}  # a command's frame's index (:meth:`_frame_id`)
         self._chain_frames = ChainFrames.of(cell.model, (), ())
-        # a tick in one compiled call (:meth:`_compiled_tick`) where the resolver's limits are
-        # the joint limits and the chains alone and the posture wraps no joint
+        # a tick's rows in one compiled call (:meth:`_compiled_tick`) where the resolver's
+        # limits are the joint limits first, then others (collision) and the chains, and the
+        # posture wraps no joint
         limits = self.resolver.limits
-        self._compiles = (len(limits) == 3 and isinstance(limits[0], JointLimits)
+        self._compiles = (isinstance(limits[0], JointLimits)
+                          and not any(isinstance(lim, JointLimits) for lim in limits[1:])
                           and not self.resolver.layout.continuous.any())  # fmt: skip
         self._cell_tick: tuple[tuple[object, ...], CellTick | None] = ((), None)
         self._chain_poses: Array | None = None  # that tick's chain frames' poses, for _closed
@@ -458,11 +460,10 @@ class CellController(Loop):
         return self._kin
 
     def _compiled_tick(self, kin: Kinematics, top: list[FrameTask]) -> Resolution | None:
-        """The resolver's tick of the frame tasks ``top`` and the posture within the joint limits
-        and the chains, their rows in one compiled call
-        (:class:`~rrc_pin.cells.cell_tick.CellTick`); None where the tick is not one (other
-        limits, no chain, as many chain rows as rates) or it finds no answer: the resolver
-        answers from the tasks and limits.
+        """The resolver's tick of the frame tasks ``top`` and the posture within the limits, their
+        rows and the chains' in one compiled call (:class:`~rrc_pin.cells.cell_tick.CellTick`);
+        None where the tick is not one (no chain, as many chain rows as rates, a continuous
+        joint) or it finds no answer: the resolver answers from the tasks and limits.
         """  # noqa: D205
         if not self._compiles or not top:
             return None
@@ -475,7 +476,7 @@ class CellController(Loop):
             measured = ((not contact.frames or contact.anchors is not None)
                         and grip.grips.shape[0] == len(grip.pairs))  # fmt: skip
             tick = CellTick(kin, top, posture, contact, grip, self.gain,
-                            self._chain_frames.frames) if (
+                            self._chain_frames.frames, self.resolver.limits[1:-2]) if (
                 0 < chains < self.cell.nv and measured) else None  # fmt: skip
             self._cell_tick = (key, tick)
         if tick is None:

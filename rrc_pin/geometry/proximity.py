@@ -65,8 +65,7 @@ takes :math:`\sin\theta` of the speed it removes into the pair from the speed al
 default, 1e-6, is 0.01 rad at d = 0.02 m (panda's finger sliding on a tilted slab: 0.39 deg,
 1.1 % of its tangential speed; where GJK stops depends on the solver's cached state, so the
 same configuration gave different rows from one call to the next); 1e-10 is 1e-4 rad there,
-less farther. That scene's limit takes 115 us a tick either way, and the recorded arm ticks
-(benchmarks/tick_answers.py: a table, facing hands) answer bitwise as before."""
+less farther (CHANGELOG.md: its cost and the recorded ticks)."""
 
 
 class Proximity(NamedTuple):
