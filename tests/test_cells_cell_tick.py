@@ -47,12 +47,14 @@ def _limits(cell, collision):
     return [JointLimits(), CollisionLimit(model)]
 
 
-def _session(cell, seed, compiled, monkeypatch, ticks=240, refuse=0, collision=None):
+def _session(cell, seed, compiled, monkeypatch, ticks=240, refuse=0, collision=None,
+             closure=True):  # fmt: skip
     """Each tick's state and report, ``compiled`` or the tasks' and limits' path alone; every
     ``refuse``-th compiled tick finds no answer (0: none). The tripod swings leg 1 a third of
     the way in and lands it at two thirds."""
     robot = rrc_pin.load(cell)
-    ctl = CellController(robot, 0.01, limits=_limits(robot, collision))
+    ctl = CellController(robot, 0.01, limits=_limits(robot, collision),
+                         **({} if closure else {"closure": None}))  # fmt: skip
     ctl._compiles = compiled
     calls = []
     run_loaded = CompiledTick.run_loaded
@@ -142,6 +144,17 @@ def test_a_limits_rows_no_command_slides_along_are_loaded_beside_the_chains(cell
     plain, _, _ = _session(cell, SEEDS[0], False, monkeypatch, collision="singular")
     _same(compiled, plain, SEEDS[0])
     assert rows and rows[0] > 0, rows
+
+
+@pytest.mark.parametrize("cell", ["gsfc_dual", "yeh_tripod"])
+def test_without_the_closure_the_compiled_rows_answer_as_the_tasks_and_limits_do(
+    cell, monkeypatch
+):
+    """``closure=None``: no correction made with the rows, the same session bit for bit."""
+    compiled, calls, _ = _session(cell, SEEDS[0], True, monkeypatch, closure=False)
+    plain, _, _ = _session(cell, SEEDS[0], False, monkeypatch, closure=False)
+    _same(compiled, plain, SEEDS[0])
+    assert calls == len(compiled)
 
 
 @pytest.mark.parametrize("cell", ["gsfc_dual", "yeh_tripod"])

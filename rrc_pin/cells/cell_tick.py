@@ -16,19 +16,22 @@ compiled tick finds no answer to goes that path (the fallbacks, the messages).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import cast
 
 import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.cells.cell_kernels import cell_rows
-from rrc_pin.compiled_tick import CompiledTick
+from rrc_pin.cells.closure import ChainFrames
+from rrc_pin.cells.closure_kernels import correction
+from rrc_pin.compiled_tick import CompiledTick, TickSource
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits import ContactLimit, GripLimit, Limit
 from rrc_pin.limits.chain_kernels import NO_POSES
 from rrc_pin.limits.frame_columns import FrameColumns
 from rrc_pin.solvers.tick.problem import Constraints, TaskRows, finite_rows, merged_rows
 from rrc_pin.solvers.tick.resolution import Resolution
-from rrc_pin.solvers.tick.tick import POSITION, RATE
+from rrc_pin.solvers.tick.tick import LB, POSITION, RATE, UB, VELOCITY
 from rrc_pin.tasks import FrameTask, PostureTask, Task
 from rrc_pin.tasks.frame_task import row_units
 
@@ -36,6 +39,9 @@ Array = npt.NDArray[np.float64]
 
 _new = tuple.__new__
 """A named tuple made of its fields' tuple (:meth:`~typing.NamedTuple._make` less its check)."""
+BOX = [LB, UB, VELOCITY]
+"""The workspace's joints rows of the tick's box as the correction reads it (lower and upper
+bounds, velocity limits)."""
 Within = Callable[..., Resolution]
 """The resolver's tick once its limits have given their constraints
 (:meth:`Resolver.run_compiled <rrc_pin.resolver.Resolver.run_compiled>`)."""
@@ -54,8 +60,10 @@ class CellTick:
         contact: The cell's contact limit, its anchors measured where it has frames.
         grip: The cell's grip limit, its grips measured where it has pairs.
         gain: The frame tasks' gain [1/s].
-        chains: The chains' frames (:class:`~rrc_pin.cells.closure.ChainFrames`' ``frames``):
-            their poses are kept (:attr:`chain_poses`).
+        chains: The chains' frames (:class:`~rrc_pin.cells.closure.ChainFrames`), contacts
+            first.
+        correct: Whether the closure's correction is made (:attr:`corrected`; the
+            controller's bound is on).
         others: The resolver's other limits (a :class:`~rrc_pin.limits.CollisionLimit`),
             between the joint limits and the chains': their constraints computed as the
             resolver computes them; rows ``G qdot <= h`` are loaded beside the chains', and a
@@ -63,9 +71,10 @@ class CellTick:
             collision pair) goes back to the resolver with the rows and constraints it has.
 
     Attributes:
-        chain_poses: The chains' frames' poses (k, 4, 4) [m] at the last tick's kinematics,
-            for the closure's correction (:func:`~rrc_pin.cells.closure.close`); None where
-            the resolver answered it.
+        corrected: The last tick's closure correction, as
+            :func:`~rrc_pin.cells.closure.close` makes it from the tick's rows, errors, box
+            and top level: the chains' error after the step (6 k,) and the rates applied
+            (nv,); None where it was not made here (not correcting, or the resolver answered).
 
     The resolver's limits are the joint limits, ``others``, ``contact`` and ``grip``, in that
     order (the controller's).
@@ -73,8 +82,8 @@ class CellTick:
 
     def __init__(
         self, kin: Kinematics, tasks: Sequence[FrameTask], posture: PostureTask,
-        contact: ContactLimit, grip: GripLimit, gain: float, chains: tuple[int, ...],
-        others: Sequence[Limit] = (),
+        contact: ContactLimit, grip: GripLimit, gain: float, chains: ChainFrames,
+        correct: bool, others: Sequence[Limit] = (),
     ) -> None:  # fmt: skip
         layout = kin.layout
         ids = layout.frames
@@ -83,8 +92,10 @@ class CellTick:
         self.columns = FrameColumns.of(kin.model, kin.data, frames)
         self.frames = tuple(dict.fromkeys(frames))  # each pose read once a tick
         row = {f: i for i, f in enumerate(self.frames)}
-        self.chains = np.array([row[f] for f in chains], dtype=np.intp)
-        self.chain_poses: Array | None = None
+        self.chain_rows = np.array([row[f] for f in chains.frames], dtype=np.intp)
+        self.chains, self.correct = chains, correct
+        self.corrected: tuple[Array, Array] | None = None
+        self.no_rows = np.zeros((0, layout.nv)), np.zeros(0)  # the correction's G, h: none
         c, g = len(contact.frames), len(grip.pairs)
         self.plan = np.array([len(tasks), c, g, *(row[f] for f in frames)], dtype=np.int64)
         self.units = [row_units(t.selected, layout.reach[t.frame]) for t in tasks]
@@ -100,6 +111,7 @@ class CellTick:
             (contact, 0, c), (grip, 6 * c, g))  # fmt: skip
         self.parts = [(at + i, limit, slice(start, start + 6 * k), limit.columns(kin)[1])
                       for i, (limit, start, k) in enumerate(chain_limits) if k]  # fmt: skip
+        self.unit = np.concatenate([unit for *_, unit in self.parts])  # the chains' rows'
         self.others = tuple(others)
         self.anchors = NO_POSES if contact.anchors is None else contact.anchors
         self.tasks, self.posture, self.contact, self.grip = tuple(tasks), posture, contact, grip
@@ -113,6 +125,7 @@ class CellTick:
         resolution; None where the compiled tick finds no answer. A tick whose other limits
         give what the compiled rows do not take goes on in the resolver (``within``).
         """  # noqa: D205
+        self.corrected = None
         others = [limit.constraints(kin, dt, previous) for limit in self.others]
         G = h = slide = None
         if others:
@@ -149,11 +162,20 @@ class CellTick:
         top = [_new(TaskRows, (rows[6 * i : 6 * i + 6], b[6 * i : 6 * i + 6], None, t.name, u))
                for i, (t, u) in enumerate(zip(tasks, self.units, strict=True))]  # fmt: skip
         posture = _new(TaskRows, (self.eye, b[m_top:], self.weights, self.posture.name, None))
-        self.chain_poses = poses[self.chains]
         constraints: list[Constraints | None] = [None, *others, NONE, NONE]
         for at, limit, part, unit in self.parts:
             constraints[at] = limit.rows_of(C[part], error[part], unit)
-        return compiled.answer(code, [top, [posture]], constraints, dt, False, start)
+        res = compiled.answer(code, [top, [posture]], constraints, dt, False, start)
+        if self.correct:  # the closure's correction, as close() makes it
+            chains = self.chains
+            G_, h_ = self.no_rows if G is None or h is None else (G, np.array(h))
+            delta, after, applied = np.empty(n), np.empty(r), np.empty(n)
+            stacked = cast(Array, cast(TickSource, res.source).stacked)  # kept: equality rows
+            correction(data.J, chains.support, chains.joint, poses[self.chain_rows],
+                       chains.contacts, chains.grips, C, error, self.unit, stacked, res.qdot,
+                       ws.joints[BOX], G_, h_, dt, delta, after, applied)  # fmt: skip
+            self.corrected = (after, applied)
+        return res
 
     def _within(self, within: Within, kin: Kinematics, others: list[Constraints], dt: float,
                 previous: Array, start: float) -> Resolution:  # fmt: skip
@@ -166,7 +188,7 @@ class CellTick:
         constraints: list[Constraints | None] = [None, *others]
         constraints += [limit.constraints(kin, dt, previous) for limit in (self.contact,
                                                                            self.grip)]  # fmt: skip
-        self.chain_poses = None
+        self.corrected = None
         return within(kin, rows, constraints, False, dt, previous, start, tasks)
 
 

@@ -139,7 +139,7 @@ class ChainFrames(NamedTuple):
 
 def close(
     kin: Kinematics, frames: ChainFrames, closure: Closure, qdot: Array, top: Array, box: Box,
-    rows: Rows | None, dt: float, poses: Array | None = None,
+    rows: Rows | None, dt: float,
 ) -> tuple[Array, Array, Array]:  # fmt: skip
     r"""The correction that closes the chains within the step, and their error after it.
 
@@ -164,8 +164,6 @@ def close(
         box: The tick's joint-rate bounds.
         rows: The tick's constraint rows ``G qdot <= h``, or None.
         dt: The step [s].
-        poses: The chains' frames' poses (k, 4, 4) at ``kin`` [m], where read already; None:
-            read here.
 
     Returns:
         The correction (nv,), zero where the projection finds none (``qdot + delta`` inside
@@ -174,10 +172,9 @@ def close(
     """
     n = qdot.size
     data = kin.data
-    if poses is None:
-        oMf, poses = data.oMf, np.empty((len(frames.frames), 4, 4))
-        for i, f in enumerate(frames.frames):
-            poses[i] = oMf[f].homogeneous
+    oMf, poses = data.oMf, np.empty((len(frames.frames), 4, 4))
+    for i, f in enumerate(frames.frames):
+        poses[i] = oMf[f].homogeneous
     G, h = (np.zeros((0, n)), np.zeros(0)) if rows is None else (rows.G, np.array(rows.h))
     delta, after, applied = np.empty(n), np.empty(closure.error.size), np.empty(n)
     closure_kernels.correction(

@@ -235,7 +235,7 @@ class CellController(Loop):
                           and not any(isinstance(lim, JointLimits) for lim in limits[1:])
                           and not self.resolver.layout.continuous.any())  # fmt: skip
         self._cell_tick: tuple[tuple[object, ...], CellTick | None] = ((), None)
-        self._chain_poses: Array | None = None  # that tick's chain frames' poses, for _closed
+        self._in_tick: tuple[Array, Array] | None = None  # that tick's correction (_closed)
         if closure is not None:
             compile_correction(cell.nv)
         scale_and_veer(np.zeros(6), np.zeros(6), np.ones(6))  # compiled now: damped ticks use it
@@ -376,6 +376,7 @@ class CellController(Loop):
                 continue
             top.append(self._task(name, twist))
         before = self._previous_rates()
+        self._in_tick = None
         r = None if hands or before is not None else self._compiled_tick(kin, top)
         if r is None:
             if hands:
@@ -442,7 +443,7 @@ class CellController(Loop):
                 if isinstance(limit, JointLimits):
                     limit.constraints(kin, self.resolver.dt, previous)
         self.resolver.reset()
-        self._kin = None
+        self._kin, self._in_tick = None, None
 
     def _kinematics(self) -> Kinematics:
         """The tick's one :class:`~rrc_pin.kinematics.Kinematics` at the current q.
@@ -469,21 +470,22 @@ class CellController(Loop):
             return None
         posture, contact, grip = self.posture, self.contact, self.grip
         key = (*top, posture, posture.q_ref, posture.gain, posture.weight, contact.frames,
-               contact.anchors, grip.pairs, grip.grips, self.gain)  # fmt: skip
+               contact.anchors, grip.pairs, grip.grips, self._chain_frames, self.gain,
+               self.closure is None)  # fmt: skip
         known, tick = self._cell_tick
         if len(known) != len(key) or any(a is not b for a, b in zip(known, key, strict=True)):
             chains = 6 * (len(contact.frames) + len(grip.pairs))
             measured = ((not contact.frames or contact.anchors is not None)
                         and grip.grips.shape[0] == len(grip.pairs))  # fmt: skip
-            tick = CellTick(kin, top, posture, contact, grip, self.gain,
-                            self._chain_frames.frames, self.resolver.limits[1:-2]) if (
+            tick = CellTick(kin, top, posture, contact, grip, self.gain, self._chain_frames,
+                            self.closure is not None, self.resolver.limits[1:-2]) if (
                 0 < chains < self.cell.nv and measured) else None  # fmt: skip
             self._cell_tick = (key, tick)
         if tick is None:
             return None
         r = self.resolver.run_compiled(tick, kin, self.resolver.dt, time.perf_counter())
         if r is not None:
-            self._chain_poses = tick.chain_poses
+            self._in_tick = tick.corrected
         return r
 
     def _frame_id(self, name: str) -> int:
@@ -616,7 +618,8 @@ class CellController(Loop):
     def _closed(self, r: Resolution) -> CellResolution:
         """``r`` with the closed chains' correction, or held still while one is lost.
 
-        The correction (:func:`~rrc_pin.cells.closure.close`) takes the error measured at the
+        The correction (:func:`~rrc_pin.cells.closure.close`, or made with the tick's compiled
+        rows, :class:`~rrc_pin.cells.cell_tick.CellTick`) takes the error measured at the
         tick's configuration (the resolver's kinematics, by the contact and grip limits) and
         the step's second order out inside the tick's box. A tick that starts with a chain
         beyond its bound holds still (``grip_lost`` / ``contact_lost``, zero rates), and so
@@ -627,7 +630,7 @@ class CellController(Loop):
         self._applied = r.qdot
         self._corrected = None
         self.chain_error = (0.0, 0.0)
-        poses, self._chain_poses = self._chain_poses, None
+        in_tick, self._in_tick = self._in_tick, None
         tasks, stacked, rows = _top_level(r)
         self._top_tasks = tasks
         hands = self._hands(tasks)
@@ -643,10 +646,13 @@ class CellController(Loop):
         if bound is None:
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
         mode, commanded, _ = self._tick
-        top = stacked if mode == "teleop" else np.zeros((0, self.cell.nv))
-        kin = self._kin if self._kin is not None else self._kinematics()
-        _, after, applied = close(kin, self._chain_frames, closure, r.qdot, top, r.box, rows,
-                                  self.dt, poses)  # fmt: skip
+        if in_tick is not None:  # made with the tick's compiled rows (CellTick)
+            after, applied = in_tick
+        else:
+            top = stacked if mode == "teleop" else np.zeros((0, self.cell.nv))
+            kin = self._kin if self._kin is not None else self._kinematics()
+            _, after, applied = close(kin, self._chain_frames, closure, r.qdot, top, r.box,
+                                      rows, self.dt)  # fmt: skip
         level = max(self.chain_error[0] / bound.position, self.chain_error[1] / bound.rotation)
         if level <= 1.0:
             self.lost = None
