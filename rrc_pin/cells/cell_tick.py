@@ -39,7 +39,7 @@ Array = npt.NDArray[np.float64]
 
 _new = tuple.__new__
 """A named tuple made of its fields' tuple (:meth:`~typing.NamedTuple._make` less its check)."""
-BOX = [LB, UB, VELOCITY]
+BOX = np.array([LB, UB, VELOCITY])
 """The workspace's joints rows of the tick's box as the correction reads it (lower and upper
 bounds, velocity limits)."""
 Within = Callable[..., Resolution]
@@ -71,7 +71,7 @@ class CellTick:
             collision pair) goes back to the resolver with the rows and constraints it has.
 
     Attributes:
-        corrected: The last tick's closure correction, as
+        corrected: The last tick's top level (its tasks' rows) and closure correction, as
             :func:`~rrc_pin.cells.closure.close` makes it from the tick's rows, errors, box
             and top level: the chains' error after the step (6 k,) and the rates applied
             (nv,); None where it was not made here (not correcting, or the resolver answered).
@@ -94,7 +94,7 @@ class CellTick:
         row = {f: i for i, f in enumerate(self.frames)}
         self.chain_rows = np.array([row[f] for f in chains.frames], dtype=np.intp)
         self.chains, self.correct = chains, correct
-        self.corrected: tuple[Array, Array] | None = None
+        self.corrected: tuple[list[TaskRows], Array, Array] | None = None
         self.no_rows = np.zeros((0, layout.nv)), np.zeros(0)  # the correction's G, h: none
         c, g = len(contact.frames), len(grip.pairs)
         self.plan = np.array([len(tasks), c, g, *(row[f] for f in frames)], dtype=np.int64)
@@ -174,7 +174,7 @@ class CellTick:
             correction(data.J, chains.support, chains.joint, poses[self.chain_rows],
                        chains.contacts, chains.grips, C, error, self.unit, stacked, res.qdot,
                        ws.joints[BOX], G_, h_, dt, delta, after, applied)  # fmt: skip
-            self.corrected = (after, applied)
+            self.corrected = (top, after, applied)
         return res
 
     def _within(self, within: Within, kin: Kinematics, others: list[Constraints], dt: float,

@@ -235,7 +235,8 @@ class CellController(Loop):
                           and not any(isinstance(lim, JointLimits) for lim in limits[1:])
                           and not self.resolver.layout.continuous.any())  # fmt: skip
         self._cell_tick: tuple[tuple[object, ...], CellTick | None] = ((), None)
-        self._in_tick: tuple[Array, Array] | None = None  # that tick's correction (_closed)
+        # that tick's top level and correction (:meth:`_closed`)
+        self._in_tick: tuple[Sequence[TaskRows], Array, Array] | None = None
         if closure is not None:
             compile_correction(cell.nv)
         scale_and_veer(np.zeros(6), np.zeros(6), np.ones(6))  # compiled now: damped ticks use it
@@ -631,7 +632,10 @@ class CellController(Loop):
         self._corrected = None
         self.chain_error = (0.0, 0.0)
         in_tick, self._in_tick = self._in_tick, None
-        tasks, stacked, rows = _top_level(r)
+        if in_tick is not None:  # the top level and the correction made with the tick's rows
+            tasks = in_tick[0]
+        else:
+            tasks, stacked, rows = _top_level(r)
         self._top_tasks = tasks
         hands = self._hands(tasks)
         measured: list[tuple[Closure | None, Lost]] = [(self.contact.last, "contact_lost"),
@@ -647,8 +651,8 @@ class CellController(Loop):
             return CellResolution.of_tick(r, r.qdot.copy(), hands)
         mode, commanded, _ = self._tick
         if in_tick is not None:  # made with the tick's compiled rows (CellTick)
-            after, applied = in_tick
-        else:
+            _, after, applied = in_tick
+        else:  # stacked and rows: the top level's, read above
             top = stacked if mode == "teleop" else np.zeros((0, self.cell.nv))
             kin = self._kin if self._kin is not None else self._kinematics()
             _, after, applied = close(kin, self._chain_frames, closure, r.qdot, top, r.box,
