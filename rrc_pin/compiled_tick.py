@@ -361,21 +361,25 @@ class CompiledTick:
         code = self._run(kin.q, previous, dt, levels)
         return self.answer(code, levels, constraints, dt, weighted, start)
 
+    def loading(self) -> None:
+        """Another compiled call is about to write the workspace's rows and sizes (a cell's,
+        :func:`rrc_pin.cells.cell_kernels.cell_rows`): what it held is forgotten, and loaded
+        again at the next tick of this one's own (:meth:`tasks`, :meth:`twist`).
+        """  # noqa: D205
+        self._loaded = None
+        self.workspace.forget()
+
     def run_loaded(self, q: Array, previous: Array, dt: float) -> int:
-        """The tick at ``q`` after ``previous`` [rad/s], step ``dt`` [s], of the rows another
-        compiled call loaded into the workspace (a cell's,
-        :func:`rrc_pin.cells.cell_kernels.cell_rows`), the QPs handed to the backend: its code
-        (:meth:`answer` reads the answer; negative: none, the caller's Python path answers).
-        What the workspace held is loaded again at the next tick.
+        """The tick of the rows loaded in the workspace at ``q`` after ``previous`` [rad/s],
+        step ``dt`` [s], its QPs handed to the backend: its code (:meth:`answer` reads the
+        answer; :data:`~rrc_pin.solvers.tick.tick.INVALID_INPUT`: a value not finite).
         """  # noqa: D205
         self._answered = None  # joints[PREVIOUS] is written
-        self._loaded = None  # and the task rows
         backend_calls.enter(self._context)
         try:
-            code = self.workspace.run(q, previous, dt)
+            code: int = self.workspace.run(q, previous, dt)
         finally:
             backend_calls.leave()
-        self.workspace.forget()
         return code
 
     def _load_constraints(self, constraints: list[Constraints | None]) -> None:
@@ -410,12 +414,7 @@ class CompiledTick:
             InvalidInput: A position (``q``) or task row (of ``levels``) not finite, with the
                 message the checks give.
         """
-        self._answered = None  # joints[PREVIOUS] is written
-        backend_calls.enter(self._context)
-        try:
-            code = self.workspace.run(q, previous, dt)
-        finally:
-            backend_calls.leave()
+        code = self.run_loaded(q, previous, dt)
         if code == tick.INVALID_INPUT:
             if self.workspace.ints[tick.INVALID] == tick.BAD_POSITION:
                 as_vector(q, "q", q.size)

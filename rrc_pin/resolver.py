@@ -429,10 +429,10 @@ class Resolver:
         rates answered are its last from then on. None where there is no compiled tick
         (several joint boxes, a mask) or ``tick`` answers none.
         """  # noqa: D205
-        compiled = self._compiled if self._free is None else None
-        if compiled is None:
-            return None
         with self._lock:
+            compiled = self._compiled if self._free is None else None
+            if compiled is None:
+                return None
             r = tick(compiled, self._last_qdot, self._tick_within, *args)
             if r is not None:
                 self._last_qdot = r.qdot

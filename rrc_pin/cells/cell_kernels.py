@@ -58,7 +58,7 @@ def cell_rows(
 
     Args:
         Jw: The joint Jacobians (6, nv_ext) in the world frame (``data.J``).
-        poses: The frames' poses (u, 4, 4) in the base frame [m], each frame once.
+        poses: The frames' poses (u, 4, 4) in the world frame [m] (``data.oMf``), each once.
         steps: The frames' steps (s, 3) (:class:`~rrc_pin.limits.frame_columns.FrameColumns`
             of the t commanded frames, the c contacts and each of the g grips' frames a and b).
         starts: (t + c + 2 g + 1,) each of those frames' first step.
@@ -85,7 +85,7 @@ def cell_rows(
     for i in range(f):
         placed[i] = poses[plan[FRAMES + i]]
     q = joints[POSITION]
-    unit, weight = values[CONSTANTS : CONSTANTS + m_top], values[CONSTANTS + m_top :]
+    unit, weight = values[CONSTANTS : CONSTANTS + m_top], values[CONSTANTS + m_top :][:n]
     q_ref = values[CONSTANTS + m_top + n :]
     frame, e = np.zeros((6, n)), np.empty(6)
     for i in range(t):

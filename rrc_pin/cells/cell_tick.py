@@ -1,16 +1,18 @@
 """CellTick: a cell controller's usual tick, its rows in one compiled call.
 
 A :class:`~rrc_pin.cells.CellController` tick whose top level is the commanded frames' tasks
-(each toward its target), with the posture below them, within the joint limits and the closed
-chains' rows (the contacts', the grips') alone, has its rows written into the resolver's
-workspace by one compiled call (:func:`~rrc_pin.cells.cell_kernels.cell_rows`) instead of the
-tasks' and limits' own calls and the workspace's loading; the resolver's compiled tick then runs
-on them (:meth:`CompiledTick.run_loaded <rrc_pin.compiled_tick.CompiledTick.run_loaded>`). The
+(each toward its target), with the posture below them, within the joint limits, the closed
+chains' rows (the contacts', the grips') and other limits' inequality rows, has its tasks' and
+chains' rows written into the resolver's workspace by one compiled call
+(:func:`~rrc_pin.cells.cell_kernels.cell_rows`) instead of the tasks' and limits' own calls and
+the workspace's loading; the resolver's compiled tick then runs on them
+(:meth:`CompiledTick.run_loaded <rrc_pin.compiled_tick.CompiledTick.run_loaded>`). The
 resolution is the resolver's (:meth:`CompiledTick.answer
 <rrc_pin.compiled_tick.CompiledTick.answer>`), of the rows and constraints the tasks and
 limits give, which the limits keep as their own (:meth:`GripLimit.rows_of
-<rrc_pin.limits.GripLimit.rows_of>`): the same bits as the tasks' and limits' path. A tick the
-compiled tick finds no answer to goes that path (the fallbacks, the messages).
+<rrc_pin.limits.GripLimit.rows_of>`), and the closure's correction is made from the same
+arrays (:func:`~rrc_pin.cells.closure.correct`): the same bits as the tasks' and limits' path.
+A tick with a value that is not finite goes that path (its messages).
 """
 
 from __future__ import annotations
@@ -22,16 +24,16 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.cells.cell_kernels import cell_rows
-from rrc_pin.cells.closure import ChainFrames
-from rrc_pin.cells.closure_kernels import correction
+from rrc_pin.cells.closure import ChainFrames, correct
 from rrc_pin.compiled_tick import CompiledTick, TickSource
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits import ContactLimit, GripLimit, Limit
 from rrc_pin.limits.chain_kernels import NO_POSES
+from rrc_pin.limits.contact_limit import Closure
 from rrc_pin.limits.frame_columns import FrameColumns
 from rrc_pin.solvers.tick.problem import Constraints, TaskRows, finite_rows, merged_rows
 from rrc_pin.solvers.tick.resolution import Resolution
-from rrc_pin.solvers.tick.tick import LB, POSITION, RATE, UB, VELOCITY
+from rrc_pin.solvers.tick.tick import INVALID_INPUT, LB, POSITION, RATE, UB, VELOCITY
 from rrc_pin.tasks import FrameTask, PostureTask, Task
 from rrc_pin.tasks.frame_task import row_units
 
@@ -42,12 +44,21 @@ _new = tuple.__new__
 BOX = np.array([LB, UB, VELOCITY])
 """The workspace's joints rows of the tick's box as the correction reads it (lower and upper
 bounds, velocity limits)."""
-Within = Callable[..., Resolution]
+Within = Callable[[Kinematics, list[list[TaskRows]], list[Constraints | None], bool, float,
+                   Array, float, list[list[Task]]], Resolution]  # fmt: skip
 """The resolver's tick once its limits have given their constraints
 (:meth:`Resolver.run_compiled <rrc_pin.resolver.Resolver.run_compiled>`)."""
-NONE = Constraints()
+NO_ROWS = Constraints()
 """What a limit without rows gives (:meth:`ContactLimit.constraints
 <rrc_pin.limits.ContactLimit.constraints>` without frames)."""
+
+
+def fits(tasks: Sequence[FrameTask]) -> bool:
+    """Whether :class:`CellTick`'s rows are those of ``tasks``: each full rows in
+    ``world_aligned``, weight 1, with a target (a cell controller's commanded frames').
+    """  # noqa: D205
+    return all(len(t.selected) == 6 and t.ref == "world_aligned" and t.target is not None
+               and isinstance(t.weight, float) and t.weight == 1.0 for t in tasks)  # fmt: skip
 
 
 class CellTick:
@@ -55,7 +66,7 @@ class CellTick:
 
     Args:
         kin: A tick's kinematics of the cell (its model, data and layout are read).
-        tasks: The top level's frame tasks (full rows, ``world_aligned``, each with a target).
+        tasks: The top level's frame tasks (:func:`fits`).
         posture: The posture task below them (no continuous joint to wrap).
         contact: The cell's contact limit, its anchors measured where it has frames.
         grip: The cell's grip limit, its grips measured where it has pairs.
@@ -105,6 +116,7 @@ class CellTick:
             [gain, posture.gain], *self.units,
             np.ones(n) if self.weights is None else self.weights, posture.q_ref,
         ])  # fmt: skip
+        self.q_ref = self.values[self.values.size - n :]  # the posture's, copied at every tick
         # each chain limit's place among the resolver's limits, its rows and their units
         at = 1 + len(others)
         chain_limits: tuple[tuple[ContactLimit | GripLimit, int, int], ...] = (
@@ -122,8 +134,9 @@ class CellTick:
         """The tick at ``kin`` after the rates ``previous`` (nv,), step ``dt`` [s], on the
         resolver's ``compiled`` tick (:meth:`Resolver.run_compiled
         <rrc_pin.resolver.Resolver.run_compiled>`), ``start`` [s] when it began: its
-        resolution; None where the compiled tick finds no answer. A tick whose other limits
-        give what the compiled rows do not take goes on in the resolver (``within``).
+        resolution (the fallbacks' where the top level finds no answer); None where a value
+        is not finite (the resolver's path names it). A tick whose other limits give what the
+        compiled rows do not take goes on in the resolver (``within``).
         """  # noqa: D205
         self.corrected = None
         others = [limit.constraints(kin, dt, previous) for limit in self.others]
@@ -136,10 +149,12 @@ class CellTick:
                 G, h, slide = merged.G, merged.h, merged.slide
         ws, n, tasks = compiled.workspace, kin.layout.nv, self.tasks
         m_top, r = 6 * len(tasks), self.rows
+        compiled.loading()
         if ws.task_rows.shape[0] < m_top + n or ws.E.shape[0] != r:  # room for the rows
             ws.load_levels([[TaskRows(np.zeros((m_top + n, n)), np.zeros(m_top + n), None, "")]],
                            False)  # fmt: skip
             ws.load_equalities(np.zeros((r, n)), np.zeros(r))
+            ws.forget()
         data = kin.data
         oMf = data.oMf
         poses = np.empty((len(self.frames), 4, 4))
@@ -148,32 +163,32 @@ class CellTick:
         twists, targets = np.empty((len(tasks), 6)), np.empty((len(tasks), 4, 4))
         for i, task in enumerate(tasks):
             twists[i], targets[i] = task.twist, task.target
+        self.q_ref[:] = self.posture.q_ref  # read at every tick, as the posture's rows read it
         C, error = np.zeros((r, n)), np.empty(r)
-        ws.joints[POSITION] = kin.q  # the posture's rows read it
+        ws.joints[POSITION] = kin.q  # the posture's rows read it (the tick writes it again)
         cell_rows(data.J, poses, self.columns.steps, self.columns.starts, self.plan,
                   self.values, twists, targets, self.anchors, self.grip.grips, ws.joints,
                   ws.task_rows, ws.rates, ws.ints, ws.E, C, error)  # fmt: skip
         if h is not None:
             ws.load_rows(G, h, slide)
         code = compiled.run_loaded(kin.q, previous, dt)
-        if code < 0:
+        if code == INVALID_INPUT:
             return None
         rows, b = ws.task_rows[:m_top].copy(), ws.rates[RATE, : m_top + n].copy()
         top = [_new(TaskRows, (rows[6 * i : 6 * i + 6], b[6 * i : 6 * i + 6], None, t.name, u))
                for i, (t, u) in enumerate(zip(tasks, self.units, strict=True))]  # fmt: skip
         posture = _new(TaskRows, (self.eye, b[m_top:], self.weights, self.posture.name, None))
-        constraints: list[Constraints | None] = [None, *others, NONE, NONE]
+        constraints: list[Constraints | None] = [None, *others, NO_ROWS, NO_ROWS]
         for at, limit, part, unit in self.parts:
             constraints[at] = limit.rows_of(C[part], error[part], unit)
         res = compiled.answer(code, [top, [posture]], constraints, dt, False, start)
-        if self.correct:  # the closure's correction, as close() makes it
-            chains = self.chains
-            G_, h_ = self.no_rows if G is None or h is None else (G, np.array(h))
-            delta, after, applied = np.empty(n), np.empty(r), np.empty(n)
-            stacked = cast(Array, cast(TickSource, res.source).stacked)  # kept: equality rows
-            correction(data.J, chains.support, chains.joint, poses[self.chain_rows],
-                       chains.contacts, chains.grips, C, error, self.unit, stacked, res.qdot,
-                       ws.joints[BOX], G_, h_, dt, delta, after, applied)  # fmt: skip
+        source = res.source
+        if self.correct and isinstance(source, TickSource):  # not the fallbacks' problem
+            G_, h_ = self.no_rows if G is None or h is None else (G, h)
+            _, after, applied = correct(data.J, self.chains, poses[self.chain_rows],
+                                        _new(Closure, (C, error, self.unit)),
+                                        cast(Array, source.stacked), res.qdot, ws.joints[BOX],
+                                        G_, h_, dt)  # fmt: skip
             self.corrected = (top, after, applied)
         return res
 

@@ -72,7 +72,7 @@ from rrc_pin.solvers.tick.problem import Box, Rows
 Array = npt.NDArray[np.float64]
 
 __all__ = ["DAMPING", "KEEP", "PASSES", "TRUST", "ChainFrames", "ClosureBound", "close",
-           "compile_correction", "largest"]
+           "compile_correction", "correct", "largest"]
 
 
 @dataclass(frozen=True)
@@ -175,13 +175,36 @@ def close(
     oMf, poses = data.oMf, np.empty((len(frames.frames), 4, 4))
     for i, f in enumerate(frames.frames):
         poses[i] = oMf[f].homogeneous
-    G, h = (np.zeros((0, n)), np.zeros(0)) if rows is None else (rows.G, np.array(rows.h))
+    G, h = (np.zeros((0, n)), np.zeros(0)) if rows is None else (rows.G, rows.h)
+    return correct(data.J, frames, poses, closure, top, qdot,
+                   np.array([box.lb, box.ub, box.velocity]), G, h, dt)  # fmt: skip
+
+
+def correct(
+    J: Array, frames: ChainFrames, poses: Array, closure: Closure, top: Array, qdot: Array,
+    box: Array, G: Array, h: Array, dt: float,
+) -> tuple[Array, Array, Array]:  # fmt: skip
+    """:func:`close` from the tick's arrays: the correction, the chains' error after the step
+    and the rates applied (:func:`~rrc_pin.cells.closure_kernels.correction`).
+
+    Args:
+        J: The tick's world Jacobian of every joint (6, nv) (``data.J``).
+        frames: The chains' frames.
+        poses: Their poses (k, 4, 4) in the world frame [m], in ``frames.frames``' order.
+        closure: The chains' rows, errors and units.
+        top: The top level's task rows (m, nv) in their metric.
+        qdot: The resolver's rates (nv,).
+        box: (3, nv) the tick's lower and upper bounds and velocity limits.
+        G: The constraint rows (p, nv), ``G qdot <= h``.
+        h: Their bounds (p,).
+        dt: The step [s].
+    """  # noqa: D205
+    n = qdot.size
     delta, after, applied = np.empty(n), np.empty(closure.error.size), np.empty(n)
     closure_kernels.correction(
-        data.J, frames.support, frames.joint, poses, frames.contacts,
-        frames.grips, np.ascontiguousarray(closure.C), closure.error, closure.unit,
-        np.ascontiguousarray(top), qdot, np.array([box.lb, box.ub, box.velocity]),
-        np.ascontiguousarray(G), h, dt, delta, after, applied,
+        J, frames.support, frames.joint, poses, frames.contacts, frames.grips,
+        np.ascontiguousarray(closure.C), closure.error, closure.unit, np.ascontiguousarray(top),
+        qdot, box, np.ascontiguousarray(G), np.array(h), dt, delta, after, applied,
     )  # fmt: skip
     return delta, after, applied
 

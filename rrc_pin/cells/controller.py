@@ -58,7 +58,7 @@ import numpy.typing as npt
 from rrc_pin.cells.cell import Cell
 from rrc_pin.cells.cell_log import CellLog
 from rrc_pin.cells.cell_resolution import CellResolution
-from rrc_pin.cells.cell_tick import CellTick
+from rrc_pin.cells.cell_tick import CellTick, fits
 from rrc_pin.cells.closure import ChainFrames, ClosureBound, close, compile_correction, largest
 from rrc_pin.compiled_tick import TickSource
 from rrc_pin.control.deadman import Deadman
@@ -475,12 +475,13 @@ class CellController(Loop):
                self.closure is None)  # fmt: skip
         known, tick = self._cell_tick
         if len(known) != len(key) or any(a is not b for a, b in zip(known, key, strict=True)):
+            posture.check(kin.layout)  # a posture replaced: refused as the resolver refuses it
             chains = 6 * (len(contact.frames) + len(grip.pairs))
             measured = ((not contact.frames or contact.anchors is not None)
                         and grip.grips.shape[0] == len(grip.pairs))  # fmt: skip
             tick = CellTick(kin, top, posture, contact, grip, self.gain, self._chain_frames,
                             self.closure is not None, self.resolver.limits[1:-2]) if (
-                0 < chains < self.cell.nv and measured) else None  # fmt: skip
+                0 < chains < self.cell.nv and measured and fits(top)) else None  # fmt: skip
             self._cell_tick = (key, tick)
         if tick is None:
             return None

@@ -514,8 +514,8 @@ class Workspace:
                 del held[s]
 
     def forget(self) -> None:
-        """Forget what the arrays hold: another compiled call wrote them (a cell's tick,
-        :func:`rrc_pin.cells.cell_kernels.cell_tick`), so the next :meth:`load_levels` loads
+        """Forget what the arrays hold: another compiled call writes them (a cell's rows,
+        :func:`rrc_pin.cells.cell_kernels.cell_rows`), so the next :meth:`load_levels` loads
         every part and writes the sizes and flags.
         """  # noqa: D205
         self._held.clear()
