@@ -30,7 +30,7 @@ from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits import ContactLimit, GripLimit, Limit
 from rrc_pin.limits.chain_kernels import NO_POSES
 from rrc_pin.limits.contact_limit import Closure
-from rrc_pin.limits.frame_columns import FrameColumns
+from rrc_pin.limits.frame_columns import FrameColumns, frame_poses
 from rrc_pin.solvers.tick.problem import Constraints, TaskRows, finite_rows, merged_rows
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.solvers.tick.tick import INVALID_INPUT, LB, POSITION, RATE, UB, VELOCITY
@@ -156,10 +156,7 @@ class CellTick:
             ws.load_equalities(np.zeros((r, n)), np.zeros(r))
             ws.forget()
         data = kin.data
-        oMf = data.oMf
-        poses = np.empty((len(self.frames), 4, 4))
-        for i, f in enumerate(self.frames):
-            poses[i] = oMf[f].homogeneous
+        poses = frame_poses(data, self.frames)
         twists, targets = np.empty((len(tasks), 6)), np.empty((len(tasks), 4, 4))
         for i, task in enumerate(tasks):
             twists[i], targets[i] = task.twist, task.target

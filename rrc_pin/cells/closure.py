@@ -66,6 +66,7 @@ from rrc_pin.cells import closure_kernels
 from rrc_pin.cells.closure_kernels import DAMPING, KEEP, PASSES, TRUST, largest
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits.contact_limit import Closure
+from rrc_pin.limits.frame_columns import frame_poses
 from rrc_pin.solvers.checks import finite_number
 from rrc_pin.solvers.tick.problem import Box, Rows
 
@@ -172,9 +173,7 @@ def close(
     """
     n = qdot.size
     data = kin.data
-    oMf, poses = data.oMf, np.empty((len(frames.frames), 4, 4))
-    for i, f in enumerate(frames.frames):
-        poses[i] = oMf[f].homogeneous
+    poses = frame_poses(data, frames.frames)
     G, h = (np.zeros((0, n)), np.zeros(0)) if rows is None else (rows.G, rows.h)
     return correct(data.J, frames, poses, closure, top, qdot,
                    np.array([box.lb, box.ub, box.velocity]), G, h, dt)  # fmt: skip

@@ -54,8 +54,17 @@ class FrameColumns(NamedTuple):
 
     def poses(self, data: pin.Data) -> Array:
         """The frames' poses (k, 4, 4) in the base frame [m], from ``data.oMf`` (placed)."""
-        oMf = data.oMf
-        return np.array([oMf[f].homogeneous for f in self.frames]).reshape(-1, 4, 4)
+        return frame_poses(data, self.frames)
+
+
+def frame_poses(data: pin.Data, frames: Sequence[int]) -> Array:
+    """The poses (k, 4, 4) in the world frame [m] of Pinocchio's ``frames``, from ``data.oMf``
+    (placed: ``updateFramePlacements``)."""  # noqa: D205, D209
+    oMf = data.oMf
+    poses = np.empty((len(frames), 4, 4))
+    for i, f in enumerate(frames):
+        poses[i] = oMf[f].homogeneous
+    return poses
 
 
 def _walk(model: pin.Model, data: pin.Data, joint: int) -> list[tuple[int, int, int]]:
