@@ -45,6 +45,7 @@ every command, the configuration is integrated on its manifold, the ticks go to 
 from __future__ import annotations
 
 import math
+import operator
 import os
 import time
 import warnings
@@ -474,7 +475,7 @@ class CellController(Loop):
                contact.anchors, grip.pairs, grip.grips, self._chain_frames, self.gain,
                self.closure is None)  # fmt: skip
         known, tick = self._cell_tick
-        if len(known) != len(key) or any(a is not b for a, b in zip(known, key, strict=True)):
+        if len(known) != len(key) or not all(map(operator.is_, known, key)):
             posture.check(kin.layout)  # a posture replaced: refused as the resolver refuses it
             chains = 6 * (len(contact.frames) + len(grip.pairs))
             measured = ((not contact.frames or contact.anchors is not None)
