@@ -6,9 +6,10 @@ retraces them), the top level's scale, each command's pose error, each grip's er
 closed chains' largest errors, and the status, mode and level statuses as one-byte codes. No
 Python object is kept per tick: gsfc_dual's row is 294 bytes, yeh_tripod's 462, so that the
 default capacity (:data:`~rrc_pin.control.trajectory_log.CAPACITY`, 60,000 ticks: 10 minutes
-at 100 Hz) holds at most 17.6 MB and 27.7 MB. The array grows by doubling up to the capacity,
-then is a ring (the oldest tick forgotten, :attr:`~CellLog.dropped` counts them). A
-:class:`CellRecord` is made when a tick is read.
+at 100 Hz) holds at most 17.6 MB and 27.7 MB. The array is made at the capacity (``numpy.empty``:
+pages the OS maps as rows are first written, so the memory in use grows with the ticks written)
+and is a ring (the oldest tick forgotten, :attr:`~CellLog.dropped` counts them): no tick copies
+the rows kept. A :class:`CellRecord` is made when a tick is read.
 """
 
 from __future__ import annotations
@@ -41,8 +42,6 @@ LEVELS = 4
 """Level statuses a row keeps (a cell's tick has two levels, the top and the posture)."""
 NONE = 255
 """The code of a level a tick did not have."""
-FIRST = 1024
-"""Rows allocated at the first tick (then doubled up to the capacity)."""
 KINDS = 256
 """Rows' codes kept made (:meth:`CellLog.add`), at most."""
 
@@ -114,7 +113,7 @@ class CellLog(RecordRing[CellRecord]):
         self._grip_at = _columns(self.objects, self._float_at[3].start + len(self.commands))
         self._unknown = np.full(self._float_at[3].stop - self._float_at[3].start, math.nan)
         self._codes_of: dict[tuple[str, str, tuple[str, ...]], npt.NDArray[np.uint8]] = {}
-        self._set_table(np.zeros(0, self.dtype))
+        self._set_table(np.empty(self._capacity, self.dtype))  # each row written whole (add)
         self._start = 0  # the oldest row's index in the ring
         self._count = 0
 
@@ -126,7 +125,8 @@ class CellLog(RecordRing[CellRecord]):
 
     @property
     def nbytes(self) -> int:
-        """Bytes the log's array holds now (its rows times :attr:`dtype`'s size)."""
+        """Bytes of the log's array: its capacity times :attr:`dtype`'s size (mapped as rows are
+        first written)."""  # noqa: D205, D209
         return int(self._table.nbytes)
 
     @property
@@ -140,8 +140,11 @@ class CellLog(RecordRing[CellRecord]):
         kept = self.table()
         self._dropped += max(0, kept.size - value)
         self._capacity = value
-        self._set_table(kept[kept.size - min(kept.size, value) :].copy())
-        self._start, self._count = 0, self._table.size
+        table = np.empty(value, self.dtype)
+        count = min(kept.size, value)
+        table[:count] = kept[kept.size - count :]
+        self._set_table(table)
+        self._start, self._count = 0, count
 
     def add(
         self, t: float, q: Array, qdot: Array, status: str, scale: float,
@@ -158,7 +161,7 @@ class CellLog(RecordRing[CellRecord]):
         if codes is None:
             codes = self._codes(status, mode, levels)
         q_at, qdot_at, scale_at, errors_at, chain_at = self._float_at
-        index = self._next()  # may grow the table: read it after
+        index = self._next()
         row = self._floats[index]
         row[0] = t
         row[q_at] = q
@@ -196,7 +199,7 @@ class CellLog(RecordRing[CellRecord]):
 
     def table(self) -> npt.NDArray[Any]:
         """The ticks kept, oldest first, as a structured array (a copy; :attr:`dtype`)."""
-        index = (self._start + np.arange(self._count)) % max(self._table.size, 1)
+        index = (self._start + np.arange(self._count)) % self._table.size
         kept: npt.NDArray[Any] = self._table[index]
         return kept
 
@@ -294,16 +297,10 @@ class CellLog(RecordRing[CellRecord]):
         self._codes_table: npt.NDArray[np.uint8] = raw[:, 8 * floats :]
 
     def _next(self) -> int:
-        """The index of the next tick's row (the array grown, or the oldest row reused)."""
+        """The index of the next tick's row (a free one, or the oldest row reused)."""
         size = self._table.size
         if self._count < size:
             index = (self._start + self._count) % size
-            self._count += 1
-        elif size < self._capacity:  # grow: the rows in time order, then room
-            grown = np.zeros(min(max(2 * size, FIRST), self._capacity), self.dtype)
-            grown[:size] = self.table()
-            self._set_table(grown)
-            self._start, index = 0, size
             self._count += 1
         else:  # full: the oldest row is reused
             index = self._start

@@ -10,7 +10,9 @@ that does not fit its column (another shape, a None) turns that column into an o
 column: nothing is refused or lost. A tick's fields are written into their row as it comes,
 its record derived when the ring is read: every tick costs the same.
 
-The columns grow by doubling up to the capacity, then the ring overwrites its oldest rows.
+Each column is made at the capacity's rows, then the ring overwrites its oldest rows: no tick
+copies the rows kept (docs/api.md, "The trajectory log's memory"). ``numpy.empty`` takes pages
+the OS maps as rows are first written, so the memory in use grows with the ticks written.
 """
 
 from __future__ import annotations
@@ -28,9 +30,6 @@ R = TypeVar("R", bound=tuple[Any, ...])
 
 CAPACITY = 60_000
 """Ticks a log keeps by default: 10 minutes at 100 Hz (:attr:`RecordRing.capacity`)."""
-
-FIRST_ROWS = 256
-"""Rows the columns are made with; they double up to the capacity."""
 
 SHARED_TEXTS = 4096
 """Distinct strings a ring shares between its rows (more are kept as they come)."""
@@ -78,7 +77,7 @@ class RecordRing(Generic[R]):
         self._capacity = _checked_capacity(capacity)
         self._derive = derive
         self._columns: dict[str, npt.NDArray[Any]] = {}
-        self._rows = 0  # rows every column has
+        self._rows = self._capacity  # rows every column has
         self._start = 0  # the row of the oldest entry
         self._size = 0
         self._pending = 0  # the newest entries, ticks not yet derived
@@ -110,13 +109,12 @@ class RecordRing(Generic[R]):
         keep = min(self._size, value)
         self._dropped += self._size - keep
         order = self._order()[self._size - keep:]
-        rows = min(value, max(keep, FIRST_ROWS))
         for name, column in self._columns.items():
-            fresh = np.empty((rows, *column.shape[1:]), column.dtype)
+            fresh = np.empty((value, *column.shape[1:]), column.dtype)
             fresh[:keep] = column[order]
             self._columns[name] = fresh
         self._plans.clear()
-        self._rows = rows if self._columns else 0
+        self._rows = value
         self._start, self._size = 0, keep
         self._pending = min(self._pending, keep)
         self._capacity = value
@@ -203,7 +201,7 @@ class RecordRing(Generic[R]):
 
     def _order(self) -> npt.NDArray[np.intp]:
         """The rows of the entries kept, oldest first."""
-        return (self._start + np.arange(self._size)) % max(self._rows, 1)
+        return (self._start + np.arange(self._size)) % self._rows
 
     def _row(self, i: int) -> int:
         """The row of entry ``i`` (0 the oldest)."""
@@ -212,24 +210,12 @@ class RecordRing(Generic[R]):
     def _push(self) -> int:
         """The row of a new newest entry: a free one, else the oldest's, forgotten."""
         if self._size < self._capacity:
-            if self._size == self._rows:
-                self._grow(min(self._capacity, max(FIRST_ROWS, 2 * self._rows)))
             self._size += 1
             return (self._start + self._size - 1) % self._rows
         row = self._start  # a full ring has as many rows as its capacity
         self._start = (row + 1) % self._rows
         self._dropped += 1
         return row
-
-    def _grow(self, rows: int) -> None:
-        """Every column to ``rows`` rows, the entries kept in order from row 0."""
-        order = self._order()
-        for name, column in self._columns.items():
-            fresh = np.empty((rows, *column.shape[1:]), column.dtype)
-            fresh[: self._size] = column[order]
-            self._columns[name] = fresh
-        self._plans.clear()
-        self._rows, self._start = rows, 0
 
     def _store(self, row: int, entry: tuple[Any, ...]) -> None:
         """Write ``entry``'s fields into ``row`` of their columns."""
