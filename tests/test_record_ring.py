@@ -11,7 +11,7 @@ import pytest
 
 import rrc_pin
 from rrc_pin.control import Controller
-from rrc_pin.control.record_ring import CAPACITY, RecordRing
+from rrc_pin.control.record_ring import CAPACITY, RecordRing, rows_array
 
 
 class Rec(NamedTuple):
@@ -66,6 +66,20 @@ def test_no_tick_copies_the_rows_kept() -> None:
         ring.append(rec(k))
     assert all(ring._columns[name] is column for name, column in columns.items())
     assert [r.t for r in ring.records] == [float(k) for k in range(1500, 2500)]
+
+
+@pytest.mark.parametrize(("shape", "dtype"), [((60_000, 7), "f8"), ((5,), "f8"), ((3, 0), "f8"),
+                                             ((4,), "u1,f8,(3,)f8"), ((6,), object)])
+def test_rows_array_is_writable_memory_of_the_shape_asked(shape, dtype) -> None:
+    """Memory mapped as it is written (an anonymous mmap, small pages), or numpy's own for
+    nothing to map and for objects; every element written is read back."""
+    dtype = np.dtype(dtype)
+    a = rows_array(shape, dtype)
+    assert a.shape == shape and a.dtype == dtype and a.flags.writeable and a.flags.c_contiguous
+    if a.size and not dtype.hasobject:
+        raw = a.view(np.uint8).reshape(-1)
+        raw[:] = np.arange(raw.size) % 251
+        np.testing.assert_array_equal(a.view(np.uint8).reshape(-1), np.arange(raw.size) % 251)
 
 
 def test_what_is_read_is_a_copy_the_ring_reuses_its_rows() -> None:
@@ -170,25 +184,28 @@ def test_a_tick_of_the_controllers_log_costs_a_few_hundred_bytes(
     monkeypatch: pytest.MonkeyPatch,
 ) -> None:
     """Issue 38: the log kept each tick's resolution (3.4-3.5 kB a tick pending, 1.1-1.3 kB
-    derived; 212-225 MB at 60,000 ticks). Its columns now: 249 B a tick pending and 324 B
-    derived for panda (8 (19 + 2 nq) + 56 B and its strings), measured here by tracemalloc
-    over 1,024 ticks (the controller's own 128 ticks in turn: stepping it under tracemalloc
-    cost minutes without the compiler); at the default capacity under 32 MB."""
+    derived; 212-225 MB at 60,000 ticks). Its columns now, made at the capacity: a row of
+    8 (19 + 2 nq) + 56 B and its strings for panda (``nbytes``), and no object kept a tick but
+    shared strings, measured by tracemalloc over 1,024 ticks, pending and derived (the
+    controller's own 128 ticks in turn: stepping it under tracemalloc cost minutes without the
+    compiler); at the default capacity under 32 MB."""
     ctl = Controller(rrc_pin.load("panda"))
     log = ctl.log
     rng = np.random.default_rng(0)
     seen: list[object] = []
     append = log.append_tick
     monkeypatch.setattr(log, "append_tick", lambda tick: (seen.append(tick), append(tick)))
-    for k in range(128):  # the kernels, the caches and the first columns warmed up too
+    for k in range(128):  # the kernels, the caches and the columns warmed up too
         ctl.step(rng.normal(size=6) * 0.1 if k % 16 == 0 else None, ref="local")
     monkeypatch.undo()
+    assert len(log.records) == 128  # the records' columns made too
+    log.capacity = TICKS  # every column made again at TICKS rows
     log.clear()
+    row = log.nbytes / TICKS
     gc.collect()
     tracemalloc.start()
     try:
         before = tracemalloc.get_traced_memory()[0]
-        log.capacity = TICKS  # the columns made again at TICKS rows: traced
         for k in range(TICKS):
             log.append_tick(seen[k % len(seen)])
         assert log.dropped == 0
@@ -199,5 +216,6 @@ def test_a_tick_of_the_controllers_log_costs_a_few_hundred_bytes(
         derived = (tracemalloc.get_traced_memory()[0] - before) / TICKS
     finally:
         tracemalloc.stop()
-    assert 150 < pending < 400 and 200 < derived < 400, (pending, derived)
-    assert derived * CAPACITY < 32e6
+    assert log.nbytes == row * TICKS  # no column made or grown since
+    assert 150 < row < 400 and pending < 16 and derived < 80, (row, pending, derived)
+    assert (row + derived) * CAPACITY < 32e6

@@ -6,10 +6,11 @@ retraces them), the top level's scale, each command's pose error, each grip's er
 closed chains' largest errors, and the status, mode and level statuses as one-byte codes. No
 Python object is kept per tick: gsfc_dual's row is 294 bytes, yeh_tripod's 462, so that the
 default capacity (:data:`~rrc_pin.control.trajectory_log.CAPACITY`, 60,000 ticks: 10 minutes
-at 100 Hz) holds at most 17.6 MB and 27.7 MB. The array is made at the capacity (``numpy.empty``:
-pages the OS maps as rows are first written, so the memory in use grows with the ticks written)
-and is a ring (the oldest tick forgotten, :attr:`~CellLog.dropped` counts them): no tick copies
-the rows kept. A :class:`CellRecord` is made when a tick is read.
+at 100 Hz) holds at most 17.6 MB and 27.7 MB. The array is made at the capacity, on memory the
+OS maps a small page at a time as rows are first written
+(:func:`~rrc_pin.control.record_ring.rows_array`), and is a ring (the oldest tick forgotten,
+:attr:`~CellLog.dropped` counts them): no tick copies the rows kept. A :class:`CellRecord` is
+made when a tick is read.
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from typing import Any, NamedTuple, get_args
 import numpy as np
 import numpy.typing as npt
 
+from rrc_pin.control.record_ring import rows_array
 from rrc_pin.control.trajectory_log import CAPACITY, RecordRing, checked_path, reason
 from rrc_pin.errors import InvalidInput
 from rrc_pin.solvers.tick.pipeline import LevelStatus, Status
@@ -113,7 +115,7 @@ class CellLog(RecordRing[CellRecord]):
         self._grip_at = _columns(self.objects, self._float_at[3].start + len(self.commands))
         self._unknown = np.full(self._float_at[3].stop - self._float_at[3].start, math.nan)
         self._codes_of: dict[tuple[str, str, tuple[str, ...]], npt.NDArray[np.uint8]] = {}
-        self._set_table(np.empty(self._capacity, self.dtype))  # each row written whole (add)
+        self._set_table(rows_array((self._capacity,), self.dtype))  # each row written whole (add)
         self._start = 0  # the oldest row's index in the ring
         self._count = 0
 
@@ -140,7 +142,7 @@ class CellLog(RecordRing[CellRecord]):
         kept = self.table()
         self._dropped += max(0, kept.size - value)
         self._capacity = value
-        table = np.empty(value, self.dtype)
+        table = rows_array((value,), self.dtype)
         count = min(kept.size, value)
         table[:count] = kept[kept.size - count :]
         self._set_table(table)

@@ -11,12 +11,15 @@ column: nothing is refused or lost. A tick's fields are written into their row a
 its record derived when the ring is read: every tick costs the same.
 
 Each column is made at the capacity's rows, then the ring overwrites its oldest rows: no tick
-copies the rows kept (docs/api.md, "The trajectory log's memory"). ``numpy.empty`` takes pages
-the OS maps as rows are first written, so the memory in use grows with the ticks written.
+copies the rows kept (docs/api.md, "The trajectory log's memory"). A column of numbers is
+memory the OS maps a small page at a time as rows are first written (:func:`rows_array`), so
+the memory in use grows with the ticks written.
 """
 
 from __future__ import annotations
 
+import math
+import mmap
 from collections.abc import Callable, Iterator
 from typing import Any, Generic, NamedTuple, TypeVar
 
@@ -110,7 +113,7 @@ class RecordRing(Generic[R]):
         self._dropped += self._size - keep
         order = self._order()[self._size - keep:]
         for name, column in self._columns.items():
-            fresh = np.empty((value, *column.shape[1:]), column.dtype)
+            fresh = rows_array((value, *column.shape[1:]), column.dtype)
             fresh[:keep] = column[order]
             self._columns[name] = fresh
         self._plans.clear()
@@ -118,6 +121,12 @@ class RecordRing(Generic[R]):
         self._start, self._size = 0, keep
         self._pending = min(self._pending, keep)
         self._capacity = value
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes of the columns, each of the capacity's rows: the numbers, and a pointer a row
+        for a column of objects (the objects not counted)."""  # noqa: D205, D209
+        return sum(int(column.nbytes) for column in self._columns.values())
 
     @property
     def records(self) -> list[R]:
@@ -321,9 +330,9 @@ def _fields(entry: tuple[Any, ...]) -> tuple[str, ...]:
 def _column_for(value: Any, rows: int) -> npt.NDArray[Any]:
     """An empty column of ``rows`` rows for values like ``value`` (module docstring)."""
     if isinstance(value, (float, np.floating)):
-        return np.empty(rows, np.float64)
+        return rows_array((rows,), np.dtype(np.float64))
     if isinstance(value, np.ndarray) and value.dtype.kind in "biuf":
-        return np.empty((rows, *value.shape), value.dtype)
+        return rows_array((rows, *value.shape), value.dtype)
     return np.empty(rows, dtype=object)
 
 
@@ -350,3 +359,22 @@ def _checked_capacity(value: int) -> int:
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
         raise InvalidInput("capacity", f"expected an integer >= 1 (ticks), got {value!r}")
     return int(value)
+
+
+def rows_array(shape: tuple[int, ...], dtype: np.dtype[Any]) -> npt.NDArray[Any]:
+    """An array of ``shape``, not initialised, on memory mapped as it is first written.
+
+    Each row is written before it is read; the OS maps the memory a small page at a time.
+
+    An anonymous ``mmap`` declining transparent huge pages (``MADV_NOHUGEPAGE``, where the OS
+    has them): numpy asks Linux for huge pages for an array of 4 MB or more, and a tick that
+    wrote the first row of a fresh 2 MB page waited while the kernel found and zeroed one
+    (docs/api.md, "The trajectory log's memory").
+    """
+    size = math.prod(shape) * dtype.itemsize
+    if size == 0 or dtype.hasobject:
+        return np.empty(shape, dtype)
+    pages = mmap.mmap(-1, size)
+    if hasattr(pages, "madvise") and hasattr(mmap, "MADV_NOHUGEPAGE"):
+        pages.madvise(mmap.MADV_NOHUGEPAGE)
+    return np.frombuffer(pages, dtype).reshape(shape)
