@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import gc
+import mmap
 import tracemalloc
+from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -80,6 +82,32 @@ def test_rows_array_is_writable_memory_of_the_shape_asked(shape, dtype) -> None:
         raw = a.view(np.uint8).reshape(-1)
         raw[:] = np.arange(raw.size) % 251
         np.testing.assert_array_equal(a.view(np.uint8).reshape(-1), np.arange(raw.size) % 251)
+
+
+def _vm_flags(address: int) -> list[str]:
+    """The flags of this process's mapping that holds ``address`` (Linux's /proc/self/smaps)."""
+    inside = False
+    for line in Path("/proc/self/smaps").read_text().splitlines():
+        head = line.split()
+        if head and "-" in head[0] and not head[0].endswith(":"):
+            low, high = (int(x, 16) for x in head[0].split("-"))
+            inside = low <= address < high
+        elif inside and head[0] == "VmFlags:":
+            return head[1:]
+    raise AssertionError(f"no mapping holds {address:#x}")
+
+
+def test_the_columns_decline_transparent_huge_pages() -> None:
+    """A log's column of numbers is a mapping that declines huge pages where the OS has them:
+    a tick that first wrote a fresh 2 MB page of one numpy had asked huge pages for waited
+    while Linux compacted memory for it (4.5-5.1 ms, docs/api.md)."""
+    a = rows_array((60_000, 15), np.dtype(np.float64))
+    a[:] = 1.0
+    if not Path("/sys/kernel/mm/transparent_hugepage").exists():  # none to decline
+        assert not hasattr(mmap, "MADV_NOHUGEPAGE") or a.flags.writeable
+        return
+    flags = _vm_flags(a.ctypes.data)
+    assert "nh" in flags and "hg" not in flags, flags
 
 
 def test_what_is_read_is_a_copy_the_ring_reuses_its_rows() -> None:

@@ -18,6 +18,7 @@ the memory in use grows with the ticks written.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import mmap
 from collections.abc import Callable, Iterator
@@ -368,13 +369,14 @@ def rows_array(shape: tuple[int, ...], dtype: np.dtype[Any]) -> npt.NDArray[Any]
 
     An anonymous ``mmap`` declining transparent huge pages (``MADV_NOHUGEPAGE``, where the OS
     has them): numpy asks Linux for huge pages for an array of 4 MB or more, and a tick that
-    wrote the first row of a fresh 2 MB page waited while the kernel found and zeroed one
+    wrote the first row of a fresh 2 MB page waited while the kernel compacted memory for one
     (docs/api.md, "The trajectory log's memory").
     """
     size = math.prod(shape) * dtype.itemsize
     if size == 0 or dtype.hasobject:
         return np.empty(shape, dtype)
     pages = mmap.mmap(-1, size)
-    if hasattr(pages, "madvise") and hasattr(mmap, "MADV_NOHUGEPAGE"):
-        pages.madvise(mmap.MADV_NOHUGEPAGE)
+    if hasattr(mmap, "MADV_NOHUGEPAGE"):
+        with contextlib.suppress(OSError):  # a kernel without transparent huge pages
+            pages.madvise(mmap.MADV_NOHUGEPAGE)
     return np.frombuffer(pages, dtype).reshape(shape)
