@@ -363,14 +363,13 @@ def _checked_capacity(value: int) -> int:
 
 
 def rows_array(shape: tuple[int, ...], dtype: np.dtype[Any]) -> npt.NDArray[Any]:
-    """An array of ``shape``, not initialised, on memory mapped as it is first written.
+    """An array of ``shape``, not initialised, on memory the OS maps as it is first written.
 
-    Each row is written before it is read; the OS maps the memory a small page at a time.
-
-    An anonymous ``mmap`` declining transparent huge pages (``MADV_NOHUGEPAGE``, where the OS
-    has them): numpy asks Linux for huge pages for an array of 4 MB or more, and a tick that
-    wrote the first row of a fresh 2 MB page waited while the kernel compacted memory for one
-    (docs/api.md, "The trajectory log's memory").
+    A small page at a time (a log writes each row before it reads it): an anonymous ``mmap``
+    declining transparent huge pages (``MADV_NOHUGEPAGE``, where the OS has them). numpy asks
+    Linux for huge pages for an array of 4 MB or more, and a tick that wrote the first row of a
+    fresh 2 MB page waited while the kernel compacted memory for one (docs/api.md, "The
+    trajectory log's memory").
     """
     size = math.prod(shape) * dtype.itemsize
     if size == 0 or dtype.hasobject:
