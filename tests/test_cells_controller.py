@@ -89,6 +89,7 @@ def test_the_grip_holds_within_its_bound_and_no_joint_leaves_its_box(soak, seed,
     assert report["rate_ratio"] <= 1.0 + 1e-9, (seed, report)
 
 
+@pytest.mark.compiled  # 1,500 ticks a session: 9-23 s each as plain Python
 @pytest.mark.parametrize("name", ["gsfc_dual", "yeh_tripod"])
 @pytest.mark.parametrize("seed", [FIXED[0], None])
 def test_a_cell_runs_at_1_khz(soak, name, seed):
