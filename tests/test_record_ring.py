@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import gc
 import mmap
+import os
 import tracemalloc
 from pathlib import Path
 from typing import NamedTuple
@@ -108,6 +109,23 @@ def test_the_columns_decline_transparent_huge_pages() -> None:
         return
     flags = _vm_flags(a.ctypes.data)
     assert "nh" in flags and "hg" not in flags, flags
+
+
+def test_a_forked_process_writes_its_own_copy_of_the_columns() -> None:
+    """The mapping is private: a child forked from the process (a worker pool's) that writes
+    into a log's columns changes its copy only (a shared mapping gave the parent its writes)."""
+    a = rows_array((1000, 3), np.dtype(np.float64))
+    a[:] = 1.0
+    if not hasattr(os, "fork"):  # no fork: nothing to share the pages with
+        assert not hasattr(mmap, "MAP_PRIVATE")
+        return
+    child = os.fork()
+    if child == 0:  # pragma: no cover - the child
+        a[:] = 7.0
+        os._exit(0 if a[0, 0] == 7.0 else 1)
+    _, status = os.waitpid(child, 0)
+    assert os.waitstatus_to_exitcode(status) == 0
+    assert (a == 1.0).all()
 
 
 def test_what_is_read_is_a_copy_the_ring_reuses_its_rows() -> None:

@@ -374,7 +374,9 @@ def rows_array(shape: tuple[int, ...], dtype: np.dtype[Any]) -> npt.NDArray[Any]
     size = math.prod(shape) * dtype.itemsize
     if size == 0 or dtype.hasobject:
         return np.empty(shape, dtype)
-    pages = mmap.mmap(-1, size)
+    # private: a process forked from this one writes into copies of the pages, not these
+    pages = (mmap.mmap(-1, size, flags=mmap.MAP_PRIVATE) if hasattr(mmap, "MAP_PRIVATE")
+             else mmap.mmap(-1, size))  # fmt: skip
     if hasattr(mmap, "MADV_NOHUGEPAGE"):
         with contextlib.suppress(OSError):  # a kernel without transparent huge pages
             pages.madvise(mmap.MADV_NOHUGEPAGE)
