@@ -9,7 +9,7 @@ from test_mimic import chain
 
 import rrc_pin
 from rrc_pin.limits.chain_kernels import frame_jacobian
-from rrc_pin.limits.frame_columns import FrameColumns, FramePoses
+from rrc_pin.limits.frame_columns import FrameColumns
 
 
 def _configurations(robot: rrc_pin.Robot, rng: np.random.Generator, count: int):
@@ -90,19 +90,3 @@ def test_the_walk_of_a_pinocchio_without_mimic_columns(name: str) -> None:
     np.testing.assert_array_equal(got.steps, want.steps)
     np.testing.assert_array_equal(got.starts, want.starts)
 
-
-def test_frame_poses_read_each_datas_placements_now() -> None:
-    """FramePoses keeps references into a Data's oMf: every call reads the placements the Data
-    holds then, and another Data is read as its own (not the first one's)."""
-    robot = rrc_pin.load("yeh_tripod")
-    model = robot.model
-    frames = [model.getFrameId(robot.tool_frames[0]), 1, model.nframes - 1]
-    read = FramePoses(frames)
-    datas = [model.createData(), model.createData()]
-    rng = np.random.default_rng(7)
-    for q, data in zip(_configurations(robot, rng, 6), datas * 3, strict=True):
-        pin.framesForwardKinematics(model, data, robot.positions(q)[2])
-        poses = read(data)
-        for i, f in enumerate(frames):
-            np.testing.assert_array_equal(poses[i], data.oMf[f].homogeneous)
-        assert poses.base is None or not np.shares_memory(poses, read(data))

@@ -30,7 +30,7 @@ from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits import ContactLimit, GripLimit, Limit
 from rrc_pin.limits.chain_kernels import NO_POSES
 from rrc_pin.limits.contact_limit import Closure
-from rrc_pin.limits.frame_columns import FrameColumns, FramePoses
+from rrc_pin.limits.frame_columns import FrameColumns, frame_poses
 from rrc_pin.solvers.tick.problem import Constraints, TaskRows, finite_rows, merged_rows
 from rrc_pin.solvers.tick.resolution import Resolution
 from rrc_pin.solvers.tick.tick import INVALID_INPUT, LB, POSITION, RATE, UB, VELOCITY
@@ -101,8 +101,8 @@ class CellTick:
         frames = [ids[t.frame] for t in tasks] + [ids[f] for f in contact.frames] + [
             ids[f] for pair in grip.pairs for f in pair]  # fmt: skip
         self.columns = FrameColumns.of(kin.model, kin.data, frames)
-        self.poses = FramePoses(dict.fromkeys(frames))  # each pose read once a tick
-        row = {f: i for i, f in enumerate(self.poses.frames)}
+        self.frames = tuple(dict.fromkeys(frames))  # each pose read once a tick
+        row = {f: i for i, f in enumerate(self.frames)}
         self.chain_rows = np.array([row[f] for f in chains.frames], dtype=np.intp)
         self.chains, self.correct = chains, correct
         self.corrected: tuple[list[TaskRows], Array, Array] | None = None
@@ -156,7 +156,7 @@ class CellTick:
             ws.load_equalities(np.zeros((r, n)), np.zeros(r))
             ws.forget()
         data = kin.data
-        poses = self.poses(data)
+        poses = frame_poses(data, self.frames)
         twists, targets = np.empty((len(tasks), 6)), np.empty((len(tasks), 4, 4))
         for i, task in enumerate(tasks):
             twists[i], targets[i] = task.twist, task.target

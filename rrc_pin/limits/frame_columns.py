@@ -15,7 +15,7 @@ frames, as the compiled rows (:mod:`rrc_pin.limits.chain_kernels`) read it at ev
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from typing import NamedTuple
 
 import numpy as np
@@ -58,36 +58,13 @@ class FrameColumns(NamedTuple):
 
 
 def frame_poses(data: pin.Data, frames: Sequence[int]) -> Array:
-    """The poses (k, 4, 4) in the world frame [m] of Pinocchio's ``frames``, from ``data.oMf``
+    """The poses (k, 4, 4) in the base frame [m] of Pinocchio's ``frames``, from ``data.oMf``
     (placed: ``updateFramePlacements``)."""  # noqa: D205, D209
-    return FramePoses(frames)(data)
-
-
-class FramePoses:
-    """The poses of Pinocchio's ``frames`` read from a Data's ``oMf`` at every tick.
-
-    ``data.oMf[i]`` is a reference to the Data's own placement (its vector is sized with the
-    Data and never reallocated): the references are taken once per Data, and each call copies
-    the placements they hold then.
-
-    Args:
-        frames: Pinocchio frame indices, k of them.
-    """
-
-    def __init__(self, frames: Iterable[int]) -> None:
-        self.frames = tuple(frames)
-        self._data: pin.Data | None = None
-        self._placed: tuple[pin.SE3, ...] = ()
-
-    def __call__(self, data: pin.Data) -> Array:
-        """The poses (k, 4, 4) in the world frame [m] held by ``data`` (placed)."""
-        if data is not self._data:
-            oMf = data.oMf
-            self._data, self._placed = data, tuple(oMf[f] for f in self.frames)
-        poses = np.empty((len(self._placed), 4, 4))
-        for i, placed in enumerate(self._placed):
-            poses[i] = placed.homogeneous
-        return poses
+    oMf = data.oMf
+    poses = np.empty((len(frames), 4, 4))
+    for i, f in enumerate(frames):
+        poses[i] = oMf[f].homogeneous
+    return poses
 
 
 def _walk(model: pin.Model, data: pin.Data, joint: int) -> list[tuple[int, int, int]]:
