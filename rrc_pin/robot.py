@@ -142,15 +142,7 @@ class Robot:
                 (lists them).
             FrameNotFound: A tool frame is not a frame of the model.
         """
-        if not isinstance(model, pin.Model):
-            raise InvalidInput("model", f"expected a pinocchio.Model, got {_brief(model)}")
-        for label, value in (("name", name), ("source", source)):
-            if not isinstance(value, str) or not value:
-                raise InvalidInput(label, f"expected a non-empty string, got {_brief(value)}")
-        if spec is not None and not isinstance(spec, ArmSpec):
-            raise InvalidInput("spec", f"expected an ArmSpec or None, got {_brief(spec)}")
-        if model.nv == 0:
-            raise URDFError(source, "no moving joint: there is nothing to control")
+        _check_arguments(model, name, source, spec)
         mimics = mimics_of(model, mimic_limits)
         model = tightened(model, mimics, source, UNBOUNDED)
         joints = _Joints.of(model, source)
@@ -721,6 +713,21 @@ def _finite_window(
     lo = np.where(lo_ok, lower, np.where(hi_ok, upper - 2.0 * np.pi, -np.pi))
     hi = np.where(hi_ok, upper, np.where(lo_ok, lower + 2.0 * np.pi, np.pi))
     return lo, hi
+
+
+def _check_arguments(model: object, name: object, source: object, spec: object) -> None:
+    """:class:`Robot`'s ``model``, ``name``, ``source`` and ``spec`` refused where they are not
+    a pinocchio.Model that moves, non-empty strings and an ArmSpec or None (named).
+    """  # noqa: D205
+    if not isinstance(model, pin.Model):
+        raise InvalidInput("model", f"expected a pinocchio.Model, got {_brief(model)}")
+    for label, value in (("name", name), ("source", source)):
+        if not isinstance(value, str) or not value:
+            raise InvalidInput(label, f"expected a non-empty string, got {_brief(value)}")
+    if spec is not None and not isinstance(spec, ArmSpec):
+        raise InvalidInput("spec", f"expected an ArmSpec or None, got {_brief(spec)}")
+    if model.nv == 0:
+        raise URDFError(str(source), "no moving joint: there is nothing to control")
 
 
 def _brief(value: object, limit: int = 60) -> str:

@@ -167,30 +167,10 @@ class CellController(Loop):
         project_contacts: bool | None = None,
         smoothing: SmoothingOptions | None = None,
     ) -> None:
-        if project_contacts is not None:  # the former closure step's switch
-            project_contacts = flag(project_contacts, "project_contacts")
-            warn_renamed("CellController(project_contacts=)", "CellController(closure=)")
-            closure = closure if project_contacts else None
-        if isinstance(cell, (str, os.PathLike)):
-            cell = loaded(cell, "cell")  # type: ignore[assignment]
-        if not isinstance(cell, Cell):
-            raise InvalidInput("cell", f"expected a Cell or a cell's name, got {cell!r}")
-        if closure is not None and not isinstance(closure, ClosureBound):
-            raise InvalidInput("closure", f"expected a ClosureBound or None, got {closure!r}")
-        given: list[Limit]
-        if limits is None:
-            given = [JointLimits()]
-        elif isinstance(limits, Sequence):
-            given = list(limits)
-        else:
-            given = [limits]
+        cell, given, closure, coupled = _settings(cell, limits, closure, project_contacts,
+                                                  coupled, smoothing)  # fmt: skip
         gain = positive(gain, "gain")
         posture_gain = positive(posture_gain, "posture_gain")
-        coupled = flag(coupled, "coupled")
-        if smoothing is not None and (cell.body is not None or (cell.objects and coupled)):
-            raise InvalidInput("smoothing", f"{cell.name} has closed chains (a held object, feet "
-                               "in support) that a jerk stage bounding each joint apart would "
-                               "open: a cell of free hands only")  # fmt: skip
         self.contact = ContactLimit((), name="contact")
         self.grip = GripLimit((), name="grip")
         super().__init__(cell, dt, q0, limits=[*given, self.contact, self.grip], qp=qp,
@@ -788,6 +768,42 @@ class CellController(Loop):
             grip[name] = float(np.linalg.norm(rel[:3, 3] - g.grip[:3, 3]))
         self.log.add(self.t, self._q, r.applied, r.status, r.scale, r.levels, errors, grip,
                      self.chain_error, mode)  # fmt: skip
+
+
+def _settings(cell: Cell | str, limits: Limit | Sequence[Limit] | None,
+              closure: ClosureBound | None, project_contacts: bool | None, coupled: bool,
+              smoothing: SmoothingOptions | None,
+              ) -> tuple[Cell, list[Limit], ClosureBound | None, bool]:  # fmt: skip
+    """:class:`CellController`'s cell (loaded where named), limits (a list, the joint limits by
+    default), closure bound (None where ``project_contacts`` is False, deprecated) and
+    ``coupled``, checked with the smoothing they allow.
+
+    Raises:
+        InvalidInput: A bad argument, named.
+    """  # noqa: D205
+    if project_contacts is not None:  # the former closure step's switch
+        project_contacts = flag(project_contacts, "project_contacts")
+        warn_renamed("CellController(project_contacts=)", "CellController(closure=)")
+        closure = closure if project_contacts else None
+    if isinstance(cell, (str, os.PathLike)):
+        cell = loaded(cell, "cell")  # type: ignore[assignment]
+    if not isinstance(cell, Cell):
+        raise InvalidInput("cell", f"expected a Cell or a cell's name, got {cell!r}")
+    if closure is not None and not isinstance(closure, ClosureBound):
+        raise InvalidInput("closure", f"expected a ClosureBound or None, got {closure!r}")
+    given: list[Limit]
+    if limits is None:
+        given = [JointLimits()]
+    elif isinstance(limits, Sequence):
+        given = list(limits)
+    else:
+        given = [limits]
+    coupled = flag(coupled, "coupled")
+    if smoothing is not None and (cell.body is not None or (cell.objects and coupled)):
+        raise InvalidInput("smoothing", f"{cell.name} has closed chains (a held object, feet "
+                           "in support) that a jerk stage bounding each joint apart would "
+                           "open: a cell of free hands only")  # fmt: skip
+    return cell, given, closure, coupled
 
 
 def _top_level(r: Resolution) -> tuple[Sequence[TaskRows], Array, Rows | None]:

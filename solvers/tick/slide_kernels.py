@@ -28,10 +28,11 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from rrc_pin.solvers.compiled import kernel
+from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.linalg import cholesky, solve_factored
 
 Array = npt.NDArray[np.float64]
+Ints = npt.NDArray[np.int64]
 
 SOLVED, NOT_DEFINITE, INFEASIBLE, NOT_CONVERGED = 0, 1, 2, 3
 """What :func:`project` returns."""
@@ -211,93 +212,123 @@ def _checked(n: int, x: Array, lb: Array, ub: Array, G: Array, h: Array) -> int:
     return SOLVED
 
 
-@kernel
-def _least_distance(E: Array, m: int, n: int, L: Array, w: Array, x: Array) -> int:
-    """``x = w + L^{-T} y``, y the least-distance answer of E's first ``m`` columns (NNLS)."""
-    u = np.zeros(m)
+@inlined
+def _entering(E: Array, m: int, n: int, passive: npt.NDArray[np.bool_], resid: Array,
+              tol: float) -> int:  # fmt: skip
+    """NNLS's most promising inactive column (its gradient ``E^T resid`` above ``tol``), or -1."""
+    best, entering = tol, -1
+    for j in range(m):
+        if passive[j]:
+            continue
+        t = 0.0
+        for i in range(n + 1):
+            t += E[i, j] * resid[i]
+        if t > best:
+            best, entering = t, j
+    return entering
+
+
+@inlined
+def _passive_solve(E: Array, m: int, n: int, passive: npt.NDArray[np.bool_], index: Ints,
+                   H: Array, g: Array, z: Array, s: Array) -> int:  # fmt: skip
+    """The least squares on the k passive columns into ``s`` (zero elsewhere), by the normal
+    equations' Cholesky factor (in ``H``), their indices into ``index``: k, or -1 where more
+    columns are passive than E has rows or the factor fails.
+    """  # noqa: D205
+    k = 0
+    for j in range(m):
+        if passive[j]:
+            if k == n + 1:
+                return -1
+            index[k] = j
+            k += 1
+    for i in range(k):
+        ci = index[i]
+        for j in range(i + 1):
+            cj = index[j]
+            t = 0.0
+            for r in range(n + 1):
+                t += E[r, ci] * E[r, cj]
+            H[i, j] = t
+        g[i] = E[n, ci]
+    # in place; the columns' unit parts make every diagonal entry at least 1
+    if not cholesky(H[:k, :k], 0.0, H[:k, :k], 1e-14):
+        return -1
+    solve_factored(H[:k, :k], g[:k], z[:k])
+    for j in range(m):
+        s[j] = 0.0
+    for i in range(k):
+        s[index[i]] = z[i]
+    return k
+
+
+@inlined
+def _step_back(u: Array, s: Array, passive: npt.NDArray[np.bool_], index: Ints, k: int) -> None:
+    """``u`` stepped toward ``s`` until a passive coefficient reaches zero, which is dropped."""
+    alpha = 1.0
+    for i in range(k):
+        j = index[i]
+        if not s[j] > 0.0:
+            t = u[j] / (u[j] - s[j])
+            if t < alpha:
+                alpha = t
+    for i in range(k):
+        j = index[i]
+        u[j] += alpha * (s[j] - u[j])
+        if not u[j] > 1e-300 or (not s[j] > 0.0 and u[j] <= 1e-15 * (1.0 + abs(s[j]))):
+            u[j] = 0.0
+            passive[j] = False
+
+
+@inlined
+def _nnls(E: Array, m: int, n: int, resid: Array, z: Array) -> bool:
+    """Lawson & Hanson's NNLS on E's first ``m`` columns (module docstring): its residual
+    ``e_n - E u`` into ``resid``; False where it did not converge. ``z`` is scratch (n + 1,).
+    """  # noqa: D205
+    u, s = np.zeros(m), np.zeros(m)
     passive = np.zeros(m, dtype=np.bool_)
-    resid = np.zeros(n + 1)  # e_n - E u
+    resid[:] = 0.0
     resid[n] = 1.0
-    s = np.zeros(m)
     index = np.empty(n + 1, dtype=np.int64)
-    H = np.empty((n + 1, n + 1))
-    g = np.empty(n + 1)
-    z = np.empty(n + 1)
+    H, g = np.empty((n + 1, n + 1)), np.empty(n + 1)
     scale_f = 0.0
     for j in range(m):
         scale_f = max(scale_f, abs(E[n, j]))
     tol = 1e-12 * (1.0 + scale_f)
     for _ in range(3 * (m + n + 1)):
-        # the most promising inactive column
-        best, entering = tol, -1
-        for j in range(m):
-            if passive[j]:
-                continue
-            t = 0.0
-            for i in range(n + 1):
-                t += E[i, j] * resid[i]
-            if t > best:
-                best, entering = t, j
+        entering = _entering(E, m, n, passive, resid, tol)
         if entering < 0:
-            break
+            return True
         passive[entering] = True
         converged = False
         for _inner in range(3 * (m + n + 1)):
-            k = 0
-            for j in range(m):
-                if passive[j]:
-                    if k == n + 1:
-                        return NOT_CONVERGED
-                    index[k] = j
-                    k += 1
-            # least squares on the passive columns: normal equations by Cholesky
-            for i in range(k):
-                ci = index[i]
-                for j in range(i + 1):
-                    cj = index[j]
-                    t = 0.0
-                    for r in range(n + 1):
-                        t += E[r, ci] * E[r, cj]
-                    H[i, j] = t
-                g[i] = E[n, ci]
-            # in place; the columns' unit parts make every diagonal entry at least 1
-            if not cholesky(H[:k, :k], 0.0, H[:k, :k], 1e-14):
-                return NOT_CONVERGED
-            solve_factored(H[:k, :k], g[:k], z[:k])
-            for j in range(m):
-                s[j] = 0.0
+            k = _passive_solve(E, m, n, passive, index, H, g, z, s)
+            if k < 0:
+                return False
             positive = True
             for i in range(k):
-                s[index[i]] = z[i]
-                if not z[i] > 0.0:
+                if not s[index[i]] > 0.0:
                     positive = False
             if positive:
-                for j in range(m):
-                    u[j] = s[j]
+                u[:] = s
                 converged = True
                 break
-            # step toward s until a passive coefficient reaches zero, and drop it
-            alpha = 1.0
-            for i in range(k):
-                j = index[i]
-                if not s[j] > 0.0:
-                    t = u[j] / (u[j] - s[j])
-                    if t < alpha:
-                        alpha = t
-            for i in range(k):
-                j = index[i]
-                u[j] += alpha * (s[j] - u[j])
-                if not u[j] > 1e-300 or (not s[j] > 0.0 and u[j] <= 1e-15 * (1.0 + abs(s[j]))):
-                    u[j] = 0.0
-                    passive[j] = False
+            _step_back(u, s, passive, index, k)
         if not converged:
-            return NOT_CONVERGED
+            return False
         for i in range(n + 1):
             t = 1.0 if i == n else 0.0
             for j in range(m):
                 t -= E[i, j] * u[j]
             resid[i] = t
-    else:
+    return False
+
+
+@kernel
+def _least_distance(E: Array, m: int, n: int, L: Array, w: Array, x: Array) -> int:
+    """``x = w + L^{-T} y``, y the least-distance answer of E's first ``m`` columns (NNLS)."""
+    resid, z = np.empty(n + 1), np.empty(n + 1)
+    if not _nnls(E, m, n, resid, z):
         return NOT_CONVERGED
     # r = E u - e_n = -resid; y = -r[:n] / r[n] = -resid[:n] / resid[n]
     norm_sq = 0.0
