@@ -167,6 +167,33 @@ def test_the_package_holds_no_timings():
     assert not found, "\n".join(found)
 
 
+LONGEST_FUNCTION = 60
+"""The lines of code (after its docstring) a function of the package takes at most: a tick a
+reader can follow, each stage a function (docs/api.md, "Layout")."""
+
+
+def _code_lines(node: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+    """The lines of ``node`` from its first statement after the docstring to its end."""
+    first = node.body[0]
+    docstring = (isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant)
+                 and isinstance(first.value.value, str))  # fmt: skip
+    start = first.end_lineno + 1 if docstring and len(node.body) > 1 else first.lineno
+    return node.end_lineno - start + 1
+
+
+def test_functions_are_short():
+    """No function of the package (its kernels too) runs over LONGEST_FUNCTION lines."""
+    found = []
+    for folder in (Path(rrc_pin.__file__).parent, Path(solvers.__file__).parent):
+        for path in sorted(folder.rglob("*.py")):
+            for node in ast.walk(ast.parse(path.read_text())):
+                if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                    lines = _code_lines(node)
+                    if lines > LONGEST_FUNCTION:
+                        found.append(f"{path.relative_to(ROOT)}:{node.lineno} {node.name}: {lines}")
+    assert not found, "\n".join(found)
+
+
 def test_a_users_solvers_module_beside_a_script_does_not_break_the_import(tmp_path):
     """Issue 40: a top-level package named ``solvers`` was shadowed by a user's solvers.py
     (``ModuleNotFoundError: No module named 'solvers.errors'``)."""
