@@ -201,6 +201,13 @@ class TwistSource(NamedTuple):
                      weighted=False, direction=self.spec.direction)  # fmt: skip
 
 
+def asks_apart(c: Constraints) -> bool:
+    """Whether a row of ``c`` the command slides along (a collision pair) has a bound below
+    zero: standing still breaks it."""  # noqa: D205, D209
+    return (c.slide is not None and c.h is not None and c.h.size > 0
+            and bool((c.slide & (c.h < 0.0)).any()))  # fmt: skip
+
+
 class CompiledTick:
     """One resolver's compiled ticks (module docstring).
 
@@ -246,6 +253,12 @@ class CompiledTick:
         self.workspace.compile(general, twists)
         if general:  # its ticks may hand QPs to the backend
             backend_calls.compile_calls(self._context)
+            backend_calls.enter(self._context)
+            try:
+                self.workspace.compile_hand_overs()
+            finally:
+                backend_calls.leave()
+                backend.reset()
 
     def twist(self, model: pin.Model, data: pin.Data, task: FrameTask, q: Array, twist: Array,
               previous: Array, dt: float, start: float) -> Resolution | None:  # fmt: skip
@@ -332,8 +345,9 @@ class CompiledTick:
 
     def answers(self, constraints: Sequence[Constraints | None]) -> bool:
         """Whether the compiled tick answers with these limits' constraints: no other box;
-        equality rows fewer than the rates and without rows the command slides along
-        (:func:`rrc_pin.solvers.tick.tick.run_within`)."""  # noqa: D205, D209
+        equality rows fewer than the rates, and beside them no row the command slides along
+        that asks a pair apart (below zero: the pipeline relaxes it where the least squares
+        fails) (:func:`rrc_pin.solvers.tick.tick.run_within`)."""  # noqa: D205, D209
         equal = 0
         for c in constraints:
             if c is None:
@@ -344,9 +358,8 @@ class CompiledTick:
                 equal += c.d.size
         if equal == 0:
             return True
-        return equal < self.workspace.n and not any(
-            c is not None and c.slide is not None and c.h is not None and c.h.size
-            and c.slide.any() for c in constraints)  # fmt: skip
+        return equal < self.workspace.n and not any(c is not None and asks_apart(c)
+                                                    for c in constraints)  # fmt: skip
 
     def tasks(self, kin: Kinematics, levels: list[list[TaskRows]], weighted: bool,
               constraints: list[Constraints | None], previous: Array, dt: float,

@@ -1,8 +1,9 @@
 """CellTick: a cell's usual tick with its rows in one compiled call answers as the tasks' and
 limits' own path does, bit for bit, over sessions that scale, damp, swing and land a leg, with
-a collision limit (its rows loaded, or the tick handed back where one is slid along), a
-singularity limit's rows, the closure off, a posture changed in place, and ticks whose top
-level finds no answer (the fallbacks); a posture of the wrong size is refused."""
+a collision limit (its rows loaded, slid along or not; the tick handed back where a pair is
+asked apart), a singularity limit's rows, the closure off, a posture changed in place, and
+ticks whose top level finds no answer (the fallbacks); a posture of the wrong size is
+refused."""
 
 from __future__ import annotations
 
@@ -70,6 +71,8 @@ class Session:
             self.compiled += 1
             return rows(*args)
 
+        self.written = []  # whether each tick's rows were the compiled call's
+
         def run(compiled_tick, q, previous, dt):
             runs.append(1)
             code = run_loaded(compiled_tick, q, previous, dt)
@@ -99,7 +102,9 @@ class Session:
             if k % 20 == 0:
                 commands = {n: rng.normal(size=6) * SPEED[n] * rng.choice(SIZES) for n in names
                             if n in SPEED}  # fmt: skip
+            before = self.compiled
             r = ctl.step(commands if k % 7 else None).resolution
+            self.written.append(self.compiled > before)
             self.ticks.append((
                 ctl.q, r.qdot, r.applied, r.status, r.scale, r.veer, r.lambda_sq, r.levels,
                 r.attempts, [t.achieved for t in r.tasks], r.active, ctl.chain_error,
@@ -139,21 +144,23 @@ def test_the_compiled_rows_answer_as_the_tasks_and_limits_do(cell, seed, monkeyp
 
 @pytest.mark.parametrize("cell", ["gsfc_dual", "yeh_tripod"])
 @pytest.mark.parametrize("collision", ["capsules", "ball"])
-def test_with_a_collision_limit_the_ticks_whose_rows_slide_go_to_the_resolver(
+def test_with_a_collision_limit_its_rows_are_loaded_beside_the_chains(
     cell, collision, monkeypatch
 ):
-    """A collision limit beside the chains, read once a tick either way: where none of its
-    rows is slid along the chains' rows are compiled, else the tick goes back to the resolver
-    with its rows (the ball in the way); the same session, bit for bit."""
+    """A collision limit beside the chains, read once a tick either way: its rows are loaded
+    beside the chains' rows, the ticks that slide along them compiled too (the ball in the
+    way), and a tick with a pair asked apart goes back to the resolver with its rows; the same
+    session, bit for bit."""
     ticks = 240 if collision == "ball" else 120  # the ball met: sliding ticks
     compiled = Session(cell, SEEDS[0], True, monkeypatch, ticks=ticks, collision=collision)
     plain = Session(cell, SEEDS[0], False, monkeypatch, ticks=ticks, collision=collision)
     _same(compiled, plain, SEEDS[0])
     assert compiled.reads == plain.reads == ticks
-    assert compiled.compiled > ticks // 4, compiled.compiled
+    assert compiled.compiled > ticks // 2, compiled.compiled
     if collision == "ball":
-        statuses = [x[3] for x in compiled.ticks]
-        assert compiled.compiled + statuses.count("sliding") <= ticks and "sliding" in statuses
+        slid = [w for w, x in zip(compiled.written, compiled.ticks, strict=True)
+                if x[3] == "sliding"]  # fmt: skip
+        assert slid and all(slid), (len(slid), sum(slid))
 
 
 @pytest.mark.parametrize("cell", ["gsfc_dual", "yeh_tripod"])

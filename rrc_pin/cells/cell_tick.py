@@ -25,7 +25,7 @@ import numpy.typing as npt
 
 from rrc_pin.cells.cell_kernels import cell_rows
 from rrc_pin.cells.closure import ChainFrames, correct
-from rrc_pin.compiled_tick import CompiledTick, TickSource
+from rrc_pin.compiled_tick import CompiledTick, TickSource, asks_apart
 from rrc_pin.kinematics import Kinematics
 from rrc_pin.limits import ContactLimit, GripLimit, Limit
 from rrc_pin.limits.chain_kernels import NO_POSES
@@ -77,9 +77,10 @@ class CellTick:
             controller's bound is on).
         others: The resolver's other limits (a :class:`~rrc_pin.limits.CollisionLimit`),
             between the joint limits and the chains': their constraints computed as the
-            resolver computes them; rows ``G qdot <= h`` are loaded beside the chains', and a
-            tick where one gives a box, equality rows or rows the command slides along (a
-            collision pair) goes back to the resolver with the rows and constraints it has.
+            resolver computes them; rows ``G qdot <= h`` are loaded beside the chains' (a
+            collision pair's among them, which the command slides along), and a tick where
+            one gives a box, equality rows or a pair asked apart (a slide row below zero)
+            goes back to the resolver with the rows and constraints it has.
 
     Attributes:
         corrected: The last tick's top level (its tasks' rows) and closure correction, as
@@ -205,6 +206,6 @@ class CellTick:
 
 
 def _rows_only(c: Constraints) -> bool:
-    """Whether ``c`` is inequality rows at most, none of which the command slides along."""
-    return c.box is None and (c.d is None or not c.d.size) and (
-        c.slide is None or c.h is None or not c.h.size or not c.slide.any())  # fmt: skip
+    """Whether ``c`` is inequality rows at most, none of which the command slides along that
+    asks a pair apart (:func:`~rrc_pin.compiled_tick.asks_apart`)."""  # noqa: D205, D209
+    return c.box is None and (c.d is None or not c.d.size) and not asks_apart(c)

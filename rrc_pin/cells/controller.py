@@ -415,8 +415,8 @@ class CellController(Loop):
             r = self.resolver.solve_at(kin, [top, [lower]] if top else [[lower]],
                                        priority="strict", qdot_prev=self._previous_rates())
             _top_level(r)  # the correction's read of the top level's rows (its kernels)
-            # the Python pipeline's stages too: it answers equality rows with rows the command
-            # slides along (a binding collision limit's)
+            # the Python pipeline's stages too: it answers equality rows beside a collision
+            # pair asked apart (a slide row below zero)
             solve(r.problem, self.resolver.backend, self.resolver.options)
         self._compiled_tick(kin, [self._task(name, np.zeros(6)) for name in names])
         still = np.zeros(self.cell.nv)

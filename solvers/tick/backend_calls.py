@@ -74,9 +74,9 @@ def compile_calls(context: Context) -> None:
     QP over; the backend's warm starts are then forgotten.
 
     The direction problem with a row (:func:`direction`); a least-squares level of one row
-    (its metric semidefinite: the backend's QP) and of every rate (the kernels'), on all
-    rates and within a subspace, with a row and without (:func:`level`); the sliding stage's
-    QP (:func:`slide`).
+    (its metric semidefinite: the backend's QP) and of every rate (the projection's kernel),
+    its rates beyond the box, on all rates and within a subspace, with a row and without
+    (:func:`level`); the sliding stage's QP (:func:`slide`).
     """
     n = context.velocity.size
     lb, ub, x = np.full(n, -1.0), np.ones(n), np.zeros(n)
@@ -87,7 +87,7 @@ def compile_calls(context: Context) -> None:
         for A in (np.eye(1, n), np.eye(n)):
             for where, N in ((TOP, np.zeros((0, n))), (1, np.eye(n))):
                 for G, h in rows:
-                    level(where, A, np.full(A.shape[0], 0.1), x, N, lb, ub, G, h, True)
+                    level(where, A, np.full(A.shape[0], 10.0), x, N, lb, ub, G, h, True)
         slide(SLIDE, np.eye(n), np.full(n, 0.1), lb, ub, *rows[0])
     finally:
         leave()
@@ -149,7 +149,7 @@ def level(where: int, A: Array, b: Array, x: Array, N: Array, lb: Array, ub: Arr
     context = _LOCAL.context
     box, rows = _box(lb, ub), _rows(G, h)
     space = Subspace(None, None) if N.shape[0] == 0 else Subspace(x, N)
-    key = "least_squares" if where == TOP else f"level{where}"
+    key = "least_squares" if where == TOP else "slide" if where == SLIDE else f"level{where}"
     try:
         qdot, null = least_squares(A, b, space, box, rows, context.backend, _work(), key,
                                    need_null)  # fmt: skip

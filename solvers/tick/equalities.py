@@ -8,14 +8,19 @@ is then solved in z, its rows :math:`AN^T`, the box and the constraint rows kept
 rates :math:`\dot q` themselves:
 
 - the direction mode (:func:`direction_within`, where :math:`d = 0` so that standing still
-  meets the rows): the least-norm z of :math:`AN^Tz = b`, its rates :math:`w = N^Tz` the
-  answer where they keep the box and rows; else the largest scale along w, the motions that
-  keep the task rates (the null space of :math:`AN^T`, times N) free
-  (:func:`~rrc_pin.solvers.tick.top.scaled_along`); past the damping threshold the damped
-  rates scaled instead (the rows' own condition number: no joint is clamped out, a column of
-  :math:`AN^T` is no joint);
+  meets the rows): the least-norm z of :math:`AN^Tz = b`, its rates :math:`w = N^Tz`; where
+  they cross a row the command slides along (a collision pair), the sliding stage first
+  (:func:`sliding_within`: the command becomes what the box and those rows let it keep, their
+  least squares in z, ``sliding``); the rates the answer where they keep the box and rows;
+  else the largest scale along w, the motions that keep the task rates (the null space of
+  :math:`AN^T`, times N) free (:func:`~rrc_pin.solvers.tick.top.scaled_along`); past the
+  damping threshold the damped rates scaled instead (the rows' own condition number: no joint
+  is clamped out, a column of :math:`AN^T` is no joint);
 - the other modes (:func:`least_squares_within`): the least squares within the subspace
-  (:func:`~rrc_pin.solvers.tick.levels.least_squares`, as a lower level is solved).
+  (:func:`~rrc_pin.solvers.tick.levels.least_squares`, as a lower level is solved). The
+  pipeline's relaxing of a collision pair asked apart (a slide row below zero) where that
+  fails is not here: the compiled tick does not take such a row with equality rows
+  (:meth:`rrc_pin.compiled_tick.CompiledTick.answers`).
 
 The lower levels then move in the top level's null space, which lies inside N's span: every
 level keeps the equality rows. Each function calls the kernels the pipeline's class methods
@@ -43,6 +48,7 @@ from rrc_pin.solvers.tick.statuses import (
     RECOVERING,
     SCALED,
     SINGULAR,
+    SLIDING,
 )
 from rrc_pin.solvers.tick.top import FAILED, Rows, Top
 
@@ -68,6 +74,22 @@ def space(C: Array, d: Array) -> tuple[Array, Array, bool]:
 
 
 @inlined
+def sliding_within(A: Array, b: Array, N: Array, rows: Rows, G: Array, h: Array) -> Array:
+    """The sliding stage within the rows' null space N (d, n): what the box and the rows the
+    command slides along (``G``, ``h``) let it keep, their least squares in the rates
+    ``N^T z`` (the pipeline's ``_slide`` within equality rows); empty where the backend failed
+    (recorded: the command kept as given).
+    """  # noqa: D205
+    n = A.shape[1]
+    # np.int64 and a bool that is not a literal: the lower levels' compiled signature, and its
+    # hand-over to the backend (compiled at its first run, Workspace.compile_hand_overs)
+    no_null = A.shape[0] < 0
+    kept, _ = least_squares(np.int64(backend_calls.SLIDE), A, b, np.zeros(n), N, rows.lb,  # type: ignore[arg-type, unused-ignore]
+                            rows.ub, G, h, rows.tol, no_null)  # fmt: skip
+    return kept
+
+
+@inlined
 def direction_within(A: Array, b: Array, N: Array, rows: Rows, dt: float, threshold: float,
                      rate_factor: float, need_null: bool) -> Top:  # fmt: skip
     """The direction mode's top level in the rates ``N^T z`` (module docstring; the pipeline's
@@ -77,9 +99,22 @@ def direction_within(A: Array, b: Array, N: Array, rows: Rows, dt: float, thresh
     Nt = np.ascontiguousarray(N.T)
     f, z = factor.least_norm(factor.qr(product(A, Nt)), b)
     w = row_values(Nt, z)
+    command, slid = b, False
+    G, h = top.slide_rows(rows)
+    if h.size and not feasibility.rows_hold(G, w, h, 0.0):  # the sliding stage changes b
+        kept = sliding_within(A, b, N, rows, G, h)
+        if kept.size:
+            if rows.slide.all() or feasibility.rows_hold(rows.G, kept, rows.h, rows.tol):
+                null = product(factor.null_basis(f)[1], N) if need_null else np.empty((0, n))
+                return top.answer(A, command, kept, SLIDING, rate_factor, null, 0.0)
+            b, slid = row_values(A, kept), True
+            f, z = factor.least_norm(f, b)
+            w = row_values(Nt, z)
     outside_range = not f.regular and not top.met(f.J, z, b)
     if feasibility.inside(w, rows.lb, rows.ub) and feasibility.rows_hold(rows.G, w, rows.h, 0.0):
         null = product(factor.null_basis(f)[1], N) if need_null else np.empty((0, n))
+        if slid:
+            return top.answer(A, command, w, SLIDING, rate_factor, null, 0.0)
         if outside_range:
             return top.answer(A, b, w, SINGULAR, rate_factor, null, 0.0)
         return top.met_top(w, rate_factor, null)
@@ -88,6 +123,8 @@ def direction_within(A: Array, b: Array, N: Array, rows: Rows, dt: float, thresh
     qdot, u, veer = top.scaled_along(A, w, null, rows)
     if u < 0.0:
         return top.passing(w, null)
+    if slid:
+        return top.answer(A, command, qdot, SLIDING, rate_factor, null, 0.0)
     if not outside_range and u >= 1.0 - EXACT_TOL:
         return top.met_top(qdot, rate_factor, null)
     unbounded = np.full(d, np.inf)  # z has no bounds: no column of A N^T is clamped

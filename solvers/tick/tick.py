@@ -607,6 +607,32 @@ class Workspace:
                 run_within(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.E,
                            ws.ints, ws.reals, ws.top)  # fmt: skip
 
+    def compile_hand_overs(self) -> None:
+        """Run :func:`run` and :func:`run_within` once each on a problem whose lower level's QP
+        goes to the backend (one row beyond the box on the rates the top level leaves free, a
+        semidefinite metric), and whose sliding stage's does (within the equality row).
+
+        numba compiles an entry's hand-over of a QP to Python (``objmode``,
+        :func:`rrc_pin.solvers.tick.levels.backend_level`) at its first run, not from its cache:
+        50-60 ms, which would stall the first tick of a session that needs the backend. The
+        caller has handed this thread's QPs to a backend (:func:`backend_calls.enter`).
+        """  # noqa: D205
+        n = self.n
+        if n < 4:  # no semidefinite lower level within one equality row
+            return
+        ws = Workspace(self.joints[LOWER], self.joints[UPPER], self.joints[VELOCITY],
+                       self.joints[ACCELERATION], 0.0, 1.0, 0.0, True, 1.0)  # fmt: skip
+        top = TaskRows(np.eye(1, n), np.full(1, 1.0), None, "", np.ones(1))
+        beyond = TaskRows(np.eye(1, n, 1), np.full(1, 1e3), None, "", None)
+        ws.load_levels([[top], [beyond]], False)
+        ws.load_rows(np.eye(1, n), np.full(1, 1e-3), np.ones(1, dtype=np.bool_))
+        ws.joints[POSITION] = np.clip(np.zeros(n), self.joints[LOWER], self.joints[UPPER])
+        ws.reals[DT] = 0.01
+        run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
+        ws.load_equalities(np.eye(1, n, n - 1), np.zeros(1))
+        run_within(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.E, ws.ints,
+                   ws.reals, ws.top)  # fmt: skip
+
     def stacked_top(self) -> Array | None:
         """The top level's rows in their metric (m, n) of the tick just run within equality rows
         (a copy), or None for a tick without them.
