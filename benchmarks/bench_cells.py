@@ -31,7 +31,11 @@ Per case and mode the tick's median, p10, p90, p99 [us] (``time.perf_counter`` a
 ``step``; the first ticks left out) and its CPU time's median and p99 (``time.thread_time``);
 of the tight mode, the loop rate they give (1 / tick [Hz]), the statuses, the largest grip
 error or foot slip, and with collision the ticks that had collision rows and the smallest
-distance seen. One core, BLAS threads pinned to 1.
+distance seen. One core, BLAS threads pinned to 1. As the console does before its loop
+starts (docs/api.md, "Pauses of the garbage collector"), what the process holds once the
+controllers are built is collected and frozen out of later collections while they run: a
+full collection of the unfrozen heap (numba's compilations included) took 44-65 ms, and which
+tick it lands in depends on what was built before.
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
 import collections  # noqa: E402
+import gc  # noqa: E402
 import json  # noqa: E402
 import sys  # noqa: E402
 from pathlib import Path  # noqa: E402
@@ -140,7 +145,12 @@ def run_cell(name: str, ticks: int) -> tuple[list[dict[str, Any]], list[dict[str
         controllers, refused = _controllers(cell)
         loops[mode] = {label: CellLoop(ctl, command, twists) for label, ctl in controllers.items()}
         progress(f"cells: {name}, {mode}")
-        times[mode] = closed_loops(mode, loops[mode], ticks, order)
+        gc.collect()
+        gc.freeze()  # as the console's loop (module docstring)
+        try:
+            times[mode] = closed_loops(mode, loops[mode], ticks, order)
+        finally:
+            gc.unfreeze()
     feet = {f: cell.fk(cell.ready(), f)[:3, 3] for f in cell.tool_frames} if cell.body else {}
     rows = []
     for label, loop in loops["tight"].items():
