@@ -361,11 +361,26 @@ def test_a_kernels_stamp_is_that_of_every_module_of_the_package_it_reaches():
 
 # -- no kernel compiled or loaded inside a control loop ---------------------------------------
 
+COMPILES = """
+from numba.core import event
+
+compiled = []  # what numba compiled (its compile events), the objmode hand-overs among them
+
+class Compiles(event.Listener):
+    def on_start(self, ev):
+        d = ev.data["dispatcher"]
+        compiled.append(f"{type(d).__name__} {getattr(d.py_func, '__qualname__', '')}")
+
+    def on_end(self, ev):
+        pass
+"""
+"""A fresh interpreter's record of what numba compiles (``event.register("numba:compile",
+Compiles())`` once it is to be watched)."""
+
 LOOP = """
 import gc, json, sys
 from collections import Counter
 import numpy as np
-from numba.core import event
 from numba.core.dispatcher import Dispatcher
 import rrc_pin
 from rrc_pin import CollisionLimit, CollisionModel, Controller, JointLimits
@@ -381,16 +396,7 @@ def signatures():
 rng = np.random.default_rng(SEED)
 out = {}
 
-compiled = []  # what numba compiled (its event), the objmode hand-overs among them
-
-class Compiles(event.Listener):
-    def on_start(self, ev):
-        d = ev.data["dispatcher"]
-        compiled.append(f"{type(d).__name__} {getattr(d.py_func, '__qualname__', '')}")
-
-    def on_end(self, ev):
-        pass
-
+""" + COMPILES + """
 event.register("numba:compile", Compiles())
 
 def session(label, controller, command, ticks=300):
@@ -519,20 +525,9 @@ def test_no_kernel_is_compiled_or_loaded_inside_a_control_loop(seed):
 HAND_OVER = """
 import json
 import numpy as np
-from numba.core import event
 import rrc_pin
 from rrc_pin import CellController, CollisionLimit, CollisionModel, JointLimits
-
-compiled = []
-
-class Compiles(event.Listener):
-    def on_start(self, ev):
-        d = ev.data["dispatcher"]
-        compiled.append(f"{type(d).__name__} {getattr(d.py_func, '__qualname__', '')}")
-
-    def on_end(self, ev):
-        pass
-
+""" + COMPILES + """
 dual = rrc_pin.load("gsfc_dual")
 ctl = CellController(dual, 0.01, limits=[JointLimits(), CollisionLimit(CollisionModel(dual,
                      "capsules"))])
