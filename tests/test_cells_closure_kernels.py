@@ -248,8 +248,12 @@ def test_the_correction_is_the_numpy_reference(cell, seed):
                                            qdot, top, box, 0.01, G, h)  # fmt: skip
         if k % 2 == 0:  # the trust region binds: the projection's answer, on it
             on = np.isclose(np.abs(got), TRUST * box.velocity, rtol=1e-9, atol=0.0)
-            assert on.any(), f"seed {seed}"
-            projected += 1
+            # or none, as the reference finds: a row held at no room, which the projection
+            # keeps with its margin to spare, may leave it no point (seed
+            # 3002881855625045783, case 6; both zero)
+            held = k % 6 == 0 and not want.any()
+            assert on.any() or held, f"seed {seed}, case {k}"
+            projected += int(on.any())
         np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12 * (1 + np.abs(want).max()),
                                    err_msg=f"seed {seed}, case {k}")  # fmt: skip
         np.testing.assert_allclose(after, want_after, rtol=0.0, atol=1e-15,
@@ -262,7 +266,7 @@ def test_the_correction_is_the_numpy_reference(cell, seed):
         if rows is not None:
             room = np.maximum(h - G @ qdot, 0.0)
             assert np.all(G @ got <= room + 1e-12 * (1 + np.abs(room))), f"seed {seed}"
-    assert projected == 12
+    assert projected >= 8  # of 12: the 4 with a row held may have none
 
 
 @pytest.mark.parametrize("seed", [FIXED, None])
