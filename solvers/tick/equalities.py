@@ -81,11 +81,9 @@ def sliding_within(A: Array, b: Array, N: Array, rows: Rows, G: Array, h: Array)
     (recorded: the command kept as given).
     """  # noqa: D205
     n = A.shape[1]
-    # np.int64 and a bool that is not a literal: the lower levels' compiled signature, and its
-    # hand-over to the backend (compiled at its first run, Workspace.compile_hand_overs)
-    no_null = A.shape[0] < 0
+    # np.int64: not a literal, so one compiled signature serves every level
     kept, _ = least_squares(np.int64(backend_calls.SLIDE), A, b, np.zeros(n), N, rows.lb,  # type: ignore[arg-type, unused-ignore]
-                            rows.ub, G, h, rows.tol, no_null)  # fmt: skip
+                            rows.ub, G, h, rows.tol, False)  # fmt: skip
     return kept
 
 

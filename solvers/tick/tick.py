@@ -588,8 +588,7 @@ class Workspace:
         without rows whose answer is exact, so that no QP is asked for and nothing is kept.
         """  # noqa: D205
         n = self.n
-        ws = Workspace(self.joints[LOWER], self.joints[UPPER], self.joints[VELOCITY],
-                       self.joints[ACCELERATION], 0.0, 1.0, 0.0, True, 1.0)  # fmt: skip
+        ws = self._scratch()
         one = TaskRows(np.eye(1, n), np.zeros(1), None, "", np.ones(1))
         ws.load_levels([[one]], False)
         ws.load_rows(None, None, None)
@@ -618,10 +617,9 @@ class Workspace:
         caller has handed this thread's QPs to a backend (:func:`backend_calls.enter`).
         """  # noqa: D205
         n = self.n
-        if n < 4:  # no semidefinite lower level within one equality row
+        if n < 3:  # no semidefinite lower level
             return
-        ws = Workspace(self.joints[LOWER], self.joints[UPPER], self.joints[VELOCITY],
-                       self.joints[ACCELERATION], 0.0, 1.0, 0.0, True, 1.0)  # fmt: skip
+        ws = self._scratch()
         top = TaskRows(np.eye(1, n), np.full(1, 1.0), None, "", np.ones(1))
         beyond = TaskRows(np.eye(1, n, 1), np.full(1, 1e3), None, "", None)
         ws.load_levels([[top], [beyond]], False)
@@ -629,9 +627,17 @@ class Workspace:
         ws.joints[POSITION] = np.clip(np.zeros(n), self.joints[LOWER], self.joints[UPPER])
         ws.reals[DT] = 0.01
         run(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.ints, ws.reals)
+        if n < 4:  # within one equality row, no semidefinite lower level
+            return
         ws.load_equalities(np.eye(1, n, n - 1), np.zeros(1))
         run_within(ws.joints, ws.task_rows, ws.rates, ws.G, ws.h, ws.slide, ws.E, ws.ints,
                    ws.reals, ws.top)  # fmt: skip
+
+    def _scratch(self) -> Workspace:
+        """A workspace of the same joints for a compiling run, its margin, damping and gains
+        neutral (:meth:`compile`, :meth:`compile_hand_overs`)."""  # noqa: D205, D209
+        return Workspace(self.joints[LOWER], self.joints[UPPER], self.joints[VELOCITY],
+                         self.joints[ACCELERATION], 0.0, 1.0, 0.0, True, 1.0)  # fmt: skip
 
     def stacked_top(self) -> Array | None:
         """The top level's rows in their metric (m, n) of the tick just run within equality rows
