@@ -29,6 +29,7 @@ singular), or just outside a joint's range (recovering).
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from collections import Counter
@@ -60,6 +61,9 @@ SIZES = (1.0, 1.0, 1.0, 1e-3, 10.0, 300.0)
 """Factors on a segment's commands, drawn uniformly."""
 STILL = 1e-9
 """A scale below this stands still along the command: its veer is not compared."""
+LEVEL_TOL = 1e-6
+"""Relative difference of a level's task error within which two answers serve it alike
+(:func:`shortfall`)."""
 UNHURRIED = QPOptions(time_limit=10.0)
 """The backend's time cap: far beyond any answer, so that the machine's load (which the default
 cap of 50 ms turns into a fallback on a slow call) does not change the answers."""
@@ -297,12 +301,30 @@ def record(path: Path, ticks: int, seed: int) -> None:
     print(f"{len(names)} cases, {sum(statuses.values())} ticks: {dict(statuses)}")
 
 
+def shortfall(r: Any, recorded: Array) -> float:
+    r"""How far the answer ``r`` serves its levels worse than the ``recorded`` rates (n,):
+    level by level in priority order, the first whose task error :math:`\|A\dot q - b\|`
+    differs by more than :data:`LEVEL_TOL` relative decides; its relative excess where r's is
+    the larger, else 0 (the same or better).
+    """
+    for level in r.problem.levels:
+        mine, theirs = (math.sqrt(sum(float(np.sum((t.A @ x - t.b) ** 2)) for t in level))
+                        for x in (r.qdot, recorded))  # fmt: skip
+        if abs(mine - theirs) > LEVEL_TOL * max(1.0, theirs):
+            return max(0.0, (mine - theirs) / max(1.0, theirs))
+    return 0.0
+
+
 def replay(data: Any, case: Case, first: int | None = None) -> dict[str, Any]:
-    """The answers of the code imported now to the recorded ticks of ``case`` (the first ones)."""
+    """The answers of the code imported now to the recorded ticks of ``case`` (the first ones),
+    and their :func:`shortfall` against the recorded ones (``"short"``).
+    """
     solve = case.make()
-    Q, X, P = (data[f"{case.name}/{key}"] for key in ("q", "command", "prev"))
+    Q, X, P, old = (data[f"{case.name}/{key}"] for key in ("q", "command", "prev", "qdot"))
     k = len(Q) if first is None else min(first, len(Q))
-    return _answers([solve(Q[i], X[i], P[i]) for i in range(k)])
+    answers = [solve(Q[i], X[i], P[i]) for i in range(k)]
+    short = [shortfall(r, old[i]) for i, r in enumerate(answers)]
+    return {**_answers(answers), "short": np.array(short)}
 
 
 def differences(data: Any, name: str, now: dict[str, Any]) -> dict[str, Any]:
@@ -325,6 +347,7 @@ def differences(data: Any, name: str, now: dict[str, Any]) -> dict[str, Any]:
         "status": old["status"],
         "per_tick": rates,
         "kernels": kernels,
+        "short": now["short"],
     }
 
 
@@ -332,13 +355,17 @@ def compare(path: Path, first: int | None, tolerance: float) -> int:
     """Replay ``path`` and print per case the largest differences; 1 where any exceeds."""
     data = np.load(path)
     known = {case.name: case for case in cases()}
-    failures, worst, total = 0, 0.0, 0
+    failures, worst, total, changed, shorter = 0, 0.0, 0, 0, [0, 0.0]
     by_source = {"kernels": [0, 0.0], "backend": [0, 0.0]}  # ticks, largest difference
     by_status: dict[str, float] = {}
     for name in data["cases"].tolist():
         found = differences(data, name, replay(data, known[name], first))
         total += found["ticks"]
         worst = max(worst, found["rates"])
+        beyond = found["per_tick"] > tolerance
+        changed += int(beyond.sum())
+        short = found["short"][beyond]
+        shorter = [shorter[0] + int((short > 0.0).sum()), max(shorter[1], short.max(initial=0.0))]
         for source, mask in (("kernels", found["kernels"]), ("backend", ~found["kernels"])):
             by_source[source][0] += int(mask.sum())
             by_source[source][1] = max(by_source[source][1],
@@ -350,7 +377,8 @@ def compare(path: Path, first: int | None, tolerance: float) -> int:
         if bad or found["rates"] > 1e-15:
             print(
                 f"{name:32s} rates {found['rates']:.3g} (tick {found['worst']}) scale "
-                f"{found['scale']:.3g} veer {found['veer']:.3g} {found['differ'] or ''}"
+                f"{found['scale']:.3g} veer {found['veer']:.3g} short "
+                f"{found['short'].max(initial=0.0):.3g} {found['differ'] or ''}"
             )
     print(
         f"{total} ticks, largest relative rate difference {worst:.3g}; per status "
@@ -358,6 +386,8 @@ def compare(path: Path, first: int | None, tolerance: float) -> int:
     )
     print("the old tick's answers from " + ", ".join(
         f"its {k}: {n} ticks, largest {d:.3g}" for k, (n, d) in by_source.items()))
+    print(f"{changed} ticks beyond {tolerance:g}: {shorter[0]} serve a level worse than the "
+          f"recording (beyond {LEVEL_TOL:g} relative), by at most {shorter[1]:.3g}")
     print(f"{failures} cases beyond {tolerance:g} or with another status, method or levels")
     return 1 if failures else 0
 

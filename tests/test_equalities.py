@@ -57,10 +57,10 @@ def agrees(r: Resolution, resolver: rrc_pin.Resolver) -> None:
 
 LOWER = 1e-3
 """[rad/s] Rates of a tick whose lower level's QP went to the backend, beside a collision limit
-whose rows the tick's answer lies on: the subspace left to the lower level moves some of those
-rows not at all (their coefficients in it are rounding, 1e-16) and the start breaks them by
-rounding (1e-12); DAQP's answer to that QP then moves with the null basis's last bits (up to
-2.4e-4 on gsfc_dual, either path against itself 1e-12). The top level's rates agree as ever."""
+whose rows the tick's answer lies on: DAQP's answer to that QP moves with the null basis's last
+bits (up to 2.3e-5 on gsfc_dual here, either path against itself 1e-12; 2.4e-4 before the rows
+the subspace cannot move at all were dropped, ``feasibility.release_unmoved``). The top level's
+rates agree as ever."""
 
 
 def agrees_above(r: Resolution, resolver: rrc_pin.Resolver) -> None:

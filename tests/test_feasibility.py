@@ -71,3 +71,23 @@ def test_around_start_against_numpy(rng: np.random.Generator) -> None:
         feasibility.around_start(lo, hi, tol, rounding)
         np.testing.assert_array_equal(lo, want_lo)
         np.testing.assert_array_equal(hi, want_hi)
+
+
+def test_release_unmoved_against_numpy(rng: np.random.Generator) -> None:
+    """A row the start meets whose coefficients are at most UNMOVED of its row's size (the box's
+    rows of unit size, then G's) is dropped; every other row kept as it is."""
+    n, p, d = 5, 3, 3
+    for _ in range(200):
+        G = rng.normal(size=(p, n)) * rng.choice([1e-3, 1.0, 1e3], size=(p, 1))
+        C = rng.normal(size=(n + p, d))
+        size = np.concatenate([np.ones(n), np.linalg.norm(G, axis=1)])
+        rounding = rng.random(n + p) < 0.5
+        C[rounding] *= (size[rounding] * rng.choice([1e-17, 1e-16, 1e-12], rounding.sum()))[:, None]
+        lo = rng.choice([-np.inf, -1.0, 0.0, 1e-7], size=n + p)
+        hi = rng.choice([np.inf, 1.0, 0.0, -1e-7], size=n + p)
+        unmoved = np.linalg.norm(C, axis=1) <= feasibility.UNMOVED * size
+        dropped = unmoved & (lo <= 0.0) & (hi >= 0.0)
+        want_lo, want_hi = np.where(dropped, -np.inf, lo), np.where(dropped, np.inf, hi)
+        feasibility.release_unmoved(C, G, lo, hi)
+        np.testing.assert_array_equal(lo, want_lo)
+        np.testing.assert_array_equal(hi, want_hi)

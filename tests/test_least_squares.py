@@ -88,3 +88,31 @@ def test_a_definite_level_outside_its_constraints_is_projected_without_the_backe
         h = np.concatenate([1.0 - x0, 1.0 + x0, rows.h - rows.G @ x0])
         z = qpsolvers.solve_ls(B, c, G, h, solver="daqp")
         np.testing.assert_allclose(x, x0 + z @ N, atol=1e-7)
+
+
+def test_a_joint_the_level_above_holds_at_its_bound_leaves_the_projection_free(
+    rng: np.random.Generator,
+) -> None:
+    """The levels above keep joint 0 at its upper bound (it lies in their rows' span), so the
+    level's null space moves it only by rounding (exactly 0 or 1e-17). That row, at the start,
+    tightened by the projection's margin, was a bound no z meets (0 <= -1e-24: refused, DAQP
+    answered) or a plane through the start in a direction of rounding: the answer then hung on
+    the basis's last bits. It is dropped: the projection answers, as the QP without it."""
+    n = 6
+    for _ in range(100):
+        above = np.vstack([np.eye(1, n), rng.normal(size=(2, n))])
+        N = np.linalg.svd(above)[2][3:]  # the null space of the levels above (3, n)
+        x0 = np.linalg.pinv(above) @ rng.normal(size=3)
+        x0[0] = 1.0  # joint 0 on its upper bound
+        x0[1:] = np.clip(x0[1:], -0.9, 0.9)
+        A, b = rng.normal(size=(n, n)), rng.normal(size=n) * 5.0
+        backend = Recording()
+        x, _ = least_squares(A, b, Subspace(x0, N), box(n, 1.0), None, backend, Work(), "t",
+                             False)  # fmt: skip
+        assert backend.seen == []
+        keep = np.arange(1, n)  # the QP on the joints the level moves
+        B, c = A @ N.T, b - A @ x0
+        G = np.vstack([N.T[keep], -N.T[keep]])
+        h = np.concatenate([1.0 - x0[keep], 1.0 + x0[keep]])
+        z = qpsolvers.solve_ls(B, c, G, h, solver="quadprog")
+        np.testing.assert_allclose(x, x0 + z @ N, atol=1e-9)

@@ -1,7 +1,8 @@
 """A least-squares level in the compiled tick (solvers/tick/levels.py) against numpy and the
 pipeline's level (solvers/tick/least_squares.py): the same rates and null space to 1e-12 on
-random levels, the top one and lower ones in a null space, with and without constraint rows,
-the optimum inside the constraints, projected onto them, or the backend's QP."""
+random levels, the top one and lower ones in a null space (some with a joint the levels above
+hold at its bound), with and without constraint rows, the optimum inside the constraints,
+projected onto them, or the backend's QP."""
 
 from __future__ import annotations
 
@@ -36,8 +37,14 @@ def level_case(rng: np.random.Generator) -> tuple:
     G, h = rng.normal(size=(p, N)), rng.uniform(0.0, 1.0, p)
     if rng.random() < 0.5:  # a lower level: x feasible, N spanning some free directions
         d = int(rng.integers(1, N))
-        basis = np.linalg.qr(rng.normal(size=(N, N)))[0][:, :d].T.copy()
+        M = rng.normal(size=(N, N))
+        held = rng.random() < 0.3  # joint 0 kept at its bound by the levels above
+        if held:
+            M[:, 0] = np.eye(N)[0]
+        basis = np.linalg.qr(M)[0][:, int(held):int(held) + d].T.copy()
         x = np.clip(rng.normal(size=N) * 0.1, lb * 0.5, ub * 0.5)
+        if held:
+            x[0] = ub[0]
         h = np.maximum(h, G @ x)
     else:
         basis, x = np.empty((0, N)), np.zeros(N)

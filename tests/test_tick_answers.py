@@ -7,6 +7,13 @@ a change of the tick's shape must change its speed, not its answers. ``python
 benchmarks/tick_answers.py compare`` runs the same comparison on any recording (10,000 ticks
 and more); here, every recorded tick is answered again in its order, by a fresh resolver per
 case.
+
+Two fixes since change answers on purpose, on lower levels: a row the levels above hold (a
+joint they keep at its bound, to the rounding of their null space) no longer keeps a level's
+projection at its start, and a semidefinite level's QP is projected by hand like a definite
+one's, not left to DAQP. A tick answered otherwise must serve every level at least as well as
+the recording: level by level, the first task error that differs is the new answer's smaller
+(``tick_answers.shortfall``).
 """
 
 from __future__ import annotations
@@ -28,10 +35,9 @@ DATA = ROOT / "tests" / "data" / "tick_answers.npz"
 TOL = 1e-8
 """Relative difference of the rates and scales allowed: the kernels' answers agree to 1e-14 on
 the recording's machine, and another CPU rounds otherwise. Where the old tick's answer came from
-the backend (DAQP), its answer moves with the last bits of its data, which the compiled tick
-forms in its own loops, not numpy's BLAS (up to 7.5e-9 here on the humanoids' three-level
-stacks; on 2 ticks of 12,200 of main's 0787da7, DAQP dropped a level on one side only): there
-nine ticks in ten within TOL, and every status the same."""
+the backend (DAQP), its answer moves with the last bits of its data (up to 7.5e-9 on the
+humanoids' three-level stacks). A rate beyond it must serve the levels no worse (module
+docstring)."""
 VEER_TOL = 1e-7
 """[rad] The veer of rates along the command is the arccosine of a cosine within rounding of 1:
 a difference of 1e-16 in it reads 1.5e-8 rad."""
@@ -56,11 +62,8 @@ def test_recorded_ticks_answered_alike(recorded: dict[str, np.ndarray], name: st
     now = tick_answers.replay(recorded, CASES[name])
     found = tick_answers.differences(recorded, name, now)
     assert found["ticks"] == len(recorded[f"{name}/qdot"]) >= 20
-    kernels = found["kernels"]  # the ticks the old tick's kernels answered, not the backend
-    assert (found["per_tick"][kernels] <= TOL).all(), f"{name}: {found['per_tick'][kernels]}"
+    changed = found["per_tick"] > TOL
+    short = found["short"][changed]
+    assert (short == 0.0).all(), f"{name}: ticks {np.flatnonzero(changed)} short by {short}"
     assert found["differ"].get("status", []) == [], f"{name}: ticks with another status"
-    backend = ~kernels
-    if backend.any():  # DAQP's answers move with the last bits of their data (module docstring)
-        close = found["per_tick"][backend] <= TOL
-        assert close.mean() >= 0.9, f"{name}: {found['per_tick'][backend]}"
     assert found["scale"] <= TOL and found["veer"] <= VEER_TOL

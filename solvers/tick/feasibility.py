@@ -103,3 +103,42 @@ def around_start(lo: Array, hi: Array, tol: float, rounding: float) -> None:
             hi[i] = max(hi[i], 0.0)
         lo[i] -= rounding
         hi[i] += rounding
+
+
+
+
+UNMOVED = 16.0 * EPS
+"""Relative size at or below which a row's coefficients in a level's subspace are rounding
+(:func:`release_unmoved`)."""
+
+
+@kernel
+def release_unmoved(C: Array, G: Array, lo: Array, hi: Array) -> None:
+    """Drop, in place (both sides made infinite), the rows ``lo <= C z <= hi`` of a level's QP
+    in a subspace, ``z = 0`` its start, that the start meets and whose coefficients are at most
+    :data:`UNMOVED` of their own row's size: the joint box (C's first n rows, of unit size)
+    then the rows ``G`` (p, n) (C's last p).
+
+    The levels above hold such a row (a joint they keep at its bound, a row in the span of
+    their tasks): its coefficients in the subspace are the rounding of its null space's basis,
+    in no direction of the level's. Kept, the margin of 1e-12 an answer is sought inside its
+    rows by makes it a bound of z (1e-24 over 1e-16: a plane through the start, in a direction
+    of rounding), and the level's projection stays at its start. Dropped, the answer moves it
+    by rounding.
+    """  # noqa: D205
+    p = G.shape[0]
+    n = C.shape[0] - p
+    for i in range(C.shape[0]):
+        if not lo[i] <= 0.0 <= hi[i]:
+            continue
+        size = 1.0
+        if i >= n:
+            size = 0.0
+            for j in range(G.shape[1]):
+                size += G[i - n, j] * G[i - n, j]
+            size = math.sqrt(size)
+        coefficients = 0.0
+        for j in range(C.shape[1]):
+            coefficients += C[i, j] * C[i, j]
+        if math.sqrt(coefficients) <= UNMOVED * size:
+            lo[i], hi[i] = -math.inf, math.inf

@@ -190,6 +190,9 @@ def _level_qp(
     # exactly on their bounds); a start farther out (the equality rows' least-norm rates of a
     # top level) is no answer: the constraints stand
     lo, hi = np.array(lo), np.array(hi)
+    feasibility.release_unmoved(C, np.empty((0, N.shape[1])) if rows is None else rows.G, lo, hi)
+    moved = np.isfinite(lo) | np.isfinite(hi)
+    C, lo, hi = C[moved], lo[moved], hi[moved]
     feasibility.around_start(lo, hi, tolerance(box), ROUNDING)
     free = np.full(d, np.inf)
     return QP(P, q, C, lo, hi, -free, free, f"{key}:{d}:{hi.size}"), Decoding(x, N.T)

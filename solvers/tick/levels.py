@@ -96,7 +96,8 @@ def one_sided(C: Array, lo: Array, hi: Array) -> tuple[Array, Array]:
 @inlined
 def subspace_rows(x: Array, N: Array, lb: Array, ub: Array, G: Array, h: Array, tol: float
                   ) -> tuple[Array, Array]:  # fmt: skip
-    """The box and rows of rates ``x + N^T z`` as one-sided rows in z, widened around z = 0
+    """The box and rows of rates ``x + N^T z`` as one-sided rows in z, without those z cannot
+    move (:func:`~rrc_pin.solvers.tick.feasibility.release_unmoved`), widened around z = 0
     where x breaks them by at most ``tol``, and by :data:`ROUNDING`
     (:func:`~rrc_pin.solvers.tick.feasibility.around_start`;
     :func:`rrc_pin.solvers.tick.least_squares._level_qp`).
@@ -111,6 +112,7 @@ def subspace_rows(x: Array, N: Array, lb: Array, ub: Array, G: Array, h: Array, 
         lo[i], hi[i] = lb[i] - x[i], ub[i] - x[i]
     for i in range(p):
         lo[n + i], hi[n + i] = -np.inf, h[i] - Gx[i]
+    feasibility.release_unmoved(C, G, lo, hi)
     feasibility.around_start(lo, hi, tol, ROUNDING)
     return one_sided(C, lo, hi)
 
