@@ -9,7 +9,7 @@ from scipy.optimize import lsq_linear
 from rrc_pin.solvers.qp_backends import make_backend
 from rrc_pin.solvers.qp_backends.base import QPBackend, QPSolution
 from rrc_pin.solvers.qp_backends.qp import QP, Work
-from rrc_pin.solvers.tick.least_squares import Subspace, least_squares
+from rrc_pin.solvers.tick.least_squares import TIE_BREAK, WELL, Subspace, least_squares
 from rrc_pin.solvers.tick.problem import Box, Rows
 
 
@@ -116,3 +116,39 @@ def test_a_joint_the_level_above_holds_at_its_bound_leaves_the_projection_free(
         h = np.concatenate([1.0 - x0[keep], 1.0 + x0[keep]])
         z = qpsolvers.solve_ls(B, c, G, h, solver="quadprog")
         np.testing.assert_allclose(x, x0 + z @ N, atol=1e-9)
+
+
+def test_a_square_level_is_projected_in_its_tie_broken_metric(rng: np.random.Generator) -> None:
+    """As many rows as unknowns (a cell's body task in its chains' null space): the backend's
+    QP carries the tie-break (TIE_BREAK); where that metric's condition number is at most WELL
+    the kernel projects in it, DAQP's answer to the same QP within its tolerance, else the
+    backend answers. Fewer rows than unknowns (a condition number of 1e6) stay the backend's."""
+    n, d = 7, 4
+    projected = 0
+    for _ in range(100):
+        N = np.linalg.qr(rng.normal(size=(n, d)))[0].T
+        x0 = rng.uniform(-0.3, 0.3, n)
+        A, b = rng.normal(size=(d, n)), rng.normal(size=d) * 3.0
+        backend = Recording()
+        x, _ = least_squares(A, b, Subspace(x0, N), box(n, 1.0), None, backend, Work(), "t",
+                             False)  # fmt: skip
+        B, c = A @ N.T, b - A @ x0
+        optimum = x0 + np.linalg.lstsq(B, c, rcond=None)[0] @ N
+        if np.all(np.abs(optimum) <= 1.0):  # inside the box: the least squares, no tie-break
+            np.testing.assert_allclose(x, optimum, atol=1e-9)
+            assert backend.seen == []
+            continue
+        P = B.T @ B + TIE_BREAK * max(np.trace(B.T @ B), 1.0) * np.eye(d)
+        if np.linalg.cond(P) > WELL:
+            assert len(backend.seen) == 1
+            continue
+        assert backend.seen == []
+        projected += 1
+        G, h = np.vstack([N.T, -N.T]), np.concatenate([1.0 - x0, 1.0 + x0])
+        z = qpsolvers.solve_qp(P, -B.T @ c, G, h, solver="daqp")
+        np.testing.assert_allclose(x, x0 + z @ N, atol=1e-9)
+    assert projected > 30, projected
+    A, b = rng.normal(size=(d - 1, n)), np.full(d - 1, 50.0)
+    backend = Recording()
+    least_squares(A, b, Subspace(x0, N), box(n, 1.0), None, backend, Work(), "t", False)
+    assert len(backend.seen) == 1

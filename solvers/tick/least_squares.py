@@ -16,19 +16,22 @@ more rows than unknowns, by the QR of :math:`B^T`
 otherwise, and by the SVD where either is rank deficient. Else, where :math:`B^TB` is
 definite (the optimum one point), the optimum is projected onto the constraints in
 the metric :math:`B^TB` by hand (:func:`~rrc_pin.solvers.tick.slide_kernels.project`: the same
-costs up to a
-constant); else, or where that kernel refuses, the backend solves the QP
+costs up to a constant); else, or where that kernel refuses, the backend solves the QP
 with :math:`P = B^TB` and :math:`q = -B^Tc` (the same normal equations, computed once):
 exactly the stated costs where P is definite (their optimum is one point). Where it is not
-(fewer independent rows than unknowns: one frame task on a redundant arm, a lower level in a
-null space) the optimal rates form a set, and the term
+(as many rows as unknowns or fewer: one frame task on a redundant arm, a lower level in a
+null space) the optimal rates may form a set, and the term
 :math:`\epsilon\|z\|^2`, :math:`\epsilon` = :data:`TIE_BREAK` times the trace of P, picks
 the least-norm ones among them; it moves the optimum of the stated costs by at most
 :math:`\epsilon/\lambda` relative along an eigenvector of P of eigenvalue :math:`\lambda`,
 as Levenberg-Marquardt damping would. (Measured on 2,000 random three-level problems: at
 1e-10, DAQP declared 154 feasible lower levels infeasible, at 1e-8 33, at 1e-6 2; DAQP's
 exact proximal iterations instead took up to 0.3 s and hit their iteration limit on 2-5 of
-200 tracking steps of rrc_k1607 and panda.)
+200 tracking steps of rrc_k1607 and panda.) Where that QP's metric :math:`P + \epsilon I` is
+well conditioned (:func:`tie_broken`: a square B of full rank), its optimum is projected in it
+by hand as well; an ill-conditioned one (fewer rows than unknowns: a condition number of about
+:math:`1/\epsilon`) stays the backend's, which solves its active set exactly where the
+projection's rounding grows with the condition number.
 
 The next level moves in the null space of B (the optimal set of a convex least squares has one
 value of Bz).
@@ -42,12 +45,13 @@ import numpy as np
 import numpy.typing as npt
 
 from rrc_pin.solvers import linalg
+from rrc_pin.solvers.compiled import kernel
 from rrc_pin.solvers.qp_backends.qp import QP, Decoding, Work, solve_within, tolerance
 from rrc_pin.solvers.tick import feasibility
 from rrc_pin.solvers.tick.direction import constraint_rows
 from rrc_pin.solvers.tick.factorization import Factorization
 from rrc_pin.solvers.tick.problem import Box, Rows
-from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project
+from rrc_pin.solvers.tick.slide_kernels import MARGIN, SOLVED, project, project_factored
 
 if TYPE_CHECKING:
     from rrc_pin.solvers.qp_backends.base import QPBackend
@@ -63,7 +67,36 @@ ROUNDING = 1e-12
 them wherever a joint is at a bound."""
 
 
+WELL = 1e4
+"""Condition number of a tie-broken level's metric up to which the kernel projects in it
+(:func:`tie_broken`): its answers then meet the constraints within 1e-12 (at 8.6e5, 8.8e-11
+over them, and the clip back into the box moved the levels above)."""
+
 _TINY = float(np.finfo(np.float64).tiny)
+
+
+@kernel
+def tie_broken(H: Array, g: Array) -> tuple[Array, Array, Array, bool]:
+    r"""A semidefinite level's QP (module docstring): its metric :math:`P = H + \epsilon I`
+    (d, d), P's Cholesky factor L (d, d) and unconstrained optimum :math:`P^{-1}g` (d,), from
+    the normal equations ``H`` = :math:`B^TB` (d, d) and ``g`` = :math:`B^Tc` (d,); and
+    whether the kernel may project in that metric (factorised, its condition number at most
+    :data:`WELL`; L and the optimum zeros where not).
+    """  # noqa: D205
+    d = g.size
+    P = H.copy()
+    trace = 0.0
+    for i in range(d):
+        trace += H[i, i]
+    epsilon = TIE_BREAK * max(trace, 1.0)
+    for i in range(d):
+        P[i, i] += epsilon
+    L, w = np.zeros((d, d)), np.zeros(d)
+    eigenvalues = np.linalg.eigvalsh(P)
+    if not eigenvalues[-1] <= WELL * eigenvalues[0] or not linalg.cholesky(P, linalg.DEFINITE, L):
+        return P, L, w, False
+    linalg.solve_factored(L, g, w)
+    return P, L, w, True
 
 
 class Subspace(NamedTuple):
@@ -151,8 +184,9 @@ def least_squares(
         rows is None or feasibility.rows_hold(rows.G, candidate, rows.h, 0.0)
     )
     if not feasible:
-        qp, decoding = _level_qp(H, g, definite, space, box, rows, key)
-        kept = _projected(B, z, qp, decoding, box, rows) if definite else None
+        P, L, w, projects = (H, None, z, True) if definite else tie_broken(H, g)
+        qp, decoding = _level_qp(P, g, space, box, rows, key)
+        kept = _projected(B, L, w, qp, decoding, box, rows) if projects else None
         candidate = kept if kept is not None else solve_within(qp, decoding, box, rows,
                                                                backend, work)  # fmt: skip
     if not need_null:
@@ -165,15 +199,13 @@ def least_squares(
 
 
 def _level_qp(
-    H: Array, g: Array, definite: bool, space: Subspace, box: Box, rows: Rows | None, key: str
+    P: Array, g: Array, space: Subspace, box: Box, rows: Rows | None, key: str
 ) -> tuple[QP, Decoding]:
-    """The level's QP in z (module docstring) from its normal equations ``(H, g)``, and how
-    its answer decodes into rates."""  # noqa: D205, D209
+    """The level's QP in z (module docstring) from its metric ``P`` (the normal equations'
+    H, or :func:`tie_broken`'s) and ``g``, and how its answer decodes into rates."""  # noqa: D205, D209
     x, N = space
     d = g.size
-    P, q = H, -g
-    if not definite:
-        P = H + TIE_BREAK * max(float(H.trace()), 1.0) * np.eye(d)
+    q = -g
     # Divided by their largest entry, the costs have the same minimiser and the backends'
     # absolute tolerances read as relative ones (a command saturating the box gave
     # gradients 1e7 times P, and proxqp iterated for 10 s).
@@ -189,8 +221,9 @@ def _level_qp(
     # z = 0, the answer so far, kept feasible where it is one to the backend's tolerance (joints
     # exactly on their bounds); a start farther out (the equality rows' least-norm rates of a
     # top level) is no answer: the constraints stand
-    lo, hi = np.array(lo), np.array(hi)
-    feasibility.release_unmoved(C, np.empty((0, N.shape[1])) if rows is None else rows.G, lo, hi)
+    C, lo, hi = np.ascontiguousarray(C), np.array(lo), np.array(hi)  # one compiled signature
+    G = np.empty((0, N.shape[1])) if rows is None else np.ascontiguousarray(rows.G)
+    feasibility.release_unmoved(C, G, lo, hi)
     moved = np.isfinite(lo) | np.isfinite(hi)
     C, lo, hi = C[moved], lo[moved], hi[moved]
     feasibility.around_start(lo, hi, tolerance(box), ROUNDING)
@@ -199,18 +232,18 @@ def _level_qp(
 
 
 def _projected(
-    B: Array, z: Array, qp: QP, decoding: Decoding, box: Box, rows: Rows | None
+    B: Array, L: Array | None, w: Array, qp: QP, decoding: Decoding, box: Box, rows: Rows | None
 ) -> Array | None:
-    r"""The level's QP solved by hand where :math:`B^TB` is definite: its optimum ``z``
-    projected onto the QP's constraints in the metric :math:`B^TB`
-    (:func:`~rrc_pin.solvers.tick.slide_kernels.project`; the same costs up to a constant), as
-    rates.
+    r"""The level's QP solved by hand: its unconstrained optimum ``w`` projected onto the QP's
+    constraints in its metric (:func:`~rrc_pin.solvers.tick.slide_kernels.project`; the same
+    costs up to a constant), as rates: :math:`B^TB` where L is None, else the metric whose
+    Cholesky factor is L (:func:`tie_broken`).
 
     Returns:
         The rates (n,), or None where the kernel refuses or its answer leaves the box or rows
         beyond :func:`~rrc_pin.solvers.qp_backends.qp.tolerance` (the backend then answers).
     """  # noqa: D205
-    d = z.size
+    d = w.size
     if qp.C is None or qp.l is None or qp.u is None:
         G, h = np.empty((0, d)), np.empty(0)
     else:
@@ -219,7 +252,11 @@ def _projected(
     out = np.empty(d)
     # C order always (Pinocchio's Jacobians are Fortran's): one compiled signature, no
     # compilation inside a running control loop
-    if project(np.ascontiguousarray(B), 0.0, z, qp.lb, qp.ub, G, h, MARGIN, out) != SOLVED:
+    if L is None:
+        code = project(np.ascontiguousarray(B), 0.0, w, qp.lb, qp.ub, G, h, MARGIN, out)
+    else:
+        code = project_factored(L, w, qp.lb, qp.ub, G, h, MARGIN, out)
+    if code != SOLVED:
         return None
     qdot = decoding.rates(out)
     tol = tolerance(box)

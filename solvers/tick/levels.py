@@ -4,9 +4,11 @@ The compiled twin of :func:`rrc_pin.solvers.tick.least_squares.least_squares` (w
 docstring gives the math): the level's rates :math:`\dot q = x + N^Tz` minimise
 :math:`\|Bz - c\|^2`, :math:`B = AN^T`, :math:`c = b - Ax`; its unconstrained optimum where it
 keeps the constraints, else, where :math:`B^TB` is definite, that optimum projected onto them
-in the metric :math:`B^TB` (:func:`~rrc_pin.solvers.tick.slide_kernels.project`). Where neither
-answers (a semidefinite metric, a projection refused) the level is the pipeline's, with the
-backend's QP (:func:`rrc_pin.solvers.tick.backend_calls.level`), from the same inputs.
+in the metric :math:`B^TB` (:func:`~rrc_pin.solvers.tick.slide_kernels.project`), or where it
+is semidefinite and its tie-broken metric well conditioned, the tie-broken QP's optimum in that
+metric (:func:`~rrc_pin.solvers.tick.least_squares.tie_broken`). Where neither answers (an
+ill-conditioned metric, a projection refused) the level is the pipeline's, with the backend's
+QP (:func:`rrc_pin.solvers.tick.backend_calls.level`), from the same inputs.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ from rrc_pin.solvers import linalg
 from rrc_pin.solvers.compiled import inlined, kernel
 from rrc_pin.solvers.linalg import row_values
 from rrc_pin.solvers.tick import backend_calls, factor, feasibility
+from rrc_pin.solvers.tick.least_squares import tie_broken
 from rrc_pin.solvers.tick.slide_kernels import (
     MARGIN,
     SOLVED,
@@ -120,8 +123,9 @@ def subspace_rows(x: Array, N: Array, lb: Array, ub: Array, G: Array, h: Array, 
 @inlined
 def projected(B: Array, H: Array, L: Array, z: Array, x: Array, N: Array, whole: bool,
               lb: Array, ub: Array, G: Array, h: Array, tol: float) -> Array:  # fmt: skip
-    r"""The level's optimum ``z`` projected onto its constraints in the metric :math:`B^TB`
-    (``H``, its Cholesky factor ``L``: :func:`optimum`), as rates; empty where the kernel
+    r"""The level's optimum ``z`` projected onto its constraints in the metric ``H``
+    (:math:`B^TB`, its Cholesky factor ``L``: :func:`optimum`; or the tie-broken metric,
+    :func:`~rrc_pin.solvers.tick.least_squares.tie_broken`), as rates; empty where the kernel
     refuses or its answer leaves the box or rows beyond ``tol``
     (:func:`rrc_pin.solvers.tick.least_squares._projected`).
     """  # noqa: D205
@@ -191,6 +195,8 @@ def least_squares(
     z, definite = optimum(B, c, H, g, L)
     candidate = z if whole else x + row_values(np.ascontiguousarray(N.T), z)
     if not (feasibility.inside(candidate, lb, ub) and feasibility.rows_hold(G, candidate, h, 0.0)):
+        if not definite:  # the QP's tie-broken metric and optimum, where well conditioned
+            H, L, z, definite = tie_broken(H, g)
         candidate = (projected(B, H, L, z, x, N, whole, lb, ub, G, h, tol) if definite
                      else np.empty(0))
         if candidate.size == 0:
