@@ -8,11 +8,11 @@ benchmarks/tick_answers.py compare`` runs the same comparison on any recording (
 and more); here, every recorded tick is answered again in its order, by a fresh resolver per
 case.
 
-Two fixes since change answers on purpose, on lower levels: a row the levels above hold (a
-joint they keep at its bound, to the rounding of their null space) no longer keeps a level's
-projection at its start, and a semidefinite level's QP is projected by hand like a definite
-one's, not left to DAQP. A tick answered otherwise must serve every level at least as well as
-the recording: level by level, the first task error that differs is the new answer's smaller
+Two changes since move the answers of ticks DAQP answered: a row the levels above hold (a
+joint they keep at its bound, to the rounding of their null space) is no longer in a level's
+QP, and a square level's tie-broken QP is projected by the kernel where well conditioned. A
+tick answered otherwise must serve every level at least as well as the recording: level by
+level, the first task error that differs is the new answer's smaller, or within 1e-6
 (``tick_answers.shortfall``).
 """
 
