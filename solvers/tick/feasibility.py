@@ -105,8 +105,6 @@ def around_start(lo: Array, hi: Array, tol: float, rounding: float) -> None:
         hi[i] += rounding
 
 
-
-
 UNMOVED = 16.0 * EPS
 """Relative size at or below which a row's coefficients in a level's subspace are rounding
 (:func:`release_unmoved`)."""
