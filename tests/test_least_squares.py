@@ -3,13 +3,20 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import qpsolvers
 from scipy.optimize import lsq_linear
 
 from rrc_pin.solvers.qp_backends import make_backend
 from rrc_pin.solvers.qp_backends.base import QPBackend, QPSolution
 from rrc_pin.solvers.qp_backends.qp import QP, Work
-from rrc_pin.solvers.tick.least_squares import TIE_BREAK, WELL, Subspace, least_squares
+from rrc_pin.solvers.tick.least_squares import (
+    TIE_BREAK,
+    WELL,
+    Subspace,
+    least_squares,
+    tie_broken,
+)
 from rrc_pin.solvers.tick.problem import Box, Rows
 
 
@@ -152,3 +159,12 @@ def test_a_square_level_is_projected_in_its_tie_broken_metric(rng: np.random.Gen
     backend = Recording()
     least_squares(A, b, Subspace(x0, N), box(n, 1.0), None, backend, Work(), "t", False)
     assert len(backend.seen) == 1
+
+
+@pytest.mark.filterwarnings("ignore:overflow:RuntimeWarning")  # the plain-Python run's sum
+def test_tie_broken_leaves_an_overflowing_metric_to_the_backend() -> None:
+    """Rows beyond 1e154 make the metric's trace overflow: no eigenvalues asked (numba's raise
+    on infinities), the projection not taken."""
+    for H in (np.diag([1e308, 1e308, 1.0]), np.full((3, 3), np.inf)):
+        assert not tie_broken(H, np.ones(3))[3]
+    assert tie_broken(np.diag([1.0, 2.0, 3.0]), np.ones(3))[3]

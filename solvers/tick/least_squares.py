@@ -38,6 +38,7 @@ value of Bz).
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
@@ -94,6 +95,8 @@ def tie_broken(H: Array, g: Array) -> tuple[Array, Array, Array, bool]:
     for i in range(d):
         P[i, i] += epsilon
     L, w = np.zeros((d, d)), np.zeros(d)
+    if not math.isfinite(epsilon):  # rows beyond 1e154: eigvalsh would raise
+        return P, L, w, False
     eigenvalues = np.linalg.eigvalsh(P)
     if not eigenvalues[-1] <= WELL * eigenvalues[0] or not linalg.cholesky(P, linalg.DEFINITE, L):
         return P, L, w, False
