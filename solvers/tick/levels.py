@@ -190,7 +190,9 @@ def least_squares(
     B = A if whole else product(A, np.ascontiguousarray(N.T))
     c = b if whole else b - row_values(A, x)
     m, d = B.shape
-    H, g, L = np.empty((d, d)), np.empty(d), np.zeros((d, d))
+    H: Array = np.empty((d, d))  # the metric, tie-broken below where semidefinite
+    L: Array = np.zeros((d, d))
+    g = np.empty(d)
     linalg.normal_equations(B, c, np.ones(m), H, g)
     z, definite = optimum(B, c, H, g, L)
     candidate = z if whole else x + row_values(np.ascontiguousarray(N.T), z)
