@@ -12,7 +12,7 @@ from rrc_pin.solvers.qp_backends.base import QPBackend, QPSolution
 from rrc_pin.solvers.qp_backends.qp import QP, Work
 from rrc_pin.solvers.tick.least_squares import (
     TIE_BREAK,
-    WELL,
+    WELL_CONDITIONED,
     Subspace,
     least_squares,
     tie_broken,
@@ -127,9 +127,10 @@ def test_a_joint_the_level_above_holds_at_its_bound_leaves_the_projection_free(
 
 def test_a_square_level_is_projected_in_its_tie_broken_metric(rng: np.random.Generator) -> None:
     """As many rows as unknowns (a cell's body task in its chains' null space): the backend's
-    QP carries the tie-break (TIE_BREAK); where that metric's condition number is at most WELL
-    the kernel projects in it, DAQP's answer to the same QP within its tolerance, else the
-    backend answers. Fewer rows than unknowns (a condition number of 1e6) stay the backend's."""
+    QP carries the tie-break (TIE_BREAK); where that metric's condition number is at most
+    WELL_CONDITIONED the kernel projects in it, DAQP's answer to the same QP within its
+    tolerance, else the backend answers. Fewer rows than unknowns (a condition number of 1e6)
+    stay the backend's."""
     n, d = 7, 4
     projected = 0
     for _ in range(100):
@@ -146,7 +147,7 @@ def test_a_square_level_is_projected_in_its_tie_broken_metric(rng: np.random.Gen
             assert backend.seen == []
             continue
         P = B.T @ B + TIE_BREAK * max(np.trace(B.T @ B), 1.0) * np.eye(d)
-        if np.linalg.cond(P) > WELL:
+        if np.linalg.cond(P) > WELL_CONDITIONED:
             assert len(backend.seen) == 1
             continue
         assert backend.seen == []

@@ -30,7 +30,7 @@ exact proximal iterations instead took up to 0.3 s and hit their iteration limit
 200 tracking steps of rrc_k1607 and panda.) Where that QP's metric :math:`P + \epsilon I` is
 well conditioned (:func:`tie_broken`: a square B of full rank), its optimum is projected in it
 by hand as well; an ill-conditioned one (fewer rows than unknowns: a condition number of about
-:math:`1/\epsilon`) stays the backend's (:data:`WELL`).
+:math:`1/\epsilon`) stays the backend's (:data:`WELL_CONDITIONED`).
 
 The next level moves in the null space of B (the optimal set of a convex least squares has one
 value of Bz).
@@ -67,7 +67,7 @@ ROUNDING = 1e-12
 them wherever a joint is at a bound."""
 
 
-WELL = 1e4
+WELL_CONDITIONED = 1e4
 """Condition number of a tie-broken level's metric up to which the kernel projects in it
 (:func:`tie_broken`). An answer moves with its data's last bits by about the condition number
 times their rounding, and the compiled tick forms the level's products in loops of its own: at
@@ -84,7 +84,7 @@ def tie_broken(H: Array, g: Array) -> tuple[Array, Array, Array, bool]:
     (d, d), P's Cholesky factor L (d, d) and unconstrained optimum :math:`P^{-1}g` (d,), from
     the normal equations ``H`` = :math:`B^TB` (d, d) and ``g`` = :math:`B^Tc` (d,); and
     whether the kernel may project in that metric (factorised, its condition number at most
-    :data:`WELL`; L and the optimum zeros where not).
+    :data:`WELL_CONDITIONED`; L and the optimum zeros where not).
     """  # noqa: D205
     d = g.size
     P = H.copy()
@@ -98,7 +98,9 @@ def tie_broken(H: Array, g: Array) -> tuple[Array, Array, Array, bool]:
     if not math.isfinite(epsilon):  # rows beyond 1e154: eigvalsh would raise
         return P, L, w, False
     eigenvalues = np.linalg.eigvalsh(P)
-    if not eigenvalues[-1] <= WELL * eigenvalues[0] or not linalg.cholesky(P, linalg.DEFINITE, L):
+    if not eigenvalues[-1] <= WELL_CONDITIONED * eigenvalues[0]:
+        return P, L, w, False
+    if not linalg.cholesky(P, linalg.DEFINITE, L):
         return P, L, w, False
     linalg.solve_factored(L, g, w)
     return P, L, w, True
